@@ -1,0 +1,111 @@
+// The station planner (ALGORITHM.md section 7; paper section 3): candidates on the operating plane,
+// visibility counts (the heat map), greedy selection, optional proximity refinement, reduction,
+// and evaluation, as one cancellable pipeline reporting progress per stage.
+#pragma once
+
+#include <cstdint>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "vc/core/geometry.h"
+#include "vc/core/progress.h"
+#include "vc/core/status.h"
+#include "vc/core/visibility.h"
+#include "vc/core/voxel_scene.h"
+
+namespace vc {
+
+struct PlanOptions {
+  // Working resolution (m); 0 = the octree's own or 0.1 m for clouds.
+  double resolution_m = 0.0;
+  uint64_t memory_budget_bytes = kDefaultMemoryBudgetBytes;
+  SelectionTest test = SelectionTest::kSurfaceVisibility;
+  ScannerModel scanner;
+  // Candidate grid over the footprint (m), tripod height above the floor (m), clearance (m).
+  double grid_spacing_m = 1.0;
+  double tripod_height_m = 1.5;
+  double clearance_m = 0.2;
+  // User-supplied candidates (world frame, m). When non-empty, replaces the generated grid.
+  std::vector<WorldPoint> candidates;
+  // Stopping rules: at most this many stations (0 = no limit); stop when the best marginal gain
+  // is below this many voxels; stop when this fraction of coverable voxels is covered.
+  int max_stations = 0;
+  uint64_t min_marginal_gain_voxels = 1;
+  double target_coverage = 1.0;
+  // Proximity refinement (s.7.4): move each station to the best of a sub-grid around it.
+  bool refine = false;
+  double refine_radius_m = 0.5;
+  double refine_step_m = 0.25;
+  // Reduction (s.7.5): remove zero-loss stations (default); with reduce_to > 0, keep removing the
+  // cheapest single or pair until at most reduce_to stations remain.
+  bool reduce = true;
+  int reduce_to = 0;
+  int threads = 0;
+
+  // INVALID_ARGUMENT naming the first bad parameter (non-finite, zero or negative, out of range).
+  Status Validate() const;
+};
+
+struct PlannedStation {
+  WorldPoint position;
+  uint64_t visible_voxels = 0;      // voxels passing the selection test from here
+  uint64_t marginal_gain = 0;       // new voxels when picked (greedy order)
+  double cumulative_coverage = 0;   // covered / coverable after this pick
+  double global_visibility = 0;     // G of this station alone
+  int candidate_index = -1;         // index into PlanResult::candidates, or -1 if refined off-grid
+};
+
+struct HeatMap {
+  // Candidates with their visibility count (Fig. 10); cells without a candidate are absent.
+  std::vector<WorldPoint> positions;
+  std::vector<uint64_t> visible_voxels;
+  double grid_spacing_m = 0;
+};
+
+struct Reduction {
+  // |P| x |P|, row-major: diagonal = G(P) - G(P - {i}); off-diagonal = G(P) - G(P - {i, j}).
+  std::vector<double> matrix;
+  int size = 0;
+  // Stations removed, as positions in the greedy order (before removal).
+  std::vector<int> removed;
+  double global_visibility_before = 0;
+  double global_visibility_after = 0;
+};
+
+struct StageTiming {
+  std::string stage;
+  double seconds = 0;
+};
+
+struct PlanResult {
+  PlanOptions options;
+  double resolution_m = 0;
+  std::string selection_test;  // "surface" or "compatibility"
+  std::vector<PlannedStation> stations;  // final stations, in greedy order
+  HeatMap heat_map;
+  Reduction reduction;
+  uint64_t candidate_count = 0;
+  uint64_t occupied_voxels = 0;
+  uint64_t coverable_voxels = 0;
+  uint64_t covered_voxels = 0;
+  Evaluation evaluation;  // of the final stations at the working resolution (with face values)
+  std::vector<StageTiming> timings;
+  std::vector<std::string> warnings;
+  // Occupied voxel centres (world, m) in id order, for visibility.ply.
+  std::vector<WorldPoint> voxel_centers;
+};
+
+// Called as each station is picked (greedy order), and once with the heat map; for streaming.
+struct PlanCallbacks {
+  std::function<void(const HeatMap&)> on_heat_map;
+  std::function<void(const PlannedStation&, int index)> on_station;
+};
+
+// Runs the whole pipeline on an already-read input. INVALID_ARGUMENT for bad options,
+// FAILED_PRECONDITION when no candidate survives, RESOURCE_EXHAUSTED over budget, CANCELLED /
+// DEADLINE_EXCEEDED from ctx.
+Result<PlanResult> Plan(const SceneInput& input, const PlanOptions& options, const JobContext& ctx = {},
+                        const PlanCallbacks& callbacks = {});
+
+}  // namespace vc

@@ -1,0 +1,56 @@
+// Amanatides & Woo (1987) voxel traversal over an OccupancyGrid.
+//
+// The segment from a to b (continuous index-space coordinates) visits, in order, every voxel whose
+// interior it passes through; a step never skips a face-adjacent voxel. Ties (the segment crossing
+// an edge or a corner exactly) are broken by a fixed rule: step x before y before z. That is the
+// rule documented in docs/VISIBILITY.md and pinned by tests/core/ray_traversal_test.cc.
+//
+// RayTraversal is the plain, readable range used by tests and cold paths
+// (`for (const VoxelIndex& v : RayTraversal(a, b))`). FirstOccupied is the hot path: the same
+// stepping, fused with the occupancy test and empty-brick skipping, giving exactly the same answer
+// as walking RayTraversal voxel by voxel. Both are re-entrant and allocation-free.
+#pragma once
+
+#include <optional>
+
+#include "vc/core/geometry.h"
+#include "vc/core/occupancy_grid.h"
+
+namespace vc {
+
+class RayTraversal {
+ public:
+  // Voxels from the one containing `a` to the one containing `b` (both in index space).
+  RayTraversal(const Eigen::Vector3d& a, const Eigen::Vector3d& b);
+
+  class Iterator {
+   public:
+    const VoxelIndex& operator*() const { return cur_; }
+    Iterator& operator++();
+    bool operator!=(const Iterator& o) const { return done_ != o.done_; }
+
+   private:
+    friend class RayTraversal;
+    VoxelIndex cur_;
+    int step_[3] = {0, 0, 0};
+    double t_max_[3] = {0, 0, 0};
+    double t_delta_[3] = {0, 0, 0};
+    int remaining_ = 0;  // voxels still to visit after cur_
+    bool done_ = true;
+  };
+
+  Iterator begin() const { return first_; }
+  Iterator end() const { return Iterator(); }
+
+ private:
+  Iterator first_;
+};
+
+// The first occupied voxel on the segment a -> b (index space), in traversal order, or nullopt if
+// the segment reaches the voxel containing b without meeting one. The voxel `transparent` (if
+// given) is treated as free.
+std::optional<VoxelIndex> FirstOccupied(const OccupancyGrid& grid, const Eigen::Vector3d& a,
+                                        const Eigen::Vector3d& b,
+                                        const VoxelIndex* transparent = nullptr);
+
+}  // namespace vc

@@ -1,0 +1,39 @@
+#!/usr/bin/env bash
+# Installs every build and test dependency of vc from Debian 12's packages.
+# Used by the README commands, .ci/run and the Dockerfile, so a brand-new Debian 12 machine needs nothing else.
+# Usage: scripts/install-deps.sh [--runtime]   (--runtime: only what the built binaries need to run)
+set -euo pipefail
+
+BUILD_PKGS=(
+  build-essential cmake ninja-build pkg-config git ca-certificates
+  libgrpc++-dev libprotobuf-dev protobuf-compiler protobuf-compiler-grpc
+  liboctomap-dev libeigen3-dev libspdlog-dev libfmt-dev
+  libgtest-dev libgmock-dev libbenchmark-dev
+  libcli11-dev nlohmann-json3-dev libhwy-dev
+  zlib1g-dev libbz2-dev libpng-dev
+  openssl python3 bzip2 gzip
+)
+RUNTIME_PKGS=(
+  libgrpc++1.51 libgrpc29 libprotobuf32 liboctomap1.9 libspdlog1.10 libfmt9 libhwy1
+  zlib1g libbz2-1.0 libpng16-16 ca-certificates
+)
+
+pkgs=("${BUILD_PKGS[@]}")
+if [[ "${1:-}" == "--runtime" ]]; then pkgs=("${RUNTIME_PKGS[@]}"); fi
+
+missing=()
+for p in "${pkgs[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if ((${#missing[@]} == 0)); then
+  echo "install-deps: all ${#pkgs[@]} packages already installed"
+  exit 0
+fi
+
+SUDO=""
+if [[ $(id -u) -ne 0 ]]; then SUDO="sudo"; fi
+echo "install-deps: installing ${missing[*]}"
+export DEBIAN_FRONTEND=noninteractive
+$SUDO apt-get update -qq
+$SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+echo "install-deps: done"

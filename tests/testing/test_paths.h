@@ -1,0 +1,17 @@
+// Paths to test data, resolved at build time.
+#pragma once
+
+#include <string>
+
+namespace vc::testing {
+
+// ../shared/data beside the checkout (real scans; see its README).
+std::string SharedDataPath(const std::string& relative);
+// tests/data in the checkout (small hand-made fixtures).
+std::string TestDataPath(const std::string& relative);
+// The build directory (where the binaries are).
+std::string BinaryDir();
+// A fresh, empty temporary directory unique to the calling test.
+std::string MakeTempDir();
+
+}  // namespace vc::testing
