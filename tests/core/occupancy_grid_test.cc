@@ -1,1 +1,67 @@
+#include "vc/core/occupancy_grid.h"
+
 #include <gtest/gtest.h>
+
+#include <random>
+#include <set>
+#include <tuple>
+
+namespace vc {
+namespace {
+
+TEST(OccupancyGridTest, AnswersExactlyTheOccupiedSet) {
+  std::mt19937_64 rng(5);
+  std::uniform_int_distribution<int> c(-40, 40);
+  std::vector<VoxelIndex> occ;
+  std::set<std::tuple<int, int, int>> truth;
+  for (int i = 0; i < 3000; ++i) {
+    VoxelIndex v{c(rng), c(rng), c(rng) / 4};
+    occ.push_back(v);
+    truth.insert({v.x, v.y, v.z});
+  }
+  auto g = OccupancyGrid::Build(0.1, occ, 1 << 24);
+  ASSERT_TRUE(g.ok()) << g.status().ToString();
+  int count = 0;
+  for (int z = -15; z <= 15; ++z)
+    for (int y = -45; y <= 45; ++y)
+      for (int x = -45; x <= 45; ++x) {
+        const bool want = truth.count({x, y, z}) > 0;
+        ASSERT_EQ(g->Occupied(x, y, z), want) << x << "," << y << "," << z;
+        count += want;
+      }
+  EXPECT_EQ(count, int(truth.size()));
+  EXPECT_GT(g->occupied_bricks(), 0u);
+  EXPECT_FALSE(g->Occupied(100000, 0, 0));
+}
+
+TEST(OccupancyGridTest, RefusesOverBudgetWithExtentAndAResolutionThatFits) {
+  std::vector<VoxelIndex> occ = {{0, 0, 0}, {20000, 20000, 20000}};
+  auto g = OccupancyGrid::Build(0.01, occ, uint64_t{1} << 30);
+  ASSERT_FALSE(g.ok());
+  EXPECT_EQ(g.status().code(), StatusCode::kResourceExhausted);
+  EXPECT_NE(g.status().message().find("200 x 200 x 200 m"), std::string::npos) << g.status().message();
+  EXPECT_NE(g.status().message().find("use a resolution of at least"), std::string::npos);
+}
+
+TEST(OccupancyGridTest, RejectsEmptyAndBadResolution) {
+  EXPECT_EQ(OccupancyGrid::Build(0.1, {}, 1 << 20).status().code(), StatusCode::kInvalidArgument);
+  EXPECT_EQ(OccupancyGrid::Build(0.0, {{0, 0, 0}}, 1 << 20).status().code(), StatusCode::kInvalidArgument);
+  EXPECT_EQ(OccupancyGrid::Build(std::nan(""), {{0, 0, 0}}, 1 << 20).status().code(), StatusCode::kInvalidArgument);
+}
+
+TEST(OccupancyGridTest, KeysMatchOctomapConventions) {
+  VoxelKey k;
+  ASSERT_TRUE(CoordToKey(0.1, WorldPoint(0.05, -0.05, 3.27), &k));
+  EXPECT_EQ(k.x, 32768);
+  EXPECT_EQ(k.y, 32767);
+  EXPECT_EQ(k.z, 32768 + 32);
+  const WorldPoint c = KeyToCoord(0.1, k);
+  EXPECT_NEAR(c.x(), 0.05, 1e-12);
+  EXPECT_NEAR(c.y(), -0.05, 1e-12);
+  EXPECT_NEAR(c.z(), 3.25, 1e-12);
+  EXPECT_FALSE(CoordToKey(0.1, WorldPoint(1e6, 0, 0), &k));
+  EXPECT_FALSE(CoordToKey(0.1, WorldPoint(std::nan(""), 0, 0), &k));
+}
+
+}  // namespace
+}  // namespace vc

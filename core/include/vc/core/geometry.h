@@ -31,7 +31,8 @@ struct VoxelKey {
 // OctoMap's key offset (tree_max_val for the 16-level tree).
 inline constexpr int kKeyOffset = 32768;
 
-// Index of a voxel in a grid's own index space (see OccupancyGrid). Distinct from VoxelKey.
+// Signed integer coordinates of a voxel at some resolution: index = key - 32768, so voxel
+// (x,y,z) covers [x*r, (x+1)*r) x ... in world metres. Distinct from VoxelKey (unsigned, offset).
 struct VoxelIndex {
   int32_t x = 0, y = 0, z = 0;
   friend bool operator==(const VoxelIndex& a, const VoxelIndex& b) {

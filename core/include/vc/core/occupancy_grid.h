@@ -1,14 +1,17 @@
 // OccupancyGrid: the traversal structure for fast, exact ray casting.
 //
-// A dense bitset over the bounding box of the occupied voxels (plus a one-voxel margin), in
-// OctoMap's key space at resolution r, with an 8x8x8-voxel brick summary used to skip empty space.
-// It answers "is voxel (x,y,z) occupied" exactly as the octree at resolution r does (ALGORITHM.md
-// section 1); anything outside the box is free. The memory is checked against a budget before
-// anything is allocated: a scene that does not fit is refused with RESOURCE_EXHAUSTED and a message
-// stating the extent and a resolution that would fit, never an out-of-memory kill.
+// A bricked bitset over the bounding box of the occupied voxels: the box is cut into bricks of
+// 8x8x8 voxels; a dense array holds one 32-bit slot per brick (0 = empty brick) and only non-empty
+// bricks store their 512 bits. Empty bricks cost 4 bytes, which also makes empty-space skipping
+// cheap. It answers "is voxel (x,y,z) occupied" exactly as the octree at resolution r does
+// (ALGORITHM.md section 1); anything outside the box is free. Memory is computed and checked
+// against a budget before anything is allocated: a scene that does not fit is refused with
+// RESOURCE_EXHAUSTED and a message stating the extent and a resolution that would fit.
 //
-// Index space: voxel (x,y,z) covers [x, x+1) x [y, y+1) x [z, z+1) in continuous index
-// coordinates; index = key - origin_key. Immutable after Build; safe to share across threads.
+// Index space ("IS"): voxel (x,y,z) (a VoxelIndex, = OctoMap key - 32768) covers
+// [x, x+1) x [y, y+1) x [z, z+1) in continuous coordinates u = p / r, where p is the world point in
+// metres. floor(p * (1/r)) is computed exactly as OctoMap's coordToKey, so keys always agree.
+// Immutable after Build; safe to share across threads.
 #pragma once
 
 #include <cstdint>
@@ -26,75 +29,78 @@ class OccupancyGrid {
 
   OccupancyGrid() = default;
 
-  // Bytes the grid needs for voxels spanning keys [min_key, max_key] at any resolution.
-  static uint64_t BytesNeeded(const VoxelKey& min_key, const VoxelKey& max_key);
+  // Bytes a grid over [min, max] (inclusive voxel indices) with `occupied_bricks` non-empty
+  // bricks needs.
+  static uint64_t BytesNeeded(const VoxelIndex& min, const VoxelIndex& max, uint64_t occupied_bricks);
 
-  // Builds the grid of `occupied` keys (any order, duplicates allowed). RESOURCE_EXHAUSTED if it
-  // needs more than `memory_budget_bytes`; INVALID_ARGUMENT if `occupied` is empty.
-  static Result<OccupancyGrid> Build(double resolution_m, const std::vector<VoxelKey>& occupied,
+  // Builds the grid of `occupied` (any order, duplicates allowed) at `resolution_m`.
+  // RESOURCE_EXHAUSTED if it needs more than `memory_budget_bytes`; INVALID_ARGUMENT if
+  // `occupied` is empty or the resolution is not positive and finite.
+  static Result<OccupancyGrid> Build(double resolution_m, const std::vector<VoxelIndex>& occupied,
                                      uint64_t memory_budget_bytes);
 
   double resolution_m() const { return resolution_m_; }
-  // Grid size in voxels per axis.
+  double inv_resolution() const { return inv_resolution_; }
+  // Smallest voxel index of the box, and its size in voxels per axis (a multiple of 8).
+  const VoxelIndex& min_index() const { return min_; }
   const Eigen::Vector3i& dims() const { return dims_; }
-  // Key of index (0,0,0).
-  const VoxelKey& origin_key() const { return origin_key_; }
+  const Eigen::Vector3i& brick_dims() const { return bdims_; }
   uint64_t memory_bytes() const;
+  uint64_t occupied_bricks() const { return payload_.size() / kBrick; }
 
-  bool InBounds(int x, int y, int z) const {
-    return static_cast<uint32_t>(x) < static_cast<uint32_t>(dims_.x()) &&
-           static_cast<uint32_t>(y) < static_cast<uint32_t>(dims_.y()) &&
-           static_cast<uint32_t>(z) < static_cast<uint32_t>(dims_.z());
-  }
-  // Occupied voxel at index (x,y,z); false outside the grid.
+  // Occupied voxel at index (x,y,z); false outside the box.
   bool Occupied(int x, int y, int z) const {
-    if (!InBounds(x, y, z)) return false;
-    const uint64_t i = LinearIndex(x, y, z);
-    return (bits_[i >> 6] >> (i & 63)) & 1u;
+    const uint32_t rx = uint32_t(x - min_.x), ry = uint32_t(y - min_.y), rz = uint32_t(z - min_.z);
+    if (rx >= uint32_t(dims_.x()) || ry >= uint32_t(dims_.y()) || rz >= uint32_t(dims_.z())) return false;
+    const uint32_t slot = bricks_[BrickLinear(rx >> kBrickShift, ry >> kBrickShift, rz >> kBrickShift)];
+    if (slot == 0) return false;
+    const uint64_t word = payload_[uint64_t(slot - 1) * kBrick + (rz & 7)];
+    return (word >> (((ry & 7) << 3) | (rx & 7))) & 1u;
   }
   bool Occupied(const VoxelIndex& v) const { return Occupied(v.x, v.y, v.z); }
-  // True if any voxel of the brick (bx,by,bz) (brick coordinates = index >> kBrickShift) is occupied.
-  bool BrickOccupied(int bx, int by, int bz) const {
-    if (bx < 0 || by < 0 || bz < 0 || bx >= bdims_.x() || by >= bdims_.y() || bz >= bdims_.z()) return false;
-    const uint64_t i = (uint64_t(bz) * bdims_.y() + by) * bdims_.x() + bx;
-    return (brick_bits_[i >> 6] >> (i & 63)) & 1u;
-  }
-  const Eigen::Vector3i& brick_dims() const { return bdims_; }
 
-  VoxelIndex KeyToIndex(const VoxelKey& k) const {
-    return {int(k.x) - origin_key_.x, int(k.y) - origin_key_.y, int(k.z) - origin_key_.z};
+  // Whether brick (bx,by,bz) (brick coordinates relative to min_index(), i.e. (x - min.x) >> 3)
+  // holds any occupied voxel; false outside.
+  bool BrickOccupied(int bx, int by, int bz) const {
+    if (uint32_t(bx) >= uint32_t(bdims_.x()) || uint32_t(by) >= uint32_t(bdims_.y()) ||
+        uint32_t(bz) >= uint32_t(bdims_.z()))
+      return false;
+    return bricks_[BrickLinear(bx, by, bz)] != 0;
   }
-  VoxelKey IndexToKey(const VoxelIndex& v) const {
-    return {uint16_t(v.x + origin_key_.x), uint16_t(v.y + origin_key_.y), uint16_t(v.z + origin_key_.z)};
-  }
-  // Continuous index-space coordinates of a world point (floor() of it is the voxel index).
-  Eigen::Vector3d WorldToIndexSpace(const WorldPoint& p) const;
-  // World point of continuous index-space coordinates.
-  WorldPoint IndexSpaceToWorld(const Eigen::Vector3d& u) const;
-  // World centre of voxel v.
-  WorldPoint VoxelCenter(const VoxelIndex& v) const {
-    return IndexSpaceToWorld(Eigen::Vector3d(v.x + 0.5, v.y + 0.5, v.z + 0.5));
-  }
-  // Voxel index containing world point p (may be out of bounds).
+
+  // Continuous index-space coordinates of a world point (metres).
+  Eigen::Vector3d WorldToIndexSpace(const WorldPoint& p) const { return p * inv_resolution_; }
+  // World point (metres) of continuous index-space coordinates.
+  WorldPoint IndexSpaceToWorld(const Eigen::Vector3d& u) const { return u * resolution_m_; }
+  // World centre of voxel v, as OctoMap's keyToCoord.
+  WorldPoint VoxelCenter(const VoxelIndex& v) const;
+  // The voxel containing world point p, as OctoMap's coordToKey (may lie outside the box).
   VoxelIndex WorldToIndex(const WorldPoint& p) const;
 
  private:
-  uint64_t LinearIndex(int x, int y, int z) const {
-    return (uint64_t(z) * dims_.y() + y) * dims_.x() + x;
+  uint64_t BrickLinear(uint32_t bx, uint32_t by, uint32_t bz) const {
+    return (uint64_t(bz) * uint64_t(bdims_.y()) + by) * uint64_t(bdims_.x()) + bx;
   }
 
   double resolution_m_ = 0;
+  double inv_resolution_ = 0;
+  VoxelIndex min_;
   Eigen::Vector3i dims_{0, 0, 0};
   Eigen::Vector3i bdims_{0, 0, 0};
-  VoxelKey origin_key_;
-  std::vector<uint64_t> bits_;
-  std::vector<uint64_t> brick_bits_;
+  std::vector<uint32_t> bricks_;   // per brick: 0 = empty, else 1 + payload brick number
+  std::vector<uint64_t> payload_;  // 8 words per non-empty brick: word z, bit (y*8 + x)
 };
 
-// OctoMap's key of a world coordinate at `resolution_m`: floor(c / r) + 32768, computed exactly
-// as OctoMap does (multiplying by 1/r in double). False if outside the 16-bit key range.
+// OctoMap's key of world point p at `resolution_m`: floor(p * (1/r)) + 32768 per axis, computed
+// exactly as OctoMap does. False if outside the 16-bit key range.
 bool CoordToKey(double resolution_m, const WorldPoint& p, VoxelKey* key);
-// World centre of a key's voxel, as OctoMap's keyToCoord.
+// World centre of a key's voxel, exactly as OctoMap's keyToCoord.
 WorldPoint KeyToCoord(double resolution_m, const VoxelKey& key);
+inline VoxelIndex KeyToIndex(const VoxelKey& k) {
+  return {int(k.x) - kKeyOffset, int(k.y) - kKeyOffset, int(k.z) - kKeyOffset};
+}
+inline VoxelKey IndexToKey(const VoxelIndex& v) {
+  return {uint16_t(v.x + kKeyOffset), uint16_t(v.y + kKeyOffset), uint16_t(v.z + kKeyOffset)};
+}
 
 }  // namespace vc

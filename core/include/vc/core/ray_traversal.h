@@ -1,9 +1,12 @@
 // Amanatides & Woo (1987) voxel traversal over an OccupancyGrid.
 //
-// The segment from a to b (continuous index-space coordinates) visits, in order, every voxel whose
-// interior it passes through; a step never skips a face-adjacent voxel. Ties (the segment crossing
-// an edge or a corner exactly) are broken by a fixed rule: step x before y before z. That is the
-// rule documented in docs/VISIBILITY.md and pinned by tests/core/ray_traversal_test.cc.
+// The segment from a to b (continuous index-space coordinates, u = p / r; see occupancy_grid.h)
+// visits, in order, every voxel whose interior it passes through, from the voxel containing a to
+// the voxel containing b; a step never skips a face-adjacent voxel. Ties (the segment crossing an
+// edge or a corner exactly) are broken by a fixed rule, the one OctoMap's castRay uses: among the
+// axes whose boundary is crossed at the same parameter, step z first, then y, then x. Each axis
+// takes exactly |floor(b) - floor(a)| steps, so the walk always ends in the voxel containing b.
+// The rule is documented in docs/VISIBILITY.md and pinned by tests/core/ray_traversal_test.cc.
 //
 // RayTraversal is the plain, readable range used by tests and cold paths
 // (`for (const VoxelIndex& v : RayTraversal(a, b))`). FirstOccupied is the hot path: the same
@@ -33,6 +36,7 @@ class RayTraversal {
     friend class RayTraversal;
     VoxelIndex cur_;
     int step_[3] = {0, 0, 0};
+    int left_[3] = {0, 0, 0};  // steps each axis still has to take
     double t_max_[3] = {0, 0, 0};
     double t_delta_[3] = {0, 0, 0};
     int remaining_ = 0;  // voxels still to visit after cur_
