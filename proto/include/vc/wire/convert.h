@@ -1,0 +1,94 @@
+// ToProto / FromProto between the vc.v1 messages and vc_core types: the one place each conversion
+// lives. The server converts core results to messages; the client converts them back and hands
+// them to vc::WritePlanOutputs / vc::WriteEvaluationOutputs.
+//
+// Bulk data (the heat map and the per-voxel results) is split into chunks of at most about
+// 0.8 MiB each (kCandidatesPerHeatMapChunk, kVoxelsPerChunk) and reassembled by
+// PlanResultAssembler, which checks that every chunk arrived exactly once and in order.
+// Functions are pure; PlanResultAssembler is not thread-safe.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <vector>
+
+#include "vc/core/planner.h"
+#include "vc/core/progress.h"
+#include "vc/core/scene_input.h"
+#include "vc/core/status.h"
+#include "vc/core/visibility.h"
+#include "vc/core/voxel_scene.h"
+#include "vc/v1/planner.pb.h"
+
+namespace vc::wire {
+
+// Voxels per VoxelChunk: 48 bytes each (centre + 6 face values), so a chunk is ~0.8 MiB.
+inline constexpr size_t kVoxelsPerChunk = 16384;
+// Candidates per HeatMapChunk (~40 bytes each on the wire).
+inline constexpr size_t kCandidatesPerHeatMapChunk = 16384;
+
+v1::Point ToProto(const WorldPoint& p);
+WorldPoint FromProto(const v1::Point& p);
+
+v1::InputFormat ToProto(InputFormat f);
+// INVALID_ARGUMENT for an unknown enum value; UNSPECIFIED is not a format (check it first).
+Result<InputFormat> FromProto(v1::InputFormat f);
+
+v1::SelectionTest ToProto(SelectionTest t);
+v1::FaceSet ToProto(FaceSet f);
+
+// Every field set.
+v1::PlanParameters ToProto(const PlanOptions& options);
+// A default-constructed PlanOptions with the fields present in `p` applied. INVALID_ARGUMENT for
+// unknown enum values; the values themselves are checked by PlanOptions::Validate.
+Result<PlanOptions> FromProto(const v1::PlanParameters& p);
+
+// What an Evaluate call runs: the viewpoints, the voxelisation and the evaluation options.
+struct EvaluateJobOptions {
+  std::vector<WorldPoint> viewpoints;
+  VoxelizeOptions voxelize;
+  EvaluateOptions evaluate;
+};
+v1::EvaluateParameters ToProto(const EvaluateJobOptions& options);
+Result<EvaluateJobOptions> FromProto(const v1::EvaluateParameters& p);
+
+v1::Progress ToProto(const ProgressEvent& e);
+ProgressEvent FromProto(const v1::Progress& p);
+
+v1::PlannedStation ToProto(const PlannedStation& s);
+PlannedStation FromProto(const v1::PlannedStation& s);
+
+// Without the per-face values (those travel in VoxelChunk); face_value_voxels is set from them.
+v1::Evaluation ToProto(const Evaluation& e);
+Evaluation FromProto(const v1::Evaluation& e);
+
+// The heat map in chunks, in order.
+std::vector<v1::HeatMapChunk> HeatMapChunks(const HeatMap& heat_map);
+// Calls fn with each VoxelChunk of result.voxel_centers and result.evaluation.best_face_values,
+// in order. Stops early and returns false when fn returns false.
+bool ForEachVoxelChunk(const PlanResult& result, const std::function<bool(v1::VoxelChunk&&)>& fn);
+// The summary that ends a Plan stream (everything but the chunked parts).
+v1::PlanResult ToProto(const PlanResult& result);
+
+// Rebuilds a vc::PlanResult from the chunks and the final summary of a Plan stream.
+class PlanResultAssembler {
+ public:
+  // DATA_LOSS if a chunk is out of order or inconsistent with the previous ones.
+  Status AddHeatMap(const v1::HeatMapChunk& chunk);
+  Status AddVoxels(const v1::VoxelChunk& chunk);
+  // The heat map received so far (complete once all its chunks arrived).
+  const HeatMap& heat_map() const { return heat_map_; }
+  // DATA_LOSS if the chunks received do not add up to what `summary` declares.
+  Result<PlanResult> Finish(const v1::PlanResult& summary) &&;
+
+ private:
+  HeatMap heat_map_;
+  uint64_t heat_map_total_ = 0;
+  std::vector<WorldPoint> centers_;
+  std::vector<std::array<float, kFacesPerVoxel>> face_values_;
+  uint64_t voxel_total_ = 0;
+};
+
+v1::EvaluateResult ToProto(const Evaluation& e, const std::vector<WorldPoint>& viewpoints);
+
+}  // namespace vc::wire

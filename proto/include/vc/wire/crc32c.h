@@ -1,0 +1,24 @@
+// CRC32C (Castagnoli): the upload checksum of the vc.v1 protocol (docs/PROTOCOL.md).
+// Polynomial 0x1EDC6F41 reflected (0x82F63B78), initial value and final xor 0xFFFFFFFF, so
+// Crc32c("123456789") == 0xE3069283. Table-driven, slice-by-8; thread-safe (no mutable state).
+#pragma once
+
+#include <cstdint>
+#include <string_view>
+
+namespace vc::wire {
+
+// Incremental CRC32C: Update() with consecutive pieces, then value().
+class Crc32c {
+ public:
+  void Update(std::string_view bytes);
+  uint32_t value() const { return ~state_; }
+
+ private:
+  uint32_t state_ = 0xFFFFFFFFu;
+};
+
+// CRC32C of `bytes` in one call.
+uint32_t ComputeCrc32c(std::string_view bytes);
+
+}  // namespace vc::wire

@@ -1,0 +1,403 @@
+#include "vc/wire/convert.h"
+
+#include <algorithm>
+#include <string>
+
+namespace vc::wire {
+
+v1::Point ToProto(const WorldPoint& p) {
+  v1::Point out;
+  out.set_x_m(p.x());
+  out.set_y_m(p.y());
+  out.set_z_m(p.z());
+  return out;
+}
+
+WorldPoint FromProto(const v1::Point& p) { return {p.x_m(), p.y_m(), p.z_m()}; }
+
+v1::InputFormat ToProto(InputFormat f) {
+  switch (f) {
+    case InputFormat::kPly: return v1::INPUT_FORMAT_PLY;
+    case InputFormat::kPcd: return v1::INPUT_FORMAT_PCD;
+    case InputFormat::kXyz: return v1::INPUT_FORMAT_XYZ;
+    case InputFormat::kLas: return v1::INPUT_FORMAT_LAS;
+    case InputFormat::kOctomapBinary: return v1::INPUT_FORMAT_OCTOMAP_BT;
+    case InputFormat::kOctomapText: return v1::INPUT_FORMAT_OCTOMAP_OT;
+    case InputFormat::kOctomapGraph: return v1::INPUT_FORMAT_OCTOMAP_GRAPH;
+  }
+  return v1::INPUT_FORMAT_UNSPECIFIED;
+}
+
+Result<InputFormat> FromProto(v1::InputFormat f) {
+  switch (f) {
+    case v1::INPUT_FORMAT_PLY: return InputFormat::kPly;
+    case v1::INPUT_FORMAT_PCD: return InputFormat::kPcd;
+    case v1::INPUT_FORMAT_XYZ: return InputFormat::kXyz;
+    case v1::INPUT_FORMAT_LAS: return InputFormat::kLas;
+    case v1::INPUT_FORMAT_OCTOMAP_BT: return InputFormat::kOctomapBinary;
+    case v1::INPUT_FORMAT_OCTOMAP_OT: return InputFormat::kOctomapText;
+    case v1::INPUT_FORMAT_OCTOMAP_GRAPH: return InputFormat::kOctomapGraph;
+    default: break;
+  }
+  return InvalidArgumentError("unknown input format value " + std::to_string(int(f)) +
+                              " in the upload spec; leave it unset to detect the format from the content");
+}
+
+v1::SelectionTest ToProto(SelectionTest t) {
+  return t == SelectionTest::kCompatibility ? v1::SELECTION_TEST_COMPATIBILITY
+                                            : v1::SELECTION_TEST_SURFACE_VISIBILITY;
+}
+
+v1::FaceSet ToProto(FaceSet f) { return f == FaceSet::kExposed ? v1::FACE_SET_EXPOSED : v1::FACE_SET_ALL; }
+
+namespace {
+
+v1::ScannerModel ToProto(const ScannerModel& s) {
+  v1::ScannerModel out;
+  out.set_min_range_m(s.min_range_m);
+  out.set_max_range_m(s.max_range_m);
+  return out;
+}
+
+void Apply(const v1::ScannerModel& p, ScannerModel* s) {
+  if (p.has_min_range_m()) s->min_range_m = p.min_range_m();
+  if (p.has_max_range_m()) s->max_range_m = p.max_range_m();
+}
+
+v1::VisibilityFigures ToProto(const VisibilityFigures& f) {
+  v1::VisibilityFigures out;
+  out.set_global_visibility(f.global_visibility);
+  out.set_fully_visible_fraction(f.fully_visible_fraction);
+  out.set_mean_full_visibility(f.mean_full_visibility);
+  out.set_partially_visible_fraction(f.partially_visible_fraction);
+  return out;
+}
+
+VisibilityFigures FromProto(const v1::VisibilityFigures& f) {
+  VisibilityFigures out;
+  out.global_visibility = f.global_visibility();
+  out.fully_visible_fraction = f.fully_visible_fraction();
+  out.mean_full_visibility = f.mean_full_visibility();
+  out.partially_visible_fraction = f.partially_visible_fraction();
+  return out;
+}
+
+v1::Reduction ToProto(const Reduction& r) {
+  v1::Reduction out;
+  out.mutable_matrix()->Add(r.matrix.begin(), r.matrix.end());
+  out.set_size(r.size);
+  out.mutable_removed()->Add(r.removed.begin(), r.removed.end());
+  out.set_global_visibility_before(r.global_visibility_before);
+  out.set_global_visibility_after(r.global_visibility_after);
+  return out;
+}
+
+Reduction FromProto(const v1::Reduction& r) {
+  Reduction out;
+  out.matrix.assign(r.matrix().begin(), r.matrix().end());
+  out.size = r.size();
+  out.removed.assign(r.removed().begin(), r.removed().end());
+  out.global_visibility_before = r.global_visibility_before();
+  out.global_visibility_after = r.global_visibility_after();
+  return out;
+}
+
+Status ChunkError(const std::string& what) {
+  return DataLossError("the server's result stream is inconsistent (" + what +
+                       "); retry, and report it if it persists");
+}
+
+}  // namespace
+
+v1::PlanParameters ToProto(const PlanOptions& o) {
+  v1::PlanParameters p;
+  p.set_resolution_m(o.resolution_m);
+  p.set_memory_budget_bytes(o.memory_budget_bytes);
+  p.set_test(ToProto(o.test));
+  *p.mutable_scanner() = ToProto(o.scanner);
+  p.set_grid_spacing_m(o.grid_spacing_m);
+  p.set_tripod_height_m(o.tripod_height_m);
+  p.set_clearance_m(o.clearance_m);
+  for (const auto& c : o.candidates) *p.add_candidates() = ToProto(c);
+  p.set_max_stations(o.max_stations);
+  p.set_min_marginal_gain_voxels(o.min_marginal_gain_voxels);
+  p.set_target_coverage(o.target_coverage);
+  p.set_refine(o.refine);
+  p.set_refine_radius_m(o.refine_radius_m);
+  p.set_refine_step_m(o.refine_step_m);
+  p.set_reduce(o.reduce);
+  p.set_reduce_to(o.reduce_to);
+  p.set_threads(o.threads);
+  return p;
+}
+
+Result<PlanOptions> FromProto(const v1::PlanParameters& p) {
+  PlanOptions o;
+  if (p.has_resolution_m()) o.resolution_m = p.resolution_m();
+  if (p.has_memory_budget_bytes()) o.memory_budget_bytes = p.memory_budget_bytes();
+  switch (p.test()) {
+    case v1::SELECTION_TEST_UNSPECIFIED: break;
+    case v1::SELECTION_TEST_SURFACE_VISIBILITY: o.test = SelectionTest::kSurfaceVisibility; break;
+    case v1::SELECTION_TEST_COMPATIBILITY: o.test = SelectionTest::kCompatibility; break;
+    default:
+      return InvalidArgumentError("unknown selection test value " + std::to_string(int(p.test())) +
+                                  "; use SURFACE_VISIBILITY or COMPATIBILITY");
+  }
+  if (p.has_scanner()) Apply(p.scanner(), &o.scanner);
+  if (p.has_grid_spacing_m()) o.grid_spacing_m = p.grid_spacing_m();
+  if (p.has_tripod_height_m()) o.tripod_height_m = p.tripod_height_m();
+  if (p.has_clearance_m()) o.clearance_m = p.clearance_m();
+  for (const auto& c : p.candidates()) o.candidates.push_back(FromProto(c));
+  if (p.has_max_stations()) o.max_stations = p.max_stations();
+  if (p.has_min_marginal_gain_voxels()) o.min_marginal_gain_voxels = p.min_marginal_gain_voxels();
+  if (p.has_target_coverage()) o.target_coverage = p.target_coverage();
+  if (p.has_refine()) o.refine = p.refine();
+  if (p.has_refine_radius_m()) o.refine_radius_m = p.refine_radius_m();
+  if (p.has_refine_step_m()) o.refine_step_m = p.refine_step_m();
+  if (p.has_reduce()) o.reduce = p.reduce();
+  if (p.has_reduce_to()) o.reduce_to = p.reduce_to();
+  if (p.has_threads()) o.threads = p.threads();
+  return o;
+}
+
+v1::EvaluateParameters ToProto(const EvaluateJobOptions& o) {
+  v1::EvaluateParameters p;
+  for (const auto& v : o.viewpoints) *p.add_viewpoints() = ToProto(v);
+  p.set_resolution_m(o.voxelize.resolution_m);
+  p.set_memory_budget_bytes(o.voxelize.memory_budget_bytes);
+  *p.mutable_scanner() = ToProto(o.evaluate.scanner);
+  p.set_faces(ToProto(o.evaluate.faces));
+  p.set_sample_faces(o.evaluate.sample_faces);
+  p.set_seed(o.evaluate.seed);
+  p.set_threads(o.evaluate.threads);
+  return p;
+}
+
+Result<EvaluateJobOptions> FromProto(const v1::EvaluateParameters& p) {
+  EvaluateJobOptions o;
+  for (const auto& v : p.viewpoints()) o.viewpoints.push_back(FromProto(v));
+  if (p.has_resolution_m()) o.voxelize.resolution_m = p.resolution_m();
+  if (p.has_memory_budget_bytes()) o.voxelize.memory_budget_bytes = p.memory_budget_bytes();
+  if (p.has_scanner()) Apply(p.scanner(), &o.evaluate.scanner);
+  switch (p.faces()) {
+    case v1::FACE_SET_UNSPECIFIED: break;
+    case v1::FACE_SET_ALL: o.evaluate.faces = FaceSet::kAll; break;
+    case v1::FACE_SET_EXPOSED: o.evaluate.faces = FaceSet::kExposed; break;
+    default:
+      return InvalidArgumentError("unknown face set value " + std::to_string(int(p.faces())) +
+                                  "; use ALL or EXPOSED");
+  }
+  if (p.has_sample_faces()) o.evaluate.sample_faces = p.sample_faces();
+  if (p.has_seed()) o.evaluate.seed = p.seed();
+  if (p.has_threads()) o.evaluate.threads = p.threads();
+  return o;
+}
+
+v1::Progress ToProto(const ProgressEvent& e) {
+  v1::Progress p;
+  p.set_stage(e.stage);
+  p.set_fraction(e.fraction);
+  p.set_message(e.message);
+  return p;
+}
+
+ProgressEvent FromProto(const v1::Progress& p) { return {p.stage(), p.fraction(), p.message()}; }
+
+v1::PlannedStation ToProto(const PlannedStation& s) {
+  v1::PlannedStation p;
+  *p.mutable_position() = ToProto(s.position);
+  p.set_visible_voxels(s.visible_voxels);
+  p.set_marginal_gain(s.marginal_gain);
+  p.set_cumulative_coverage(s.cumulative_coverage);
+  p.set_global_visibility(s.global_visibility);
+  p.set_candidate_index(s.candidate_index);
+  return p;
+}
+
+PlannedStation FromProto(const v1::PlannedStation& p) {
+  PlannedStation s;
+  s.position = FromProto(p.position());
+  s.visible_voxels = p.visible_voxels();
+  s.marginal_gain = p.marginal_gain();
+  s.cumulative_coverage = p.cumulative_coverage();
+  s.global_visibility = p.global_visibility();
+  s.candidate_index = p.candidate_index();
+  return s;
+}
+
+v1::Evaluation ToProto(const Evaluation& e) {
+  v1::Evaluation p;
+  p.set_resolution_m(e.resolution_m);
+  p.set_faces_total(e.faces_total);
+  p.set_faces_evaluated(e.faces_evaluated);
+  p.set_sampled(e.sampled);
+  *p.mutable_overall() = ToProto(e.overall);
+  p.set_global_visibility_ci95(e.global_visibility_ci95);
+  for (const auto& f : e.per_viewpoint) *p.add_per_viewpoint() = ToProto(f);
+  p.set_face_value_voxels(e.best_face_values.size());
+  return p;
+}
+
+Evaluation FromProto(const v1::Evaluation& p) {
+  Evaluation e;
+  e.resolution_m = p.resolution_m();
+  e.faces_total = p.faces_total();
+  e.faces_evaluated = p.faces_evaluated();
+  e.sampled = p.sampled();
+  e.overall = FromProto(p.overall());
+  e.global_visibility_ci95 = p.global_visibility_ci95();
+  for (const auto& f : p.per_viewpoint()) e.per_viewpoint.push_back(FromProto(f));
+  return e;
+}
+
+std::vector<v1::HeatMapChunk> HeatMapChunks(const HeatMap& h) {
+  std::vector<v1::HeatMapChunk> chunks;
+  const size_t n = h.positions.size();
+  for (size_t first = 0; first < n; first += kCandidatesPerHeatMapChunk) {
+    v1::HeatMapChunk c;
+    c.set_first_index(first);
+    c.set_total_candidates(n);
+    c.set_grid_spacing_m(h.grid_spacing_m);
+    const size_t end = std::min(n, first + kCandidatesPerHeatMapChunk);
+    for (size_t i = first; i < end; ++i) {
+      *c.add_positions() = ToProto(h.positions[i]);
+      c.add_visible_voxels(i < h.visible_voxels.size() ? h.visible_voxels[i] : 0);
+    }
+    chunks.push_back(std::move(c));
+  }
+  return chunks;
+}
+
+bool ForEachVoxelChunk(const PlanResult& result, const std::function<bool(v1::VoxelChunk&&)>& fn) {
+  const auto& centers = result.voxel_centers;
+  const auto& values = result.evaluation.best_face_values;
+  const bool with_values = values.size() == centers.size();
+  const size_t n = centers.size();
+  for (size_t first = 0; first < n; first += kVoxelsPerChunk) {
+    const size_t end = std::min(n, first + kVoxelsPerChunk);
+    v1::VoxelChunk c;
+    c.set_first_voxel_id(first);
+    c.set_total_voxels(n);
+    c.mutable_centers_xyz_m()->Reserve(int((end - first) * 3));
+    for (size_t i = first; i < end; ++i) {
+      c.add_centers_xyz_m(centers[i].x());
+      c.add_centers_xyz_m(centers[i].y());
+      c.add_centers_xyz_m(centers[i].z());
+    }
+    if (with_values) {
+      c.mutable_best_face_values()->Reserve(int((end - first) * kFacesPerVoxel));
+      for (size_t i = first; i < end; ++i) {
+        for (float v : values[i]) c.add_best_face_values(v);
+      }
+    }
+    if (!fn(std::move(c))) return false;
+  }
+  return true;
+}
+
+v1::PlanResult ToProto(const PlanResult& r) {
+  v1::PlanResult p;
+  *p.mutable_options() = ToProto(r.options);
+  p.set_resolution_m(r.resolution_m);
+  p.set_selection_test(r.selection_test);
+  for (const auto& s : r.stations) *p.add_stations() = ToProto(s);
+  *p.mutable_reduction() = ToProto(r.reduction);
+  p.set_candidate_count(r.candidate_count);
+  p.set_occupied_voxels(r.occupied_voxels);
+  p.set_coverable_voxels(r.coverable_voxels);
+  p.set_covered_voxels(r.covered_voxels);
+  *p.mutable_evaluation() = ToProto(r.evaluation);
+  if (r.evaluation.best_face_values.size() != r.voxel_centers.size()) {
+    p.mutable_evaluation()->set_face_value_voxels(0);  // not streamed (see ForEachVoxelChunk)
+  }
+  for (const auto& t : r.timings) {
+    auto* pt = p.add_timings();
+    pt->set_stage(t.stage);
+    pt->set_seconds(t.seconds);
+  }
+  for (const auto& w : r.warnings) p.add_warnings(w);
+  p.set_heat_map_candidates(r.heat_map.positions.size());
+  p.set_voxel_count(r.voxel_centers.size());
+  return p;
+}
+
+Status PlanResultAssembler::AddHeatMap(const v1::HeatMapChunk& c) {
+  if (c.first_index() != heat_map_.positions.size()) {
+    if (c.first_index() != 0) return ChunkError("heat map chunk out of order");
+    heat_map_ = HeatMap{};  // a fresh heat map replaces an earlier one
+  }
+  if (c.positions_size() != c.visible_voxels_size()) return ChunkError("heat map chunk sizes differ");
+  heat_map_total_ = c.total_candidates();
+  heat_map_.grid_spacing_m = c.grid_spacing_m();
+  for (int i = 0; i < c.positions_size(); ++i) {
+    heat_map_.positions.push_back(FromProto(c.positions(i)));
+    heat_map_.visible_voxels.push_back(c.visible_voxels(i));
+  }
+  if (heat_map_.positions.size() > heat_map_total_) return ChunkError("more heat map candidates than declared");
+  return Status::Ok();
+}
+
+Status PlanResultAssembler::AddVoxels(const v1::VoxelChunk& c) {
+  if (c.first_voxel_id() != centers_.size()) return ChunkError("voxel chunk out of order");
+  if (c.centers_xyz_m_size() % 3 != 0) return ChunkError("voxel chunk with a partial centre");
+  const int n = c.centers_xyz_m_size() / 3;
+  const bool with_values = c.best_face_values_size() > 0;
+  if (with_values && c.best_face_values_size() != n * kFacesPerVoxel) {
+    return ChunkError("voxel chunk with face values for a different number of voxels");
+  }
+  if (with_values != (face_values_.size() == centers_.size()) && !centers_.empty()) {
+    return ChunkError("face values present in some voxel chunks only");
+  }
+  voxel_total_ = c.total_voxels();
+  for (int i = 0; i < n; ++i) {
+    centers_.emplace_back(c.centers_xyz_m(3 * i), c.centers_xyz_m(3 * i + 1), c.centers_xyz_m(3 * i + 2));
+    if (with_values) {
+      std::array<float, kFacesPerVoxel> v{};
+      for (int f = 0; f < kFacesPerVoxel; ++f) v[f] = c.best_face_values(kFacesPerVoxel * i + f);
+      face_values_.push_back(v);
+    }
+  }
+  if (centers_.size() > voxel_total_) return ChunkError("more voxels than declared");
+  return Status::Ok();
+}
+
+Result<PlanResult> PlanResultAssembler::Finish(const v1::PlanResult& p) && {
+  if (heat_map_.positions.size() != p.heat_map_candidates()) {
+    return ChunkError("received " + std::to_string(heat_map_.positions.size()) + " heat map candidates of " +
+                      std::to_string(p.heat_map_candidates()));
+  }
+  if (centers_.size() != p.voxel_count()) {
+    return ChunkError("received " + std::to_string(centers_.size()) + " voxels of " +
+                      std::to_string(p.voxel_count()));
+  }
+  if (p.evaluation().face_value_voxels() != 0 && face_values_.size() != p.evaluation().face_value_voxels()) {
+    return ChunkError("received face values for " + std::to_string(face_values_.size()) + " voxels of " +
+                      std::to_string(p.evaluation().face_value_voxels()));
+  }
+  PlanResult r;
+  VC_ASSIGN_OR_RETURN(r.options, FromProto(p.options()));
+  r.resolution_m = p.resolution_m();
+  r.selection_test = p.selection_test();
+  for (const auto& s : p.stations()) r.stations.push_back(FromProto(s));
+  r.heat_map = std::move(heat_map_);
+  r.reduction = FromProto(p.reduction());
+  r.candidate_count = p.candidate_count();
+  r.occupied_voxels = p.occupied_voxels();
+  r.coverable_voxels = p.coverable_voxels();
+  r.covered_voxels = p.covered_voxels();
+  r.evaluation = FromProto(p.evaluation());
+  r.evaluation.best_face_values = std::move(face_values_);
+  for (const auto& t : p.timings()) r.timings.push_back({t.stage(), t.seconds()});
+  r.warnings.assign(p.warnings().begin(), p.warnings().end());
+  r.voxel_centers = std::move(centers_);
+  return r;
+}
+
+v1::EvaluateResult ToProto(const Evaluation& e, const std::vector<WorldPoint>& viewpoints) {
+  v1::EvaluateResult r;
+  *r.mutable_evaluation() = ToProto(e);
+  for (const auto& v : viewpoints) *r.add_viewpoints() = ToProto(v);
+  return r;
+}
+
+}  // namespace vc::wire

@@ -1,0 +1,44 @@
+// Configuration of vc-server (set by flags and VC_* environment variables in main.cc).
+#pragma once
+
+#include <chrono>
+#include <cstdint>
+#include <string>
+
+#include "vc/core/status.h"
+#include "vc/core/voxel_scene.h"
+
+namespace vc::server {
+
+struct ServerOptions {
+  // host:port to listen on; port 0 picks a free port (see Server::port()).
+  std::string listen = "0.0.0.0:50051";
+  // Worker threads running jobs; 0 = one per core.
+  int workers = 0;
+  // Jobs that may wait for a worker (beyond those running); more get RESOURCE_EXHAUSTED.
+  int queue = 16;
+  // Largest upload accepted, in bytes.
+  uint64_t max_upload_bytes = uint64_t{1} << 30;
+  // Upper bound on a job's memory budget (PlanOptions::memory_budget_bytes), in bytes; requests
+  // above it are capped to it.
+  uint64_t max_memory_budget_bytes = kDefaultMemoryBudgetBytes;
+  // Threads each job may use; 0 = cores / workers (at least 1).
+  int threads_per_job = 0;
+  // PEM files. With cert and key the server speaks TLS; with client_ca it also requires and
+  // verifies client certificates (mutual TLS).
+  std::string tls_cert_file;
+  std::string tls_key_file;
+  std::string tls_client_ca_file;
+  // When non-empty, vc.v1 calls must carry "authorization: Bearer <token>".
+  std::string token;
+  // On shutdown, running jobs get this long to finish before they are cancelled.
+  std::chrono::milliseconds shutdown_grace{std::chrono::seconds(30)};
+
+  // INVALID_ARGUMENT naming the first bad field.
+  Status Validate() const;
+  // Workers and per-job threads with the 0 defaults resolved.
+  int EffectiveWorkers() const;
+  int EffectiveThreadsPerJob() const;
+};
+
+}  // namespace vc::server

@@ -1,0 +1,39 @@
+// StationPlannerService: the vc.v1.StationPlanner gRPC service (callback API, gRFC L67).
+//
+// Stateless: a job lives exactly as long as its stream. Reactions on gRPC's threads only do protocol
+// work; every job runs on the service's own bounded WorkerPool. Each RPC body is thin: convert the
+// spec (vc::wire::FromProto), call one Backend function, stream the converted result, and map the
+// vc::Status with ToGrpcStatus. Thread-safe; destroying the service joins its workers (shut the
+// grpc::Server down first).
+#pragma once
+
+#include <memory>
+
+#include "vc/server/backend.h"
+#include "vc/server/server_options.h"
+#include "vc/server/worker_pool.h"
+#include "vc/v1/planner.grpc.pb.h"
+
+namespace vc::server {
+
+namespace internal {
+struct ServiceState;
+}
+
+class StationPlannerService final : public v1::StationPlanner::CallbackService {
+ public:
+  StationPlannerService(const ServerOptions& options, Backend backend);
+  ~StationPlannerService() override;
+
+  grpc::ServerBidiReactor<v1::PlanRequest, v1::PlanResponse>* Plan(grpc::CallbackServerContext* ctx) override;
+  grpc::ServerBidiReactor<v1::EvaluateRequest, v1::EvaluateResponse>* Evaluate(
+      grpc::CallbackServerContext* ctx) override;
+
+  // The pool running the jobs (for observation in tests and logs).
+  const WorkerPool& pool() const;
+
+ private:
+  std::unique_ptr<internal::ServiceState> state_;
+};
+
+}  // namespace vc::server

@@ -1,0 +1,16 @@
+// vc::Status -> grpc::Status: the one place core codes become gRPC codes (a single switch).
+#pragma once
+
+#include <grpcpp/support/status.h>
+
+#include "vc/core/status.h"
+
+namespace vc::server {
+
+// The gRPC code with the same meaning as `code` (google.rpc.Code numbering).
+grpc::StatusCode ToGrpcCode(StatusCode code);
+
+// Same code, same message.
+grpc::Status ToGrpcStatus(const Status& status);
+
+}  // namespace vc::server

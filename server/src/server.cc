@@ -1,0 +1,80 @@
+#include "vc/server/server.h"
+
+#include <grpcpp/ext/proto_server_reflection_plugin.h>
+#include <grpcpp/grpcpp.h>
+#include <grpcpp/health_check_service_interface.h>
+#include <spdlog/spdlog.h>
+
+#include <fstream>
+#include <sstream>
+
+#include "vc/server/service.h"
+
+namespace vc::server {
+
+Result<std::string> ReadTextFile(const std::string& path, const std::string& what) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return NotFoundError("cannot read the " + what + " file '" + path + "'");
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+namespace {
+
+Result<std::shared_ptr<grpc::ServerCredentials>> Credentials(const ServerOptions& o) {
+  if (o.tls_cert_file.empty()) return grpc::InsecureServerCredentials();
+  VC_ASSIGN_OR_RETURN(std::string cert, ReadTextFile(o.tls_cert_file, "TLS certificate (--tls-cert)"));
+  VC_ASSIGN_OR_RETURN(std::string key, ReadTextFile(o.tls_key_file, "TLS key (--tls-key)"));
+  grpc::SslServerCredentialsOptions ssl(o.tls_client_ca_file.empty()
+                                            ? GRPC_SSL_DONT_REQUEST_CLIENT_CERTIFICATE
+                                            : GRPC_SSL_REQUEST_AND_REQUIRE_CLIENT_CERTIFICATE_AND_VERIFY);
+  if (!o.tls_client_ca_file.empty()) {
+    VC_ASSIGN_OR_RETURN(ssl.pem_root_certs, ReadTextFile(o.tls_client_ca_file, "client CA (--tls-client-ca)"));
+  }
+  ssl.pem_key_cert_pairs.push_back({std::move(key), std::move(cert)});
+  return grpc::SslServerCredentials(ssl);
+}
+
+}  // namespace
+
+Result<std::unique_ptr<Server>> Server::Start(const ServerOptions& options, Backend backend) {
+  VC_RETURN_IF_ERROR(options.Validate());
+  VC_ASSIGN_OR_RETURN(auto credentials, Credentials(options));
+  grpc::EnableDefaultHealthCheckService(true);
+  grpc::reflection::InitProtoReflectionServerBuilderPlugin();
+
+  std::unique_ptr<Server> s(new Server());
+  s->service_ = std::make_unique<StationPlannerService>(options, std::move(backend));
+  grpc::ServerBuilder builder;
+  builder.AddListeningPort(options.listen, credentials, &s->port_);
+  builder.RegisterService(s->service_.get());
+  builder.SetMaxReceiveMessageSize(4 << 20);
+  s->server_ = builder.BuildAndStart();
+  if (!s->server_ || s->port_ == 0) {
+    s->service_.reset();
+    return InternalError("cannot listen on " + options.listen +
+                         ": the address is in use or not local; choose another --listen");
+  }
+  s->server_->GetHealthCheckService()->SetServingStatus(true);
+  spdlog::info("vc-server listening on {} (port {}), {} workers x {} threads, queue {}, tls={}, token={}",
+               options.listen, s->port_, options.EffectiveWorkers(), options.EffectiveThreadsPerJob(),
+               options.queue, options.tls_cert_file.empty() ? "off" : (options.tls_client_ca_file.empty() ? "on" : "mutual"),
+               options.token.empty() ? "off" : "on");
+  return s;
+}
+
+Server::~Server() { Shutdown(std::chrono::milliseconds(0)); }
+
+void Server::Shutdown(std::chrono::milliseconds grace) {
+  if (shut_down_ || !server_) return;
+  shut_down_ = true;
+  server_->GetHealthCheckService()->SetServingStatus(false);
+  server_->Shutdown(std::chrono::system_clock::now() + grace);
+  server_->Wait();
+  service_.reset();  // joins the workers; every job has ended with its call
+}
+
+const WorkerPool& Server::pool() const { return service_->pool(); }
+
+}  // namespace vc::server

@@ -1,0 +1,38 @@
+#include "vc/server/server_options.h"
+
+#include <algorithm>
+#include <thread>
+
+namespace vc::server {
+namespace {
+
+int Cores() { return std::max(1, int(std::thread::hardware_concurrency())); }
+
+}  // namespace
+
+Status ServerOptions::Validate() const {
+  if (listen.empty() || listen.find(':') == std::string::npos) {
+    return InvalidArgumentError("--listen '" + listen + "' is not host:port (e.g. 0.0.0.0:50051)");
+  }
+  if (workers < 0) return InvalidArgumentError("--workers must be >= 0 (0 = one per core)");
+  if (queue < 0) return InvalidArgumentError("--queue must be >= 0");
+  if (max_upload_bytes == 0) return InvalidArgumentError("--max-upload-bytes must be > 0");
+  if (max_memory_budget_bytes == 0) return InvalidArgumentError("--max-memory-budget-bytes must be > 0");
+  if (threads_per_job < 0) return InvalidArgumentError("--threads-per-job must be >= 0 (0 = cores / workers)");
+  if (tls_cert_file.empty() != tls_key_file.empty()) {
+    return InvalidArgumentError("--tls-cert and --tls-key must be given together");
+  }
+  if (!tls_client_ca_file.empty() && tls_cert_file.empty()) {
+    return InvalidArgumentError("--tls-client-ca needs --tls-cert and --tls-key");
+  }
+  if (shutdown_grace.count() < 0) return InvalidArgumentError("--shutdown-grace must be >= 0");
+  return Status::Ok();
+}
+
+int ServerOptions::EffectiveWorkers() const { return workers > 0 ? workers : Cores(); }
+
+int ServerOptions::EffectiveThreadsPerJob() const {
+  return threads_per_job > 0 ? threads_per_job : std::max(1, Cores() / EffectiveWorkers());
+}
+
+}  // namespace vc::server

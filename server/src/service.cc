@@ -1,0 +1,159 @@
+#include "vc/server/service.h"
+
+#include <algorithm>
+#include <random>
+
+#include "job_reactor.h"
+
+namespace vc::server {
+namespace internal {
+
+bool TokenMatches(const grpc::CallbackServerContext& ctx, const std::string& token, std::string* why) {
+  if (token.empty()) return true;
+  const auto& md = ctx.client_metadata();
+  const auto it = md.find("authorization");
+  if (it == md.end()) {
+    *why = "this server requires a bearer token: pass --token (or set VC_TOKEN)";
+    return false;
+  }
+  const std::string_view got(it->second.data(), it->second.size());
+  const std::string expected = "Bearer " + token;
+  unsigned diff = got.size() == expected.size() ? 0u : 1u;
+  for (size_t i = 0; i < expected.size(); ++i) diff |= unsigned(expected[i] ^ (i < got.size() ? got[i] : 0));
+  if (diff != 0) {
+    *why = "the bearer token is wrong: check --token (or VC_TOKEN)";
+    return false;
+  }
+  return true;
+}
+
+std::string NewJobId(ServiceState& state) {
+  static const uint64_t salt = [] {
+    std::random_device rd;
+    return (uint64_t{rd()} << 32) ^ rd();
+  }();
+  const uint64_t n = state.next_job.fetch_add(1);
+  return fmt::format("j-{:012x}", (salt ^ (n * 0x9E3779B97F4A7C15ull)) & 0xFFFFFFFFFFFFull);
+}
+
+std::string HumanBytes(uint64_t bytes) {
+  if (bytes < 1024) return std::to_string(bytes) + " B";
+  if (bytes < (uint64_t{1} << 20)) return fmt::format("{:.1f} KiB", bytes / 1024.0);
+  if (bytes < (uint64_t{1} << 30)) return fmt::format("{:.1f} MiB", bytes / 1048576.0);
+  return fmt::format("{:.2f} GiB", bytes / 1073741824.0);
+}
+
+namespace {
+
+// The job's thread count: the request's, capped by the server's per-job share (0 = the share).
+int JobThreads(int requested, const ServerOptions& o) {
+  const int share = o.EffectiveThreadsPerJob();
+  return requested <= 0 ? share : std::min(requested, share);
+}
+
+class PlanReactor final : public JobReactor<v1::PlanRequest, v1::PlanResponse> {
+ public:
+  using JobReactor::JobReactor;
+
+ private:
+  Result<v1::UploadSpec> TakeSpec(const v1::PlanRequest& request) override {
+    VC_ASSIGN_OR_RETURN(options_, wire::FromProto(request.spec().parameters()));
+    options_.memory_budget_bytes = std::min(options_.memory_budget_bytes, options().max_memory_budget_bytes);
+    if (options_.threads < 0) return InvalidArgumentError("threads must be >= 0 (0 = the server's share)");
+    options_.threads = JobThreads(options_.threads, options());
+    VC_RETURN_IF_ERROR(options_.Validate());
+    return request.spec().upload();
+  }
+
+  Status Run(const SceneInput& input, const JobContext& ctx) override {
+    PlanCallbacks callbacks;
+    callbacks.on_heat_map = [this](const HeatMap& h) { PostHeatMap(h); };
+    callbacks.on_station = [this](const PlannedStation& s, int index) {
+      v1::PlanResponse r;
+      r.mutable_station()->set_index(index);
+      *r.mutable_station()->mutable_station() = wire::ToProto(s);
+      Post(std::move(r));
+    };
+    VC_ASSIGN_OR_RETURN(const PlanResult result, backend().plan(input, options_, ctx, callbacks));
+    for (const auto& t : result.timings) NoteTiming(t.stage, t.seconds);
+    stations_ = result.stations.size();
+    // The final heat map, then the voxels, then the summary: together the whole PlanResult.
+    PostHeatMap(result.heat_map);
+    wire::ForEachVoxelChunk(result, [this](v1::VoxelChunk&& c) {
+      v1::PlanResponse r;
+      *r.mutable_voxels() = std::move(c);
+      return Post(std::move(r), /*bulk=*/true);
+    });
+    v1::PlanResponse r;
+    *r.mutable_result() = wire::ToProto(result);
+    Post(std::move(r), /*bulk=*/true);
+    return ctx.CheckCancelled("the plan (while sending the result)");
+  }
+
+  void PostHeatMap(const HeatMap& h) {
+    for (auto& c : wire::HeatMapChunks(h)) {
+      v1::PlanResponse r;
+      *r.mutable_heat_map() = std::move(c);
+      if (!Post(std::move(r), /*bulk=*/true)) return;
+    }
+  }
+
+  std::string LogDetails() const override { return fmt::format(" stations={}", stations_); }
+
+  PlanOptions options_;
+  size_t stations_ = 0;
+};
+
+class EvaluateReactor final : public JobReactor<v1::EvaluateRequest, v1::EvaluateResponse> {
+ public:
+  using JobReactor::JobReactor;
+
+ private:
+  Result<v1::UploadSpec> TakeSpec(const v1::EvaluateRequest& request) override {
+    VC_ASSIGN_OR_RETURN(options_, wire::FromProto(request.spec().parameters()));
+    options_.voxelize.memory_budget_bytes =
+        std::min(options_.voxelize.memory_budget_bytes, options().max_memory_budget_bytes);
+    VC_RETURN_IF_ERROR(ValidateEvaluateJob(options_));
+    options_.evaluate.threads = JobThreads(options_.evaluate.threads, options());
+    options_.evaluate.keep_face_values = false;
+    return request.spec().upload();
+  }
+
+  Status Run(const SceneInput& input, const JobContext& ctx) override {
+    VC_ASSIGN_OR_RETURN(const Evaluation evaluation, backend().evaluate(input, options_, ctx));
+    v1::EvaluateResponse r;
+    *r.mutable_result() = wire::ToProto(evaluation, options_.viewpoints);
+    Post(std::move(r));
+    return ctx.CheckCancelled("the evaluation (while sending the result)");
+  }
+
+  std::string LogDetails() const override { return fmt::format(" viewpoints={}", options_.viewpoints.size()); }
+
+  wire::EvaluateJobOptions options_;
+};
+
+}  // namespace
+}  // namespace internal
+
+StationPlannerService::StationPlannerService(const ServerOptions& options, Backend backend)
+    : state_(std::make_unique<internal::ServiceState>(options, std::move(backend))) {}
+
+StationPlannerService::~StationPlannerService() = default;
+
+grpc::ServerBidiReactor<v1::PlanRequest, v1::PlanResponse>* StationPlannerService::Plan(
+    grpc::CallbackServerContext* ctx) {
+  auto* reactor = new internal::PlanReactor(ctx, state_.get(), "Plan");
+  reactor->Start();
+  return reactor;
+}
+
+grpc::ServerBidiReactor<v1::EvaluateRequest, v1::EvaluateResponse>* StationPlannerService::Evaluate(
+    grpc::CallbackServerContext* ctx) {
+  auto* reactor = new internal::EvaluateReactor(ctx, state_.get(), "Evaluate");
+  reactor->Start();
+  return reactor;
+}
+
+const WorkerPool& StationPlannerService::pool() const { return state_->pool; }
+
+}  // namespace vc::server
