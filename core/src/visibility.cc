@@ -1,1 +1,490 @@
-// Placeholder: implementation in progress.
+// The visibility engine. Definitions: ALGORITHM.md sections 3-6 and docs/VISIBILITY.md.
+//
+// Work sharing that keeps the definitions exact:
+// - A corner's visibility does not depend on which voxel is transparent. If the first occupied
+//   voxel h on the ray o->c is the face's own voxel v, then v is one of the 8 voxels around c and
+//   the corner counts as visible either way; if the ray passes through v at all, it stays inside
+//   v until c (v is convex and c is on its boundary), so with v transparent nothing else is met.
+//   So Evaluate casts one ray per distinct lattice corner and viewpoint, shared by up to 24 faces.
+// - A voxel whose 6 neighbours are all occupied is never compatible (the ray to its centre must
+//   enter through a neighbour) and has no exposed face, so the selection tests skip it.
+#include "vc/core/visibility.h"
+
+#include <algorithm>
+#include <atomic>
+#include <bit>
+#include <cmath>
+#include <mutex>
+#include <random>
+
+#include "parallel.h"
+#include "vc/core/ray_traversal.h"
+
+namespace vc {
+namespace {
+
+using Eigen::Vector3d;
+using planner::ParallelChunks;
+
+constexpr double kHalfPi = 1.57079632679489661923;
+
+// Outward normal axis and sign of a face.
+int FaceAxis(Face f) { return int(f) / 2; }
+int FaceSign(Face f) { return (int(f) % 2) ? 1 : -1; }
+
+// Centre of face f of voxel v, in index space.
+Vector3d FaceCenterIS(const VoxelIndex& v, Face f) {
+  Vector3d c(v.x + 0.5, v.y + 0.5, v.z + 0.5);
+  const int a = FaceAxis(f);
+  c[a] += 0.5 * FaceSign(f);
+  return c;
+}
+
+VoxelIndex Neighbour(const VoxelIndex& v, Face f) {
+  VoxelIndex n = v;
+  const int a = FaceAxis(f);
+  (a == 0 ? n.x : a == 1 ? n.y : n.z) += FaceSign(f);
+  return n;
+}
+
+bool Enclosed(const OccupancyGrid& g, const VoxelIndex& v) {
+  return g.Occupied(v.x - 1, v.y, v.z) && g.Occupied(v.x + 1, v.y, v.z) && g.Occupied(v.x, v.y - 1, v.z) &&
+         g.Occupied(v.x, v.y + 1, v.z) && g.Occupied(v.x, v.y, v.z - 1) && g.Occupied(v.x, v.y, v.z + 1);
+}
+
+bool InsideOccupied(const OccupancyGrid& g, const Vector3d& u) {
+  return g.Occupied(int(std::floor(u.x())), int(std::floor(u.y())), int(std::floor(u.z())));
+}
+
+bool CompatibleIS(const OccupancyGrid& g, const Vector3d& uo, const VoxelIndex& v) {
+  const auto hit = FirstOccupied(g, uo, Vector3d(v.x + 0.5, v.y + 0.5, v.z + 0.5));
+  return hit && *hit == v;
+}
+
+bool SurfaceVisibleIS(const OccupancyGrid& g, const Vector3d& uo, const VoxelIndex& v) {
+  // Candidate faces: per axis, the one o is strictly outside of; most directly facing first.
+  Face faces[3];
+  double weight[3];
+  int n = 0;
+  const double lo[3] = {double(v.x), double(v.y), double(v.z)};
+  for (int a = 0; a < 3; ++a) {
+    if (uo[a] < lo[a]) {
+      faces[n] = Face(2 * a);
+      weight[n++] = lo[a] - uo[a];
+    } else if (uo[a] > lo[a] + 1) {
+      faces[n] = Face(2 * a + 1);
+      weight[n++] = uo[a] - lo[a] - 1;
+    }
+  }
+  // Sort by distance from the face plane, descending (n <= 3).
+  for (int i = 0; i < n; ++i)
+    for (int j = i + 1; j < n; ++j)
+      if (weight[j] > weight[i]) {
+        std::swap(weight[i], weight[j]);
+        std::swap(faces[i], faces[j]);
+      }
+  for (int i = 0; i < n; ++i) {
+    if (g.Occupied(Neighbour(v, faces[i]))) continue;  // not exposed
+    if (!FirstOccupied(g, uo, FaceCenterIS(v, faces[i]), &v)) return true;
+  }
+  return false;
+}
+
+// Corner visibility (s.4): the first occupied voxel on the ray to lattice point c is one of the 8
+// voxels sharing c, or there is none. Independent of transparency (see the file comment).
+bool CornerVisibleIS(const OccupancyGrid& g, const Vector3d& uo, const VoxelIndex& c) {
+  const auto hit = FirstOccupied(g, uo, Vector3d(c.x, c.y, c.z));
+  if (!hit) return true;
+  return (hit->x == c.x || hit->x == c.x - 1) && (hit->y == c.y || hit->y == c.y - 1) &&
+         (hit->z == c.z || hit->z == c.z - 1);
+}
+
+// Corner k (bit 0: +x, bit 1: +y, bit 2: +z) of voxel v.
+VoxelIndex Corner(const VoxelIndex& v, int k) { return {v.x + (k & 1), v.y + ((k >> 1) & 1), v.z + ((k >> 2) & 1)}; }
+
+// The 4 corner numbers of each face.
+constexpr int kFaceCorners[6][4] = {
+    {0, 2, 4, 6},  // -x
+    {1, 3, 5, 7},  // +x
+    {0, 1, 4, 5},  // -y
+    {2, 3, 6, 7},  // +y
+    {0, 1, 2, 3},  // -z
+    {4, 5, 6, 7},  // +z
+};
+
+Perception FromCount(int visible) {
+  return visible == 4 ? Perception::kFull : visible > 0 ? Perception::kPartial : Perception::kNone;
+}
+
+// V of a face given its perception, from world viewpoint o (s.5).
+double FaceValue(Perception p, const WorldPoint& o, const VoxelIndex& v, Face f, double r, const ScannerModel& s) {
+  if (p == Perception::kNone) return 0.0;
+  const WorldPoint center = FaceCenterIS(v, f) * r;
+  const Vector3d ray = center - o;
+  const double d = ray.norm();
+  Vector3d normal = Vector3d::Zero();
+  normal[FaceAxis(f)] = FaceSign(f);
+  const double cos_theta = d > 0 ? std::clamp(ray.dot(normal) / d, -1.0, 1.0) : 1.0;
+  return VisibilityValue(p, d, std::acos(cos_theta), s);
+}
+
+uint64_t PackCorner(const VoxelIndex& c) {
+  constexpr int kBias = 1 << 20;
+  return (uint64_t(c.z + kBias) << 42) | (uint64_t(c.y + kBias) << 21) | uint64_t(c.x + kBias);
+}
+
+VoxelIndex UnpackCorner(uint64_t p) {
+  constexpr int kBias = 1 << 20;
+  constexpr uint64_t kMask = (uint64_t{1} << 21) - 1;
+  return {int(p & kMask) - kBias, int((p >> 21) & kMask) - kBias, int(p >> 42) - kBias};
+}
+
+// Accumulates the figures of s.6 over faces.
+struct Tally {
+  double sum_v = 0;
+  double sum_full_v = 0;
+  uint64_t full = 0;
+  uint64_t partial = 0;
+  void Add(Perception p, double v) {
+    sum_v += v;
+    if (p == Perception::kFull && v > 0) {
+      ++full;
+      sum_full_v += v;
+    } else if (p != Perception::kNone && v > 0) {
+      ++partial;
+    }
+  }
+  void Merge(const Tally& o) {
+    sum_v += o.sum_v;
+    sum_full_v += o.sum_full_v;
+    full += o.full;
+    partial += o.partial;
+  }
+  VisibilityFigures Figures(uint64_t faces) const {
+    VisibilityFigures f;
+    if (faces == 0) return f;
+    f.global_visibility = sum_v / double(faces);
+    f.fully_visible_fraction = double(full) / double(faces);
+    f.mean_full_visibility = full ? sum_full_v / double(full) : 0.0;
+    f.partially_visible_fraction = double(partial) / double(faces);
+    return f;
+  }
+};
+
+// Rate-limited, thread-safe progress for one stage.
+class StageProgress {
+ public:
+  StageProgress(const JobContext& ctx, std::string stage, uint64_t total)
+      : ctx_(ctx), stage_(std::move(stage)), total_(std::max<uint64_t>(total, 1)) {}
+  void Add(uint64_t n) {
+    const uint64_t before = done_.fetch_add(n);
+    const uint64_t step = std::max<uint64_t>(total_ / 100, 1);
+    if ((before + n) / step != before / step) {
+      std::lock_guard<std::mutex> lock(mu_);
+      ctx_.Report(stage_, std::min(1.0, double(before + n) / double(total_)));
+    }
+  }
+
+ private:
+  const JobContext& ctx_;
+  std::string stage_;
+  uint64_t total_;
+  std::atomic<uint64_t> done_{0};
+  std::mutex mu_;
+};
+
+bool FaceInSet(const OccupancyGrid& g, const VoxelIndex& v, Face f, FaceSet set) {
+  return set == FaceSet::kAll || !g.Occupied(Neighbour(v, f));
+}
+
+}  // namespace
+
+std::string_view SelectionTestName(SelectionTest t) {
+  return t == SelectionTest::kCompatibility ? "compatibility" : "surface";
+}
+
+Status ScannerModel::Validate() const {
+  if (!std::isfinite(min_range_m) || !std::isfinite(max_range_m) || min_range_m < 0 || max_range_m <= min_range_m) {
+    return InvalidArgumentError("scanner range must satisfy 0 <= min_range_m < max_range_m (finite), got [" +
+                                std::to_string(min_range_m) + ", " + std::to_string(max_range_m) + "] m");
+  }
+  return Status::Ok();
+}
+
+bool IsCompatible(const OccupancyGrid& grid, const WorldPoint& o, const VoxelIndex& v) {
+  const Vector3d uo = grid.WorldToIndexSpace(o);
+  if (InsideOccupied(grid, uo)) return false;
+  return CompatibleIS(grid, uo, v);
+}
+
+bool IsSurfaceVisible(const OccupancyGrid& grid, const WorldPoint& o, const VoxelIndex& v) {
+  const Vector3d uo = grid.WorldToIndexSpace(o);
+  if (InsideOccupied(grid, uo)) return false;
+  return SurfaceVisibleIS(grid, uo, v);
+}
+
+bool PassesTest(SelectionTest test, const OccupancyGrid& grid, const WorldPoint& o, const VoxelIndex& v) {
+  return test == SelectionTest::kCompatibility ? IsCompatible(grid, o, v) : IsSurfaceVisible(grid, o, v);
+}
+
+Perception PerceiveFace(const OccupancyGrid& grid, const WorldPoint& o, const VoxelIndex& v, Face f) {
+  const Vector3d uo = grid.WorldToIndexSpace(o);
+  int visible = 0;
+  for (int k : kFaceCorners[int(f)]) visible += CornerVisibleIS(grid, uo, Corner(v, k));
+  return FromCount(visible);
+}
+
+double VisibilityValue(Perception p, double d, double theta, const ScannerModel& s) {
+  if (p == Perception::kNone || !(d >= s.min_range_m) || !(d <= s.max_range_m)) return 0.0;
+  if (p == Perception::kPartial) return 0.3;
+  const double D = std::clamp((d - s.min_range_m) / (s.max_range_m - s.min_range_m), 0.0, 1.0);
+  const double A = std::clamp(std::abs(theta - kHalfPi) / kHalfPi, 0.0, 1.0);
+  return 0.5 + 0.3 * (1.0 - D) + 0.2 * A;
+}
+
+double FaceVisibility(const OccupancyGrid& grid, const WorldPoint& o, const VoxelIndex& v, Face f,
+                      const ScannerModel& scanner) {
+  return FaceValue(PerceiveFace(grid, o, v, f), o, v, f, grid.resolution_m(), scanner);
+}
+
+size_t VoxelSet::count() const {
+  size_t n = 0;
+  for (uint64_t w : words_) n += std::popcount(w);
+  return n;
+}
+
+size_t VoxelSet::CountAnd(const VoxelSet& other) const {
+  size_t n = 0;
+  const size_t m = std::min(words_.size(), other.words_.size());
+  for (size_t i = 0; i < m; ++i) n += std::popcount(words_[i] & other.words_[i]);
+  return n;
+}
+
+void VoxelSet::Subtract(const VoxelSet& other) {
+  const size_t m = std::min(words_.size(), other.words_.size());
+  for (size_t i = 0; i < m; ++i) words_[i] &= ~other.words_[i];
+}
+
+void VoxelSet::Union(const VoxelSet& other) {
+  const size_t m = std::min(words_.size(), other.words_.size());
+  for (size_t i = 0; i < m; ++i) words_[i] |= other.words_[i];
+}
+
+Result<std::vector<VoxelSet>> ComputeVisibilitySets(const VoxelScene& scene, const std::vector<WorldPoint>& viewpoints,
+                                                    const VisibilitySetsOptions& options, const JobContext& ctx) {
+  const OccupancyGrid& g = scene.grid;
+  const size_t n = scene.occupied.size();
+  // Voxels that can pass either test: not enclosed.
+  std::vector<uint32_t> candidates;
+  std::vector<VoxelIndex> index(n);
+  for (size_t i = 0; i < n; ++i) {
+    index[i] = KeyToIndex(scene.occupied[i]);
+    if (!Enclosed(g, index[i])) candidates.push_back(uint32_t(i));
+  }
+  std::vector<VoxelSet> sets(viewpoints.size(), VoxelSet(n));
+  std::vector<Vector3d> uo(viewpoints.size());
+  std::vector<char> valid(viewpoints.size());
+  for (size_t k = 0; k < viewpoints.size(); ++k) {
+    uo[k] = g.WorldToIndexSpace(viewpoints[k]);
+    valid[k] = viewpoints[k].allFinite() && !InsideOccupied(g, uo[k]);
+  }
+  // Chunks of candidate voxels whose ids fall in distinct 64-bit words per chunk would be needed
+  // for lock-free writes; instead each chunk covers one viewpoint and a word-aligned id range.
+  constexpr uint64_t kIdsPerChunk = 64 * 64;
+  const uint64_t id_chunks = (n + kIdsPerChunk - 1) / kIdsPerChunk;
+  // Start offsets into `candidates` for each id chunk.
+  std::vector<size_t> chunk_start(id_chunks + 1);
+  for (uint64_t c = 0; c <= id_chunks; ++c) {
+    chunk_start[c] = std::lower_bound(candidates.begin(), candidates.end(), uint32_t(std::min<uint64_t>(c * kIdsPerChunk, n))) -
+                     candidates.begin();
+  }
+  const uint64_t tasks = viewpoints.size() * id_chunks;
+  StageProgress progress(ctx, "visibility", tasks);
+  const bool compat = options.test == SelectionTest::kCompatibility;
+  Status st = ParallelChunks(tasks, 1, options.threads, ctx, [&](uint64_t task, uint64_t, uint64_t) {
+    const size_t k = task / id_chunks, c = task % id_chunks;
+    if (valid[k]) {
+      VoxelSet& set = sets[k];
+      for (size_t j = chunk_start[c]; j < chunk_start[c + 1]; ++j) {
+        const uint32_t id = candidates[j];
+        if (compat ? CompatibleIS(g, uo[k], index[id]) : SurfaceVisibleIS(g, uo[k], index[id])) set.set(id);
+      }
+    }
+    progress.Add(1);
+  });
+  VC_RETURN_IF_ERROR(st);
+  return sets;
+}
+
+Result<Evaluation> Evaluate(const VoxelScene& scene, const std::vector<WorldPoint>& viewpoints,
+                            const EvaluateOptions& options, const JobContext& ctx) {
+  VC_RETURN_IF_ERROR(options.scanner.Validate());
+  for (size_t k = 0; k < viewpoints.size(); ++k) {
+    if (!viewpoints[k].allFinite()) {
+      return InvalidArgumentError("viewpoint " + std::to_string(k + 1) + " has a non-finite coordinate");
+    }
+  }
+  const OccupancyGrid& g = scene.grid;
+  const double r = scene.resolution_m;
+  const size_t n = scene.occupied.size();
+  const size_t nv = viewpoints.size();
+  Evaluation ev;
+  ev.resolution_m = r;
+  std::vector<VoxelIndex> index(n);
+  for (size_t i = 0; i < n; ++i) index[i] = KeyToIndex(scene.occupied[i]);
+
+  // F: all faces, or the exposed ones.
+  uint64_t faces_total = 0;
+  for (size_t i = 0; i < n; ++i)
+    for (int f = 0; f < kFacesPerVoxel; ++f) faces_total += FaceInSet(g, index[i], Face(f), options.faces);
+  ev.faces_total = faces_total;
+  ev.per_viewpoint.resize(nv);
+  if (faces_total == 0) return ev;
+
+  std::vector<Vector3d> uo(nv);
+  for (size_t k = 0; k < nv; ++k) uo[k] = g.WorldToIndexSpace(viewpoints[k]);
+
+  if (options.sample_faces > 0) {
+    // Unbiased uniform sample of F with replacement: pick a voxel id and a face uniformly, and
+    // re-draw faces outside F (rejection keeps the distribution uniform over F).
+    ev.sampled = true;
+    ev.faces_evaluated = options.sample_faces;
+    std::mt19937_64 rng(options.seed);
+    std::uniform_int_distribution<uint64_t> pick(0, n * kFacesPerVoxel - 1);
+    std::vector<std::pair<uint32_t, uint8_t>> sample(options.sample_faces);
+    for (auto& s : sample) {
+      while (true) {
+        const uint64_t p = pick(rng);
+        const uint32_t id = uint32_t(p / kFacesPerVoxel);
+        const uint8_t f = uint8_t(p % kFacesPerVoxel);
+        if (FaceInSet(g, index[id], Face(f), options.faces)) {
+          s = {id, f};
+          break;
+        }
+      }
+    }
+    constexpr uint64_t kChunk = 256;
+    const uint64_t chunks = (sample.size() + kChunk - 1) / kChunk;
+    std::vector<Tally> overall(chunks);
+    std::vector<double> sum_sq(chunks, 0.0);
+    std::vector<std::vector<Tally>> per(chunks, std::vector<Tally>(nv));
+    StageProgress progress(ctx, "evaluate", chunks);
+    VC_RETURN_IF_ERROR(ParallelChunks(sample.size(), kChunk, options.threads, ctx, [&](uint64_t c, uint64_t b, uint64_t e) {
+      for (uint64_t i = b; i < e; ++i) {
+        const VoxelIndex& v = index[sample[i].first];
+        const Face f = Face(sample[i].second);
+        double best = 0;
+        Perception best_p = Perception::kNone;
+        for (size_t k = 0; k < nv; ++k) {
+          int visible = 0;
+          for (int q : kFaceCorners[int(f)]) visible += CornerVisibleIS(g, uo[k], Corner(v, q));
+          const Perception p = FromCount(visible);
+          const double val = FaceValue(p, viewpoints[k], v, f, r, options.scanner);
+          per[c][k].Add(p, val);
+          if (val > best || (val == best && p > best_p)) {
+            best = val;
+            best_p = p;
+          }
+        }
+        overall[c].Add(best_p, best);
+        sum_sq[c] += best * best;
+      }
+      progress.Add(1);
+    }));
+    Tally total;
+    double sq = 0;
+    std::vector<Tally> per_total(nv);
+    for (uint64_t c = 0; c < chunks; ++c) {
+      total.Merge(overall[c]);
+      sq += sum_sq[c];
+      for (size_t k = 0; k < nv; ++k) per_total[k].Merge(per[c][k]);
+    }
+    const double m = double(sample.size());
+    ev.overall = total.Figures(sample.size());
+    const double mean = ev.overall.global_visibility;
+    const double var = m > 1 ? std::max(0.0, (sq - m * mean * mean) / (m - 1)) : 0.0;
+    ev.global_visibility_ci95 = 1.96 * std::sqrt(var / m);
+    for (size_t k = 0; k < nv; ++k) ev.per_viewpoint[k] = per_total[k].Figures(sample.size());
+    return ev;
+  }
+
+  // Exact mode. Distinct lattice corners of all occupied voxels, and each voxel's 8 corner ids.
+  ev.faces_evaluated = faces_total;
+  std::vector<uint64_t> corners;
+  corners.reserve(n * 8);
+  for (size_t i = 0; i < n; ++i)
+    for (int q = 0; q < 8; ++q) corners.push_back(PackCorner(Corner(index[i], q)));
+  std::sort(corners.begin(), corners.end());
+  corners.erase(std::unique(corners.begin(), corners.end()), corners.end());
+  std::vector<std::array<uint32_t, 8>> voxel_corners(n);
+  for (size_t i = 0; i < n; ++i)
+    for (int q = 0; q < 8; ++q)
+      voxel_corners[i][q] =
+          uint32_t(std::lower_bound(corners.begin(), corners.end(), PackCorner(Corner(index[i], q))) - corners.begin());
+  VC_RETURN_IF_ERROR(ctx.CheckCancelled("evaluation"));
+
+  std::vector<double> best(n * kFacesPerVoxel, 0.0);
+  std::vector<uint8_t> best_p(n * kFacesPerVoxel, 0);
+  if (options.keep_per_viewpoint_values) ev.per_viewpoint_face_values.assign(nv, {});
+  std::vector<uint64_t> visible_bits((corners.size() + 63) / 64);
+  constexpr uint64_t kCornerChunk = 64 * 256;
+  constexpr uint64_t kVoxelChunk = 4096;
+  const uint64_t voxel_chunks = (n + kVoxelChunk - 1) / kVoxelChunk;
+  StageProgress progress(ctx, "evaluate", nv);
+  for (size_t k = 0; k < nv; ++k) {
+    // 1. One ray per corner.
+    std::fill(visible_bits.begin(), visible_bits.end(), 0);
+    VC_RETURN_IF_ERROR(ParallelChunks(corners.size(), kCornerChunk, options.threads, ctx, [&](uint64_t, uint64_t b, uint64_t e) {
+      for (uint64_t c = b; c < e; ++c) {
+        if (CornerVisibleIS(g, uo[k], UnpackCorner(corners[c]))) visible_bits[c >> 6] |= uint64_t{1} << (c & 63);
+      }
+    }));
+    // 2. Faces from their corners.
+    std::vector<Tally> tallies(voxel_chunks);
+    std::vector<float>* keep = options.keep_per_viewpoint_values ? &ev.per_viewpoint_face_values[k] : nullptr;
+    if (keep) keep->assign(n * kFacesPerVoxel, 0.0f);
+    VC_RETURN_IF_ERROR(ParallelChunks(n, kVoxelChunk, options.threads, ctx, [&](uint64_t chunk, uint64_t b, uint64_t e) {
+      Tally& t = tallies[chunk];
+      for (uint64_t i = b; i < e; ++i) {
+        for (int f = 0; f < kFacesPerVoxel; ++f) {
+          if (!FaceInSet(g, index[i], Face(f), options.faces)) continue;
+          int visible = 0;
+          for (int q : kFaceCorners[f]) {
+            const uint32_t c = voxel_corners[i][q];
+            visible += (visible_bits[c >> 6] >> (c & 63)) & 1;
+          }
+          const Perception p = FromCount(visible);
+          const double val = FaceValue(p, viewpoints[k], index[i], Face(f), r, options.scanner);
+          t.Add(p, val);
+          const size_t slot = i * kFacesPerVoxel + f;
+          if (keep) (*keep)[slot] = float(val);
+          if (val > best[slot] || (val == best[slot] && uint8_t(p) > best_p[slot])) {
+            best[slot] = val;
+            best_p[slot] = uint8_t(p);
+          }
+        }
+      }
+    }));
+    Tally total;
+    for (const Tally& t : tallies) total.Merge(t);
+    ev.per_viewpoint[k] = total.Figures(faces_total);
+    progress.Add(1);
+  }
+  // Overall: the best V of each face over all viewpoints.
+  Tally total;
+  for (size_t i = 0; i < n; ++i)
+    for (int f = 0; f < kFacesPerVoxel; ++f) {
+      if (!FaceInSet(g, index[i], Face(f), options.faces)) continue;
+      const size_t slot = i * kFacesPerVoxel + f;
+      total.Add(Perception(best_p[slot]), best[slot]);
+    }
+  ev.overall = total.Figures(faces_total);
+  if (options.keep_face_values) {
+    ev.best_face_values.resize(n);
+    for (size_t i = 0; i < n; ++i)
+      for (int f = 0; f < kFacesPerVoxel; ++f) ev.best_face_values[i][f] = float(best[i * kFacesPerVoxel + f]);
+  }
+  return ev;
+}
+
+}  // namespace vc

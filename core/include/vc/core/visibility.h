@@ -126,8 +126,11 @@ struct EvaluateOptions {
   // replacement), reporting a 95 % confidence interval.
   uint64_t sample_faces = 0;
   uint64_t seed = 1;
-  // Keep each face's best V (needed by visibility.ply and by reduction). Exact mode only.
+  // Keep each face's best V (needed by visibility.ply). Exact mode only.
   bool keep_face_values = false;
+  // Keep every viewpoint's V of every face (needed by reduction). Exact mode only; costs
+  // 24 bytes per occupied voxel and viewpoint.
+  bool keep_per_viewpoint_values = false;
 };
 
 struct Evaluation {
@@ -141,6 +144,9 @@ struct Evaluation {
   std::vector<VisibilityFigures> per_viewpoint;
   // With keep_face_values: per voxel id, the best V of each of its 6 faces (F order: voxel id, then Face).
   std::vector<std::array<float, kFacesPerVoxel>> best_face_values;
+  // With keep_per_viewpoint_values: per viewpoint, V of every face at index voxel_id * 6 + face.
+  // Faces outside F hold 0.
+  std::vector<std::vector<float>> per_viewpoint_face_values;
 };
 
 // Evaluates a set of viewpoints on `scene` (s.6): G of the whole set and figures per viewpoint.

@@ -1,0 +1,311 @@
+#include "vc/core/visibility.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "vc/core/ray_traversal.h"
+
+namespace vc {
+namespace {
+
+using Eigen::Vector3d;
+constexpr double kPi = 3.14159265358979323846;
+
+// A scene at resolution 1 m from voxel indices (index = world metres, so hand computation is easy).
+VoxelScene MakeScene(const std::vector<VoxelIndex>& voxels, double r = 1.0) {
+  VoxelScene s;
+  s.resolution_m = r;
+  for (const auto& v : voxels) s.occupied.push_back(IndexToKey(v));
+  std::sort(s.occupied.begin(), s.occupied.end());
+  s.occupied.erase(std::unique(s.occupied.begin(), s.occupied.end()), s.occupied.end());
+  std::vector<VoxelIndex> idx;
+  for (const auto& k : s.occupied) idx.push_back(KeyToIndex(k));
+  s.grid = *OccupancyGrid::Build(r, idx, 1 << 26);
+  return s;
+}
+
+// ---- Hand-computed cases ----
+
+TEST(PerceiveFaceTest, LoneVoxelIsTransparentSoEveryFaceIsFull) {
+  // A single voxel seen from straight above: with the voxel itself transparent (paper s.2.1),
+  // every corner ray ends in one of the 8 voxels around its corner, so all 6 faces are full.
+  const VoxelScene s = MakeScene({{0, 0, 0}});
+  const WorldPoint o(0.5, 0.5, 5.5);
+  for (int f = 0; f < 6; ++f) EXPECT_EQ(PerceiveFace(s.grid, o, {0, 0, 0}, Face(f)), Perception::kFull) << f;
+}
+
+TEST(PerceiveFaceTest, FaceBehindAWallIsNotVisible) {
+  std::vector<VoxelIndex> v = {{0, 0, 0}};
+  for (int x = -5; x <= 5; ++x)
+    for (int y = -5; y <= 5; ++y) v.push_back({x, y, 2});  // a plate at z in [2,3)
+  const VoxelScene s = MakeScene(v);
+  const WorldPoint o(0.5, 0.5, 5.5);
+  EXPECT_EQ(PerceiveFace(s.grid, o, {0, 0, 0}, Face::kPosZ), Perception::kNone);
+  EXPECT_EQ(FaceVisibility(s.grid, o, {0, 0, 0}, Face::kPosZ, {}), 0.0);
+  EXPECT_FALSE(IsCompatible(s.grid, o, {0, 0, 0}));
+  EXPECT_FALSE(IsSurfaceVisible(s.grid, o, {0, 0, 0}));
+}
+
+TEST(PerceiveFaceTest, HalfHiddenFaceIsPartial) {
+  // Viewpoint (2.5, 0.5, 8.5). In the layer z in [2,3), the rays to the top corners with x = 0
+  // run at x = (z - 1) / 3, in column 0; those to the corners with x = 1 run at
+  // x = 1 + (z - 1) / 5, in column 1. A bar of voxels (0, -1..1, 2) hides exactly the two x = 0
+  // corners: 2 of 4 visible -> partial, V = 0.3.
+  std::vector<VoxelIndex> v = {{0, 0, 0}};
+  for (int y = -1; y <= 1; ++y) v.push_back({0, y, 2});
+  const VoxelScene s = MakeScene(v);
+  const WorldPoint o(2.5, 0.5, 8.5);
+  EXPECT_EQ(PerceiveFace(s.grid, o, {0, 0, 0}, Face::kPosZ), Perception::kPartial);
+  EXPECT_DOUBLE_EQ(FaceVisibility(s.grid, o, {0, 0, 0}, Face::kPosZ, {}), 0.3);
+  // Without the bar the same face is full.
+  const VoxelScene bare = MakeScene({{0, 0, 0}});
+  EXPECT_EQ(PerceiveFace(bare.grid, o, {0, 0, 0}, Face::kPosZ), Perception::kFull);
+}
+
+TEST(VisibilityValueTest, HandValues) {
+  const ScannerModel s;  // [0.5, 75] m
+  // d = 10.5 m, theta = 60 deg: D = 10/74.5, A = 1/3.
+  EXPECT_NEAR(VisibilityValue(Perception::kFull, 10.5, kPi / 3, s), 0.5 + 0.3 * (1 - 10.0 / 74.5) + 0.2 / 3, 1e-12);
+  // Head-on from either side (theta = 0 or pi) gives A = 1; grazing (pi/2) gives A = 0.
+  EXPECT_NEAR(VisibilityValue(Perception::kFull, 0.5, 0.0, s), 1.0, 1e-12);
+  EXPECT_NEAR(VisibilityValue(Perception::kFull, 0.5, kPi, s), 1.0, 1e-12);
+  EXPECT_NEAR(VisibilityValue(Perception::kFull, 0.5, kPi / 2, s), 0.8, 1e-12);
+  // At Rmax, D = 1: only the class constant and the angle term remain.
+  EXPECT_NEAR(VisibilityValue(Perception::kFull, 75.0, 0.0, s), 0.7, 1e-12);
+  EXPECT_DOUBLE_EQ(VisibilityValue(Perception::kPartial, 20.0, 1.0, s), 0.3);
+  EXPECT_DOUBLE_EQ(VisibilityValue(Perception::kNone, 20.0, 0.0, s), 0.0);
+  // Outside [Rmin, Rmax]: not visible, whatever the class.
+  EXPECT_DOUBLE_EQ(VisibilityValue(Perception::kFull, 0.49, 0.0, s), 0.0);
+  EXPECT_DOUBLE_EQ(VisibilityValue(Perception::kFull, 75.01, 0.0, s), 0.0);
+  EXPECT_DOUBLE_EQ(VisibilityValue(Perception::kPartial, 80, 0.0, s), 0.0);
+}
+
+TEST(FaceVisibilityTest, DistanceAndAngleMeasuredToFaceCentre) {
+  const VoxelScene s = MakeScene({{0, 0, 0}});
+  // Top face centre (0.5, 0.5, 1); viewpoint 4 m straight above: d = 4, head-on.
+  EXPECT_NEAR(FaceVisibility(s.grid, WorldPoint(0.5, 0.5, 5.0), {0, 0, 0}, Face::kPosZ, {}),
+              0.5 + 0.3 * (1 - 3.5 / 74.5) + 0.2, 1e-12);
+  // +x face centre (1, 0.5, 0.5) from (4, 0.5, 3.5): ray (-3, 0, -3), 45 deg off the normal.
+  EXPECT_NEAR(FaceVisibility(s.grid, WorldPoint(4, 0.5, 3.5), {0, 0, 0}, Face::kPosX, {}),
+              0.5 + 0.3 * (1 - (std::sqrt(18.0) - 0.5) / 74.5) + 0.2 * 0.5, 1e-12);
+}
+
+TEST(ScannerModelTest, RejectsBadRanges) {
+  EXPECT_TRUE(ScannerModel{}.Validate().ok());
+  EXPECT_FALSE((ScannerModel{2.0, 1.0}).Validate().ok());
+  EXPECT_FALSE((ScannerModel{std::nan(""), 1.0}).Validate().ok());
+  EXPECT_FALSE((ScannerModel{-1.0, 10.0}).Validate().ok());
+}
+
+TEST(SelectionTestsTest, CompatibilityHasThe45DegreeConeSurfaceVisibilityDoesNot) {
+  // A floor plate one voxel thick; viewpoint 1.5 m above voxel (0,0,0)'s centre.
+  std::vector<VoxelIndex> v;
+  for (int x = -45; x <= 45; ++x)
+    for (int y = -5; y <= 5; ++y) v.push_back({x, y, 0});
+  const VoxelScene s = MakeScene(v, 0.1);
+  const WorldPoint o(0.05, 0.05, 1.6);
+  EXPECT_TRUE(IsCompatible(s.grid, o, {0, 0, 0}));
+  EXPECT_TRUE(IsSurfaceVisible(s.grid, o, {0, 0, 0}));
+  // 0.9 m off (about 30 deg from the normal): still inside the cone.
+  EXPECT_TRUE(IsCompatible(s.grid, o, {9, 0, 0}));
+  // 4 m off (about 69 deg): the ray to the centre enters the layer through a neighbour.
+  EXPECT_FALSE(IsCompatible(s.grid, o, {-40, 0, 0}));
+  EXPECT_TRUE(IsSurfaceVisible(s.grid, o, {-40, 0, 0}));
+  // A viewpoint inside an occupied voxel sees nothing.
+  EXPECT_FALSE(IsSurfaceVisible(s.grid, WorldPoint(0.05, 0.05, 0.05), {1, 0, 0}));
+  EXPECT_FALSE(IsCompatible(s.grid, WorldPoint(0.05, 0.05, 0.05), {1, 0, 0}));
+}
+
+// ---- Oracles written plainly from the definitions ----
+
+std::optional<VoxelIndex> PlainFirstHit(const OccupancyGrid& g, const Vector3d& a, const Vector3d& b,
+                                        const VoxelIndex* transparent) {
+  for (const VoxelIndex& v : RayTraversal(a, b)) {
+    if (transparent && v == *transparent) continue;
+    if (g.Occupied(v)) return v;
+  }
+  return std::nullopt;
+}
+
+bool PlainCompatible(const OccupancyGrid& g, const Vector3d& uo, const VoxelIndex& v) {
+  if (g.Occupied(int(std::floor(uo.x())), int(std::floor(uo.y())), int(std::floor(uo.z())))) return false;
+  auto h = PlainFirstHit(g, uo, Vector3d(v.x + 0.5, v.y + 0.5, v.z + 0.5), nullptr);
+  return h && *h == v;
+}
+
+bool PlainSurfaceVisible(const OccupancyGrid& g, const Vector3d& uo, const VoxelIndex& v) {
+  if (g.Occupied(int(std::floor(uo.x())), int(std::floor(uo.y())), int(std::floor(uo.z())))) return false;
+  for (int axis = 0; axis < 3; ++axis) {
+    for (int side = 0; side < 2; ++side) {
+      const double plane = (axis == 0 ? v.x : axis == 1 ? v.y : v.z) + side;
+      const bool facing = side ? uo[axis] > plane : uo[axis] < plane;
+      if (!facing) continue;
+      VoxelIndex n = v;
+      (axis == 0 ? n.x : axis == 1 ? n.y : n.z) += side ? 1 : -1;
+      if (g.Occupied(n)) continue;
+      Vector3d c(v.x + 0.5, v.y + 0.5, v.z + 0.5);
+      c[axis] = plane;
+      if (!PlainFirstHit(g, uo, c, &v)) return true;
+    }
+  }
+  return false;
+}
+
+double PlainFaceValue(const OccupancyGrid& g, const WorldPoint& o, const VoxelIndex& v, int face) {
+  const Vector3d uo = o / g.resolution_m();
+  const int axis = face / 2, side = face % 2;
+  int visible = 0;
+  for (int a = 0; a < 2; ++a)
+    for (int b = 0; b < 2; ++b) {
+      Vector3d c(v.x, v.y, v.z);
+      c[axis] += side;
+      c[(axis + 1) % 3] += a;
+      c[(axis + 2) % 3] += b;
+      auto h = PlainFirstHit(g, uo, c, &v);
+      const bool near = h && std::abs(h->x + 0.5 - c.x()) < 1 && std::abs(h->y + 0.5 - c.y()) < 1 &&
+                        std::abs(h->z + 0.5 - c.z()) < 1;
+      visible += (!h || near);
+    }
+  if (visible == 0) return 0;
+  Vector3d center(v.x + 0.5, v.y + 0.5, v.z + 0.5);
+  center[axis] += side ? 0.5 : -0.5;
+  center *= g.resolution_m();
+  const double d = (center - o).norm();
+  if (d < 0.5 || d > 75) return 0;
+  if (visible < 4) return 0.3;
+  Vector3d n = Vector3d::Zero();
+  n[axis] = side ? 1 : -1;
+  const double theta = std::acos(std::clamp((center - o).dot(n) / d, -1.0, 1.0));
+  return 0.5 + 0.3 * (1 - (d - 0.5) / 74.5) + 0.2 * std::abs(theta - kPi / 2) / (kPi / 2);
+}
+
+VoxelScene RandomScene(std::mt19937_64& rng, int count, int extent, double r) {
+  std::uniform_int_distribution<int> c(0, extent - 1);
+  std::vector<VoxelIndex> v;
+  for (int i = 0; i < count; ++i) v.push_back({c(rng), c(rng), c(rng)});
+  // A floor, so some voxels are enclosed or half-hidden.
+  for (int x = 0; x < extent; ++x)
+    for (int y = 0; y < extent; ++y) v.push_back({x, y, 0});
+  return MakeScene(v, r);
+}
+
+std::vector<WorldPoint> RandomViewpoints(std::mt19937_64& rng, int count, int extent, double r) {
+  std::uniform_real_distribution<double> u(0.2, extent - 0.2);
+  std::vector<WorldPoint> out;
+  for (int i = 0; i < count; ++i) out.emplace_back(u(rng) * r, u(rng) * r, u(rng) * r);
+  return out;
+}
+
+TEST(ComputeVisibilitySetsTest, EqualsBruteForceOracleForBothTests) {
+  std::mt19937_64 rng(42);
+  for (int trial = 0; trial < 6; ++trial) {
+    const VoxelScene s = RandomScene(rng, 120, 12, 0.1);
+    const auto vps = RandomViewpoints(rng, 5, 12, 0.1);
+    for (SelectionTest test : {SelectionTest::kCompatibility, SelectionTest::kSurfaceVisibility}) {
+      VisibilitySetsOptions opt;
+      opt.test = test;
+      opt.threads = 2;
+      auto sets = ComputeVisibilitySets(s, vps, opt);
+      ASSERT_TRUE(sets.ok());
+      size_t positives = 0;
+      for (size_t k = 0; k < vps.size(); ++k) {
+        const Vector3d uo = vps[k] / 0.1;
+        for (size_t id = 0; id < s.occupied.size(); ++id) {
+          const VoxelIndex v = KeyToIndex(s.occupied[id]);
+          const bool want = test == SelectionTest::kCompatibility ? PlainCompatible(s.grid, uo, v)
+                                                                  : PlainSurfaceVisible(s.grid, uo, v);
+          ASSERT_EQ((*sets)[k].test(id), want) << "trial " << trial << " test " << int(test) << " vp " << k << " voxel " << id;
+          positives += want;
+        }
+      }
+      EXPECT_GT(positives, 0u);
+    }
+  }
+}
+
+TEST(EvaluateTest, GlobalVisibilityEqualsBruteForce) {
+  std::mt19937_64 rng(7);
+  for (int trial = 0; trial < 4; ++trial) {
+    const VoxelScene s = RandomScene(rng, 60, 9, 1.0);
+    const auto vps = RandomViewpoints(rng, 3, 9, 1.0);
+    EvaluateOptions opt;
+    opt.keep_face_values = true;
+    opt.keep_per_viewpoint_values = true;
+    auto ev = Evaluate(s, vps, opt);
+    ASSERT_TRUE(ev.ok()) << ev.status().ToString();
+    const size_t n = s.occupied.size();
+    ASSERT_EQ(ev->faces_total, 6 * n);
+    double sum_best = 0;
+    std::vector<double> sum_vp(vps.size(), 0);
+    for (size_t id = 0; id < n; ++id) {
+      const VoxelIndex v = KeyToIndex(s.occupied[id]);
+      for (int f = 0; f < 6; ++f) {
+        double best = 0;
+        for (size_t k = 0; k < vps.size(); ++k) {
+          const double val = PlainFaceValue(s.grid, vps[k], v, f);
+          ASSERT_NEAR(ev->per_viewpoint_face_values[k][id * 6 + f], val, 1e-6);
+          sum_vp[k] += val;
+          best = std::max(best, val);
+        }
+        ASSERT_NEAR(ev->best_face_values[id][f], best, 1e-6);
+        sum_best += best;
+      }
+    }
+    EXPECT_NEAR(ev->overall.global_visibility, sum_best / double(6 * n), 1e-9);
+    EXPECT_GT(ev->overall.global_visibility, 0.0);
+    for (size_t k = 0; k < vps.size(); ++k)
+      EXPECT_NEAR(ev->per_viewpoint[k].global_visibility, sum_vp[k] / double(6 * n), 1e-9);
+  }
+}
+
+TEST(EvaluateTest, SamplingIsUnbiasedWithinItsConfidenceInterval) {
+  std::mt19937_64 rng(99);
+  const VoxelScene s = RandomScene(rng, 400, 20, 0.1);
+  const auto vps = RandomViewpoints(rng, 3, 20, 0.1);
+  auto exact = Evaluate(s, vps, {});
+  ASSERT_TRUE(exact.ok());
+  EvaluateOptions opt;
+  opt.sample_faces = 20000;
+  opt.seed = 5;
+  auto est = Evaluate(s, vps, opt);
+  ASSERT_TRUE(est.ok());
+  EXPECT_TRUE(est->sampled);
+  EXPECT_GT(est->global_visibility_ci95, 0.0);
+  EXPECT_LT(est->global_visibility_ci95, 0.01);
+  EXPECT_NEAR(est->overall.global_visibility, exact->overall.global_visibility, 1.5 * est->global_visibility_ci95);
+}
+
+TEST(EvaluateTest, ExposedFaceSetExcludesSharedFaces) {
+  const VoxelScene s = MakeScene({{0, 0, 0}, {1, 0, 0}});
+  EvaluateOptions opt;
+  opt.faces = FaceSet::kExposed;
+  auto ev = Evaluate(s, {WorldPoint(0.5, 0.5, 5.5)}, opt);
+  ASSERT_TRUE(ev.ok());
+  EXPECT_EQ(ev->faces_total, 10u);
+  opt.faces = FaceSet::kAll;
+  EXPECT_EQ(Evaluate(s, {WorldPoint(0.5, 0.5, 5.5)}, opt)->faces_total, 12u);
+}
+
+TEST(EvaluateTest, RejectsNonFiniteViewpointAndBadRange) {
+  const VoxelScene s = MakeScene({{0, 0, 0}});
+  EXPECT_EQ(Evaluate(s, {WorldPoint(std::nan(""), 0, 0)}, {}).status().code(), StatusCode::kInvalidArgument);
+  EvaluateOptions opt;
+  opt.scanner.max_range_m = 0.1;
+  EXPECT_EQ(Evaluate(s, {WorldPoint(0, 0, 3)}, opt).status().code(), StatusCode::kInvalidArgument);
+}
+
+TEST(ComputeVisibilitySetsTest, CancellationStopsTheJob) {
+  std::mt19937_64 rng(1);
+  const VoxelScene s = RandomScene(rng, 100, 10, 0.1);
+  CancelToken token;
+  token.Cancel();
+  JobContext ctx;
+  ctx.cancel = &token;
+  auto r = ComputeVisibilitySets(s, RandomViewpoints(rng, 3, 10, 0.1), {}, ctx);
+  EXPECT_EQ(r.status().code(), StatusCode::kCancelled);
+}
+
+}  // namespace
+}  // namespace vc
