@@ -1,0 +1,98 @@
+// vc::client::Client: the typed client of vc.v1.StationPlanner and of the gRPC health service.
+//
+// Uploads a scene in chunks (with its CRC32C), follows the event stream, and returns the core
+// types (vc::PlanResult, vc::Evaluation) rebuilt by vc::wire, ready for vc::WritePlanOutputs.
+// Transient UNAVAILABLE failures before the server accepted the job are retried with exponential
+// backoff; every other status is returned as it came. Not thread-safe; use one per thread.
+#pragma once
+
+#include <grpcpp/grpcpp.h>
+
+#include <chrono>
+#include <functional>
+#include <memory>
+#include <string>
+#include <string_view>
+
+#include "vc/core/planner.h"
+#include "vc/core/progress.h"
+#include "vc/core/status.h"
+#include "vc/core/visibility.h"
+#include "vc/wire/convert.h"
+
+namespace vc::client {
+
+struct ConnectionOptions {
+  // host:port of vc-server.
+  std::string server = "localhost:50051";
+  // TLS: on when `tls` or any file below is set. CA file (PEM) verifying the server; empty = the
+  // system roots. Client certificate and key (PEM) for mutual TLS.
+  bool tls = false;
+  std::string tls_ca_file;
+  std::string tls_cert_file;
+  std::string tls_key_file;
+  // Name to verify the server certificate against, when it differs from the host in `server`.
+  std::string tls_server_name;
+  // Sent as "authorization: Bearer <token>" when non-empty.
+  std::string token;
+  // gzip-compress requests.
+  bool gzip = true;
+  // Attempts for transient UNAVAILABLE (connection refused, server restarting); 1 = no retry.
+  int max_attempts = 5;
+  std::chrono::milliseconds initial_backoff{200};
+  // Per-call deadline; 0 = none.
+  std::chrono::milliseconds timeout{0};
+  // Bytes per upload chunk (well under the 4 MiB message limit).
+  size_t chunk_bytes = size_t{256} << 10;
+};
+
+// What the caller sees while a job runs; every member optional. Called on the calling thread.
+struct JobObserver {
+  std::function<void(const std::string& job_id, uint32_t queue_position)> on_accepted;
+  std::function<void(const ProgressEvent&)> on_progress;
+  std::function<void(const HeatMap&)> on_heat_map;
+  std::function<void(const PlannedStation&, int index)> on_station;
+  // Called before each retry, with the failed attempt's status and the wait.
+  std::function<void(const grpc::Status&, std::chrono::milliseconds)> on_retry;
+};
+
+// A value, or the gRPC status of the call that failed.
+template <typename T>
+struct [[nodiscard]] CallResult {
+  grpc::Status status;
+  T value{};
+  bool ok() const { return status.ok(); }
+};
+
+// A scene to upload: its bytes and a label for error messages (the file name).
+struct Upload {
+  std::string bytes;
+  std::string source_name;
+};
+
+// Reads a file into an Upload. NOT_FOUND if it cannot be read.
+Result<Upload> ReadUpload(const std::string& path);
+
+class Client {
+ public:
+  // Reads the TLS files and makes the channel (connecting lazily). NOT_FOUND for a missing file.
+  static Result<std::unique_ptr<Client>> Create(const ConnectionOptions& options);
+
+  CallResult<PlanResult> Plan(const Upload& upload, const PlanOptions& options, const JobObserver& observer = {});
+  CallResult<Evaluation> Evaluate(const Upload& upload, const wire::EvaluateJobOptions& options,
+                                  const JobObserver& observer = {});
+  // grpc.health.v1.Health/Check of `service` ("" = the whole server). The value is the serving
+  // status name ("SERVING"); a server that is not serving gives UNAVAILABLE.
+  CallResult<std::string> Health(const std::string& service = "");
+
+ private:
+  Client() = default;
+  void Prepare(grpc::ClientContext* ctx) const;
+  template <typename Fn>
+  grpc::Status WithRetries(const JobObserver& observer, Fn&& attempt);
+
+  ConnectionOptions options_;
+  std::shared_ptr<grpc::Channel> channel_;
+};
+
+}  // namespace vc::client
