@@ -1,0 +1,67 @@
+// Greedy station selection (ALGORITHM.md s.7.3; paper s.3.2) over precomputed visibility sets.
+//
+// Each round picks the candidate that sees the most still-uncovered coverable voxels (coverable =
+// seen by at least one candidate); ties go to the lowest candidate index. The plain version
+// recounts every candidate each round; the lazy version (CELF, Leskovec et al. 2007) keeps stale
+// gains as upper bounds in a max-heap, which is exact because gains only shrink as coverage grows,
+// and the heap orders (gain desc, index asc) so both versions pick identically. Internal to
+// vc_core (tests include it by path). Thread-compatible: no shared state.
+#pragma once
+
+#include <cstdint>
+#include <string_view>
+#include <vector>
+
+#include "vc/core/progress.h"
+#include "vc/core/status.h"
+#include "vc/core/visibility.h"
+
+namespace vc::planner {
+
+struct GreedyOptions {
+  // At most this many picks; 0 = no limit.
+  int max_stations = 0;
+  // Stop when the best marginal gain is below this many voxels (a 0 gain always stops).
+  uint64_t min_marginal_gain = 1;
+  // Stop once covered / coverable >= this fraction, in (0, 1].
+  double target_coverage = 1.0;
+  // CELF lazy evaluation (true) or the plain recount of every candidate per round (false).
+  bool lazy = true;
+};
+
+enum class GreedyStop {
+  kExhausted,       // every coverable voxel is covered (or nothing was coverable)
+  kTargetReached,   // target_coverage reached
+  kMaxStations,     // max_stations picks made
+  kMinGain,         // best marginal gain below min_marginal_gain
+};
+// "exhausted", "target_reached", "max_stations", "min_gain".
+std::string_view GreedyStopName(GreedyStop stop);
+
+struct GreedyPick {
+  int candidate = -1;          // index into the sets
+  uint64_t marginal_gain = 0;  // voxels newly covered by this pick
+  uint64_t covered_after = 0;  // covered voxels after this pick
+};
+
+struct GreedyResult {
+  std::vector<GreedyPick> picks;
+  uint64_t coverable = 0;  // |union of all sets|
+  uint64_t covered = 0;    // |union of the picked sets|
+  GreedyStop stop = GreedyStop::kExhausted;
+  uint64_t gain_evaluations = 0;  // intersections counted (lazy needs far fewer)
+};
+
+// Greedy maximum coverage over `sets` (all of the same size). INVALID_ARGUMENT for sets of
+// different sizes or bad options; CANCELLED / DEADLINE_EXCEEDED from ctx (checked every round).
+Result<GreedyResult> SelectGreedy(const std::vector<VoxelSet>& sets, const GreedyOptions& options,
+                                  const JobContext& ctx = {});
+
+// |a AND b| over the raw bitset words (equal sizes).
+uint64_t CountAnd(const VoxelSet& a, const VoxelSet& b);
+// Number of set bits.
+uint64_t CountBits(const VoxelSet& a);
+// a |= b.
+void UnionInto(VoxelSet& a, const VoxelSet& b);
+
+}  // namespace vc::planner
