@@ -23,9 +23,11 @@ inline int ResolveThreads(int requested, uint64_t chunks) {
 }
 
 // Calls fn(chunk, begin, end) for every chunk of [0, n) of `chunk_size` items, on `threads`
-// workers. Stops early and returns the token's status when ctx is cancelled (checked per chunk).
+// workers. Stops early and returns the token's status, naming `what`, when ctx is cancelled
+// (checked per chunk).
 inline Status ParallelChunks(uint64_t n, uint64_t chunk_size, int threads, const JobContext& ctx,
-                             const std::function<void(uint64_t chunk, uint64_t begin, uint64_t end)>& fn) {
+                             const std::function<void(uint64_t chunk, uint64_t begin, uint64_t end)>& fn,
+                             const char* what = "the computation") {
   const uint64_t chunks = (n + chunk_size - 1) / chunk_size;
   const int workers = ResolveThreads(threads, chunks);
   std::atomic<uint64_t> next{0};
@@ -34,7 +36,7 @@ inline Status ParallelChunks(uint64_t n, uint64_t chunk_size, int threads, const
     while (!stop.load(std::memory_order_relaxed)) {
       const uint64_t c = next.fetch_add(1);
       if (c >= chunks) return;
-      if (!ctx.CheckCancelled("planning").ok()) {
+      if (!ctx.CheckCancelled(what).ok()) {
         stop.store(true);
         return;
       }
@@ -50,7 +52,7 @@ inline Status ParallelChunks(uint64_t n, uint64_t chunk_size, int threads, const
     work();
     for (auto& t : pool) t.join();
   }
-  return ctx.CheckCancelled("planning");
+  return ctx.CheckCancelled(what);
 }
 
 }  // namespace vc::planner
