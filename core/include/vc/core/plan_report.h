@@ -27,6 +27,16 @@ std::string EvaluationToJson(const Evaluation& evaluation, const std::vector<Wor
 Status WriteEvaluationOutputs(const Evaluation& evaluation, const std::vector<WorldPoint>& viewpoints,
                               const std::string& out_dir);
 
+// Pixel size of a picture.
+struct ImageSize {
+  int width = 0;
+  int height = 0;
+};
+// Size of heatmap.png for `result` (layout in docs/PLANNING.md: one panel per floor level).
+ImageSize HeatmapImageSize(const PlanResult& result);
+// Size of reduction.png for a |P| x |P| matrix.
+ImageSize ReductionImageSize(int stations);
+
 // Parses a stations CSV ("x,y,z" per line, optional header line, '#' comments). INVALID_ARGUMENT
 // naming `source` and the line on a malformed or non-finite row, or when there is no station.
 Result<std::vector<WorldPoint>> ParseStationsCsv(std::string_view text, std::string_view source);
