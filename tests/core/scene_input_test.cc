@@ -271,6 +271,42 @@ TEST(SceneInputTest, ReadSceneFileUsesThePathAsSource) {
             path + ": line 2: expected at least 3 columns (x y z), found 2 in \"4 5\"");
 }
 
+// Flips random bytes of valid inputs of every format: every result is a value or a clean error.
+TEST(SceneInputTest, RandomCorruptionGivesOnlyCleanErrors) {
+  std::string ply_bin =
+      "ply\nformat binary_little_endian 1.0\nelement vertex 4\nproperty float x\n"
+      "property double y\nproperty short z\nelement face 2\nproperty list uchar int v\n"
+      "end_header\n";
+  for (int i = 0; i < 4; ++i) ply_bin += std::string("\0\0\x80?\0\0\0\0\0\0\xf0?\x05\0", 14);
+  for (int i = 0; i < 2; ++i) ply_bin += std::string("\x03\0\0\0\0\x01\0\0\0\x02\0\0\0", 13);
+  ASSERT_TRUE(ReadScene(ply_bin, "seed.ply").ok());
+  std::string pcd =
+      "VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH 2\nHEIGHT 1\n"
+      "POINTS 2\nDATA binary_compressed\n";
+  // LZF: a 12-byte literal (x0 x1 y0) then a back-reference repeating the last 12 bytes.
+  const std::string literal("\0\0\x80?\0\0\0@\0\0@@", 12);
+  pcd += std::string("\x10\0\0\0\x18\0\0\0", 8) + "\x0b" + literal + std::string("\xe0\x03\x0b", 3);
+  ASSERT_TRUE(ReadScene(pcd, "seed.pcd").ok()) << ReadScene(pcd, "seed.pcd").status().ToString();
+  std::stringstream bt;
+  ASSERT_TRUE(SmallTree()->writeBinary(bt));
+  const std::string seeds[] = {ply_bin, pcd, kPly, kXyz, Gzip(kXyz), Bzip2(kPly), bt.str()};
+  uint32_t rng = 12345;
+  auto next = [&] { return rng = rng * 1664525u + 1013904223u; };
+  for (const std::string& seed : seeds) {
+    for (int round = 0; round < 300; ++round) {
+      std::string bad = seed;
+      const int flips = 1 + static_cast<int>(next() % 4);
+      for (int f = 0; f < flips; ++f) bad[next() % bad.size()] = static_cast<char>(next() >> 24);
+      Result<SceneInput> r = ReadScene(bad, "fuzz");
+      if (r.ok()) continue;
+      const StatusCode code = r.status().code();
+      EXPECT_TRUE(code == StatusCode::kInvalidArgument || code == StatusCode::kResourceExhausted)
+          << r.status().ToString();
+      EXPECT_THAT(r.status().message(), HasSubstr("fuzz"));
+    }
+  }
+}
+
 // --- Real scans (../shared/data, see its README) ---
 
 TEST(SceneInputRealDataTest, HallScanBzip2Xyz) {
