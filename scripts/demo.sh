@@ -1,0 +1,57 @@
+#!/usr/bin/env bash
+# The main job: plan the scanner stations for one real office floor (geb079, OctoMap) end to end.
+# Installs the dependencies, builds the release preset, starts vc-server on a free loopback port,
+# inspects the scene locally, submits it with vc-client (live progress), prints the stations,
+# leaves plan.json, stations.csv, visibility.ply, heatmap.png and reduction.png in vc-out/, and
+# stops the server.
+# Usage: scripts/demo.sh [extra vc-client submit flags...]
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+scene=../shared/data/geb079/geb079.bt
+out=vc-out
+
+bash scripts/install-deps.sh
+cmake --preset release
+cmake --build --preset release
+
+bin=build/release
+server="$bin/server/vc-server"
+client="$bin/client/vc-client"
+
+log=$(mktemp)
+server_pid=""
+stop_server() {
+  if [[ -n "$server_pid" ]] && kill -0 "$server_pid" 2>/dev/null; then
+    kill -TERM "$server_pid"
+    wait "$server_pid" || true
+  fi
+  server_pid=""
+}
+trap 'stop_server; rm -f "$log"' EXIT
+
+echo "=== starting vc-server on a free loopback port"
+"$server" --listen 127.0.0.1:0 --workers 1 >"$log" 2>&1 &
+server_pid=$!
+port=""
+for _ in $(seq 1 100); do
+  port=$(sed -n 's/.*listening on .* (port \([0-9]*\)).*/\1/p' "$log" | head -1)
+  [[ -n "$port" ]] && break
+  kill -0 "$server_pid" 2>/dev/null || { cat "$log"; echo "demo: vc-server failed to start" >&2; exit 1; }
+  sleep 0.1
+done
+[[ -n "$port" ]] || { cat "$log"; echo "demo: vc-server did not report its port" >&2; exit 1; }
+addr="127.0.0.1:$port"
+"$client" health --server "$addr"
+
+echo "=== vc-client inspect $scene"
+"$client" inspect "$scene"
+
+echo "=== vc-client submit $scene --out $out"
+"$client" submit "$scene" --server "$addr" --out "$out" "$@"
+
+echo "=== server log"
+stop_server
+cat "$log"
+echo "=== results in $out/:"
+ls -l "$out"

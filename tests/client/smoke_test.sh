@@ -1,0 +1,73 @@
+#!/usr/bin/env bash
+# Smoke test of the real binaries over loopback: vc-synth makes a box room, vc-server plans it for
+# vc-client, and the output files are checked. Usage: smoke_test.sh VC_SERVER VC_CLIENT VC_SYNTH
+set -euo pipefail
+server_bin="$1" client_bin="$2" synth_bin="$3"
+work=$(mktemp -d)
+server_pid=""
+cleanup() {
+  if [[ -n "$server_pid" ]]; then kill "$server_pid" 2>/dev/null || true; wait "$server_pid" 2>/dev/null || true; fi
+  rm -rf "$work"
+}
+trap cleanup EXIT
+fail() { echo "smoke: FAIL: $*" >&2; [[ -f "$work/server.log" ]] && tail -20 "$work/server.log" >&2; exit 1; }
+
+"$synth_bin" box --out "$work/box.ply" >/dev/null || fail "vc-synth box failed"
+[[ -s "$work/box.ply" ]] || fail "vc-synth wrote no box.ply"
+
+# Port 0: the server picks a free port and logs it.
+"$server_bin" --listen 127.0.0.1:0 --workers 1 --shutdown-grace 2 >"$work/server.log" 2>&1 &
+server_pid=$!
+port=""
+for _ in $(seq 1 100); do
+  port=$(sed -n 's/.*listening on .* (port \([0-9]*\)).*/\1/p' "$work/server.log" | head -1)
+  [[ -n "$port" ]] && break
+  kill -0 "$server_pid" 2>/dev/null || fail "vc-server exited"
+  sleep 0.1
+done
+[[ -n "$port" ]] || fail "vc-server did not report its port"
+addr="127.0.0.1:$port"
+
+"$client_bin" health --server "$addr" | grep -qx SERVING || fail "health is not SERVING"
+
+"$client_bin" submit "$work/box.ply" --server "$addr" --out "$work/out" >"$work/client.out" 2>"$work/client.err" \
+  || { cat "$work/client.err" >&2; fail "vc-client submit failed"; }
+grep -q "progress:" "$work/client.err" || fail "no progress lines on a non-terminal"
+grep -q "station(s)" "$work/client.out" || fail "no station list printed"
+
+for f in plan.json stations.csv visibility.ply heatmap.png reduction.png; do
+  [[ -s "$work/out/$f" ]] || fail "missing or empty $f"
+done
+python3 - "$work/out" <<'PY' || fail "output contents"
+import json, sys, os
+out = sys.argv[1]
+plan = json.load(open(os.path.join(out, "plan.json")))
+assert isinstance(plan, dict), "plan.json is not an object"
+stations = plan.get("stations")
+assert isinstance(stations, list) and len(stations) >= 1, "plan.json has no stations"
+rows = [l for l in open(os.path.join(out, "stations.csv")) if l.strip() and not l.startswith("#")]
+data = [r for r in rows if not r[0].isalpha()]
+assert len(data) == len(stations), f"stations.csv has {len(data)} rows, plan.json {len(stations)} stations"
+for r in data:
+    assert len(r.split(",")) >= 3, f"bad row {r!r}"
+for png in ("heatmap.png", "reduction.png"):
+    assert open(os.path.join(out, png), "rb").read(8) == b"\x89PNG\r\n\x1a\n", png + " is not a PNG"
+assert open(os.path.join(out, "visibility.ply"), "rb").read(4) == b"ply\n", "visibility.ply is not a PLY"
+print(f"smoke: {len(stations)} station(s)")
+PY
+
+# A bad input gives a clear error and the INVALID_ARGUMENT exit status (3).
+head -c 100 "$work/box.ply" > "$work/broken.ply"
+set +e
+"$client_bin" submit "$work/broken.ply" --server "$addr" --out "$work/out2" >/dev/null 2>"$work/err2"
+rc=$?
+set -e
+[[ $rc -eq 3 ]] || fail "broken upload exited $rc, expected 3 ($(cat "$work/err2"))"
+
+# SIGTERM: the server drains and exits 0.
+kill -TERM "$server_pid"
+wait "$server_pid" && rc=0 || rc=$?
+server_pid=""
+[[ $rc -eq 0 ]] || fail "vc-server exited $rc after SIGTERM"
+grep -q "job .* status=OK" "$work/server.log" || fail "no job log line"
+echo "smoke: OK"

@@ -1,0 +1,145 @@
+// CRC32C and the proto <-> core conversions (vc::wire).
+#include <gtest/gtest.h>
+
+#include "vc/wire/convert.h"
+#include "vc/wire/crc32c.h"
+
+namespace vc::wire {
+namespace {
+
+TEST(Crc32c, KnownVectors) {
+  EXPECT_EQ(ComputeCrc32c("123456789"), 0xE3069283u);
+  EXPECT_EQ(ComputeCrc32c(""), 0u);
+  EXPECT_EQ(ComputeCrc32c(std::string(32, '\0')), 0x8A9136AAu);  // RFC 3720 B.4
+}
+
+TEST(Crc32c, IncrementalEqualsOneShotAtEverySplit) {
+  std::string s;
+  for (int i = 0; i < 100; ++i) s += char(i * 37 + 11);
+  const uint32_t whole = ComputeCrc32c(s);
+  for (size_t cut = 0; cut <= s.size(); ++cut) {
+    Crc32c c;
+    c.Update(std::string_view(s).substr(0, cut));
+    c.Update(std::string_view(s).substr(cut));
+    ASSERT_EQ(c.value(), whole) << cut;
+  }
+}
+
+TEST(PlanParameters, RoundTripKeepsEveryField) {
+  PlanOptions o;
+  o.resolution_m = 0.07;
+  o.memory_budget_bytes = 12345;
+  o.test = SelectionTest::kCompatibility;
+  o.scanner.min_range_m = 0.3;
+  o.scanner.max_range_m = 40;
+  o.grid_spacing_m = 0.7;
+  o.tripod_height_m = 1.2;
+  o.clearance_m = 0.4;
+  o.candidates = {{1, 2, 3}, {4, 5, 6}};
+  o.max_stations = 9;
+  o.min_marginal_gain_voxels = 17;
+  o.target_coverage = 0.9;
+  o.refine = !PlanOptions{}.refine;
+  o.refine_radius_m = 0.8;
+  o.refine_step_m = 0.1;
+  o.reduce = !PlanOptions{}.reduce;
+  o.reduce_to = 3;
+  o.threads = 5;
+  auto back = FromProto(ToProto(o));
+  ASSERT_TRUE(back.ok());
+  // Compare through the proto (every field), so a field added to one side only shows up here.
+  EXPECT_EQ(ToProto(*back).SerializeAsString(), ToProto(o).SerializeAsString());
+  EXPECT_EQ(back->test, SelectionTest::kCompatibility);
+  EXPECT_EQ(back->candidates.size(), 2u);
+}
+
+TEST(PlanParameters, UnsetFieldsTakeTheDefaults) {
+  auto o = FromProto(v1::PlanParameters{});
+  ASSERT_TRUE(o.ok());
+  EXPECT_EQ(ToProto(*o).SerializeAsString(), ToProto(PlanOptions{}).SerializeAsString());
+}
+
+PlanResult BigResult(size_t voxels, size_t candidates) {
+  PlanResult r;
+  r.resolution_m = 0.1;
+  r.selection_test = "surface";
+  for (size_t i = 0; i < voxels; ++i) {
+    r.voxel_centers.emplace_back(i * 0.1, -double(i), 0.5);
+    std::array<float, kFacesPerVoxel> v{};
+    for (int f = 0; f < kFacesPerVoxel; ++f) v[f] = float(i % 97) / 97.f + float(f);
+    r.evaluation.best_face_values.push_back(v);
+  }
+  for (size_t i = 0; i < candidates; ++i) {
+    r.heat_map.positions.emplace_back(double(i), 0, 1.5);
+    r.heat_map.visible_voxels.push_back(i * 3);
+  }
+  r.heat_map.grid_spacing_m = 1;
+  r.stations.push_back({{1, 2, 3}, 10, 10, 0.5, 0.2, 4});
+  r.reduction.size = 1;
+  r.reduction.matrix = {0.25};
+  r.occupied_voxels = voxels;
+  r.evaluation.per_viewpoint.resize(1);
+  r.evaluation.overall.global_visibility = 0.42;
+  r.timings.push_back({"greedy", 1.5});
+  r.warnings.push_back("w");
+  return r;
+}
+
+TEST(PlanResultChunks, ReassembleExactlyAndStayUnderOneMebibyte) {
+  const PlanResult r = BigResult(3 * kVoxelsPerChunk + 5, kCandidatesPerHeatMapChunk + 1);
+  PlanResultAssembler a;
+  for (const auto& c : HeatMapChunks(r.heat_map)) {
+    EXPECT_LE(c.ByteSizeLong(), size_t{1} << 20);
+    ASSERT_TRUE(a.AddHeatMap(c).ok());
+  }
+  int chunks = 0;
+  ForEachVoxelChunk(r, [&](v1::VoxelChunk&& c) {
+    EXPECT_LE(c.ByteSizeLong(), size_t{1} << 20);
+    EXPECT_TRUE(a.AddVoxels(c).ok());
+    ++chunks;
+    return true;
+  });
+  EXPECT_EQ(chunks, 4);
+  auto back = std::move(a).Finish(ToProto(r));
+  ASSERT_TRUE(back.ok()) << back.status().ToString();
+  EXPECT_EQ(back->voxel_centers, r.voxel_centers);
+  EXPECT_EQ(back->evaluation.best_face_values, r.evaluation.best_face_values);
+  EXPECT_EQ(back->heat_map.positions, r.heat_map.positions);
+  EXPECT_EQ(back->heat_map.visible_voxels, r.heat_map.visible_voxels);
+  EXPECT_EQ(back->stations[0].position, r.stations[0].position);
+  EXPECT_EQ(back->stations[0].candidate_index, 4);
+  EXPECT_EQ(back->reduction.matrix, r.reduction.matrix);
+  EXPECT_DOUBLE_EQ(back->evaluation.overall.global_visibility, 0.42);
+  EXPECT_EQ(back->timings[0].stage, "greedy");
+  EXPECT_EQ(back->warnings, r.warnings);
+}
+
+TEST(PlanResultChunks, MissingChunkIsDataLoss) {
+  const PlanResult r = BigResult(2 * kVoxelsPerChunk, 3);
+  PlanResultAssembler a;
+  for (const auto& c : HeatMapChunks(r.heat_map)) ASSERT_TRUE(a.AddHeatMap(c).ok());
+  bool first = true;
+  ForEachVoxelChunk(r, [&](v1::VoxelChunk&& c) {
+    if (!first) return true;  // drop the second chunk
+    first = false;
+    return a.AddVoxels(c).ok();
+  });
+  auto back = std::move(a).Finish(ToProto(r));
+  ASSERT_FALSE(back.ok());
+  EXPECT_EQ(back.status().code(), StatusCode::kDataLoss);
+}
+
+TEST(PlanResultChunks, OutOfOrderChunkIsDataLoss) {
+  const PlanResult r = BigResult(2 * kVoxelsPerChunk, 0);
+  std::vector<v1::VoxelChunk> chunks;
+  ForEachVoxelChunk(r, [&](v1::VoxelChunk&& c) {
+    chunks.push_back(std::move(c));
+    return true;
+  });
+  ASSERT_EQ(chunks.size(), 2u);
+  PlanResultAssembler a;
+  EXPECT_EQ(a.AddVoxels(chunks[1]).code(), StatusCode::kDataLoss);
+}
+
+}  // namespace
+}  // namespace vc::wire
