@@ -217,8 +217,8 @@ Result<ScanGraphData> ReadScanGraph(std::string_view bytes, std::string_view sou
   size_t pos = 0;
   uint32_t nodes = 0;
   if (!ReadPod(bytes, &pos, &nodes)) return err(0, "too short for a scan graph");
-  // Each node needs at least a pose (4+24 + 4+32 bytes), an id and a point count.
-  constexpr size_t kMinNode = 28 + 36 + 4 + 4;
+  // Each node needs at least a point count, a pose (4+24 + 4+32 bytes) and an id.
+  constexpr size_t kMinNode = 4 + 28 + 36 + 4;
   if (nodes == 0) return err(0, "the graph has no scans");
   if (uint64_t(nodes) * kMinNode > bytes.size()) {
     return err(0, "declares " + std::to_string(nodes) + " scans but holds only " + std::to_string(bytes.size()) +
@@ -234,32 +234,43 @@ Result<ScanGraphData> ReadScanGraph(std::string_view bytes, std::string_view sou
     }
     return true;
   };
+  // OctoMap's ScanNode::writeBinary: the scan's points (uint32 count, then per point an int32 3
+  // and 3 doubles), then the pose (int32 3 + 3 doubles, int32 4 + 4 doubles: w x y z), then the id.
   for (uint32_t n = 0; n < nodes; ++n) {
     const size_t node_pos = pos;
-    double t[3], q[4];
-    uint32_t id = 0, count = 0;
-    if (!read_vec(3, t) || !read_vec(4, q)) return err(node_pos, "scan " + std::to_string(n) + ": malformed pose (expected 3 + 4 doubles)");
-    if (!ReadPod(bytes, &pos, &id) || !ReadPod(bytes, &pos, &count)) return err(pos, "scan " + std::to_string(n) + ": truncated");
+    uint32_t count = 0;
+    if (!ReadPod(bytes, &pos, &count)) return err(pos, "scan " + std::to_string(n) + ": truncated before its point count");
     constexpr size_t kPoint = 4 + 3 * sizeof(double);
     if (uint64_t(count) * kPoint > bytes.size() - pos) {
       return err(pos, "scan " + std::to_string(n) + " declares " + std::to_string(count) + " points but only " +
                           std::to_string((bytes.size() - pos) / kPoint) + " fit in the rest of the file (truncated?)");
     }
+    std::vector<Eigen::Vector3d> local(count);
+    for (uint32_t i = 0; i < count; ++i) {
+      double p[3];
+      if (!read_vec(3, p)) return err(pos, "scan " + std::to_string(n) + ", point " + std::to_string(i) + ": malformed");
+      // OctoMap keeps points as float.
+      local[i] = Eigen::Vector3d{double(float(p[0])), double(float(p[1])), double(float(p[2]))};
+    }
+    double t[3], q[4];
+    uint32_t id = 0;
+    if (!read_vec(3, t) || !read_vec(4, q)) {
+      return err(pos, "scan " + std::to_string(n) + ": malformed pose (expected 3 + 4 doubles after its points)");
+    }
+    if (!ReadPod(bytes, &pos, &id)) return err(pos, "scan " + std::to_string(n) + ": truncated before its id");
     for (double v : t) {
       if (!std::isfinite(v)) return err(node_pos, "scan " + std::to_string(n) + ": non-finite origin");
     }
     Eigen::Quaterniond rot(q[0], q[1], q[2], q[3]);
-    if (!std::isfinite(rot.norm()) || rot.norm() < 1e-9) return err(node_pos, "scan " + std::to_string(n) + ": invalid rotation quaternion");
+    if (!std::isfinite(rot.norm()) || rot.norm() < 1e-9) {
+      return err(node_pos, "scan " + std::to_string(n) + ": invalid rotation quaternion");
+    }
     rot.normalize();
     const Eigen::Vector3d trans(t[0], t[1], t[2]);
     out.origins.push_back(trans);
     out.points.reserve(out.points.size() + count);
-    for (uint32_t i = 0; i < count; ++i) {
-      double p[3];
-      if (!read_vec(3, p)) return err(pos, "scan " + std::to_string(n) + ", point " + std::to_string(i) + ": malformed");
-      // OctoMap stores points as float.
-      const Eigen::Vector3d local{double(float(p[0])), double(float(p[1])), double(float(p[2]))};
-      const Eigen::Vector3d w = rot * local + trans;
+    for (const Eigen::Vector3d& l : local) {
+      const Eigen::Vector3d w = rot * l + trans;
       if (!w.allFinite()) {
         ++out.dropped_nonfinite;
         continue;
@@ -267,6 +278,7 @@ Result<ScanGraphData> ReadScanGraph(std::string_view bytes, std::string_view sou
       out.points.emplace_back(w.cast<float>());
     }
   }
+  // Edges (uint32 count, then per edge two ids, a pose and a weight) follow; vc does not use them.
   return out;
 }
 

@@ -241,7 +241,8 @@ TEST(SceneInputTest, ScanGraphIsTriedLastForBinaryContent) {
   graph.addNode(scan1, octomap::pose6d(10, 0, 0, 0, 0, 0));
   auto* scan2 = new octomap::Pointcloud();
   scan2->push_back(0, 1, 0);
-  graph.addNode(scan2, octomap::pose6d(0, 0, 5, 0, 0, 0));
+  // Yaw +90 degrees: the local x axis becomes the world y axis.
+  graph.addNode(scan2, octomap::pose6d(0, 0, 5, 0, 0, M_PI / 2));
   std::stringstream s;
   graph.writeBinary(s);
   Result<SceneInput> r = ReadScene(s.str(), "g.graph");
@@ -250,6 +251,11 @@ TEST(SceneInputTest, ScanGraphIsTriedLastForBinaryContent) {
   EXPECT_EQ(r->points.size(), 3u);
   ASSERT_EQ(r->scan_origins.size(), 2u);
   EXPECT_EQ(r->scan_origins[1], Eigen::Vector3d(0, 0, 5));
+  EXPECT_EQ(r->scan_origins[0], Eigen::Vector3d(10, 0, 0));
+  // Points are transformed into the world frame by their scan's pose.
+  EXPECT_TRUE(r->points[0].isApprox(Eigen::Vector3f(11, 0, 0))) << r->points[0].transpose();
+  EXPECT_TRUE(r->points[1].isApprox(Eigen::Vector3f(12, 0, 0))) << r->points[1].transpose();
+  EXPECT_TRUE(r->points[2].isApprox(Eigen::Vector3f(-1, 0, 5), 1e-5f)) << r->points[2].transpose();
 }
 
 TEST(SceneInputTest, ReadSceneFileNotFound) {
