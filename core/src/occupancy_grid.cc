@@ -24,7 +24,7 @@ uint64_t OccupancyGrid::BytesNeeded(const VoxelIndex& min, const VoxelIndex& max
   const uint64_t bx = uint64_t(max.x - min.x) / kBrick + 1;
   const uint64_t by = uint64_t(max.y - min.y) / kBrick + 1;
   const uint64_t bz = uint64_t(max.z - min.z) / kBrick + 1;
-  return bx * by * bz * sizeof(uint32_t) + occupied_bricks * kBrick * sizeof(uint64_t);
+  return bx * by * bz * (sizeof(uint32_t) + sizeof(uint8_t)) + occupied_bricks * kBrick * sizeof(uint64_t);
 }
 
 Result<OccupancyGrid> OccupancyGrid::Build(double resolution_m, const std::vector<VoxelIndex>& occupied,
@@ -45,7 +45,7 @@ Result<OccupancyGrid> OccupancyGrid::Build(double resolution_m, const std::vecto
                  nbz = uint64_t(hi.z - lo.z) / kBrick + 1;
   const uint64_t slots = nbx * nby * nbz;
   // The slot array alone must fit before we count bricks (which needs it).
-  const uint64_t slot_bytes = slots * sizeof(uint32_t);
+  const uint64_t slot_bytes = slots * (sizeof(uint32_t) + sizeof(uint8_t));
   auto refuse = [&](uint64_t need) {
     const double ex = (hi.x - lo.x + 1) * resolution_m, ey = (hi.y - lo.y + 1) * resolution_m,
                  ez = (hi.z - lo.z + 1) * resolution_m;
@@ -88,11 +88,45 @@ Result<OccupancyGrid> OccupancyGrid::Build(double resolution_m, const std::vecto
     const uint32_t slot = g.bricks_[g.BrickLinear(rx >> kBrickShift, ry >> kBrickShift, rz >> kBrickShift)];
     g.payload_[uint64_t(slot - 1) * kBrick + (rz & 7)] |= uint64_t{1} << (((ry & 7) << 3) | (rx & 7));
   }
+  g.ComputeBrickDistances();
   return g;
 }
 
+void OccupancyGrid::ComputeBrickDistances() {
+  // Exact Chebyshev (L-infinity) distance transform, separable: D = min over q of
+  // max(|dx|, |dy|, |dz|), computed one axis at a time as h(i) = min_r max(r, f(i-r), f(i+r))
+  // over r <= kCap. Bricks outside the grid are empty and do not count as sources.
+  constexpr int kCap = 255;
+  const int nx = bdims_.x(), ny = bdims_.y(), nz = bdims_.z();
+  std::vector<int> d(bricks_.size());
+  for (size_t i = 0; i < bricks_.size(); ++i) d[i] = bricks_[i] ? 0 : kCap;
+  std::vector<int> line, out;
+  auto pass = [&](int n, int count_a, int count_b, auto index) {
+    line.resize(n);
+    out.resize(n);
+    for (int a = 0; a < count_a; ++a)
+      for (int b = 0; b < count_b; ++b) {
+        for (int i = 0; i < n; ++i) line[i] = d[index(i, a, b)];
+        for (int i = 0; i < n; ++i) {
+          int best = line[i];
+          for (int r = 1; r < best; ++r) {
+            const int lo = i - r >= 0 ? line[i - r] : kCap, hi = i + r < n ? line[i + r] : kCap;
+            best = std::min(best, std::max(r, std::min(lo, hi)));
+          }
+          out[i] = best;
+        }
+        for (int i = 0; i < n; ++i) d[index(i, a, b)] = out[i];
+      }
+  };
+  pass(nx, ny, nz, [&](int i, int a, int b) { return BrickLinear(i, a, b); });
+  pass(ny, nx, nz, [&](int i, int a, int b) { return BrickLinear(a, i, b); });
+  pass(nz, nx, ny, [&](int i, int a, int b) { return BrickLinear(a, b, i); });
+  brick_distance_.resize(d.size());
+  for (size_t i = 0; i < d.size(); ++i) brick_distance_[i] = uint8_t(std::min(d[i], kCap));
+}
+
 uint64_t OccupancyGrid::memory_bytes() const {
-  return bricks_.size() * sizeof(uint32_t) + payload_.size() * sizeof(uint64_t);
+  return bricks_.size() * sizeof(uint32_t) + brick_distance_.size() + payload_.size() * sizeof(uint64_t);
 }
 
 WorldPoint OccupancyGrid::VoxelCenter(const VoxelIndex& v) const { return KeyToCoord(resolution_m_, IndexToKey(v)); }

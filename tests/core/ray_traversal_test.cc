@@ -148,6 +148,43 @@ TEST(FirstOccupiedTest, MatchesVoxelByVoxelWalkOnRandomGrids) {
   }
 }
 
+// Sparse scenes with long rays: the empty-space jumps must give the plain walk's answer.
+TEST(FirstOccupiedTest, EmptySpaceSkippingMatchesPlainWalkOnSparseScenes) {
+  std::mt19937_64 rng(17);
+  std::uniform_int_distribution<int> c(-120, 120);
+  std::uniform_real_distribution<double> u(-130, 130);
+  int hits = 0;
+  for (int scene = 0; scene < 10; ++scene) {
+    std::vector<VoxelIndex> occ;
+    for (int i = 0; i < 40; ++i) {
+      // Small clusters and thin walls, far apart.
+      const VoxelIndex base{c(rng), c(rng), c(rng)};
+      for (int d = 0; d < 30; ++d) occ.push_back({base.x + d % 6, base.y + d / 6, base.z});
+    }
+    for (int y = -120; y <= 120; ++y)
+      for (int z = -20; z <= 20; ++z) occ.push_back({37, y, z});  // a wall
+    auto grid = OccupancyGrid::Build(0.1, occ, 1 << 26);
+    ASSERT_TRUE(grid.ok());
+    for (int r = 0; r < 2000; ++r) {
+      const Vector3d a(u(rng), u(rng), u(rng) / 4), b(u(rng), u(rng), u(rng) / 4);
+      std::optional<VoxelIndex> expect;
+      for (const VoxelIndex& v : RayTraversal(a, b)) {
+        if (grid->Occupied(v)) {
+          expect = v;
+          break;
+        }
+      }
+      const auto got = FirstOccupied(*grid, a, b);
+      ASSERT_EQ(got.has_value(), expect.has_value()) << "scene " << scene << " ray " << r;
+      if (got) {
+        ++hits;
+        ASSERT_EQ(T(*got), T(*expect)) << "scene " << scene << " ray " << r;
+      }
+    }
+  }
+  EXPECT_GT(hits, 2000);
+}
+
 // Cross-check against OctoMap's own castRay on the real geb079 map: identical first hits.
 TEST(FirstOccupiedTest, AgreesWithOctomapCastRayOnGeb079) {
   auto input = ReadSceneFile(testing::SharedDataPath("geb079/geb079.bt"));

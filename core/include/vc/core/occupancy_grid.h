@@ -2,8 +2,9 @@
 //
 // A bricked bitset over the bounding box of the occupied voxels: the box is cut into bricks of
 // 8x8x8 voxels; a dense array holds one 32-bit slot per brick (0 = empty brick) and only non-empty
-// bricks store their 512 bits. Empty bricks cost 4 bytes, which also makes empty-space skipping
-// cheap. It answers "is voxel (x,y,z) occupied" exactly as the octree at resolution r does
+// bricks store their 512 bits. Empty bricks cost 4 bytes. For empty-space skipping each brick
+// also stores its Chebyshev distance, in bricks, to the nearest non-empty brick (capped at 255):
+// a ray in a brick at distance k may jump across the (2k-1)^3-brick box around it untested. It answers "is voxel (x,y,z) occupied" exactly as the octree at resolution r does
 // (ALGORITHM.md section 1); anything outside the box is free. Memory is computed and checked
 // against a budget before anything is allocated: a scene that does not fit is refused with
 // RESOURCE_EXHAUSTED and a message stating the extent and a resolution that would fit.
@@ -45,6 +46,15 @@ class OccupancyGrid {
   const VoxelIndex& min_index() const { return min_; }
   const Eigen::Vector3i& dims() const { return dims_; }
   const Eigen::Vector3i& brick_dims() const { return bdims_; }
+  // Linear brick number of brick (bx,by,bz) (relative brick coordinates, in range).
+  uint64_t BrickLinear(uint32_t bx, uint32_t by, uint32_t bz) const {
+    return (uint64_t(bz) * uint64_t(bdims_.y()) + by) * uint64_t(bdims_.x()) + bx;
+  }
+  // Payload slot of a brick (0 = empty) and its distance to the nearest non-empty brick.
+  uint32_t BrickSlot(uint64_t brick) const { return bricks_[brick]; }
+  uint8_t BrickDistance(uint64_t brick) const { return brick_distance_[brick]; }
+  // The 8 words of a non-empty brick's bits (word z, bit y*8+x).
+  const uint64_t* BrickBits(uint32_t slot) const { return &payload_[uint64_t(slot - 1) * kBrick]; }
   uint64_t memory_bytes() const;
   uint64_t occupied_bricks() const { return payload_.size() / kBrick; }
 
@@ -78,9 +88,7 @@ class OccupancyGrid {
   VoxelIndex WorldToIndex(const WorldPoint& p) const;
 
  private:
-  uint64_t BrickLinear(uint32_t bx, uint32_t by, uint32_t bz) const {
-    return (uint64_t(bz) * uint64_t(bdims_.y()) + by) * uint64_t(bdims_.x()) + bx;
-  }
+  void ComputeBrickDistances();
 
   double resolution_m_ = 0;
   double inv_resolution_ = 0;
@@ -89,6 +97,7 @@ class OccupancyGrid {
   Eigen::Vector3i bdims_{0, 0, 0};
   std::vector<uint32_t> bricks_;   // per brick: 0 = empty, else 1 + payload brick number
   std::vector<uint64_t> payload_;  // 8 words per non-empty brick: word z, bit (y*8 + x)
+  std::vector<uint8_t> brick_distance_;  // Chebyshev distance in bricks to a non-empty brick
 };
 
 // OctoMap's key of world point p at `resolution_m`: floor(p * (1/r)) + 32768 per axis, computed

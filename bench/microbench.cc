@@ -1,0 +1,62 @@
+// Micro-benchmarks of the hot kernels on a fixed synthetic scene (Google Benchmark).
+#include <benchmark/benchmark.h>
+
+#include <random>
+
+#include "vc/core/ray_traversal.h"
+#include "vc/core/synth.h"
+#include "vc/core/visibility.h"
+#include "vc/core/voxel_scene.h"
+
+namespace {
+
+const vc::VoxelScene& Scene() {
+  static const vc::VoxelScene scene = [] {
+    vc::SceneInput in;
+    vc::SynthOptions so;
+    in.points = *vc::GenerateScene("rooms:4", so);
+    vc::VoxelizeOptions vo;
+    vo.resolution_m = 0.1;
+    return *vc::Voxelize(in, vo);
+  }();
+  return scene;
+}
+
+void BM_FirstOccupied(benchmark::State& state) {
+  const auto& s = Scene();
+  std::mt19937_64 rng(1);
+  const vc::WorldPoint lo = s.BoundsMin(), hi = s.BoundsMax();
+  std::uniform_real_distribution<double> ux(lo.x(), hi.x()), uy(lo.y(), hi.y()), uz(lo.z(), hi.z());
+  std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> rays(4096);
+  for (auto& r : rays) r = {vc::WorldPoint(ux(rng), uy(rng), uz(rng)) / s.resolution_m, vc::WorldPoint(ux(rng), uy(rng), uz(rng)) / s.resolution_m};
+  size_t i = 0;
+  for (auto _ : state) {
+    const auto& r = rays[i++ & 4095];
+    benchmark::DoNotOptimize(vc::FirstOccupied(s.grid, r.first, r.second));
+  }
+  state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(BM_FirstOccupied);
+
+void BM_VisibilitySets(benchmark::State& state) {
+  const auto& s = Scene();
+  const vc::WorldPoint c = (s.BoundsMin() + s.BoundsMax()) / 2;
+  vc::VisibilitySetsOptions o;
+  o.test = state.range(0) ? vc::SelectionTest::kCompatibility : vc::SelectionTest::kSurfaceVisibility;
+  o.threads = 1;
+  for (auto _ : state) benchmark::DoNotOptimize(vc::ComputeVisibilitySets(s, {c}, o));
+  state.SetItemsProcessed(state.iterations() * int64_t(s.occupied.size()));
+}
+BENCHMARK(BM_VisibilitySets)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
+
+void BM_EvaluateExact(benchmark::State& state) {
+  const auto& s = Scene();
+  const vc::WorldPoint c = (s.BoundsMin() + s.BoundsMax()) / 2;
+  vc::EvaluateOptions o;
+  o.threads = 1;
+  for (auto _ : state) benchmark::DoNotOptimize(vc::Evaluate(s, {c}, o));
+  state.SetItemsProcessed(state.iterations() * int64_t(s.occupied.size()) * 6);
+}
+BENCHMARK(BM_EvaluateExact)->Unit(benchmark::kMillisecond);
+
+}  // namespace

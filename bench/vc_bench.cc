@@ -1,0 +1,219 @@
+// vc-bench: one run, one scene, the same rays for OctoMap and for vc.
+//
+// Prints: OctoMap castRay rays/s (on a subsample) and ours on identical rays with an identity
+// check and the per-core ratio; the full visibility-set computation (both selection tests); the
+// end-to-end plan per stage; peak RSS; and scaling tables against footprint and candidate
+// spacing. No assertions on time: figures are printed for docs/BENCHMARKS.md. `--quick` runs a
+// small scene in seconds so CI keeps the tool building and running.
+#include <sys/resource.h>
+
+#include <CLI/CLI.hpp>
+
+#include <chrono>
+#include <cstdio>
+#include <iostream>
+#include <random>
+#include <string>
+#include <thread>
+
+#include "vc/core/octomap_adapter.h"
+#include "vc/core/planner.h"
+#include "vc/core/ray_traversal.h"
+#include "vc/core/scene_input.h"
+#include "vc/core/synth.h"
+#include "vc/core/visibility.h"
+#include "vc/core/voxel_scene.h"
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double Seconds(Clock::time_point a) { return std::chrono::duration<double>(Clock::now() - a).count(); }
+
+double PeakRssMiB() {
+  rusage ru{};
+  getrusage(RUSAGE_SELF, &ru);
+  return double(ru.ru_maxrss) / 1024.0;
+}
+
+vc::Result<vc::SceneInput> LoadScene(const std::string& scene, double spacing, int tiles) {
+  vc::SceneInput input;
+  if (scene.find('/') != std::string::npos || scene.find('.') != std::string::npos) {
+    auto r = vc::ReadSceneFile(scene);
+    if (!r.ok() || tiles == 1) return r;
+    input = std::move(*r);
+  } else {
+    vc::SynthOptions so;
+    so.spacing_m = spacing;
+    VC_ASSIGN_OR_RETURN(input.points, vc::GenerateScene(scene, so));
+  }
+  if (tiles > 1) {
+    if (input.octree) return vc::InvalidArgumentError("tiling needs a point cloud scene");
+    // Footprint scaling: copies side by side (2: along x; 4: 2 x 2).
+    Eigen::Vector3f lo = input.points.front(), hi = lo;
+    for (const auto& p : input.points) {
+      lo = lo.cwiseMin(p);
+      hi = hi.cwiseMax(p);
+    }
+    const Eigen::Vector3f step = (hi - lo) + Eigen::Vector3f(2.0f, 2.0f, 0.0f);
+    const size_t n = input.points.size();
+    for (int t = 1; t < tiles; ++t) {
+      const Eigen::Vector3f shift(step.x() * float(t % 2), step.y() * float(t / 2), 0.0f);
+      for (size_t i = 0; i < n; ++i) input.points.push_back(input.points[i] + shift);
+    }
+  }
+  return input;
+}
+
+struct Ray {
+  Eigen::Vector3d origin;     // world, m
+  Eigen::Vector3d direction;  // unit, as OctoMap normalises it (float)
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"vc-bench: end-to-end and ray-casting benchmarks against OctoMap"};
+  std::string scene = "hall";
+  double spacing = 0.05, resolution = 0.1, grid = 1.0;
+  int rays = 200000, octomap_rays = 20000, threads = 2;
+  bool quick = false, scaling = true;
+  app.add_option("--scene", scene, "synthetic scene spec (hall, box, comb:5, ...) or a file path");
+  app.add_option("--spacing", spacing, "point spacing of synthetic scenes, m");
+  app.add_option("--resolution", resolution, "working resolution, m");
+  app.add_option("--grid", grid, "candidate grid spacing, m");
+  app.add_option("--rays", rays, "rays for our traversal");
+  app.add_option("--octomap-rays", octomap_rays, "rays (a prefix of ours) for OctoMap castRay");
+  app.add_option("--threads", threads, "worker threads for the plan");
+  app.add_flag("--quick", quick, "small scene, few rays, no scaling tables (CI)");
+  app.add_flag("!--no-scaling", scaling, "skip the scaling tables");
+  CLI11_PARSE(app, argc, argv);
+  if (quick) {
+    scene = "rooms:3";
+    rays = 20000;
+    octomap_rays = 2000;
+    scaling = false;
+  }
+
+  std::printf("vc-bench: scene %s, resolution %.3f m, candidate grid %.2f m, %d threads (hardware: %u)\n",
+              scene.c_str(), resolution, grid, threads, std::thread::hardware_concurrency());
+  auto t0 = Clock::now();
+  auto input = LoadScene(scene, spacing, 1);
+  if (!input.ok()) {
+    std::fprintf(stderr, "vc-bench: %s\n", input.status().ToString().c_str());
+    return 2;
+  }
+  const double load_s = Seconds(t0);
+  vc::VoxelizeOptions vo;
+  vo.resolution_m = input->octree ? 0.0 : resolution;
+  t0 = Clock::now();
+  auto vs = vc::Voxelize(*input, vo);
+  if (!vs.ok()) {
+    std::fprintf(stderr, "vc-bench: %s\n", vs.status().ToString().c_str());
+    return 2;
+  }
+  const double vox_s = Seconds(t0);
+  const vc::VoxelScene& s = *vs;
+  std::printf("scene: %zu points, %zu occupied voxels at %.3f m, grid %.1f MiB; load %.2f s, voxelise %.2f s\n",
+              input->points.size(), s.occupied.size(), s.resolution_m, double(s.grid.memory_bytes()) / (1 << 20),
+              load_s, vox_s);
+
+  // ---- Rays: identical for both ----
+  auto tree = input->octree ? std::const_pointer_cast<octomap::OcTree>(input->octree)
+                            : vc::BuildOctree(s.resolution_m, s.occupied);
+  const vc::WorldPoint lo = s.BoundsMin(), hi = s.BoundsMax();
+  const double length = (hi - lo).norm();
+  std::mt19937_64 rng(2014);
+  std::uniform_real_distribution<double> ux(lo.x(), hi.x()), uy(lo.y(), hi.y()), uz(lo.z(), hi.z());
+  std::uniform_int_distribution<size_t> pick(0, s.occupied.size() - 1);
+  std::vector<Ray> ray_set;
+  ray_set.reserve(rays);
+  while (int(ray_set.size()) < rays) {
+    const Eigen::Vector3f o(float(ux(rng)), float(uy(rng)), float(uz(rng)));
+    if (s.grid.Occupied(s.grid.WorldToIndex(o.cast<double>()))) continue;
+    const Eigen::Vector3f target = s.Center(pick(rng)).cast<float>();
+    Eigen::Vector3f d = target - o;
+    if (d.norm() < 1e-3f) continue;
+    // OctoMap normalises in float; both sides use exactly that direction.
+    d /= d.norm();
+    ray_set.push_back({o.cast<double>(), d.cast<double>()});
+  }
+  std::vector<std::optional<vc::VoxelIndex>> ours(ray_set.size());
+  t0 = Clock::now();
+  for (size_t i = 0; i < ray_set.size(); ++i) {
+    const Eigen::Vector3d a = ray_set[i].origin * s.grid.inv_resolution();
+    const Eigen::Vector3d b = (ray_set[i].origin + ray_set[i].direction * length) * s.grid.inv_resolution();
+    ours[i] = vc::FirstOccupied(s.grid, a, b);
+  }
+  const double ours_s = Seconds(t0);
+  const int m = std::min<int>(octomap_rays, int(ray_set.size()));
+  int mismatches = 0, hits = 0;
+  std::vector<vc::CastRayOutcome> theirs(m);
+  t0 = Clock::now();
+  for (int i = 0; i < m; ++i) theirs[i] = vc::OctomapCastRay(*tree, ray_set[i].origin, ray_set[i].direction, length);
+  const double theirs_s = Seconds(t0);
+  for (int i = 0; i < m; ++i) {
+    const bool hit = theirs[i].kind == vc::CastRayOutcome::Kind::kHitOccupied;
+    hits += hit;
+    if (hit != ours[i].has_value() || (hit && vc::IndexToKey(*ours[i]) != theirs[i].hit)) ++mismatches;
+  }
+  const double ours_rps = double(ray_set.size()) / ours_s, theirs_rps = double(m) / theirs_s;
+  std::printf("\n## Rays (single core, identical rays; first occupied voxel)\n");
+  std::printf("| engine | rays | rays/s | ratio per core |\n|---|---|---|---|\n");
+  std::printf("| OctoMap castRay | %d | %.0f | 1.0 |\n", m, theirs_rps);
+  std::printf("| vc FirstOccupied | %zu | %.0f | %.1fx |\n", ray_set.size(), ours_rps, ours_rps / theirs_rps);
+  std::printf("identity check on the %d shared rays: %d mismatches (%d hits) -> %s\n", m, mismatches, hits,
+              mismatches == 0 ? "IDENTICAL" : "DIFFERENT");
+
+  // ---- Plan end to end ----
+  auto plan_once = [&](const vc::SceneInput& in, double grid_m, bool print) -> double {
+    vc::PlanOptions po;
+    po.resolution_m = in.octree ? 0.0 : resolution;
+    po.grid_spacing_m = grid_m;
+    po.threads = threads;
+    const auto start = Clock::now();
+    auto plan = vc::Plan(in, po);
+    const double total = Seconds(start);
+    if (!plan.ok()) {
+      std::printf("plan failed: %s\n", plan.status().ToString().c_str());
+      return -1;
+    }
+    if (print) {
+      std::printf("\n## End-to-end plan (%d threads)\n| stage | seconds |\n|---|---|\n", threads);
+      for (const auto& t : plan->timings) std::printf("| %s | %.3f |\n", t.stage.c_str(), t.seconds);
+      std::printf("| **total (wall, incl. voxelise)** | **%.3f** |\n", total);
+      std::printf("%zu stations from %llu candidates; %llu occupied, %llu coverable, %llu covered voxels; G = %.4f\n",
+                  plan->stations.size(), (unsigned long long)plan->candidate_count,
+                  (unsigned long long)plan->occupied_voxels, (unsigned long long)plan->coverable_voxels,
+                  (unsigned long long)plan->covered_voxels, plan->evaluation.overall.global_visibility);
+      // The full visibility-set computation for both tests, on the plan's candidates.
+      for (vc::SelectionTest test : {vc::SelectionTest::kSurfaceVisibility, vc::SelectionTest::kCompatibility}) {
+        vc::VisibilitySetsOptions vo2;
+        vo2.test = test;
+        vo2.threads = threads;
+        const auto c0 = Clock::now();
+        auto sets = vc::ComputeVisibilitySets(s, plan->heat_map.positions, vo2);
+        std::printf("visibility sets (%s): %zu candidates x %zu voxels in %.3f s\n",
+                    std::string(vc::SelectionTestName(test)).c_str(), plan->heat_map.positions.size(),
+                    s.occupied.size(), Seconds(c0));
+      }
+    }
+    return total;
+  };
+  plan_once(*input, grid, true);
+  std::printf("\npeak RSS: %.1f MiB\n", PeakRssMiB());
+
+  if (scaling && !input->octree) {
+    std::printf("\n## Scaling: footprint (candidate grid %.2f m)\n| footprint | occupied voxels | plan s |\n|---|---|---|\n", grid);
+    for (int tiles : {1, 2, 4}) {
+      auto in = LoadScene(scene, spacing, tiles);
+      if (!in.ok()) continue;
+      auto v = vc::Voxelize(*in, vo);
+      const double secs = plan_once(*in, grid, false);
+      std::printf("| %dx | %zu | %.2f |\n", tiles, v.ok() ? v->occupied.size() : size_t{0}, secs);
+    }
+    std::printf("\n## Scaling: candidate spacing (footprint 1x)\n| spacing m | plan s |\n|---|---|\n");
+    for (double g : {2.0, 1.0, 0.5}) std::printf("| %.2f | %.2f |\n", g, plan_once(*input, g, false));
+  }
+  std::printf("\npeak RSS (all runs): %.1f MiB\n", PeakRssMiB());
+  return mismatches == 0 ? 0 : 1;
+}
