@@ -22,9 +22,9 @@ int FreeVoxelsNeeded(double resolution_m, const CandidateOptions& o) {
   return std::max(1, static_cast<int>(std::ceil((o.tripod_height_m + o.clearance_m) / resolution_m - 1e-9)));
 }
 
-// Half-width (voxels) of a level's height band: 0.25 m, at least 2 voxels.
+// Half-width (voxels) of a level's height band: 0.15 m, at least 2 voxels.
 int BandVoxels(double resolution_m) {
-  return std::max(2, static_cast<int>(std::ceil(0.25 / resolution_m - 1e-9)));
+  return std::max(2, static_cast<int>(std::ceil(0.15 / resolution_m - 1e-9)));
 }
 
 // Standing surfaces of column (x, y) (voxel indices), top to bottom. Outside the box is free.
@@ -54,15 +54,18 @@ void ColumnSurfaces(const OccupancyGrid& grid, int x, int y, int free_needed, st
 
 constexpr int kNoSurface = std::numeric_limits<int>::min();
 
-// Highest standing surface with z in [lo, hi] in the 3 x 3 columns around (cx, cy), or kNoSurface.
-int HighestSurfaceInBand(const OccupancyGrid& grid, int cx, int cy, int lo, int hi, int free_needed,
-                         std::vector<Surface>& scratch) {
+// The standing surface with z in [ref - band, ref + band] closest to ref (the higher on a tie) in
+// the 3 x 3 columns around (cx, cy), or kNoSurface.
+int SurfaceNear(const OccupancyGrid& grid, int cx, int cy, int ref, int band, int free_needed,
+                std::vector<Surface>& scratch) {
   int best = kNoSurface;
   for (int dy = -1; dy <= 1; ++dy) {
     for (int dx = -1; dx <= 1; ++dx) {
       ColumnSurfaces(grid, cx + dx, cy + dy, free_needed, scratch);
       for (const Surface& s : scratch) {
-        if (s.z >= lo && s.z <= hi) best = std::max(best, s.z);
+        if (s.z < ref - band || s.z > ref + band) continue;
+        const int d = std::abs(s.z - ref), d_best = best == kNoSurface ? band + 1 : std::abs(best - ref);
+        if (d < d_best || (d == d_best && s.z > best)) best = s.z;
       }
     }
   }
@@ -112,8 +115,8 @@ std::optional<double> FloorTopNear(const OccupancyGrid& grid, double x_m, double
   const int z_ref = static_cast<int>(std::lround(u.z())) - 1;
   const int band = BandVoxels(r);
   std::vector<Surface> scratch;
-  const int z = HighestSurfaceInBand(grid, static_cast<int>(std::floor(u.x())), static_cast<int>(std::floor(u.y())),
-                                     z_ref - band, z_ref + band, FreeVoxelsNeeded(r, options), scratch);
+  const int z = SurfaceNear(grid, static_cast<int>(std::floor(u.x())), static_cast<int>(std::floor(u.y())), z_ref,
+                            band, FreeVoxelsNeeded(r, options), scratch);
   if (z == kNoSurface) return std::nullopt;
   return grid.IndexSpaceToWorld(Eigen::Vector3d(0, 0, z + 1)).z();
 }
@@ -202,9 +205,8 @@ Result<CandidateGrid> GenerateCandidates(const VoxelScene& scene, const Candidat
       for (size_t ix = 0; ix < xs.size(); ++ix) {
         ++out.cells;
         const Eigen::Vector3d u = grid.WorldToIndexSpace(WorldPoint(xs[ix], ys[iy], lo.z()));
-        const int z = HighestSurfaceInBand(grid, static_cast<int>(std::floor(u.x())),
-                                           static_cast<int>(std::floor(u.y())), lz - band, lz + band,
-                                           free_needed, scratch);
+        const int z = SurfaceNear(grid, static_cast<int>(std::floor(u.x())), static_cast<int>(std::floor(u.y())),
+                                  lz, band, free_needed, scratch);
         if (z == kNoSurface) {
           ++out.rejected_no_floor;
           continue;

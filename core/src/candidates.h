@@ -2,13 +2,13 @@
 //
 // Standing surfaces: in every voxel column, the top voxel of each occupied run with at least
 // tripod height + clearance of free space above it. Floor levels: the dominant heights of those
-// surfaces over the whole scene (a histogram of columns, smoothed over +-0.25 m; a level needs at
+// surfaces over the whole scene (a histogram of columns, smoothed over +-0.15 m (at least 2 voxels); a level needs at
 // least a quarter of the strongest level's columns and lies at least tripod height + clearance
 // from a stronger one, so desks and shelves under a floor's ceiling do not count). A level whose
 // surfaces are mostly roofs — nothing occupied above them, another occupied run below them in the
 // same column (the outside of a ceiling) — is dropped; an open room's floor (nothing below) stays. Candidates: for each level and each cell of a grid over the occupied
-// footprint, the highest standing surface of that level within +-0.25 m under the cell centre
-// (in the 3 x 3 voxel columns around it) is the cell's floor; the candidate stands at its top +
+// footprint, the standing surface within +-0.15 m of that level closest to it under the cell
+// centre (in the 3 x 3 voxel columns around it) is the cell's floor (uneven floors and ramps); the candidate stands at its top +
 // tripod height, and is kept if the voxels within the clearance radius are all free. So every
 // storey of a multi-level scene gets its own candidates, each with floor below it. Internal to
 // vc_core.
@@ -53,8 +53,8 @@ Result<CandidateGrid> GenerateCandidates(const VoxelScene& scene, const Candidat
 // True if p's voxel is free and no occupied voxel's cube comes closer than clearance_m to p.
 bool HasClearance(const OccupancyGrid& grid, const WorldPoint& p, double clearance_m);
 
-// Top (m) of the highest standing surface within +-0.25 m (at least 2 voxels) of `near_z_m` under
-// (x, y) (3 x 3 voxel columns), or nullopt. Used to move a station during refinement.
+// Top (m) of the standing surface closest to `near_z_m`, within +-0.15 m (at least 2 voxels),
+// under (x, y) (3 x 3 voxel columns), or nullopt. Used to move a station during refinement.
 std::optional<double> FloorTopNear(const OccupancyGrid& grid, double x_m, double y_m, double near_z_m,
                                    const CandidateOptions& options);
 

@@ -147,4 +147,84 @@ Result<GreedyResult> SelectGreedy(const std::vector<VoxelSet>& sets, const Greed
   return result;
 }
 
+Result<ConsolidateResult> ConsolidatePicks(const std::vector<VoxelSet>& sets, std::vector<int> picks,
+                                           const JobContext& ctx) {
+  ConsolidateResult out;
+  if (sets.empty() || picks.empty()) {
+    out.picks = std::move(picks);
+    return out;
+  }
+  const size_t words = sets[0].words().size();
+  std::vector<int> order(sets.size());
+  for (size_t i = 0; i < order.size(); ++i) order[i] = static_cast<int>(i);
+  std::vector<uint64_t> sizes(sets.size());
+  for (size_t i = 0; i < sets.size(); ++i) sizes[i] = CountBits(sets[i]);
+  std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return sizes[a] > sizes[b]; });
+
+  std::vector<uint64_t> c1(words), c2(words), c3(words), rest(words);
+  std::vector<size_t> nonzero;
+  bool changed = true;
+  while (changed) {
+    changed = false;
+    VC_RETURN_IF_ERROR(ctx.CheckCancelled("consolidation"));
+    // Voxels covered at least once, twice, three times.
+    std::fill(c1.begin(), c1.end(), 0);
+    std::fill(c2.begin(), c2.end(), 0);
+    std::fill(c3.begin(), c3.end(), 0);
+    for (int p : picks) {
+      const auto& w = sets[p].words();
+      for (size_t k = 0; k < words; ++k) {
+        c3[k] |= c2[k] & w[k];
+        c2[k] |= c1[k] & w[k];
+        c1[k] |= w[k];
+      }
+    }
+    // A pick nobody needs: all its voxels are covered twice. The latest such pick goes first.
+    for (size_t i = picks.size(); i-- > 0 && picks.size() > 1;) {
+      const auto& w = sets[picks[i]].words();
+      bool needed = false;
+      for (size_t k = 0; k < words && !needed; ++k) needed = (w[k] & ~c2[k]) != 0;
+      if (!needed) {
+        picks.erase(picks.begin() + static_cast<std::ptrdiff_t>(i));
+        ++out.dropped;
+        changed = true;
+        break;
+      }
+    }
+    if (changed) continue;
+    // Two picks one candidate can stand in for.
+    for (size_t a = 0; a < picks.size() && !changed; ++a) {
+      VC_RETURN_IF_ERROR(ctx.CheckCancelled("consolidation"));
+      const auto& wa = sets[picks[a]].words();
+      for (size_t b = a + 1; b < picks.size() && !changed; ++b) {
+        const auto& wb = sets[picks[b]].words();
+        // Voxels only a or b cover: in both and covered exactly twice, or in one and covered once.
+        nonzero.clear();
+        for (size_t k = 0; k < words; ++k) {
+          rest[k] = (wa[k] & wb[k] & ~c3[k]) | ((wa[k] ^ wb[k]) & ~c2[k]);
+          if (rest[k]) nonzero.push_back(k);
+        }
+        for (int c : order) {
+          const auto& wc = sets[c].words();
+          bool covers = true;
+          for (size_t k : nonzero) {
+            if (rest[k] & ~wc[k]) {
+              covers = false;
+              break;
+            }
+          }
+          if (!covers) continue;
+          picks[a] = c;
+          picks.erase(picks.begin() + static_cast<std::ptrdiff_t>(b));
+          ++out.merged;
+          changed = true;
+          break;
+        }
+      }
+    }
+  }
+  out.picks = std::move(picks);
+  return out;
+}
+
 }  // namespace vc::planner

@@ -247,6 +247,61 @@ TEST(GreedyTest, NothingCoverableMeansNoPick) {
   EXPECT_EQ(r.stop, GreedyStop::kExhausted);
 }
 
+std::vector<int> Consolidated(const std::vector<VoxelSet>& sets, std::vector<int> picks) {
+  Result<ConsolidateResult> r = ConsolidatePicks(sets, std::move(picks));
+  EXPECT_TRUE(r.ok());
+  return r.ok() ? r->picks : std::vector<int>{};
+}
+
+uint64_t Covered(const std::vector<VoxelSet>& sets, const std::vector<int>& picks) {
+  VoxelSet u(sets[0].size());
+  for (int p : picks) UnionInto(u, sets[p]);
+  return CountBits(u);
+}
+
+TEST(ConsolidateTest, RepairsTheClassicTrapToTheOptimum) {
+  std::vector<VoxelSet> sets = {MakeSet(12, {0, 1, 2, 3, 4, 5}), MakeSet(12, {6, 7, 8, 9, 10, 11}),
+                                MakeSet(12, {0, 1, 2, 6, 7, 8, 3})};
+  const std::vector<int> greedy = Picks(Greedy(sets));
+  ASSERT_EQ(greedy, std::vector<int>({2, 1, 0}));
+  EXPECT_EQ(Consolidated(sets, greedy), std::vector<int>({1, 0}));  // pick 2 is covered by 0 and 1
+}
+
+TEST(ConsolidateTest, MergesTwoPicksIntoOneCandidate) {
+  // Two half-rooms (0, 1) picked, while candidate 2 sees both halves; 3 covers the rest.
+  std::vector<VoxelSet> sets = {MakeSet(10, {0, 1, 2, 8}), MakeSet(10, {3, 4, 5, 9}), MakeSet(10, {0, 1, 2, 3, 4, 5}),
+                                MakeSet(10, {6, 7, 8, 9})};
+  Result<ConsolidateResult> r = ConsolidatePicks(sets, {0, 1, 3});
+  ASSERT_TRUE(r.ok());
+  EXPECT_EQ(r->picks, std::vector<int>({2, 3}));
+  EXPECT_EQ(r->merged, 1);
+  EXPECT_EQ(r->dropped, 0);
+}
+
+TEST(ConsolidateTest, NeverLosesCoverageNorAddsPicks) {
+  std::mt19937 rng(77);
+  int saved = 0;
+  for (int trial = 0; trial < 200; ++trial) {
+    const size_t n = 20 + rng() % 200;
+    std::vector<VoxelSet> sets;
+    for (size_t i = 0; i < 5 + rng() % 30; ++i) {
+      VoxelSet s(n);
+      const size_t start = rng() % n, len = 1 + rng() % (n / 3);
+      for (size_t v = 0; v < len; ++v) s.set((start + v) % n);
+      sets.push_back(s);
+    }
+    const std::vector<int> greedy = Picks(Greedy(sets));
+    const std::vector<int> merged = Consolidated(sets, greedy);
+    EXPECT_EQ(Covered(sets, merged), Covered(sets, greedy)) << "trial " << trial;
+    EXPECT_LE(merged.size(), greedy.size());
+    if (sets.size() <= 16) {
+      EXPECT_GE(static_cast<int>(merged.size()), MinimumCover(sets));
+    }
+    saved += static_cast<int>(greedy.size() - merged.size());
+  }
+  EXPECT_GT(saved, 0);  // the instances exercised it
+}
+
 TEST(GreedyTest, RejectsSetsOfDifferentSizes) {
   std::vector<VoxelSet> sets = {VoxelSet(10), VoxelSet(11)};
   const auto r = SelectGreedy(sets, {});

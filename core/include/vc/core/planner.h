@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <limits>
 #include <string>
 #include <vector>
@@ -33,6 +34,9 @@ struct PlanOptions {
   int max_stations = 0;
   uint64_t min_marginal_gain_voxels = 1;
   double target_coverage = 1.0;
+  // After greedy selection: drop picks the others cover and replace two picks by one candidate
+  // that sees all they alone covered (coverage never shrinks; docs/PLANNING.md).
+  bool consolidate = true;
   // Proximity refinement (s.7.4): move each station to the best of a sub-grid around it.
   bool refine = false;
   double refine_radius_m = 0.5;
@@ -71,6 +75,8 @@ struct Reduction {
   std::vector<int> removed;
   double global_visibility_before = 0;
   double global_visibility_after = 0;
+  // P: the stations the matrix is about (greedy order, after refinement), world frame (m).
+  std::vector<WorldPoint> positions;
 };
 
 struct StageTiming {
@@ -92,11 +98,20 @@ struct PlanResult {
   Evaluation evaluation;  // of the final stations at the working resolution (with face values)
   std::vector<StageTiming> timings;
   std::vector<std::string> warnings;
+  // Floor levels found for the operating plane (top of the floor, m), ascending; empty with
+  // user-supplied candidates.
+  std::vector<double> floor_levels_m;
+  // Why greedy selection stopped: "exhausted", "target_reached", "max_stations" or "min_gain".
+  std::string stop_reason;
+  // Greedy picks, and how many of them consolidation saved.
+  int greedy_stations = 0;
+  int consolidated = 0;
   // Occupied voxel centres (world, m) in id order, for visibility.ply.
   std::vector<WorldPoint> voxel_centers;
 };
 
-// Called as each station is picked (greedy order), and once with the heat map; for streaming.
+// Called once with the heat map, then for each station selected (greedy order, after
+// consolidation, before refinement and reduction, so global_visibility is still 0); for streaming.
 struct PlanCallbacks {
   std::function<void(const HeatMap&)> on_heat_map;
   std::function<void(const PlannedStation&, int index)> on_station;
