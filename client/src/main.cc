@@ -103,6 +103,8 @@ int main(int argc, char** argv) {
   submit->add_option("--min-gain", plan.min_marginal_gain_voxels, "stop when a station adds fewer voxels")
       ->capture_default_str();
   submit->add_option("--target-coverage", plan.target_coverage, "stop at this covered fraction (0..1]")->capture_default_str();
+  submit->add_flag("--consolidate,!--no-consolidate", plan.consolidate,
+                   "drop covered picks and merge pairs after greedy selection")->capture_default_str();
   submit->add_flag("--refine,!--no-refine", plan.refine, "refine each station on a local sub-grid")->capture_default_str();
   submit->add_option("--refine-radius", plan.refine_radius_m, "refinement radius in m")->capture_default_str();
   submit->add_option("--refine-step", plan.refine_step_m, "refinement step in m")->capture_default_str();

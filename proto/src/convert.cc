@@ -89,6 +89,7 @@ v1::Reduction ToProto(const Reduction& r) {
   out.mutable_removed()->Add(r.removed.begin(), r.removed.end());
   out.set_global_visibility_before(r.global_visibility_before);
   out.set_global_visibility_after(r.global_visibility_after);
+  for (const auto& p : r.positions) *out.add_positions() = wire::ToProto(p);
   return out;
 }
 
@@ -99,6 +100,7 @@ Reduction FromProto(const v1::Reduction& r) {
   out.removed.assign(r.removed().begin(), r.removed().end());
   out.global_visibility_before = r.global_visibility_before();
   out.global_visibility_after = r.global_visibility_after();
+  for (const auto& p : r.positions()) out.positions.push_back(wire::FromProto(p));
   return out;
 }
 
@@ -128,6 +130,7 @@ v1::PlanParameters ToProto(const PlanOptions& o) {
   p.set_reduce(o.reduce);
   p.set_reduce_to(o.reduce_to);
   p.set_threads(o.threads);
+  p.set_consolidate(o.consolidate);
   return p;
 }
 
@@ -157,6 +160,7 @@ Result<PlanOptions> FromProto(const v1::PlanParameters& p) {
   if (p.has_reduce()) o.reduce = p.reduce();
   if (p.has_reduce_to()) o.reduce_to = p.reduce_to();
   if (p.has_threads()) o.threads = p.threads();
+  if (p.has_consolidate()) o.consolidate = p.consolidate();
   return o;
 }
 
@@ -318,6 +322,10 @@ v1::PlanResult ToProto(const PlanResult& r) {
   for (const auto& w : r.warnings) p.add_warnings(w);
   p.set_heat_map_candidates(r.heat_map.positions.size());
   p.set_voxel_count(r.voxel_centers.size());
+  p.mutable_floor_levels_m()->Add(r.floor_levels_m.begin(), r.floor_levels_m.end());
+  p.set_stop_reason(r.stop_reason);
+  p.set_greedy_stations(r.greedy_stations);
+  p.set_consolidated(r.consolidated);
   return p;
 }
 
@@ -389,6 +397,10 @@ Result<PlanResult> PlanResultAssembler::Finish(const v1::PlanResult& p) && {
   r.evaluation.best_face_values = std::move(face_values_);
   for (const auto& t : p.timings()) r.timings.push_back({t.stage(), t.seconds()});
   r.warnings.assign(p.warnings().begin(), p.warnings().end());
+  r.floor_levels_m.assign(p.floor_levels_m().begin(), p.floor_levels_m().end());
+  r.stop_reason = p.stop_reason();
+  r.greedy_stations = p.greedy_stations();
+  r.consolidated = p.consolidated();
   r.voxel_centers = std::move(centers_);
   return r;
 }

@@ -299,7 +299,7 @@ class JobReactor : public grpc::ServerBidiReactor<Request, Response> {
       const auto level = s.ok() || s.code() == StatusCode::kInvalidArgument ? spdlog::level::info
                          : s.code() == StatusCode::kInternal                  ? spdlog::level::err
                                                                               : spdlog::level::warn;
-      spdlog::log(level, "job {} {} peer={} upload={} upload={:.3f}s queued={:.3f}s{} total={:.3f}s{} status={}",
+      spdlog::log(level, "job {} {} peer={} upload={} upload={:.3f}s queued={:.3f}s{} elapsed={:.3f}s{} status={}",
                   job_id_, method_, ctx_->peer(), HumanBytes(upload_.total_size_bytes()), upload_seconds_, wait_s,
                   timings_, total, LogDetails(), s.ok() ? std::string("OK") : s.ToString());
     }

@@ -43,8 +43,11 @@ import json, sys, os
 out = sys.argv[1]
 plan = json.load(open(os.path.join(out, "plan.json")))
 assert isinstance(plan, dict), "plan.json is not an object"
-stations = plan.get("stations")
+for key in ("schema", "resolution_m", "viewpoints", "coverage", "reduction", "candidates", "parameters"):
+    assert key in plan, "plan.json lacks " + key
+stations = plan["viewpoints"]
 assert isinstance(stations, list) and len(stations) >= 1, "plan.json has no stations"
+assert plan["coverage"]["covered_voxels"] > 0, "nothing covered"
 rows = [l for l in open(os.path.join(out, "stations.csv")) if l.strip() and not l.startswith("#")]
 data = [r for r in rows if not r[0].isalpha()]
 assert len(data) == len(stations), f"stations.csv has {len(data)} rows, plan.json {len(stations)} stations"

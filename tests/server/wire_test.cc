@@ -45,6 +45,7 @@ TEST(PlanParameters, RoundTripKeepsEveryField) {
   o.reduce = !PlanOptions{}.reduce;
   o.reduce_to = 3;
   o.threads = 5;
+  o.consolidate = !PlanOptions{}.consolidate;
   auto back = FromProto(ToProto(o));
   ASSERT_TRUE(back.ok());
   // Compare through the proto (every field), so a field added to one side only shows up here.
@@ -82,6 +83,11 @@ PlanResult BigResult(size_t voxels, size_t candidates) {
   r.evaluation.overall.global_visibility = 0.42;
   r.timings.push_back({"greedy", 1.5});
   r.warnings.push_back("w");
+  r.reduction.positions = {{1, 2, 3}};
+  r.floor_levels_m = {0.0, 3.1};
+  r.stop_reason = "target_reached";
+  r.greedy_stations = 2;
+  r.consolidated = 1;
   return r;
 }
 
@@ -112,6 +118,11 @@ TEST(PlanResultChunks, ReassembleExactlyAndStayUnderOneMebibyte) {
   EXPECT_DOUBLE_EQ(back->evaluation.overall.global_visibility, 0.42);
   EXPECT_EQ(back->timings[0].stage, "greedy");
   EXPECT_EQ(back->warnings, r.warnings);
+  EXPECT_EQ(back->reduction.positions, r.reduction.positions);
+  EXPECT_EQ(back->floor_levels_m, r.floor_levels_m);
+  EXPECT_EQ(back->stop_reason, "target_reached");
+  EXPECT_EQ(back->greedy_stations, 2);
+  EXPECT_EQ(back->consolidated, 1);
 }
 
 TEST(PlanResultChunks, MissingChunkIsDataLoss) {
