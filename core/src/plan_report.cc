@@ -453,6 +453,9 @@ std::string PlanToJson(const PlanResult& r) {
   Json candidates{{"count", r.candidate_count},
                   {"grid_spacing_m", r.heat_map.grid_spacing_m},
                   {"floor_levels_m", r.floor_levels_m},
+                  {"grid_cells", r.grid_cells},
+                  {"cells_without_floor", r.cells_without_floor},
+                  {"cells_failing_clearance", r.cells_failing_clearance},
                   {"visible_voxels", std::move(heat)}};
   Json timings = Json::object();
   for (const StageTiming& t : r.timings) timings[t.stage] = t.seconds;

@@ -169,6 +169,9 @@ Result<PlanResult> Plan(const SceneInput& input, const PlanOptions& options, con
     VC_ASSIGN_OR_RETURN(planner::CandidateGrid grid,
                         planner::GenerateCandidates(scene, cand_options, StageContext(ctx, "candidates")));
     for (const planner::FloorLevel& l : grid.levels) result.floor_levels_m.push_back(l.z_m);
+    result.grid_cells = grid.cells;
+    result.cells_without_floor = grid.rejected_no_floor;
+    result.cells_failing_clearance = grid.rejected_clearance;
     if (grid.positions.empty()) {
       if (grid.levels.empty()) {
         return FailedPreconditionError(

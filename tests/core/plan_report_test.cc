@@ -105,6 +105,11 @@ TEST(PlanReportTest, PlanJsonHasEveryDocumentedKey) {
   EXPECT_DOUBLE_EQ(j["reduction"]["matrix"][1][2].get<double>(), 0.12);
   EXPECT_EQ(j["reduction"]["removed"], json::array({2}));
   EXPECT_EQ(j["candidates"]["count"].get<int>(), 12);
+  for (const char* key : {"grid_spacing_m", "floor_levels_m", "grid_cells", "cells_without_floor",
+                          "cells_failing_clearance", "visible_voxels"}) {
+    EXPECT_TRUE(j["candidates"].contains(key)) << key;
+  }
+  for (const char* key : {"greedy_stations", "consolidated"}) EXPECT_TRUE(j.contains(key)) << key;
   EXPECT_EQ(j["candidates"]["visible_voxels"].size(), 12u);
   EXPECT_EQ(j["candidates"]["visible_voxels"][11][3].get<int>(), 132);
   EXPECT_DOUBLE_EQ(j["timings_s"]["voxelize"].get<double>(), 0.5);

@@ -92,6 +92,11 @@ struct PlanResult {
   HeatMap heat_map;
   Reduction reduction;
   uint64_t candidate_count = 0;
+  // Generated grid: cells examined (per floor level), those with no floor below, and those whose
+  // candidate failed the clearance (0 with user candidates).
+  uint64_t grid_cells = 0;
+  uint64_t cells_without_floor = 0;
+  uint64_t cells_failing_clearance = 0;
   uint64_t occupied_voxels = 0;
   uint64_t coverable_voxels = 0;
   uint64_t covered_voxels = 0;
