@@ -34,6 +34,34 @@ TEST(OccupancyGridTest, AnswersExactlyTheOccupiedSet) {
   EXPECT_FALSE(g->Occupied(100000, 0, 0));
 }
 
+TEST(OccupancyGridTest, VoxelDistanceFieldIsTheExactChessboardDistance) {
+  std::mt19937_64 rng(8);
+  std::uniform_int_distribution<int> c(0, 29);
+  std::vector<VoxelIndex> occ;
+  for (int i = 0; i < 25; ++i) occ.push_back({c(rng), c(rng), c(rng) / 3});
+  auto g = OccupancyGrid::Build(0.1, occ, 1 << 24);
+  ASSERT_TRUE(g.ok());
+  ASSERT_TRUE(g->has_voxel_distance());
+  const VoxelIndex lo = g->min_index();
+  int max_seen = 0;
+  for (int z = 0; z < g->dims().z(); ++z)
+    for (int y = 0; y < g->dims().y(); ++y)
+      for (int x = 0; x < g->dims().x(); ++x) {
+        int want = 255;
+        for (const VoxelIndex& o : occ) {
+          want = std::min(want, std::max({std::abs(lo.x + x - o.x), std::abs(lo.y + y - o.y), std::abs(lo.z + z - o.z)}));
+        }
+        ASSERT_EQ(int(g->voxel_distance()[g->VoxelLinear(x, y, z)]), want) << x << "," << y << "," << z;
+        max_seen = std::max(max_seen, want);
+      }
+  EXPECT_GT(max_seen, 5);
+  // Brick distances never overstate the free space.
+  for (int bz = 0; bz < g->brick_dims().z(); ++bz)
+    for (int by = 0; by < g->brick_dims().y(); ++by)
+      for (int bx = 0; bx < g->brick_dims().x(); ++bx)
+        EXPECT_EQ(g->BrickOccupied(bx, by, bz), g->BrickDistance(g->BrickLinear(bx, by, bz)) == 0);
+}
+
 TEST(OccupancyGridTest, RefusesOverBudgetWithExtentAndAResolutionThatFits) {
   std::vector<VoxelIndex> occ = {{0, 0, 0}, {20000, 20000, 20000}};
   auto g = OccupancyGrid::Build(0.01, occ, uint64_t{1} << 30);
