@@ -326,6 +326,9 @@ v1::PlanResult ToProto(const PlanResult& r) {
   p.set_stop_reason(r.stop_reason);
   p.set_greedy_stations(r.greedy_stations);
   p.set_consolidated(r.consolidated);
+  p.set_grid_cells(r.grid_cells);
+  p.set_cells_without_floor(r.cells_without_floor);
+  p.set_cells_failing_clearance(r.cells_failing_clearance);
   return p;
 }
 
@@ -401,6 +404,9 @@ Result<PlanResult> PlanResultAssembler::Finish(const v1::PlanResult& p) && {
   r.stop_reason = p.stop_reason();
   r.greedy_stations = p.greedy_stations();
   r.consolidated = p.consolidated();
+  r.grid_cells = p.grid_cells();
+  r.cells_without_floor = p.cells_without_floor();
+  r.cells_failing_clearance = p.cells_failing_clearance();
   r.voxel_centers = std::move(centers_);
   return r;
 }

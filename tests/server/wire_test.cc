@@ -88,6 +88,9 @@ PlanResult BigResult(size_t voxels, size_t candidates) {
   r.stop_reason = "target_reached";
   r.greedy_stations = 2;
   r.consolidated = 1;
+  r.grid_cells = 11;
+  r.cells_without_floor = 3;
+  r.cells_failing_clearance = 2;
   return r;
 }
 
@@ -123,6 +126,16 @@ TEST(PlanResultChunks, ReassembleExactlyAndStayUnderOneMebibyte) {
   EXPECT_EQ(back->stop_reason, "target_reached");
   EXPECT_EQ(back->greedy_stations, 2);
   EXPECT_EQ(back->consolidated, 1);
+  EXPECT_EQ(back->grid_cells, 11u);
+  EXPECT_EQ(back->cells_without_floor, 3u);
+  EXPECT_EQ(back->cells_failing_clearance, 2u);
+}
+
+// A tripwire: when a field is added to PlanResult or PlanOptions, its size changes; carry the new
+// field in proto/vc/v1/planner.proto and proto/src/convert.cc (both ways), then update the sizes.
+TEST(PlanResultChunks, EveryCoreFieldIsCarried) {
+  EXPECT_EQ(sizeof(PlanResult), 704u) << "PlanResult changed: update the vc.v1 PlanResult and vc::wire";
+  EXPECT_EQ(sizeof(PlanOptions), 152u) << "PlanOptions changed: update vc.v1 PlanParameters and vc::wire";
 }
 
 TEST(PlanResultChunks, MissingChunkIsDataLoss) {
