@@ -99,6 +99,121 @@ bool CornerVisibleIS(const OccupancyGrid& g, const Vector3d& uo, const VoxelInde
          (hit->z == c.z || hit->z == c.z - 1);
 }
 
+// Exact ray avoidance: a small cache of occluders recently hit by rays from the same viewpoint.
+// If a segment passes through the interior of a cached occluder h (by a margin far above rounding),
+// the walk must visit h, so its first occupied voxel is h or one before it: the target is not
+// reached. For a corner ray the same holds when h is outside the 2x2x2 block around the corner:
+// once a segment enters that (convex) block it stays inside it up to the corner, so every voxel
+// outside the block is visited before any inside it. Targets are processed in sorted, spatially
+// coherent order, so neighbouring targets usually share their occluder.
+class OccluderCache {
+ public:
+  // True if segment a->b provably passes through a cached occluder other than `except`.
+  bool Blocks(const Vector3d& a, const Vector3d& b, const VoxelIndex& except) const {
+    const Vector3d d = b - a;
+    for (int i = 0; i < count_; ++i) {
+      const VoxelIndex& h = voxels_[i];
+      if (h == except) continue;
+      if (PassesThroughInterior(a, d, h)) return true;
+    }
+    return false;
+  }
+  // As Blocks, for a ray ending at lattice corner c: occluders next to c do not count.
+  bool BlocksCorner(const Vector3d& a, const VoxelIndex& c) const {
+    const Vector3d b(c.x, c.y, c.z), d = b - a;
+    for (int i = 0; i < count_; ++i) {
+      const VoxelIndex& h = voxels_[i];
+      const bool near = (h.x == c.x || h.x == c.x - 1) && (h.y == c.y || h.y == c.y - 1) && (h.z == c.z || h.z == c.z - 1);
+      if (!near && PassesThroughInterior(a, d, h)) return true;
+    }
+    return false;
+  }
+  void Add(const VoxelIndex& h) {
+    for (int i = 0; i < count_; ++i)
+      if (voxels_[i] == h) return;
+    voxels_[next_] = h;
+    next_ = (next_ + 1) % kSize;
+    count_ = std::min(count_ + 1, kSize);
+  }
+
+ private:
+  static constexpr int kSize = 8;
+  // Slab test: the open segment meets the open cube with a margin (in the segment parameter and
+  // in voxel units) of 1e-7, far above the traversal's rounding.
+  static bool PassesThroughInterior(const Vector3d& a, const Vector3d& d, const VoxelIndex& h) {
+    constexpr double kMargin = 1e-7;
+    double t0 = 0, t1 = 1;
+    const double lo[3] = {double(h.x), double(h.y), double(h.z)};
+    for (int i = 0; i < 3; ++i) {
+      if (std::abs(d[i]) < 1e-12) {
+        if (a[i] <= lo[i] + kMargin || a[i] >= lo[i] + 1 - kMargin) return false;
+        continue;
+      }
+      const double inv = 1.0 / d[i];
+      double ta = (lo[i] + kMargin - a[i]) * inv, tb = (lo[i] + 1 - kMargin - a[i]) * inv;
+      if (ta > tb) std::swap(ta, tb);
+      t0 = std::max(t0, ta);
+      t1 = std::min(t1, tb);
+      if (t1 - t0 <= kMargin) return false;
+    }
+    // The overlap must lie strictly inside the segment.
+    return t0 > kMargin && t1 < 1 - kMargin;
+  }
+
+  VoxelIndex voxels_[kSize];
+  int count_ = 0;
+  int next_ = 0;
+};
+
+bool CompatibleCached(const OccupancyGrid& g, const Vector3d& uo, const VoxelIndex& v, OccluderCache& cache) {
+  const Vector3d target(v.x + 0.5, v.y + 0.5, v.z + 0.5);
+  if (cache.Blocks(uo, target, v)) return false;
+  const auto hit = FirstOccupied(g, uo, target);
+  if (hit && *hit != v) cache.Add(*hit);
+  return hit && *hit == v;
+}
+
+bool SurfaceVisibleCached(const OccupancyGrid& g, const Vector3d& uo, const VoxelIndex& v, OccluderCache& cache) {
+  Face faces[3];
+  double weight[3];
+  int n = 0;
+  const double lo[3] = {double(v.x), double(v.y), double(v.z)};
+  for (int a = 0; a < 3; ++a) {
+    if (uo[a] < lo[a]) {
+      faces[n] = Face(2 * a);
+      weight[n++] = lo[a] - uo[a];
+    } else if (uo[a] > lo[a] + 1) {
+      faces[n] = Face(2 * a + 1);
+      weight[n++] = uo[a] - lo[a] - 1;
+    }
+  }
+  for (int i = 0; i < n; ++i)
+    for (int j = i + 1; j < n; ++j)
+      if (weight[j] > weight[i]) {
+        std::swap(weight[i], weight[j]);
+        std::swap(faces[i], faces[j]);
+      }
+  for (int i = 0; i < n; ++i) {
+    if (g.Occupied(Neighbour(v, faces[i]))) continue;  // not exposed
+    const Vector3d target = FaceCenterIS(v, faces[i]);
+    if (cache.Blocks(uo, target, v)) continue;
+    const auto hit = FirstOccupied(g, uo, target, &v);
+    if (!hit) return true;
+    cache.Add(*hit);
+  }
+  return false;
+}
+
+bool CornerVisibleCached(const OccupancyGrid& g, const Vector3d& uo, const VoxelIndex& c, OccluderCache& cache) {
+  if (cache.BlocksCorner(uo, c)) return false;
+  const auto hit = FirstOccupied(g, uo, Vector3d(c.x, c.y, c.z));
+  if (!hit) return true;
+  const bool near = (hit->x == c.x || hit->x == c.x - 1) && (hit->y == c.y || hit->y == c.y - 1) &&
+                    (hit->z == c.z || hit->z == c.z - 1);
+  if (!near) cache.Add(*hit);
+  return near;
+}
+
 // Corner k (bit 0: +x, bit 1: +y, bit 2: +z) of voxel v.
 VoxelIndex Corner(const VoxelIndex& v, int k) { return {v.x + (k & 1), v.y + ((k >> 1) & 1), v.z + ((k >> 2) & 1)}; }
 
@@ -305,9 +420,12 @@ Result<std::vector<VoxelSet>> ComputeVisibilitySets(const VoxelScene& scene, con
     const size_t k = task / id_chunks, c = task % id_chunks;
     if (valid[k]) {
       VoxelSet& set = sets[k];
+      OccluderCache cache;
       for (size_t j = chunk_start[c]; j < chunk_start[c + 1]; ++j) {
         const uint32_t id = candidates[j];
-        if (compat ? CompatibleIS(g, uo[k], index[id]) : SurfaceVisibleIS(g, uo[k], index[id])) set.set(id);
+        if (compat ? CompatibleCached(g, uo[k], index[id], cache) : SurfaceVisibleCached(g, uo[k], index[id], cache)) {
+          set.set(id);
+        }
       }
     }
     progress.Add(1);
@@ -435,8 +553,9 @@ Result<Evaluation> Evaluate(const VoxelScene& scene, const std::vector<WorldPoin
     // 1. One ray per corner.
     std::fill(visible_bits.begin(), visible_bits.end(), 0);
     VC_RETURN_IF_ERROR(ParallelChunks(corners.size(), kCornerChunk, options.threads, ctx, [&](uint64_t, uint64_t b, uint64_t e) {
+      OccluderCache cache;
       for (uint64_t c = b; c < e; ++c) {
-        if (CornerVisibleIS(g, uo[k], UnpackCorner(corners[c]))) visible_bits[c >> 6] |= uint64_t{1} << (c & 63);
+        if (CornerVisibleCached(g, uo[k], UnpackCorner(corners[c]), cache)) visible_bits[c >> 6] |= uint64_t{1} << (c & 63);
       }
     }));
     // 2. Faces from their corners.
