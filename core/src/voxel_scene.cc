@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 
 #include "vc/core/octomap_adapter.h"
@@ -54,6 +55,30 @@ Status CheckExtent(const Eigen::Vector3d& lo_m, const Eigen::Vector3d& hi_m, dou
   }
   return Status::Ok();
 }
+
+// The scene of sorted, unique keys at resolution r: the voxel list and its traversal grid.
+Result<VoxelScene> SceneFromKeys(double r, std::vector<VoxelKey> occupied, uint64_t budget, const JobContext& ctx) {
+  VoxelScene scene;
+  scene.resolution_m = r;
+  scene.occupied = std::move(occupied);
+  std::vector<VoxelIndex> idx(scene.occupied.size());
+  for (size_t i = 0; i < idx.size(); ++i) idx[i] = KeyToIndex(scene.occupied[i]);
+  const uint64_t list_bytes = scene.occupied.size() * sizeof(VoxelKey);
+  if (list_bytes >= budget) {
+    return ResourceExhaustedError("the scene has " + std::to_string(scene.occupied.size()) +
+                                  " occupied voxels, over the memory budget; use a coarser resolution");
+  }
+  VC_ASSIGN_OR_RETURN(scene.grid, OccupancyGrid::Build(r, idx, budget - list_bytes));
+  ctx.Report("voxelize", 1.0, std::to_string(scene.occupied.size()) + " occupied voxels");
+  return scene;
+}
+
+// VoxelAccumulator's recent-key cache: 2^14 slots (128 KiB), and a value no 48-bit key takes.
+constexpr size_t kRecentSlots = size_t{1} << 14;
+constexpr uint64_t kNoKey = ~uint64_t{0};
+size_t RecentSlot(uint64_t key) { return size_t((key * 0x9E3779B97F4A7C15ull) >> 50); }
+// Least room the key buffer is given for new keys after a merge (512 KiB).
+constexpr size_t kMinRoom = size_t{1} << 16;
 
 }  // namespace
 
@@ -152,21 +177,149 @@ Result<std::vector<VoxelKey>> OccupiedKeys(const SceneInput& input, double r, ui
 }
 
 Result<VoxelScene> Voxelize(const SceneInput& input, const VoxelizeOptions& options, const JobContext& ctx) {
-  VoxelScene scene;
-  scene.resolution_m = WorkingResolution(input, options);
-  ctx.Report("voxelize", 0.0, "voxelising at " + std::to_string(scene.resolution_m) + " m");
-  VC_ASSIGN_OR_RETURN(scene.occupied, OccupiedKeys(input, scene.resolution_m, options.memory_budget_bytes, ctx));
-  std::vector<VoxelIndex> idx(scene.occupied.size());
-  for (size_t i = 0; i < idx.size(); ++i) idx[i] = KeyToIndex(scene.occupied[i]);
-  const uint64_t list_bytes = scene.occupied.size() * sizeof(VoxelKey);
-  if (list_bytes >= options.memory_budget_bytes) {
-    return ResourceExhaustedError("the scene has " + std::to_string(scene.occupied.size()) +
-                                  " occupied voxels, over the memory budget; use a coarser resolution");
-  }
-  VC_ASSIGN_OR_RETURN(scene.grid, OccupancyGrid::Build(scene.resolution_m, idx, options.memory_budget_bytes - list_bytes));
+  const double r = WorkingResolution(input, options);
+  ctx.Report("voxelize", 0.0, "voxelising at " + std::to_string(r) + " m");
+  VC_ASSIGN_OR_RETURN(std::vector<VoxelKey> occupied, OccupiedKeys(input, r, options.memory_budget_bytes, ctx));
+  VC_ASSIGN_OR_RETURN(VoxelScene scene, SceneFromKeys(r, std::move(occupied), options.memory_budget_bytes, ctx));
   scene.scan_origins = input.scan_origins;
-  ctx.Report("voxelize", 1.0, std::to_string(scene.occupied.size()) + " occupied voxels");
   return scene;
+}
+
+VoxelAccumulator::VoxelAccumulator(double resolution_m, uint64_t memory_budget_bytes)
+    : resolution_m_(resolution_m),
+      inv_resolution_(1.0 / resolution_m),
+      memory_budget_bytes_(memory_budget_bytes),
+      status_(CheckResolution(resolution_m)),
+      recent_(kRecentSlots, kNoKey),
+      lo_m_(Eigen::Vector3f::Constant(std::numeric_limits<float>::infinity())),
+      hi_m_(-lo_m_) {
+  NotePeak(memory_bytes());
+}
+
+uint64_t VoxelAccumulator::memory_bytes() const {
+  return (keys_.capacity() + recent_.capacity()) * sizeof(uint64_t);
+}
+
+void VoxelAccumulator::Add(const Eigen::Vector3f& p) {
+  if (!p.allFinite()) {
+    ++dropped_nonfinite_;
+    return;
+  }
+  if (!status_.ok()) return;
+  ++points_added_;
+  lo_m_ = lo_m_.cwiseMin(p);
+  hi_m_ = hi_m_.cwiseMax(p);
+  // OctoMap's coordToKey, as OccupiedKeys computes it: floor(u) for u = p * (1/r). In range,
+  // floor(u) is int(u) (truncation) minus one where that rounded a negative u up.
+  const double ux = inv_resolution_ * double(p.x()), uy = inv_resolution_ * double(p.y()),
+               uz = inv_resolution_ * double(p.z());
+  if (!(std::min({ux, uy, uz}) >= -kKeyOffset) || !(std::max({ux, uy, uz}) < kKeyOffset)) {
+    status_ = CheckExtent(lo_m_.cast<double>(), hi_m_.cast<double>(), resolution_m_, memory_budget_bytes_);
+    if (status_.ok()) {
+      status_ = InvalidArgumentError("a point lies outside OctoMap's key range at resolution " +
+                                     std::to_string(resolution_m_) + " m; use a coarser resolution");
+    }
+    return;
+  }
+  auto floor_key = [](double u) {
+    const int i = int(u);
+    return uint16_t(i - int(u < double(i)) + kKeyOffset);
+  };
+  const uint64_t key = Pack(VoxelKey{floor_key(ux), floor_key(uy), floor_key(uz)});
+  if (key == last_key_) return;
+  last_key_ = key;
+  uint64_t& recent = recent_[RecentSlot(key)];
+  if (recent == key) return;
+  recent = key;
+  if (keys_.size() == keys_.capacity()) {
+    Merge();
+    Grow();
+    if (!status_.ok()) return;
+  }
+  keys_.push_back(key);
+}
+
+void VoxelAccumulator::Merge() {
+  const size_t a = sorted_;
+  const auto tail = keys_.begin() + ptrdiff_t(a);
+  std::sort(tail, keys_.end());
+  const size_t b = size_t(std::unique(tail, keys_.end()) - tail);
+  if (a == 0 || b == 0) {
+    keys_.resize(a + b);
+    sorted_ = a + b;
+    return;
+  }
+  // Merge from the back into [0, a + b): with w - i = j + (duplicates so far) >= j, a write never
+  // lands on an unread prefix key. Duplicates leave a gap [i, w) that is closed afterwards.
+  const std::vector<uint64_t> scratch(tail, tail + ptrdiff_t(b));
+  NotePeak(memory_bytes() + scratch.capacity() * sizeof(uint64_t));
+  size_t i = a, j = b, w = a + b;
+  while (j > 0) {
+    if (i > 0 && keys_[i - 1] >= scratch[j - 1]) {
+      if (keys_[i - 1] == scratch[j - 1]) --j;
+      keys_[--w] = keys_[--i];
+    } else {
+      keys_[--w] = scratch[--j];
+    }
+  }
+  std::move(keys_.begin() + ptrdiff_t(w), keys_.begin() + ptrdiff_t(a + b), keys_.begin() + ptrdiff_t(i));
+  keys_.resize(i + (a + b - w));
+  sorted_ = keys_.size();
+}
+
+void VoxelAccumulator::Grow() {
+  status_ = CheckExtent(lo_m_.cast<double>(), hi_m_.cast<double>(), resolution_m_, memory_budget_bytes_);
+  if (!status_.ok()) return;
+  const size_t n = keys_.size(), cap = keys_.capacity();
+  // Growing holds the old and the new buffer at once, and a merge holds the buffer and a scratch
+  // copy of its tail (no longer than the buffer), so a capacity of half the usable keys keeps
+  // both within the budget.
+  const uint64_t recent_bytes = recent_.capacity() * sizeof(uint64_t);
+  const uint64_t max_cap = memory_budget_bytes_ > recent_bytes ? (memory_budget_bytes_ - recent_bytes) / 16 : 0;
+  const size_t room = std::max<size_t>(n / 2, kMinRoom);
+  if (cap - n < room && cap < max_cap) {
+    const size_t new_cap = size_t(std::min<uint64_t>(std::max(2 * cap, n + room), max_cap));
+    std::vector<uint64_t> grown;
+    grown.reserve(new_cap);
+    grown.assign(keys_.begin(), keys_.end());
+    NotePeak(memory_bytes() + grown.capacity() * sizeof(uint64_t));
+    keys_.swap(grown);
+  }
+  if (keys_.capacity() - n >= std::max<size_t>(keys_.capacity() / 16, 1)) return;
+  // Full: occupied voxels of surfaces scale about with 1/r^2.
+  const Eigen::Vector3f ext = hi_m_ - lo_m_;
+  const double need = double(n + n / 16 + 1) * 16 + double(recent_bytes);
+  const double factor = std::max(std::sqrt(need / double(std::max<uint64_t>(memory_budget_bytes_, 1)) * 1.25), 1.01);
+  std::ostringstream os;
+  os.precision(4);
+  os << "the cloud spans " << ext.x() << " x " << ext.y() << " x " << ext.z() << " m and has more than " << n
+     << " occupied voxels at resolution " << resolution_m_ << " m; streaming their keys needs more than the memory budget of "
+     << double(memory_budget_bytes_) / double(1 << 20) << " MiB; use a resolution of at least "
+     << std::ceil(resolution_m_ * factor * 1000) / 1000 << " m, raise the budget, or crop the scene";
+  status_ = ResourceExhaustedError(os.str());
+}
+
+Result<VoxelScene> VoxelAccumulator::Finish(const JobContext& ctx) {
+  if (finished_) return FailedPreconditionError("VoxelAccumulator::Finish was already called");
+  finished_ = true;
+  VC_RETURN_IF_ERROR(status_);
+  if (points_added_ == 0) {
+    return InvalidArgumentError(dropped_nonfinite_ == 0 ? std::string("the point cloud is empty")
+                                                        : "the point cloud has no finite point (" +
+                                                              std::to_string(dropped_nonfinite_) +
+                                                              " non-finite points dropped)");
+  }
+  VC_RETURN_IF_ERROR(CheckExtent(lo_m_.cast<double>(), hi_m_.cast<double>(), resolution_m_, memory_budget_bytes_));
+  ctx.Report("voxelize", 0.0, "voxelising at " + std::to_string(resolution_m_) + " m");
+  VC_RETURN_IF_ERROR(ctx.CheckCancelled("voxelisation"));
+  Merge();
+  std::vector<VoxelKey> occupied(keys_.size());
+  for (size_t i = 0; i < occupied.size(); ++i) occupied[i] = Unpack(keys_[i]);
+  NotePeak(memory_bytes() + occupied.capacity() * sizeof(VoxelKey));
+  std::vector<uint64_t>().swap(keys_);
+  std::vector<uint64_t>().swap(recent_);
+  sorted_ = 0;
+  return SceneFromKeys(resolution_m_, std::move(occupied), memory_budget_bytes_, ctx);
 }
 
 }  // namespace vc
