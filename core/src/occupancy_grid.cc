@@ -89,55 +89,7 @@ Result<OccupancyGrid> OccupancyGrid::Build(double resolution_m, const std::vecto
     g.payload_[uint64_t(slot - 1) * kBrick + (rz & 7)] |= uint64_t{1} << (((ry & 7) << 3) | (rx & 7));
   }
   g.ComputeBrickDistances();
-  const uint64_t voxels = uint64_t(g.dims_.x()) * uint64_t(g.dims_.y()) * uint64_t(g.dims_.z());
-  if (need + voxels <= memory_budget_bytes) g.ComputeVoxelDistances();
   return g;
-}
-
-void OccupancyGrid::ComputeVoxelDistances() {
-  // Chessboard distance transform, exact with two raster passes over the 26-neighbourhood with
-  // unit weights (Rosenfeld & Pfaltz 1966): the chessboard metric is the path metric of 26-steps.
-  const int nx = dims_.x(), ny = dims_.y(), nz = dims_.z();
-  voxel_distance_.assign(uint64_t(nx) * ny * nz, 255);
-  for (uint64_t b = 0; b < bricks_.size(); ++b) {
-    if (bricks_[b] == 0) continue;
-    const uint64_t* bits = &payload_[uint64_t(bricks_[b] - 1) * kBrick];
-    const int bx = int(b % uint64_t(bdims_.x())), by = int((b / uint64_t(bdims_.x())) % uint64_t(bdims_.y())),
-              bz = int(b / (uint64_t(bdims_.x()) * uint64_t(bdims_.y())));
-    for (int z = 0; z < kBrick; ++z)
-      for (int yx = 0; yx < 64; ++yx)
-        if ((bits[z] >> yx) & 1u)
-          voxel_distance_[VoxelLinear(bx * kBrick + (yx & 7), by * kBrick + (yx >> 3), bz * kBrick + z)] = 0;
-  }
-  uint8_t* d = voxel_distance_.data();
-  const int64_t sx = 1, sy = nx, sz = int64_t(nx) * ny;
-  auto relax = [&](int x, int y, int z, int dir) {
-    const int64_t p = z * sz + y * sy + x * sx;
-    int best = d[p];
-    if (best == 0) return;
-    for (int dz = -1; dz <= 1; ++dz) {
-      const int zz = z + dz * dir;
-      if (zz < 0 || zz >= nz) continue;
-      for (int dy = -1; dy <= 1; ++dy) {
-        const int yy = y + dy * dir;
-        if (yy < 0 || yy >= ny) continue;
-        for (int dx = -1; dx <= 1; ++dx) {
-          // Only neighbours already visited in this pass's raster order.
-          if (dz > 0 || (dz == 0 && (dy > 0 || (dy == 0 && dx >= 0)))) continue;
-          const int xx = x + dx * dir;
-          if (xx < 0 || xx >= nx) continue;
-          best = std::min(best, d[zz * sz + yy * sy + xx * sx] + 1);
-        }
-      }
-    }
-    d[p] = uint8_t(std::min(best, 255));
-  };
-  for (int z = 0; z < nz; ++z)
-    for (int y = 0; y < ny; ++y)
-      for (int x = 0; x < nx; ++x) relax(x, y, z, 1);
-  for (int z = nz - 1; z >= 0; --z)
-    for (int y = ny - 1; y >= 0; --y)
-      for (int x = nx - 1; x >= 0; --x) relax(x, y, z, -1);
 }
 
 void OccupancyGrid::ComputeBrickDistances() {
@@ -174,8 +126,7 @@ void OccupancyGrid::ComputeBrickDistances() {
 }
 
 uint64_t OccupancyGrid::memory_bytes() const {
-  return bricks_.size() * sizeof(uint32_t) + brick_distance_.size() + payload_.size() * sizeof(uint64_t) +
-         voxel_distance_.size();
+  return bricks_.size() * sizeof(uint32_t) + brick_distance_.size() + payload_.size() * sizeof(uint64_t);
 }
 
 WorldPoint OccupancyGrid::VoxelCenter(const VoxelIndex& v) const { return KeyToCoord(resolution_m_, IndexToKey(v)); }

@@ -46,75 +46,12 @@ RayTraversal::Iterator& RayTraversal::Iterator::operator++() {
   return *this;
 }
 
-namespace {
-
-using internal::JumpAcrossBox;
 using internal::JumpAcrossFreeBrickBox;
-using internal::kMinVoxelJump;
-
-// FirstOccupied on the per-voxel distance field: occupancy is distance 0, and at distance d the
-// cube of radius d-1 around the current voxel is free.
-std::optional<VoxelIndex> FirstOccupiedWithDistanceField(const OccupancyGrid& grid, Walk& w, const VoxelIndex& skip) {
-  const uint8_t* dist = grid.voxel_distance();
-  const VoxelIndex& lo = grid.min_index();
-  const int lo3[3] = {lo.x, lo.y, lo.z};
-  const uint32_t nx = uint32_t(grid.dims().x()), ny = uint32_t(grid.dims().y()), nz = uint32_t(grid.dims().z());
-  bool was_inside = false;
-  while (true) {
-    int x = w.cur[0], y = w.cur[1], z = w.cur[2];
-    double tx = w.t_max[0], ty = w.t_max[1], tz = w.t_max[2];
-    int lx = w.left[0], ly = w.left[1], lz = w.left[2];
-    int remaining = w.remaining;
-    const int sx = w.step[0], sy = w.step[1], sz = w.step[2];
-    const double dx = w.t_delta[0], dy = w.t_delta[1], dz = w.t_delta[2];
-    int jump = 0;
-    while (true) {
-      const uint32_t rx = uint32_t(x - lo3[0]), ry = uint32_t(y - lo3[1]), rz = uint32_t(z - lo3[2]);
-      if (rx < nx && ry < ny && rz < nz) {
-        was_inside = true;
-        const int d = dist[(uint64_t(rz) * ny + ry) * nx + rx];
-        if (d == 0) {
-          const VoxelIndex v{x, y, z};
-          if (v != skip) return v;
-        } else if (d >= kMinVoxelJump) {
-          jump = d - 1;
-          break;
-        }
-      } else if (was_inside) {
-        return std::nullopt;
-      }
-      if (remaining == 0) return std::nullopt;
-      // Tie rule: z, then y, then x among equal parameters (OctoMap's).
-      if (tz <= ty && tz <= tx) {
-        z += sz;
-        tz = --lz == 0 ? kInf : tz + dz;
-      } else if (ty <= tx) {
-        y += sy;
-        ty = --ly == 0 ? kInf : ty + dy;
-      } else {
-        x += sx;
-        tx = --lx == 0 ? kInf : tx + dx;
-      }
-      --remaining;
-    }
-    w.cur[0] = x, w.cur[1] = y, w.cur[2] = z;
-    w.t_max[0] = tx, w.t_max[1] = ty, w.t_max[2] = tz;
-    w.left[0] = lx, w.left[1] = ly, w.left[2] = lz;
-    w.remaining = remaining;
-    const int box_lo[3] = {x - jump, y - jump, z - jump}, box_hi[3] = {x + jump, y + jump, z + jump};
-    if (!JumpAcrossBox(box_lo, box_hi, w)) return std::nullopt;
-    if (w.remaining == 0) return std::nullopt;
-    w.Advance();
-  }
-}
-
-}  // namespace
 
 std::optional<VoxelIndex> FirstOccupied(const OccupancyGrid& grid, const Eigen::Vector3d& a,
                                         const Eigen::Vector3d& b, const VoxelIndex* transparent) {
   Walk w(a, b);
   const VoxelIndex skip = transparent ? *transparent : VoxelIndex{INT32_MIN, INT32_MIN, INT32_MIN};
-  if (grid.has_voxel_distance()) return FirstOccupiedWithDistanceField(grid, w, skip);
   const VoxelIndex& lo = grid.min_index();
   const int lo3[3] = {lo.x, lo.y, lo.z};
   const uint32_t nx = uint32_t(grid.dims().x()), ny = uint32_t(grid.dims().y()), nz = uint32_t(grid.dims().z());

@@ -5,9 +5,8 @@
 // bricks store their 512 bits. Empty bricks cost 4 bytes. For empty-space skipping each brick
 // also stores its Chebyshev distance, in bricks, to the nearest non-empty brick (capped at 255):
 // a ray in a brick at distance k may jump across the (2k-1)^3-brick box around it untested.
-// When the budget allows one more byte per voxel of the box, each voxel also stores its exact
-// Chebyshev (chessboard) distance to the nearest occupied voxel (0 = occupied, capped at 255),
-// which lets a ray jump across the free cube around it and makes the occupancy test one load. It answers "is voxel (x,y,z) occupied" exactly as the octree at resolution r does
+// (A per-voxel distance field was tried and removed: its byte per voxel of the box falls out of
+// cache, and traversal was 1.2-2x slower in wall time than with these brick distances.) It answers "is voxel (x,y,z) occupied" exactly as the octree at resolution r does
 // (ALGORITHM.md section 1); anything outside the box is free. Memory is computed and checked
 // against a budget before anything is allocated: a scene that does not fit is refused with
 // RESOURCE_EXHAUSTED and a message stating the extent and a resolution that would fit.
@@ -56,14 +55,6 @@ class OccupancyGrid {
   // Payload slot of a brick (0 = empty) and its distance to the nearest non-empty brick.
   uint32_t BrickSlot(uint64_t brick) const { return bricks_[brick]; }
   uint8_t BrickDistance(uint64_t brick) const { return brick_distance_[brick]; }
-  // Whether the per-voxel distance field is present (it is when it fits the memory budget).
-  bool has_voxel_distance() const { return !voxel_distance_.empty(); }
-  // Per-voxel Chebyshev distance to the nearest occupied voxel, indexed by VoxelLinear.
-  const uint8_t* voxel_distance() const { return voxel_distance_.data(); }
-  // Linear voxel number of relative voxel coordinates (x - min.x, ...), in range.
-  uint64_t VoxelLinear(uint32_t rx, uint32_t ry, uint32_t rz) const {
-    return (uint64_t(rz) * uint64_t(dims_.y()) + ry) * uint64_t(dims_.x()) + rx;
-  }
   // The 8 words of a non-empty brick's bits (word z, bit y*8+x).
   const uint64_t* BrickBits(uint32_t slot) const { return &payload_[uint64_t(slot - 1) * kBrick]; }
   uint64_t memory_bytes() const;
@@ -100,7 +91,6 @@ class OccupancyGrid {
 
  private:
   void ComputeBrickDistances();
-  void ComputeVoxelDistances();
 
   double resolution_m_ = 0;
   double inv_resolution_ = 0;
@@ -110,7 +100,6 @@ class OccupancyGrid {
   std::vector<uint32_t> bricks_;   // per brick: 0 = empty, else 1 + payload brick number
   std::vector<uint64_t> payload_;  // 8 words per non-empty brick: word z, bit (y*8 + x)
   std::vector<uint8_t> brick_distance_;  // Chebyshev distance in bricks to a non-empty brick
-  std::vector<uint8_t> voxel_distance_;  // optional: Chebyshev distance in voxels, 0 = occupied
 };
 
 // OctoMap's key of world point p at `resolution_m`: floor(p * (1/r)) + 32768 per axis, computed
