@@ -13,6 +13,8 @@
 
 #include <cmath>
 #include <cstring>
+#include <iostream>
+#include <mutex>
 #include <sstream>
 
 #include "vc/core/occupancy_grid.h"
@@ -139,6 +141,27 @@ struct FullWalker {
   }
 };
 
+// OctoMap reports through std::cerr (and, for a few errors, fprintf). While OctoMap parses a
+// stream we have already validated, its std::cerr chatter ("Reading binary octree type OcTree")
+// is swallowed: our own Status carries anything that matters. std::cerr's buffer is
+// process-wide, so the swap is serialised; vc itself logs through spdlog, never std::cerr.
+class QuietCerr {
+ public:
+  QuietCerr() : lock_(Mutex()), saved_(std::cerr.rdbuf(sink_.rdbuf())) {}
+  ~QuietCerr() { std::cerr.rdbuf(saved_); }
+  QuietCerr(const QuietCerr&) = delete;
+  QuietCerr& operator=(const QuietCerr&) = delete;
+
+ private:
+  static std::mutex& Mutex() {
+    static std::mutex mu;
+    return mu;
+  }
+  std::lock_guard<std::mutex> lock_;
+  std::ostringstream sink_;
+  std::streambuf* saved_;
+};
+
 template <typename T>
 bool ReadPod(std::string_view bytes, size_t* pos, T* out) {
   if (*pos + sizeof(T) > bytes.size()) return false;
@@ -166,6 +189,7 @@ Result<std::shared_ptr<octomap::OcTree>> ReadOctreeBinary(std::string_view bytes
   header << "# Octomap OcTree binary file\nid OcTree\nsize " << h.size << "\nres " << h.res << "\ndata\n";
   std::istringstream stream{header.str() + std::string(bytes.substr(h.data_offset))};
   auto tree = std::make_shared<octomap::OcTree>(h.res);
+  QuietCerr quiet;
   if (!tree->readBinary(stream)) {
     return InvalidArgumentError(std::string(source) + ": OctoMap could not read the binary tree");
   }
@@ -201,6 +225,7 @@ Result<std::shared_ptr<octomap::OcTree>> ReadOctreeText(std::string_view bytes, 
     stream_text = os.str() + rewritten;
   }
   std::istringstream stream(stream_text);
+  QuietCerr quiet;
   std::unique_ptr<octomap::AbstractOcTree> tree(octomap::AbstractOcTree::read(stream));
   auto* oc = dynamic_cast<octomap::OcTree*>(tree.get());
   if (oc == nullptr) {
