@@ -56,49 +56,6 @@ bool InsideOccupied(const OccupancyGrid& g, const Vector3d& u) {
   return g.Occupied(int(std::floor(u.x())), int(std::floor(u.y())), int(std::floor(u.z())));
 }
 
-bool CompatibleIS(const OccupancyGrid& g, const Vector3d& uo, const VoxelIndex& v) {
-  const auto hit = FirstOccupied(g, uo, Vector3d(v.x + 0.5, v.y + 0.5, v.z + 0.5));
-  return hit && *hit == v;
-}
-
-bool SurfaceVisibleIS(const OccupancyGrid& g, const Vector3d& uo, const VoxelIndex& v) {
-  // Candidate faces: per axis, the one o is strictly outside of; most directly facing first.
-  Face faces[3];
-  double weight[3];
-  int n = 0;
-  const double lo[3] = {double(v.x), double(v.y), double(v.z)};
-  for (int a = 0; a < 3; ++a) {
-    if (uo[a] < lo[a]) {
-      faces[n] = Face(2 * a);
-      weight[n++] = lo[a] - uo[a];
-    } else if (uo[a] > lo[a] + 1) {
-      faces[n] = Face(2 * a + 1);
-      weight[n++] = uo[a] - lo[a] - 1;
-    }
-  }
-  // Sort by distance from the face plane, descending (n <= 3).
-  for (int i = 0; i < n; ++i)
-    for (int j = i + 1; j < n; ++j)
-      if (weight[j] > weight[i]) {
-        std::swap(weight[i], weight[j]);
-        std::swap(faces[i], faces[j]);
-      }
-  for (int i = 0; i < n; ++i) {
-    if (g.Occupied(Neighbour(v, faces[i]))) continue;  // not exposed
-    if (!FirstOccupied(g, uo, FaceCenterIS(v, faces[i]), &v)) return true;
-  }
-  return false;
-}
-
-// Corner visibility (s.4): the first occupied voxel on the ray to lattice point c is one of the 8
-// voxels sharing c, or there is none. Independent of transparency (see the file comment).
-bool CornerVisibleIS(const OccupancyGrid& g, const Vector3d& uo, const VoxelIndex& c) {
-  const auto hit = FirstOccupied(g, uo, Vector3d(c.x, c.y, c.z));
-  if (!hit) return true;
-  return (hit->x == c.x || hit->x == c.x - 1) && (hit->y == c.y || hit->y == c.y - 1) &&
-         (hit->z == c.z || hit->z == c.z - 1);
-}
-
 // Exact ray avoidance: a small cache of occluders recently hit by rays from the same viewpoint.
 // If a segment passes through the interior of a cached occluder h (by a margin far above rounding),
 // the walk must visit h, so its first occupied voxel is h or one before it: the target is not
@@ -173,8 +130,9 @@ bool CompatibleCached(const OccupancyGrid& g, const Vector3d& uo, const VoxelInd
   return hit && *hit == v;
 }
 
-bool SurfaceVisibleCached(const OccupancyGrid& g, const Vector3d& uo, const VoxelIndex& v, OccluderCache& cache) {
-  Face faces[3];
+// The exposed-or-not faces of v that face o (o strictly outside the face's plane), the one most
+// directly facing o first. Returns how many (at most 3).
+int FacingFaces(const Vector3d& uo, const VoxelIndex& v, Face faces[3]) {
   double weight[3];
   int n = 0;
   const double lo[3] = {double(v.x), double(v.y), double(v.z)};
@@ -193,6 +151,12 @@ bool SurfaceVisibleCached(const OccupancyGrid& g, const Vector3d& uo, const Voxe
         std::swap(weight[i], weight[j]);
         std::swap(faces[i], faces[j]);
       }
+  return n;
+}
+
+bool SurfaceVisibleCached(const OccupancyGrid& g, const Vector3d& uo, const VoxelIndex& v, OccluderCache& cache) {
+  Face faces[3];
+  const int n = FacingFaces(uo, v, faces);
   for (int i = 0; i < n; ++i) {
     if (g.Occupied(Neighbour(v, faces[i]))) continue;  // not exposed
     const Vector3d target = FaceCenterIS(v, faces[i]);
@@ -329,13 +293,15 @@ Status ScannerModel::Validate() const {
 bool IsCompatible(const OccupancyGrid& grid, const WorldPoint& o, const VoxelIndex& v) {
   const Vector3d uo = grid.WorldToIndexSpace(o);
   if (InsideOccupied(grid, uo)) return false;
-  return CompatibleIS(grid, uo, v);
+  OccluderCache cache;
+  return CompatibleCached(grid, uo, v, cache);
 }
 
 bool IsSurfaceVisible(const OccupancyGrid& grid, const WorldPoint& o, const VoxelIndex& v) {
   const Vector3d uo = grid.WorldToIndexSpace(o);
   if (InsideOccupied(grid, uo)) return false;
-  return SurfaceVisibleIS(grid, uo, v);
+  OccluderCache cache;
+  return SurfaceVisibleCached(grid, uo, v, cache);
 }
 
 bool PassesTest(SelectionTest test, const OccupancyGrid& grid, const WorldPoint& o, const VoxelIndex& v) {
@@ -345,7 +311,8 @@ bool PassesTest(SelectionTest test, const OccupancyGrid& grid, const WorldPoint&
 Perception PerceiveFace(const OccupancyGrid& grid, const WorldPoint& o, const VoxelIndex& v, Face f) {
   const Vector3d uo = grid.WorldToIndexSpace(o);
   int visible = 0;
-  for (int k : kFaceCorners[int(f)]) visible += CornerVisibleIS(grid, uo, Corner(v, k));
+  OccluderCache cache;
+  for (int k : kFaceCorners[int(f)]) visible += CornerVisibleCached(grid, uo, Corner(v, k), cache);
   return FromCount(visible);
 }
 
@@ -495,7 +462,8 @@ Result<Evaluation> Evaluate(const VoxelScene& scene, const std::vector<WorldPoin
         Perception best_p = Perception::kNone;
         for (size_t k = 0; k < nv; ++k) {
           int visible = 0;
-          for (int q : kFaceCorners[int(f)]) visible += CornerVisibleIS(g, uo[k], Corner(v, q));
+          OccluderCache cache;
+          for (int q : kFaceCorners[int(f)]) visible += CornerVisibleCached(g, uo[k], Corner(v, q), cache);
           const Perception p = FromCount(visible);
           const double val = FaceValue(p, viewpoints[k], v, f, r, options.scanner);
           per[c][k].Add(p, val);
