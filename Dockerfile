@@ -13,7 +13,7 @@ COPY . .
 ARG VC_SKIP_TESTS=0
 RUN rm -rf build && cmake --preset release -DVC_BUILD_BENCH=OFF \
  && cmake --build --preset release \
- && if [ "$VC_SKIP_TESTS" != 1 ]; then ctest --preset release -j2 -L server; fi \
+ && if [ "$VC_SKIP_TESTS" != 1 ]; then ctest --preset release -j2 -L 'server|tsan'; fi \
  && install -D build/release/server/vc-server /out/usr/local/bin/vc-server \
  && install -D build/release/client/vc-client /out/usr/local/bin/vc-client
 
