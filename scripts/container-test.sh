@@ -12,8 +12,10 @@ apt-get install -y -qq podman buildah debootstrap >/dev/null
 
 base=localhost/debian:bookworm
 if ! podman image exists "$base"; then
-  mirror=$(grep -rhoE 'https?://[^ ]+' /etc/apt/sources.list /etc/apt/sources.list.d/ 2>/dev/null \
-             | grep -v security | head -1)
+  # The Debian mirror apt uses: URIs: lines of *.sources, deb lines of *.list (either may be absent).
+  mirror=$( { grep -hE '^URIs:' /etc/apt/sources.list.d/*.sources 2>/dev/null | awk '{print $2}';
+              grep -hE '^deb ' /etc/apt/sources.list /etc/apt/sources.list.d/*.list 2>/dev/null | awk '{print $2}'; } \
+            | grep -v security | head -1 || true)
   mirror=${mirror:-http://deb.debian.org/debian}
   rootfs=$(mktemp -d)
   echo "container-test: debootstrap bookworm from $mirror"
