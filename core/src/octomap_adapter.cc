@@ -307,12 +307,6 @@ Result<ScanGraphData> ReadScanGraph(std::string_view bytes, std::string_view sou
   return out;
 }
 
-std::string WriteOctreeBinary(const octomap::OcTree& tree) {
-  std::ostringstream os;
-  tree.writeBinaryConst(os);
-  return os.str();
-}
-
 double OctreeResolution(const octomap::OcTree& tree) { return tree.getResolution(); }
 
 size_t CountOccupiedLeaves(const octomap::OcTree& tree) {
@@ -351,13 +345,6 @@ std::shared_ptr<octomap::OcTree> BuildOctree(double resolution_m, const std::vec
   tree->updateInnerOccupancy();
   tree->prune();
   return tree;
-}
-
-bool OctomapCoordToKey(const octomap::OcTree& tree, const WorldPoint& p, VoxelKey* key) {
-  octomap::OcTreeKey k;
-  if (!tree.coordToKeyChecked(p.x(), p.y(), p.z(), k)) return false;
-  *key = {k[0], k[1], k[2]};
-  return true;
 }
 
 CastRayOutcome OctomapCastRay(const octomap::OcTree& tree, const WorldPoint& origin, const Eigen::Vector3d& direction,

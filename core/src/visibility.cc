@@ -304,10 +304,6 @@ bool IsSurfaceVisible(const OccupancyGrid& grid, const WorldPoint& o, const Voxe
   return SurfaceVisibleCached(grid, uo, v, cache);
 }
 
-bool PassesTest(SelectionTest test, const OccupancyGrid& grid, const WorldPoint& o, const VoxelIndex& v) {
-  return test == SelectionTest::kCompatibility ? IsCompatible(grid, o, v) : IsSurfaceVisible(grid, o, v);
-}
-
 Perception PerceiveFace(const OccupancyGrid& grid, const WorldPoint& o, const VoxelIndex& v, Face f) {
   const Vector3d uo = grid.WorldToIndexSpace(o);
   int visible = 0;

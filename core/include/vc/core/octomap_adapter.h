@@ -37,9 +37,6 @@ struct ScanGraphData {
 };
 Result<ScanGraphData> ReadScanGraph(std::string_view bytes, std::string_view source);
 
-// Serialises a tree to the .bt format (for tests and for writing results).
-std::string WriteOctreeBinary(const octomap::OcTree& tree);
-
 // Resolution of a tree, in metres.
 double OctreeResolution(const octomap::OcTree& tree);
 
@@ -56,9 +53,6 @@ void OccupiedBoundingBox(const octomap::OcTree& tree, WorldPoint* min, WorldPoin
 // Builds an OcTree of `resolution_m` with exactly `occupied` as occupied voxels (others unknown),
 // pruned. The key numbers are the same at equal resolution.
 std::shared_ptr<octomap::OcTree> BuildOctree(double resolution_m, const std::vector<VoxelKey>& occupied);
-
-// OctoMap's own key for a coordinate at `resolution_m`; false if outside the key range.
-bool OctomapCoordToKey(const octomap::OcTree& tree, const WorldPoint& p, VoxelKey* key);
 
 // What octomap::OcTree::castRay reported, made explicit.
 struct CastRayOutcome {

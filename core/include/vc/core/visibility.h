@@ -51,8 +51,6 @@ enum class Perception : uint8_t { kNone = 0, kPartial, kFull };
 bool IsCompatible(const OccupancyGrid& grid, const WorldPoint& o, const VoxelIndex& v);
 // s.3b. False if o is inside an occupied voxel.
 bool IsSurfaceVisible(const OccupancyGrid& grid, const WorldPoint& o, const VoxelIndex& v);
-// Either test.
-bool PassesTest(SelectionTest test, const OccupancyGrid& grid, const WorldPoint& o, const VoxelIndex& v);
 
 // s.4: full, partial or no perception of face `f` of voxel v from o.
 Perception PerceiveFace(const OccupancyGrid& grid, const WorldPoint& o, const VoxelIndex& v, Face f);
