@@ -17,13 +17,16 @@
 #include <mutex>
 #include <random>
 
+#include "occluders.h"
 #include "parallel.h"
+#include "surface_groups.h"
 #include "vc/core/ray_traversal.h"
 
 namespace vc {
 namespace {
 
 using Eigen::Vector3d;
+using internal::OccluderCache;
 using planner::ParallelChunks;
 
 constexpr double kHalfPi = 1.57079632679489661923;
@@ -55,72 +58,6 @@ bool Enclosed(const OccupancyGrid& g, const VoxelIndex& v) {
 bool InsideOccupied(const OccupancyGrid& g, const Vector3d& u) {
   return g.Occupied(int(std::floor(u.x())), int(std::floor(u.y())), int(std::floor(u.z())));
 }
-
-// Exact ray avoidance: a small cache of occluders recently hit by rays from the same viewpoint.
-// If a segment passes through the interior of a cached occluder h (by a margin far above rounding),
-// the walk must visit h, so its first occupied voxel is h or one before it: the target is not
-// reached. For a corner ray the same holds when h is outside the 2x2x2 block around the corner:
-// once a segment enters that (convex) block it stays inside it up to the corner, so every voxel
-// outside the block is visited before any inside it. Targets are processed in sorted, spatially
-// coherent order, so neighbouring targets usually share their occluder.
-class OccluderCache {
- public:
-  // True if segment a->b provably passes through a cached occluder other than `except`.
-  bool Blocks(const Vector3d& a, const Vector3d& b, const VoxelIndex& except) const {
-    const Vector3d d = b - a;
-    for (int i = 0; i < count_; ++i) {
-      const VoxelIndex& h = voxels_[i];
-      if (h == except) continue;
-      if (PassesThroughInterior(a, d, h)) return true;
-    }
-    return false;
-  }
-  // As Blocks, for a ray ending at lattice corner c: occluders next to c do not count.
-  bool BlocksCorner(const Vector3d& a, const VoxelIndex& c) const {
-    const Vector3d b(c.x, c.y, c.z), d = b - a;
-    for (int i = 0; i < count_; ++i) {
-      const VoxelIndex& h = voxels_[i];
-      const bool near = (h.x == c.x || h.x == c.x - 1) && (h.y == c.y || h.y == c.y - 1) && (h.z == c.z || h.z == c.z - 1);
-      if (!near && PassesThroughInterior(a, d, h)) return true;
-    }
-    return false;
-  }
-  void Add(const VoxelIndex& h) {
-    for (int i = 0; i < count_; ++i)
-      if (voxels_[i] == h) return;
-    voxels_[next_] = h;
-    next_ = (next_ + 1) % kSize;
-    count_ = std::min(count_ + 1, kSize);
-  }
-
- private:
-  static constexpr int kSize = 8;
-  // Slab test: the open segment meets the open cube with a margin (in the segment parameter and
-  // in voxel units) of 1e-7, far above the traversal's rounding.
-  static bool PassesThroughInterior(const Vector3d& a, const Vector3d& d, const VoxelIndex& h) {
-    constexpr double kMargin = 1e-7;
-    double t0 = 0, t1 = 1;
-    const double lo[3] = {double(h.x), double(h.y), double(h.z)};
-    for (int i = 0; i < 3; ++i) {
-      if (std::abs(d[i]) < 1e-12) {
-        if (a[i] <= lo[i] + kMargin || a[i] >= lo[i] + 1 - kMargin) return false;
-        continue;
-      }
-      const double inv = 1.0 / d[i];
-      double ta = (lo[i] + kMargin - a[i]) * inv, tb = (lo[i] + 1 - kMargin - a[i]) * inv;
-      if (ta > tb) std::swap(ta, tb);
-      t0 = std::max(t0, ta);
-      t1 = std::min(t1, tb);
-      if (t1 - t0 <= kMargin) return false;
-    }
-    // The overlap must lie strictly inside the segment.
-    return t0 > kMargin && t1 < 1 - kMargin;
-  }
-
-  VoxelIndex voxels_[kSize];
-  int count_ = 0;
-  int next_ = 0;
-};
 
 bool CompatibleCached(const OccupancyGrid& g, const Vector3d& uo, const VoxelIndex& v, OccluderCache& cache) {
   const Vector3d target(v.x + 0.5, v.y + 0.5, v.z + 0.5);
@@ -169,8 +106,11 @@ bool SurfaceVisibleCached(const OccupancyGrid& g, const Vector3d& uo, const Voxe
 }
 
 bool CornerVisibleCached(const OccupancyGrid& g, const Vector3d& uo, const VoxelIndex& c, OccluderCache& cache) {
-  if (cache.BlocksCorner(uo, c)) return false;
-  const auto hit = FirstOccupied(g, uo, Vector3d(c.x, c.y, c.z));
+  // Occluders in the 2x2x2 block around c do not count: once a segment enters that (convex)
+  // block it stays inside it up to c, so every voxel outside it is visited first.
+  const Vector3d end(c.x, c.y, c.z);
+  if (cache.Blocks(uo, end, {c.x - 1, c.y - 1, c.z - 1}, c)) return false;
+  const auto hit = FirstOccupied(g, uo, end);
   if (!hit) return true;
   const bool near = (hit->x == c.x || hit->x == c.x - 1) && (hit->y == c.y || hit->y == c.y - 1) &&
                     (hit->z == c.z || hit->z == c.z - 1);
@@ -366,8 +306,35 @@ Result<std::vector<VoxelSet>> ComputeVisibilitySets(const VoxelScene& scene, con
     uo[k] = g.WorldToIndexSpace(viewpoints[k]);
     valid[k] = viewpoints[k].allFinite() && !InsideOccupied(g, uo[k]);
   }
-  // Chunks of candidate voxels whose ids fall in distinct 64-bit words per chunk would be needed
-  // for lock-free writes; instead each chunk covers one viewpoint and a word-aligned id range.
+
+  if (options.test == SelectionTest::kSurfaceVisibility && !options.per_voxel) {
+    // Grouped: tasks are (viewpoint, run of bricks); tasks of one viewpoint share its set's
+    // words, so bits are set atomically.
+    const internal::SurfaceTargets targets(g, index, candidates);
+    constexpr uint64_t kBricksPerTask = 256;
+    const uint64_t brick_chunks = std::max<uint64_t>(1, (targets.brick_count() + kBricksPerTask - 1) / kBricksPerTask);
+    const uint64_t tasks = viewpoints.size() * brick_chunks;
+    StageProgress progress(ctx, "visibility", tasks);
+    Status st = ParallelChunks(tasks, 1, options.threads, ctx, [&](uint64_t task, uint64_t, uint64_t) {
+      const size_t k = task / brick_chunks, c = task % brick_chunks;
+      if (valid[k]) {
+        OccluderCache cache;
+        std::vector<uint32_t> seen;
+        const size_t b0 = c * kBricksPerTask, b1 = std::min<size_t>(b0 + kBricksPerTask, targets.brick_count());
+        targets.AppendVisible(uo[k], b0, b1, cache, seen);
+        std::vector<uint64_t>& words = sets[k].words();
+        for (uint32_t id : seen) {
+          std::atomic_ref<uint64_t>(words[id >> 6]).fetch_or(uint64_t{1} << (id & 63), std::memory_order_relaxed);
+        }
+      }
+      progress.Add(1);
+    });
+    VC_RETURN_IF_ERROR(st);
+    return sets;
+  }
+
+  // Per voxel. Each chunk covers one viewpoint and a word-aligned id range, so writes to a set
+  // never share a word between chunks.
   constexpr uint64_t kIdsPerChunk = 64 * 64;
   const uint64_t id_chunks = (n + kIdsPerChunk - 1) / kIdsPerChunk;
   // Start offsets into `candidates` for each id chunk.

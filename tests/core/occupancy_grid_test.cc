@@ -58,6 +58,31 @@ TEST(OccupancyGridTest, BrickDistancesAreTheExactChessboardDistanceBetweenBricks
   EXPECT_GT(max_seen, 3);
 }
 
+TEST(OccupancyGridTest, AnyOccupiedAgreesWithVoxelByVoxelOnRandomBoxes) {
+  std::mt19937_64 rng(3);
+  std::uniform_int_distribution<int> c(-20, 20), len(0, 19);
+  std::vector<VoxelIndex> v;
+  for (int i = 0; i < 150; ++i) v.push_back({c(rng), c(rng), c(rng)});
+  const OccupancyGrid g = *OccupancyGrid::Build(0.1, v, 1 << 24);
+  int hits = 0;
+  for (int trial = 0; trial < 3000; ++trial) {
+    // Boxes inside, across and outside the grid's box (which spans about [-24, 23]).
+    const VoxelIndex lo{c(rng) - 10, c(rng) - 10, c(rng) - 10};
+    const VoxelIndex hi{lo.x + len(rng), lo.y + len(rng), lo.z + len(rng)};
+    bool want = false;
+    for (int z = lo.z; z <= hi.z && !want; ++z)
+      for (int y = lo.y; y <= hi.y && !want; ++y)
+        for (int x = lo.x; x <= hi.x && !want; ++x) want = g.Occupied(x, y, z);
+    ASSERT_EQ(g.AnyOccupied(lo, hi), want) << trial;
+    hits += want;
+  }
+  EXPECT_GT(hits, 300);
+  EXPECT_LT(hits, 2700);
+  // A single voxel box, and an empty (inverted) box.
+  EXPECT_TRUE(g.AnyOccupied(v[0], v[0]));
+  EXPECT_FALSE(g.AnyOccupied({5, 5, 5}, {4, 5, 5}));
+}
+
 TEST(OccupancyGridTest, RefusesOverBudgetWithExtentAndAResolutionThatFits) {
   std::vector<VoxelIndex> occ = {{0, 0, 0}, {20000, 20000, 20000}};
   auto g = OccupancyGrid::Build(0.01, occ, uint64_t{1} << 30);

@@ -80,6 +80,10 @@ class OccupancyGrid {
     return bricks_[BrickLinear(bx, by, bz)] != 0;
   }
 
+  // Whether any voxel of the box [lo, hi] (inclusive voxel indices) is occupied. Bricks are
+  // tested a word (an 8x8 slice) at a time; empty bricks cost one load.
+  bool AnyOccupied(const VoxelIndex& lo, const VoxelIndex& hi) const;
+
   // Continuous index-space coordinates of a world point (metres).
   Eigen::Vector3d WorldToIndexSpace(const WorldPoint& p) const { return p * inv_resolution_; }
   // World point (metres) of continuous index-space coordinates.

@@ -93,6 +93,9 @@ struct VisibilitySetsOptions {
   SelectionTest test = SelectionTest::kSurfaceVisibility;
   // Worker threads; 0 = hardware concurrency.
   int threads = 0;
+  // Surface test only: decide every voxel by its own rays instead of by groups of faces (same
+  // answers, slower; kept as the reference for tests and benchmarks).
+  bool per_voxel = false;
 };
 
 // For each viewpoint, the occupied voxels that pass the selection test. Viewpoints inside an

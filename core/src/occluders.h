@@ -1,0 +1,138 @@
+// Internal to vc_core: exact shortcuts that prove a segment blocked without walking it.
+//
+// If a segment passes through the interior of a box of occupied voxels (by a margin far above
+// the traversal's rounding), the Amanatides & Woo walk must visit one of the box's voxels, so
+// its first occupied voxel is that one or an earlier one. Used by the visibility engine
+// (visibility.cc, surface_groups.cc).
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+
+#include "vc/core/occupancy_grid.h"
+
+namespace vc::internal {
+
+// An axis-aligned box of voxels [lo, hi] (inclusive indices), all occupied.
+struct SolidBox {
+  VoxelIndex lo, hi;
+  bool Contains(const VoxelIndex& v) const {
+    return v.x >= lo.x && v.x <= hi.x && v.y >= lo.y && v.y <= hi.y && v.z >= lo.z && v.z <= hi.z;
+  }
+};
+
+// Margin, in voxels and in the segment parameter: 1e-5 is far above the walk's rounding
+// (about 1e-9 voxels on a 4000-voxel segment) and far below anything geometric.
+inline constexpr double kInteriorMargin = 1e-5;
+
+// A segment a->b with its direction's reciprocals, for repeated box tests.
+struct Segment {
+  Eigen::Vector3d a, d, inv;
+  Segment(const Eigen::Vector3d& from, const Eigen::Vector3d& to) : a(from), d(to - from) {
+    for (int i = 0; i < 3; ++i) inv[i] = std::abs(d[i]) < 1e-12 ? 0.0 : 1.0 / d[i];
+  }
+};
+
+// True if the segment meets the open box (lo + m, hi + 1 - m) over a parameter interval of
+// length > m that lies strictly inside (m, 1 - m): it enters the box's interior after it starts
+// and leaves it before it ends.
+inline bool PassesThroughInterior(const Segment& s, const SolidBox& box) {
+  constexpr double m = kInteriorMargin;
+  const double lo[3] = {double(box.lo.x), double(box.lo.y), double(box.lo.z)};
+  const double hi[3] = {double(box.hi.x) + 1, double(box.hi.y) + 1, double(box.hi.z) + 1};
+  double t0 = 0, t1 = 1;
+  for (int i = 0; i < 3; ++i) {
+    if (s.inv[i] == 0.0) {
+      if (s.a[i] <= lo[i] + m || s.a[i] >= hi[i] - m) return false;
+      continue;
+    }
+    double ta = (lo[i] + m - s.a[i]) * s.inv[i], tb = (hi[i] - m - s.a[i]) * s.inv[i];
+    if (ta > tb) std::swap(ta, tb);
+    t0 = std::max(t0, ta);
+    t1 = std::min(t1, tb);
+    if (t1 - t0 <= m) return false;
+  }
+  return t0 > m && t1 < 1 - m;
+}
+
+// The box of occupied voxels grown greedily from occupied voxel h: each side moves out one
+// layer at a time while the whole new layer is occupied, at most `limit` voxels from h.
+inline SolidBox GrowSolidBox(const OccupancyGrid& g, const VoxelIndex& h, int limit) {
+  SolidBox box{h, h};
+  int* lo[3] = {&box.lo.x, &box.lo.y, &box.lo.z};
+  int* hi[3] = {&box.hi.x, &box.hi.y, &box.hi.z};
+  const int h3[3] = {h.x, h.y, h.z};
+  bool grew = true;
+  while (grew) {
+    grew = false;
+    for (int axis = 0; axis < 3; ++axis) {
+      for (int side = 0; side < 2; ++side) {
+        const int layer = side == 0 ? *lo[axis] - 1 : *hi[axis] + 1;
+        if (std::abs(layer - h3[axis]) > limit) continue;
+        int l[3] = {box.lo.x, box.lo.y, box.lo.z}, u[3] = {box.hi.x, box.hi.y, box.hi.z};
+        l[axis] = u[axis] = layer;
+        bool full = true;
+        for (int z = l[2]; z <= u[2] && full; ++z)
+          for (int y = l[1]; y <= u[1] && full; ++y)
+            for (int x = l[0]; x <= u[0] && full; ++x) full = g.Occupied(x, y, z);
+        if (full) {
+          (side == 0 ? *lo[axis] : *hi[axis]) = layer;
+          grew = true;
+        }
+      }
+    }
+  }
+  return box;
+}
+
+// A small cache of occluders recently hit by rays from one viewpoint. Targets are processed in
+// spatially coherent order, so neighbouring targets usually share their occluder.
+class OccluderCache {
+ public:
+  // True if segment a->b provably passes through a cached occluder that contains no voxel of the
+  // box [keep_lo, keep_hi] (the voxels that may be transparent for this segment).
+  bool Blocks(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const VoxelIndex& keep_lo,
+              const VoxelIndex& keep_hi) const {
+    if (count_ == 0) return false;
+    const Segment seg(a, b);
+    for (int i = 0; i < count_; ++i) {
+      const SolidBox& box = boxes_[i];
+      const bool overlaps = box.lo.x <= keep_hi.x && box.hi.x >= keep_lo.x && box.lo.y <= keep_hi.y &&
+                            box.hi.y >= keep_lo.y && box.lo.z <= keep_hi.z && box.hi.z >= keep_lo.z;
+      if (!overlaps && PassesThroughInterior(seg, box)) return true;
+    }
+    return false;
+  }
+  bool Blocks(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const VoxelIndex& keep) const {
+    return Blocks(a, b, keep, keep);
+  }
+  // True if pred(box) holds for some cached box.
+  template <typename Pred>
+  bool Any(Pred&& pred) const {
+    for (int i = 0; i < count_; ++i)
+      if (pred(boxes_[i])) return true;
+    return false;
+  }
+  // A cached box that contains voxel h, or nullptr.
+  const SolidBox* Find(const VoxelIndex& h) const {
+    for (int i = 0; i < count_; ++i)
+      if (boxes_[i].Contains(h)) return &boxes_[i];
+    return nullptr;
+  }
+  void Add(const SolidBox& box) {
+    boxes_[next_] = box;
+    next_ = (next_ + 1) % kSize;
+    count_ = std::min(count_ + 1, kSize);
+  }
+  void Add(const VoxelIndex& h) {
+    if (!Find(h)) Add(SolidBox{h, h});
+  }
+
+ private:
+  static constexpr int kSize = 8;
+  SolidBox boxes_[kSize];
+  int count_ = 0;
+  int next_ = 0;
+};
+
+}  // namespace vc::internal

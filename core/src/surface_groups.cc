@@ -1,0 +1,312 @@
+// Grouped surface visibility. Within a brick, the exposed faces that face the viewpoint o are
+// grouped by orientation and plane (e.g. the 64 top faces of a floor brick). A group, or a
+// quadrant of it, is decided at once by one of two certificates, each exact:
+//
+// - Free cone. Let the faces lie on the plane u[a] = P, with o strictly on one side. The walk
+//   from o to a face centre stays on o's side of the plane until its last voxel (a face's own
+//   voxel on the far side, which is transparent, or its free neighbour on o's side): the face
+//   centre lies on the plane, so the walk's last step along a is its final step. Every voxel the
+//   walk visits meets the segment up to rounding (about 1e-9 voxels). So if no occupied voxel on
+//   o's side comes within 1e-4 of any segment from o to the group's rectangle, every face of the
+//   group is reached: visible. FreeCone checks this over a cover of the cone by boxes.
+// - Solid occluder. If the segments from o to the rectangle's 4 corners all pass through the
+//   interior of a box of occupied voxels that holds none of the group's voxels, every segment to
+//   a point of the rectangle does too (the set of points q for which [o, q] meets a convex body
+//   is convex), so every face of the group is blocked.
+//
+// Each group first casts one exact ray to its middle face; the answer picks which certificate to
+// try. Groups that neither certificate decides are split in four, down to a few faces; what is
+// left is decided ray by ray as IsSurfaceVisible does.
+#include "surface_groups.h"
+
+#include <algorithm>
+#include <array>
+#include <bit>
+#include <cmath>
+#include <optional>
+
+#include "vc/core/ray_traversal.h"
+
+namespace vc::internal {
+namespace {
+
+using Eigen::Vector3d;
+
+constexpr int kMinSplit = 4;      // groups this small are not split further
+constexpr int kGrowLimit = 8;     // how far a solid occluder box grows from the voxel hit
+constexpr double kConeStep = 8;   // length (voxels) of each box of the cone's cover
+constexpr double kConeMargin = 1e-4;
+
+int At(const VoxelIndex& v, int axis) { return axis == 0 ? v.x : axis == 1 ? v.y : v.z; }
+
+// Positions p = u * 8 + w with u in [u0, u1] and w in [w0, w1].
+uint64_t RectMask(int u0, int u1, int w0, int w1) {
+  const uint64_t row = ((uint64_t{2} << w1) - (uint64_t{1} << w0)) * 0x0101010101010101ull;
+  const uint64_t rows = (u1 == 7 ? ~uint64_t{0} : (uint64_t{1} << (8 * (u1 + 1))) - 1) & ~((uint64_t{1} << (8 * u0)) - 1);
+  return row & rows;
+}
+
+}  // namespace
+
+bool FreeCone(const OccupancyGrid& grid, const Vector3d& uo, int axis, bool viewer_above, int plane,
+              const Vector3d& q0, const Vector3d& q1) {
+  double len = 0;
+  for (int i = 0; i < 3; ++i) len = std::max({len, std::abs(q0[i] - uo[i]), std::abs(q1[i] - uo[i])});
+  if (!(len > 0)) return false;
+  const VoxelIndex& gmin = grid.min_index();
+  const int gmin3[3] = {gmin.x, gmin.y, gmin.z};
+  // The part of the cone between parameters s0 and s1 lies in the box spanned by its 8 extreme
+  // points (o + s (q - o) is linear in s and in q), widened by the margin, cut to o's side of the
+  // plane.
+  auto piece = [&](double s0, double s1, int lo[3], int hi[3]) {
+    for (int i = 0; i < 3; ++i) {  // q0 <= q1 and s >= 0: the low end comes from q0, the high from q1
+      const double l0 = uo[i] + s0 * (q0[i] - uo[i]), l1 = uo[i] + s1 * (q0[i] - uo[i]);
+      const double h0 = uo[i] + s0 * (q1[i] - uo[i]), h1 = uo[i] + s1 * (q1[i] - uo[i]);
+      lo[i] = int(std::floor(std::min(l0, l1) - kConeMargin));
+      hi[i] = int(std::floor(std::max(h0, h1) + kConeMargin));
+    }
+    if (viewer_above) {
+      lo[axis] = std::max(lo[axis], plane);
+    } else {
+      hi[axis] = std::min(hi[axis], plane - 1);
+    }
+  };
+  double s0 = 0;
+  while (s0 < 1) {
+    int lo[3], hi[3];
+    // Empty-space skipping: a brick at distance k >= 2 from every non-empty brick sits in a free
+    // box of bricks reaching k - 1 bricks out; a piece whose box lies inside it needs no test.
+    const Vector3d c = uo + s0 * (0.5 * (q0 + q1) - uo);
+    int rel[3];
+    bool in_grid = true;
+    for (int i = 0; i < 3; ++i) {
+      rel[i] = int(std::floor(c[i])) - gmin3[i];
+      in_grid = in_grid && rel[i] >= 0 && rel[i] < grid.dims()[i];
+    }
+    if (in_grid) {
+      const int k = grid.BrickDistance(grid.BrickLinear(uint32_t(rel[0]) >> 3, uint32_t(rel[1]) >> 3, uint32_t(rel[2]) >> 3)) - 1;
+      if (k >= 1) {
+        const double s1 = std::min(1.0, s0 + k * OccupancyGrid::kBrick / len);
+        piece(s0, s1, lo, hi);
+        bool inside = true;
+        for (int i = 0; i < 3; ++i) {
+          const int free_lo = gmin3[i] + ((rel[i] >> 3) - k) * OccupancyGrid::kBrick;
+          const int free_hi = gmin3[i] + ((rel[i] >> 3) + k + 1) * OccupancyGrid::kBrick - 1;
+          inside = inside && lo[i] >= free_lo && hi[i] <= free_hi;
+        }
+        if (inside) {
+          s0 = s1;
+          continue;
+        }
+      }
+    }
+    const double s1 = std::min(1.0, s0 + kConeStep / len);
+    piece(s0, s1, lo, hi);
+    if (lo[axis] <= hi[axis] && grid.AnyOccupied({lo[0], lo[1], lo[2]}, {hi[0], hi[1], hi[2]})) return false;
+    s0 = s1;
+  }
+  return true;
+}
+
+SurfaceTargets::SurfaceTargets(const OccupancyGrid& grid, const std::vector<VoxelIndex>& index,
+                               const std::vector<uint32_t>& ids)
+    : grid_(grid) {
+  const VoxelIndex& m = grid.min_index();
+  std::vector<std::pair<uint64_t, uint32_t>> keyed;
+  keyed.reserve(ids.size());
+  for (uint32_t id : ids) {
+    const VoxelIndex& v = index[id];
+    const uint32_t rx = uint32_t(v.x - m.x), ry = uint32_t(v.y - m.y), rz = uint32_t(v.z - m.z);
+    keyed.emplace_back(grid.BrickLinear(rx >> 3, ry >> 3, rz >> 3), id);
+  }
+  std::sort(keyed.begin(), keyed.end());
+  targets_.reserve(keyed.size());
+  for (size_t i = 0; i < keyed.size(); ++i) {
+    const VoxelIndex& v = index[keyed[i].second];
+    uint8_t exposed = 0;
+    const int d[6][3] = {{-1, 0, 0}, {1, 0, 0}, {0, -1, 0}, {0, 1, 0}, {0, 0, -1}, {0, 0, 1}};
+    for (int f = 0; f < 6; ++f)
+      if (!grid.Occupied(v.x + d[f][0], v.y + d[f][1], v.z + d[f][2])) exposed |= uint8_t(1u << f);
+    if (exposed == 0) continue;
+    const int lx = (v.x - m.x) & 7, ly = (v.y - m.y) & 7, lz = (v.z - m.z) & 7;
+    if (bricks_.empty() || keyed[i].first != keyed[i - 1].first) {
+      const uint32_t at = uint32_t(targets_.size());
+      if (!bricks_.empty()) bricks_.back().end = at;
+      bricks_.push_back({{v.x - lx, v.y - ly, v.z - lz}, at, at});
+    }
+    targets_.push_back({keyed[i].second, {uint8_t(lx), uint8_t(ly), uint8_t(lz)}, exposed});
+  }
+  if (!bricks_.empty()) bricks_.back().end = uint32_t(targets_.size());
+}
+
+void SurfaceTargets::AppendVisible(const Vector3d& uo, size_t brick_begin, size_t brick_end, OccluderCache& cache,
+                                   std::vector<uint32_t>& visible_ids) const {
+  // Per brick scratch: at most 512 targets. A face group is one plane of a brick, held as a 64-bit
+  // mask over the plane's 8x8 positions p = u * 8 + w (u, w: the local coordinates along the
+  // plane's axes b1 = (a+1) % 3 and b2 = (a+2) % 3).
+  std::array<uint8_t, 512> visible;
+  std::array<uint8_t, 512> tried;  // bit f: face f is decided blocked, or its own ray was cast
+  uint64_t members[3][2][8];
+  uint16_t slot[3][8][64];  // target at position p of layer `layer` of axis a
+
+  for (size_t b = brick_begin; b < brick_end; ++b) {
+    const Brick& brick = bricks_[b];
+    const Target* t = &targets_[brick.begin];
+    const int n = int(brick.end - brick.begin);
+    const int base[3] = {brick.base.x, brick.base.y, brick.base.z};
+    std::fill_n(visible.begin(), n, 0);
+    std::fill_n(tried.begin(), n, 0);
+    std::fill_n(&members[0][0][0], 3 * 2 * 8, 0);
+    // Which face of a voxel in layer l faces o along axis a: 1 (+a), 0 (-a) or -1 (neither).
+    int8_t facing[3][8];
+    for (int a = 0; a < 3; ++a)
+      for (int l = 0; l < 8; ++l) {
+        const int voxel_a = base[a] + l;
+        facing[a][l] = int8_t(uo[a] > voxel_a + 1 ? 1 : uo[a] < voxel_a ? 0 : -1);
+      }
+    for (int j = 0; j < n; ++j) {
+      for (int a = 0; a < 3; ++a) {
+        const int layer = t[j].local[a];
+        const int sp = facing[a][layer];
+        if (sp < 0 || !((t[j].exposed >> (2 * a + sp)) & 1)) continue;
+        const int p = t[j].local[(a + 1) % 3] * 8 + t[j].local[(a + 2) % 3];
+        members[a][sp][layer] |= uint64_t{1} << p;
+        slot[a][layer][p] = uint16_t(j);
+      }
+    }
+
+    for (int a = 0; a < 3; ++a) {
+      const int b1 = (a + 1) % 3, b2 = (a + 2) % 3;
+      for (int sp = 0; sp < 2; ++sp) {
+        const uint8_t face_bit = uint8_t(1u << (2 * a + sp));
+        for (int layer = 0; layer < 8; ++layer) {
+          uint64_t undecided = members[a][sp][layer];
+          if (undecided == 0) continue;
+          const uint16_t* at = slot[a][layer];
+          for (uint64_t m = undecided; m; m &= m - 1) {  // seen already through another face
+            if (visible[at[std::countr_zero(m)]]) undecided &= ~(m & -m);
+          }
+          uint64_t seen = 0;
+          const int voxel_a = base[a] + layer;
+          const int plane = sp ? voxel_a + 1 : voxel_a;
+          // Decides the undecided faces inside the local rectangle `rect` (a mask).
+          auto decide = [&](auto&& self, int u0, int u1, int w0, int w1) -> void {
+            const uint64_t rect = RectMask(u0, u1, w0, w1);
+            const uint64_t sub = undecided & rect;
+            if (sub == 0) return;
+            const int umin = std::countr_zero(sub) >> 3, umax = (63 - std::countl_zero(sub)) >> 3;
+            uint64_t cols = sub | (sub >> 32);
+            cols |= cols >> 16;
+            cols |= cols >> 8;
+            cols &= 0xff;
+            const int wmin = std::countr_zero(cols), wmax = 31 - std::countl_zero(uint32_t(cols));
+            // The rectangle of face centres, and the voxels that are transparent for its rays.
+            Vector3d q0, q1;
+            q0[a] = q1[a] = plane;
+            q0[b1] = base[b1] + umin + 0.5, q1[b1] = base[b1] + umax + 0.5;
+            q0[b2] = base[b2] + wmin + 0.5, q1[b2] = base[b2] + wmax + 0.5;
+            int keep_lo[3], keep_hi[3];
+            keep_lo[a] = keep_hi[a] = voxel_a;
+            keep_lo[b1] = base[b1] + umin, keep_hi[b1] = base[b1] + umax;
+            keep_lo[b2] = base[b2] + wmin, keep_hi[b2] = base[b2] + wmax;
+            const VoxelIndex klo{keep_lo[0], keep_lo[1], keep_lo[2]}, khi{keep_hi[0], keep_hi[1], keep_hi[2]};
+            std::array<Segment, 4> corners{Segment(uo, q0), Segment(uo, q0), Segment(uo, q0), Segment(uo, q0)};
+            for (int c = 1; c < 4; ++c) {
+              Vector3d q = q0;
+              if (c & 1) q[b1] = q1[b1];
+              if (c & 2) q[b2] = q1[b2];
+              corners[c] = Segment(uo, q);
+            }
+            auto blocks_all = [&](const SolidBox& box) {
+              const bool overlaps = box.lo.x <= khi.x && box.hi.x >= klo.x && box.lo.y <= khi.y && box.hi.y >= klo.y &&
+                                    box.lo.z <= khi.z && box.hi.z >= klo.z;
+              if (overlaps) return false;
+              for (const Segment& c : corners)
+                if (!PassesThroughInterior(c, box)) return false;
+              return true;
+            };
+            const bool single = (sub & (sub - 1)) == 0;
+            if (!single && cache.Any(blocks_all)) {
+              undecided &= ~sub;  // all blocked
+              return;
+            }
+            // One exact ray to the face nearest the rectangle's middle.
+            const int cu2 = umin + umax, cw2 = wmin + wmax;
+            int mid = -1, best = 1 << 30;
+            for (uint64_t m = sub; m; m &= m - 1) {
+              const int p = std::countr_zero(m);
+              const int d = std::abs(2 * (p >> 3) - cu2) + std::abs(2 * (p & 7) - cw2);
+              if (d < best) best = d, mid = p;
+            }
+            const Target& tm = t[at[mid]];
+            const VoxelIndex v{base[0] + tm.local[0], base[1] + tm.local[1], base[2] + tm.local[2]};
+            Vector3d target(v.x + 0.5, v.y + 0.5, v.z + 0.5);
+            target[a] = plane;
+            const bool cache_blocks = cache.Blocks(uo, target, v);
+            const std::optional<VoxelIndex> hit = cache_blocks ? std::nullopt : FirstOccupied(grid_, uo, target, &v);
+            undecided &= ~(uint64_t{1} << mid);
+            if (!cache_blocks && !hit) {
+              seen |= uint64_t{1} << mid;
+              if (single) return;
+              if (FreeCone(grid_, uo, a, sp == 1, plane, q0, q1)) {
+                seen |= sub;
+                undecided &= ~sub;
+                return;
+              }
+            } else if (hit) {
+              const SolidBox* cached = cache.Find(*hit);
+              const SolidBox box = cached ? *cached : GrowSolidBox(grid_, *hit, kGrowLimit);
+              if (!cached) cache.Add(box);
+              if (!single && blocks_all(box)) {
+                undecided &= ~sub;
+                return;
+              }
+            }
+            if (single || std::popcount(sub) <= kMinSplit) return;
+            const int um = (u0 + u1) / 2, wm = (w0 + w1) / 2;
+            self(self, u0, um, w0, wm);
+            if (um < u1) self(self, um + 1, u1, w0, wm);
+            if (wm < w1) self(self, u0, um, wm + 1, w1);
+            if (um < u1 && wm < w1) self(self, um + 1, u1, wm + 1, w1);
+          };
+          decide(decide, 0, 7, 0, 7);
+          // Write back: seen faces make their voxel visible; decided, unseen faces are blocked.
+          for (uint64_t m = members[a][sp][layer] & ~undecided; m; m &= m - 1) {
+            const int p = std::countr_zero(m);
+            if ((seen >> p) & 1) {
+              visible[at[p]] = 1;
+            } else {
+              tried[at[p]] |= face_bit;
+            }
+          }
+        }
+      }
+    }
+
+    // What no group decided: ray by ray, as IsSurfaceVisible.
+    for (int j = 0; j < n; ++j) {
+      if (!visible[j]) {
+        const VoxelIndex v{base[0] + t[j].local[0], base[1] + t[j].local[1], base[2] + t[j].local[2]};
+        for (int a = 0; a < 3 && !visible[j]; ++a) {
+          const int sp = facing[a][t[j].local[a]];
+          if (sp < 0) continue;
+          const int voxel_a = At(v, a);
+          const int f = 2 * a + sp;
+          if (!((t[j].exposed >> f) & 1) || ((tried[j] >> f) & 1)) continue;
+          Vector3d target(v.x + 0.5, v.y + 0.5, v.z + 0.5);
+          target[a] = sp ? voxel_a + 1 : voxel_a;
+          if (cache.Blocks(uo, target, v)) continue;
+          const auto hit = FirstOccupied(grid_, uo, target, &v);
+          if (!hit) {
+            visible[j] = 1;
+          } else {
+            cache.Add(*hit);
+          }
+        }
+      }
+      if (visible[j]) visible_ids.push_back(t[j].id);
+    }
+  }
+}
+
+}  // namespace vc::internal

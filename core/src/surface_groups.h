@@ -1,0 +1,52 @@
+// Internal to vc_core: surface visibility (ALGORITHM.md s.3b) of all voxels of a scene from one
+// viewpoint, decided for whole groups of faces at once where that can be proven, and ray by ray
+// where it cannot. The answers are those of the per-voxel test (IsSurfaceVisible); the argument
+// for each shortcut is in docs/VISIBILITY.md ("Grouped surface visibility") and the tests compare
+// the two on synthetic and real scenes.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "occluders.h"
+#include "vc/core/occupancy_grid.h"
+
+namespace vc::internal {
+
+class SurfaceTargets {
+ public:
+  // The voxels `ids` (positions in `index`) that have at least one exposed face, brick by brick.
+  SurfaceTargets(const OccupancyGrid& grid, const std::vector<VoxelIndex>& index, const std::vector<uint32_t>& ids);
+
+  size_t brick_count() const { return bricks_.size(); }
+
+  // Appends to `visible` the id of every target in bricks [brick_begin, brick_end) that is
+  // surface-visible from uo (index space; uo must not lie in an occupied voxel). `cache` carries
+  // occluders between calls for the same viewpoint.
+  void AppendVisible(const Eigen::Vector3d& uo, size_t brick_begin, size_t brick_end, OccluderCache& cache,
+                     std::vector<uint32_t>& visible) const;
+
+ private:
+  struct Target {
+    uint32_t id;
+    uint8_t local[3];  // position inside the brick, 0..7 per axis
+    uint8_t exposed;   // bit f: face f's neighbour is free
+  };
+  struct Brick {
+    VoxelIndex base;  // smallest voxel index of the brick
+    uint32_t begin, end;
+  };
+
+  const OccupancyGrid& grid_;
+  std::vector<Target> targets_;
+  std::vector<Brick> bricks_;
+};
+
+// True if no occupied voxel on the viewer's side of the plane u[axis] = plane comes within
+// reach of a segment from uo to a point of the rectangle q0..q1 on that plane (q0[axis] =
+// q1[axis] = plane, q0 <= q1 on every axis; viewer_above: uo[axis] > plane, else uo[axis] < plane). Conservative: a
+// false answer proves nothing.
+bool FreeCone(const OccupancyGrid& grid, const Eigen::Vector3d& uo, int axis, bool viewer_above, int plane,
+              const Eigen::Vector3d& q0, const Eigen::Vector3d& q1);
+
+}  // namespace vc::internal
