@@ -106,12 +106,12 @@ class OccluderCache {
   bool Blocks(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const VoxelIndex& keep) const {
     return Blocks(a, b, keep, keep);
   }
-  // True if pred(box) holds for some cached box.
+  // A cached box for which pred(box) holds, or nullptr.
   template <typename Pred>
-  bool Any(Pred&& pred) const {
+  const SolidBox* FindIf(Pred&& pred) const {
     for (int i = 0; i < count_; ++i)
-      if (pred(boxes_[i])) return true;
-    return false;
+      if (pred(boxes_[i])) return &boxes_[i];
+    return nullptr;
   }
   // A cached box that contains voxel h, or nullptr.
   const SolidBox* Find(const VoxelIndex& h) const {

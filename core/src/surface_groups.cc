@@ -121,6 +121,7 @@ SurfaceTargets::SurfaceTargets(const OccupancyGrid& grid, const std::vector<Voxe
   }
   std::sort(keyed.begin(), keyed.end());
   targets_.reserve(keyed.size());
+  uint64_t brick_key = ~uint64_t{0};
   for (size_t i = 0; i < keyed.size(); ++i) {
     const VoxelIndex& v = index[keyed[i].second];
     uint8_t exposed = 0;
@@ -129,7 +130,8 @@ SurfaceTargets::SurfaceTargets(const OccupancyGrid& grid, const std::vector<Voxe
       if (!grid.Occupied(v.x + d[f][0], v.y + d[f][1], v.z + d[f][2])) exposed |= uint8_t(1u << f);
     if (exposed == 0) continue;
     const int lx = (v.x - m.x) & 7, ly = (v.y - m.y) & 7, lz = (v.z - m.z) & 7;
-    if (bricks_.empty() || keyed[i].first != keyed[i - 1].first) {
+    if (keyed[i].first != brick_key) {
+      brick_key = keyed[i].first;
       const uint32_t at = uint32_t(targets_.size());
       if (!bricks_.empty()) bricks_.back().end = at;
       bricks_.push_back({{v.x - lx, v.y - ly, v.z - lz}, at, at});
@@ -139,173 +141,339 @@ SurfaceTargets::SurfaceTargets(const OccupancyGrid& grid, const std::vector<Voxe
   if (!bricks_.empty()) bricks_.back().end = uint32_t(targets_.size());
 }
 
-void SurfaceTargets::AppendVisible(const Vector3d& uo, size_t brick_begin, size_t brick_end, OccluderCache& cache,
-                                   std::vector<uint32_t>& visible_ids) const {
-  // Per brick scratch: at most 512 targets. A face group is one plane of a brick, held as a 64-bit
-  // mask over the plane's 8x8 positions p = u * 8 + w (u, w: the local coordinates along the
-  // plane's axes b1 = (a+1) % 3 and b2 = (a+2) % 3).
-  std::array<uint8_t, 512> visible;
-  std::array<uint8_t, 512> tried;  // bit f: face f is decided blocked, or its own ray was cast
+// The walk over a brick's face groups shared by both uses. A face group is one plane of a
+// brick, held as a 64-bit mask over the plane's 8x8 positions p = u * 8 + w (u, w: the local
+// coordinates along the plane's axes b1 = (a+1) % 3 and b2 = (a+2) % 3). `Kind` says which
+// points of a face the rays go to and records the decisions:
+//   Rect(...)        the rectangle of those points for the faces in [umin,umax] x [wmin,wmax],
+//                    and the box of voxels that may be transparent for (or near the end of)
+//                    its rays; a solid occluder must not overlap it;
+//   Mid(...)         one exact ray to a point of face (j, a, sp): seen, or the occluder hit;
+//   Skip(j)          the face's voxel needs no decision (surface visibility: seen already);
+//   Decided(...)     the group's faces decided seen and blocked.
+template <typename Kind>
+void SurfaceTargets::WalkGroups(const Vector3d& uo, const Brick& brick, OccluderCache& cache, Kind& kind) const {
   uint64_t members[3][2][8];
   uint16_t slot[3][8][64];  // target at position p of layer `layer` of axis a
-
-  for (size_t b = brick_begin; b < brick_end; ++b) {
-    const Brick& brick = bricks_[b];
-    const Target* t = &targets_[brick.begin];
-    const int n = int(brick.end - brick.begin);
-    const int base[3] = {brick.base.x, brick.base.y, brick.base.z};
-    std::fill_n(visible.begin(), n, 0);
-    std::fill_n(tried.begin(), n, 0);
-    std::fill_n(&members[0][0][0], 3 * 2 * 8, 0);
-    // Which face of a voxel in layer l faces o along axis a: 1 (+a), 0 (-a) or -1 (neither).
-    int8_t facing[3][8];
-    for (int a = 0; a < 3; ++a)
-      for (int l = 0; l < 8; ++l) {
-        const int voxel_a = base[a] + l;
-        facing[a][l] = int8_t(uo[a] > voxel_a + 1 ? 1 : uo[a] < voxel_a ? 0 : -1);
-      }
-    for (int j = 0; j < n; ++j) {
-      for (int a = 0; a < 3; ++a) {
-        const int layer = t[j].local[a];
-        const int sp = facing[a][layer];
-        if (sp < 0 || !((t[j].exposed >> (2 * a + sp)) & 1)) continue;
-        const int p = t[j].local[(a + 1) % 3] * 8 + t[j].local[(a + 2) % 3];
-        members[a][sp][layer] |= uint64_t{1} << p;
-        slot[a][layer][p] = uint16_t(j);
-      }
-    }
-
+  const Target* t = &targets_[brick.begin];
+  const int n = int(brick.end - brick.begin);
+  const int base[3] = {brick.base.x, brick.base.y, brick.base.z};
+  std::fill_n(&members[0][0][0], 3 * 2 * 8, 0);
+  for (int j = 0; j < n; ++j) {
     for (int a = 0; a < 3; ++a) {
-      const int b1 = (a + 1) % 3, b2 = (a + 2) % 3;
-      for (int sp = 0; sp < 2; ++sp) {
-        const uint8_t face_bit = uint8_t(1u << (2 * a + sp));
-        for (int layer = 0; layer < 8; ++layer) {
-          uint64_t undecided = members[a][sp][layer];
-          if (undecided == 0) continue;
-          const uint16_t* at = slot[a][layer];
-          for (uint64_t m = undecided; m; m &= m - 1) {  // seen already through another face
-            if (visible[at[std::countr_zero(m)]]) undecided &= ~(m & -m);
+      const int layer = t[j].local[a];
+      const int sp = kind.facing[a][layer];
+      if (sp < 0 || !((t[j].exposed >> (2 * a + sp)) & 1)) continue;
+      const int p = t[j].local[(a + 1) % 3] * 8 + t[j].local[(a + 2) % 3];
+      members[a][sp][layer] |= uint64_t{1} << p;
+      slot[a][layer][p] = uint16_t(j);
+    }
+  }
+
+  for (int a = 0; a < 3; ++a) {
+    const int b1 = (a + 1) % 3, b2 = (a + 2) % 3;
+    for (int sp = 0; sp < 2; ++sp) {
+      for (int layer = 0; layer < 8; ++layer) {
+        uint64_t undecided = members[a][sp][layer];
+        if (undecided == 0) continue;
+        const uint16_t* at = slot[a][layer];
+        for (uint64_t m = undecided; m; m &= m - 1) {
+          if (kind.Skip(at[std::countr_zero(m)])) undecided &= ~(m & -m);
+        }
+        uint64_t seen = 0;
+        const int voxel_a = base[a] + layer;
+        const int plane = sp ? voxel_a + 1 : voxel_a;
+        // Decides the undecided faces inside the local rectangle [u0,u1] x [w0,w1].
+        auto decide = [&](auto&& self, int u0, int u1, int w0, int w1) -> void {
+          const uint64_t sub = undecided & RectMask(u0, u1, w0, w1);
+          if (sub == 0) return;
+          const int umin = std::countr_zero(sub) >> 3, umax = (63 - std::countl_zero(sub)) >> 3;
+          uint64_t cols = sub | (sub >> 32);
+          cols |= cols >> 16;
+          cols |= cols >> 8;
+          cols &= 0xff;
+          const int wmin = std::countr_zero(cols), wmax = 31 - std::countl_zero(uint32_t(cols));
+          Vector3d q0, q1;
+          VoxelIndex klo, khi;
+          kind.Rect(a, base, plane, voxel_a, umin, umax, wmin, wmax, q0, q1, klo, khi);
+          std::array<Segment, 4> corners{Segment(uo, q0), Segment(uo, q0), Segment(uo, q0), Segment(uo, q0)};
+          for (int c = 1; c < 4; ++c) {
+            Vector3d q = q0;
+            if (c & 1) q[b1] = q1[b1];
+            if (c & 2) q[b2] = q1[b2];
+            corners[c] = Segment(uo, q);
           }
-          uint64_t seen = 0;
-          const int voxel_a = base[a] + layer;
-          const int plane = sp ? voxel_a + 1 : voxel_a;
-          // Decides the undecided faces inside the local rectangle `rect` (a mask).
-          auto decide = [&](auto&& self, int u0, int u1, int w0, int w1) -> void {
-            const uint64_t rect = RectMask(u0, u1, w0, w1);
-            const uint64_t sub = undecided & rect;
-            if (sub == 0) return;
-            const int umin = std::countr_zero(sub) >> 3, umax = (63 - std::countl_zero(sub)) >> 3;
-            uint64_t cols = sub | (sub >> 32);
-            cols |= cols >> 16;
-            cols |= cols >> 8;
-            cols &= 0xff;
-            const int wmin = std::countr_zero(cols), wmax = 31 - std::countl_zero(uint32_t(cols));
-            // The rectangle of face centres, and the voxels that are transparent for its rays.
-            Vector3d q0, q1;
-            q0[a] = q1[a] = plane;
-            q0[b1] = base[b1] + umin + 0.5, q1[b1] = base[b1] + umax + 0.5;
-            q0[b2] = base[b2] + wmin + 0.5, q1[b2] = base[b2] + wmax + 0.5;
-            int keep_lo[3], keep_hi[3];
-            keep_lo[a] = keep_hi[a] = voxel_a;
-            keep_lo[b1] = base[b1] + umin, keep_hi[b1] = base[b1] + umax;
-            keep_lo[b2] = base[b2] + wmin, keep_hi[b2] = base[b2] + wmax;
-            const VoxelIndex klo{keep_lo[0], keep_lo[1], keep_lo[2]}, khi{keep_hi[0], keep_hi[1], keep_hi[2]};
-            std::array<Segment, 4> corners{Segment(uo, q0), Segment(uo, q0), Segment(uo, q0), Segment(uo, q0)};
-            for (int c = 1; c < 4; ++c) {
-              Vector3d q = q0;
-              if (c & 1) q[b1] = q1[b1];
-              if (c & 2) q[b2] = q1[b2];
-              corners[c] = Segment(uo, q);
-            }
-            auto blocks_all = [&](const SolidBox& box) {
-              const bool overlaps = box.lo.x <= khi.x && box.hi.x >= klo.x && box.lo.y <= khi.y && box.hi.y >= klo.y &&
-                                    box.lo.z <= khi.z && box.hi.z >= klo.z;
-              if (overlaps) return false;
-              for (const Segment& c : corners)
-                if (!PassesThroughInterior(c, box)) return false;
-              return true;
-            };
-            const bool single = (sub & (sub - 1)) == 0;
-            if (!single && cache.Any(blocks_all)) {
+          auto blocks_all = [&](const SolidBox& box) {
+            const bool overlaps = box.lo.x <= khi.x && box.hi.x >= klo.x && box.lo.y <= khi.y && box.hi.y >= klo.y &&
+                                  box.lo.z <= khi.z && box.hi.z >= klo.z;
+            if (overlaps) return false;
+            for (const Segment& c : corners)
+              if (!PassesThroughInterior(c, box)) return false;
+            return true;
+          };
+          const bool single = (sub & (sub - 1)) == 0;
+          if (!single) {
+            if (const SolidBox* box = cache.FindIf(blocks_all)) {
               undecided &= ~sub;  // all blocked
+              kind.BlockedGroup(a, sp, plane, umin, umax, wmin, wmax, sub, at, *box);
               return;
             }
-            // One exact ray to the face nearest the rectangle's middle.
-            const int cu2 = umin + umax, cw2 = wmin + wmax;
-            int mid = -1, best = 1 << 30;
-            for (uint64_t m = sub; m; m &= m - 1) {
-              const int p = std::countr_zero(m);
-              const int d = std::abs(2 * (p >> 3) - cu2) + std::abs(2 * (p & 7) - cw2);
-              if (d < best) best = d, mid = p;
-            }
-            const Target& tm = t[at[mid]];
-            const VoxelIndex v{base[0] + tm.local[0], base[1] + tm.local[1], base[2] + tm.local[2]};
-            Vector3d target(v.x + 0.5, v.y + 0.5, v.z + 0.5);
-            target[a] = plane;
-            const bool cache_blocks = cache.Blocks(uo, target, v);
-            const std::optional<VoxelIndex> hit = cache_blocks ? std::nullopt : FirstOccupied(grid_, uo, target, &v);
-            undecided &= ~(uint64_t{1} << mid);
-            if (!cache_blocks && !hit) {
-              seen |= uint64_t{1} << mid;
-              if (single) return;
-              if (FreeCone(grid_, uo, a, sp == 1, plane, q0, q1)) {
-                seen |= sub;
-                undecided &= ~sub;
-                return;
-              }
-            } else if (hit) {
-              const SolidBox* cached = cache.Find(*hit);
-              const SolidBox box = cached ? *cached : GrowSolidBox(grid_, *hit, kGrowLimit);
-              if (!cached) cache.Add(box);
-              if (!single && blocks_all(box)) {
-                undecided &= ~sub;
-                return;
-              }
-            }
-            if (single || std::popcount(sub) <= kMinSplit) return;
-            const int um = (u0 + u1) / 2, wm = (w0 + w1) / 2;
-            self(self, u0, um, w0, wm);
-            if (um < u1) self(self, um + 1, u1, w0, wm);
-            if (wm < w1) self(self, u0, um, wm + 1, w1);
-            if (um < u1 && wm < w1) self(self, um + 1, u1, wm + 1, w1);
-          };
-          decide(decide, 0, 7, 0, 7);
-          // Write back: seen faces make their voxel visible; decided, unseen faces are blocked.
-          for (uint64_t m = members[a][sp][layer] & ~undecided; m; m &= m - 1) {
+          }
+          // One exact ray to the face nearest the rectangle's middle.
+          const int cu2 = umin + umax, cw2 = wmin + wmax;
+          int mid = -1, best = 1 << 30;
+          for (uint64_t m = sub; m; m &= m - 1) {
             const int p = std::countr_zero(m);
-            if ((seen >> p) & 1) {
-              visible[at[p]] = 1;
-            } else {
-              tried[at[p]] |= face_bit;
+            const int d = std::abs(2 * (p >> 3) - cu2) + std::abs(2 * (p & 7) - cw2);
+            if (d < best) best = d, mid = p;
+          }
+          std::optional<VoxelIndex> occluder;
+          const bool mid_seen = kind.Mid(at[mid], a, sp, plane, cache, occluder);
+          if (kind.kMidDecidesFace) {
+            undecided &= ~(uint64_t{1} << mid);
+            if (mid_seen) seen |= uint64_t{1} << mid;
+            if (single) return;
+          }
+          if (mid_seen) {
+            if (FreeCone(grid_, uo, a, sp == 1, plane, q0, q1)) {
+              seen |= sub;
+              undecided &= ~sub;
+              kind.SeenGroup(a, sp, plane, umin, umax, wmin, wmax, sub, at);
+              return;
+            }
+          } else if (occluder) {
+            const SolidBox* cached = cache.Find(*occluder);
+            const SolidBox box = cached ? *cached : GrowSolidBox(grid_, *occluder, kGrowLimit);
+            if (!cached) cache.Add(box);
+            if (blocks_all(box)) {
+              undecided &= ~sub;
+              kind.BlockedGroup(a, sp, plane, umin, umax, wmin, wmax, sub, at, box);
+              return;
             }
           }
-        }
+          if (single || std::popcount(sub) <= kMinSplit) return;
+          const int um = (u0 + u1) / 2, wm = (w0 + w1) / 2;
+          self(self, u0, um, w0, wm);
+          if (um < u1) self(self, um + 1, u1, w0, wm);
+          if (wm < w1) self(self, u0, um, wm + 1, w1);
+          if (um < u1 && wm < w1) self(self, um + 1, u1, wm + 1, w1);
+        };
+        decide(decide, 0, 7, 0, 7);
+        kind.Decided(a, sp, members[a][sp][layer] & ~undecided, seen, at);
       }
     }
+  }
+}
+
+namespace {
+
+// Which face of a voxel in layer l of a brick faces o along axis a: 1 (+a), 0 (-a) or -1.
+void FacingTable(const Vector3d& uo, const int base[3], int8_t facing[3][8]) {
+  for (int a = 0; a < 3; ++a)
+    for (int l = 0; l < 8; ++l) {
+      const int voxel_a = base[a] + l;
+      facing[a][l] = int8_t(uo[a] > voxel_a + 1 ? 1 : uo[a] < voxel_a ? 0 : -1);
+    }
+}
+
+}  // namespace
+
+// Surface visibility: rays to face centres; a face's own voxel is transparent.
+struct SurfaceTargets::CentreKind {
+  static constexpr bool kMidDecidesFace = true;
+  const OccupancyGrid& grid;
+  const Vector3d& uo;
+  const Target* t;
+  const int* base;
+  int8_t facing[3][8];
+  std::array<uint8_t, 512> visible;
+  std::array<uint8_t, 512> tried;  // bit f: face f is decided blocked, or its own ray was cast
+
+  VoxelIndex VoxelOf(int j) const { return {base[0] + t[j].local[0], base[1] + t[j].local[1], base[2] + t[j].local[2]}; }
+  bool Skip(int j) const { return visible[j]; }
+  void Rect(int a, const int b[3], int plane, int voxel_a, int umin, int umax, int wmin, int wmax, Vector3d& q0,
+            Vector3d& q1, VoxelIndex& klo, VoxelIndex& khi) const {
+    const int b1 = (a + 1) % 3, b2 = (a + 2) % 3;
+    q0[a] = q1[a] = plane;
+    q0[b1] = b[b1] + umin + 0.5, q1[b1] = b[b1] + umax + 0.5;
+    q0[b2] = b[b2] + wmin + 0.5, q1[b2] = b[b2] + wmax + 0.5;
+    int lo[3], hi[3];
+    lo[a] = hi[a] = voxel_a;
+    lo[b1] = b[b1] + umin, hi[b1] = b[b1] + umax;
+    lo[b2] = b[b2] + wmin, hi[b2] = b[b2] + wmax;
+    klo = {lo[0], lo[1], lo[2]}, khi = {hi[0], hi[1], hi[2]};
+  }
+  bool Mid(int j, int a, int, int plane, OccluderCache& cache, std::optional<VoxelIndex>& occluder) {
+    const VoxelIndex v = VoxelOf(j);
+    Vector3d target(v.x + 0.5, v.y + 0.5, v.z + 0.5);
+    target[a] = plane;
+    if (cache.Blocks(uo, target, v)) return false;
+    occluder = FirstOccupied(grid, uo, target, &v);
+    return !occluder;
+  }
+  void SeenGroup(int, int, int, int, int, int, int, uint64_t, const uint16_t*) {}
+  void BlockedGroup(int, int, int, int, int, int, int, uint64_t, const uint16_t*, const SolidBox&) {}
+  void Decided(int a, int sp, uint64_t decided, uint64_t seen, const uint16_t* at) {
+    const uint8_t face_bit = uint8_t(1u << (2 * a + sp));
+    for (uint64_t m = decided; m; m &= m - 1) {
+      const int p = std::countr_zero(m);
+      if ((seen >> p) & 1) {
+        visible[at[p]] = 1;
+      } else {
+        tried[at[p]] |= face_bit;
+      }
+    }
+  }
+};
+
+void SurfaceTargets::AppendVisible(const Vector3d& uo, size_t brick_begin, size_t brick_end, OccluderCache& cache,
+                                   std::vector<uint32_t>& visible_ids) const {
+  for (size_t b = brick_begin; b < brick_end; ++b) {
+    const Brick& brick = bricks_[b];
+    const int base[3] = {brick.base.x, brick.base.y, brick.base.z};
+    const int n = int(brick.end - brick.begin);
+    CentreKind kind{grid_, uo, &targets_[brick.begin], base, {}, {}, {}};
+    FacingTable(uo, base, kind.facing);
+    std::fill_n(kind.visible.begin(), n, 0);
+    std::fill_n(kind.tried.begin(), n, 0);
+    WalkGroups(uo, brick, cache, kind);
 
     // What no group decided: ray by ray, as IsSurfaceVisible.
+    const Target* t = kind.t;
     for (int j = 0; j < n; ++j) {
-      if (!visible[j]) {
-        const VoxelIndex v{base[0] + t[j].local[0], base[1] + t[j].local[1], base[2] + t[j].local[2]};
-        for (int a = 0; a < 3 && !visible[j]; ++a) {
-          const int sp = facing[a][t[j].local[a]];
+      if (!kind.visible[j]) {
+        const VoxelIndex v = kind.VoxelOf(j);
+        for (int a = 0; a < 3 && !kind.visible[j]; ++a) {
+          const int sp = kind.facing[a][t[j].local[a]];
           if (sp < 0) continue;
-          const int voxel_a = At(v, a);
           const int f = 2 * a + sp;
-          if (!((t[j].exposed >> f) & 1) || ((tried[j] >> f) & 1)) continue;
+          if (!((t[j].exposed >> f) & 1) || ((kind.tried[j] >> f) & 1)) continue;
           Vector3d target(v.x + 0.5, v.y + 0.5, v.z + 0.5);
-          target[a] = sp ? voxel_a + 1 : voxel_a;
+          target[a] = sp ? At(v, a) + 1 : At(v, a);
           if (cache.Blocks(uo, target, v)) continue;
           const auto hit = FirstOccupied(grid_, uo, target, &v);
           if (!hit) {
-            visible[j] = 1;
+            kind.visible[j] = 1;
           } else {
             cache.Add(*hit);
           }
         }
       }
-      if (visible[j]) visible_ids.push_back(t[j].id);
+      if (kind.visible[j]) visible_ids.push_back(t[j].id);
     }
+  }
+}
+
+// Corner visibility (ALGORITHM.md s.4): rays to lattice corners; a corner counts as seen when the
+// first occupied voxel is none or one of the 8 voxels around it. With the faces' plane at
+// u[a] = P and o strictly on one side, a walk to a corner on that plane stays on o's side until
+// it is within rounding of the corner, where every voxel it visits is one of those 8. So the
+// free cone proves every corner of its faces seen, and a solid box outside the 8-voxel blocks of
+// all the group's corners proves them all blocked (a walk meets it before it enters the convex
+// block around its corner, and never leaves that block again).
+struct SurfaceTargets::CornerKind {
+  static constexpr bool kMidDecidesFace = false;
+  const OccupancyGrid& grid;
+  const Vector3d& uo;
+  const Target* t;
+  const int* base;
+  int8_t facing[3][8];
+  std::vector<CornerDecision>& out;
+
+  bool Skip(int) const { return false; }
+  void Rect(int a, const int b[3], int plane, int, int umin, int umax, int wmin, int wmax, Vector3d& q0, Vector3d& q1,
+            VoxelIndex& klo, VoxelIndex& khi) const {
+    const int b1 = (a + 1) % 3, b2 = (a + 2) % 3;
+    q0[a] = q1[a] = plane;
+    q0[b1] = b[b1] + umin, q1[b1] = b[b1] + umax + 1;
+    q0[b2] = b[b2] + wmin, q1[b2] = b[b2] + wmax + 1;
+    int lo[3], hi[3];
+    lo[a] = plane - 1, hi[a] = plane;
+    lo[b1] = b[b1] + umin - 1, hi[b1] = b[b1] + umax + 1;
+    lo[b2] = b[b2] + wmin - 1, hi[b2] = b[b2] + wmax + 1;
+    klo = {lo[0], lo[1], lo[2]}, khi = {hi[0], hi[1], hi[2]};
+  }
+  // The ray to the face's corner with the smallest in-plane coordinates.
+  bool Mid(int j, int a, int sp, int plane, OccluderCache& cache, std::optional<VoxelIndex>& occluder) {
+    VoxelIndex c{base[0] + t[j].local[0], base[1] + t[j].local[1], base[2] + t[j].local[2]};
+    (a == 0 ? c.x : a == 1 ? c.y : c.z) = plane;
+    const Vector3d end(c.x, c.y, c.z);
+    bool seen = false;
+    if (!cache.Blocks(uo, end, {c.x - 1, c.y - 1, c.z - 1}, c)) {
+      const auto hit = FirstOccupied(grid, uo, end);
+      const bool near = hit && (hit->x == c.x || hit->x == c.x - 1) && (hit->y == c.y || hit->y == c.y - 1) &&
+                        (hit->z == c.z || hit->z == c.z - 1);
+      seen = !hit || near;
+      if (hit && !near) occluder = hit;
+    }
+    // Corner number of c in voxel j: bit a set on the + side, other bits 0.
+    out.push_back({t[j].id, uint8_t(sp ? 1u << a : 0u), 0xff, seen});
+    return seen;
+  }
+  void Decided(int a, int sp, uint64_t decided, uint64_t seen, const uint16_t* at) {
+    for (uint64_t m = decided; m; m &= m - 1) {
+      const int p = std::countr_zero(m);
+      out.push_back({t[at[p]].id, 0, uint8_t(2 * a + sp), bool((seen >> p) & 1)});
+    }
+  }
+  // The back corners: the group's voxels' corners on their other plane (back = plane -+ 1),
+  // one layer beyond the faces. A walk to a back corner crosses the front plane, then the
+  // voxel layer; when every segment of the group moves less than one voxel along the plane per
+  // voxel across it (by a margin), the part inside the layer stays among the 8 voxels around
+  // its corner. So the front plane's certificates carry over to the back corners' rectangle.
+  void BackRect(int a, int sp, int plane, int umin, int umax, int wmin, int wmax, Vector3d& q0, Vector3d& q1,
+                VoxelIndex& klo, VoxelIndex& khi) const {
+    Rect(a, base, plane, 0, umin, umax, wmin, wmax, q0, q1, klo, khi);
+    const int back = sp ? plane - 1 : plane + 1;
+    q0[a] = q1[a] = back;
+    (a == 0 ? klo.x : a == 1 ? klo.y : klo.z) = back - 1;
+    (a == 0 ? khi.x : a == 1 ? khi.y : khi.z) = back;
+  }
+  bool Steep(int a, const Vector3d& q0, const Vector3d& q1) const {
+    constexpr double kSlopeMargin = 1e-6;
+    const double across = std::abs(q0[a] - uo[a]) * (1 - kSlopeMargin);
+    for (int i = 0; i < 3; ++i) {
+      if (i == a) continue;
+      if (std::abs(q0[i] - uo[i]) >= across || std::abs(q1[i] - uo[i]) >= across) return false;
+    }
+    return true;
+  }
+  void BackDecided(int a, int sp, uint64_t sub, const uint16_t* at, bool seen) {
+    for (uint64_t m = sub; m; m &= m - 1) out.push_back({t[at[std::countr_zero(m)]].id, 0, uint8_t(2 * a + (1 - sp)), seen});
+  }
+  void SeenGroup(int a, int sp, int plane, int umin, int umax, int wmin, int wmax, uint64_t sub, const uint16_t* at) {
+    Vector3d q0, q1;
+    VoxelIndex klo, khi;
+    BackRect(a, sp, plane, umin, umax, wmin, wmax, q0, q1, klo, khi);
+    if (Steep(a, q0, q1) && FreeCone(grid, uo, a, sp == 1, plane, q0, q1)) BackDecided(a, sp, sub, at, true);
+  }
+  void BlockedGroup(int a, int sp, int plane, int umin, int umax, int wmin, int wmax, uint64_t sub, const uint16_t* at,
+                    const SolidBox& box) {
+    Vector3d q0, q1;
+    VoxelIndex klo, khi;
+    BackRect(a, sp, plane, umin, umax, wmin, wmax, q0, q1, klo, khi);
+    const bool overlaps = box.lo.x <= khi.x && box.hi.x >= klo.x && box.lo.y <= khi.y && box.hi.y >= klo.y &&
+                          box.lo.z <= khi.z && box.hi.z >= klo.z;
+    if (overlaps) return;
+    const int b1 = (a + 1) % 3, b2 = (a + 2) % 3;
+    for (int c = 0; c < 4; ++c) {
+      Vector3d q = q0;
+      if (c & 1) q[b1] = q1[b1];
+      if (c & 2) q[b2] = q1[b2];
+      if (!PassesThroughInterior(Segment(uo, q), box)) return;
+    }
+    BackDecided(a, sp, sub, at, false);
+  }
+};
+
+void SurfaceTargets::AppendCornerDecisions(const Vector3d& uo, size_t brick_begin, size_t brick_end,
+                                           OccluderCache& cache, std::vector<CornerDecision>& decisions) const {
+  for (size_t b = brick_begin; b < brick_end; ++b) {
+    const Brick& brick = bricks_[b];
+    const int base[3] = {brick.base.x, brick.base.y, brick.base.z};
+    CornerKind kind{grid_, uo, &targets_[brick.begin], base, {}, decisions};
+    FacingTable(uo, base, kind.facing);
+    WalkGroups(uo, brick, cache, kind);
   }
 }
 

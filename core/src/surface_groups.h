@@ -20,11 +20,26 @@ class SurfaceTargets {
 
   size_t brick_count() const { return bricks_.size(); }
 
+  // A corner-visibility decision for voxel `id`: either one corner (face == 0xff; corner number
+  // k, bit 0: +x, bit 1: +y, bit 2: +z) or all 4 corners of face `face`.
+  struct CornerDecision {
+    uint32_t id;
+    uint8_t corner;
+    uint8_t face;
+    bool seen;
+  };
+
   // Appends to `visible` the id of every target in bricks [brick_begin, brick_end) that is
   // surface-visible from uo (index space; uo must not lie in an occupied voxel). `cache` carries
   // occluders between calls for the same viewpoint.
   void AppendVisible(const Eigen::Vector3d& uo, size_t brick_begin, size_t brick_end, OccluderCache& cache,
                      std::vector<uint32_t>& visible) const;
+
+  // Appends corner-visibility decisions (ALGORITHM.md s.4, the 8-voxel corner rule) that groups
+  // of faces facing uo in bricks [brick_begin, brick_end) prove; corners not mentioned are
+  // undecided. One corner may be decided more than once, always the same way.
+  void AppendCornerDecisions(const Eigen::Vector3d& uo, size_t brick_begin, size_t brick_end, OccluderCache& cache,
+                             std::vector<CornerDecision>& decisions) const;
 
  private:
   struct Target {
@@ -36,6 +51,11 @@ class SurfaceTargets {
     VoxelIndex base;  // smallest voxel index of the brick
     uint32_t begin, end;
   };
+
+  struct CentreKind;
+  struct CornerKind;
+  template <typename Kind>
+  void WalkGroups(const Eigen::Vector3d& uo, const Brick& brick, OccluderCache& cache, Kind& kind) const;
 
   const OccupancyGrid& grid_;
   std::vector<Target> targets_;

@@ -105,7 +105,34 @@ bool SurfaceVisibleCached(const OccupancyGrid& g, const Vector3d& uo, const Voxe
   return false;
 }
 
+// True if the segment uo->c passes, half a voxel before reaching c's plane along some axis,
+// through the interior of an occupied voxel that is not one of the 8 around c. The segment is
+// outside the (convex) 2x2x2 block around c there, so the walk meets that voxel before any of
+// the 8: c is not seen. This catches the surface's own layer hiding the corners behind it at
+// grazing angles, without a walk.
+bool LastLayerBlocksCorner(const OccupancyGrid& g, const Vector3d& uo, const VoxelIndex& c) {
+  constexpr double kMargin = internal::kInteriorMargin;
+  const Vector3d end(c.x, c.y, c.z);
+  for (int a = 0; a < 3; ++a) {
+    const double across = std::abs(uo[a] - end[a]);
+    if (across < 1) continue;
+    const Vector3d p = end + (uo - end) * (0.5 / across);
+    VoxelIndex h;
+    bool interior = true, near = true;
+    for (int i = 0; i < 3; ++i) {
+      const double f = std::floor(p[i]);
+      interior = interior && p[i] - f > kMargin && p[i] - f < 1 - kMargin;
+      const int hi = int(f), ci = i == 0 ? c.x : i == 1 ? c.y : c.z;
+      near = near && (hi == ci || hi == ci - 1);
+      (i == 0 ? h.x : i == 1 ? h.y : h.z) = hi;
+    }
+    if (interior && !near && g.Occupied(h)) return true;
+  }
+  return false;
+}
+
 bool CornerVisibleCached(const OccupancyGrid& g, const Vector3d& uo, const VoxelIndex& c, OccluderCache& cache) {
+  if (LastLayerBlocksCorner(g, uo, c)) return false;
   // Occluders in the 2x2x2 block around c do not count: once a segment enters that (convex)
   // block it stays inside it up to c, so every voxel outside it is visited first.
   const Vector3d end(c.x, c.y, c.z);
@@ -480,12 +507,46 @@ Result<Evaluation> Evaluate(const VoxelScene& scene, const std::vector<WorldPoin
   constexpr uint64_t kVoxelChunk = 4096;
   const uint64_t voxel_chunks = (n + kVoxelChunk - 1) / kVoxelChunk;
   StageProgress progress(ctx, "evaluate", nv);
+  // Corners that groups of faces decide at once (surface_groups.h), per viewpoint.
+  std::vector<uint32_t> exposed_ids;
+  for (size_t i = 0; i < n; ++i)
+    if (!Enclosed(g, index[i])) exposed_ids.push_back(uint32_t(i));
+  const internal::SurfaceTargets targets(g, index, exposed_ids);
+  constexpr uint64_t kBricksPerTask = 256;
+  const uint64_t brick_chunks = (targets.brick_count() + kBricksPerTask - 1) / kBricksPerTask;
+  std::vector<uint64_t> decided_bits(visible_bits.size());
   for (size_t k = 0; k < nv; ++k) {
-    // 1. One ray per corner.
+    // 1. Corners decided by face groups, then one ray per remaining corner. Tasks share words
+    // of the bitsets, so the group pass sets bits atomically.
     std::fill(visible_bits.begin(), visible_bits.end(), 0);
+    std::fill(decided_bits.begin(), decided_bits.end(), 0);
+    if (!options.per_corner && !InsideOccupied(g, uo[k])) {
+      VC_RETURN_IF_ERROR(ParallelChunks(brick_chunks, 1, options.threads, ctx, [&](uint64_t task, uint64_t, uint64_t) {
+        OccluderCache cache;
+        std::vector<internal::SurfaceTargets::CornerDecision> decisions;
+        const size_t b0 = task * kBricksPerTask, b1 = std::min<size_t>(b0 + kBricksPerTask, targets.brick_count());
+        targets.AppendCornerDecisions(uo[k], b0, b1, cache, decisions);
+        auto set = [](std::vector<uint64_t>& bits, uint32_t c) {
+          std::atomic_ref<uint64_t>(bits[c >> 6]).fetch_or(uint64_t{1} << (c & 63), std::memory_order_relaxed);
+        };
+        for (const auto& d : decisions) {
+          auto apply = [&](int q) {
+            const uint32_t c = voxel_corners[d.id][q];
+            set(decided_bits, c);
+            if (d.seen) set(visible_bits, c);
+          };
+          if (d.face == 0xff) {
+            apply(d.corner);
+          } else {
+            for (int q : kFaceCorners[d.face]) apply(q);
+          }
+        }
+      }));
+    }
     VC_RETURN_IF_ERROR(ParallelChunks(corners.size(), kCornerChunk, options.threads, ctx, [&](uint64_t, uint64_t b, uint64_t e) {
       OccluderCache cache;
       for (uint64_t c = b; c < e; ++c) {
+        if ((decided_bits[c >> 6] >> (c & 63)) & 1) continue;
         if (CornerVisibleCached(g, uo[k], UnpackCorner(corners[c]), cache)) visible_bits[c >> 6] |= uint64_t{1} << (c & 63);
       }
     }));

@@ -57,6 +57,29 @@ size_t ExpectSameSets(const VoxelScene& s, const std::vector<WorldPoint>& vps, c
   return visible;
 }
 
+// Exact evaluation with corners decided by face groups must give every face the same V as with
+// one ray per corner.
+void ExpectSameEvaluation(const VoxelScene& s, const std::vector<WorldPoint>& vps, const std::string& what) {
+  EvaluateOptions grouped;
+  grouped.threads = 2;
+  grouped.keep_per_viewpoint_values = true;
+  EvaluateOptions per_corner = grouped;
+  per_corner.per_corner = true;
+  auto a = Evaluate(s, vps, grouped);
+  auto b = Evaluate(s, vps, per_corner);
+  ASSERT_TRUE(a.ok() && b.ok()) << what;
+  size_t mismatches = 0, seen = 0;
+  for (size_t k = 0; k < vps.size(); ++k) {
+    for (size_t i = 0; i < a->per_viewpoint_face_values[k].size(); ++i) {
+      mismatches += a->per_viewpoint_face_values[k][i] != b->per_viewpoint_face_values[k][i];
+      seen += b->per_viewpoint_face_values[k][i] > 0;
+    }
+  }
+  EXPECT_EQ(mismatches, 0u) << what;
+  EXPECT_GT(seen, 0u) << what;
+  EXPECT_EQ(a->overall.global_visibility, b->overall.global_visibility) << what;
+}
+
 std::vector<WorldPoint> Candidates(const VoxelScene& s, size_t every) {
   auto grid = planner::GenerateCandidates(s, {});
   EXPECT_TRUE(grid.ok());
@@ -127,6 +150,35 @@ TEST(GroupedSurfaceVisibilityTest, SameSetsAsPerVoxelOnGeb079) {
   Result<VoxelScene> s = Voxelize(*in, vo);
   ASSERT_TRUE(s.ok());
   EXPECT_GT(ExpectSameSets(*s, Candidates(*s, 13), "geb079"), 0u);
+}
+
+TEST(GroupedCornersTest, SameFaceValuesAsPerCornerOnSyntheticScenes) {
+  for (const char* spec : {"hall", "rooms:3", "twofloor"}) {
+    const VoxelScene s = SyntheticScene(spec);
+    ExpectSameEvaluation(s, Candidates(s, 211), spec);
+  }
+}
+
+TEST(GroupedCornersTest, SameFaceValuesAsPerCornerOnClutteredPlanesAndGeb079) {
+  std::mt19937_64 rng(9);
+  std::vector<VoxelIndex> v;
+  std::uniform_int_distribution<int> c(0, 39);
+  for (int x = 0; x < 40; ++x)
+    for (int y = 0; y < 40; ++y) {
+      v.push_back({x, y, 0});
+      v.push_back({x, y, 25});             // ceiling
+      if ((x + y) % 7) v.push_back({0, x, y % 25});  // wall with slots
+    }
+  for (int i = 0; i < 150; ++i) v.push_back({c(rng), c(rng), 1 + c(rng) / 2});
+  const VoxelScene s = MakeScene(v);
+  ExpectSameEvaluation(s, {WorldPoint(2.05, 1.55, 1.5), WorldPoint(0.35, 3.3, 0.2), WorldPoint(3.95, 3.95, 2.45)},
+                       "cluttered");
+
+  Result<SceneInput> in = ReadSceneFile(testing::SharedDataPath("geb079/geb079.bt"));
+  ASSERT_TRUE(in.ok()) << in.status().ToString();
+  Result<VoxelScene> g = Voxelize(*in, VoxelizeOptions{});
+  ASSERT_TRUE(g.ok());
+  ExpectSameEvaluation(*g, Candidates(*g, 31), "geb079");
 }
 
 TEST(FreeConeTest, EmptySpaceIsFreeAndAnyVoxelInTheConeIsNot) {

@@ -132,6 +132,9 @@ struct EvaluateOptions {
   // Keep every viewpoint's V of every face (needed by reduction). Exact mode only; costs
   // 24 bytes per occupied voxel and viewpoint.
   bool keep_per_viewpoint_values = false;
+  // Exact mode: decide every lattice corner by its own ray instead of first by groups of faces
+  // (same answers, slower; kept as the reference for tests and benchmarks).
+  bool per_corner = false;
 };
 
 struct Evaluation {
