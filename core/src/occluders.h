@@ -10,16 +10,12 @@
 #include <cmath>
 
 #include "vc/core/occupancy_grid.h"
+#include "vc/core/ray_traversal.h"
 
 namespace vc::internal {
 
-// An axis-aligned box of voxels [lo, hi] (inclusive indices), all occupied.
-struct SolidBox {
-  VoxelIndex lo, hi;
-  bool Contains(const VoxelIndex& v) const {
-    return v.x >= lo.x && v.x <= hi.x && v.y >= lo.y && v.y <= hi.y && v.z >= lo.z && v.z <= hi.z;
-  }
-};
+// An axis-aligned box of voxels, all occupied.
+using SolidBox = VoxelBox;
 
 // Margin, in voxels and in the segment parameter: 1e-5 is far above the walk's rounding
 // (about 1e-9 voxels on a 4000-voxel segment) and far below anything geometric.

@@ -32,14 +32,15 @@ class SurfaceTargets {
   // Appends to `visible` the id of every target in bricks [brick_begin, brick_end) that is
   // surface-visible from uo (index space; uo must not lie in an occupied voxel). `cache` carries
   // occluders between calls for the same viewpoint.
-  void AppendVisible(const Eigen::Vector3d& uo, size_t brick_begin, size_t brick_end, OccluderCache& cache,
-                     std::vector<uint32_t>& visible) const;
+  // `free_start`: a box of free voxels around uo (GrowFreeBox); free-cone tests skip it.
+  void AppendVisible(const Eigen::Vector3d& uo, const VoxelBox& free_start, size_t brick_begin, size_t brick_end,
+                     OccluderCache& cache, std::vector<uint32_t>& visible) const;
 
   // Appends corner-visibility decisions (ALGORITHM.md s.4, the 8-voxel corner rule) that groups
   // of faces facing uo in bricks [brick_begin, brick_end) prove; corners not mentioned are
   // undecided. One corner may be decided more than once, always the same way.
-  void AppendCornerDecisions(const Eigen::Vector3d& uo, size_t brick_begin, size_t brick_end, OccluderCache& cache,
-                             std::vector<CornerDecision>& decisions) const;
+  void AppendCornerDecisions(const Eigen::Vector3d& uo, const VoxelBox& free_start, size_t brick_begin,
+                             size_t brick_end, OccluderCache& cache, std::vector<CornerDecision>& decisions) const;
 
  private:
   struct Target {
@@ -55,7 +56,8 @@ class SurfaceTargets {
   struct CentreKind;
   struct CornerKind;
   template <typename Kind>
-  void WalkGroups(const Eigen::Vector3d& uo, const Brick& brick, OccluderCache& cache, Kind& kind) const;
+  void WalkGroups(const Eigen::Vector3d& uo, const VoxelBox& free_start, const Brick& brick, OccluderCache& cache,
+                  Kind& kind) const;
 
   const OccupancyGrid& grid_;
   std::vector<Target> targets_;
@@ -65,8 +67,9 @@ class SurfaceTargets {
 // True if no occupied voxel on the viewer's side of the plane u[axis] = plane comes within
 // reach of a segment from uo to a point of the rectangle q0..q1 on that plane (q0[axis] =
 // q1[axis] = plane, q0 <= q1 on every axis; viewer_above: uo[axis] > plane, else uo[axis] < plane). Conservative: a
-// false answer proves nothing.
+// false answer proves nothing. Parts of the cone inside `free_start` (a box known to hold no
+// occupied voxel), if given, are not tested.
 bool FreeCone(const OccupancyGrid& grid, const Eigen::Vector3d& uo, int axis, bool viewer_above, int plane,
-              const Eigen::Vector3d& q0, const Eigen::Vector3d& q1);
+              const Eigen::Vector3d& q0, const Eigen::Vector3d& q1, const VoxelBox* free_start = nullptr);
 
 }  // namespace vc::internal
