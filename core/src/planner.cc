@@ -158,6 +158,11 @@ Result<PlanResult> Plan(const SceneInput& input, const PlanOptions& options, con
   if (user_candidates) {
     for (size_t i = 0; i < options.candidates.size(); ++i) {
       const WorldPoint& p = options.candidates[i];
+      if (!ViewpointInRange(p, scene.resolution_m)) {
+        return InvalidArgumentError("candidates[" + std::to_string(i) + "] (" + Num(p.x()) + ", " + Num(p.y()) + ", " +
+                                    Num(p.z()) + ") is more than " + Num(kMaxViewpointIndex * scene.resolution_m) +
+                                    " m from the origin along an axis; use coordinates in the scene's frame");
+      }
       if (scene.grid.Occupied(scene.grid.WorldToIndex(p))) {
         return InvalidArgumentError("candidates[" + std::to_string(i) + "] (" + Num(p.x()) + ", " + Num(p.y()) +
                                     ", " + Num(p.z()) + ") lies inside an occupied voxel");

@@ -39,6 +39,19 @@ constexpr double kConeMargin = 1e-4;
 
 int At(const VoxelIndex& v, int axis) { return axis == 0 ? v.x : axis == 1 ? v.y : v.z; }
 
+// floor(x) as an int, for |x| well inside the int range (index-space coordinates here): cheaper
+// than std::floor without SSE4.1, and exact.
+int FloorInt(double x) {
+  const int i = int(x);
+  return i - (x < double(i));
+}
+
+// True if mask has more than k bits set.
+bool MoreThan(uint64_t mask, int k) {
+  for (int i = 0; i < k && mask; ++i) mask &= mask - 1;
+  return mask != 0;
+}
+
 // Positions p = u * 8 + w with u in [u0, u1] and w in [w0, w1].
 uint64_t RectMask(int u0, int u1, int w0, int w1) {
   const uint64_t row = ((uint64_t{2} << w1) - (uint64_t{1} << w0)) * 0x0101010101010101ull;
@@ -62,8 +75,8 @@ bool FreeCone(const OccupancyGrid& grid, const Vector3d& uo, int axis, bool view
     for (int i = 0; i < 3; ++i) {  // q0 <= q1 and s >= 0: the low end comes from q0, the high from q1
       const double l0 = uo[i] + s0 * (q0[i] - uo[i]), l1 = uo[i] + s1 * (q0[i] - uo[i]);
       const double h0 = uo[i] + s0 * (q1[i] - uo[i]), h1 = uo[i] + s1 * (q1[i] - uo[i]);
-      lo[i] = int(std::floor(std::min(l0, l1) - kConeMargin));
-      hi[i] = int(std::floor(std::max(h0, h1) + kConeMargin));
+      lo[i] = FloorInt(std::min(l0, l1) - kConeMargin);
+      hi[i] = FloorInt(std::max(h0, h1) + kConeMargin);
     }
     if (viewer_above) {
       lo[axis] = std::max(lo[axis], plane);
@@ -80,7 +93,7 @@ bool FreeCone(const OccupancyGrid& grid, const Vector3d& uo, int axis, bool view
     int rel[3];
     bool in_grid = true;
     for (int i = 0; i < 3; ++i) {
-      rel[i] = int(std::floor(c[i])) - gmin3[i];
+      rel[i] = FloorInt(c[i]) - gmin3[i];
       in_grid = in_grid && rel[i] >= 0 && rel[i] < grid.dims()[i];
     }
     if (in_grid) {
@@ -254,7 +267,7 @@ void SurfaceTargets::WalkGroups(const Vector3d& uo, const VoxelBox& free_start, 
               return;
             }
           }
-          if (single || std::popcount(sub) <= kMinSplit) return;
+          if (single || !MoreThan(sub, kMinSplit)) return;
           const int um = (u0 + u1) / 2, wm = (w0 + w1) / 2;
           self(self, u0, um, w0, wm);
           if (um < u1) self(self, um + 1, u1, w0, wm);

@@ -251,6 +251,11 @@ bool FaceInSet(const OccupancyGrid& g, const VoxelIndex& v, Face f, FaceSet set)
 
 }  // namespace
 
+bool ViewpointInRange(const WorldPoint& o, double resolution_m) {
+  if (!o.allFinite() || !(resolution_m > 0)) return false;
+  return (o / resolution_m).cwiseAbs().maxCoeff() <= kMaxViewpointIndex;
+}
+
 std::string_view SelectionTestName(SelectionTest t) {
   return t == SelectionTest::kCompatibility ? "compatibility" : "surface";
 }
@@ -337,7 +342,7 @@ Result<std::vector<VoxelSet>> ComputeVisibilitySets(const VoxelScene& scene, con
   std::vector<char> valid(viewpoints.size());
   for (size_t k = 0; k < viewpoints.size(); ++k) {
     uo[k] = g.WorldToIndexSpace(viewpoints[k]);
-    valid[k] = viewpoints[k].allFinite() && !InsideOccupied(g, uo[k]);
+    valid[k] = ViewpointInRange(viewpoints[k], g.resolution_m()) && !InsideOccupied(g, uo[k]);
   }
 
   if (options.test == SelectionTest::kSurfaceVisibility && !options.per_voxel) {
@@ -407,6 +412,11 @@ Result<Evaluation> Evaluate(const VoxelScene& scene, const std::vector<WorldPoin
   for (size_t k = 0; k < viewpoints.size(); ++k) {
     if (!viewpoints[k].allFinite()) {
       return InvalidArgumentError("viewpoint " + std::to_string(k + 1) + " has a non-finite coordinate");
+    }
+    if (!ViewpointInRange(viewpoints[k], scene.resolution_m)) {
+      return InvalidArgumentError("viewpoint " + std::to_string(k + 1) + " is more than " +
+                                  std::to_string(int64_t(kMaxViewpointIndex * scene.resolution_m)) +
+                                  " m from the origin along an axis; use coordinates in the scene's frame");
     }
   }
   const OccupancyGrid& g = scene.grid;

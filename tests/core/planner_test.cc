@@ -349,6 +349,12 @@ TEST(PlannerTest, UserCandidateInsideAnOccupiedVoxelIsRejected) {
   ASSERT_FALSE(r.ok());
   EXPECT_EQ(r.status().code(), StatusCode::kInvalidArgument);
   EXPECT_NE(r.status().message().find("candidates[1]"), std::string::npos) << r.status().message();
+  // A candidate absurdly far away is refused too, before any ray is cast.
+  o.candidates = {WorldPoint(centre.x(), centre.y(), info->floor_heights_m[0] + 1.5), WorldPoint(3e9, 0, 0)};
+  r = Plan(Synthetic("box"), o);
+  ASSERT_FALSE(r.ok());
+  EXPECT_EQ(r.status().code(), StatusCode::kInvalidArgument);
+  EXPECT_NE(r.status().message().find("from the origin"), std::string::npos) << r.status().message();
 }
 
 TEST(PlannerTest, MaxStationsStopsEarlyWithAWarning) {

@@ -294,6 +294,15 @@ TEST(EvaluateTest, RejectsNonFiniteViewpointAndBadRange) {
   EvaluateOptions opt;
   opt.scanner.max_range_m = 0.1;
   EXPECT_EQ(Evaluate(s, {WorldPoint(0, 0, 3)}, opt).status().code(), StatusCode::kInvalidArgument);
+  // Absurdly far (beyond 2^20 voxels): refused by Evaluate, sees nothing in the selection sets.
+  const WorldPoint far(0, 0, 1e12);
+  const Status st = Evaluate(s, {far}, {}).status();
+  EXPECT_EQ(st.code(), StatusCode::kInvalidArgument);
+  EXPECT_NE(st.message().find("from the origin"), std::string::npos) << st.ToString();
+  auto sets = ComputeVisibilitySets(s, {far, WorldPoint(0.5, 0.5, 3)}, {});
+  ASSERT_TRUE(sets.ok());
+  EXPECT_EQ((*sets)[0].count(), 0u);
+  EXPECT_EQ((*sets)[1].count(), 1u);
 }
 
 TEST(ComputeVisibilitySetsTest, CancellationStopsTheJob) {

@@ -63,6 +63,12 @@ double VisibilityValue(Perception p, double distance_m, double theta_rad, const 
 double FaceVisibility(const OccupancyGrid& grid, const WorldPoint& o, const VoxelIndex& v, Face f,
                       const ScannerModel& scanner);
 
+// Viewpoints farther than this many voxels from the origin along an axis are refused (Evaluate,
+// Plan) or see nothing (ComputeVisibilitySets): ray arithmetic uses int voxel indices, and a
+// scene's own voxels lie within OctoMap's 16-bit key range (+-32768).
+inline constexpr double kMaxViewpointIndex = 1 << 20;
+bool ViewpointInRange(const WorldPoint& o, double resolution_m);
+
 // --- Bulk: many viewpoints x all occupied voxels ---
 
 // A set of occupied-voxel ids (VoxelScene::occupied positions) as a bitset.
