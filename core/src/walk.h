@@ -79,19 +79,23 @@ inline bool JumpAcrossBox(const int box_lo[3], const int box_hi[3], Walk& w) {
   int steps_to_exit[3];
   bool end_inside = true;
   double t_exit = kInf;
+  int exit_axis = -1;
   for (int i = 0; i < 3; ++i) {
     const int end_i = w.cur[i] + w.step[i] * w.left[i];
     end_inside = end_inside && end_i >= box_lo[i] && end_i <= box_hi[i];
     steps_to_exit[i] = w.step[i] > 0 ? box_hi[i] - w.cur[i] : w.step[i] < 0 ? w.cur[i] - box_lo[i] : 0;
     if (w.step[i] != 0 && w.left[i] > steps_to_exit[i]) {
-      t_exit = std::min(t_exit, w.t_max[i] + steps_to_exit[i] * w.t_delta[i]);
+      const double t = w.t_max[i] + steps_to_exit[i] * w.t_delta[i];
+      if (t < t_exit) t_exit = t, exit_axis = i;
     }
   }
   if (end_inside) return false;
   for (int i = 0; i < 3; ++i) {
     if (w.left[i] == 0 || !(w.t_max[i] < t_exit)) continue;
-    // Crossings of axis i strictly before t_exit, never past the box or the walk's end.
-    int n = int(std::ceil((t_exit - w.t_max[i]) / w.t_delta[i]));
+    // Crossings of axis i strictly before t_exit, never past the box or the walk's end. For the
+    // axis that defines t_exit the quotient is steps_to_exit up to rounding, and the clamp makes
+    // it exactly that: no division needed.
+    int n = i == exit_axis ? steps_to_exit[i] : int(std::ceil((t_exit - w.t_max[i]) / w.t_delta[i]));
     n = std::clamp(n, 0, std::min(steps_to_exit[i], w.left[i]));
     if (n == 0) continue;
     w.cur[i] += w.step[i] * n;
