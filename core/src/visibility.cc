@@ -513,11 +513,12 @@ Result<Evaluation> Evaluate(const VoxelScene& scene, const std::vector<WorldPoin
   std::sort(corners.begin(), corners.end());
   corners.erase(std::unique(corners.begin(), corners.end()), corners.end());
   std::vector<std::array<uint32_t, 8>> voxel_corners(n);
-  for (size_t i = 0; i < n; ++i)
-    for (int q = 0; q < 8; ++q)
-      voxel_corners[i][q] =
-          uint32_t(std::lower_bound(corners.begin(), corners.end(), PackCorner(Corner(index[i], q))) - corners.begin());
-  VC_RETURN_IF_ERROR(ctx.CheckCancelled("evaluation"));
+  VC_RETURN_IF_ERROR(ParallelChunks(n, 16384, options.threads, ctx, [&](uint64_t, uint64_t b, uint64_t e) {
+    for (uint64_t i = b; i < e; ++i)
+      for (int q = 0; q < 8; ++q)
+        voxel_corners[i][q] = uint32_t(std::lower_bound(corners.begin(), corners.end(), PackCorner(Corner(index[i], q))) -
+                                       corners.begin());
+  }));
 
   std::vector<double> best(n * kFacesPerVoxel, 0.0);
   std::vector<uint8_t> best_p(n * kFacesPerVoxel, 0);
