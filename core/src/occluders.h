@@ -125,7 +125,7 @@ class OccluderCache {
   }
 
  private:
-  static constexpr int kSize = 8;
+  static constexpr int kSize = 4;
   SolidBox boxes_[kSize];
   int count_ = 0;
   int next_ = 0;
