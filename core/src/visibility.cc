@@ -506,19 +506,35 @@ Result<Evaluation> Evaluate(const VoxelScene& scene, const std::vector<WorldPoin
 
   // Exact mode. Distinct lattice corners of all occupied voxels, and each voxel's 8 corner ids.
   ev.faces_evaluated = faces_total;
+  // The voxels are sorted by (z, y, x), so for each corner number q the corners of voxels in id
+  // order form a sorted stream (a fixed offset keeps the order). Merging the 8 streams lists the
+  // distinct corners in order and gives each voxel its 8 corner ids, without a sort or a search.
+  if (std::adjacent_find(scene.occupied.begin(), scene.occupied.end(),
+                         [](const VoxelKey& a, const VoxelKey& b) { return !(a < b); }) != scene.occupied.end()) {
+    return InvalidArgumentError("the scene's voxels must be sorted and unique (VoxelScene::occupied)");
+  }
   std::vector<uint64_t> corners;
-  corners.reserve(n * 8);
-  for (size_t i = 0; i < n; ++i)
-    for (int q = 0; q < 8; ++q) corners.push_back(PackCorner(Corner(index[i], q)));
-  std::sort(corners.begin(), corners.end());
-  corners.erase(std::unique(corners.begin(), corners.end()), corners.end());
+  corners.reserve(n * 3);
   std::vector<std::array<uint32_t, 8>> voxel_corners(n);
-  VC_RETURN_IF_ERROR(ParallelChunks(n, 16384, options.threads, ctx, [&](uint64_t, uint64_t b, uint64_t e) {
-    for (uint64_t i = b; i < e; ++i)
-      for (int q = 0; q < 8; ++q)
-        voxel_corners[i][q] = uint32_t(std::lower_bound(corners.begin(), corners.end(), PackCorner(Corner(index[i], q))) -
-                                       corners.begin());
-  }));
+  {
+    constexpr uint64_t kDone = ~uint64_t{0};
+    size_t pos[8] = {0, 0, 0, 0, 0, 0, 0, 0};
+    uint64_t head[8];
+    for (int q = 0; q < 8; ++q) head[q] = n ? PackCorner(Corner(index[0], q)) : kDone;
+    while (true) {
+      const uint64_t next = *std::min_element(head, head + 8);
+      if (next == kDone) break;
+      const uint32_t id = uint32_t(corners.size());
+      corners.push_back(next);
+      for (int q = 0; q < 8; ++q) {
+        while (head[q] == next) {
+          voxel_corners[pos[q]][q] = id;
+          head[q] = ++pos[q] < n ? PackCorner(Corner(index[pos[q]], q)) : kDone;
+        }
+      }
+    }
+  }
+  VC_RETURN_IF_ERROR(ctx.CheckCancelled("evaluation"));
 
   std::vector<double> best(n * kFacesPerVoxel, 0.0);
   std::vector<uint8_t> best_p(n * kFacesPerVoxel, 0);

@@ -8,6 +8,7 @@
 #include <random>
 
 #include "../../core/src/candidates.h"
+#include "testing/scenes.h"
 #include "testing/test_paths.h"
 #include "vc/core/scene_input.h"
 #include "vc/core/synth.h"
@@ -25,15 +26,7 @@ using internal::Segment;
 using internal::SolidBox;
 
 VoxelScene MakeScene(const std::vector<VoxelIndex>& voxels, double r = 0.1) {
-  VoxelScene s;
-  s.resolution_m = r;
-  for (const auto& v : voxels) s.occupied.push_back(IndexToKey(v));
-  std::sort(s.occupied.begin(), s.occupied.end());
-  s.occupied.erase(std::unique(s.occupied.begin(), s.occupied.end()), s.occupied.end());
-  std::vector<VoxelIndex> idx;
-  for (const auto& k : s.occupied) idx.push_back(KeyToIndex(k));
-  s.grid = *OccupancyGrid::Build(r, idx, 1 << 26);
-  return s;
+  return testing::SceneOfVoxels(voxels, r);
 }
 
 // Grouped and per-voxel sets must be identical, voxel by voxel. Returns the number visible.

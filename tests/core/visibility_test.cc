@@ -5,6 +5,7 @@
 #include <cmath>
 #include <random>
 
+#include "testing/scenes.h"
 #include "vc/core/ray_traversal.h"
 
 namespace vc {
@@ -15,15 +16,7 @@ constexpr double kPi = 3.14159265358979323846;
 
 // A scene at resolution 1 m from voxel indices (index = world metres, so hand computation is easy).
 VoxelScene MakeScene(const std::vector<VoxelIndex>& voxels, double r = 1.0) {
-  VoxelScene s;
-  s.resolution_m = r;
-  for (const auto& v : voxels) s.occupied.push_back(IndexToKey(v));
-  std::sort(s.occupied.begin(), s.occupied.end());
-  s.occupied.erase(std::unique(s.occupied.begin(), s.occupied.end()), s.occupied.end());
-  std::vector<VoxelIndex> idx;
-  for (const auto& k : s.occupied) idx.push_back(KeyToIndex(k));
-  s.grid = *OccupancyGrid::Build(r, idx, 1 << 26);
-  return s;
+  return testing::SceneOfVoxels(voxels, r);
 }
 
 // ---- Hand-computed cases ----
