@@ -4,8 +4,8 @@
 #   asan     - AddressSanitizer + UndefinedBehaviorSanitizer: every test except the `slow` label
 #   tsan     - ThreadSanitizer on the tests whose concurrency is all ours (label `tsan`): the worker
 #              pool, status mapping, wire code and the multi-threaded visibility engine. The gRPC
-#              service tests are not run here: Debian's gRPC and absl are not instrumented, and their
-#              futex-based mutexes hide every happens-before edge that gRPC provides (README, Testing).
+#              service tests are not run here: Debian's gRPC, absl and protobuf are not instrumented,
+#              so tsan cannot see the ordering gRPC provides between its threads (README, Testing).
 # Usage: scripts/test.sh [--quick]   (--quick: the release preset only)
 set -euo pipefail
 cd "$(dirname "$0")/.."
