@@ -6,7 +6,8 @@
 //   from o to a face centre stays on o's side of the plane until its last voxel (a face's own
 //   voxel on the far side, which is transparent, or its free neighbour on o's side): the face
 //   centre lies on the plane, so the walk's last step along a is its final step. Every voxel the
-//   walk visits meets the segment up to rounding (about 1e-9 voxels). So if no occupied voxel on
+//   walk visits meets the segment up to rounding (below 2e-8 voxels while ShortcutsHold, which
+//   callers check). So if no occupied voxel on
 //   o's side comes within 1e-4 of any segment from o to the group's rectangle, every face of the
 //   group is reached: visible. FreeCone checks this over a cover of the cone by boxes.
 // - Solid occluder. If the segments from o to the rectangle's 4 corners all pass through the

@@ -1,7 +1,8 @@
 // Internal to vc_core: surface visibility (ALGORITHM.md s.3b) of all voxels of a scene from one
 // viewpoint, decided for whole groups of faces at once where that can be proven, and ray by ray
 // where it cannot. The answers are those of the per-voxel test (IsSurfaceVisible); the argument
-// for each shortcut is in docs/VISIBILITY.md ("Grouped surface visibility") and the tests compare
+// for each shortcut is in docs/VISIBILITY.md ("Work avoidance that keeps every answer") and the
+// tests compare
 // the two on synthetic and real scenes.
 #pragma once
 
@@ -30,7 +31,8 @@ class SurfaceTargets {
   };
 
   // Appends to `visible` the id of every target in bricks [brick_begin, brick_end) that is
-  // surface-visible from uo (index space; uo must not lie in an occupied voxel). `cache` carries
+  // surface-visible from uo (index space; uo must not lie in an occupied voxel, and
+  // ShortcutsHold(grid, uo) must be true). `cache` carries
   // occluders between calls for the same viewpoint.
   // `free_start`: a box of free voxels around uo (GrowFreeBox); free-cone tests skip it.
   void AppendVisible(const Eigen::Vector3d& uo, const VoxelBox& free_start, size_t brick_begin, size_t brick_end,
@@ -65,10 +67,11 @@ class SurfaceTargets {
 };
 
 // True if no occupied voxel on the viewer's side of the plane u[axis] = plane comes within
-// reach of a segment from uo to a point of the rectangle q0..q1 on that plane (q0[axis] =
-// q1[axis] = plane, q0 <= q1 on every axis; viewer_above: uo[axis] > plane, else uo[axis] < plane). Conservative: a
-// false answer proves nothing. Parts of the cone inside `free_start` (a box known to hold no
-// occupied voxel), if given, are not tested.
+// reach of a segment from uo to a point of the rectangle q0..q1 (q0 <= q1 on every axis;
+// viewer_above: uo[axis] > plane, else uo[axis] < plane). The rectangle normally lies on the
+// plane; the back-corner test passes one a layer beyond it, and still only o's side is tested.
+// Conservative: a false answer proves nothing. Parts of the cone inside `free_start` (a box known
+// to hold no occupied voxel), if given, are not tested.
 bool FreeCone(const OccupancyGrid& grid, const Eigen::Vector3d& uo, int axis, bool viewer_above, int plane,
               const Eigen::Vector3d& q0, const Eigen::Vector3d& q1, const VoxelBox* free_start = nullptr);
 

@@ -138,7 +138,7 @@ bool LastLayerBlocksCorner(const OccupancyGrid& g, const Vector3d& uo, const Vox
 }
 
 bool CornerVisibleCached(const OccupancyGrid& g, const Vector3d& uo, const VoxelIndex& c, OccluderCache& cache) {
-  if (LastLayerBlocksCorner(g, uo, c)) return false;
+  if (cache.enabled() && LastLayerBlocksCorner(g, uo, c)) return false;  // shortcuts hold (occluders.h)
   // Occluders in the 2x2x2 block around c do not count: once a segment enters that (convex)
   // block it stays inside it up to c, so every voxel outside it is visited first.
   const Vector3d end(c.x, c.y, c.z);
@@ -269,23 +269,26 @@ Status ScannerModel::Validate() const {
 }
 
 bool IsCompatible(const OccupancyGrid& grid, const WorldPoint& o, const VoxelIndex& v) {
+  if (!ViewpointInRange(o, grid.resolution_m())) return false;
   const Vector3d uo = grid.WorldToIndexSpace(o);
   if (InsideOccupied(grid, uo)) return false;
-  OccluderCache cache;
+  OccluderCache cache(internal::ShortcutsHold(grid, uo));
   return CompatibleCached(grid, uo, v, cache);
 }
 
 bool IsSurfaceVisible(const OccupancyGrid& grid, const WorldPoint& o, const VoxelIndex& v) {
+  if (!ViewpointInRange(o, grid.resolution_m())) return false;
   const Vector3d uo = grid.WorldToIndexSpace(o);
   if (InsideOccupied(grid, uo)) return false;
-  OccluderCache cache;
+  OccluderCache cache(internal::ShortcutsHold(grid, uo));
   return SurfaceVisibleCached(grid, uo, v, cache);
 }
 
 Perception PerceiveFace(const OccupancyGrid& grid, const WorldPoint& o, const VoxelIndex& v, Face f) {
+  if (!ViewpointInRange(o, grid.resolution_m())) return Perception::kNone;
   const Vector3d uo = grid.WorldToIndexSpace(o);
   int visible = 0;
-  OccluderCache cache;
+  OccluderCache cache(internal::ShortcutsHold(grid, uo));
   for (int k : kFaceCorners[int(f)]) visible += CornerVisibleCached(grid, uo, Corner(v, k), cache);
   return FromCount(visible);
 }
@@ -339,19 +342,21 @@ Result<std::vector<VoxelSet>> ComputeVisibilitySets(const VoxelScene& scene, con
   }
   std::vector<VoxelSet> sets(viewpoints.size(), VoxelSet(n));
   std::vector<Vector3d> uo(viewpoints.size());
-  std::vector<char> valid(viewpoints.size());
+  std::vector<char> valid(viewpoints.size()), shortcuts(viewpoints.size());
   for (size_t k = 0; k < viewpoints.size(); ++k) {
     uo[k] = g.WorldToIndexSpace(viewpoints[k]);
     valid[k] = ViewpointInRange(viewpoints[k], g.resolution_m()) && !InsideOccupied(g, uo[k]);
+    shortcuts[k] = valid[k] && internal::ShortcutsHold(g, uo[k]);
   }
+  const bool grouped = options.test == SelectionTest::kSurfaceVisibility && !options.per_voxel;
 
-  if (options.test == SelectionTest::kSurfaceVisibility && !options.per_voxel) {
-    // Grouped: tasks are (viewpoint, run of bricks); tasks of one viewpoint share its set's
-    // words, so bits are set atomically.
+  if (grouped) {
+    // Grouped, for viewpoints where the shortcuts' margins hold: tasks are (viewpoint, run of
+    // bricks); tasks of one viewpoint share its set's words, so bits are set atomically.
     const internal::SurfaceTargets targets(g, index, candidates);
     std::vector<VoxelBox> free_start(viewpoints.size());
     VC_RETURN_IF_ERROR(ParallelChunks(viewpoints.size(), 1, options.threads, ctx, [&](uint64_t k, uint64_t, uint64_t) {
-      if (valid[k]) free_start[k] = FreeBoxAround(g, uo[k]);
+      if (shortcuts[k]) free_start[k] = FreeBoxAround(g, uo[k]);
     }));
     constexpr uint64_t kBricksPerTask = 256;
     const uint64_t brick_chunks = std::max<uint64_t>(1, (targets.brick_count() + kBricksPerTask - 1) / kBricksPerTask);
@@ -359,7 +364,7 @@ Result<std::vector<VoxelSet>> ComputeVisibilitySets(const VoxelScene& scene, con
     StageProgress progress(ctx, "visibility", tasks);
     Status st = ParallelChunks(tasks, 1, options.threads, ctx, [&](uint64_t task, uint64_t, uint64_t) {
       const size_t k = task / brick_chunks, c = task % brick_chunks;
-      if (valid[k]) {
+      if (shortcuts[k]) {
         OccluderCache cache;
         std::vector<uint32_t> seen;
         const size_t b0 = c * kBricksPerTask, b1 = std::min<size_t>(b0 + kBricksPerTask, targets.brick_count());
@@ -372,11 +377,12 @@ Result<std::vector<VoxelSet>> ComputeVisibilitySets(const VoxelScene& scene, con
       progress.Add(1);
     });
     VC_RETURN_IF_ERROR(st);
-    return sets;
+    if (std::equal(valid.begin(), valid.end(), shortcuts.begin())) return sets;
   }
 
-  // Per voxel. Each chunk covers one viewpoint and a word-aligned id range, so writes to a set
-  // never share a word between chunks.
+  // Per voxel: every viewpoint, or (after the grouped pass) those too far for the shortcuts, whose
+  // rays are then walked plainly. Each chunk covers one viewpoint and a word-aligned id range, so
+  // writes to a set never share a word between chunks.
   constexpr uint64_t kIdsPerChunk = 64 * 64;
   const uint64_t id_chunks = (n + kIdsPerChunk - 1) / kIdsPerChunk;
   // Start offsets into `candidates` for each id chunk.
@@ -390,9 +396,9 @@ Result<std::vector<VoxelSet>> ComputeVisibilitySets(const VoxelScene& scene, con
   const bool compat = options.test == SelectionTest::kCompatibility;
   Status st = ParallelChunks(tasks, 1, options.threads, ctx, [&](uint64_t task, uint64_t, uint64_t) {
     const size_t k = task / id_chunks, c = task % id_chunks;
-    if (valid[k]) {
+    if (valid[k] && !(grouped && shortcuts[k])) {
       VoxelSet& set = sets[k];
-      OccluderCache cache;
+      OccluderCache cache(shortcuts[k]);
       for (size_t j = chunk_start[c]; j < chunk_start[c + 1]; ++j) {
         const uint32_t id = candidates[j];
         if (compat ? CompatibleCached(g, uo[k], index[id], cache) : SurfaceVisibleCached(g, uo[k], index[id], cache)) {
@@ -437,7 +443,11 @@ Result<Evaluation> Evaluate(const VoxelScene& scene, const std::vector<WorldPoin
   if (faces_total == 0) return ev;
 
   std::vector<Vector3d> uo(nv);
-  for (size_t k = 0; k < nv; ++k) uo[k] = g.WorldToIndexSpace(viewpoints[k]);
+  std::vector<char> shortcuts(nv);  // the shortcuts' margins hold for rays from viewpoint k
+  for (size_t k = 0; k < nv; ++k) {
+    uo[k] = g.WorldToIndexSpace(viewpoints[k]);
+    shortcuts[k] = internal::ShortcutsHold(g, uo[k]);
+  }
 
   if (options.sample_faces > 0) {
     // Unbiased uniform sample of F with replacement: pick a voxel id and a face uniformly, and
@@ -472,7 +482,7 @@ Result<Evaluation> Evaluate(const VoxelScene& scene, const std::vector<WorldPoin
         Perception best_p = Perception::kNone;
         for (size_t k = 0; k < nv; ++k) {
           int visible = 0;
-          OccluderCache cache;
+          OccluderCache cache(shortcuts[k]);
           for (int q : kFaceCorners[int(f)]) visible += CornerVisibleCached(g, uo[k], Corner(v, q), cache);
           const Perception p = FromCount(visible);
           const double val = FaceValue(p, viewpoints[k], v, f, r, options.scanner);
@@ -557,7 +567,7 @@ Result<Evaluation> Evaluate(const VoxelScene& scene, const std::vector<WorldPoin
     // of the bitsets, so the group pass sets bits atomically.
     std::fill(visible_bits.begin(), visible_bits.end(), 0);
     std::fill(decided_bits.begin(), decided_bits.end(), 0);
-    const bool grouped = !options.per_corner && !InsideOccupied(g, uo[k]);
+    const bool grouped = !options.per_corner && shortcuts[k] && !InsideOccupied(g, uo[k]);
     const VoxelBox free_start = grouped ? FreeBoxAround(g, uo[k]) : VoxelBox{};
     if (grouped) {
       VC_RETURN_IF_ERROR(ParallelChunks(brick_chunks, 1, options.threads, ctx, [&](uint64_t task, uint64_t, uint64_t) {
@@ -583,7 +593,7 @@ Result<Evaluation> Evaluate(const VoxelScene& scene, const std::vector<WorldPoin
       }));
     }
     VC_RETURN_IF_ERROR(ParallelChunks(corners.size(), kCornerChunk, options.threads, ctx, [&](uint64_t, uint64_t b, uint64_t e) {
-      OccluderCache cache;
+      OccluderCache cache(shortcuts[k]);
       for (uint64_t c = b; c < e; ++c) {
         if ((decided_bits[c >> 6] >> (c & 63)) & 1) continue;
         if (CornerVisibleCached(g, uo[k], UnpackCorner(corners[c]), cache)) {

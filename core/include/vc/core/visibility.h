@@ -138,8 +138,9 @@ struct EvaluateOptions {
   // Keep every viewpoint's V of every face (needed by reduction). Exact mode only; costs
   // 24 bytes per occupied voxel and viewpoint.
   bool keep_per_viewpoint_values = false;
-  // Exact mode: decide every lattice corner by its own ray instead of first by groups of faces
-  // (same answers, slower; kept as the reference for tests and benchmarks).
+  // Exact mode: decide every lattice corner on its own (its ray, after the per-ray shortcuts: the
+  // occluder cache and the grazing-layer test) instead of first by groups of faces (same answers,
+  // slower; kept as the reference for tests and benchmarks).
   bool per_corner = false;
 };
 
@@ -160,6 +161,8 @@ struct Evaluation {
 };
 
 // Evaluates a set of viewpoints on `scene` (s.6): G of the whole set and figures per viewpoint.
+// INVALID_ARGUMENT for a non-finite or out-of-range viewpoint, a bad scanner range, or (exact
+// mode) a scene whose voxels are not sorted and unique as VoxelScene requires.
 Result<Evaluation> Evaluate(const VoxelScene& scene, const std::vector<WorldPoint>& viewpoints,
                             const EvaluateOptions& options, const JobContext& ctx = {});
 
