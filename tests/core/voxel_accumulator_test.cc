@@ -4,17 +4,14 @@
 #include <limits>
 #include <random>
 
+#include "testing/scenes.h"
 #include "vc/core/synth.h"
 #include "vc/core/voxel_scene.h"
 
 namespace vc {
 namespace {
 
-SceneInput Cloud(std::vector<Eigen::Vector3f> pts) {
-  SceneInput in;
-  in.points = std::move(pts);
-  return in;
-}
+using testing::Cloud;
 
 Result<VoxelScene> Accumulate(const std::vector<Eigen::Vector3f>& pts, double r, uint64_t budget) {
   VoxelAccumulator acc(r, budget);

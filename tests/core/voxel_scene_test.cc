@@ -5,17 +5,14 @@
 
 #include <random>
 
+#include "testing/scenes.h"
 #include "testing/test_paths.h"
 #include "vc/core/octomap_adapter.h"
 
 namespace vc {
 namespace {
 
-SceneInput Cloud(std::vector<Eigen::Vector3f> pts) {
-  SceneInput in;
-  in.points = std::move(pts);
-  return in;
-}
+using testing::Cloud;
 
 TEST(VoxelizeTest, CloudKeysMatchOctomapKeys) {
   std::mt19937_64 rng(9);

@@ -2,8 +2,15 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <utility>
 
 namespace vc::testing {
+
+SceneInput Cloud(std::vector<Eigen::Vector3f> points) {
+  SceneInput in;
+  in.points = std::move(points);
+  return in;
+}
 
 VoxelScene SceneOfVoxels(const std::vector<VoxelIndex>& voxels, double r) {
   VoxelScene s;

@@ -1,11 +1,15 @@
-// Small scenes for tests, built straight from voxel indices.
+// Small scenes for tests, built straight from points or voxel indices.
 #pragma once
 
 #include <vector>
 
+#include "vc/core/scene_input.h"
 #include "vc/core/voxel_scene.h"
 
 namespace vc::testing {
+
+// A point-cloud input holding `points` (world, m).
+SceneInput Cloud(std::vector<Eigen::Vector3f> points);
 
 // The scene whose occupied voxels are exactly `voxels` (duplicates allowed) at resolution r (m).
 VoxelScene SceneOfVoxels(const std::vector<VoxelIndex>& voxels, double r);
