@@ -10,12 +10,16 @@
 #include <cmath>
 
 #include "vc/core/occupancy_grid.h"
-#include "vc/core/ray_traversal.h"
 
 namespace vc::internal {
 
-// An axis-aligned box of voxels, all occupied.
-using SolidBox = VoxelBox;
+// An axis-aligned box of voxels [lo, hi] (inclusive indices), all occupied.
+struct SolidBox {
+  VoxelIndex lo, hi;
+  bool Contains(const VoxelIndex& v) const {
+    return v.x >= lo.x && v.x <= hi.x && v.y >= lo.y && v.y <= hi.y && v.z >= lo.z && v.z <= hi.z;
+  }
+};
 
 // The shortcuts here and the certificates in surface_groups.cc rely on margins of 1e-6 to 1e-4
 // voxels against the walk's rounding. Along a segment of L voxels the walk's crossing parameters

@@ -111,36 +111,4 @@ std::optional<VoxelIndex> FirstOccupied(const OccupancyGrid& grid, const Eigen::
   }
 }
 
-VoxelBox GrowFreeBox(const OccupancyGrid& grid, const VoxelIndex& start, int limit) {
-  VoxelBox box{start, start};
-  if (grid.Occupied(start)) return box;
-  const VoxelIndex& gmin = grid.min_index();
-  const int s3[3] = {start.x, start.y, start.z};
-  int lo[3] = {start.x, start.y, start.z}, hi[3] = {start.x, start.y, start.z};
-  int cap_lo[3], cap_hi[3];
-  for (int i = 0; i < 3; ++i) {
-    const int g0 = i == 0 ? gmin.x : i == 1 ? gmin.y : gmin.z;
-    cap_lo[i] = std::max(s3[i] - limit, std::min(s3[i], g0 - OccupancyGrid::kBrick));
-    cap_hi[i] = std::min(s3[i] + limit, std::max(s3[i], g0 + grid.dims()[i] - 1 + OccupancyGrid::kBrick));
-  }
-  bool grew = true;
-  while (grew) {
-    grew = false;
-    for (int axis = 0; axis < 3; ++axis) {
-      for (int side = 0; side < 2; ++side) {
-        const int layer = side == 0 ? lo[axis] - 1 : hi[axis] + 1;
-        if (layer < cap_lo[axis] || layer > cap_hi[axis]) continue;
-        int l[3] = {lo[0], lo[1], lo[2]}, u[3] = {hi[0], hi[1], hi[2]};
-        l[axis] = u[axis] = layer;
-        if (grid.AnyOccupied({l[0], l[1], l[2]}, {u[0], u[1], u[2]})) continue;
-        (side == 0 ? lo[axis] : hi[axis]) = layer;
-        grew = true;
-      }
-    }
-  }
-  box.lo = {lo[0], lo[1], lo[2]};
-  box.hi = {hi[0], hi[1], hi[2]};
-  return box;
-}
-
 }  // namespace vc

@@ -63,7 +63,7 @@ uint64_t RectMask(int u0, int u1, int w0, int w1) {
 }  // namespace
 
 bool FreeCone(const OccupancyGrid& grid, const Vector3d& uo, int axis, bool viewer_above, int plane,
-              const Vector3d& q0, const Vector3d& q1, const VoxelBox* free_start) {
+              const Vector3d& q0, const Vector3d& q1) {
   double len = 0;
   for (int i = 0; i < 3; ++i) len = std::max({len, std::abs(q0[i] - uo[i]), std::abs(q1[i] - uo[i])});
   if (!(len > 0)) return false;
@@ -116,9 +116,7 @@ bool FreeCone(const OccupancyGrid& grid, const Vector3d& uo, int axis, bool view
     }
     const double s1 = std::min(1.0, s0 + kConeStep / len);
     piece(s0, s1, lo, hi);
-    const bool in_free_start = free_start && free_start->Contains({lo[0], lo[1], lo[2]}) &&
-                               free_start->Contains({hi[0], hi[1], hi[2]});
-    if (!in_free_start && lo[axis] <= hi[axis] && grid.AnyOccupied({lo[0], lo[1], lo[2]}, {hi[0], hi[1], hi[2]})) return false;
+    if (lo[axis] <= hi[axis] && grid.AnyOccupied({lo[0], lo[1], lo[2]}, {hi[0], hi[1], hi[2]})) return false;
     s0 = s1;
   }
   return true;
@@ -168,8 +166,7 @@ SurfaceTargets::SurfaceTargets(const OccupancyGrid& grid, const std::vector<Voxe
 //   Skip(j)          the face's voxel needs no decision (surface visibility: seen already);
 //   Decided(...)     the group's faces decided seen and blocked.
 template <typename Kind>
-void SurfaceTargets::WalkGroups(const Vector3d& uo, const VoxelBox& free_start, const Brick& brick,
-                                OccluderCache& cache, Kind& kind) const {
+void SurfaceTargets::WalkGroups(const Vector3d& uo, const Brick& brick, OccluderCache& cache, Kind& kind) const {
   uint64_t members[3][2][8];
   uint16_t slot[3][8][64];  // target at position p of layer `layer` of axis a
   const Target* t = &targets_[brick.begin];
@@ -252,7 +249,7 @@ void SurfaceTargets::WalkGroups(const Vector3d& uo, const VoxelBox& free_start, 
             if (single) return;
           }
           if (mid_seen) {
-            if (FreeCone(grid_, uo, a, sp == 1, plane, q0, q1, &free_start)) {
+            if (FreeCone(grid_, uo, a, sp == 1, plane, q0, q1)) {
               seen |= sub;
               undecided &= ~sub;
               kind.SeenGroup(a, sp, plane, umin, umax, wmin, wmax, sub, at);
@@ -343,8 +340,8 @@ struct SurfaceTargets::CentreKind {
   }
 };
 
-void SurfaceTargets::AppendVisible(const Vector3d& uo, const VoxelBox& free_start, size_t brick_begin,
-                                   size_t brick_end, OccluderCache& cache, std::vector<uint32_t>& visible_ids) const {
+void SurfaceTargets::AppendVisible(const Vector3d& uo, size_t brick_begin, size_t brick_end, OccluderCache& cache,
+                                   std::vector<uint32_t>& visible_ids) const {
   for (size_t b = brick_begin; b < brick_end; ++b) {
     const Brick& brick = bricks_[b];
     const int base[3] = {brick.base.x, brick.base.y, brick.base.z};
@@ -353,7 +350,7 @@ void SurfaceTargets::AppendVisible(const Vector3d& uo, const VoxelBox& free_star
     FacingTable(uo, base, kind.facing);
     std::fill_n(kind.visible.begin(), n, 0);
     std::fill_n(kind.tried.begin(), n, 0);
-    WalkGroups(uo, free_start, brick, cache, kind);
+    WalkGroups(uo, brick, cache, kind);
 
     // What no group decided: ray by ray, as IsSurfaceVisible.
     const Target* t = kind.t;
@@ -392,7 +389,6 @@ struct SurfaceTargets::CornerKind {
   static constexpr bool kMidDecidesFace = false;
   const OccupancyGrid& grid;
   const Vector3d& uo;
-  const VoxelBox& free_start;
   const Target* t;
   const int* base;
   int8_t facing[3][8];
@@ -463,7 +459,7 @@ struct SurfaceTargets::CornerKind {
     Vector3d q0, q1;
     VoxelIndex klo, khi;
     BackRect(a, sp, plane, umin, umax, wmin, wmax, q0, q1, klo, khi);
-    if (Steep(a, q0, q1) && FreeCone(grid, uo, a, sp == 1, plane, q0, q1, &free_start)) BackDecided(a, sp, sub, at, true);
+    if (Steep(a, q0, q1) && FreeCone(grid, uo, a, sp == 1, plane, q0, q1)) BackDecided(a, sp, sub, at, true);
   }
   void BlockedGroup(int a, int sp, int plane, int umin, int umax, int wmin, int wmax, uint64_t sub, const uint16_t* at,
                     const SolidBox& box) {
@@ -484,15 +480,14 @@ struct SurfaceTargets::CornerKind {
   }
 };
 
-void SurfaceTargets::AppendCornerDecisions(const Vector3d& uo, const VoxelBox& free_start, size_t brick_begin,
-                                           size_t brick_end, OccluderCache& cache,
-                                           std::vector<CornerDecision>& decisions) const {
+void SurfaceTargets::AppendCornerDecisions(const Vector3d& uo, size_t brick_begin, size_t brick_end,
+                                           OccluderCache& cache, std::vector<CornerDecision>& decisions) const {
   for (size_t b = brick_begin; b < brick_end; ++b) {
     const Brick& brick = bricks_[b];
     const int base[3] = {brick.base.x, brick.base.y, brick.base.z};
-    CornerKind kind{grid_, uo, free_start, &targets_[brick.begin], base, {}, decisions};
+    CornerKind kind{grid_, uo, &targets_[brick.begin], base, {}, decisions};
     FacingTable(uo, base, kind.facing);
-    WalkGroups(uo, free_start, brick, cache, kind);
+    WalkGroups(uo, brick, cache, kind);
   }
 }
 

@@ -34,15 +34,14 @@ class SurfaceTargets {
   // surface-visible from uo (index space; uo must not lie in an occupied voxel, and
   // ShortcutsHold(grid, uo) must be true). `cache` carries
   // occluders between calls for the same viewpoint.
-  // `free_start`: a box of free voxels around uo (GrowFreeBox); free-cone tests skip it.
-  void AppendVisible(const Eigen::Vector3d& uo, const VoxelBox& free_start, size_t brick_begin, size_t brick_end,
-                     OccluderCache& cache, std::vector<uint32_t>& visible) const;
+  void AppendVisible(const Eigen::Vector3d& uo, size_t brick_begin, size_t brick_end, OccluderCache& cache,
+                     std::vector<uint32_t>& visible) const;
 
   // Appends corner-visibility decisions (ALGORITHM.md s.4, the 8-voxel corner rule) that groups
   // of faces facing uo in bricks [brick_begin, brick_end) prove; corners not mentioned are
   // undecided. One corner may be decided more than once, always the same way.
-  void AppendCornerDecisions(const Eigen::Vector3d& uo, const VoxelBox& free_start, size_t brick_begin,
-                             size_t brick_end, OccluderCache& cache, std::vector<CornerDecision>& decisions) const;
+  void AppendCornerDecisions(const Eigen::Vector3d& uo, size_t brick_begin, size_t brick_end, OccluderCache& cache,
+                             std::vector<CornerDecision>& decisions) const;
 
  private:
   struct Target {
@@ -58,8 +57,7 @@ class SurfaceTargets {
   struct CentreKind;
   struct CornerKind;
   template <typename Kind>
-  void WalkGroups(const Eigen::Vector3d& uo, const VoxelBox& free_start, const Brick& brick, OccluderCache& cache,
-                  Kind& kind) const;
+  void WalkGroups(const Eigen::Vector3d& uo, const Brick& brick, OccluderCache& cache, Kind& kind) const;
 
   const OccupancyGrid& grid_;
   std::vector<Target> targets_;
@@ -70,9 +68,8 @@ class SurfaceTargets {
 // reach of a segment from uo to a point of the rectangle q0..q1 (q0 <= q1 on every axis;
 // viewer_above: uo[axis] > plane, else uo[axis] < plane). The rectangle normally lies on the
 // plane; the back-corner test passes one a layer beyond it, and still only o's side is tested.
-// Conservative: a false answer proves nothing. Parts of the cone inside `free_start` (a box known
-// to hold no occupied voxel), if given, are not tested.
+// Conservative: a false answer proves nothing.
 bool FreeCone(const OccupancyGrid& grid, const Eigen::Vector3d& uo, int axis, bool viewer_above, int plane,
-              const Eigen::Vector3d& q0, const Eigen::Vector3d& q1, const VoxelBox* free_start = nullptr);
+              const Eigen::Vector3d& q0, const Eigen::Vector3d& q1);
 
 }  // namespace vc::internal

@@ -59,12 +59,6 @@ bool InsideOccupied(const OccupancyGrid& g, const Vector3d& u) {
   return g.Occupied(int(std::floor(u.x())), int(std::floor(u.y())), int(std::floor(u.z())));
 }
 
-// The box of free voxels around a viewpoint that every ray from it crosses in one jump.
-VoxelBox FreeBoxAround(const OccupancyGrid& g, const Vector3d& uo) {
-  constexpr int kLimit = 4096;
-  return GrowFreeBox(g, {int(std::floor(uo.x())), int(std::floor(uo.y())), int(std::floor(uo.z()))}, kLimit);
-}
-
 bool CompatibleCached(const OccupancyGrid& g, const Vector3d& uo, const VoxelIndex& v, OccluderCache& cache) {
   const Vector3d target(v.x + 0.5, v.y + 0.5, v.z + 0.5);
   if (cache.Blocks(uo, target, v)) return false;
@@ -354,10 +348,6 @@ Result<std::vector<VoxelSet>> ComputeVisibilitySets(const VoxelScene& scene, con
     // Grouped, for viewpoints where the shortcuts' margins hold: tasks are (viewpoint, run of
     // bricks); tasks of one viewpoint share its set's words, so bits are set atomically.
     const internal::SurfaceTargets targets(g, index, candidates);
-    std::vector<VoxelBox> free_start(viewpoints.size());
-    VC_RETURN_IF_ERROR(ParallelChunks(viewpoints.size(), 1, options.threads, ctx, [&](uint64_t k, uint64_t, uint64_t) {
-      if (shortcuts[k]) free_start[k] = FreeBoxAround(g, uo[k]);
-    }));
     constexpr uint64_t kBricksPerTask = 256;
     const uint64_t brick_chunks = std::max<uint64_t>(1, (targets.brick_count() + kBricksPerTask - 1) / kBricksPerTask);
     const uint64_t tasks = viewpoints.size() * brick_chunks;
@@ -368,7 +358,7 @@ Result<std::vector<VoxelSet>> ComputeVisibilitySets(const VoxelScene& scene, con
         OccluderCache cache;
         std::vector<uint32_t> seen;
         const size_t b0 = c * kBricksPerTask, b1 = std::min<size_t>(b0 + kBricksPerTask, targets.brick_count());
-        targets.AppendVisible(uo[k], free_start[k], b0, b1, cache, seen);
+        targets.AppendVisible(uo[k], b0, b1, cache, seen);
         std::vector<uint64_t>& words = sets[k].words();
         for (uint32_t id : seen) {
           std::atomic_ref<uint64_t>(words[id >> 6]).fetch_or(uint64_t{1} << (id & 63), std::memory_order_relaxed);
@@ -568,13 +558,12 @@ Result<Evaluation> Evaluate(const VoxelScene& scene, const std::vector<WorldPoin
     std::fill(visible_bits.begin(), visible_bits.end(), 0);
     std::fill(decided_bits.begin(), decided_bits.end(), 0);
     const bool grouped = !options.per_corner && shortcuts[k] && !InsideOccupied(g, uo[k]);
-    const VoxelBox free_start = grouped ? FreeBoxAround(g, uo[k]) : VoxelBox{};
     if (grouped) {
       VC_RETURN_IF_ERROR(ParallelChunks(brick_chunks, 1, options.threads, ctx, [&](uint64_t task, uint64_t, uint64_t) {
         OccluderCache cache;
         std::vector<internal::SurfaceTargets::CornerDecision> decisions;
         const size_t b0 = task * kBricksPerTask, b1 = std::min<size_t>(b0 + kBricksPerTask, targets.brick_count());
-        targets.AppendCornerDecisions(uo[k], free_start, b0, b1, cache, decisions);
+        targets.AppendCornerDecisions(uo[k], b0, b1, cache, decisions);
         auto set = [](std::vector<uint64_t>& bits, uint32_t c) {
           std::atomic_ref<uint64_t>(bits[c >> 6]).fetch_or(uint64_t{1} << (c & 63), std::memory_order_relaxed);
         };

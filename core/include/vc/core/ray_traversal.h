@@ -57,17 +57,4 @@ std::optional<VoxelIndex> FirstOccupied(const OccupancyGrid& grid, const Eigen::
                                         const Eigen::Vector3d& b,
                                         const VoxelIndex* transparent = nullptr);
 
-// An axis-aligned box of voxels [lo, hi] (inclusive indices).
-struct VoxelBox {
-  VoxelIndex lo, hi;
-  bool Contains(const VoxelIndex& v) const {
-    return v.x >= lo.x && v.x <= hi.x && v.y >= lo.y && v.y <= hi.y && v.z >= lo.z && v.z <= hi.z;
-  }
-};
-
-// A box of free voxels around the free voxel `start`, grown greedily: each side moves out one
-// layer at a time while the new layer holds no occupied voxel, at most `limit` voxels from start
-// and never more than a brick beyond the grid's box. {start, start} if start is occupied.
-VoxelBox GrowFreeBox(const OccupancyGrid& grid, const VoxelIndex& start, int limit);
-
 }  // namespace vc
