@@ -59,6 +59,12 @@ bool InsideOccupied(const OccupancyGrid& g, const Vector3d& u) {
   return g.Occupied(int(std::floor(u.x())), int(std::floor(u.y())), int(std::floor(u.z())));
 }
 
+// Sets bit i of a bitset that other tasks may be setting bits of at the same time (the join of
+// the parallel loop orders it before any read).
+void SetBitConcurrently(std::vector<uint64_t>& words, uint64_t i) {
+  std::atomic_ref<uint64_t>(words[i >> 6]).fetch_or(uint64_t{1} << (i & 63), std::memory_order_relaxed);
+}
+
 bool CompatibleCached(const OccupancyGrid& g, const Vector3d& uo, const VoxelIndex& v, OccluderCache& cache) {
   const Vector3d target(v.x + 0.5, v.y + 0.5, v.z + 0.5);
   if (cache.Blocks(uo, target, v)) return false;
@@ -359,10 +365,7 @@ Result<std::vector<VoxelSet>> ComputeVisibilitySets(const VoxelScene& scene, con
         std::vector<uint32_t> seen;
         const size_t b0 = c * kBricksPerTask, b1 = std::min<size_t>(b0 + kBricksPerTask, targets.brick_count());
         targets.AppendVisible(uo[k], b0, b1, cache, seen);
-        std::vector<uint64_t>& words = sets[k].words();
-        for (uint32_t id : seen) {
-          std::atomic_ref<uint64_t>(words[id >> 6]).fetch_or(uint64_t{1} << (id & 63), std::memory_order_relaxed);
-        }
+        for (uint32_t id : seen) SetBitConcurrently(sets[k].words(), id);
       }
       progress.Add(1);
     });
@@ -564,14 +567,11 @@ Result<Evaluation> Evaluate(const VoxelScene& scene, const std::vector<WorldPoin
         std::vector<internal::SurfaceTargets::CornerDecision> decisions;
         const size_t b0 = task * kBricksPerTask, b1 = std::min<size_t>(b0 + kBricksPerTask, targets.brick_count());
         targets.AppendCornerDecisions(uo[k], b0, b1, cache, decisions);
-        auto set = [](std::vector<uint64_t>& bits, uint32_t c) {
-          std::atomic_ref<uint64_t>(bits[c >> 6]).fetch_or(uint64_t{1} << (c & 63), std::memory_order_relaxed);
-        };
         for (const auto& d : decisions) {
           auto apply = [&](int q) {
             const uint32_t c = voxel_corners[d.id][q];
-            set(decided_bits, c);
-            if (d.seen) set(visible_bits, c);
+            SetBitConcurrently(decided_bits, c);
+            if (d.seen) SetBitConcurrently(visible_bits, c);
           };
           if (d.face == 0xff) {
             apply(d.corner);
