@@ -19,6 +19,11 @@ struct SolidBox {
   bool Contains(const VoxelIndex& v) const {
     return v.x >= lo.x && v.x <= hi.x && v.y >= lo.y && v.y <= hi.y && v.z >= lo.z && v.z <= hi.z;
   }
+  // Whether the box shares a voxel with the box [other_lo, other_hi].
+  bool Overlaps(const VoxelIndex& other_lo, const VoxelIndex& other_hi) const {
+    return lo.x <= other_hi.x && hi.x >= other_lo.x && lo.y <= other_hi.y && hi.y >= other_lo.y && lo.z <= other_hi.z &&
+           hi.z >= other_lo.z;
+  }
 };
 
 // The shortcuts here and the certificates in surface_groups.cc rely on margins of 1e-6 to 1e-4
@@ -121,9 +126,7 @@ class OccluderCache {
     const Segment seg(a, b);
     for (int i = 0; i < count_; ++i) {
       const SolidBox& box = boxes_[i];
-      const bool overlaps = box.lo.x <= keep_hi.x && box.hi.x >= keep_lo.x && box.lo.y <= keep_hi.y &&
-                            box.hi.y >= keep_lo.y && box.lo.z <= keep_hi.z && box.hi.z >= keep_lo.z;
-      if (!overlaps && PassesThroughInterior(seg, box)) return true;
+      if (!box.Overlaps(keep_lo, keep_hi) && PassesThroughInterior(seg, box)) return true;
     }
     return false;
   }

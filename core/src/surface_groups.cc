@@ -60,6 +60,30 @@ uint64_t RectMask(int u0, int u1, int w0, int w1) {
   return row & rows;
 }
 
+// The segments from uo to the 4 corners of the rectangle q0..q1 on plane u[a] = q0[a].
+std::array<Segment, 4> RectSegments(const Vector3d& uo, int a, const Vector3d& q0, const Vector3d& q1) {
+  const int b1 = (a + 1) % 3, b2 = (a + 2) % 3;
+  std::array<Segment, 4> segments{Segment(uo, q0), Segment(uo, q0), Segment(uo, q0), Segment(uo, q0)};
+  for (int c = 1; c < 4; ++c) {
+    Vector3d q = q0;
+    if (c & 1) q[b1] = q1[b1];
+    if (c & 2) q[b2] = q1[b2];
+    segments[c] = Segment(uo, q);
+  }
+  return segments;
+}
+
+// The solid-occluder certificate: the box holds none of the voxels [keep_lo, keep_hi] and every
+// segment to the rectangle's corners passes through its interior, so every segment to a point of
+// the rectangle does (the set of such end points is convex).
+bool BlocksRect(const SolidBox& box, const std::array<Segment, 4>& corners, const VoxelIndex& keep_lo,
+                const VoxelIndex& keep_hi) {
+  if (box.Overlaps(keep_lo, keep_hi)) return false;
+  for (const Segment& c : corners)
+    if (!PassesThroughInterior(c, box)) return false;
+  return true;
+}
+
 }  // namespace
 
 bool FreeCone(const OccupancyGrid& grid, const Vector3d& uo, int axis, bool viewer_above, int plane,
@@ -185,7 +209,6 @@ void SurfaceTargets::WalkGroups(const Vector3d& uo, const Brick& brick, Occluder
   }
 
   for (int a = 0; a < 3; ++a) {
-    const int b1 = (a + 1) % 3, b2 = (a + 2) % 3;
     for (int sp = 0; sp < 2; ++sp) {
       for (int layer = 0; layer < 8; ++layer) {
         uint64_t undecided = members[a][sp][layer];
@@ -210,21 +233,8 @@ void SurfaceTargets::WalkGroups(const Vector3d& uo, const Brick& brick, Occluder
           Vector3d q0, q1;
           VoxelIndex klo, khi;
           kind.Rect(a, base, plane, voxel_a, umin, umax, wmin, wmax, q0, q1, klo, khi);
-          std::array<Segment, 4> corners{Segment(uo, q0), Segment(uo, q0), Segment(uo, q0), Segment(uo, q0)};
-          for (int c = 1; c < 4; ++c) {
-            Vector3d q = q0;
-            if (c & 1) q[b1] = q1[b1];
-            if (c & 2) q[b2] = q1[b2];
-            corners[c] = Segment(uo, q);
-          }
-          auto blocks_all = [&](const SolidBox& box) {
-            const bool overlaps = box.lo.x <= khi.x && box.hi.x >= klo.x && box.lo.y <= khi.y && box.hi.y >= klo.y &&
-                                  box.lo.z <= khi.z && box.hi.z >= klo.z;
-            if (overlaps) return false;
-            for (const Segment& c : corners)
-              if (!PassesThroughInterior(c, box)) return false;
-            return true;
-          };
+          const std::array<Segment, 4> corners = RectSegments(uo, a, q0, q1);
+          auto blocks_all = [&](const SolidBox& box) { return BlocksRect(box, corners, klo, khi); };
           const bool single = (sub & (sub - 1)) == 0;
           if (!single) {
             if (const SolidBox* box = cache.FindIf(blocks_all)) {
@@ -466,17 +476,7 @@ struct SurfaceTargets::CornerKind {
     Vector3d q0, q1;
     VoxelIndex klo, khi;
     BackRect(a, sp, plane, umin, umax, wmin, wmax, q0, q1, klo, khi);
-    const bool overlaps = box.lo.x <= khi.x && box.hi.x >= klo.x && box.lo.y <= khi.y && box.hi.y >= klo.y &&
-                          box.lo.z <= khi.z && box.hi.z >= klo.z;
-    if (overlaps) return;
-    const int b1 = (a + 1) % 3, b2 = (a + 2) % 3;
-    for (int c = 0; c < 4; ++c) {
-      Vector3d q = q0;
-      if (c & 1) q[b1] = q1[b1];
-      if (c & 2) q[b2] = q1[b2];
-      if (!PassesThroughInterior(Segment(uo, q), box)) return;
-    }
-    BackDecided(a, sp, sub, at, false);
+    if (BlocksRect(box, RectSegments(uo, a, q0, q1), klo, khi)) BackDecided(a, sp, sub, at, false);
   }
 };
 

@@ -55,6 +55,14 @@ bool Enclosed(const OccupancyGrid& g, const VoxelIndex& v) {
          g.Occupied(v.x, v.y + 1, v.z) && g.Occupied(v.x, v.y, v.z - 1) && g.Occupied(v.x, v.y, v.z + 1);
 }
 
+// Ids of the voxels with at least one free neighbour (the only ones with an exposed face).
+std::vector<uint32_t> NotEnclosed(const OccupancyGrid& g, const std::vector<VoxelIndex>& index) {
+  std::vector<uint32_t> ids;
+  for (size_t i = 0; i < index.size(); ++i)
+    if (!Enclosed(g, index[i])) ids.push_back(uint32_t(i));
+  return ids;
+}
+
 bool InsideOccupied(const OccupancyGrid& g, const Vector3d& u) {
   return g.Occupied(int(std::floor(u.x())), int(std::floor(u.y())), int(std::floor(u.z())));
 }
@@ -333,13 +341,10 @@ Result<std::vector<VoxelSet>> ComputeVisibilitySets(const VoxelScene& scene, con
                                                     const VisibilitySetsOptions& options, const JobContext& ctx) {
   const OccupancyGrid& g = scene.grid;
   const size_t n = scene.occupied.size();
-  // Voxels that can pass either test: not enclosed.
-  std::vector<uint32_t> candidates;
   std::vector<VoxelIndex> index(n);
-  for (size_t i = 0; i < n; ++i) {
-    index[i] = KeyToIndex(scene.occupied[i]);
-    if (!Enclosed(g, index[i])) candidates.push_back(uint32_t(i));
-  }
+  for (size_t i = 0; i < n; ++i) index[i] = KeyToIndex(scene.occupied[i]);
+  // Voxels that can pass either test.
+  const std::vector<uint32_t> candidates = NotEnclosed(g, index);
   std::vector<VoxelSet> sets(viewpoints.size(), VoxelSet(n));
   std::vector<Vector3d> uo(viewpoints.size());
   std::vector<char> valid(viewpoints.size()), shortcuts(viewpoints.size());
@@ -548,10 +553,7 @@ Result<Evaluation> Evaluate(const VoxelScene& scene, const std::vector<WorldPoin
   const uint64_t voxel_chunks = (n + kVoxelChunk - 1) / kVoxelChunk;
   StageProgress progress(ctx, "evaluate", nv);
   // Corners that groups of faces decide at once (surface_groups.h), per viewpoint.
-  std::vector<uint32_t> exposed_ids;
-  for (size_t i = 0; i < n; ++i)
-    if (!Enclosed(g, index[i])) exposed_ids.push_back(uint32_t(i));
-  const internal::SurfaceTargets targets(g, index, exposed_ids);
+  const internal::SurfaceTargets targets(g, index, NotEnclosed(g, index));
   constexpr uint64_t kBricksPerTask = 256;
   const uint64_t brick_chunks = (targets.brick_count() + kBricksPerTask - 1) / kBricksPerTask;
   std::vector<uint64_t> decided_bits(visible_bits.size());
