@@ -89,6 +89,11 @@ Result<OccupancyGrid> OccupancyGrid::Build(double resolution_m, const std::vecto
     g.payload_[uint64_t(slot - 1) * kBrick + (rz & 7)] |= uint64_t{1} << (((ry & 7) << 3) | (rx & 7));
   }
   g.ComputeBrickDistances();
+  // Padding for the SIMD ray kernel, which reads the slot and distance of a brick as the low bits
+  // of an unaligned 64-bit load (ray_batch.cc).
+  g.brick_count_ = g.bricks_.size();
+  g.bricks_.resize(g.brick_count_ + 2, 0);
+  g.brick_distance_.resize(g.brick_count_ + 8, 0);
   return g;
 }
 

@@ -95,8 +95,14 @@ inline bool JumpAcrossBox(const int box_lo[3], const int box_hi[3], Walk& w) {
     // Crossings of axis i strictly before t_exit, never past the box or the walk's end. For the
     // axis that defines t_exit the quotient is steps_to_exit up to rounding, and the clamp makes
     // it exactly that: no division needed.
-    int n = i == exit_axis ? steps_to_exit[i] : int(std::ceil((t_exit - w.t_max[i]) / w.t_delta[i]));
-    n = std::clamp(n, 0, std::min(steps_to_exit[i], w.left[i]));
+    // The clamp is done in double before converting, so a quotient that is NaN or beyond int's
+    // range is well defined (0 or the limit); the SIMD kernel (ray_batch.cc) does the same.
+    const int limit = std::min(steps_to_exit[i], w.left[i]);
+    int n = limit;
+    if (i != exit_axis) {
+      const double q = std::ceil((t_exit - w.t_max[i]) / w.t_delta[i]);
+      n = !(q > 0) ? 0 : q >= double(limit) ? limit : int(q);
+    }
     if (n == 0) continue;
     w.cur[i] += w.step[i] * n;
     w.left[i] -= n;

@@ -57,6 +57,12 @@ class OccupancyGrid {
   uint8_t BrickDistance(uint64_t brick) const { return brick_distance_[brick]; }
   // The 8 words of a non-empty brick's bits (word z, bit y*8+x).
   const uint64_t* BrickBits(uint32_t slot) const { return &payload_[uint64_t(slot - 1) * kBrick]; }
+  // Raw arrays for vectorised kernels: brick_count() slots and distances, each followed by
+  // padding so that an 8-byte load at any brick's entry stays inside the allocation.
+  uint64_t brick_count() const { return brick_count_; }
+  const uint32_t* brick_slots() const { return bricks_.data(); }
+  const uint8_t* brick_distances() const { return brick_distance_.data(); }
+  const uint64_t* payload() const { return payload_.data(); }
   uint64_t memory_bytes() const;
   uint64_t occupied_bricks() const { return payload_.size() / kBrick; }
 
@@ -101,6 +107,7 @@ class OccupancyGrid {
   VoxelIndex min_;
   Eigen::Vector3i dims_{0, 0, 0};
   Eigen::Vector3i bdims_{0, 0, 0};
+  uint64_t brick_count_ = 0;
   std::vector<uint32_t> bricks_;   // per brick: 0 = empty, else 1 + payload brick number
   std::vector<uint64_t> payload_;  // 8 words per non-empty brick: word z, bit (y*8 + x)
   std::vector<uint8_t> brick_distance_;  // Chebyshev distance in bricks to a non-empty brick

@@ -15,6 +15,7 @@
 #pragma once
 
 #include <optional>
+#include <span>
 
 #include "vc/core/geometry.h"
 #include "vc/core/occupancy_grid.h"
@@ -56,5 +57,13 @@ class RayTraversal {
 std::optional<VoxelIndex> FirstOccupied(const OccupancyGrid& grid, const Eigen::Vector3d& a,
                                         const Eigen::Vector3d& b,
                                         const VoxelIndex* transparent = nullptr);
+
+// FirstOccupied on many segments at once: out[i] = FirstOccupied(grid, a[i], b[i]), bit for bit,
+// for i < min(a.size(), b.size(), out.size()). One segment per SIMD lane (8 on AVX-512, 4 on AVX2),
+// with the instruction set chosen at run time by Google Highway; a lane that finishes takes the
+// next segment at once. For throughput on independent rays; FirstOccupied stays the per-ray API.
+// Returns the name of the instruction set it ran on ("AVX3", "AVX2", "SSE4", "SSSE3", "Scalar").
+const char* FirstOccupiedBatch(const OccupancyGrid& grid, std::span<const Eigen::Vector3d> a,
+                               std::span<const Eigen::Vector3d> b, std::span<std::optional<VoxelIndex>> out);
 
 }  // namespace vc

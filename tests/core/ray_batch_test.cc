@@ -1,0 +1,161 @@
+// FirstOccupiedBatch against FirstOccupied, answer by answer, on every instruction set Highway
+// compiled in and this CPU supports, the forced scalar one included.
+#include <gtest/gtest.h>
+#include <hwy/targets.h>
+
+#include <cmath>
+#include <optional>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "testing/test_paths.h"
+#include "vc/core/ray_traversal.h"
+#include "vc/core/scene_input.h"
+#include "vc/core/voxel_scene.h"
+
+namespace vc {
+namespace {
+
+using Eigen::Vector3d;
+
+struct Segments {
+  std::vector<Vector3d> a, b;
+  void Add(const Vector3d& from, const Vector3d& to) {
+    a.push_back(from);
+    b.push_back(to);
+  }
+};
+
+// Runs the batch once per target (each forced through Highway's test mock) and compares every
+// answer with the scalar FirstOccupied. Returns how many answers were hits.
+int ExpectSameOnEveryTarget(const OccupancyGrid& grid, const Segments& s, const std::string& what) {
+  std::vector<std::optional<VoxelIndex>> expect(s.a.size());
+  int hits = 0;
+  for (size_t i = 0; i < s.a.size(); ++i) {
+    expect[i] = FirstOccupied(grid, s.a[i], s.b[i]);
+    hits += expect[i].has_value();
+  }
+  const std::vector<int64_t> targets = hwy::SupportedAndGeneratedTargets();
+  for (int64_t target : targets) {
+    hwy::SetSupportedTargetsForTest(target);
+    std::vector<std::optional<VoxelIndex>> got(s.a.size(), VoxelIndex{1 << 30, 0, 0});
+    const std::string ran = FirstOccupiedBatch(grid, s.a, s.b, got);
+    EXPECT_EQ(ran, hwy::TargetName(target)) << "the dispatch did not run the forced target";
+    int differ = 0;
+    for (size_t i = 0; i < got.size(); ++i) {
+      if (got[i] != expect[i]) {
+        if (++differ <= 3) {
+          ADD_FAILURE() << what << " on " << ran << ": segment " << i << " (" << s.a[i].transpose() << ") -> ("
+                        << s.b[i].transpose() << ") differs";
+        }
+      }
+    }
+    EXPECT_EQ(differ, 0) << what << " on " << ran << ", of " << got.size() << " segments";
+  }
+  hwy::SetSupportedTargetsForTest(0);
+  return hits;
+}
+
+TEST(FirstOccupiedBatchTest, TheScalarTargetIsCompiledAndTested) {
+  bool scalar = false;
+  for (int64_t t : hwy::SupportedAndGeneratedTargets()) scalar |= t == HWY_SCALAR || t == HWY_EMU128;
+  EXPECT_TRUE(scalar) << "the forced-scalar path is not among the compiled targets";
+}
+
+TEST(FirstOccupiedBatchTest, MatchesFirstOccupiedOnRandomGrids) {
+  std::mt19937_64 rng(11);
+  std::uniform_int_distribution<int> c(-30, 30);
+  std::uniform_real_distribution<double> u(-36, 36);
+  for (int scene = 0; scene < 6; ++scene) {
+    std::vector<VoxelIndex> occ;
+    for (int i = 0; i < 3000; ++i) occ.push_back({c(rng), c(rng), c(rng) / 2});
+    auto grid = OccupancyGrid::Build(0.1, occ, 1 << 24);
+    ASSERT_TRUE(grid.ok());
+    Segments s;
+    for (int r = 0; r < 3000; ++r) s.Add({u(rng), u(rng), u(rng)}, {u(rng), u(rng), u(rng)});
+    const int hits = ExpectSameOnEveryTarget(*grid, s, "random grid " + std::to_string(scene));
+    EXPECT_GT(hits, 1000);
+  }
+}
+
+// Sparse scenes with long segments: most of each walk is jumps across free boxes of bricks.
+TEST(FirstOccupiedBatchTest, MatchesFirstOccupiedAcrossFreeBoxes) {
+  std::mt19937_64 rng(5);
+  std::uniform_int_distribution<int> c(-200, 200);
+  std::uniform_real_distribution<double> u(-230, 230);
+  std::vector<VoxelIndex> occ;
+  for (int i = 0; i < 60; ++i) {
+    const VoxelIndex base{c(rng), c(rng), c(rng) / 4};
+    for (int d = 0; d < 36; ++d) occ.push_back({base.x + d % 6, base.y + d / 6, base.z});
+  }
+  for (int y = -150; y <= 150; ++y)
+    for (int z = -30; z <= 30; ++z) occ.push_back({41, y, z});
+  auto grid = OccupancyGrid::Build(0.1, occ, 1 << 26);
+  ASSERT_TRUE(grid.ok());
+  Segments s;
+  for (int r = 0; r < 20000; ++r) s.Add({u(rng), u(rng), u(rng) / 4}, {u(rng), u(rng), u(rng) / 4});
+  EXPECT_GT(ExpectSameOnEveryTarget(*grid, s, "sparse scene"), 3000);
+}
+
+// Exact ties: endpoints on lattice points and voxel centres, axis-aligned and diagonal segments,
+// zero-length segments, segments that start or end outside the grid's box, and segments that
+// start inside an occupied voxel.
+TEST(FirstOccupiedBatchTest, MatchesFirstOccupiedOnTiesAndEdgeCases) {
+  std::vector<VoxelIndex> occ;
+  for (int x = -8; x <= 8; ++x)
+    for (int y = -8; y <= 8; ++y) {
+      occ.push_back({x, y, -8});                        // floor
+      if ((x + y) % 3 == 0) occ.push_back({x, y, 4});   // a perforated slab
+    }
+  for (int z = -8; z <= 8; ++z) occ.push_back({0, 0, z});  // a post
+  auto grid = OccupancyGrid::Build(0.1, occ, 1 << 24);
+  ASSERT_TRUE(grid.ok());
+  Segments s;
+  std::mt19937_64 rng(9);
+  std::uniform_int_distribution<int> p(-20, 20);
+  for (int r = 0; r < 6000; ++r) {
+    const double ha = (r % 3 == 0) ? 0.5 : 0.0, hb = (r % 2 == 0) ? 0.5 : 0.0;
+    s.Add({p(rng) + ha, p(rng) + ha, p(rng) + ha}, {p(rng) + hb, p(rng) + hb, p(rng) + hb});
+  }
+  for (int k = -20; k <= 20; ++k) {
+    s.Add({k + 0.5, 0.5, 20.5}, {k + 0.5, 0.5, -20.5});  // straight down
+    s.Add({-20.0, k, k}, {20.0, -k, -k});                 // through edges and corners
+    s.Add({k, k, k}, {k, k, k});                          // zero length
+    s.Add({0.5, 0.5, 0.5}, {k, 20.0, 3.0});               // starts inside the post
+    s.Add({-3e4, k, 2.5}, {3e4, -k, 2.5});                // far outside at both ends
+  }
+  EXPECT_GT(ExpectSameOnEveryTarget(*grid, s, "ties and edge cases"), 1000);  // seen: 1664
+}
+
+// The real geb079 map: segments between random points in and around the building.
+TEST(FirstOccupiedBatchTest, MatchesFirstOccupiedOnGeb079) {
+  auto input = ReadSceneFile(testing::SharedDataPath("geb079/geb079.bt"));
+  ASSERT_TRUE(input.ok()) << input.status().ToString();
+  auto scene = Voxelize(*input, {});
+  ASSERT_TRUE(scene.ok()) << scene.status().ToString();
+  const double r = scene->resolution_m;
+  std::mt19937_64 rng(2014);
+  std::uniform_real_distribution<double> ux(-8.0, 31.0), uy(-7.5, 7.4), uz(-0.3, 2.8);
+  Segments s;
+  for (int n = 0; n < 20000; ++n) {
+    s.Add(Vector3d(ux(rng), uy(rng), uz(rng)) / r, Vector3d(ux(rng), uy(rng), uz(rng)) / r);
+  }
+  EXPECT_GT(ExpectSameOnEveryTarget(scene->grid, s, "geb079"), 5000);
+}
+
+TEST(FirstOccupiedBatchTest, EmptyAndUnevenSpans) {
+  auto grid = OccupancyGrid::Build(0.1, {{0, 0, 0}}, 1 << 20);
+  ASSERT_TRUE(grid.ok());
+  std::vector<Vector3d> a = {{-5, 0.5, 0.5}, {-5, 3.5, 0.5}}, b = {{5, 0.5, 0.5}};
+  std::vector<std::optional<VoxelIndex>> out(3, VoxelIndex{7, 7, 7});
+  FirstOccupiedBatch(*grid, a, b, out);  // one segment: the shortest span decides
+  ASSERT_TRUE(out[0].has_value());
+  EXPECT_EQ(*out[0], (VoxelIndex{0, 0, 0}));
+  EXPECT_EQ(out[1], (VoxelIndex{7, 7, 7}));  // untouched
+  FirstOccupiedBatch(*grid, std::span<const Vector3d>(), std::span<const Vector3d>(), out);
+  EXPECT_EQ(out[1], (VoxelIndex{7, 7, 7}));
+}
+
+}  // namespace
+}  // namespace vc
