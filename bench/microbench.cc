@@ -2,6 +2,7 @@
 #include <benchmark/benchmark.h>
 
 #include <random>
+#include <string>
 
 #include "vc/core/ray_traversal.h"
 #include "vc/core/synth.h"
@@ -50,7 +51,7 @@ void BM_FirstOccupiedBatch(benchmark::State& state) {
     b[i] = vc::WorldPoint(ux(rng), uy(rng), uz(rng)) / s.resolution_m;
   }
   std::vector<std::optional<vc::VoxelIndex>> out(a.size());
-  const char* target = "";
+  std::string target;
   for (auto _ : state) {
     target = vc::FirstOccupiedBatch(s.grid, a, b, out);
     benchmark::DoNotOptimize(out.data());

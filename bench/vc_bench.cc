@@ -8,6 +8,7 @@
 #include <sys/resource.h>
 
 #include <CLI/CLI.hpp>
+#include <hwy/targets.h>
 
 #include <algorithm>
 #include <chrono>
@@ -144,7 +145,7 @@ int main(int argc, char** argv) {
   std::string scene = "hall";
   double spacing = 0.05, resolution = 0.1, grid = 1.0;
   int rays = 200000, octomap_rays = 20000, threads = 2;
-  bool quick = false, scaling = true, rays_only = false, fine_eval = false;
+  bool quick = false, scaling = true, rays_only = false, fine_eval = false, all_targets = false;
   app.add_option("--scene", scene, "synthetic scene spec (hall, box, comb:5, ...) or a file path");
   app.add_option("--spacing", spacing, "point spacing of synthetic scenes, m");
   app.add_option("--resolution", resolution, "working resolution, m");
@@ -155,6 +156,7 @@ int main(int argc, char** argv) {
   app.add_flag("--quick", quick, "small scene, few rays, no scaling tables (CI)");
   app.add_flag("!--no-scaling", scaling, "skip the scaling tables");
   app.add_flag("--rays-only", rays_only, "only the ray comparison with OctoMap");
+  app.add_flag("--all-targets", all_targets, "also time the SIMD batch kernel on every other instruction set");
   app.add_flag("--fine-eval", fine_eval,
                "only the fine evaluation: the hall sampled at 0.005 m, a 10-station plan evaluated at 0.01 m "
                "by sampling to a 95 % interval of +-0.5 %");
@@ -251,11 +253,29 @@ int main(int argc, char** argv) {
   const double batch_rps = double(ray_set.size()) / batch_s;
   std::printf("| vc FirstOccupiedBatch (%s) | %zu | %.0f | %.1fx |\n", batch_target.c_str(), ray_set.size(),
               batch_rps, batch_rps / theirs_rps);
+  int forced_differ = 0;
+  if (all_targets) {
+    // The lanes kernel on every other instruction set compiled in and supported here, forced
+    // through Highway's test mock: what the lanes would give on a CPU without the best one.
+    const std::vector<int64_t> targets = hwy::SupportedAndGeneratedTargets();
+    for (size_t k = 1; k < targets.size(); ++k) {
+      hwy::SetSupportedTargetsForTest(targets[k]);
+      std::vector<std::optional<vc::VoxelIndex>> forced(ray_set.size());
+      t0 = Clock::now();
+      const std::string name = vc::FirstOccupiedBatch(s.grid, seg_a, seg_b, forced, vc::BatchKernel::kLanes);
+      const double rps = double(ray_set.size()) / Seconds(t0);
+      const bool same = forced == ours;
+      std::printf("| vc FirstOccupiedBatch (%s, forced) | %zu | %.0f | %.1fx |%s\n", name.c_str(), ray_set.size(), rps,
+                  rps / theirs_rps, same ? "" : " DIFFERENT");
+      forced_differ += !same;
+    }
+    hwy::SetSupportedTargetsForTest(0);
+  }
   std::printf("identity check on the %d shared rays: %d mismatches (%d hits) -> %s\n", m, mismatches, hits,
               mismatches == 0 ? "IDENTICAL" : "DIFFERENT");
   std::printf("batch against FirstOccupied on all %zu rays: %zu differ -> %s\n", ray_set.size(), batch_differ,
               batch_differ == 0 ? "IDENTICAL" : "DIFFERENT");
-  mismatches += int(batch_differ);
+  mismatches += int(batch_differ) + forced_differ;
 
   if (rays_only) return mismatches == 0 ? 0 : 1;
 

@@ -283,9 +283,21 @@ HWY_INLINE void LaneGroup::Advance() {
   rem_ = hn::IfThenElse(done_, rem_, hn::Sub(rem_, one));
 }
 
-// Returns the target it was compiled for, so callers and tests see which one the dispatch chose.
+// Whether the lanes beat the scalar walk on this target. Measured on the hall (BENCHMARKS.md):
+// AVX-512's 8 lanes 1.8x the scalar walk; AVX2's 4 lanes and SSE4's 2 about 0.9x (AVX2 lacks
+// 64-bit unsigned compares, min and conversions, which Highway emulates); SSSE3 and the scalar
+// target about 0.5x.
+constexpr bool kLanesPay = HWY_TARGET == HWY_AVX3 || HWY_TARGET == HWY_AVX3_DL;
+
+// Returns the target it was compiled for, and in *lanes whether it used the lanes, so callers and
+// tests see what the dispatch chose.
 int64_t FirstOccupiedBatchImpl(const OccupancyGrid& grid, const Eigen::Vector3d* a, const Eigen::Vector3d* b,
-                               size_t count, std::optional<VoxelIndex>* out) {
+                               size_t count, std::optional<VoxelIndex>* out, bool force_lanes, bool* lanes) {
+  *lanes = kLanesPay || force_lanes;
+  if (!*lanes) {
+    for (size_t i = 0; i < count; ++i) out[i] = FirstOccupied(grid, a[i], b[i]);
+    return HWY_TARGET;
+  }
   HWY_ASSERT(hn::Lanes(D()) <= 16);
   const GridView view(grid);
   Source src{a, b, count, 0, out};
@@ -310,17 +322,20 @@ namespace vc {
 
 HWY_EXPORT(FirstOccupiedBatchImpl);
 
-const char* FirstOccupiedBatch(const OccupancyGrid& grid, std::span<const Eigen::Vector3d> a,
-                               std::span<const Eigen::Vector3d> b, std::span<std::optional<VoxelIndex>> out) {
+std::string FirstOccupiedBatch(const OccupancyGrid& grid, std::span<const Eigen::Vector3d> a,
+                               std::span<const Eigen::Vector3d> b, std::span<std::optional<VoxelIndex>> out,
+                               BatchKernel kernel) {
   const size_t n = std::min({a.size(), b.size(), out.size()});
   // The kernel forms brick numbers with 32x32-bit products (row = bz * by_count + by).
   const bool fits = uint64_t(grid.brick_dims().y()) * uint64_t(grid.brick_dims().z()) < (uint64_t{1} << 32);
   if (!fits || grid.brick_count() == 0) {
     for (size_t i = 0; i < n; ++i) out[i] = FirstOccupied(grid, a[i], b[i]);
-    return "none (scalar FirstOccupied)";
+    return "per segment (grid too large for the lanes)";
   }
-  if (n == 0) return "none (no segments)";
-  return hwy::TargetName(HWY_DYNAMIC_DISPATCH(FirstOccupiedBatchImpl)(grid, a.data(), b.data(), n, out.data()));
+  bool lanes = false;
+  const int64_t target = HWY_DYNAMIC_DISPATCH(FirstOccupiedBatchImpl)(grid, a.data(), b.data(), n, out.data(),
+                                                                      kernel == BatchKernel::kLanes, &lanes);
+  return std::string(hwy::TargetName(target)) + (lanes ? " lanes" : " per segment");
 }
 
 }  // namespace vc

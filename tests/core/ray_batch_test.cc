@@ -1,5 +1,6 @@
-// FirstOccupiedBatch against FirstOccupied, answer by answer, on every instruction set Highway
-// compiled in and this CPU supports, the forced scalar one included.
+// FirstOccupiedBatch against FirstOccupied, answer by answer: its lanes kernel forced on every
+// instruction set Highway compiled in and this CPU supports, the scalar one included, so the
+// kernel is tested on any CI machine, with or without AVX-512.
 #include <gtest/gtest.h>
 #include <hwy/targets.h>
 
@@ -40,8 +41,8 @@ int ExpectSameOnEveryTarget(const OccupancyGrid& grid, const Segments& s, const 
   for (int64_t target : targets) {
     hwy::SetSupportedTargetsForTest(target);
     std::vector<std::optional<VoxelIndex>> got(s.a.size(), VoxelIndex{1 << 30, 0, 0});
-    const std::string ran = FirstOccupiedBatch(grid, s.a, s.b, got);
-    EXPECT_EQ(ran, hwy::TargetName(target)) << "the dispatch did not run the forced target";
+    const std::string ran = FirstOccupiedBatch(grid, s.a, s.b, got, BatchKernel::kLanes);
+    EXPECT_EQ(ran, std::string(hwy::TargetName(target)) + " lanes") << "the dispatch did not run the forced target";
     int differ = 0;
     for (size_t i = 0; i < got.size(); ++i) {
       if (got[i] != expect[i]) {
@@ -144,16 +145,33 @@ TEST(FirstOccupiedBatchTest, MatchesFirstOccupiedOnGeb079) {
   EXPECT_GT(ExpectSameOnEveryTarget(scene->grid, s, "geb079"), 5000);
 }
 
+// The default kernel: lanes where they pay (AVX-512), FirstOccupied per segment elsewhere.
+TEST(FirstOccupiedBatchTest, AutoUsesLanesOnlyWhereTheyPay) {
+  auto grid = OccupancyGrid::Build(0.1, {{0, 0, 0}, {3, 0, 0}}, 1 << 20);
+  ASSERT_TRUE(grid.ok());
+  std::vector<Vector3d> a = {{-5, 0.5, 0.5}, {1.5, 0.5, 0.5}}, b = {{5, 0.5, 0.5}, {9, 0.5, 0.5}};
+  for (int64_t target : hwy::SupportedAndGeneratedTargets()) {
+    hwy::SetSupportedTargetsForTest(target);
+    std::vector<std::optional<VoxelIndex>> out(2);
+    const std::string ran = FirstOccupiedBatch(*grid, a, b, out);
+    const bool pays = target == HWY_AVX3 || target == HWY_AVX3_DL;
+    EXPECT_EQ(ran, std::string(hwy::TargetName(target)) + (pays ? " lanes" : " per segment"));
+    EXPECT_EQ(out[0], (VoxelIndex{0, 0, 0}));
+    EXPECT_EQ(out[1], (VoxelIndex{3, 0, 0}));
+  }
+  hwy::SetSupportedTargetsForTest(0);
+}
+
 TEST(FirstOccupiedBatchTest, EmptyAndUnevenSpans) {
   auto grid = OccupancyGrid::Build(0.1, {{0, 0, 0}}, 1 << 20);
   ASSERT_TRUE(grid.ok());
   std::vector<Vector3d> a = {{-5, 0.5, 0.5}, {-5, 3.5, 0.5}}, b = {{5, 0.5, 0.5}};
   std::vector<std::optional<VoxelIndex>> out(3, VoxelIndex{7, 7, 7});
-  FirstOccupiedBatch(*grid, a, b, out);  // one segment: the shortest span decides
+  FirstOccupiedBatch(*grid, a, b, out, BatchKernel::kLanes);  // one segment: the shortest span decides
   ASSERT_TRUE(out[0].has_value());
   EXPECT_EQ(*out[0], (VoxelIndex{0, 0, 0}));
   EXPECT_EQ(out[1], (VoxelIndex{7, 7, 7}));  // untouched
-  FirstOccupiedBatch(*grid, std::span<const Vector3d>(), std::span<const Vector3d>(), out);
+  FirstOccupiedBatch(*grid, std::span<const Vector3d>(), std::span<const Vector3d>(), out, BatchKernel::kLanes);
   EXPECT_EQ(out[1], (VoxelIndex{7, 7, 7}));
 }
 

@@ -16,6 +16,7 @@
 
 #include <optional>
 #include <span>
+#include <string>
 
 #include "vc/core/geometry.h"
 #include "vc/core/occupancy_grid.h"
@@ -59,11 +60,15 @@ std::optional<VoxelIndex> FirstOccupied(const OccupancyGrid& grid, const Eigen::
                                         const VoxelIndex* transparent = nullptr);
 
 // FirstOccupied on many segments at once: out[i] = FirstOccupied(grid, a[i], b[i]), bit for bit,
-// for i < min(a.size(), b.size(), out.size()). One segment per SIMD lane (8 on AVX-512, 4 on AVX2),
-// with the instruction set chosen at run time by Google Highway; a lane that finishes takes the
-// next segment at once. For throughput on independent rays; FirstOccupied stays the per-ray API.
-// Returns the name of the instruction set it ran on ("AVX3", "AVX2", "SSE4", "SSSE3", "Scalar").
-const char* FirstOccupiedBatch(const OccupancyGrid& grid, std::span<const Eigen::Vector3d> a,
-                               std::span<const Eigen::Vector3d> b, std::span<std::optional<VoxelIndex>> out);
+// for i < min(a.size(), b.size(), out.size()). Google Highway picks the instruction set at run
+// time. Where SIMD pays (AVX-512: 8 lanes of doubles) each lane walks one segment and takes the
+// next one as soon as its own ends; elsewhere (AVX2 and below, where the lanes measured slower
+// than the scalar walk) it calls FirstOccupied per segment, unless `kernel` is kLanes, which
+// forces the lanes on any target (for tests and benchmarks). Returns what ran, e.g.
+// "AVX3 lanes", "AVX2 per segment", "SCALAR lanes".
+enum class BatchKernel { kAuto, kLanes };
+std::string FirstOccupiedBatch(const OccupancyGrid& grid, std::span<const Eigen::Vector3d> a,
+                               std::span<const Eigen::Vector3d> b, std::span<std::optional<VoxelIndex>> out,
+                               BatchKernel kernel = BatchKernel::kAuto);
 
 }  // namespace vc
