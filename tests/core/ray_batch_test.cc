@@ -119,7 +119,8 @@ TEST(FirstOccupiedBatchTest, MatchesFirstOccupiedOnTiesAndEdgeCases) {
     const double ha = (r % 3 == 0) ? 0.5 : 0.0, hb = (r % 2 == 0) ? 0.5 : 0.0;
     s.Add({p(rng) + ha, p(rng) + ha, p(rng) + ha}, {p(rng) + hb, p(rng) + hb, p(rng) + hb});
   }
-  for (int k = -20; k <= 20; ++k) {
+  for (int i = -20; i <= 20; ++i) {
+    const double k = i;
     s.Add({k + 0.5, 0.5, 20.5}, {k + 0.5, 0.5, -20.5});  // straight down
     s.Add({-20.0, k, k}, {20.0, -k, -k});                 // through edges and corners
     s.Add({k, k, k}, {k, k, k});                          // zero length
