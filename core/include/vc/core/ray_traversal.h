@@ -64,7 +64,8 @@ std::optional<VoxelIndex> FirstOccupied(const OccupancyGrid& grid, const Eigen::
 // time. Where SIMD pays (AVX-512: 8 lanes of doubles) each lane walks one segment and takes the
 // next one as soon as its own ends; elsewhere (AVX2 and below, where the lanes measured slower
 // than the scalar walk) it calls FirstOccupied per segment, unless `kernel` is kLanes, which
-// forces the lanes on any target (for tests and benchmarks). Returns what ran, e.g.
+// forces the lanes on any target (for tests and benchmarks). A grid whose bricks in y times z
+// reach 2^32 is always walked per segment. Returns what ran, e.g.
 // "AVX3 lanes", "AVX2 per segment", "SCALAR lanes".
 enum class BatchKernel { kAuto, kLanes };
 std::string FirstOccupiedBatch(const OccupancyGrid& grid, std::span<const Eigen::Vector3d> a,
