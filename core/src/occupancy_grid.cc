@@ -130,36 +130,6 @@ void OccupancyGrid::ComputeBrickDistances() {
   for (size_t i = 0; i < d.size(); ++i) brick_distance_[i] = uint8_t(std::min(d[i], kCap));
 }
 
-bool OccupancyGrid::AnyOccupied(const VoxelIndex& lo, const VoxelIndex& hi) const {
-  const int lo3[3] = {lo.x - min_.x, lo.y - min_.y, lo.z - min_.z};
-  const int hi3[3] = {hi.x - min_.x, hi.y - min_.y, hi.z - min_.z};
-  int r0[3], r1[3];
-  for (int i = 0; i < 3; ++i) {
-    r0[i] = std::max(lo3[i], 0);
-    r1[i] = std::min(hi3[i], dims_[i] - 1);
-    if (r0[i] > r1[i]) return false;  // the box misses the grid: all free
-  }
-  for (int bz = r0[2] >> kBrickShift; bz <= r1[2] >> kBrickShift; ++bz) {
-    const int z0 = std::max(r0[2] - bz * kBrick, 0), z1 = std::min(r1[2] - bz * kBrick, kBrick - 1);
-    for (int by = r0[1] >> kBrickShift; by <= r1[1] >> kBrickShift; ++by) {
-      const int y0 = std::max(r0[1] - by * kBrick, 0), y1 = std::min(r1[1] - by * kBrick, kBrick - 1);
-      // Bits y0..y1 of a word's 8-bit rows.
-      const uint64_t rows = (y1 == kBrick - 1 ? ~uint64_t{0} : (uint64_t{1} << (8 * (y1 + 1))) - 1) &
-                            ~((uint64_t{1} << (8 * y0)) - 1);
-      for (int bx = r0[0] >> kBrickShift; bx <= r1[0] >> kBrickShift; ++bx) {
-        const uint32_t slot = bricks_[BrickLinear(uint32_t(bx), uint32_t(by), uint32_t(bz))];
-        if (slot == 0) continue;
-        const int x0 = std::max(r0[0] - bx * kBrick, 0), x1 = std::min(r1[0] - bx * kBrick, kBrick - 1);
-        const uint64_t mask = rows & (((uint64_t{2} << x1) - (uint64_t{1} << x0)) * 0x0101010101010101ull);
-        const uint64_t* words = BrickBits(slot);
-        for (int z = z0; z <= z1; ++z)
-          if (words[z] & mask) return true;
-      }
-    }
-  }
-  return false;
-}
-
 uint64_t OccupancyGrid::memory_bytes() const {
   return bricks_.size() * sizeof(uint32_t) + brick_distance_.size() + payload_.size() * sizeof(uint64_t);
 }

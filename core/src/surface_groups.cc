@@ -26,6 +26,8 @@
 #include <cmath>
 #include <optional>
 
+#include <Eigen/Geometry>
+
 #include "vc/core/ray_traversal.h"
 
 namespace vc::internal {
@@ -35,7 +37,7 @@ using Eigen::Vector3d;
 
 constexpr int kMinSplit = 4;      // groups this small are not split further
 constexpr int kGrowLimit = 8;     // how far a solid occluder box grows from the voxel hit
-constexpr double kConeStep = 4;   // length (voxels) of each box of the cone's cover (4 measured best of 2-16)
+constexpr double kConeStep = 8;   // length (voxels) of each box of the cone's cover (8 measured best of 2-32)
 constexpr double kConeMargin = 1e-4;
 
 int At(const VoxelIndex& v, int axis) { return axis == 0 ? v.x : axis == 1 ? v.y : v.z; }
@@ -84,6 +86,54 @@ bool BlocksRect(const SolidBox& box, const std::array<Segment, 4>& corners, cons
   return true;
 }
 
+// The 4 side planes of the pyramid from uo to the rectangle q0..q1 on plane u[axis] = q0[axis],
+// each through uo and one edge of the rectangle. The box cover in FreeCone holds more than the
+// pyramid; a voxel of the cover that lies wholly outside one side plane, by more than the cone's
+// margin, is not within that margin of any segment to the rectangle and cannot block one.
+class ConeSides {
+ public:
+  ConeSides(const Vector3d& uo, int axis, Vector3d q0, Vector3d q1) {
+    const int b1 = (axis + 1) % 3, b2 = (axis + 2) % 3;
+    // A rectangle one row wide is widened by a quarter voxel each way, so that every side plane
+    // is well defined. A wider pyramid holds the narrower one: it only rules out fewer voxels.
+    for (int b : {b1, b2}) {
+      if (q1[b] - q0[b] < 0.5) q0[b] -= 0.25, q1[b] += 0.25;
+    }
+    Vector3d c[4] = {q0, q0, q1, q0};
+    c[1][b1] = q1[b1];
+    c[3][b2] = q1[b2];
+    const Vector3d inside = 0.5 * (q0 + q1) - uo;
+    for (int i = 0; i < 4; ++i) {
+      Vector3d n = (c[i] - uo).cross(c[(i + 1) % 4] - uo);
+      const double side = n.dot(inside);
+      if (!(std::abs(side) > 0)) continue;  // uo on the rectangle's plane: no plane, rules nothing out
+      if (side > 0) n = -n;                 // outward
+      // Voxel v (the cube [v, v + 1]) is outside by more than the margin if the smallest n.x
+      // over the cube, n.v + (sum of n's negative components), exceeds n.uo + margin |n|. The
+      // margin covers the cone's 1e-4 plus the rounding of n (below 1e-6 voxels at the
+      // distances ShortcutsHold allows, the rectangle being at least half a voxel wide).
+      normal_[count_] = n;
+      limit_[count_] = n.dot(uo) + (kConeMargin + kSideSlack) * n.norm() - std::min(n.x(), 0.0) -
+                       std::min(n.y(), 0.0) - std::min(n.z(), 0.0);
+      ++count_;
+    }
+  }
+
+  // True if voxel v lies outside the pyramid by more than the margin.
+  bool Excludes(const VoxelIndex& v) const {
+    const Vector3d p(v.x, v.y, v.z);
+    for (int i = 0; i < count_; ++i)
+      if (normal_[i].dot(p) > limit_[i]) return true;
+    return false;
+  }
+
+ private:
+  static constexpr double kSideSlack = 1e-5;
+  Vector3d normal_[4];
+  double limit_[4];
+  int count_ = 0;
+};
+
 }  // namespace
 
 bool FreeCone(const OccupancyGrid& grid, const Vector3d& uo, int axis, bool viewer_above, int plane,
@@ -109,6 +159,7 @@ bool FreeCone(const OccupancyGrid& grid, const Vector3d& uo, int axis, bool view
       hi[axis] = std::min(hi[axis], plane - 1);
     }
   };
+  std::optional<ConeSides> sides;
   double s0 = 0;
   while (s0 < 1) {
     int lo[3], hi[3];
@@ -140,7 +191,14 @@ bool FreeCone(const OccupancyGrid& grid, const Vector3d& uo, int axis, bool view
     }
     const double s1 = std::min(1.0, s0 + kConeStep / len);
     piece(s0, s1, lo, hi);
-    if (lo[axis] <= hi[axis] && grid.AnyOccupied({lo[0], lo[1], lo[2]}, {hi[0], hi[1], hi[2]})) return false;
+    // A box of the cover holds more than the cone: its occupied voxels are tested against the
+    // cone's side planes before they count.
+    if (lo[axis] <= hi[axis] && grid.AnyOccupiedWhere({lo[0], lo[1], lo[2]}, {hi[0], hi[1], hi[2]}, [&](const VoxelIndex& v) {
+          if (!sides) sides.emplace(uo, axis, q0, q1);
+          return !sides->Excludes(v);
+        })) {
+      return false;
+    }
     s0 = s1;
   }
   return true;

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <random>
 #include <set>
 #include <tuple>
@@ -81,6 +82,39 @@ TEST(OccupancyGridTest, AnyOccupiedAgreesWithVoxelByVoxelOnRandomBoxes) {
   // A single voxel box, and an empty (inverted) box.
   EXPECT_TRUE(g.AnyOccupied(v[0], v[0]));
   EXPECT_FALSE(g.AnyOccupied({5, 5, 5}, {4, 5, 5}));
+}
+
+TEST(OccupancyGridTest, AnyOccupiedWhereVisitsExactlyTheOccupiedVoxelsOfTheBox) {
+  std::mt19937_64 rng(5);
+  std::uniform_int_distribution<int> c(-20, 20), len(0, 19);
+  std::vector<VoxelIndex> v;
+  for (int i = 0; i < 400; ++i) v.push_back({c(rng), c(rng), c(rng)});
+  const OccupancyGrid g = *OccupancyGrid::Build(0.1, v, 1 << 24);
+  auto key = [](const VoxelIndex& a) { return std::tuple(a.x, a.y, a.z); };
+  for (int trial = 0; trial < 1000; ++trial) {
+    const VoxelIndex lo{c(rng) - 10, c(rng) - 10, c(rng) - 10};
+    const VoxelIndex hi{lo.x + len(rng), lo.y + len(rng), lo.z + len(rng)};
+    std::vector<std::tuple<int, int, int>> want, got;
+    for (int z = lo.z; z <= hi.z; ++z)
+      for (int y = lo.y; y <= hi.y; ++y)
+        for (int x = lo.x; x <= hi.x; ++x)
+          if (g.Occupied(x, y, z)) want.push_back({x, y, z});
+    // A predicate that is never true sees every occupied voxel of the box, once.
+    EXPECT_FALSE(g.AnyOccupiedWhere(lo, hi, [&](const VoxelIndex& a) {
+      got.push_back(key(a));
+      return false;
+    }));
+    std::sort(want.begin(), want.end());
+    std::sort(got.begin(), got.end());
+    ASSERT_EQ(got, want) << trial;
+    // One that picks a single voxel is true exactly when that voxel is in the box.
+    if (!want.empty()) {
+      const auto pick = want[want.size() / 2];
+      EXPECT_TRUE(g.AnyOccupiedWhere(lo, hi, [&](const VoxelIndex& a) { return key(a) == pick; }));
+      EXPECT_FALSE(g.AnyOccupiedWhere({lo.x, lo.y, std::get<2>(pick) + 1}, hi,
+                                      [&](const VoxelIndex& a) { return key(a) == pick; }));
+    }
+  }
 }
 
 TEST(OccupancyGridTest, RefusesOverBudgetWithExtentAndAResolutionThatFits) {

@@ -17,6 +17,8 @@
 // Immutable after Build; safe to share across threads.
 #pragma once
 
+#include <algorithm>
+#include <bit>
 #include <cstdint>
 #include <vector>
 
@@ -88,7 +90,20 @@ class OccupancyGrid {
 
   // Whether any voxel of the box [lo, hi] (inclusive voxel indices) is occupied. Bricks are
   // tested a word (an 8x8 slice) at a time; empty bricks cost one load.
-  bool AnyOccupied(const VoxelIndex& lo, const VoxelIndex& hi) const;
+  bool AnyOccupied(const VoxelIndex& lo, const VoxelIndex& hi) const {
+    return ScanBox(lo, hi, [](uint64_t bits, int, int, int) { return bits != 0; });
+  }
+  // Whether some occupied voxel v of the box [lo, hi] has pred(v) true. Stops at the first one.
+  template <typename Pred>
+  bool AnyOccupiedWhere(const VoxelIndex& lo, const VoxelIndex& hi, Pred&& pred) const {
+    return ScanBox(lo, hi, [&](uint64_t bits, int x0, int y0, int z) {
+      for (; bits; bits &= bits - 1) {
+        const int p = std::countr_zero(bits);
+        if (pred(VoxelIndex{x0 + (p & 7), y0 + (p >> 3), z})) return true;
+      }
+      return false;
+    });
+  }
 
   // Continuous index-space coordinates of a world point (metres).
   Eigen::Vector3d WorldToIndexSpace(const WorldPoint& p) const { return p * inv_resolution_; }
@@ -101,6 +116,11 @@ class OccupancyGrid {
 
  private:
   void ComputeBrickDistances();
+  // Calls fn(bits, x0, y0, z) for each word (an 8x8 slice of a non-empty brick) that meets the
+  // box [lo, hi], with bits cut to the box (bit y*8+x is voxel (x0 + x, y0 + y, z), in index
+  // space); true as soon as fn returns true.
+  template <typename Fn>
+  bool ScanBox(const VoxelIndex& lo, const VoxelIndex& hi, Fn&& fn) const;
 
   double resolution_m_ = 0;
   double inv_resolution_ = 0;
@@ -112,6 +132,38 @@ class OccupancyGrid {
   std::vector<uint64_t> payload_;  // 8 words per non-empty brick: word z, bit (y*8 + x)
   std::vector<uint8_t> brick_distance_;  // Chebyshev distance in bricks to a non-empty brick
 };
+
+template <typename Fn>
+bool OccupancyGrid::ScanBox(const VoxelIndex& lo, const VoxelIndex& hi, Fn&& fn) const {
+  const int lo3[3] = {lo.x - min_.x, lo.y - min_.y, lo.z - min_.z};
+  const int hi3[3] = {hi.x - min_.x, hi.y - min_.y, hi.z - min_.z};
+  int r0[3], r1[3];
+  for (int i = 0; i < 3; ++i) {
+    r0[i] = std::max(lo3[i], 0);
+    r1[i] = std::min(hi3[i], dims_[i] - 1);
+    if (r0[i] > r1[i]) return false;  // the box misses the grid: all free
+  }
+  for (int bz = r0[2] >> kBrickShift; bz <= r1[2] >> kBrickShift; ++bz) {
+    const int z0 = std::max(r0[2] - bz * kBrick, 0), z1 = std::min(r1[2] - bz * kBrick, kBrick - 1);
+    for (int by = r0[1] >> kBrickShift; by <= r1[1] >> kBrickShift; ++by) {
+      const int y0 = std::max(r0[1] - by * kBrick, 0), y1 = std::min(r1[1] - by * kBrick, kBrick - 1);
+      // Bits y0..y1 of a word's 8-bit rows.
+      const uint64_t rows = (y1 == kBrick - 1 ? ~uint64_t{0} : (uint64_t{1} << (8 * (y1 + 1))) - 1) &
+                            ~((uint64_t{1} << (8 * y0)) - 1);
+      for (int bx = r0[0] >> kBrickShift; bx <= r1[0] >> kBrickShift; ++bx) {
+        const uint32_t slot = bricks_[BrickLinear(uint32_t(bx), uint32_t(by), uint32_t(bz))];
+        if (slot == 0) continue;
+        const int x0 = std::max(r0[0] - bx * kBrick, 0), x1 = std::min(r1[0] - bx * kBrick, kBrick - 1);
+        const uint64_t mask = rows & (((uint64_t{2} << x1) - (uint64_t{1} << x0)) * 0x0101010101010101ull);
+        const uint64_t* words = BrickBits(slot);
+        for (int z = z0; z <= z1; ++z) {
+          if (fn(words[z] & mask, min_.x + bx * kBrick, min_.y + by * kBrick, min_.z + bz * kBrick + z)) return true;
+        }
+      }
+    }
+  }
+  return false;
+}
 
 // OctoMap's key of world point p at `resolution_m`: floor(p * (1/r)) + 32768 per axis, computed
 // exactly as OctoMap does. False if outside the 16-bit key range.
