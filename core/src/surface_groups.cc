@@ -248,7 +248,8 @@ SurfaceTargets::SurfaceTargets(const OccupancyGrid& grid, const std::vector<Voxe
 //   Skip(j)          the face's voxel needs no decision (surface visibility: seen already);
 //   Decided(...)     the group's faces decided seen and blocked.
 template <typename Kind>
-void SurfaceTargets::WalkGroups(const Vector3d& uo, const Brick& brick, OccluderCache& cache, Kind& kind) const {
+void SurfaceTargets::WalkGroups(const Vector3d& uo, const Brick& brick, GroupWalk& walk, Kind& kind) const {
+  OccluderCache& cache = walk.cache;
   uint64_t members[3][2][8];
   uint16_t slot[3][8][64];  // target at position p of layer `layer` of axis a
   const Target* t = &targets_[brick.begin];
@@ -296,11 +297,19 @@ void SurfaceTargets::WalkGroups(const Vector3d& uo, const Brick& brick, Occluder
           const bool single = (sub & (sub - 1)) == 0;
           if (!single) {
             if (const SolidBox* box = cache.FindIf(blocks_all)) {
+              walk.expect_seen = false;
               undecided &= ~sub;  // all blocked
               kind.BlockedGroup(a, sp, plane, umin, umax, wmin, wmax, sub, at, *box);
               return;
             }
           }
+          auto seen_group = [&] {
+            seen |= sub;
+            undecided &= ~sub;
+            kind.SeenGroup(a, sp, plane, umin, umax, wmin, wmax, sub, at);
+          };
+          const bool cone_first = !single && walk.expect_seen;
+          if (cone_first && FreeCone(grid_, uo, a, sp == 1, plane, q0, q1)) return seen_group();
           // One exact ray to the face nearest the rectangle's middle.
           const int cu2 = umin + umax, cw2 = wmin + wmax;
           int mid = -1, best = 1 << 30;
@@ -311,18 +320,14 @@ void SurfaceTargets::WalkGroups(const Vector3d& uo, const Brick& brick, Occluder
           }
           std::optional<VoxelIndex> occluder;
           const bool mid_seen = kind.Mid(at[mid], a, sp, plane, cache, occluder);
+          walk.expect_seen = mid_seen;
           if (kind.kMidDecidesFace) {
             undecided &= ~(uint64_t{1} << mid);
             if (mid_seen) seen |= uint64_t{1} << mid;
             if (single) return;
           }
           if (mid_seen) {
-            if (FreeCone(grid_, uo, a, sp == 1, plane, q0, q1)) {
-              seen |= sub;
-              undecided &= ~sub;
-              kind.SeenGroup(a, sp, plane, umin, umax, wmin, wmax, sub, at);
-              return;
-            }
+            if (!cone_first && FreeCone(grid_, uo, a, sp == 1, plane, q0, q1)) return seen_group();
           } else if (occluder) {
             const SolidBox* cached = cache.Find(*occluder);
             const SolidBox box = cached ? *cached : GrowSolidBox(grid_, *occluder, kGrowLimit);
@@ -408,8 +413,9 @@ struct SurfaceTargets::CentreKind {
   }
 };
 
-void SurfaceTargets::AppendVisible(const Vector3d& uo, size_t brick_begin, size_t brick_end, OccluderCache& cache,
+void SurfaceTargets::AppendVisible(const Vector3d& uo, size_t brick_begin, size_t brick_end, GroupWalk& walk,
                                    std::vector<uint32_t>& visible_ids) const {
+  OccluderCache& cache = walk.cache;
   for (size_t b = brick_begin; b < brick_end; ++b) {
     const Brick& brick = bricks_[b];
     const int base[3] = {brick.base.x, brick.base.y, brick.base.z};
@@ -418,7 +424,7 @@ void SurfaceTargets::AppendVisible(const Vector3d& uo, size_t brick_begin, size_
     FacingTable(uo, base, kind.facing);
     std::fill_n(kind.visible.begin(), n, 0);
     std::fill_n(kind.tried.begin(), n, 0);
-    WalkGroups(uo, brick, cache, kind);
+    WalkGroups(uo, brick, walk, kind);
 
     // What no group decided: ray by ray, as IsSurfaceVisible.
     const Target* t = kind.t;
@@ -538,14 +544,14 @@ struct SurfaceTargets::CornerKind {
   }
 };
 
-void SurfaceTargets::AppendCornerDecisions(const Vector3d& uo, size_t brick_begin, size_t brick_end,
-                                           OccluderCache& cache, std::vector<CornerDecision>& decisions) const {
+void SurfaceTargets::AppendCornerDecisions(const Vector3d& uo, size_t brick_begin, size_t brick_end, GroupWalk& walk,
+                                           std::vector<CornerDecision>& decisions) const {
   for (size_t b = brick_begin; b < brick_end; ++b) {
     const Brick& brick = bricks_[b];
     const int base[3] = {brick.base.x, brick.base.y, brick.base.z};
     CornerKind kind{grid_, uo, &targets_[brick.begin], base, {}, decisions};
     FacingTable(uo, base, kind.facing);
-    WalkGroups(uo, brick, cache, kind);
+    WalkGroups(uo, brick, walk, kind);
   }
 }
 

@@ -14,6 +14,15 @@
 
 namespace vc::internal {
 
+// What a walk over face groups carries from one group to the next, for one viewpoint: the
+// occluders its rays met, and whether the last group decided was seen. After a seen group the
+// free cone is tried before the middle ray, since it usually holds and then spares the ray; after
+// a hidden one the ray comes first. Either order gives the same answers.
+struct GroupWalk {
+  OccluderCache cache;
+  bool expect_seen = false;
+};
+
 class SurfaceTargets {
  public:
   // The voxels `ids` (positions in `index`) that have at least one exposed face, brick by brick.
@@ -32,15 +41,15 @@ class SurfaceTargets {
 
   // Appends to `visible` the id of every target in bricks [brick_begin, brick_end) that is
   // surface-visible from uo (index space; uo must not lie in an occupied voxel, and
-  // ShortcutsHold(grid, uo) must be true). `cache` carries
-  // occluders between calls for the same viewpoint.
-  void AppendVisible(const Eigen::Vector3d& uo, size_t brick_begin, size_t brick_end, OccluderCache& cache,
+  // ShortcutsHold(grid, uo) must be true). `walk` carries state between calls for the same
+  // viewpoint.
+  void AppendVisible(const Eigen::Vector3d& uo, size_t brick_begin, size_t brick_end, GroupWalk& walk,
                      std::vector<uint32_t>& visible) const;
 
   // Appends corner-visibility decisions (ALGORITHM.md s.4, the 8-voxel corner rule) that groups
   // of faces facing uo in bricks [brick_begin, brick_end) prove; corners not mentioned are
   // undecided. One corner may be decided more than once, always the same way.
-  void AppendCornerDecisions(const Eigen::Vector3d& uo, size_t brick_begin, size_t brick_end, OccluderCache& cache,
+  void AppendCornerDecisions(const Eigen::Vector3d& uo, size_t brick_begin, size_t brick_end, GroupWalk& walk,
                              std::vector<CornerDecision>& decisions) const;
 
  private:
@@ -57,7 +66,7 @@ class SurfaceTargets {
   struct CentreKind;
   struct CornerKind;
   template <typename Kind>
-  void WalkGroups(const Eigen::Vector3d& uo, const Brick& brick, OccluderCache& cache, Kind& kind) const;
+  void WalkGroups(const Eigen::Vector3d& uo, const Brick& brick, GroupWalk& walk, Kind& kind) const;
 
   const OccupancyGrid& grid_;
   std::vector<Target> targets_;

@@ -366,10 +366,10 @@ Result<std::vector<VoxelSet>> ComputeVisibilitySets(const VoxelScene& scene, con
     Status st = ParallelChunks(tasks, 1, options.threads, ctx, [&](uint64_t task, uint64_t, uint64_t) {
       const size_t k = task / brick_chunks, c = task % brick_chunks;
       if (shortcuts[k]) {
-        OccluderCache cache;
+        internal::GroupWalk walk;
         std::vector<uint32_t> seen;
         const size_t b0 = c * kBricksPerTask, b1 = std::min<size_t>(b0 + kBricksPerTask, targets.brick_count());
-        targets.AppendVisible(uo[k], b0, b1, cache, seen);
+        targets.AppendVisible(uo[k], b0, b1, walk, seen);
         for (uint32_t id : seen) SetBitConcurrently(sets[k].words(), id);
       }
       progress.Add(1);
@@ -565,10 +565,10 @@ Result<Evaluation> Evaluate(const VoxelScene& scene, const std::vector<WorldPoin
     const bool grouped = !options.per_corner && shortcuts[k] && !InsideOccupied(g, uo[k]);
     if (grouped) {
       VC_RETURN_IF_ERROR(ParallelChunks(brick_chunks, 1, options.threads, ctx, [&](uint64_t task, uint64_t, uint64_t) {
-        OccluderCache cache;
+        internal::GroupWalk walk;
         std::vector<internal::SurfaceTargets::CornerDecision> decisions;
         const size_t b0 = task * kBricksPerTask, b1 = std::min<size_t>(b0 + kBricksPerTask, targets.brick_count());
-        targets.AppendCornerDecisions(uo[k], b0, b1, cache, decisions);
+        targets.AppendCornerDecisions(uo[k], b0, b1, walk, decisions);
         for (const auto& d : decisions) {
           auto apply = [&](int q) {
             const uint32_t c = voxel_corners[d.id][q];
