@@ -175,11 +175,17 @@ TEST(GroupedCornersTest, SameFaceValuesAsPerCornerOnClutteredPlanesAndGeb079) {
   ExpectSameEvaluation(*g, Candidates(*g, 31), "geb079");
 }
 
+// The layer z = 0 over [0, n) x [0, n): a floor whose top faces lie on the plane z = 1.
+std::vector<VoxelIndex> Floor(int n) {
+  std::vector<VoxelIndex> v;
+  for (int x = 0; x < n; ++x)
+    for (int y = 0; y < n; ++y) v.push_back({x, y, 0});
+  return v;
+}
+
 TEST(FreeConeTest, EmptySpaceIsFreeAndAnyVoxelInTheConeIsNot) {
   // Viewer at height 20 above a floor (z = 0 layer, top plane z = 1); faces in [10, 13] x [10, 13].
-  std::vector<VoxelIndex> floor;
-  for (int x = 0; x < 32; ++x)
-    for (int y = 0; y < 32; ++y) floor.push_back({x, y, 0});
+  const std::vector<VoxelIndex> floor = Floor(32);
   const Vector3d o(2.5, 3.5, 20.25);
   const Vector3d q0(10.5, 10.5, 1), q1(13.5, 13.5, 1);
   {
@@ -224,9 +230,7 @@ TEST(FreeConeTest, VoxelsOfTheBoxCoverOutsideThePyramidDoNotCount) {
   // towards o (to x < 10 for any piece longer than 1.2 voxels); a voxel resting on the floor
   // just in front of the rectangle lies in that box but below every line of sight (at z in
   // [1, 2] the pyramid has x > 10.08).
-  std::vector<VoxelIndex> floor;
-  for (int x = 0; x < 32; ++x)
-    for (int y = 0; y < 32; ++y) floor.push_back({x, y, 0});
+  const std::vector<VoxelIndex> floor = Floor(32);
   const Vector3d o(2.5, 3.5, 20.25);
   const Vector3d q0(10.5, 10.5, 1), q1(13.5, 13.5, 1);
   {
@@ -265,9 +269,7 @@ TEST(FreeConeTest, WhatItProvesFreeIsFreeOnRandomClutter) {
   std::uniform_real_distribution<double> u01(0, 1);
   int proven = 0, refuted = 0;
   for (int scene = 0; scene < 6; ++scene) {
-    std::vector<VoxelIndex> v;
-    for (int x = 0; x < 40; ++x)
-      for (int y = 0; y < 40; ++y) v.push_back({x, y, 0});  // floor: faces on the plane z = 1
+    std::vector<VoxelIndex> v = Floor(40);
     for (int i = 0; i < 60 + 60 * scene; ++i) v.push_back({c(rng), c(rng), 1 + c(rng) % 12});
     const VoxelScene s = MakeScene(v);
     for (int trial = 0; trial < 400; ++trial) {
