@@ -16,8 +16,9 @@
 //   is convex), so every face of the group is blocked.
 //
 // Each group first casts one exact ray to its middle face; the answer picks which certificate to
-// try. Groups that neither certificate decides are split in four, down to a few faces; what is
-// left is decided ray by ray as IsSurfaceVisible does.
+// try (after a seen group, the free cone is tried before that ray). Groups that neither
+// certificate decides are split in four, down to a few faces; what is left is decided ray by ray
+// as IsSurfaceVisible does.
 #include "surface_groups.h"
 
 #include <algorithm>
