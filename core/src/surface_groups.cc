@@ -95,27 +95,38 @@ class ConeSides {
  public:
   ConeSides(const Vector3d& uo, int axis, Vector3d q0, Vector3d q1) {
     const int b1 = (axis + 1) % 3, b2 = (axis + 2) % 3;
+    if (!(uo[axis] != q0[axis])) return;  // uo on the rectangle's plane (callers exclude it): no planes
     // A rectangle one row wide is widened by a quarter voxel each way, so that every side plane
     // is well defined. A wider pyramid holds the narrower one: it only rules out fewer voxels.
     for (int b : {b1, b2}) {
       if (q1[b] - q0[b] < 0.5) q0[b] -= 0.25, q1[b] += 0.25;
     }
+    // The corners run counter-clockwise about the axis (b1 x b2 = axis). So, for a point m of
+    // the rectangle, (c_i - uo) x (c_i+1 - uo) . (m - uo) has the sign of q0[axis] - uo[axis]:
+    // the orientation follows from the side uo is on, exactly, with no rounded test.
     Vector3d c[4] = {q0, q0, q1, q0};
     c[1][b1] = q1[b1];
     c[3][b2] = q1[b2];
-    const Vector3d inside = 0.5 * (q0 + q1) - uo;
+    const bool inward = q0[axis] > uo[axis];
+    // Rounding. The corners and uo are exact; each computed normal n is within about
+    // 2e-15 * reach^2 of the exact one, where reach bounds |c - uo| per axis. A voxel of the
+    // cover lies within sqrt(3) (reach + 2) of uo, so its distance to the computed plane is off
+    // by at most 4e-15 * reach^2 * (reach + 2) / |n|. A plane is used only where that is below
+    // kSideSlack (with a factor 2.5 to spare); an edge seen end-on, whose plane is ill defined,
+    // is skipped, which only rules out fewer voxels.
+    double reach = 0;
+    for (const Vector3d& ci : c) reach = std::max(reach, (ci - uo).cwiseAbs().maxCoeff());
+    const double rounding = 1e-14 * reach * reach * (reach + 2);
     for (int i = 0; i < 4; ++i) {
       Vector3d n = (c[i] - uo).cross(c[(i + 1) % 4] - uo);
-      const double side = n.dot(inside);
-      if (!(std::abs(side) > 0)) continue;  // uo on the rectangle's plane: no plane, rules nothing out
-      if (side > 0) n = -n;                 // outward
+      const double norm = n.norm();
+      if (!(rounding < kSideSlack * norm)) continue;
+      if (inward) n = -n;
       // Voxel v (the cube [v, v + 1]) is outside by more than the margin if the smallest n.x
-      // over the cube, n.v + (sum of n's negative components), exceeds n.uo + margin |n|. The
-      // margin covers the cone's 1e-4 plus the rounding of n (below 1e-6 voxels at the
-      // distances ShortcutsHold allows, the rectangle being at least half a voxel wide).
+      // over the cube, n.v + (sum of n's negative components), exceeds n.uo + margin |n|.
       normal_[count_] = n;
-      limit_[count_] = n.dot(uo) + (kConeMargin + kSideSlack) * n.norm() - std::min(n.x(), 0.0) -
-                       std::min(n.y(), 0.0) - std::min(n.z(), 0.0);
+      limit_[count_] = n.dot(uo) + (kConeMargin + kSideSlack) * norm - std::min(n.x(), 0.0) - std::min(n.y(), 0.0) -
+                       std::min(n.z(), 0.0);
       ++count_;
     }
   }
