@@ -108,12 +108,15 @@ class ConeSides {
     c[1][b1] = q1[b1];
     c[3][b2] = q1[b2];
     const bool inward = q0[axis] > uo[axis];
-    // Rounding. The corners and uo are exact; each computed normal n is within about
-    // 2e-15 * reach^2 of the exact one, where reach bounds |c - uo| per axis. A voxel of the
-    // cover lies within sqrt(3) (reach + 2) of uo, so its distance to the computed plane is off
-    // by at most 4e-15 * reach^2 * (reach + 2) / |n|. A plane is used only where that is below
-    // kSideSlack (with a factor 2.5 to spare); an edge seen end-on, whose plane is ill defined,
-    // is skipped, which only rules out fewer voxels.
+    // Rounding. The corners and uo are exact, so each computed normal n is within 1.6e-15 *
+    // reach^2 of the exact one N, where reach bounds |c - uo| per axis. Every point z of the
+    // pyramid has N.(z - uo) <= 0 and lies within sqrt(3) reach of uo, so n.(z - uo) / |n| is
+    // at most 2.7e-15 * reach^3 / |n|: a cube beyond the computed plane by margin + slack is
+    // more than the margin from the pyramid while that is below kSideSlack. A plane is used
+    // only where 1e-14 * reach^2 (reach + 2) < kSideSlack |n|, which keeps it below 0.27 of the
+    // slack; evaluating n.v and n.uo in absolute coordinates adds about 1e-10 |n|. A plane
+    // through uo and an edge whose line passes near uo is ill defined and is skipped, which
+    // only rules out fewer voxels.
     double reach = 0;
     for (const Vector3d& ci : c) reach = std::max(reach, (ci - uo).cwiseAbs().maxCoeff());
     const double rounding = 1e-14 * reach * reach * (reach + 2);

@@ -247,9 +247,9 @@ TEST(FreeConeTest, VoxelsOfTheBoxCoverOutsideThePyramidDoNotCount) {
       }
   }
   {
-    // A voxel that the segment to the corner (13.5, 13.5, 1) passes through (at s = 0.9) counts.
+    // A voxel that the segment to the corner (13.5, 13.5, 1) passes through counts.
     std::vector<VoxelIndex> v = floor;
-    v.push_back({12, 12, 2});
+    v.push_back({12, 12, 2});  // crossed by that segment for s in [0.896, 0.948]
     EXPECT_FALSE(FreeCone(MakeScene(v).grid, o, 2, true, 1, q0, q1));
   }
   {
@@ -264,42 +264,80 @@ TEST(FreeConeTest, VoxelsOfTheBoxCoverOutsideThePyramidDoNotCount) {
 
 // Soundness on random clutter: whenever FreeCone proves a rectangle free, no walk from o to a
 // point of it meets an occupied voxel on o's side of the plane; and the test does prove many.
+// Every axis, both sides of the plane, near the origin and 20,000 voxels from it.
 TEST(FreeConeTest, WhatItProvesFreeIsFreeOnRandomClutter) {
   std::mt19937_64 rng(11);
   std::uniform_int_distribution<int> c(0, 39);
   std::uniform_real_distribution<double> u01(0, 1);
-  int proven = 0, refuted = 0;
-  for (int scene = 0; scene < 6; ++scene) {
-    std::vector<VoxelIndex> v = Floor(40);
-    for (int i = 0; i < 60 + 60 * scene; ++i) v.push_back({c(rng), c(rng), 1 + c(rng) % 12});
+  int proven = 0, refuted = 0, proven_far = 0, proven_grazing = 0;
+  for (int scene = 0; scene < 12; ++scene) {
+    const int axis = scene % 3, b1 = (axis + 1) % 3, b2 = (axis + 2) % 3;
+    const bool above = (scene / 3) % 2 == 0;  // viewer above a floor, or below a ceiling
+    const int off = scene >= 6 ? 20000 : 0;
+    // Local coordinates (u along b1, w along b2, h along the axis) to index space.
+    auto at = [&](double u, double w, double h) {
+      Vector3d g;
+      g[b1] = u + off, g[b2] = w + off, g[axis] = h + off;
+      return g;
+    };
+    // The surface layer is h = 0; its faces towards the viewer lie on h = 1 (above) or h = 0.
+    const int plane_h = above ? 1 : 0;
+    const double toward = above ? 1 : -1;
+    std::vector<VoxelIndex> v;
+    auto add = [&](int u, int w, int h) {
+      const Vector3d g = at(u, w, h);
+      v.push_back({int(g.x()), int(g.y()), int(g.z())});
+    };
+    for (int u = 0; u < 40; ++u)
+      for (int w = 0; w < 40; ++w) add(u, w, 0);
+    for (int i = 0; i < 100 + 40 * (scene % 6); ++i) add(c(rng), c(rng), above ? 1 + c(rng) % 12 : -1 - c(rng) % 12);
     const VoxelScene s = MakeScene(v);
-    for (int trial = 0; trial < 600; ++trial) {
-      Vector3d o(40 * u01(rng), 40 * u01(rng), 2 + 30 * u01(rng));
-      const int x0 = c(rng) % 36, y0 = c(rng) % 36, w = c(rng) % 5, h = c(rng) % 5;
-      const Vector3d q0(x0 + 0.5, y0 + 0.5, 1), q1(x0 + w + 0.5, y0 + h + 0.5, 1);
-      // A third of the views graze the floor, from 0.1 down to 1e-9 above it; half of those lie
-      // on the line of one of the rectangle's edges, where that side plane is ill defined.
-      if (trial % 3 == 1) {
-        o.z() = 1 + std::pow(10.0, -1 - trial % 9);
-        if (trial % 2) o.y() = q0.y();
+    for (int trial = 0; trial < 300; ++trial) {
+      const int u0 = c(rng) % 36, w0 = c(rng) % 36, du = c(rng) % 5, dw = c(rng) % 5;
+      // Face centres on the plane (corner evaluation uses integer corners; both are rectangles).
+      const double shift = trial % 7 == 0 ? 0.0 : 0.5;
+      // Every 5th rectangle lies one layer beyond the plane, as the back corners' do; only o's
+      // side of the plane is tested then too.
+      const double q_h = trial % 5 == 3 ? plane_h - toward : plane_h;
+      const Vector3d q0 = at(u0 + shift, w0 + shift, q_h), q1 = at(u0 + du + shift, w0 + dw + shift, q_h);
+      double ou = 40 * u01(rng), ow = 40 * u01(rng), oh = plane_h + toward * (1 + 30 * u01(rng));
+      const bool grazing = trial % 4 == 1, far = trial % 4 == 2;
+      if (grazing) {
+        // From 0.1 down to 1e-9 off the plane; every other one on the line of an edge, exactly or
+        // by an offset below a unit in the last place of the far coordinates.
+        oh = plane_h + toward * std::pow(10.0, -1 - trial % 9);
+        if (trial % 2) ow = w0 + shift + (trial % 3) * 3e-11;
+      } else if (far) {
+        // Hundreds to thousands of voxels away, low over the plane.
+        ou = u0 + (trial % 8 < 4 ? -1 : 1) * (200 + 2800 * u01(rng));
+        oh = plane_h + toward * (0.5 + 20 * u01(rng));
       }
+      const Vector3d o = at(ou, ow, oh);
       if (s.grid.Occupied(int(std::floor(o.x())), int(std::floor(o.y())), int(std::floor(o.z())))) continue;
-      if (!FreeCone(s.grid, o, 2, true, 1, q0, q1)) {
+      if (!FreeCone(s.grid, o, axis, above, plane_h + off, q0, q1)) {
         ++refuted;
         continue;
       }
       ++proven;
+      proven_far += far;
+      proven_grazing += grazing;
       for (int k = 0; k < 30; ++k) {
-        // Face centres, corners of the rectangle and random points of it.
-        const double fx = k < 4 ? (k & 1) : u01(rng), fy = k < 4 ? (k >> 1) : u01(rng);
-        const Vector3d q(q0.x() + fx * (q1.x() - q0.x()), q0.y() + fy * (q1.y() - q0.y()), 1);
+        // Corners of the rectangle and random points of it.
+        const double fu = k < 4 ? (k & 1) : u01(rng), fw = k < 4 ? (k >> 1) : u01(rng);
+        Vector3d q = q0;
+        q[b1] += fu * (q1[b1] - q0[b1]);
+        q[b2] += fw * (q1[b2] - q0[b2]);
         const auto hit = FirstOccupied(s.grid, o, q);
-        ASSERT_TRUE(!hit || hit->z < 1) << "scene " << scene << " trial " << trial << " point " << k;
+        const int hit_h = hit ? (axis == 0 ? hit->x : axis == 1 ? hit->y : hit->z) - off : 0;
+        ASSERT_TRUE(!hit || (above ? hit_h < plane_h : hit_h >= plane_h))
+            << "scene " << scene << " trial " << trial << " point " << k;
       }
     }
   }
-  EXPECT_GT(proven, 300);
-  EXPECT_GT(refuted, 300);
+  EXPECT_GT(proven, 600);
+  EXPECT_GT(refuted, 600);
+  EXPECT_GT(proven_far, 50);
+  EXPECT_GT(proven_grazing, 50);
 }
 
 TEST(SolidBoxTest, GrowsAcrossAWallAndBlocksSegmentsThroughItsInterior) {
