@@ -70,7 +70,11 @@ bool InsideOccupied(const OccupancyGrid& g, const Vector3d& u) {
 // Sets bit i of a bitset that other tasks may be setting bits of at the same time (the join of
 // the parallel loop orders it before any read).
 void SetBitConcurrently(std::vector<uint64_t>& words, uint64_t i) {
-  std::atomic_ref<uint64_t>(words[i >> 6]).fetch_or(uint64_t{1} << (i & 63), std::memory_order_relaxed);
+  std::atomic_ref<uint64_t> word(words[i >> 6]);
+  const uint64_t bit = uint64_t{1} << (i & 63);
+  // A corner is often decided many times (it is shared by up to 24 faces): a plain load skips
+  // the locked instruction when the bit is set already.
+  if (!(word.load(std::memory_order_relaxed) & bit)) word.fetch_or(bit, std::memory_order_relaxed);
 }
 
 bool CompatibleCached(const OccupancyGrid& g, const Vector3d& uo, const VoxelIndex& v, OccluderCache& cache) {
@@ -185,7 +189,8 @@ double FaceValue(Perception p, const WorldPoint& o, const VoxelIndex& v, Face f,
   Vector3d normal = Vector3d::Zero();
   normal[FaceAxis(f)] = FaceSign(f);
   const double cos_theta = d > 0 ? std::clamp(ray.dot(normal) / d, -1.0, 1.0) : 1.0;
-  return VisibilityValue(p, d, std::acos(cos_theta), s);
+  // The angle only counts for a fully perceived face; the acos is skipped for the others.
+  return VisibilityValue(p, d, p == Perception::kFull ? std::acos(cos_theta) : kHalfPi, s);
 }
 
 uint64_t PackCorner(const VoxelIndex& c) {
@@ -546,6 +551,13 @@ Result<Evaluation> Evaluate(const VoxelScene& scene, const std::vector<WorldPoin
 
   std::vector<double> best(n * kFacesPerVoxel, 0.0);
   std::vector<uint8_t> best_p(n * kFacesPerVoxel, 0);
+  // Bit f: face f of the voxel is in options.faces (the same for every viewpoint).
+  std::vector<uint8_t> faces_in_set(n, 0);
+  for (size_t i = 0; i < n; ++i) {
+    for (int f = 0; f < kFacesPerVoxel; ++f) {
+      if (FaceInSet(g, index[i], Face(f), options.faces)) faces_in_set[i] |= uint8_t(1u << f);
+    }
+  }
   if (options.keep_per_viewpoint_values) ev.per_viewpoint_face_values.assign(nv, {});
   std::vector<uint64_t> visible_bits((corners.size() + 63) / 64);
   constexpr uint64_t kCornerChunk = 64 * 256;
@@ -600,7 +612,7 @@ Result<Evaluation> Evaluate(const VoxelScene& scene, const std::vector<WorldPoin
       Tally& t = tallies[chunk];
       for (uint64_t i = b; i < e; ++i) {
         for (int f = 0; f < kFacesPerVoxel; ++f) {
-          if (!FaceInSet(g, index[i], Face(f), options.faces)) continue;
+          if (!((faces_in_set[i] >> f) & 1)) continue;
           int visible = 0;
           for (int q : kFaceCorners[f]) {
             const uint32_t c = voxel_corners[i][q];
