@@ -28,6 +28,7 @@ namespace {
 using Eigen::Vector3d;
 using internal::OccluderCache;
 using planner::ParallelChunks;
+using planner::ResolveThreads;
 
 constexpr double kHalfPi = 1.57079632679489661923;
 
@@ -361,11 +362,14 @@ Result<std::vector<VoxelSet>> ComputeVisibilitySets(const VoxelScene& scene, con
   const bool grouped = options.test == SelectionTest::kSurfaceVisibility && !options.per_voxel;
 
   if (grouped) {
-    // Grouped, for viewpoints where the shortcuts' margins hold: tasks are (viewpoint, run of
-    // bricks); tasks of one viewpoint share its set's words, so bits are set atomically.
+    // Grouped, for viewpoints where the shortcuts' margins hold. With enough viewpoints to keep
+    // every thread busy, a task is one viewpoint and owns its set. Otherwise tasks are
+    // (viewpoint, run of bricks); tasks of one viewpoint share its set's words, so bits are set
+    // atomically.
     const internal::SurfaceTargets targets(g, index, candidates);
-    constexpr uint64_t kBricksPerTask = 256;
-    const uint64_t brick_chunks = std::max<uint64_t>(1, (targets.brick_count() + kBricksPerTask - 1) / kBricksPerTask);
+    const bool task_per_viewpoint = viewpoints.size() >= 8 * uint64_t(ResolveThreads(options.threads, viewpoints.size()));
+    const uint64_t bricks_per_task = task_per_viewpoint ? std::max<uint64_t>(1, targets.brick_count()) : 256;
+    const uint64_t brick_chunks = std::max<uint64_t>(1, (targets.brick_count() + bricks_per_task - 1) / bricks_per_task);
     const uint64_t tasks = viewpoints.size() * brick_chunks;
     StageProgress progress(ctx, "visibility", tasks);
     Status st = ParallelChunks(tasks, 1, options.threads, ctx, [&](uint64_t task, uint64_t, uint64_t) {
@@ -373,9 +377,13 @@ Result<std::vector<VoxelSet>> ComputeVisibilitySets(const VoxelScene& scene, con
       if (shortcuts[k]) {
         internal::GroupWalk walk;
         std::vector<uint32_t> seen;
-        const size_t b0 = c * kBricksPerTask, b1 = std::min<size_t>(b0 + kBricksPerTask, targets.brick_count());
+        const size_t b0 = c * bricks_per_task, b1 = std::min<size_t>(b0 + bricks_per_task, targets.brick_count());
         targets.AppendVisible(uo[k], b0, b1, walk, seen);
-        for (uint32_t id : seen) SetBitConcurrently(sets[k].words(), id);
+        if (brick_chunks == 1) {
+          for (uint32_t id : seen) sets[k].set(id);
+        } else {
+          for (uint32_t id : seen) SetBitConcurrently(sets[k].words(), id);
+        }
       }
       progress.Add(1);
     });
