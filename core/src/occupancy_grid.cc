@@ -24,7 +24,7 @@ uint64_t OccupancyGrid::BytesNeeded(const VoxelIndex& min, const VoxelIndex& max
   const uint64_t bx = uint64_t(max.x - min.x) / kBrick + 1;
   const uint64_t by = uint64_t(max.y - min.y) / kBrick + 1;
   const uint64_t bz = uint64_t(max.z - min.z) / kBrick + 1;
-  return bx * by * bz * (sizeof(uint32_t) + sizeof(uint8_t)) + occupied_bricks * kBrick * sizeof(uint64_t);
+  return bx * by * bz * sizeof(int32_t) + occupied_bricks * kBrick * sizeof(uint64_t);
 }
 
 Result<OccupancyGrid> OccupancyGrid::Build(double resolution_m, const std::vector<VoxelIndex>& occupied,
@@ -45,7 +45,7 @@ Result<OccupancyGrid> OccupancyGrid::Build(double resolution_m, const std::vecto
                  nbz = uint64_t(hi.z - lo.z) / kBrick + 1;
   const uint64_t slots = nbx * nby * nbz;
   // The slot array alone must fit before we count bricks (which needs it).
-  const uint64_t slot_bytes = slots * (sizeof(uint32_t) + sizeof(uint8_t));
+  const uint64_t slot_bytes = slots * sizeof(int32_t);
   auto refuse = [&](uint64_t need) {
     const double ex = (hi.x - lo.x + 1) * resolution_m, ey = (hi.y - lo.y + 1) * resolution_m,
                  ez = (hi.z - lo.z + 1) * resolution_m;
@@ -73,11 +73,11 @@ Result<OccupancyGrid> OccupancyGrid::Build(double resolution_m, const std::vecto
   g.bricks_.assign(slots, 0);
   uint64_t used = 0;
   for (const VoxelIndex& v : occupied) {
-    uint32_t& slot = g.bricks_[g.BrickLinear(uint32_t(v.x - lo.x) >> kBrickShift, uint32_t(v.y - lo.y) >> kBrickShift,
+    int32_t& slot = g.bricks_[g.BrickLinear(uint32_t(v.x - lo.x) >> kBrickShift, uint32_t(v.y - lo.y) >> kBrickShift,
                                              uint32_t(v.z - lo.z) >> kBrickShift)];
     if (slot == 0) {
-      if (used + 1 >= std::numeric_limits<uint32_t>::max()) return refuse(~uint64_t{0});
-      slot = uint32_t(++used);
+      if (used + 1 >= uint64_t(std::numeric_limits<int32_t>::max())) return refuse(~uint64_t{0});
+      slot = int32_t(++used);
     }
   }
   const uint64_t need = BytesNeeded(lo, hi, used);
@@ -85,15 +85,10 @@ Result<OccupancyGrid> OccupancyGrid::Build(double resolution_m, const std::vecto
   g.payload_.assign(used * kBrick, 0);
   for (const VoxelIndex& v : occupied) {
     const uint32_t rx = uint32_t(v.x - lo.x), ry = uint32_t(v.y - lo.y), rz = uint32_t(v.z - lo.z);
-    const uint32_t slot = g.bricks_[g.BrickLinear(rx >> kBrickShift, ry >> kBrickShift, rz >> kBrickShift)];
+    const uint32_t slot = uint32_t(g.bricks_[g.BrickLinear(rx >> kBrickShift, ry >> kBrickShift, rz >> kBrickShift)]);
     g.payload_[uint64_t(slot - 1) * kBrick + (rz & 7)] |= uint64_t{1} << (((ry & 7) << 3) | (rx & 7));
   }
   g.ComputeBrickDistances();
-  // Padding for the SIMD ray kernel, which reads the slot and distance of a brick as the low bits
-  // of an unaligned 64-bit load (ray_batch.cc).
-  g.brick_count_ = g.bricks_.size();
-  g.bricks_.resize(g.brick_count_ + 2, 0);
-  g.brick_distance_.resize(g.brick_count_ + 8, 0);
   return g;
 }
 
@@ -104,7 +99,7 @@ void OccupancyGrid::ComputeBrickDistances() {
   constexpr int kCap = 255;
   const int nx = bdims_.x(), ny = bdims_.y(), nz = bdims_.z();
   std::vector<int> d(bricks_.size());
-  for (size_t i = 0; i < bricks_.size(); ++i) d[i] = bricks_[i] ? 0 : kCap;
+  for (size_t i = 0; i < bricks_.size(); ++i) d[i] = bricks_[i] > 0 ? 0 : kCap;
   std::vector<int> line, out;
   auto pass = [&](int n, int count_a, int count_b, auto index) {
     line.resize(n);
@@ -126,12 +121,13 @@ void OccupancyGrid::ComputeBrickDistances() {
   pass(nx, ny, nz, [&](int i, int a, int b) { return BrickLinear(i, a, b); });
   pass(ny, nx, nz, [&](int i, int a, int b) { return BrickLinear(a, i, b); });
   pass(nz, nx, ny, [&](int i, int a, int b) { return BrickLinear(a, b, i); });
-  brick_distance_.resize(d.size());
-  for (size_t i = 0; i < d.size(); ++i) brick_distance_[i] = uint8_t(std::min(d[i], kCap));
+  for (size_t i = 0; i < d.size(); ++i) {
+    if (d[i] > 0) bricks_[i] = -std::min(d[i], kCap);
+  }
 }
 
 uint64_t OccupancyGrid::memory_bytes() const {
-  return bricks_.size() * sizeof(uint32_t) + brick_distance_.size() + payload_.size() * sizeof(uint64_t);
+  return bricks_.size() * sizeof(int32_t) + payload_.size() * sizeof(uint64_t);
 }
 
 WorldPoint OccupancyGrid::VoxelCenter(const VoxelIndex& v) const { return KeyToCoord(resolution_m_, IndexToKey(v)); }

@@ -1,15 +1,29 @@
-// FirstOccupiedBatch: FirstOccupied on many segments at once, one segment per SIMD lane, with the
-// instruction set chosen at run time (Google Highway's dynamic dispatch; never -march=native).
+// FirstOccupiedBatch: FirstOccupied on many segments at once, one segment per SIMD lane of floats,
+// with the instruction set chosen at run time (Google Highway's dynamic dispatch; never
+// -march=native). The answers are FirstOccupied's, segment for segment.
 //
-// Every lane performs exactly the operations of the scalar FirstOccupied (ray_traversal.cc) in
-// the same order: the Walk set-up (walk.h, shared), the occupancy test per voxel, the jump across
-// the free box of bricks whenever the walk enters an empty brick (JumpAcrossBox, re-stated here
-// lane-wise with the same IEEE double operations), and the step with OctoMap's tie rule. So each
-// answer is bit-for-bit the scalar one, on every target including near-ties; the tests compare
-// every compiled target, the forced-scalar one included, against FirstOccupied.
+// Why float lanes give FirstOccupied's answers (docs/VISIBILITY.md, "Many segments at once"):
+// - The set-up is the scalar Walk (walk.h, shared): the start voxel, the steps and the number of
+//   boundary crossings per axis are the same integers. Only the order in which the crossings of
+//   different axes come is decided in float.
+// - A lane never accumulates a parameter. The parameter of crossing j of axis i is computed from
+//   the parameter of the axis's last crossing: t = T_last - (crossings left after j) * t_delta,
+//   one fused multiply-add (or a multiply and an add where the target has no FMA). Its error is at
+//   most 4 * 2^-24 (all crossings lie in [0, 1]), whatever the number of steps, so two parameters
+//   in float differ from their exact values by less than 2^-21 together.
+// - Every decision the lane takes (which axis crosses next; where a jump across a free box of
+//   bricks lands) is taken only if the parameters it compares are more than kMargin = 2^-20 apart.
+//   Then the lane's order is the exact order of the crossings, and so is the order in
+//   FirstOccupied, whose double parameters are within 10^-12 of exact. A decision closer than the
+//   margin (a near-tie, or an exact one: lattice-point rays have many) is not taken: the segment is
+//   marked and walked by FirstOccupied afterwards.
+// - Near-ties that no lane decision looks at lie strictly inside a free box the lane jumped across.
+//   Either order of those crossings visits only voxels of the box, which are free, and reaches the
+//   same voxel after both, so FirstOccupied's answer does not depend on them.
+// tests/core/ray_batch_test.cc compares every answer with FirstOccupied, near-ties included.
 //
-// A lane whose segment ends (a hit, leaving the grid's box, reaching the end) is refilled with the
-// next segment at once, so lanes do not wait for each other.
+// A lane whose segment ends (a hit, leaving the grid's box, reaching the end, a near-tie) is
+// refilled with the next segment at once, so lanes do not wait for each other.
 
 #undef HWY_TARGET_INCLUDE
 #define HWY_TARGET_INCLUDE "ray_batch.cc"
@@ -18,73 +32,85 @@
 #include <hwy/highway.h>
 
 #include <algorithm>
+#include <bit>
+#include <cmath>
 #include <cstdint>
 #include <limits>
 #include <optional>
 #include <span>
 #include <string>
+#include <vector>
 
 #include "vc/core/ray_traversal.h"
 #include "walk.h"
+
+// foreach_target.h includes this file once per target; these constants are defined once.
+#ifndef VC_CORE_RAY_BATCH_CONSTANTS_
+#define VC_CORE_RAY_BATCH_CONSTANTS_
+namespace vc::internal {
+// Two float parameters closer than this are a near-tie (see the top of this file).
+inline constexpr float kMargin = 0x1p-20f;
+// Segments the lanes do not take: longer than this many steps per axis (so that the counts stay
+// exact in float and the products in int32), or with coordinates beyond +-2^30.
+inline constexpr int kMaxLaneSteps = 1 << 22;
+inline constexpr double kMaxLaneCoordinate = 0x1p30;
+// A lane that enters an empty brick waits (keeps its state) until this many of its group's
+// walking lanes are waiting too, or all of them are, so that one pass of the jump serves many
+// lanes. A group refills its ended lanes once this many have ended (or the segments run out).
+// Measured on the hall (docs/BENCHMARKS.md): 4 or 8 waiting and 1 or 2 ended are alike, 1.1-1.2x
+// over jumping and refilling at once; waiting for all 16 lanes is 3x slower.
+inline constexpr size_t kJumpBatch = 8;
+inline constexpr size_t kRefillBatch = 2;
+}  // namespace vc::internal
+#endif
 
 HWY_BEFORE_NAMESPACE();
 namespace vc {
 namespace HWY_NAMESPACE {
 namespace hn = hwy::HWY_NAMESPACE;
 
-using D = hn::ScalableTag<double>;
+using D = hn::ScalableTag<float>;
 using DI = hn::RebindToSigned<D>;
 using DU = hn::RebindToUnsigned<D>;
-using VD = hn::Vec<D>;
+using VF = hn::Vec<D>;
 using VI = hn::Vec<DI>;
 using MI = hn::Mask<DI>;
 
-// The segments still to cast, and where the answers go.
+// The segments still to cast, where the answers go, and the segments left to FirstOccupied.
 struct Source {
   const Eigen::Vector3d* a;
   const Eigen::Vector3d* b;
   size_t count;
   size_t next;
   std::optional<VoxelIndex>* out;
+  std::vector<size_t>* unsure;
 };
 
-// The grid as the kernel reads it.
+// The grid as the kernel reads it: the brick entries (slot, or minus the distance) and the payload
+// as 32-bit words (word 2w + h of a brick holds rows y = 4h..4h+3 of its 64-bit word w; x86 is
+// little-endian).
 struct GridView {
   explicit GridView(const OccupancyGrid& grid)
       : lo{hn::Set(DI(), grid.min_index().x), hn::Set(DI(), grid.min_index().y), hn::Set(DI(), grid.min_index().z)},
-        dims{hn::Set(DU(), uint64_t(grid.dims().x())), hn::Set(DU(), uint64_t(grid.dims().y())),
-             hn::Set(DU(), uint64_t(grid.dims().z()))},
-        bdx(uint64_t(grid.brick_dims().x())),
-        bdy(uint64_t(grid.brick_dims().y())),
-        // The padding after both arrays (occupancy_grid.h) keeps these 8-byte loads in bounds.
-        slots(reinterpret_cast<const uint64_t*>(grid.brick_slots())),
-        dists(reinterpret_cast<const uint64_t*>(grid.brick_distances())),
-        payload(grid.payload()) {}
+        dims{hn::Set(DU(), uint32_t(grid.dims().x())), hn::Set(DU(), uint32_t(grid.dims().y())),
+             hn::Set(DU(), uint32_t(grid.dims().z()))},
+        bdx(hn::Set(DI(), grid.brick_dims().x())),
+        bdy(hn::Set(DI(), grid.brick_dims().y())),
+        entries(grid.brick_entries()),
+        payload(reinterpret_cast<const int32_t*>(grid.payload())) {}
 
-  // Brick number (bz * bdy + by) * bdx + bx of in-box relative coordinates. The row number fits
-  // in 32 bits (checked by the caller), so 32x32 -> 64-bit products suffice.
+  // Brick number (bz * bdy + by) * bdx + bx of in-box relative coordinates; below 2^31 (checked
+  // by the caller).
   VI BrickNumber(VI rx, VI ry, VI rz) const {
-    const DI di;
-    const DU du;
     const VI bx = hn::ShiftRight<3>(rx), by = hn::ShiftRight<3>(ry), bz = hn::ShiftRight<3>(rz);
-#if HWY_TARGET == HWY_SCALAR
-    (void)du;
-    const uint64_t row = uint64_t(hn::GetLane(bz)) * bdy + uint64_t(hn::GetLane(by));
-    return hn::Set(di, int64_t(row * bdx + uint64_t(hn::GetLane(bx))));
-#else
-    const hn::Repartition<uint32_t, DU> du32;
-    const auto row = hn::Add(hn::MulEven(hn::BitCast(du32, bz), hn::Set(du32, uint32_t(bdy))), hn::BitCast(du, by));
-    return hn::BitCast(di, hn::Add(hn::MulEven(hn::BitCast(du32, row), hn::Set(du32, uint32_t(bdx))),
-                                   hn::BitCast(du, bx)));
-#endif
+    return hn::Add(hn::Mul(hn::Add(hn::Mul(bz, bdy), by), bdx), bx);
   }
 
   VI lo[3];
   hn::Vec<DU> dims[3];
-  uint64_t bdx, bdy;
-  const uint64_t* slots;
-  const uint64_t* dists;
-  const uint64_t* payload;
+  VI bdx, bdy;
+  const int32_t* entries;
+  const int32_t* payload;
 };
 
 // One vector of lanes, each walking its own segment. A lane whose segment has ended is frozen (its
@@ -105,13 +131,19 @@ class LaneGroup {
   void RefillIfEnded(Source& src) {
     const DI di;
     if (hn::AllFalse(di, done_)) return;
+    if (src.next < src.count && hn::CountTrue(di, done_) < std::min(internal::kRefillBatch, hn::Lanes(D()))) return;
     Store();
     hn::Store(hn::VecFromMask(di, done_), di, s_.done);
     hn::Store(hn::VecFromMask(di, hit_), di, s_.hit);
+    hn::Store(hn::VecFromMask(di, unsure_), di, s_.unsure);
     for (size_t l = 0; l < hn::Lanes(D()); ++l) {
       if (!s_.done[l]) continue;
-      src.out[s_.id[l]] = s_.hit[l] ? std::optional<VoxelIndex>(VoxelIndex{int(s_.x[l]), int(s_.y[l]), int(s_.z[l])})
-                                    : std::nullopt;
+      if (s_.unsure[l]) {
+        src.unsure->push_back(size_t(s_.id[l]));
+      } else {
+        src.out[s_.id[l]] = s_.hit[l] ? std::optional<VoxelIndex>(VoxelIndex{s_.x[l], s_.y[l], s_.z[l]})
+                                      : std::nullopt;
+      }
       --active_;
       Take(l, src);
     }
@@ -122,127 +154,174 @@ class LaneGroup {
   // Lane state in memory while lanes are refilled (structure of arrays; 16 >= lanes of any target).
   struct State {
     static constexpr size_t kMax = 16;
-    alignas(64) int64_t x[kMax], y[kMax], z[kMax];
-    alignas(64) int64_t lx[kMax], ly[kMax], lz[kMax], rem[kMax];
-    alignas(64) int64_t sx[kMax], sy[kMax], sz[kMax], was[kMax], id[kMax], hit[kMax], done[kMax];
-    alignas(64) double tx[kMax], ty[kMax], tz[kMax], dx[kMax], dy[kMax], dz[kMax];
+    alignas(64) int32_t x[kMax], y[kMax], z[kMax], lx[kMax], ly[kMax], lz[kMax];
+    alignas(64) int32_t sx[kMax], sy[kMax], sz[kMax], was[kMax], id[kMax], hit[kMax], done[kMax], unsure[kMax];
+    alignas(64) float dx[kMax], dy[kMax], dz[kMax], ex[kMax], ey[kMax], ez[kMax];
   };
 
-  // Loads the next segment into lane `l` with the scalar set-up, or parks the lane: far outside
-  // the box, never inside, with nothing that reaches zero, so it never ends or touches memory.
+  // Loads the next segment the lanes can take into lane `l`, or parks the lane: far outside the
+  // box, never inside, stepping by 0 along z forever, so it never ends or touches memory.
+  // Segments the lanes cannot hold go straight to FirstOccupied.
   void Take(size_t l, Source& src) {
+    while (src.next < src.count && !TakeSegment(l, src.a[src.next], src.b[src.next])) {
+      src.unsure->push_back(src.next++);
+    }
     if (src.next < src.count) {
-      const internal::Walk w(src.a[src.next], src.b[src.next]);
-      s_.x[l] = w.cur[0], s_.y[l] = w.cur[1], s_.z[l] = w.cur[2];
-      s_.lx[l] = w.left[0], s_.ly[l] = w.left[1], s_.lz[l] = w.left[2], s_.rem[l] = w.remaining;
-      s_.sx[l] = w.step[0], s_.sy[l] = w.step[1], s_.sz[l] = w.step[2];
-      s_.tx[l] = w.t_max[0], s_.ty[l] = w.t_max[1], s_.tz[l] = w.t_max[2];
-      s_.dx[l] = w.t_delta[0], s_.dy[l] = w.t_delta[1], s_.dz[l] = w.t_delta[2];
-      s_.id[l] = int64_t(src.next++);
+      s_.id[l] = int32_t(src.next++);
       ++active_;
     } else {
-      constexpr int64_t kFar = int64_t{1} << 60;
+      constexpr int32_t kFar = int32_t{1} << 30;
       s_.x[l] = s_.y[l] = s_.z[l] = -kFar;
-      s_.lx[l] = s_.ly[l] = s_.lz[l] = s_.rem[l] = kFar;
+      s_.lx[l] = s_.ly[l] = s_.lz[l] = kFar;
       s_.sx[l] = s_.sy[l] = s_.sz[l] = 0;
-      s_.tx[l] = s_.ty[l] = s_.tz[l] = internal::kInf;
       s_.dx[l] = s_.dy[l] = s_.dz[l] = 0;
+      s_.ex[l] = s_.ey[l] = internal::kInf;
+      s_.ez[l] = 0;
       s_.id[l] = -1;
     }
     s_.was[l] = 0;
     s_.done[l] = 0;
   }
 
+  // The scalar Walk's set-up of a -> b in lane `l`, with each axis's last crossing parameter.
+  // False if the lanes cannot hold the segment.
+  bool TakeSegment(size_t l, const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+    for (int i = 0; i < 3; ++i) {
+      if (!(std::abs(a[i]) < internal::kMaxLaneCoordinate && std::abs(b[i]) < internal::kMaxLaneCoordinate)) {
+        return false;
+      }
+    }
+    const internal::Walk w(a, b);
+    int32_t* cur[3] = {s_.x, s_.y, s_.z};
+    int32_t* left[3] = {s_.lx, s_.ly, s_.lz};
+    int32_t* step[3] = {s_.sx, s_.sy, s_.sz};
+    float* delta[3] = {s_.dx, s_.dy, s_.dz};
+    float* last[3] = {s_.ex, s_.ey, s_.ez};
+    for (int i = 0; i < 3; ++i) {
+      if (w.left[i] > internal::kMaxLaneSteps) return false;
+      cur[i][l] = w.cur[i];
+      left[i][l] = w.left[i];
+      step[i][l] = w.step[i];
+      if (w.left[i] == 0) {  // never crosses: its next crossing is at infinity
+        delta[i][l] = 0;
+        last[i][l] = internal::kInf;
+        continue;
+      }
+      const float dt = float(w.t_delta[i]), tl = float(w.t_max[i] + (w.left[i] - 1) * w.t_delta[i]);
+      if (!std::isfinite(dt) || !std::isfinite(tl)) return false;
+      delta[i][l] = dt;
+      last[i][l] = tl;
+    }
+    return true;
+  }
+
   void Load() {
     const D d;
     const DI di;
     x_ = hn::Load(di, s_.x), y_ = hn::Load(di, s_.y), z_ = hn::Load(di, s_.z);
-    lx_ = hn::Load(di, s_.lx), ly_ = hn::Load(di, s_.ly), lz_ = hn::Load(di, s_.lz), rem_ = hn::Load(di, s_.rem);
+    lx_ = hn::Load(di, s_.lx), ly_ = hn::Load(di, s_.ly), lz_ = hn::Load(di, s_.lz);
     sx_ = hn::Load(di, s_.sx), sy_ = hn::Load(di, s_.sy), sz_ = hn::Load(di, s_.sz), was_ = hn::Load(di, s_.was);
-    tx_ = hn::Load(d, s_.tx), ty_ = hn::Load(d, s_.ty), tz_ = hn::Load(d, s_.tz);
     dx_ = hn::Load(d, s_.dx), dy_ = hn::Load(d, s_.dy), dz_ = hn::Load(d, s_.dz);
+    ex_ = hn::Load(d, s_.ex), ey_ = hn::Load(d, s_.ey), ez_ = hn::Load(d, s_.ez);
     done_ = hn::MaskFromVec(hn::Load(di, s_.done));
-    hit_ = done_;
+    hit_ = unsure_ = done_;
   }
 
   void Store() {
-    const D d;
     const DI di;
     hn::Store(x_, di, s_.x), hn::Store(y_, di, s_.y), hn::Store(z_, di, s_.z);
-    hn::Store(lx_, di, s_.lx), hn::Store(ly_, di, s_.ly), hn::Store(lz_, di, s_.lz), hn::Store(rem_, di, s_.rem);
+    hn::Store(lx_, di, s_.lx), hn::Store(ly_, di, s_.ly), hn::Store(lz_, di, s_.lz);
     hn::Store(was_, di, s_.was);
-    hn::Store(tx_, d, s_.tx), hn::Store(ty_, d, s_.ty), hn::Store(tz_, d, s_.tz);
   }
 
-  MI JumpAcrossFreeBricks(MI jump, VI brick, const VI rel[3]);
+  // Parameter of the crossing of an axis after which `after` crossings are left (after >= 0):
+  // T_last - after * t_delta.
+  static VF Crossing(VI after, VF delta, VF last) { return hn::NegMulAdd(hn::ConvertTo(D(), after), delta, last); }
+
+  MI JumpAcrossFreeBricks(MI jump, VI entry, const VI rel[3]);
 
   const GridView& g_;
   State s_;
   size_t active_ = 0;
-  VI x_, y_, z_, lx_, ly_, lz_, rem_, sx_, sy_, sz_, was_;
-  VD tx_, ty_, tz_, dx_, dy_, dz_;
-  MI done_, hit_;
+  VI x_, y_, z_, lx_, ly_, lz_, sx_, sy_, sz_, was_;
+  VF dx_, dy_, dz_, ex_, ey_, ez_;
+  MI done_, hit_, unsure_;
 };
 
-// Lane-wise JumpAcrossBox (walk.h) for the lanes in `jump`, over the free box of bricks around
-// each lane's empty brick: the same double operations in the same order. Returns the lanes whose
+// Jumps the lanes in `jump` to the last voxel of their walk inside the free box of bricks around
+// their (empty) brick, as JumpAcrossBox (walk.h) does, each decision certified by the margin.
+// Lanes whose jump is a near-tie are marked unsure and left as they are. Returns the lanes whose
 // segment ends inside their box.
-HWY_INLINE MI LaneGroup::JumpAcrossFreeBricks(MI jump, VI brick, const VI rel[3]) {
+HWY_INLINE MI LaneGroup::JumpAcrossFreeBricks(MI jump, VI entry, const VI rel[3]) {
   const D d;
   const DI di;
-  const DU du;
   const VI zero = hn::Zero(di), one = hn::Set(di, 1);
-  const VD inf = hn::Set(d, internal::kInf);
-  const VI k = hn::Sub(hn::BitCast(di, hn::And(hn::GatherOffset(du, g_.dists, brick), hn::Set(du, 0xFF))), one);
-  VD t_exit = inf;
-  VI exit_axis = hn::Set(di, -1);
-  MI end_inside = hn::Eq(zero, zero);
-  VI ste[3];
+  const VF inf = hn::Set(d, internal::kInf), margin = hn::Set(d, internal::kMargin);
+  const VI k = hn::Sub(hn::Neg(entry), one);  // the brick's distance - 1
   VI* cur[3] = {&x_, &y_, &z_};
   VI* left[3] = {&lx_, &ly_, &lz_};
-  VD* t_max[3] = {&tx_, &ty_, &tz_};
   const VI step[3] = {sx_, sy_, sz_};
-  const VD t_delta[3] = {dx_, dy_, dz_};
+  const VF delta[3] = {dx_, dy_, dz_}, last[3] = {ex_, ey_, ez_};
+  MI end_inside = hn::Eq(zero, zero);
+  VI ste[3];
+  VF exit_t[3];  // parameter at which each axis leaves the box (inf if the walk ends first)
+  const VI k8 = hn::ShiftLeft<OccupancyGrid::kBrickShift>(k), seven = hn::Set(di, OccupancyGrid::kBrick - 1);
   for (int i = 0; i < 3; ++i) {
+    // In coordinates relative to the grid: the box spans bricks brick_i - k .. brick_i + k, so the
+    // walk's last voxel is in it iff its brick is within k of brick_i, and the steps to the box's
+    // face are 8k plus those to the brick's face.
     const VI brick_i = hn::ShiftRight<OccupancyGrid::kBrickShift>(rel[i]);
-    const VI box_lo = hn::Add(g_.lo[i], hn::ShiftLeft<OccupancyGrid::kBrickShift>(hn::Sub(brick_i, k)));
-    const VI box_hi =
-        hn::Sub(hn::Add(g_.lo[i], hn::ShiftLeft<OccupancyGrid::kBrickShift>(hn::Add(hn::Add(brick_i, k), one))), one);
-    const MI pos = hn::Gt(step[i], zero), neg = hn::Lt(step[i], zero);
-    const VI end_i = hn::Add(*cur[i], hn::IfThenElse(pos, *left[i], hn::IfThenElseZero(neg, hn::Neg(*left[i]))));
-    end_inside = hn::And(end_inside, hn::Not(hn::Or(hn::Lt(end_i, box_lo), hn::Gt(end_i, box_hi))));
-    ste[i] = hn::IfThenElse(pos, hn::Sub(box_hi, *cur[i]), hn::IfThenElseZero(neg, hn::Sub(*cur[i], box_lo)));
-    const MI moving = hn::And(hn::Or(pos, neg), hn::Gt(*left[i], ste[i]));
-    const VD t = hn::Add(*t_max[i], hn::Mul(hn::ConvertTo(d, ste[i]), t_delta[i]));
-    const auto earlier = hn::And(hn::RebindMask(d, moving), hn::Lt(t, t_exit));
-    t_exit = hn::IfThenElse(earlier, t, t_exit);
-    exit_axis = hn::IfThenElse(hn::RebindMask(di, earlier), hn::Set(di, i), exit_axis);
+    const MI pos = hn::Gt(step[i], zero);
+    const VI end_rel = hn::Add(rel[i], hn::IfThenElse(pos, *left[i], hn::Neg(*left[i])));  // left = 0 if no step
+    end_inside = hn::And(end_inside,
+                         hn::Lt(hn::Abs(hn::Sub(hn::ShiftRight<OccupancyGrid::kBrickShift>(end_rel), brick_i)), hn::Add(k, one)));
+    const VI in_brick = hn::And(rel[i], seven);
+    ste[i] = hn::Add(k8, hn::IfThenElse(pos, hn::Sub(seven, in_brick), in_brick));
+    const MI leaves = hn::Gt(*left[i], ste[i]);
+    exit_t[i] = hn::IfThenElse(hn::RebindMask(d, leaves), Crossing(hn::Sub(hn::Sub(*left[i], one), ste[i]), delta[i], last[i]),
+                               inf);
   }
+  const VF t_exit = hn::Min(exit_t[0], hn::Min(exit_t[1], exit_t[2]));
+  const VF near = hn::Add(t_exit, margin), below = hn::Sub(t_exit, margin);
+  // The axis that leaves the box first must be clear of the others' exits.
+  const auto n0 = hn::Le(exit_t[0], near), n1 = hn::Le(exit_t[1], near), n2 = hn::Le(exit_t[2], near);
+  auto tie = hn::Or(hn::And(n0, n1), hn::Or(hn::And(n0, n2), hn::And(n1, n2)));
   const MI go = hn::AndNot(end_inside, jump);
+  VI n[3];
   for (int i = 0; i < 3; ++i) {
-    const auto crosses = hn::And(hn::RebindMask(d, hn::And(go, hn::Ne(*left[i], zero))), hn::Lt(*t_max[i], t_exit));
+    // Crossings of axis i strictly before t_exit, at most to the box's face or the walk's end: the
+    // exit axis goes to its face; another takes ceil((t_exit - t) / t_delta), and both crossings
+    // around t_exit must be clear of it.
     const VI limit = hn::Min(ste[i], *left[i]);
-    const VD q = hn::Ceil(hn::Div(hn::Sub(t_exit, *t_max[i]), t_delta[i]));
-    const VD nd = hn::IfThenElseZero(hn::Gt(q, hn::Zero(d)), hn::Min(q, hn::ConvertTo(d, limit)));
-    const VI n = hn::IfThenElse(hn::Eq(exit_axis, hn::Set(di, i)), limit, hn::ConvertTo(di, nd));
-    const MI move = hn::And(hn::RebindMask(di, crosses), hn::Ne(n, zero));
-    const VI signed_n = hn::IfThenElse(hn::Gt(step[i], zero), n, hn::Neg(n));
-    *cur[i] = hn::IfThenElse(move, hn::Add(*cur[i], signed_n), *cur[i]);
-    *left[i] = hn::IfThenElse(move, hn::Sub(*left[i], n), *left[i]);
-    rem_ = hn::IfThenElse(move, hn::Sub(rem_, n), rem_);
-    const VD moved = hn::IfThenElse(hn::RebindMask(d, hn::Eq(*left[i], zero)), inf,
-                                    hn::Add(*t_max[i], hn::Mul(hn::ConvertTo(d, n), t_delta[i])));
-    *t_max[i] = hn::IfThenElse(hn::RebindMask(d, move), moved, *t_max[i]);
+    const auto is_exit = hn::Eq(exit_t[i], t_exit);
+    const VF t = Crossing(hn::Sub(*left[i], one), delta[i], last[i]);  // the next crossing
+    const VF q = hn::Ceil(hn::Div(hn::Sub(t_exit, t), delta[i]));
+    const VF nf = hn::IfThenElseZero(hn::Gt(q, hn::Zero(d)), hn::Min(q, hn::ConvertTo(d, limit)));
+    n[i] = hn::IfThenElse(hn::RebindMask(di, is_exit), limit, hn::ConvertTo(di, nf));
+    const VI after = hn::Sub(*left[i], n[i]);  // crossings left after the jump
+    const auto next_late = hn::Or(hn::RebindMask(d, hn::Eq(after, zero)),
+                                  hn::Gt(Crossing(hn::Sub(after, one), delta[i], last[i]), near));
+    const auto prev_early = hn::Or(hn::RebindMask(d, hn::Eq(n[i], zero)), hn::Lt(Crossing(after, delta[i], last[i]), below));
+    const auto moving = hn::RebindMask(d, hn::Ne(*left[i], zero));
+    tie = hn::Or(tie, hn::AndNot(is_exit, hn::And(moving, hn::Not(hn::And(next_late, prev_early)))));
   }
-  return hn::And(jump, end_inside);
+  const MI unsure = hn::And(go, hn::RebindMask(di, tie));
+  unsure_ = hn::Or(unsure_, unsure);
+  const MI move = hn::AndNot(unsure, go);
+  for (int i = 0; i < 3; ++i) {
+    const MI m = hn::And(move, hn::Ne(n[i], zero));
+    const VI signed_n = hn::IfThenElse(hn::Gt(step[i], zero), n[i], hn::Neg(n[i]));
+    *cur[i] = hn::IfThenElse(m, hn::Add(*cur[i], signed_n), *cur[i]);
+    *left[i] = hn::IfThenElse(m, hn::Sub(*left[i], n[i]), *left[i]);
+  }
+  return hn::Or(unsure, hn::And(jump, end_inside));
 }
 
 HWY_INLINE void LaneGroup::Advance() {
   const D d;
   const DI di;
   const DU du;
-  const VI zero = hn::Zero(di), one = hn::Set(di, 1), seven = hn::Set(di, 7);
-  const VD inf = hn::Set(d, internal::kInf);
+  const VI zero = hn::Zero(di), one = hn::Set(di, 1), three = hn::Set(di, 3), seven = hn::Set(di, 7);
   // ---- The current voxel: occupied, an empty brick to jump across, or outside the box.
   const VI rel[3] = {hn::Sub(x_, g_.lo[0]), hn::Sub(y_, g_.lo[1]), hn::Sub(z_, g_.lo[2])};
   const MI inside = hn::RebindMask(di, hn::And(hn::Lt(hn::BitCast(du, rel[0]), g_.dims[0]),
@@ -250,49 +329,58 @@ HWY_INLINE void LaneGroup::Advance() {
                                                        hn::Lt(hn::BitCast(du, rel[2]), g_.dims[2]))));
   was_ = hn::Or(was_, hn::VecFromMask(di, inside));
   const VI brick = hn::IfThenElseZero(inside, g_.BrickNumber(rel[0], rel[1], rel[2]));
-  const VI slot =
-      hn::BitCast(di, hn::And(hn::GatherOffset(du, g_.slots, hn::ShiftLeft<2>(brick)), hn::Set(du, 0xFFFFFFFFu)));
-  const MI filled = hn::And(inside, hn::Ne(slot, zero));
-  const VI word_index =
-      hn::IfThenElseZero(filled, hn::Add(hn::ShiftLeft<3>(hn::Sub(slot, one)), hn::And(rel[2], seven)));
-  const auto word = hn::GatherIndex(du, g_.payload, word_index);
-  const auto bit = hn::BitCast(du, hn::Or(hn::ShiftLeft<3>(hn::And(rel[1], seven)), hn::And(rel[0], seven)));
+  const VI slot = hn::GatherIndex(di, g_.entries, brick);
+  const MI filled = hn::And(inside, hn::Gt(slot, zero));
+  const VI word_index = hn::IfThenElseZero(
+      filled, hn::Add(hn::ShiftLeft<4>(hn::Sub(slot, one)),
+                      hn::Add(hn::ShiftLeft<1>(hn::And(rel[2], seven)), hn::ShiftRight<2>(hn::And(rel[1], seven)))));
+  const auto word = hn::BitCast(du, hn::GatherIndex(di, g_.payload, word_index));
+  const auto bit = hn::BitCast(du, hn::Or(hn::ShiftLeft<3>(hn::And(rel[1], three)), hn::And(rel[0], seven)));
   hit_ = hn::And(filled, hn::RebindMask(di, hn::Ne(hn::And(hn::operator>>(word, bit), hn::Set(du, 1)), hn::Zero(du))));
   MI end = hn::Or(hit_, hn::AndNot(inside, hn::MaskFromVec(was_)));
   const MI empty = hn::AndNot(done_, hn::AndNot(filled, inside));
-  if (!hn::AllFalse(di, empty)) end = hn::Or(end, JumpAcrossFreeBricks(empty, brick, rel));
-  done_ = hn::Or(done_, hn::Or(end, hn::Eq(rem_, zero)));
+  MI wait = hn::FirstN(di, 0);
+  const size_t waiting = hn::CountTrue(di, empty);
+  if (waiting >= std::min(internal::kJumpBatch, active_ - hn::CountTrue(di, done_))) {
+    end = hn::Or(end, JumpAcrossFreeBricks(empty, slot, rel));
+  } else {
+    wait = empty;
+  }
+  done_ = hn::Or(done_, hn::Or(end, hn::Eq(hn::Or(lx_, hn::Or(ly_, lz_)), zero)));
 
-  // ---- One step for the lanes still walking (scalar: FirstOccupied's loop, or Walk::Advance
-  // after a jump), with OctoMap's tie rule.
-  const auto z_first = hn::And(hn::Le(tz_, ty_), hn::Le(tz_, tx_));
-  const auto y_first = hn::AndNot(z_first, hn::Le(ty_, tx_));
-  const auto x_first = hn::Not(hn::Or(z_first, y_first));
-  const MI mz = hn::AndNot(done_, hn::RebindMask(di, z_first));
-  const MI my = hn::AndNot(done_, hn::RebindMask(di, y_first));
-  const MI mx = hn::AndNot(done_, hn::RebindMask(di, x_first));
+  // ---- One step for the lanes still walking: the axis whose crossing comes first, if no other
+  // comes within the margin (else the lane is unsure and ends).
+  // Each axis's next crossing. An axis with no crossing left gives the one after its last, beyond
+  // the segment's end (t >= 1, and every crossing left lies in [0, 1]), so it is never taken:
+  // either another axis comes first by the margin, or the lane is unsure.
+  const VF tx = Crossing(hn::Sub(lx_, one), dx_, ex_), ty = Crossing(hn::Sub(ly_, one), dy_, ey_),
+           tz = Crossing(hn::Sub(lz_, one), dz_, ez_);
+  const VF first = hn::Min(tx, hn::Min(ty, tz));
+  const VF near = hn::Add(first, hn::Set(d, internal::kMargin));
+  const auto nx = hn::Le(tx, near), ny = hn::Le(ty, near), nz = hn::Le(tz, near);
+  const MI still = hn::Or(done_, wait);
+  const MI tie = hn::AndNot(still, hn::RebindMask(di, hn::Or(hn::And(nx, ny), hn::Or(hn::And(nx, nz), hn::And(ny, nz)))));
+  unsure_ = hn::Or(unsure_, tie);
+  done_ = hn::Or(done_, tie);
+  const MI mz = hn::AndNot(still, hn::AndNot(tie, hn::RebindMask(di, hn::Eq(tz, first))));
+  const MI my = hn::AndNot(still, hn::AndNot(tie, hn::RebindMask(di, hn::Eq(ty, first))));
+  const MI mx = hn::AndNot(still, hn::AndNot(tie, hn::RebindMask(di, hn::Eq(tx, first))));
   z_ = hn::IfThenElse(mz, hn::Add(z_, sz_), z_);
   y_ = hn::IfThenElse(my, hn::Add(y_, sy_), y_);
   x_ = hn::IfThenElse(mx, hn::Add(x_, sx_), x_);
   lz_ = hn::IfThenElse(mz, hn::Sub(lz_, one), lz_);
   ly_ = hn::IfThenElse(my, hn::Sub(ly_, one), ly_);
   lx_ = hn::IfThenElse(mx, hn::Sub(lx_, one), lx_);
-  tz_ = hn::IfThenElse(hn::RebindMask(d, mz), hn::IfThenElse(hn::RebindMask(d, hn::Eq(lz_, zero)), inf, hn::Add(tz_, dz_)), tz_);
-  ty_ = hn::IfThenElse(hn::RebindMask(d, my), hn::IfThenElse(hn::RebindMask(d, hn::Eq(ly_, zero)), inf, hn::Add(ty_, dy_)), ty_);
-  tx_ = hn::IfThenElse(hn::RebindMask(d, mx), hn::IfThenElse(hn::RebindMask(d, hn::Eq(lx_, zero)), inf, hn::Add(tx_, dx_)), tx_);
-  rem_ = hn::IfThenElse(done_, rem_, hn::Sub(rem_, one));
 }
 
-// Whether the lanes beat the scalar walk on this target. Measured on the hall (BENCHMARKS.md):
-// AVX-512's 8 lanes 1.8x the scalar walk; AVX2's 4 lanes and SSE4's 2 about 0.9x (AVX2 lacks
-// 64-bit unsigned compares, min and conversions, which Highway emulates); SSSE3 and the scalar
-// target about 0.5x.
+// Whether the lanes beat the scalar walk on this target (measured on the hall, BENCHMARKS.md).
 constexpr bool kLanesPay = HWY_TARGET == HWY_AVX3 || HWY_TARGET == HWY_AVX3_DL;
 
 // Returns the target it was compiled for, and in *lanes whether it used the lanes, so callers and
-// tests see what the dispatch chose.
+// tests see what the dispatch chose. Segments the lanes leave go to `unsure`.
 int64_t FirstOccupiedBatchImpl(const OccupancyGrid& grid, const Eigen::Vector3d* a, const Eigen::Vector3d* b,
-                               size_t count, std::optional<VoxelIndex>* out, bool force_lanes, bool* lanes) {
+                               size_t count, std::optional<VoxelIndex>* out, bool force_lanes, bool* lanes,
+                               std::vector<size_t>* unsure) {
   *lanes = kLanesPay || force_lanes;
   if (!*lanes) {
     for (size_t i = 0; i < count; ++i) out[i] = FirstOccupied(grid, a[i], b[i]);
@@ -300,9 +388,8 @@ int64_t FirstOccupiedBatchImpl(const OccupancyGrid& grid, const Eigen::Vector3d*
   }
   HWY_ASSERT(hn::Lanes(D()) <= 16);
   const GridView view(grid);
-  Source src{a, b, count, 0, out};
-  // Two independent groups, so that one group's gathers overlap the other's arithmetic (1.3x over
-  // one group on the hall; three are no faster than two: docs/BENCHMARKS.md).
+  Source src{a, b, count, 0, out, unsure};
+  // Two independent groups, so that one group's gathers overlap the other's arithmetic.
   LaneGroup g0(view, src), g1(view, src);
   while (g0.active() + g1.active() > 0) {
     g0.Advance();
@@ -320,21 +407,27 @@ HWY_AFTER_NAMESPACE();
 #if HWY_ONCE
 namespace vc {
 
+static_assert(std::endian::native == std::endian::little, "the lanes read a brick's 64-bit words as 32-bit halves");
+
 HWY_EXPORT(FirstOccupiedBatchImpl);
 
 std::string FirstOccupiedBatch(const OccupancyGrid& grid, std::span<const Eigen::Vector3d> a,
                                std::span<const Eigen::Vector3d> b, std::span<std::optional<VoxelIndex>> out,
-                               BatchKernel kernel) {
+                               BatchKernel kernel, size_t* rechecked) {
   const size_t n = std::min({a.size(), b.size(), out.size()});
-  // The kernel forms brick numbers with 32x32-bit products (row = bz * by_count + by).
-  const bool fits = uint64_t(grid.brick_dims().y()) * uint64_t(grid.brick_dims().z()) < (uint64_t{1} << 32);
+  if (rechecked) *rechecked = 0;
+  // The kernel forms brick numbers and payload word numbers in int32.
+  const bool fits = grid.brick_count() < (uint64_t{1} << 31) && grid.occupied_bricks() < (uint64_t{1} << 26);
   if (!fits || grid.brick_count() == 0) {
     for (size_t i = 0; i < n; ++i) out[i] = FirstOccupied(grid, a[i], b[i]);
     return "per segment (grid too large for the lanes)";
   }
   bool lanes = false;
+  std::vector<size_t> unsure;
   const int64_t target = HWY_DYNAMIC_DISPATCH(FirstOccupiedBatchImpl)(grid, a.data(), b.data(), n, out.data(),
-                                                                      kernel == BatchKernel::kLanes, &lanes);
+                                                                      kernel == BatchKernel::kLanes, &lanes, &unsure);
+  for (size_t i : unsure) out[i] = FirstOccupied(grid, a[i], b[i]);
+  if (rechecked) *rechecked = unsure.size();
   return std::string(hwy::TargetName(target)) + (lanes ? " lanes" : " per segment");
 }
 

@@ -146,6 +146,81 @@ TEST(FirstOccupiedBatchTest, MatchesFirstOccupiedOnGeb079) {
   EXPECT_GT(ExpectSameOnEveryTarget(scene->grid, s, "geb079"), 5000);
 }
 
+// Near-ties: lattice-point and voxel-centre endpoints moved by a few ulps, by 2^-30 and by 1e-7
+// of a voxel, so that crossings of different axes fall just inside and just outside the lanes'
+// margin (2^-20 of the segment) on both sides of exact ties.
+TEST(FirstOccupiedBatchTest, MatchesFirstOccupiedOnNearTies) {
+  std::mt19937_64 rng(21);
+  std::uniform_int_distribution<int> c(-12, 12), p(-16, 16), way(0, 5);
+  std::vector<VoxelIndex> occ;
+  for (int i = 0; i < 700; ++i) occ.push_back({c(rng), c(rng), c(rng)});
+  auto grid = OccupancyGrid::Build(0.1, occ, 1 << 24);
+  ASSERT_TRUE(grid.ok());
+  const double nudges[] = {0.0, 0x1p-50, 0x1p-30, 1e-7, 3e-6};
+  auto nudge = [&](double v) {
+    switch (way(rng)) {
+      case 0: return std::nextafter(v, 1e9);
+      case 1: return std::nextafter(std::nextafter(v, -1e9), -1e9);
+      default: return v + (way(rng) % 2 ? 1 : -1) * nudges[way(rng) % 5];
+    }
+  };
+  Segments s;
+  for (int r = 0; r < 12000; ++r) {
+    const double h = (r % 4 == 0) ? 0.5 : 0.0;
+    Vector3d a(p(rng) + h, p(rng) + h, p(rng) + h), b(p(rng), p(rng), p(rng));
+    for (int i = 0; i < 3; ++i) a[i] = nudge(a[i]), b[i] = nudge(b[i]);
+    s.Add(a, b);
+  }
+  EXPECT_GT(ExpectSameOnEveryTarget(*grid, s, "near-ties"), 2000);
+}
+
+// What the lanes leave to FirstOccupied: every segment whose walk meets an exact tie before it
+// ends, and every segment too long or too far out for their float and int32 arithmetic; of
+// generic rays, few.
+TEST(FirstOccupiedBatchTest, ExactTiesAndOversizedSegmentsAreLeftToFirstOccupied) {
+  std::vector<VoxelIndex> occ;
+  for (int x = -40; x <= 40; ++x)
+    for (int y = -40; y <= 40; ++y) occ.push_back({x, y, -20});  // a floor
+  Segments ties, oversized, generic;
+  for (int k = -10; k <= 10; ++k) {
+    // Through voxel corners: all three axes cross together at every step.
+    ties.Add({double(k), double(k), 0.0}, {double(k) + 30, double(k) - 30, -30.0});
+    // Through edges: x and z cross together.
+    ties.Add({double(k), 0.5, 0.0}, {double(k) - 30, 0.5, -30.0});
+  }
+  // Each starts inside the grid's box (a voxel at z = 20 makes it span z = -20..20) and leaves it
+  // or hits the floor within a few dozen steps, so FirstOccupied is quick on them (it walks a
+  // segment that starts far outside the box voxel by voxel up to the box).
+  occ.push_back({0, 0, 20});
+  oversized.Add({0.5, 0.5, 10.5}, {5e6, 0.5, -1e4});    // 5e6 steps along x (> 2^22)
+  oversized.Add({0.5, 0.5, 10.5}, {0.5, 0.5, -6e6});    // 6e6 steps along z, hits the floor
+  oversized.Add({0.5, 0.5, 10.5}, {2e9, 0.5, 10.5});    // an end beyond 2^30
+  oversized.Add({0.5, 0.5, 10.5}, {0.5, -2e9, -30.5});
+  std::mt19937_64 rng(4);
+  std::uniform_real_distribution<double> u(-45, 45);
+  for (int r = 0; r < 4000; ++r) generic.Add({u(rng), u(rng), u(rng) / 2 + 5}, {u(rng), u(rng), -25.0});
+  auto grid = OccupancyGrid::Build(0.1, occ, 1 << 24);
+  ASSERT_TRUE(grid.ok());
+  for (int64_t target : hwy::SupportedAndGeneratedTargets()) {
+    hwy::SetSupportedTargetsForTest(target);
+    const std::string name = hwy::TargetName(target);
+    for (const Segments* set : {&ties, &oversized, &generic}) {
+      std::vector<std::optional<VoxelIndex>> got(set->a.size());
+      size_t rechecked = 99999;
+      FirstOccupiedBatch(*grid, set->a, set->b, got, BatchKernel::kLanes, &rechecked);
+      for (size_t i = 0; i < got.size(); ++i) {
+        ASSERT_EQ(got[i], FirstOccupied(*grid, set->a[i], set->b[i])) << name << ", segment " << i;
+      }
+      if (set == &generic) {
+        EXPECT_LT(rechecked, got.size() / 20) << name << ": generic rays should rarely be near-ties";
+      } else {
+        EXPECT_EQ(rechecked, got.size()) << name << (set == &ties ? ": exact ties" : ": oversized segments");
+      }
+    }
+  }
+  hwy::SetSupportedTargetsForTest(0);
+}
+
 // The default kernel: lanes where they pay (AVX-512), FirstOccupied per segment elsewhere.
 TEST(FirstOccupiedBatchTest, AutoUsesLanesOnlyWhereTheyPay) {
   auto grid = OccupancyGrid::Build(0.1, {{0, 0, 0}, {3, 0, 0}}, 1 << 20);

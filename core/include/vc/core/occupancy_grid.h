@@ -1,10 +1,12 @@
 // OccupancyGrid: the traversal structure for fast, exact ray casting.
 //
 // A bricked bitset over the bounding box of the occupied voxels: the box is cut into bricks of
-// 8x8x8 voxels; a dense array holds one 32-bit slot per brick (0 = empty brick) and only non-empty
-// bricks store their 512 bits. Empty bricks cost 4 bytes. For empty-space skipping each brick
-// also stores its Chebyshev distance, in bricks, to the nearest non-empty brick (capped at 255):
-// a ray in a brick at distance k may jump across the (2k-1)^3-brick box around it untested.
+// 8x8x8 voxels; a dense array holds one 32-bit entry per brick and only non-empty bricks store
+// their 512 bits. Empty bricks cost 4 bytes. A non-empty brick's entry is its slot (1 + its number
+// among the non-empty bricks); an empty brick's entry is, negated, its Chebyshev distance in bricks
+// to the nearest non-empty brick (capped at 255), for empty-space skipping: a ray in a brick at
+// distance k may jump across the (2k-1)^3-brick box around it untested. One load thus tells a ray
+// both whether to test bits and how far it may jump.
 // (A per-voxel distance field was tried and removed: its byte per voxel of the box falls out of
 // cache, and traversal was 1.2-2x slower in wall time than with these brick distances.) It answers "is voxel (x,y,z) occupied" exactly as the octree at resolution r does
 // (ALGORITHM.md section 1); anything outside the box is free. Memory is computed and checked
@@ -54,16 +56,16 @@ class OccupancyGrid {
   uint64_t BrickLinear(uint32_t bx, uint32_t by, uint32_t bz) const {
     return (uint64_t(bz) * uint64_t(bdims_.y()) + by) * uint64_t(bdims_.x()) + bx;
   }
-  // Payload slot of a brick (0 = empty) and its distance to the nearest non-empty brick.
-  uint32_t BrickSlot(uint64_t brick) const { return bricks_[brick]; }
-  uint8_t BrickDistance(uint64_t brick) const { return brick_distance_[brick]; }
+  // Payload slot of a brick (0 = empty) and its distance to the nearest non-empty brick (0 for a
+  // non-empty brick).
+  uint32_t BrickSlot(uint64_t brick) const { return uint32_t(std::max(bricks_[brick], 0)); }
+  uint8_t BrickDistance(uint64_t brick) const { return uint8_t(std::max(-bricks_[brick], 0)); }
   // The 8 words of a non-empty brick's bits (word z, bit y*8+x).
   const uint64_t* BrickBits(uint32_t slot) const { return &payload_[uint64_t(slot - 1) * kBrick]; }
-  // Raw arrays for vectorised kernels: brick_count() slots and distances, each followed by
-  // padding so that an 8-byte load at any brick's entry stays inside the allocation.
-  uint64_t brick_count() const { return brick_count_; }
-  const uint32_t* brick_slots() const { return bricks_.data(); }
-  const uint8_t* brick_distances() const { return brick_distance_.data(); }
+  // Raw arrays for vectorised kernels: brick_count() entries, each the slot if positive, else
+  // minus the distance.
+  uint64_t brick_count() const { return bricks_.size(); }
+  const int32_t* brick_entries() const { return bricks_.data(); }
   const uint64_t* payload() const { return payload_.data(); }
   uint64_t memory_bytes() const;
   uint64_t occupied_bricks() const { return payload_.size() / kBrick; }
@@ -72,8 +74,8 @@ class OccupancyGrid {
   bool Occupied(int x, int y, int z) const {
     const uint32_t rx = uint32_t(x - min_.x), ry = uint32_t(y - min_.y), rz = uint32_t(z - min_.z);
     if (rx >= uint32_t(dims_.x()) || ry >= uint32_t(dims_.y()) || rz >= uint32_t(dims_.z())) return false;
-    const uint32_t slot = bricks_[BrickLinear(rx >> kBrickShift, ry >> kBrickShift, rz >> kBrickShift)];
-    if (slot == 0) return false;
+    const int32_t slot = bricks_[BrickLinear(rx >> kBrickShift, ry >> kBrickShift, rz >> kBrickShift)];
+    if (slot <= 0) return false;
     const uint64_t word = payload_[uint64_t(slot - 1) * kBrick + (rz & 7)];
     return (word >> (((ry & 7) << 3) | (rx & 7))) & 1u;
   }
@@ -85,7 +87,7 @@ class OccupancyGrid {
     if (uint32_t(bx) >= uint32_t(bdims_.x()) || uint32_t(by) >= uint32_t(bdims_.y()) ||
         uint32_t(bz) >= uint32_t(bdims_.z()))
       return false;
-    return bricks_[BrickLinear(bx, by, bz)] != 0;
+    return bricks_[BrickLinear(bx, by, bz)] > 0;
   }
 
   // Whether any voxel of the box [lo, hi] (inclusive voxel indices) is occupied. Bricks are
@@ -127,10 +129,8 @@ class OccupancyGrid {
   VoxelIndex min_;
   Eigen::Vector3i dims_{0, 0, 0};
   Eigen::Vector3i bdims_{0, 0, 0};
-  uint64_t brick_count_ = 0;
-  std::vector<uint32_t> bricks_;   // per brick: 0 = empty, else 1 + payload brick number
+  std::vector<int32_t> bricks_;    // per brick: 1 + payload brick number, or minus the distance
   std::vector<uint64_t> payload_;  // 8 words per non-empty brick: word z, bit (y*8 + x)
-  std::vector<uint8_t> brick_distance_;  // Chebyshev distance in bricks to a non-empty brick
 };
 
 template <typename Fn>
@@ -151,8 +151,8 @@ bool OccupancyGrid::ScanBox(const VoxelIndex& lo, const VoxelIndex& hi, Fn&& fn)
       const uint64_t rows = (y1 == kBrick - 1 ? ~uint64_t{0} : (uint64_t{1} << (8 * (y1 + 1))) - 1) &
                             ~((uint64_t{1} << (8 * y0)) - 1);
       for (int bx = r0[0] >> kBrickShift; bx <= r1[0] >> kBrickShift; ++bx) {
-        const uint32_t slot = bricks_[BrickLinear(uint32_t(bx), uint32_t(by), uint32_t(bz))];
-        if (slot == 0) continue;
+        const int32_t slot = bricks_[BrickLinear(uint32_t(bx), uint32_t(by), uint32_t(bz))];
+        if (slot <= 0) continue;
         const int x0 = std::max(r0[0] - bx * kBrick, 0), x1 = std::min(r1[0] - bx * kBrick, kBrick - 1);
         const uint64_t mask = rows & (((uint64_t{2} << x1) - (uint64_t{1} << x0)) * 0x0101010101010101ull);
         const uint64_t* words = BrickBits(slot);

@@ -59,17 +59,18 @@ std::optional<VoxelIndex> FirstOccupied(const OccupancyGrid& grid, const Eigen::
                                         const Eigen::Vector3d& b,
                                         const VoxelIndex* transparent = nullptr);
 
-// FirstOccupied on many segments at once: out[i] = FirstOccupied(grid, a[i], b[i]), bit for bit,
-// for i < min(a.size(), b.size(), out.size()). Google Highway picks the instruction set at run
-// time. Where SIMD pays (AVX-512: 8 lanes of doubles) each lane walks one segment and takes the
-// next one as soon as its own ends; elsewhere (AVX2 and below, where the lanes measured slower
-// than the scalar walk) it calls FirstOccupied per segment, unless `kernel` is kLanes, which
-// forces the lanes on any target (for tests and benchmarks). A grid whose bricks in y times z
-// reach 2^32 is always walked per segment. Returns what ran, e.g.
-// "AVX3 lanes", "AVX2 per segment", "SCALAR lanes".
+// FirstOccupied on many segments at once: out[i] = FirstOccupied(grid, a[i], b[i]) for
+// i < min(a.size(), b.size(), out.size()). Google Highway picks the instruction set at run time.
+// Where SIMD pays (AVX-512: 16 lanes of floats) each lane walks one segment and takes the next one
+// as soon as its own ends; a segment on which a lane would have to decide a near-tie (two boundary
+// crossings within 2^-20 of each other in the segment's parameter) is left to FirstOccupied, and
+// *rechecked (if given) counts those. Elsewhere (AVX2 and below, where the lanes measured slower
+// than the scalar walk) it calls FirstOccupied per segment, unless `kernel` is kLanes, which forces
+// the lanes on any target (for tests and benchmarks). A grid of 2^31 bricks or more is always
+// walked per segment. Returns what ran, e.g. "AVX3 lanes", "AVX2 per segment", "SCALAR lanes".
 enum class BatchKernel { kAuto, kLanes };
 std::string FirstOccupiedBatch(const OccupancyGrid& grid, std::span<const Eigen::Vector3d> a,
                                std::span<const Eigen::Vector3d> b, std::span<std::optional<VoxelIndex>> out,
-                               BatchKernel kernel = BatchKernel::kAuto);
+                               BatchKernel kernel = BatchKernel::kAuto, size_t* rechecked = nullptr);
 
 }  // namespace vc
