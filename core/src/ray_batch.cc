@@ -14,7 +14,7 @@
 // - Every decision the lane takes (which axis crosses next; where a jump across a free box of
 //   bricks lands) is taken only if the parameters it compares are more than kMargin = 2^-20 apart.
 //   Then the lane's order is the exact order of the crossings, and so is the order in
-//   FirstOccupied, whose double parameters are within 10^-12 of exact. A decision closer than the
+//   FirstOccupied, whose double parameters are within 10^-9 of exact. A decision closer than the
 //   margin (a near-tie, or an exact one: lattice-point rays have many) is not taken: the segment is
 //   marked and walked by FirstOccupied afterwards.
 // - Near-ties that no lane decision looks at lie strictly inside a free box the lane jumped across.
@@ -416,11 +416,20 @@ std::string FirstOccupiedBatch(const OccupancyGrid& grid, std::span<const Eigen:
                                BatchKernel kernel, size_t* rechecked) {
   const size_t n = std::min({a.size(), b.size(), out.size()});
   if (rechecked) *rechecked = 0;
-  // The kernel forms brick numbers and payload word numbers in int32.
-  const bool fits = grid.brick_count() < (uint64_t{1} << 31) && grid.occupied_bricks() < (uint64_t{1} << 26);
+  // The kernel forms brick numbers, payload word numbers, segment numbers and voxel coordinates
+  // (a voxel plus at most kMaxLaneSteps) in int32, and parks spare lanes at voxel -2^30 on every
+  // axis, which must lie outside the grid's box: so the box must lie within +-2^29.
+  const VoxelIndex lo = grid.min_index();
+  const bool near = std::abs(int64_t(lo.x)) < (int64_t{1} << 29) && std::abs(int64_t(lo.y)) < (int64_t{1} << 29) &&
+                    std::abs(int64_t(lo.z)) < (int64_t{1} << 29) &&
+                    int64_t(lo.x) + grid.dims().x() < (int64_t{1} << 29) &&
+                    int64_t(lo.y) + grid.dims().y() < (int64_t{1} << 29) &&
+                    int64_t(lo.z) + grid.dims().z() < (int64_t{1} << 29);
+  const bool fits = grid.brick_count() < (uint64_t{1} << 31) && grid.occupied_bricks() < (uint64_t{1} << 26) &&
+                    near && n < (size_t{1} << 31);
   if (!fits || grid.brick_count() == 0) {
     for (size_t i = 0; i < n; ++i) out[i] = FirstOccupied(grid, a[i], b[i]);
-    return "per segment (grid too large for the lanes)";
+    return "per segment (grid too large or too far out for the lanes)";
   }
   bool lanes = false;
   std::vector<size_t> unsure;

@@ -238,6 +238,25 @@ TEST(FirstOccupiedBatchTest, AutoUsesLanesOnlyWhereTheyPay) {
   hwy::SetSupportedTargetsForTest(0);
 }
 
+// A grid far from the origin (here at the lanes' parking voxel, -2^30 on every axis) is walked per
+// segment, with FirstOccupied's answers (review finding: the lanes would have hit it).
+TEST(FirstOccupiedBatchTest, GridsFarOutAreWalkedPerSegment) {
+  const int far = -(1 << 30);
+  auto grid = OccupancyGrid::Build(0.1, {{far, far, far}, {far + 3, far, far}}, 1 << 20);
+  ASSERT_TRUE(grid.ok());
+  const std::vector<Vector3d> a = {{far + 1.5, far + 0.5, far + 0.5}, {far - 5.0, far + 0.5, far + 0.5}};
+  const std::vector<Vector3d> b = {{far + 9.5, far + 0.5, far + 0.5}, {far + 1.5, far + 0.5, far + 0.5}};
+  for (int64_t target : hwy::SupportedAndGeneratedTargets()) {
+    hwy::SetSupportedTargetsForTest(target);
+    std::vector<std::optional<VoxelIndex>> out(2);
+    EXPECT_EQ(FirstOccupiedBatch(*grid, a, b, out, BatchKernel::kLanes),
+              "per segment (grid too large or too far out for the lanes)");
+    EXPECT_EQ(out[0], (VoxelIndex{far + 3, far, far}));
+    EXPECT_EQ(out[1], (VoxelIndex{far, far, far}));
+  }
+  hwy::SetSupportedTargetsForTest(0);
+}
+
 TEST(FirstOccupiedBatchTest, EmptyAndUnevenSpans) {
   auto grid = OccupancyGrid::Build(0.1, {{0, 0, 0}}, 1 << 20);
   ASSERT_TRUE(grid.ok());
