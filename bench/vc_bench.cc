@@ -150,7 +150,7 @@ int main(int argc, char** argv) {
   std::string scene = "hall";
   double spacing = 0.05, resolution = 0.1, grid = 1.0;
   int rays = 200000, octomap_rays = 20000, threads = 2, repeat = 5;
-  bool quick = false, scaling = true, rays_only = false, fine_eval = false, all_targets = false;
+  bool quick = false, scaling = true, rays_only = false, fine_eval = false, all_targets = false, sets = true;
   app.add_option("--scene", scene, "synthetic scene spec (hall, box, comb:5, ...) or a file path");
   app.add_option("--spacing", spacing, "point spacing of synthetic scenes, m");
   app.add_option("--resolution", resolution, "working resolution, m");
@@ -162,6 +162,7 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(1, 1000));
   app.add_flag("--quick", quick, "small scene, few rays, no scaling tables (CI)");
   app.add_flag("!--no-scaling", scaling, "skip the scaling tables");
+  app.add_flag("!--no-sets", sets, "skip the three full visibility-set computations after the plan");
   app.add_flag("--rays-only", rays_only, "only the ray comparison with OctoMap");
   app.add_flag("--all-targets", all_targets, "also time the SIMD batch kernel on every other instruction set");
   app.add_flag("--fine-eval", fine_eval,
@@ -321,7 +322,7 @@ int main(int argc, char** argv) {
                   (unsigned long long)plan->covered_voxels, plan->evaluation.overall.global_visibility);
       // The full visibility-set computation for both tests, on the plan's candidates; the surface
       // test also per voxel (no face groups), the baseline of the grouped method.
-      for (int run = 0; run < 3; ++run) {
+      for (int run = 0; run < (sets ? 3 : 0); ++run) {
         vc::VisibilitySetsOptions vo2;
         vo2.test = run == 2 ? vc::SelectionTest::kCompatibility : vc::SelectionTest::kSurfaceVisibility;
         vo2.per_voxel = run == 1;

@@ -14,6 +14,7 @@
 #include <atomic>
 #include <bit>
 #include <cmath>
+#include <memory>
 #include <mutex>
 #include <random>
 
@@ -31,6 +32,10 @@ using planner::ParallelChunks;
 using planner::ResolveThreads;
 
 constexpr double kHalfPi = 1.57079632679489661923;
+// Exact evaluation gives each thread whole viewpoints once there are this many per thread (fewer
+// leave threads idle at the end; see Evaluate).
+constexpr uint64_t kEvaluateViewpointsPerThread = 4;
+constexpr uint64_t kEvaluateExtraWorkBytes = uint64_t{256} << 20;
 
 // Outward normal axis and sign of a face.
 int FaceAxis(Face f) { return int(f) / 2; }
@@ -557,8 +562,6 @@ Result<Evaluation> Evaluate(const VoxelScene& scene, const std::vector<WorldPoin
   }
   VC_RETURN_IF_ERROR(ctx.CheckCancelled("evaluation"));
 
-  std::vector<double> best(n * kFacesPerVoxel, 0.0);
-  std::vector<uint8_t> best_p(n * kFacesPerVoxel, 0);
   // Bit f: face f of the voxel is in options.faces (the same for every viewpoint).
   std::vector<uint8_t> faces_in_set(n, 0);
   for (size_t i = 0; i < n; ++i) {
@@ -567,7 +570,6 @@ Result<Evaluation> Evaluate(const VoxelScene& scene, const std::vector<WorldPoin
     }
   }
   if (options.keep_per_viewpoint_values) ev.per_viewpoint_face_values.assign(nv, {});
-  std::vector<uint64_t> visible_bits((corners.size() + 63) / 64);
   constexpr uint64_t kCornerChunk = 64 * 256;
   constexpr uint64_t kVoxelChunk = 4096;
   const uint64_t voxel_chunks = (n + kVoxelChunk - 1) / kVoxelChunk;
@@ -576,15 +578,35 @@ Result<Evaluation> Evaluate(const VoxelScene& scene, const std::vector<WorldPoin
   const internal::SurfaceTargets targets(g, index, NotEnclosed(g, index));
   constexpr uint64_t kBricksPerTask = 256;
   const uint64_t brick_chunks = (targets.brick_count() + kBricksPerTask - 1) / kBricksPerTask;
-  std::vector<uint64_t> decided_bits(visible_bits.size());
-  for (size_t k = 0; k < nv; ++k) {
-    // 1. Corners decided by face groups, then one ray per remaining corner. Tasks share words
-    // of the bitsets, so the group pass sets bits atomically.
-    std::fill(visible_bits.begin(), visible_bits.end(), 0);
-    std::fill(decided_bits.begin(), decided_bits.end(), 0);
+
+  // What evaluating viewpoints needs besides the scene: the corner bitsets of the viewpoint at
+  // hand, and the best V (and its perception) of each face over the viewpoints evaluated so far.
+  struct Work {
+    explicit Work(size_t corner_words, size_t slots)
+        : visible_bits(corner_words), decided_bits(corner_words), best(slots, 0.0), best_p(slots, 0) {}
+    std::vector<uint64_t> visible_bits, decided_bits;
+    std::vector<double> best;
+    std::vector<uint8_t> best_p;
+  };
+  const size_t corner_words = (corners.size() + 63) / 64;
+  // Viewpoint k into `w`, on `threads` workers (1: all in the calling thread, with no atomics).
+  // Its figures do not depend on `threads`: partial sums are merged in chunk order.
+  auto evaluate_viewpoint = [&](size_t k, int threads, Work& w) -> Status {
+    const bool shared = ResolveThreads(threads, brick_chunks) > 1;  // the group pass runs on several threads
+    // 1. Corners decided by face groups, then one ray per remaining corner. With several
+    // workers, tasks share words of the bitsets, so the group pass sets bits atomically.
+    std::fill(w.visible_bits.begin(), w.visible_bits.end(), 0);
+    std::fill(w.decided_bits.begin(), w.decided_bits.end(), 0);
+    auto set_bit = [shared](std::vector<uint64_t>& words, uint32_t c) {
+      if (shared) {
+        SetBitConcurrently(words, c);
+      } else {
+        words[c >> 6] |= uint64_t{1} << (c & 63);
+      }
+    };
     const bool grouped = !options.per_corner && shortcuts[k] && !InsideOccupied(g, uo[k]);
     if (grouped) {
-      VC_RETURN_IF_ERROR(ParallelChunks(brick_chunks, 1, options.threads, ctx, [&](uint64_t task, uint64_t, uint64_t) {
+      VC_RETURN_IF_ERROR(ParallelChunks(brick_chunks, 1, threads, ctx, [&](uint64_t task, uint64_t, uint64_t) {
         internal::GroupWalk walk;
         std::vector<internal::SurfaceTargets::CornerDecision> decisions;
         const size_t b0 = task * kBricksPerTask, b1 = std::min<size_t>(b0 + kBricksPerTask, targets.brick_count());
@@ -592,8 +614,8 @@ Result<Evaluation> Evaluate(const VoxelScene& scene, const std::vector<WorldPoin
         for (const auto& d : decisions) {
           auto apply = [&](int q) {
             const uint32_t c = voxel_corners[d.id][q];
-            SetBitConcurrently(decided_bits, c);
-            if (d.seen) SetBitConcurrently(visible_bits, c);
+            set_bit(w.decided_bits, c);
+            if (d.seen) set_bit(w.visible_bits, c);
           };
           if (d.face == 0xff) {
             apply(d.corner);
@@ -603,12 +625,12 @@ Result<Evaluation> Evaluate(const VoxelScene& scene, const std::vector<WorldPoin
         }
       }));
     }
-    VC_RETURN_IF_ERROR(ParallelChunks(corners.size(), kCornerChunk, options.threads, ctx, [&](uint64_t, uint64_t b, uint64_t e) {
+    VC_RETURN_IF_ERROR(ParallelChunks(corners.size(), kCornerChunk, threads, ctx, [&](uint64_t, uint64_t b, uint64_t e) {
       OccluderCache cache(shortcuts[k]);
       for (uint64_t c = b; c < e; ++c) {
-        if ((decided_bits[c >> 6] >> (c & 63)) & 1) continue;
+        if ((w.decided_bits[c >> 6] >> (c & 63)) & 1) continue;
         if (CornerVisibleCached(g, uo[k], UnpackCorner(corners[c]), cache)) {
-          visible_bits[c >> 6] |= uint64_t{1} << (c & 63);
+          w.visible_bits[c >> 6] |= uint64_t{1} << (c & 63);
         }
       }
     }));
@@ -616,7 +638,7 @@ Result<Evaluation> Evaluate(const VoxelScene& scene, const std::vector<WorldPoin
     std::vector<Tally> tallies(voxel_chunks);
     std::vector<float>* keep = options.keep_per_viewpoint_values ? &ev.per_viewpoint_face_values[k] : nullptr;
     if (keep) keep->assign(n * kFacesPerVoxel, 0.0f);
-    VC_RETURN_IF_ERROR(ParallelChunks(n, kVoxelChunk, options.threads, ctx, [&](uint64_t chunk, uint64_t b, uint64_t e) {
+    VC_RETURN_IF_ERROR(ParallelChunks(n, kVoxelChunk, threads, ctx, [&](uint64_t chunk, uint64_t b, uint64_t e) {
       Tally& t = tallies[chunk];
       for (uint64_t i = b; i < e; ++i) {
         for (int f = 0; f < kFacesPerVoxel; ++f) {
@@ -624,16 +646,16 @@ Result<Evaluation> Evaluate(const VoxelScene& scene, const std::vector<WorldPoin
           int visible = 0;
           for (int q : kFaceCorners[f]) {
             const uint32_t c = voxel_corners[i][q];
-            visible += (visible_bits[c >> 6] >> (c & 63)) & 1;
+            visible += (w.visible_bits[c >> 6] >> (c & 63)) & 1;
           }
           const Perception p = FromCount(visible);
           const double val = FaceValue(p, viewpoints[k], index[i], Face(f), r, options.scanner);
           t.Add(p, val);
           const size_t slot = i * kFacesPerVoxel + f;
           if (keep) (*keep)[slot] = float(val);
-          if (val > best[slot] || (val == best[slot] && uint8_t(p) > best_p[slot])) {
-            best[slot] = val;
-            best_p[slot] = uint8_t(p);
+          if (val > w.best[slot] || (val == w.best[slot] && uint8_t(p) > w.best_p[slot])) {
+            w.best[slot] = val;
+            w.best_p[slot] = uint8_t(p);
           }
         }
       }
@@ -642,6 +664,55 @@ Result<Evaluation> Evaluate(const VoxelScene& scene, const std::vector<WorldPoin
     for (const Tally& t : tallies) total.Merge(t);
     ev.per_viewpoint[k] = total.Figures(faces_total);
     progress.Add(1);
+    return Status::Ok();
+  };
+
+  // With enough viewpoints per thread, a task is one viewpoint, evaluated by one thread into
+  // that thread's Work (no joins within a viewpoint, no atomics); the threads' best values are
+  // merged at the end. Otherwise the viewpoints are evaluated one after another, each on all
+  // threads. Both give the same figures: the best (V, perception) pair of a face is the same
+  // whatever the order of the viewpoints.
+  // Each extra thread's Work costs 9 bytes per face; beyond kEvaluateExtraWorkBytes in all, the
+  // viewpoints are evaluated one after another instead.
+  const int workers = ResolveThreads(options.threads, nv);
+  const uint64_t extra_bytes = uint64_t(workers - 1) * n * kFacesPerVoxel * (sizeof(double) + sizeof(uint8_t));
+  std::vector<std::unique_ptr<Work>> works;
+  if (workers > 1 && nv >= kEvaluateViewpointsPerThread * uint64_t(workers) && extra_bytes <= kEvaluateExtraWorkBytes) {
+    std::mutex mu;
+    std::vector<Work*> idle;
+    Status failed = Status::Ok();
+    VC_RETURN_IF_ERROR(ParallelChunks(nv, 1, workers, ctx, [&](uint64_t k, uint64_t, uint64_t) {
+      Work* w = nullptr;
+      {
+        std::lock_guard<std::mutex> lock(mu);
+        if (idle.empty()) {
+          works.push_back(std::make_unique<Work>(corner_words, n * kFacesPerVoxel));
+          idle.push_back(works.back().get());
+        }
+        w = idle.back();
+        idle.pop_back();
+      }
+      const Status st = evaluate_viewpoint(k, 1, *w);
+      std::lock_guard<std::mutex> lock(mu);
+      if (!st.ok() && failed.ok()) failed = st;
+      idle.push_back(w);
+    }));
+    VC_RETURN_IF_ERROR(failed);
+  } else {
+    works.push_back(std::make_unique<Work>(corner_words, n * kFacesPerVoxel));
+    for (size_t k = 0; k < nv; ++k) VC_RETURN_IF_ERROR(evaluate_viewpoint(k, options.threads, *works[0]));
+  }
+  std::vector<double>& best = works[0]->best;
+  std::vector<uint8_t>& best_p = works[0]->best_p;
+  for (size_t t = 1; t < works.size(); ++t) {
+    for (size_t slot = 0; slot < best.size(); ++slot) {
+      const double val = works[t]->best[slot];
+      const uint8_t p = works[t]->best_p[slot];
+      if (val > best[slot] || (val == best[slot] && p > best_p[slot])) {
+        best[slot] = val;
+        best_p[slot] = p;
+      }
+    }
   }
   // Overall: the best V of each face over all viewpoints.
   Tally total;
