@@ -428,6 +428,18 @@ Result<std::vector<VoxelSet>> ComputeVisibilitySets(const VoxelScene& scene, con
   return sets;
 }
 
+namespace {
+// A face's best (V, perception) so far: the larger V, and on equal V the better perception. The
+// result does not depend on the order in which the viewpoints' values arrive.
+template <typename P>
+void KeepBest(double val, P p, double& best, P& best_p) {
+  if (val > best || (val == best && p > best_p)) {
+    best = val;
+    best_p = p;
+  }
+}
+}  // namespace
+
 Result<Evaluation> Evaluate(const VoxelScene& scene, const std::vector<WorldPoint>& viewpoints,
                             const EvaluateOptions& options, const JobContext& ctx) {
   VC_RETURN_IF_ERROR(options.scanner.Validate());
@@ -503,10 +515,7 @@ Result<Evaluation> Evaluate(const VoxelScene& scene, const std::vector<WorldPoin
           const Perception p = FromCount(visible);
           const double val = FaceValue(p, viewpoints[k], v, f, r, options.scanner);
           per[c][k].Add(p, val);
-          if (val > best || (val == best && p > best_p)) {
-            best = val;
-            best_p = p;
-          }
+          KeepBest(val, p, best, best_p);
         }
         overall[c].Add(best_p, best);
         sum_sq[c] += best * best;
@@ -653,10 +662,7 @@ Result<Evaluation> Evaluate(const VoxelScene& scene, const std::vector<WorldPoin
           t.Add(p, val);
           const size_t slot = i * kFacesPerVoxel + f;
           if (keep) (*keep)[slot] = float(val);
-          if (val > w.best[slot] || (val == w.best[slot] && uint8_t(p) > w.best_p[slot])) {
-            w.best[slot] = val;
-            w.best_p[slot] = uint8_t(p);
-          }
+          KeepBest(val, uint8_t(p), w.best[slot], w.best_p[slot]);
         }
       }
     }));
@@ -678,17 +684,18 @@ Result<Evaluation> Evaluate(const VoxelScene& scene, const std::vector<WorldPoin
   const uint64_t extra_bytes = uint64_t(workers - 1) * n * kFacesPerVoxel * (sizeof(double) + sizeof(uint8_t));
   std::vector<std::unique_ptr<Work>> works;
   if (workers > 1 && nv >= kEvaluateViewpointsPerThread * uint64_t(workers) && extra_bytes <= kEvaluateExtraWorkBytes) {
-    std::mutex mu;
+    // Allocated here, in the calling thread, so that running out of memory is not a worker's.
     std::vector<Work*> idle;
+    for (int t = 0; t < workers; ++t) {
+      works.push_back(std::make_unique<Work>(corner_words, n * kFacesPerVoxel));
+      idle.push_back(works.back().get());
+    }
+    std::mutex mu;
     Status failed = Status::Ok();
     VC_RETURN_IF_ERROR(ParallelChunks(nv, 1, workers, ctx, [&](uint64_t k, uint64_t, uint64_t) {
       Work* w = nullptr;
       {
-        std::lock_guard<std::mutex> lock(mu);
-        if (idle.empty()) {
-          works.push_back(std::make_unique<Work>(corner_words, n * kFacesPerVoxel));
-          idle.push_back(works.back().get());
-        }
+        std::lock_guard<std::mutex> lock(mu);  // at most `workers` tasks run at once
         w = idle.back();
         idle.pop_back();
       }
@@ -705,14 +712,7 @@ Result<Evaluation> Evaluate(const VoxelScene& scene, const std::vector<WorldPoin
   std::vector<double>& best = works[0]->best;
   std::vector<uint8_t>& best_p = works[0]->best_p;
   for (size_t t = 1; t < works.size(); ++t) {
-    for (size_t slot = 0; slot < best.size(); ++slot) {
-      const double val = works[t]->best[slot];
-      const uint8_t p = works[t]->best_p[slot];
-      if (val > best[slot] || (val == best[slot] && p > best_p[slot])) {
-        best[slot] = val;
-        best_p[slot] = p;
-      }
-    }
+    for (size_t slot = 0; slot < best.size(); ++slot) KeepBest(works[t]->best[slot], works[t]->best_p[slot], best[slot], best_p[slot]);
   }
   // Overall: the best V of each face over all viewpoints.
   Tally total;
