@@ -578,7 +578,11 @@ Result<Evaluation> Evaluate(const VoxelScene& scene, const std::vector<WorldPoin
       if (FaceInSet(g, index[i], Face(f), options.faces)) faces_in_set[i] |= uint8_t(1u << f);
     }
   }
-  if (options.keep_per_viewpoint_values) ev.per_viewpoint_face_values.assign(nv, {});
+  // Sized here, in the calling thread, like every large allocation of this mode: running out of
+  // memory must not happen in a worker thread.
+  if (options.keep_per_viewpoint_values) {
+    ev.per_viewpoint_face_values.assign(nv, std::vector<float>(n * kFacesPerVoxel, 0.0f));
+  }
   constexpr uint64_t kCornerChunk = 64 * 256;
   constexpr uint64_t kVoxelChunk = 4096;
   const uint64_t voxel_chunks = (n + kVoxelChunk - 1) / kVoxelChunk;
@@ -591,9 +595,11 @@ Result<Evaluation> Evaluate(const VoxelScene& scene, const std::vector<WorldPoin
   // What evaluating viewpoints needs besides the scene: the corner bitsets of the viewpoint at
   // hand, and the best V (and its perception) of each face over the viewpoints evaluated so far.
   struct Work {
-    explicit Work(size_t corner_words, size_t slots)
-        : visible_bits(corner_words), decided_bits(corner_words), best(slots, 0.0), best_p(slots, 0) {}
+    Work(size_t corner_words, size_t slots, size_t voxel_chunks)
+        : visible_bits(corner_words), decided_bits(corner_words), tallies(voxel_chunks), best(slots, 0.0),
+          best_p(slots, 0) {}
     std::vector<uint64_t> visible_bits, decided_bits;
+    std::vector<Tally> tallies;  // per chunk of voxels, for the viewpoint at hand
     std::vector<double> best;
     std::vector<uint8_t> best_p;
   };
@@ -644,9 +650,9 @@ Result<Evaluation> Evaluate(const VoxelScene& scene, const std::vector<WorldPoin
       }
     }));
     // 2. Faces from their corners.
-    std::vector<Tally> tallies(voxel_chunks);
+    std::vector<Tally>& tallies = w.tallies;
+    std::fill(tallies.begin(), tallies.end(), Tally{});
     std::vector<float>* keep = options.keep_per_viewpoint_values ? &ev.per_viewpoint_face_values[k] : nullptr;
-    if (keep) keep->assign(n * kFacesPerVoxel, 0.0f);
     VC_RETURN_IF_ERROR(ParallelChunks(n, kVoxelChunk, threads, ctx, [&](uint64_t chunk, uint64_t b, uint64_t e) {
       Tally& t = tallies[chunk];
       for (uint64_t i = b; i < e; ++i) {
@@ -687,7 +693,7 @@ Result<Evaluation> Evaluate(const VoxelScene& scene, const std::vector<WorldPoin
     // Allocated here, in the calling thread, so that running out of memory is not a worker's.
     std::vector<Work*> idle;
     for (int t = 0; t < workers; ++t) {
-      works.push_back(std::make_unique<Work>(corner_words, n * kFacesPerVoxel));
+      works.push_back(std::make_unique<Work>(corner_words, n * kFacesPerVoxel, voxel_chunks));
       idle.push_back(works.back().get());
     }
     std::mutex mu;
@@ -703,10 +709,10 @@ Result<Evaluation> Evaluate(const VoxelScene& scene, const std::vector<WorldPoin
       std::lock_guard<std::mutex> lock(mu);
       if (!st.ok() && failed.ok()) failed = st;
       idle.push_back(w);
-    }));
+    }, "evaluation"));
     VC_RETURN_IF_ERROR(failed);
   } else {
-    works.push_back(std::make_unique<Work>(corner_words, n * kFacesPerVoxel));
+    works.push_back(std::make_unique<Work>(corner_words, n * kFacesPerVoxel, voxel_chunks));
     for (size_t k = 0; k < nv; ++k) VC_RETURN_IF_ERROR(evaluate_viewpoint(k, options.threads, *works[0]));
   }
   std::vector<double>& best = works[0]->best;
