@@ -18,12 +18,13 @@
 //   margin (a near-tie, or an exact one: lattice-point rays have many) is not taken: the segment is
 //   marked and walked by FirstOccupied afterwards.
 // - Near-ties that no lane decision looks at lie strictly inside a free box the lane jumped across.
-//   Either order of those crossings visits only voxels of the box, which are free, and reaches the
-//   same voxel after both, so FirstOccupied's answer does not depend on them.
+//   FirstOccupied does not walk through them either: it jumps across the same box from the same
+//   voxel (walk.h), and where that jump lands depends only on decisions the lane certified.
 // tests/core/ray_batch_test.cc compares every answer with FirstOccupied, near-ties included.
 //
 // A lane whose segment ends (a hit, leaving the grid's box, reaching the end, a near-tie) is
-// refilled with the next segment at once, so lanes do not wait for each other.
+// refilled with the next segment once kRefillBatch lanes of its group have ended, so lanes do not
+// wait for the slowest of their group.
 
 #undef HWY_TARGET_INCLUDE
 #define HWY_TARGET_INCLUDE "ray_batch.cc"
@@ -159,8 +160,9 @@ class LaneGroup {
     alignas(64) float dx[kMax], dy[kMax], dz[kMax], ex[kMax], ey[kMax], ez[kMax];
   };
 
-  // Loads the next segment the lanes can take into lane `l`, or parks the lane: far outside the
-  // box, never inside, stepping by 0 along z forever, so it never ends or touches memory.
+  // Loads the next segment the lanes can take into lane `l`, or parks the lane: at voxel -2^30,
+  // outside the box (FirstOccupiedBatch checks that), stepping by 0 along z forever, so it never
+  // ends and its gathers read only entry 0.
   // Segments the lanes cannot hold go straight to FirstOccupied.
   void Take(size_t l, Source& src) {
     while (src.next < src.count && !TakeSegment(l, src.a[src.next], src.b[src.next])) {

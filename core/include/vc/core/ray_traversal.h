@@ -67,7 +67,8 @@ std::optional<VoxelIndex> FirstOccupied(const OccupancyGrid& grid, const Eigen::
 // *rechecked (if given) counts those. Elsewhere (AVX2 and below, where the lanes measured slower
 // than the scalar walk) it calls FirstOccupied per segment, unless `kernel` is kLanes, which forces
 // the lanes on any target (for tests and benchmarks). A grid of 2^31 bricks or more, or one not
-// within +-2^29 voxels of the origin, and batches of 2^31 segments or more, are walked per segment. Returns what ran, e.g. "AVX3 lanes", "AVX2 per segment", "SCALAR lanes".
+// within +-2^29 voxels of the origin, and batches of 2^31 segments or more, are walked per
+// segment. Returns what ran, e.g. "AVX3 lanes", "AVX2 per segment", "SCALAR lanes".
 enum class BatchKernel { kAuto, kLanes };
 std::string FirstOccupiedBatch(const OccupancyGrid& grid, std::span<const Eigen::Vector3d> a,
                                std::span<const Eigen::Vector3d> b, std::span<std::optional<VoxelIndex>> out,
