@@ -724,7 +724,7 @@ Result<Evaluation> Evaluate(const VoxelScene& scene, const std::vector<WorldPoin
   Tally total;
   for (size_t i = 0; i < n; ++i)
     for (int f = 0; f < kFacesPerVoxel; ++f) {
-      if (!FaceInSet(g, index[i], Face(f), options.faces)) continue;
+      if (!((faces_in_set[i] >> f) & 1)) continue;
       const size_t slot = i * kFacesPerVoxel + f;
       total.Add(Perception(best_p[slot]), best[slot]);
     }
