@@ -3,9 +3,11 @@
 // -march=native). The answers are FirstOccupied's, segment for segment.
 //
 // Why float lanes give FirstOccupied's answers (docs/VISIBILITY.md, "Many segments at once"):
-// - The set-up is the scalar Walk (walk.h, shared): the start voxel, the steps and the number of
-//   boundary crossings per axis are the same integers. Only the order in which the crossings of
-//   different axes come is decided in float.
+// - The set-up is the scalar Walk's (walk.h), operation for operation, in double lanes a chunk of
+//   segments ahead (Source::Prepare): the start voxel, the steps and the number of boundary
+//   crossings per axis are the same integers, and t_delta and the last crossing parameter are the
+//   Walk's doubles rounded to float. Only the order in which the crossings of different axes come
+//   is decided in float.
 // - A lane never accumulates a parameter. The parameter of crossing j of axis i is computed from
 //   the parameter of the axis's last crossing: t = T_last - (crossings left after j) * t_delta,
 //   one fused multiply-add (or a multiply and an add where the target has no FMA). Its error is at
@@ -36,6 +38,7 @@
 #include <bit>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <limits>
 #include <optional>
 #include <span>
@@ -77,14 +80,114 @@ using VF = hn::Vec<D>;
 using VI = hn::Vec<DI>;
 using MI = hn::Mask<DI>;
 
+using DD = hn::ScalableTag<double>;
+using VD = hn::Vec<DD>;
+
+// Segments set up for the lanes, a chunk at a time (structure of arrays): each axis's start voxel,
+// step and number of crossings, exactly the scalar Walk's integers (walk.h), and its t_delta and
+// last crossing parameter rounded to float from the Walk's double values.
+struct Prepared {
+  static constexpr size_t kChunk = 128;  // a multiple of any target's double lanes
+  alignas(64) int32_t cur[3][kChunk], left[3][kChunk], step[3][kChunk], id[kChunk];
+  alignas(64) float delta[3][kChunk], last[3][kChunk];
+  size_t size = 0, pos = 0;
+};
+
+static_assert(sizeof(Eigen::Vector3d) == 3 * sizeof(double), "segment ends are read as packed x, y, z triples");
+
 // The segments still to cast, where the answers go, and the segments left to FirstOccupied.
 struct Source {
   const Eigen::Vector3d* a;
   const Eigen::Vector3d* b;
   size_t count;
-  size_t next;
+  size_t next;  // the first segment not yet prepared
   std::optional<VoxelIndex>* out;
   std::vector<size_t>* unsure;
+  Prepared prep;
+
+  // Whether segments remain, prepared or not.
+  bool More() const { return prep.pos < prep.size || next < count; }
+
+  // Whether a prepared segment is ready for a lane (preparing the next chunk if needed).
+  bool Ready() {
+    if (prep.pos == prep.size && next < count) Prepare();
+    return prep.pos < prep.size;
+  }
+
+  // Sets up the next chunk of segments in double lanes, with the scalar Walk's operations, and
+  // sends the segments the lanes cannot hold straight to FirstOccupied: ends beyond
+  // +-kMaxLaneCoordinate (or NaN), more than kMaxLaneSteps crossings on an axis, or a crossing
+  // parameter too large for a float.
+  void Prepare() {
+    const DD dd;
+    const hn::Rebind<int32_t, DD> d32;
+    const hn::Rebind<float, DD> df;
+    constexpr size_t kMaxD = 8;  // double lanes of the widest target
+    const size_t N = hn::Lanes(dd);
+    HWY_ASSERT(N <= kMaxD);
+    const VD zero = hn::Zero(dd), one = hn::Set(dd, 1.0), inf = hn::Set(dd, internal::kInf);
+    const VD max_coordinate = hn::Set(dd, internal::kMaxLaneCoordinate), max_steps = hn::Set(dd, internal::kMaxLaneSteps);
+    const VD max_float = hn::Set(dd, 0x1p126);  // below it, a double rounds to a finite float
+    prep.size = prep.pos = 0;
+    while (next < count && prep.size + N <= Prepared::kChunk) {
+      const size_t n = std::min(N, count - next);
+      const double* pa = a[next].data();
+      const double* pb = b[next].data();
+      alignas(64) double tail_a[3 * kMaxD] = {}, tail_b[3 * kMaxD] = {};
+      if (n < N) {
+        std::copy(pa, pa + 3 * n, tail_a);
+        std::copy(pb, pb + 3 * n, tail_b);
+        pa = tail_a, pb = tail_b;
+      }
+      VD av[3], bv[3];
+      hn::LoadInterleaved3(dd, pa, av[0], av[1], av[2]);
+      hn::LoadInterleaved3(dd, pb, bv[0], bv[1], bv[2]);
+      auto ok = hn::FirstN(dd, n);
+      VD cur[3], step[3], left[3], delta[3], last[3];
+      for (int i = 0; i < 3; ++i) {
+        ok = hn::And(ok, hn::And(hn::Lt(hn::Abs(av[i]), max_coordinate), hn::Lt(hn::Abs(bv[i]), max_coordinate)));
+        const VD fa = hn::Floor(av[i]), fb = hn::Floor(bv[i]), d = hn::Sub(bv[i], av[i]);
+        const auto pos = hn::Gt(d, zero), neg = hn::Lt(d, zero);
+        cur[i] = fa;
+        step[i] = hn::IfThenElse(pos, one, hn::IfThenElseZero(neg, hn::Neg(one)));
+        // Walk: t_delta = 1/d or -1/d; t_max = (fa + 1 - a)/d or (fa - a)/d; left = fb - fa or fa - fb.
+        const VD t_delta = hn::Div(one, hn::Abs(d));
+        const VD t_max = hn::Div(hn::Sub(hn::IfThenElse(pos, hn::Add(fa, one), fa), av[i]), d);
+        left[i] = hn::IfThenElse(pos, hn::Sub(fb, fa), hn::IfThenElseZero(neg, hn::Sub(fa, fb)));
+        const auto moving = hn::Gt(left[i], zero);
+        const VD t_last = hn::Add(t_max, hn::Mul(hn::Sub(left[i], one), t_delta));
+        ok = hn::And(ok, hn::Le(left[i], max_steps));
+        ok = hn::And(ok, hn::Or(hn::Not(moving), hn::And(hn::Lt(t_delta, max_float), hn::Lt(t_last, max_float))));
+        left[i] = hn::IfThenElseZero(moving, left[i]);
+        delta[i] = hn::IfThenElseZero(moving, t_delta);  // an axis that never crosses: 0 and infinity
+        last[i] = hn::IfThenElse(moving, t_last, inf);
+      }
+      // Rejected lanes hold garbage; they are masked out below, and the conversions are defined.
+      for (int i = 0; i < 3; ++i) {
+        cur[i] = hn::IfThenElseZero(ok, cur[i]), left[i] = hn::IfThenElseZero(ok, left[i]);
+        last[i] = hn::IfThenElseZero(ok, last[i]);
+      }
+      const auto ok32 = hn::Ne(hn::DemoteTo(d32, hn::IfThenElseZero(ok, one)), hn::Zero(d32));
+      const auto okf = hn::RebindMask(df, ok32);
+      for (int i = 0; i < 3; ++i) {
+        hn::CompressStore(hn::DemoteTo(d32, cur[i]), ok32, d32, prep.cur[i] + prep.size);
+        hn::CompressStore(hn::DemoteTo(d32, left[i]), ok32, d32, prep.left[i] + prep.size);
+        hn::CompressStore(hn::DemoteTo(d32, step[i]), ok32, d32, prep.step[i] + prep.size);
+        hn::CompressStore(hn::DemoteTo(df, delta[i]), okf, df, prep.delta[i] + prep.size);
+        hn::CompressStore(hn::DemoteTo(df, last[i]), okf, df, prep.last[i] + prep.size);
+      }
+      const size_t kept = hn::CompressStore(hn::Iota(d32, int32_t(next)), ok32, d32, prep.id + prep.size);
+      if (kept < n) {
+        alignas(64) int32_t taken[kMaxD];
+        hn::Store(hn::VecFromMask(d32, ok32), d32, taken);
+        for (size_t j = 0; j < n; ++j) {
+          if (!taken[j]) unsure->push_back(next + j);
+        }
+      }
+      prep.size += kept;
+      next += n;
+    }
+  }
 };
 
 // The grid as the kernel reads it: the brick entries (slot, or minus the distance) and the payload
@@ -132,18 +235,17 @@ class LaneGroup {
   void RefillIfEnded(Source& src) {
     const DI di;
     if (hn::AllFalse(di, done_)) return;
-    if (src.next < src.count && hn::CountTrue(di, done_) < std::min(internal::kRefillBatch, hn::Lanes(D()))) return;
+    if (src.More() && hn::CountTrue(di, done_) < std::min(internal::kRefillBatch, hn::Lanes(D()))) return;
     Store();
-    hn::Store(hn::VecFromMask(di, done_), di, s_.done);
-    hn::Store(hn::VecFromMask(di, hit_), di, s_.hit);
-    hn::Store(hn::VecFromMask(di, unsure_), di, s_.unsure);
-    for (size_t l = 0; l < hn::Lanes(D()); ++l) {
-      if (!s_.done[l]) continue;
-      if (s_.unsure[l]) {
+    const uint64_t ended = Bits(done_), hits = Bits(hit_), unsure = Bits(unsure_);
+    for (uint64_t m = ended; m != 0; m &= m - 1) {
+      const size_t l = size_t(std::countr_zero(m));
+      const uint64_t lane = uint64_t{1} << l;
+      if (unsure & lane) {
         src.unsure->push_back(size_t(s_.id[l]));
       } else {
-        src.out[s_.id[l]] = s_.hit[l] ? std::optional<VoxelIndex>(VoxelIndex{s_.x[l], s_.y[l], s_.z[l]})
-                                      : std::nullopt;
+        src.out[s_.id[l]] = (hits & lane) ? std::optional<VoxelIndex>(VoxelIndex{s_.x[l], s_.y[l], s_.z[l]})
+                                          : std::nullopt;
       }
       --active_;
       Take(l, src);
@@ -156,20 +258,23 @@ class LaneGroup {
   struct State {
     static constexpr size_t kMax = 16;
     alignas(64) int32_t x[kMax], y[kMax], z[kMax], lx[kMax], ly[kMax], lz[kMax];
-    alignas(64) int32_t sx[kMax], sy[kMax], sz[kMax], was[kMax], id[kMax], hit[kMax], done[kMax], unsure[kMax];
+    alignas(64) int32_t sx[kMax], sy[kMax], sz[kMax], was[kMax], id[kMax];
     alignas(64) float dx[kMax], dy[kMax], dz[kMax], ex[kMax], ey[kMax], ez[kMax];
   };
 
-  // Loads the next segment the lanes can take into lane `l`, or parks the lane: at voxel -2^30,
-  // outside the box (FirstOccupiedBatch checks that), stepping by 0 along z forever, so it never
-  // ends and its gathers read only entry 0.
-  // Segments the lanes cannot hold go straight to FirstOccupied.
+  // Loads the next prepared segment into lane `l`, or parks the lane: at voxel -2^30, outside the
+  // box (FirstOccupiedBatch checks that), stepping by 0 along z forever, so it never ends and its
+  // gathers read only entry 0.
   void Take(size_t l, Source& src) {
-    while (src.next < src.count && !TakeSegment(l, src.a[src.next], src.b[src.next])) {
-      src.unsure->push_back(src.next++);
-    }
-    if (src.next < src.count) {
-      s_.id[l] = int32_t(src.next++);
+    if (src.Ready()) {
+      Prepared& p = src.prep;
+      const size_t k = p.pos++;
+      s_.x[l] = p.cur[0][k], s_.y[l] = p.cur[1][k], s_.z[l] = p.cur[2][k];
+      s_.lx[l] = p.left[0][k], s_.ly[l] = p.left[1][k], s_.lz[l] = p.left[2][k];
+      s_.sx[l] = p.step[0][k], s_.sy[l] = p.step[1][k], s_.sz[l] = p.step[2][k];
+      s_.dx[l] = p.delta[0][k], s_.dy[l] = p.delta[1][k], s_.dz[l] = p.delta[2][k];
+      s_.ex[l] = p.last[0][k], s_.ey[l] = p.last[1][k], s_.ez[l] = p.last[2][k];
+      s_.id[l] = p.id[k];
       ++active_;
     } else {
       constexpr int32_t kFar = int32_t{1} << 30;
@@ -182,39 +287,15 @@ class LaneGroup {
       s_.id[l] = -1;
     }
     s_.was[l] = 0;
-    s_.done[l] = 0;
   }
 
-  // The scalar Walk's set-up of a -> b in lane `l`, with each axis's last crossing parameter.
-  // False if the lanes cannot hold the segment.
-  bool TakeSegment(size_t l, const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
-    for (int i = 0; i < 3; ++i) {
-      if (!(std::abs(a[i]) < internal::kMaxLaneCoordinate && std::abs(b[i]) < internal::kMaxLaneCoordinate)) {
-        return false;
-      }
-    }
-    const internal::Walk w(a, b);
-    int32_t* cur[3] = {s_.x, s_.y, s_.z};
-    int32_t* left[3] = {s_.lx, s_.ly, s_.lz};
-    int32_t* step[3] = {s_.sx, s_.sy, s_.sz};
-    float* delta[3] = {s_.dx, s_.dy, s_.dz};
-    float* last[3] = {s_.ex, s_.ey, s_.ez};
-    for (int i = 0; i < 3; ++i) {
-      if (w.left[i] > internal::kMaxLaneSteps) return false;
-      cur[i][l] = w.cur[i];
-      left[i][l] = w.left[i];
-      step[i][l] = w.step[i];
-      if (w.left[i] == 0) {  // never crosses: its next crossing is at infinity
-        delta[i][l] = 0;
-        last[i][l] = internal::kInf;
-        continue;
-      }
-      const float dt = float(w.t_delta[i]), tl = float(w.t_max[i] + (w.left[i] - 1) * w.t_delta[i]);
-      if (!std::isfinite(dt) || !std::isfinite(tl)) return false;
-      delta[i][l] = dt;
-      last[i][l] = tl;
-    }
-    return true;
+  // The lanes of a mask as bits (lane l is bit l).
+  static uint64_t Bits(MI m) {
+    uint8_t bytes[8] = {};
+    hn::StoreMaskBits(DI(), m, bytes);
+    uint64_t bits = 0;
+    std::memcpy(&bits, bytes, sizeof(bits));
+    return bits;
   }
 
   void Load() {
@@ -225,8 +306,7 @@ class LaneGroup {
     sx_ = hn::Load(di, s_.sx), sy_ = hn::Load(di, s_.sy), sz_ = hn::Load(di, s_.sz), was_ = hn::Load(di, s_.was);
     dx_ = hn::Load(d, s_.dx), dy_ = hn::Load(d, s_.dy), dz_ = hn::Load(d, s_.dz);
     ex_ = hn::Load(d, s_.ex), ey_ = hn::Load(d, s_.ey), ez_ = hn::Load(d, s_.ez);
-    done_ = hn::MaskFromVec(hn::Load(di, s_.done));
-    hit_ = unsure_ = done_;
+    done_ = hit_ = unsure_ = hn::FirstN(di, 0);  // every ended lane was refilled or parked
   }
 
   void Store() {
@@ -390,7 +470,7 @@ int64_t FirstOccupiedBatchImpl(const OccupancyGrid& grid, const Eigen::Vector3d*
   }
   HWY_ASSERT(hn::Lanes(D()) <= 16);
   const GridView view(grid);
-  Source src{a, b, count, 0, out, unsure};
+  Source src{a, b, count, 0, out, unsure, {}};
   // Two independent groups, so that one group's gathers overlap the other's arithmetic.
   LaneGroup g0(view, src), g1(view, src);
   while (g0.active() + g1.active() > 0) {

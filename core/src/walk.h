@@ -1,7 +1,7 @@
 // Internal to vc_core: the Amanatides & Woo (1987) walk state and the exact jumps across free
 // boxes used by FirstOccupied (ray_traversal.cc). Any other traversal must share this code or
 // perform exactly its operations: a jump adds n * t_delta in one go, so the jump policy itself
-// decides later tie-breaks. The SIMD kernel (ray_batch.cc) shares Walk and re-states
+// decides later tie-breaks. The SIMD kernel (ray_batch.cc) re-states Walk's set-up and
 // JumpAcrossBox lane-wise, operation for operation; a change here must be made there too, and
 // tests/core/ray_batch_test.cc fails if the two disagree. Plain scalar double code for the
 // baseline ISA. Re-entrant; no state beyond the Walk.

@@ -221,6 +221,49 @@ TEST(FirstOccupiedBatchTest, ExactTiesAndOversizedSegmentsAreLeftToFirstOccupied
   hwy::SetSupportedTargetsForTest(0);
 }
 
+// The lanes set segments up in double lanes, a chunk of 128 at a time: every batch size around a
+// vector's and a chunk's length gives FirstOccupied's answers, and a segment whose crossing
+// parameters do not fit a float (an axis crossed once over a length of 2^-130 voxels) is left to
+// FirstOccupied wherever it falls in its vector.
+TEST(FirstOccupiedBatchTest, EveryBatchSizeAndAxesTooSteepForFloats) {
+  std::vector<VoxelIndex> occ;
+  for (int x = -12; x <= 12; ++x)
+    for (int y = -12; y <= 12; ++y) {
+      occ.push_back({x, y, -6});
+      if ((x * y) % 5 == 1) occ.push_back({x, y, 2});
+    }
+  auto grid = OccupancyGrid::Build(0.1, occ, 1 << 24);
+  ASSERT_TRUE(grid.ok());
+  std::mt19937_64 rng(21);
+  std::uniform_real_distribution<double> u(-15, 15);
+  Segments all;
+  for (int r = 0; r < 400; ++r) all.Add({u(rng), u(rng), u(rng) / 3 + 4}, {u(rng), u(rng), u(rng) / 3 - 4});
+  const double tiny = std::ldexp(1.0, -130);
+  for (size_t i = 5; i < all.a.size(); i += 37) {  // z crosses 0 once: t_delta ~ 2^129
+    all.a[i] = {u(rng), u(rng), -tiny};
+    all.b[i] = {u(rng), u(rng), tiny / 2};
+  }
+  for (size_t n : {size_t{1}, size_t{2}, size_t{3}, size_t{7}, size_t{8}, size_t{9}, size_t{15}, size_t{16},
+                   size_t{17}, size_t{31}, size_t{33}, size_t{127}, size_t{128}, size_t{129}, size_t{255},
+                   size_t{256}, size_t{257}, size_t{400}}) {
+    Segments s;
+    s.a.assign(all.a.begin(), all.a.begin() + long(n));
+    s.b.assign(all.b.begin(), all.b.begin() + long(n));
+    ExpectSameOnEveryTarget(*grid, s, std::to_string(n) + " segments");
+  }
+  Segments steep;
+  for (int r = 0; r < 40; ++r) steep.Add({u(rng), u(rng), -tiny}, {u(rng), u(rng), tiny / 2});
+  for (int64_t target : hwy::SupportedAndGeneratedTargets()) {
+    hwy::SetSupportedTargetsForTest(target);
+    std::vector<std::optional<VoxelIndex>> got(steep.a.size());
+    size_t rechecked = 0;
+    FirstOccupiedBatch(*grid, steep.a, steep.b, got, BatchKernel::kLanes, &rechecked);
+    EXPECT_EQ(rechecked, steep.a.size()) << hwy::TargetName(target);
+    for (size_t i = 0; i < got.size(); ++i) EXPECT_EQ(got[i], FirstOccupied(*grid, steep.a[i], steep.b[i]));
+  }
+  hwy::SetSupportedTargetsForTest(0);
+}
+
 // The default kernel: lanes where they pay (AVX-512), FirstOccupied per segment elsewhere.
 TEST(FirstOccupiedBatchTest, AutoUsesLanesOnlyWhereTheyPay) {
   auto grid = OccupancyGrid::Build(0.1, {{0, 0, 0}, {3, 0, 0}}, 1 << 20);
