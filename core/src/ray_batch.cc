@@ -103,6 +103,7 @@ struct Source {
   size_t next;  // the first segment not yet prepared
   std::optional<VoxelIndex>* out;
   std::vector<size_t>* unsure;
+  int32_t lo[3];  // start voxels are stored relative to this corner of the grid's box
   Prepared prep;
 
   // Whether segments remain, prepared or not.
@@ -170,7 +171,7 @@ struct Source {
       const auto ok32 = hn::Ne(hn::DemoteTo(d32, hn::IfThenElseZero(ok, one)), hn::Zero(d32));
       const auto okf = hn::RebindMask(df, ok32);
       for (int i = 0; i < 3; ++i) {
-        hn::CompressStore(hn::DemoteTo(d32, cur[i]), ok32, d32, prep.cur[i] + prep.size);
+        hn::CompressStore(hn::Sub(hn::DemoteTo(d32, cur[i]), hn::Set(d32, lo[i])), ok32, d32, prep.cur[i] + prep.size);
         hn::CompressStore(hn::DemoteTo(d32, left[i]), ok32, d32, prep.left[i] + prep.size);
         hn::CompressStore(hn::DemoteTo(d32, step[i]), ok32, d32, prep.step[i] + prep.size);
         hn::CompressStore(hn::DemoteTo(df, delta[i]), okf, df, prep.delta[i] + prep.size);
@@ -195,7 +196,7 @@ struct Source {
 // little-endian).
 struct GridView {
   explicit GridView(const OccupancyGrid& grid)
-      : lo{hn::Set(DI(), grid.min_index().x), hn::Set(DI(), grid.min_index().y), hn::Set(DI(), grid.min_index().z)},
+      : lo{grid.min_index().x, grid.min_index().y, grid.min_index().z},
         dims{hn::Set(DU(), uint32_t(grid.dims().x())), hn::Set(DU(), uint32_t(grid.dims().y())),
              hn::Set(DU(), uint32_t(grid.dims().z()))},
         bdx(hn::Set(DI(), grid.brick_dims().x())),
@@ -210,7 +211,7 @@ struct GridView {
     return hn::Add(hn::Mul(hn::Add(hn::Mul(bz, bdy), by), bdx), bx);
   }
 
-  VI lo[3];
+  int32_t lo[3];  // lanes hold voxel coordinates relative to this corner of the box
   hn::Vec<DU> dims[3];
   VI bdx, bdy;
   const int32_t* entries;
@@ -244,7 +245,8 @@ class LaneGroup {
       if (unsure & lane) {
         src.unsure->push_back(size_t(s_.id[l]));
       } else {
-        src.out[s_.id[l]] = (hits & lane) ? std::optional<VoxelIndex>(VoxelIndex{s_.x[l], s_.y[l], s_.z[l]})
+        src.out[s_.id[l]] = (hits & lane) ? std::optional<VoxelIndex>(VoxelIndex{
+                                                s_.x[l] + g_.lo[0], s_.y[l] + g_.lo[1], s_.z[l] + g_.lo[2]})
                                           : std::nullopt;
       }
       --active_;
@@ -262,8 +264,8 @@ class LaneGroup {
     alignas(64) float dx[kMax], dy[kMax], dz[kMax], ex[kMax], ey[kMax], ez[kMax];
   };
 
-  // Loads the next prepared segment into lane `l`, or parks the lane: at voxel -2^30, outside the
-  // box (FirstOccupiedBatch checks that), stepping by 0 along z forever, so it never ends and its
+  // Loads the next prepared segment into lane `l`, or parks the lane: at -2^30 on every axis
+  // relative to the box, so outside it, stepping by 0 along z forever, so it never ends and its
   // gathers read only entry 0.
   void Take(size_t l, Source& src) {
     if (src.Ready()) {
@@ -303,7 +305,8 @@ class LaneGroup {
     const DI di;
     x_ = hn::Load(di, s_.x), y_ = hn::Load(di, s_.y), z_ = hn::Load(di, s_.z);
     lx_ = hn::Load(di, s_.lx), ly_ = hn::Load(di, s_.ly), lz_ = hn::Load(di, s_.lz);
-    sx_ = hn::Load(di, s_.sx), sy_ = hn::Load(di, s_.sy), sz_ = hn::Load(di, s_.sz), was_ = hn::Load(di, s_.was);
+    sx_ = hn::Load(di, s_.sx), sy_ = hn::Load(di, s_.sy), sz_ = hn::Load(di, s_.sz);
+    was_ = hn::MaskFromVec(hn::Load(di, s_.was));
     dx_ = hn::Load(d, s_.dx), dy_ = hn::Load(d, s_.dy), dz_ = hn::Load(d, s_.dz);
     ex_ = hn::Load(d, s_.ex), ey_ = hn::Load(d, s_.ey), ez_ = hn::Load(d, s_.ez);
     done_ = hit_ = unsure_ = hn::FirstN(di, 0);  // every ended lane was refilled or parked
@@ -313,7 +316,7 @@ class LaneGroup {
     const DI di;
     hn::Store(x_, di, s_.x), hn::Store(y_, di, s_.y), hn::Store(z_, di, s_.z);
     hn::Store(lx_, di, s_.lx), hn::Store(ly_, di, s_.ly), hn::Store(lz_, di, s_.lz);
-    hn::Store(was_, di, s_.was);
+    hn::Store(hn::VecFromMask(di, was_), di, s_.was);
   }
 
   // Parameter of the crossing of an axis after which `after` crossings are left (after >= 0):
@@ -325,9 +328,9 @@ class LaneGroup {
   const GridView& g_;
   State s_;
   size_t active_ = 0;
-  VI x_, y_, z_, lx_, ly_, lz_, sx_, sy_, sz_, was_;
+  VI x_, y_, z_, lx_, ly_, lz_, sx_, sy_, sz_;  // x_, y_, z_: the voxel, relative to GridView::lo
   VF dx_, dy_, dz_, ex_, ey_, ez_;
-  MI done_, hit_, unsure_;
+  MI was_, done_, hit_, unsure_;  // was_: the lane has been inside the box
 };
 
 // Jumps the lanes in `jump` to the last voxel of their walk inside the free box of bricks around
@@ -405,11 +408,11 @@ HWY_INLINE void LaneGroup::Advance() {
   const DU du;
   const VI zero = hn::Zero(di), one = hn::Set(di, 1), three = hn::Set(di, 3), seven = hn::Set(di, 7);
   // ---- The current voxel: occupied, an empty brick to jump across, or outside the box.
-  const VI rel[3] = {hn::Sub(x_, g_.lo[0]), hn::Sub(y_, g_.lo[1]), hn::Sub(z_, g_.lo[2])};
+  const VI rel[3] = {x_, y_, z_};
   const MI inside = hn::RebindMask(di, hn::And(hn::Lt(hn::BitCast(du, rel[0]), g_.dims[0]),
                                                hn::And(hn::Lt(hn::BitCast(du, rel[1]), g_.dims[1]),
                                                        hn::Lt(hn::BitCast(du, rel[2]), g_.dims[2]))));
-  was_ = hn::Or(was_, hn::VecFromMask(di, inside));
+  was_ = hn::Or(was_, inside);
   const VI brick = hn::IfThenElseZero(inside, g_.BrickNumber(rel[0], rel[1], rel[2]));
   const VI slot = hn::GatherIndex(di, g_.entries, brick);
   const MI filled = hn::And(inside, hn::Gt(slot, zero));
@@ -419,7 +422,7 @@ HWY_INLINE void LaneGroup::Advance() {
   const auto word = hn::BitCast(du, hn::GatherIndex(di, g_.payload, word_index));
   const auto bit = hn::BitCast(du, hn::Or(hn::ShiftLeft<3>(hn::And(rel[1], three)), hn::And(rel[0], seven)));
   hit_ = hn::And(filled, hn::RebindMask(di, hn::Ne(hn::And(hn::operator>>(word, bit), hn::Set(du, 1)), hn::Zero(du))));
-  MI end = hn::Or(hit_, hn::AndNot(inside, hn::MaskFromVec(was_)));
+  MI end = hn::Or(hit_, hn::AndNot(inside, was_));
   const MI empty = hn::AndNot(done_, hn::AndNot(filled, inside));
   MI wait = hn::FirstN(di, 0);
   const size_t waiting = hn::CountTrue(di, empty);
@@ -470,7 +473,8 @@ int64_t FirstOccupiedBatchImpl(const OccupancyGrid& grid, const Eigen::Vector3d*
   }
   HWY_ASSERT(hn::Lanes(D()) <= 16);
   const GridView view(grid);
-  Source src{a, b, count, 0, out, unsure, {}};
+  const VoxelIndex& lo = grid.min_index();
+  Source src{a, b, count, 0, out, unsure, {lo.x, lo.y, lo.z}, {}};
   // Two independent groups, so that one group's gathers overlap the other's arithmetic.
   LaneGroup g0(view, src), g1(view, src);
   while (g0.active() + g1.active() > 0) {
@@ -499,8 +503,8 @@ std::string FirstOccupiedBatch(const OccupancyGrid& grid, std::span<const Eigen:
   const size_t n = std::min({a.size(), b.size(), out.size()});
   if (rechecked) *rechecked = 0;
   // The kernel forms brick numbers, payload word numbers, segment numbers and voxel coordinates
-  // (a voxel plus at most kMaxLaneSteps) in int32, and parks spare lanes at voxel -2^30 on every
-  // axis, which must lie outside the grid's box: so the box must lie within +-2^29.
+  // relative to the box's corner (a voxel within +-2^30, plus at most kMaxLaneSteps, minus the
+  // corner) in int32: so the box must lie within +-2^29.
   const VoxelIndex lo = grid.min_index();
   const bool near = std::abs(int64_t(lo.x)) < (int64_t{1} << 29) && std::abs(int64_t(lo.y)) < (int64_t{1} << 29) &&
                     std::abs(int64_t(lo.z)) < (int64_t{1} << 29) &&
