@@ -163,10 +163,11 @@ struct Source {
         delta[i] = hn::IfThenElseZero(moving, t_delta);  // an axis that never crosses: 0 and infinity
         last[i] = hn::IfThenElse(moving, t_last, inf);
       }
-      // Rejected lanes hold garbage; they are masked out below, and the conversions are defined.
+      // Rejected lanes may hold NaN or values beyond int32 and float: zeroed, so that every
+      // conversion below is in range (their results are not stored).
       for (int i = 0; i < 3; ++i) {
         cur[i] = hn::IfThenElseZero(ok, cur[i]), left[i] = hn::IfThenElseZero(ok, left[i]);
-        last[i] = hn::IfThenElseZero(ok, last[i]);
+        delta[i] = hn::IfThenElseZero(ok, delta[i]), last[i] = hn::IfThenElseZero(ok, last[i]);
       }
       const auto ok32 = hn::Ne(hn::DemoteTo(d32, hn::IfThenElseZero(ok, one)), hn::Zero(d32));
       const auto okf = hn::RebindMask(df, ok32);
