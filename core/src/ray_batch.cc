@@ -39,7 +39,6 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
-#include <limits>
 #include <optional>
 #include <span>
 #include <string>
@@ -103,7 +102,7 @@ struct Source {
   size_t next;  // the first segment not yet prepared
   std::optional<VoxelIndex>* out;
   std::vector<size_t>* unsure;
-  int32_t lo[3];  // start voxels are stored relative to this corner of the grid's box
+  const int32_t* lo;  // GridView::lo: start voxels are stored relative to the box's corner
   Prepared prep;
 
   // Whether segments remain, prepared or not.
@@ -474,8 +473,7 @@ int64_t FirstOccupiedBatchImpl(const OccupancyGrid& grid, const Eigen::Vector3d*
   }
   HWY_ASSERT(hn::Lanes(D()) <= 16);
   const GridView view(grid);
-  const VoxelIndex& lo = grid.min_index();
-  Source src{a, b, count, 0, out, unsure, {lo.x, lo.y, lo.z}, {}};
+  Source src{a, b, count, 0, out, unsure, view.lo, {}};
   // Two independent groups, so that one group's gathers overlap the other's arithmetic.
   LaneGroup g0(view, src), g1(view, src);
   while (g0.active() + g1.active() > 0) {
