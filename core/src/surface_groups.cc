@@ -151,8 +151,53 @@ class ConeSides {
 
 }  // namespace
 
+FreeBox GrowFreeBox(const OccupancyGrid& grid, const Vector3d& uo) {
+  FreeBox box;
+  if (!uo.allFinite()) return box;
+  const VoxelIndex v{FloorInt(uo.x()), FloorInt(uo.y()), FloorInt(uo.z())};
+  if (grid.Occupied(v)) return box;
+  box.lo = box.hi = v;
+  int* lo[3] = {&box.lo.x, &box.lo.y, &box.lo.z};
+  int* hi[3] = {&box.hi.x, &box.hi.y, &box.hi.z};
+  const VoxelIndex& gmin = grid.min_index();
+  // Beyond the grid everything is free; the box need not reach further than one voxel out.
+  const int limit_lo[3] = {gmin.x - 1, gmin.y - 1, gmin.z - 1};
+  const int limit_hi[3] = {gmin.x + grid.dims()[0], gmin.y + grid.dims()[1], gmin.z + grid.dims()[2]};
+  int step[6] = {1, 1, 1, 1, 1, 1};
+  for (bool any = true; any;) {
+    any = false;
+    for (int side = 0; side < 6; ++side) {
+      if (step[side] == 0) continue;
+      any = true;
+      const int a = side >> 1;
+      const bool up = side & 1;
+      const int room = up ? limit_hi[a] - *hi[a] : *lo[a] - limit_lo[a];
+      const int n = std::min(step[side], room);
+      if (n <= 0) {
+        step[side] = 0;
+        continue;
+      }
+      VoxelIndex slo = box.lo, shi = box.hi;
+      int* sl[3] = {&slo.x, &slo.y, &slo.z};
+      int* sh[3] = {&shi.x, &shi.y, &shi.z};
+      if (up) {
+        *sl[a] = *hi[a] + 1, *sh[a] = *hi[a] + n;
+      } else {
+        *sl[a] = *lo[a] - n, *sh[a] = *lo[a] - 1;
+      }
+      if (grid.AnyOccupied(slo, shi)) {
+        step[side] /= 2;
+      } else {
+        (up ? *hi[a] : *lo[a]) += up ? n : -n;
+        step[side] = std::min(2 * step[side], 64);
+      }
+    }
+  }
+  return box;
+}
+
 bool FreeCone(const OccupancyGrid& grid, const Vector3d& uo, int axis, bool viewer_above, int plane,
-              const Vector3d& q0, const Vector3d& q1) {
+              const Vector3d& q0, const Vector3d& q1, const FreeBox& around) {
   double len = 0;
   for (int i = 0; i < 3; ++i) len = std::max({len, std::abs(q0[i] - uo[i]), std::abs(q1[i] - uo[i])});
   if (!(len > 0)) return false;
@@ -176,6 +221,25 @@ bool FreeCone(const OccupancyGrid& grid, const Vector3d& uo, int axis, bool view
   };
   std::optional<ConeSides> sides;
   double s0 = 0;
+  if (!around.empty()) {
+    // The part of the cone from o to parameter s lies inside the free box around o while its
+    // box does; the largest such s is solved for, then checked with the pieces' own rounding.
+    const int flo[3] = {around.lo.x, around.lo.y, around.lo.z};
+    const int fhi[3] = {around.hi.x, around.hi.y, around.hi.z};
+    double s = 1;
+    for (int i = 0; i < 3; ++i) {
+      if (q0[i] < uo[i]) s = std::min(s, (uo[i] - kConeMargin - flo[i]) / (uo[i] - q0[i]));
+      if (q1[i] > uo[i]) s = std::min(s, (fhi[i] + 1 - kConeMargin - uo[i]) / (q1[i] - uo[i]));
+    }
+    s *= 0.999;
+    if (s > 0) {
+      int lo[3], hi[3];
+      piece(0, s, lo, hi);
+      bool inside = true;
+      for (int i = 0; i < 3; ++i) inside = inside && lo[i] >= flo[i] && hi[i] <= fhi[i];
+      if (inside) s0 = s;
+    }
+  }
   while (s0 < 1) {
     int lo[3], hi[3];
     // Empty-space skipping: a brick at distance k >= 2 from every non-empty brick sits in a free
@@ -324,7 +388,7 @@ void SurfaceTargets::WalkGroups(const Vector3d& uo, const Brick& brick, GroupWal
             kind.SeenGroup(a, sp, plane, umin, umax, wmin, wmax, sub, at);
           };
           const bool cone_first = !single && walk.expect_seen;
-          if (cone_first && FreeCone(grid_, uo, a, sp == 1, plane, q0, q1)) return seen_group();
+          if (cone_first && FreeCone(grid_, uo, a, sp == 1, plane, q0, q1, walk.around)) return seen_group();
           // One exact ray to the face nearest the rectangle's middle.
           const int cu2 = umin + umax, cw2 = wmin + wmax;
           int mid = -1, best = 1 << 30;
@@ -342,7 +406,7 @@ void SurfaceTargets::WalkGroups(const Vector3d& uo, const Brick& brick, GroupWal
             if (single) return;
           }
           if (mid_seen) {
-            if (!cone_first && FreeCone(grid_, uo, a, sp == 1, plane, q0, q1)) return seen_group();
+            if (!cone_first && FreeCone(grid_, uo, a, sp == 1, plane, q0, q1, walk.around)) return seen_group();
           } else if (occluder) {
             const SolidBox* cached = cache.Find(*occluder);
             const SolidBox box = cached ? *cached : GrowSolidBox(grid_, *occluder, kGrowLimit);
@@ -482,6 +546,7 @@ struct SurfaceTargets::CornerKind {
   const int* base;
   int8_t facing[3][8];
   std::vector<CornerDecision>& out;
+  const FreeBox& around;
 
   bool Skip(int) const { return false; }
   void Rect(int a, const int b[3], int plane, int, int umin, int umax, int wmin, int wmax, Vector3d& q0, Vector3d& q1,
@@ -548,7 +613,7 @@ struct SurfaceTargets::CornerKind {
     Vector3d q0, q1;
     VoxelIndex klo, khi;
     BackRect(a, sp, plane, umin, umax, wmin, wmax, q0, q1, klo, khi);
-    if (Steep(a, q0, q1) && FreeCone(grid, uo, a, sp == 1, plane, q0, q1)) BackDecided(a, sp, sub, at, true);
+    if (Steep(a, q0, q1) && FreeCone(grid, uo, a, sp == 1, plane, q0, q1, around)) BackDecided(a, sp, sub, at, true);
   }
   void BlockedGroup(int a, int sp, int plane, int umin, int umax, int wmin, int wmax, uint64_t sub, const uint16_t* at,
                     const SolidBox& box) {
@@ -564,7 +629,7 @@ void SurfaceTargets::AppendCornerDecisions(const Vector3d& uo, size_t brick_begi
   for (size_t b = brick_begin; b < brick_end; ++b) {
     const Brick& brick = bricks_[b];
     const int base[3] = {brick.base.x, brick.base.y, brick.base.z};
-    CornerKind kind{grid_, uo, &targets_[brick.begin], base, {}, decisions};
+    CornerKind kind{grid_, uo, &targets_[brick.begin], base, {}, decisions, walk.around};
     FacingTable(uo, base, kind.facing);
     WalkGroups(uo, brick, walk, kind);
   }

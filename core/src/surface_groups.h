@@ -18,8 +18,18 @@ namespace vc::internal {
 // occluders its rays met, and whether the last group decided was seen. After a seen group the
 // free cone is tried before the middle ray, since it usually holds and then spares the ray; after
 // a hidden one the ray comes first. Either order gives the same answers.
+// A box of voxels [lo, hi] (inclusive) that holds no occupied voxel; empty when lo.x > hi.x.
+struct FreeBox {
+  VoxelIndex lo{0, 0, 0}, hi{-1, -1, -1};
+  bool empty() const { return lo.x > hi.x; }
+};
+
+// A free box around the voxel that holds uo, grown greedily (empty if that voxel is occupied).
+FreeBox GrowFreeBox(const OccupancyGrid& grid, const Eigen::Vector3d& uo);
+
 struct GroupWalk {
   OccluderCache cache;
+  FreeBox around;  // a free box around the viewpoint; the free cone skips the part inside it
   bool expect_seen = false;
 };
 
@@ -79,6 +89,6 @@ class SurfaceTargets {
 // plane; the back-corner test passes one a layer beyond it, and still only o's side is tested.
 // Conservative: a false answer proves nothing.
 bool FreeCone(const OccupancyGrid& grid, const Eigen::Vector3d& uo, int axis, bool viewer_above, int plane,
-              const Eigen::Vector3d& q0, const Eigen::Vector3d& q1);
+              const Eigen::Vector3d& q0, const Eigen::Vector3d& q1, const FreeBox& around = FreeBox());
 
 }  // namespace vc::internal

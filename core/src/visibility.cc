@@ -381,6 +381,7 @@ Result<std::vector<VoxelSet>> ComputeVisibilitySets(const VoxelScene& scene, con
       const size_t k = task / brick_chunks, c = task % brick_chunks;
       if (shortcuts[k]) {
         internal::GroupWalk walk;
+        walk.around = internal::GrowFreeBox(g, uo[k]);
         std::vector<uint32_t> seen;
         const size_t b0 = c * bricks_per_task, b1 = std::min<size_t>(b0 + bricks_per_task, targets.brick_count());
         targets.AppendVisible(uo[k], b0, b1, walk, seen);
@@ -623,6 +624,7 @@ Result<Evaluation> Evaluate(const VoxelScene& scene, const std::vector<WorldPoin
     if (grouped) {
       VC_RETURN_IF_ERROR(ParallelChunks(brick_chunks, 1, threads, ctx, [&](uint64_t task, uint64_t, uint64_t) {
         internal::GroupWalk walk;
+        walk.around = internal::GrowFreeBox(g, uo[k]);
         std::vector<internal::SurfaceTargets::CornerDecision> decisions;
         const size_t b0 = task * kBricksPerTask, b1 = std::min<size_t>(b0 + kBricksPerTask, targets.brick_count());
         targets.AppendCornerDecisions(uo[k], b0, b1, walk, decisions);

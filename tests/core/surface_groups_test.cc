@@ -21,6 +21,8 @@ namespace vc {
 namespace {
 
 using Eigen::Vector3d;
+using internal::FreeBox;
+using internal::GrowFreeBox;
 using internal::FreeCone;
 using internal::GrowSolidBox;
 using internal::PassesThroughInterior;
@@ -269,7 +271,7 @@ TEST(FreeConeTest, WhatItProvesFreeIsFreeOnRandomClutter) {
   std::mt19937_64 rng(11);
   std::uniform_int_distribution<int> c(0, 39);
   std::uniform_real_distribution<double> u01(0, 1);
-  int proven = 0, refuted = 0, proven_far = 0, proven_grazing = 0;
+  int proven = 0, refuted = 0, proven_far = 0, proven_grazing = 0, proven_boxed = 0;
   for (int scene = 0; scene < 12; ++scene) {
     const int axis = scene % 3, b1 = (axis + 1) % 3, b2 = (axis + 2) % 3;
     const bool above = (scene / 3) % 2 == 0;  // viewer above a floor, or below a ceiling
@@ -314,7 +316,13 @@ TEST(FreeConeTest, WhatItProvesFreeIsFreeOnRandomClutter) {
       }
       const Vector3d o = at(ou, ow, oh);
       if (s.grid.Occupied(int(std::floor(o.x())), int(std::floor(o.y())), int(std::floor(o.z())))) continue;
-      if (!FreeCone(s.grid, o, axis, above, plane_h + off, q0, q1)) {
+      // Without and with the free box around o, whose part of the cone is then not scanned.
+      const FreeBox around = GrowFreeBox(s.grid, o);
+      ASSERT_FALSE(around.empty());
+      const bool plain = FreeCone(s.grid, o, axis, above, plane_h + off, q0, q1);
+      const bool boxed = FreeCone(s.grid, o, axis, above, plane_h + off, q0, q1, around);
+      proven_boxed += boxed;
+      if (!plain && !boxed) {
         ++refuted;
         continue;
       }
@@ -338,6 +346,53 @@ TEST(FreeConeTest, WhatItProvesFreeIsFreeOnRandomClutter) {
   EXPECT_GT(refuted, 600);
   EXPECT_GT(proven_far, 50);
   EXPECT_GT(proven_grazing, 50);
+  EXPECT_GT(proven_boxed, 600);
+}
+
+// The free box around a viewpoint holds no occupied voxel, and none of its sides can move out by
+// one layer (each stops at an occupied voxel or one voxel beyond the grid).
+TEST(FreeBoxTest, HoldsNoOccupiedVoxelAndNoSideCanGrow) {
+  std::mt19937_64 rng(5);
+  std::uniform_int_distribution<int> c(0, 29);
+  std::uniform_real_distribution<double> u01(0, 30);
+  for (int scene = 0; scene < 6; ++scene) {
+    std::vector<VoxelIndex> v;
+    for (int i = 0; i < 20 + 60 * scene; ++i) v.push_back({c(rng), c(rng), c(rng)});
+    const VoxelScene s = MakeScene(v);
+    const VoxelIndex& gmin = s.grid.min_index();
+    int grown = 0;
+    for (int trial = 0; trial < 40; ++trial) {
+      const Vector3d o(u01(rng), u01(rng), u01(rng));
+      const FreeBox box = GrowFreeBox(s.grid, o);
+      if (s.grid.Occupied(int(std::floor(o.x())), int(std::floor(o.y())), int(std::floor(o.z())))) {
+        EXPECT_TRUE(box.empty());
+        continue;
+      }
+      ASSERT_FALSE(box.empty());
+      EXPECT_TRUE(box.lo.x <= o.x() && o.x() < box.hi.x + 1 && box.lo.y <= o.y() && o.y() < box.hi.y + 1 &&
+                  box.lo.z <= o.z() && o.z() < box.hi.z + 1);
+      for (int z = box.lo.z; z <= box.hi.z; ++z)
+        for (int y = box.lo.y; y <= box.hi.y; ++y)
+          for (int x = box.lo.x; x <= box.hi.x; ++x) ASSERT_FALSE(s.grid.Occupied(x, y, z)) << x << " " << y << " " << z;
+      const int lo[3] = {box.lo.x, box.lo.y, box.lo.z}, hi[3] = {box.hi.x, box.hi.y, box.hi.z};
+      const int glo[3] = {gmin.x - 1, gmin.y - 1, gmin.z - 1};
+      const int ghi[3] = {gmin.x + s.grid.dims()[0], gmin.y + s.grid.dims()[1], gmin.z + s.grid.dims()[2]};
+      for (int side = 0; side < 6; ++side) {
+        const int a = side / 2;
+        const bool up = side % 2;
+        if (up ? hi[a] >= ghi[a] : lo[a] <= glo[a]) continue;  // at the limit (or o beyond it)
+        int l[3] = {lo[0], lo[1], lo[2]}, h[3] = {hi[0], hi[1], hi[2]};
+        l[a] = h[a] = up ? hi[a] + 1 : lo[a] - 1;
+        bool any = false;
+        for (int z = l[2]; z <= h[2]; ++z)
+          for (int y = l[1]; y <= h[1]; ++y)
+            for (int x = l[0]; x <= h[0]; ++x) any = any || s.grid.Occupied(x, y, z);
+        EXPECT_TRUE(any) << "side " << side << " could grow";
+      }
+      grown += (box.hi.x - box.lo.x) * (box.hi.y - box.lo.y) * (box.hi.z - box.lo.z) > 0;
+    }
+    EXPECT_GT(grown, 0);
+  }
 }
 
 TEST(SolidBoxTest, GrowsAcrossAWallAndBlocksSegmentsThroughItsInterior) {
