@@ -96,11 +96,7 @@ inline SolidBox GrowSolidBox(const OccupancyGrid& g, const VoxelIndex& h, int li
         if (std::abs(layer - h3[axis]) > limit) continue;
         int l[3] = {box.lo.x, box.lo.y, box.lo.z}, u[3] = {box.hi.x, box.hi.y, box.hi.z};
         l[axis] = u[axis] = layer;
-        bool full = true;
-        for (int z = l[2]; z <= u[2] && full; ++z)
-          for (int y = l[1]; y <= u[1] && full; ++y)
-            for (int x = l[0]; x <= u[0] && full; ++x) full = g.Occupied(x, y, z);
-        if (full) {
+        if (g.AllOccupied({l[0], l[1], l[2]}, {u[0], u[1], u[2]})) {
           (side == 0 ? *lo[axis] : *hi[axis]) = layer;
           grew = true;
         }

@@ -84,6 +84,36 @@ TEST(OccupancyGridTest, AnyOccupiedAgreesWithVoxelByVoxelOnRandomBoxes) {
   EXPECT_FALSE(g.AnyOccupied({5, 5, 5}, {4, 5, 5}));
 }
 
+// A solid block with scattered holes, so that many boxes are full; boxes inside, across its
+// edges and outside the grid, and crossing brick boundaries.
+TEST(OccupancyGridTest, AllOccupiedAgreesWithVoxelByVoxelOnRandomBoxes) {
+  std::mt19937_64 rng(4);
+  std::uniform_int_distribution<int> c(-17, 17), len(0, 9), hole(-13, 13);
+  std::set<std::tuple<int, int, int>> holes;
+  for (int i = 0; i < 40; ++i) holes.insert({hole(rng), hole(rng), hole(rng)});
+  std::vector<VoxelIndex> v;
+  for (int z = -13; z <= 13; ++z)
+    for (int y = -13; y <= 13; ++y)
+      for (int x = -13; x <= 13; ++x)
+        if (!holes.count({x, y, z})) v.push_back({x, y, z});
+  const OccupancyGrid g = *OccupancyGrid::Build(0.1, v, 1 << 24);
+  int full = 0;
+  for (int trial = 0; trial < 4000; ++trial) {
+    const VoxelIndex lo{c(rng), c(rng), c(rng)};
+    const VoxelIndex hi{lo.x + len(rng), lo.y + len(rng), lo.z + len(rng)};
+    bool want = true;
+    for (int z = lo.z; z <= hi.z && want; ++z)
+      for (int y = lo.y; y <= hi.y && want; ++y)
+        for (int x = lo.x; x <= hi.x && want; ++x) want = g.Occupied(x, y, z);
+    ASSERT_EQ(g.AllOccupied(lo, hi), want) << trial;
+    full += want;
+  }
+  EXPECT_GT(full, 300);
+  EXPECT_LT(full, 3700);
+  EXPECT_TRUE(g.AllOccupied(v[0], v[0]));
+  EXPECT_FALSE(g.AllOccupied({5, 5, 5}, {4, 5, 5}));  // an empty (inverted) box
+}
+
 TEST(OccupancyGridTest, AnyOccupiedWhereVisitsExactlyTheOccupiedVoxelsOfTheBox) {
   std::mt19937_64 rng(5);
   std::uniform_int_distribution<int> c(-20, 20), len(0, 19);

@@ -93,12 +93,21 @@ class OccupancyGrid {
   // Whether any voxel of the box [lo, hi] (inclusive voxel indices) is occupied. Bricks are
   // tested a word (an 8x8 slice) at a time; empty bricks cost one load.
   bool AnyOccupied(const VoxelIndex& lo, const VoxelIndex& hi) const {
-    return ScanBox(lo, hi, [](uint64_t bits, int, int, int) { return bits != 0; });
+    return ScanBox(lo, hi, [](uint64_t bits, uint64_t, int, int, int) { return bits != 0; });
+  }
+  // Whether every voxel of the box [lo, hi] is occupied (false if any of it lies outside the
+  // grid). Tested a word at a time, as AnyOccupied.
+  bool AllOccupied(const VoxelIndex& lo, const VoxelIndex& hi) const {
+    if (lo.x < min_.x || lo.y < min_.y || lo.z < min_.z || hi.x - min_.x >= dims_.x() || hi.y - min_.y >= dims_.y() ||
+        hi.z - min_.z >= dims_.z() || lo.x > hi.x || lo.y > hi.y || lo.z > hi.z) {
+      return false;
+    }
+    return !ScanBox</*kEmptyBricks=*/true>(lo, hi, [](uint64_t bits, uint64_t mask, int, int, int) { return bits != mask; });
   }
   // Whether some occupied voxel v of the box [lo, hi] has pred(v) true. Stops at the first one.
   template <typename Pred>
   bool AnyOccupiedWhere(const VoxelIndex& lo, const VoxelIndex& hi, Pred&& pred) const {
-    return ScanBox(lo, hi, [&](uint64_t bits, int x0, int y0, int z) {
+    return ScanBox(lo, hi, [&](uint64_t bits, uint64_t, int x0, int y0, int z) {
       for (; bits; bits &= bits - 1) {
         const int p = std::countr_zero(bits);
         if (pred(VoxelIndex{x0 + (p & 7), y0 + (p >> 3), z})) return true;
@@ -118,10 +127,12 @@ class OccupancyGrid {
 
  private:
   void ComputeBrickDistances();
-  // Calls fn(bits, x0, y0, z) for each word (an 8x8 slice of a non-empty brick) that meets the
-  // box [lo, hi], with bits cut to the box (bit y*8+x is voxel (x0 + x, y0 + y, z), in index
-  // space); true as soon as fn returns true.
-  template <typename Fn>
+  // Calls fn(bits, mask, x0, y0, z) for each word (an 8x8 slice of a non-empty brick) that meets
+  // the box [lo, hi], with mask the word's bits inside the box and bits the occupied ones among
+  // them (bit y*8+x is voxel (x0 + x, y0 + y, z), in index space); true as soon as fn returns
+  // true. kEmptyBricks: empty bricks are visited too, once each, with bits 0 and the mask of
+  // their first word in the box.
+  template <bool kEmptyBricks = false, typename Fn>
   bool ScanBox(const VoxelIndex& lo, const VoxelIndex& hi, Fn&& fn) const;
 
   double resolution_m_ = 0;
@@ -133,7 +144,7 @@ class OccupancyGrid {
   std::vector<uint64_t> payload_;  // 8 words per non-empty brick: word z, bit (y*8 + x)
 };
 
-template <typename Fn>
+template <bool kEmptyBricks, typename Fn>
 bool OccupancyGrid::ScanBox(const VoxelIndex& lo, const VoxelIndex& hi, Fn&& fn) const {
   const int lo3[3] = {lo.x - min_.x, lo.y - min_.y, lo.z - min_.z};
   const int hi3[3] = {hi.x - min_.x, hi.y - min_.y, hi.z - min_.z};
@@ -152,12 +163,16 @@ bool OccupancyGrid::ScanBox(const VoxelIndex& lo, const VoxelIndex& hi, Fn&& fn)
                             ~((uint64_t{1} << (8 * y0)) - 1);
       for (int bx = r0[0] >> kBrickShift; bx <= r1[0] >> kBrickShift; ++bx) {
         const int32_t slot = bricks_[BrickLinear(uint32_t(bx), uint32_t(by), uint32_t(bz))];
-        if (slot <= 0) continue;
+        if (slot <= 0 && !kEmptyBricks) continue;
         const int x0 = std::max(r0[0] - bx * kBrick, 0), x1 = std::min(r1[0] - bx * kBrick, kBrick - 1);
         const uint64_t mask = rows & (((uint64_t{2} << x1) - (uint64_t{1} << x0)) * 0x0101010101010101ull);
+        if (slot <= 0) {
+          if (fn(uint64_t{0}, mask, min_.x + bx * kBrick, min_.y + by * kBrick, min_.z + bz * kBrick + z0)) return true;
+          continue;
+        }
         const uint64_t* words = BrickBits(slot);
         for (int z = z0; z <= z1; ++z) {
-          if (fn(words[z] & mask, min_.x + bx * kBrick, min_.y + by * kBrick, min_.z + bz * kBrick + z)) return true;
+          if (fn(words[z] & mask, mask, min_.x + bx * kBrick, min_.y + by * kBrick, min_.z + bz * kBrick + z)) return true;
         }
       }
     }
