@@ -492,9 +492,95 @@ struct SurfaceTargets::CentreKind {
   }
 };
 
+namespace {
+
+// The faces that no group decided, one ray each as IsSurfaceVisible casts them, walked in batches
+// by FirstOccupiedBatch. A voxel's faces that face o are tried in axis order, and the next one
+// only when the last was blocked, as there; faces that a cached occluder proves blocked get no
+// ray. The order in which rays are cast changes only what the cache holds, never an answer.
+//
+// The batch walks without the face's own voxel v being transparent. That changes nothing: the
+// segment ends at the face's centre on the plane between v and its free neighbour, so a walk
+// visits v, if at all, as its last voxel (the last step along the face's axis comes at the
+// segment's end and every other axis's last crossing is at least half a voxel before it; see
+// docs/VISIBILITY.md). A batch answer of v is therefore "reached": the answer FirstOccupied gives
+// with v transparent.
+class LeftoverRays {
+ public:
+  LeftoverRays(const OccupancyGrid& grid, const Vector3d& uo, OccluderCache& cache, std::vector<uint32_t>& visible_ids)
+      : grid_(grid), uo_(uo), cache_(cache), visible_ids_(visible_ids) {}
+
+  // Voxel v (target id) with the faces `faces` (bit f: face f, exposed, facing o, not decided)
+  // still to try.
+  void Add(uint32_t id, const VoxelIndex& v, uint8_t faces) {
+    if (Queue({id, v, faces}, pending_) && pending_.size() >= kBatch) Flush();
+  }
+
+  // Casts every queued ray, and the further rays their answers call for.
+  void Flush() {
+    while (!pending_.empty()) {
+      from_.assign(pending_.size(), uo_);
+      to_.resize(pending_.size());
+      hits_.resize(pending_.size());
+      for (size_t i = 0; i < pending_.size(); ++i) to_[i] = Target(pending_[i]);
+      FirstOccupiedBatch(grid_, from_, to_, hits_);
+      next_.clear();
+      for (size_t i = 0; i < pending_.size(); ++i) {
+        Entry& e = pending_[i];
+        const std::optional<VoxelIndex>& hit = hits_[i];
+        if (!hit || *hit == e.v) {
+          visible_ids_.push_back(e.id);
+          continue;
+        }
+        cache_.Add(*hit);
+        e.faces &= uint8_t(e.faces - 1);  // that face is blocked: on to the next
+        Queue(e, next_);
+      }
+      pending_.swap(next_);
+    }
+  }
+
+ private:
+  static constexpr size_t kBatch = 256;
+  struct Entry {
+    uint32_t id;
+    VoxelIndex v;
+    uint8_t faces;  // the lowest bit is the face whose ray is queued
+  };
+
+  Vector3d Target(const Entry& e) const {
+    const int f = std::countr_zero(unsigned(e.faces)), a = f >> 1;
+    Vector3d target(e.v.x + 0.5, e.v.y + 0.5, e.v.z + 0.5);
+    target[a] = At(e.v, a) + (f & 1);
+    return target;
+  }
+
+  // Drops the faces a cached occluder proves blocked, then queues the ray to the first face left.
+  // False if none is left: the voxel is not visible.
+  bool Queue(Entry e, std::vector<Entry>& into) const {
+    for (; e.faces; e.faces &= uint8_t(e.faces - 1)) {
+      if (!cache_.Blocks(uo_, Target(e), e.v)) {
+        into.push_back(e);
+        return true;
+      }
+    }
+    return false;
+  }
+
+  const OccupancyGrid& grid_;
+  const Vector3d& uo_;
+  OccluderCache& cache_;
+  std::vector<uint32_t>& visible_ids_;
+  std::vector<Entry> pending_, next_;
+  std::vector<Vector3d> from_, to_;
+  std::vector<std::optional<VoxelIndex>> hits_;
+};
+
+}  // namespace
+
 void SurfaceTargets::AppendVisible(const Vector3d& uo, size_t brick_begin, size_t brick_end, GroupWalk& walk,
                                    std::vector<uint32_t>& visible_ids) const {
-  OccluderCache& cache = walk.cache;
+  LeftoverRays rays(grid_, uo, walk.cache, visible_ids);
   for (size_t b = brick_begin; b < brick_end; ++b) {
     const Brick& brick = bricks_[b];
     const int base[3] = {brick.base.x, brick.base.y, brick.base.z};
@@ -505,30 +591,23 @@ void SurfaceTargets::AppendVisible(const Vector3d& uo, size_t brick_begin, size_
     std::fill_n(kind.tried.begin(), n, 0);
     WalkGroups(uo, brick, walk, kind);
 
-    // What no group decided: ray by ray, as IsSurfaceVisible.
+    // What no group decided: a ray per face, in batches.
     const Target* t = kind.t;
     for (int j = 0; j < n; ++j) {
-      if (!kind.visible[j]) {
-        const VoxelIndex v = kind.VoxelOf(j);
-        for (int a = 0; a < 3 && !kind.visible[j]; ++a) {
-          const int sp = kind.facing[a][t[j].local[a]];
-          if (sp < 0) continue;
-          const int f = 2 * a + sp;
-          if (!((t[j].exposed >> f) & 1) || ((kind.tried[j] >> f) & 1)) continue;
-          Vector3d target(v.x + 0.5, v.y + 0.5, v.z + 0.5);
-          target[a] = sp ? At(v, a) + 1 : At(v, a);
-          if (cache.Blocks(uo, target, v)) continue;
-          const auto hit = FirstOccupied(grid_, uo, target, &v);
-          if (!hit) {
-            kind.visible[j] = 1;
-          } else {
-            cache.Add(*hit);
-          }
-        }
+      if (kind.visible[j]) {
+        visible_ids.push_back(t[j].id);
+        continue;
       }
-      if (kind.visible[j]) visible_ids.push_back(t[j].id);
+      uint8_t faces = 0;
+      for (int a = 0; a < 3; ++a) {
+        const int sp = kind.facing[a][t[j].local[a]];
+        if (sp >= 0) faces |= uint8_t(1u << (2 * a + sp));
+      }
+      faces &= t[j].exposed & ~kind.tried[j];
+      if (faces) rays.Add(t[j].id, kind.VoxelOf(j), faces);
     }
   }
+  rays.Flush();
 }
 
 // Corner visibility (ALGORITHM.md s.4): rays to lattice corners; a corner counts as seen when the
