@@ -81,24 +81,27 @@ inline bool PassesThroughInterior(const Segment& s, const SolidBox& box) {
 }
 
 // The box of occupied voxels grown greedily from occupied voxel h: each side moves out one
-// layer at a time while the whole new layer is occupied, at most `limit` voxels from h.
+// layer at a time while the whole new layer is occupied, at most `limit` voxels from h. A side
+// whose next layer is not all occupied is never tried again: that layer only grows as the other
+// sides move, so it keeps the free voxel that stopped it.
 inline SolidBox GrowSolidBox(const OccupancyGrid& g, const VoxelIndex& h, int limit) {
   SolidBox box{h, h};
   int* lo[3] = {&box.lo.x, &box.lo.y, &box.lo.z};
   int* hi[3] = {&box.hi.x, &box.hi.y, &box.hi.z};
   const int h3[3] = {h.x, h.y, h.z};
-  bool grew = true;
-  while (grew) {
-    grew = false;
+  unsigned open = 0x3f;  // bit 2 * axis + side: that side may still move
+  while (open) {
     for (int axis = 0; axis < 3; ++axis) {
       for (int side = 0; side < 2; ++side) {
+        const unsigned bit = 1u << (2 * axis + side);
+        if (!(open & bit)) continue;
         const int layer = side == 0 ? *lo[axis] - 1 : *hi[axis] + 1;
-        if (std::abs(layer - h3[axis]) > limit) continue;
         int l[3] = {box.lo.x, box.lo.y, box.lo.z}, u[3] = {box.hi.x, box.hi.y, box.hi.z};
         l[axis] = u[axis] = layer;
-        if (g.AllOccupied({l[0], l[1], l[2]}, {u[0], u[1], u[2]})) {
+        if (std::abs(layer - h3[axis]) > limit || !g.AllOccupied({l[0], l[1], l[2]}, {u[0], u[1], u[2]})) {
+          open &= ~bit;
+        } else {
           (side == 0 ? *lo[axis] : *hi[axis]) = layer;
-          grew = true;
         }
       }
     }
