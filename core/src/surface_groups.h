@@ -14,22 +14,25 @@
 
 namespace vc::internal {
 
-// What a walk over face groups carries from one group to the next, for one viewpoint: the
-// occluders its rays met, and whether the last group decided was seen. After a seen group the
-// free cone is tried before the middle ray, since it usually holds and then spares the ray; after
-// a hidden one the ray comes first. Either order gives the same answers.
 // A box of voxels [lo, hi] (inclusive) that holds no occupied voxel; empty when lo.x > hi.x.
 struct FreeBox {
   VoxelIndex lo{0, 0, 0}, hi{-1, -1, -1};
   bool empty() const { return lo.x > hi.x; }
 };
 
-// A free box around the voxel that holds uo, grown greedily (empty if that voxel is occupied).
+// A free box around the voxel that holds uo: each side pushed out 1, 2, 4, ... (at most 64)
+// layers at a time while the new slab is free, by fewer when it is not, until no side can move
+// by one layer or it is one voxel beyond the grid. Empty if uo is not finite or its voxel is
+// occupied.
 FreeBox GrowFreeBox(const OccupancyGrid& grid, const Eigen::Vector3d& uo);
 
+// What a walk over face groups carries from one group to the next, for one viewpoint: the
+// occluders its rays met, and whether the last group decided was seen. After a seen group the
+// free cone is tried before the middle ray, since it usually holds and then spares the ray; after
+// a hidden one the ray comes first. Either order gives the same answers.
 struct GroupWalk {
   OccluderCache cache;
-  FreeBox around;  // a free box around the viewpoint; the free cone skips the part inside it
+  FreeBox around;  // a free box around the viewpoint (GrowFreeBox), or empty; see FreeCone
   bool expect_seen = false;
 };
 
@@ -87,7 +90,8 @@ class SurfaceTargets {
 // reach of a segment from uo to a point of the rectangle q0..q1 (q0 <= q1 on every axis;
 // viewer_above: uo[axis] > plane, else uo[axis] < plane). The rectangle normally lies on the
 // plane; the back-corner test passes one a layer beyond it, and still only o's side is tested.
-// Conservative: a false answer proves nothing.
+// Conservative: a false answer proves nothing. `around` must hold no occupied voxel (it is
+// trusted): the part of the cone inside it is not scanned.
 bool FreeCone(const OccupancyGrid& grid, const Eigen::Vector3d& uo, int axis, bool viewer_above, int plane,
               const Eigen::Vector3d& q0, const Eigen::Vector3d& q1, const FreeBox& around = FreeBox());
 

@@ -354,7 +354,7 @@ TEST(FreeConeTest, WhatItProvesFreeIsFreeOnRandomClutter) {
 TEST(FreeBoxTest, HoldsNoOccupiedVoxelAndNoSideCanGrow) {
   std::mt19937_64 rng(5);
   std::uniform_int_distribution<int> c(0, 29);
-  std::uniform_real_distribution<double> u01(0, 30);
+  std::uniform_real_distribution<double> u01(-8, 38);  // the scenes span about [0, 30): inside and out
   for (int scene = 0; scene < 6; ++scene) {
     std::vector<VoxelIndex> v;
     for (int i = 0; i < 20 + 60 * scene; ++i) v.push_back({c(rng), c(rng), c(rng)});
@@ -393,6 +393,79 @@ TEST(FreeBoxTest, HoldsNoOccupiedVoxelAndNoSideCanGrow) {
     }
     EXPECT_GT(grown, 0);
   }
+}
+
+// FreeCone trusts the free box it is given: the part of the cone inside it is not scanned. With a
+// box that (wrongly) claims the space around an occluder next to o, a blocked rectangle is
+// "proven" free; with the true box, or none, it is not. So the skip is taken, and the box must be
+// free (GrowFreeBox's is, FreeBoxTest).
+TEST(FreeConeTest, SkipsThePartOfTheConeInsideTheFreeBox) {
+  std::vector<VoxelIndex> v;
+  for (int x = 0; x < 40; ++x)
+    for (int y = 0; y < 40; ++y) v.push_back({x, y, 0});  // a floor, faces up on z = 1
+  v.push_back({20, 20, 28});                             // an occluder just below o
+  const VoxelScene s = MakeScene(v);
+  const Vector3d o(20.5, 20.5, 29.5), q0(18.5, 18.5, 1), q1(22.5, 22.5, 1);
+  EXPECT_FALSE(FreeCone(s.grid, o, 2, true, 1, q0, q1));
+  const FreeBox around = GrowFreeBox(s.grid, o);
+  EXPECT_GT(around.lo.z, 28);  // the true box stops above the occluder
+  EXPECT_FALSE(FreeCone(s.grid, o, 2, true, 1, q0, q1, around));
+  const FreeBox wrong{{0, 0, 10}, {40, 40, 40}};  // holds the occluder
+  EXPECT_TRUE(FreeCone(s.grid, o, 2, true, 1, q0, q1, wrong));
+}
+
+// GrowSolidBox skips a side once its next layer was not all occupied; the old loop tried every
+// side in every round. Both give the same box, here on random dense clutter.
+TEST(SolidBoxTest, SameBoxAsRetryingEverySide) {
+  auto retrying = [](const OccupancyGrid& g, const VoxelIndex& h, int limit) {
+    SolidBox box{h, h};
+    int* lo[3] = {&box.lo.x, &box.lo.y, &box.lo.z};
+    int* hi[3] = {&box.hi.x, &box.hi.y, &box.hi.z};
+    const int h3[3] = {h.x, h.y, h.z};
+    for (bool grew = true; grew;) {
+      grew = false;
+      for (int axis = 0; axis < 3; ++axis)
+        for (int side = 0; side < 2; ++side) {
+          const int layer = side == 0 ? *lo[axis] - 1 : *hi[axis] + 1;
+          if (std::abs(layer - h3[axis]) > limit) continue;
+          int l[3] = {box.lo.x, box.lo.y, box.lo.z}, u[3] = {box.hi.x, box.hi.y, box.hi.z};
+          l[axis] = u[axis] = layer;
+          bool full = true;
+          for (int z = l[2]; z <= u[2] && full; ++z)
+            for (int y = l[1]; y <= u[1] && full; ++y)
+              for (int x = l[0]; x <= u[0] && full; ++x) full = g.Occupied(x, y, z);
+          if (full) {
+            (side == 0 ? *lo[axis] : *hi[axis]) = layer;
+            grew = true;
+          }
+        }
+    }
+    return box;
+  };
+  std::mt19937_64 rng(9);
+  std::uniform_int_distribution<int> c(0, 23);
+  std::uniform_real_distribution<double> u01(0, 1);
+  int large = 0;
+  for (int scene = 0; scene < 4; ++scene) {
+    // Slabs and blocks with random holes, so that boxes stop on every side at different rounds.
+    std::vector<VoxelIndex> v;
+    const double density = 0.9 + 0.025 * scene;
+    for (int z = 0; z < 24; ++z)
+      for (int y = 0; y < 24; ++y)
+        for (int x = 0; x < 24; ++x)
+          if ((scene % 2 == 0 || z % 6 < 3) && u01(rng) < density) v.push_back({x, y, z});
+    const VoxelScene s = MakeScene(v);
+    for (int trial = 0; trial < 200; ++trial) {
+      const VoxelIndex h{c(rng), c(rng), c(rng)};
+      if (!s.grid.Occupied(h)) continue;
+      for (int limit : {2, 8}) {
+        const SolidBox want = retrying(s.grid, h, limit), got = GrowSolidBox(s.grid, h, limit);
+        ASSERT_TRUE(got.lo == want.lo && got.hi == want.hi) << "scene " << scene << " trial " << trial;
+        large += (got.hi.x - got.lo.x) * (got.hi.y - got.lo.y) * (got.hi.z - got.lo.z) >= 8;
+      }
+    }
+  }
+  EXPECT_GT(large, 20);
 }
 
 TEST(SolidBoxTest, GrowsAcrossAWallAndBlocksSegmentsThroughItsInterior) {
