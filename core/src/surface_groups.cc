@@ -63,15 +63,17 @@ uint64_t RectMask(int u0, int u1, int w0, int w1) {
   return row & rows;
 }
 
-// The segments from uo to the 4 corners of the rectangle q0..q1 on plane u[a] = q0[a].
+// The segments from uo to the 4 corners of the rectangle q0..q1 on plane u[a] = q0[a]. The
+// corners share their coordinate along a and, in pairs, each other one, so each distinct
+// component of d and its reciprocal is computed once: the values Segment(uo, corner) holds.
 std::array<Segment, 4> RectSegments(const Vector3d& uo, int a, const Vector3d& q0, const Vector3d& q1) {
   const int b1 = (a + 1) % 3, b2 = (a + 2) % 3;
-  std::array<Segment, 4> segments{Segment(uo, q0), Segment(uo, q0), Segment(uo, q0), Segment(uo, q0)};
+  const Segment first(uo, q0);
+  std::array<Segment, 4> segments{first, first, first, first};
+  const Segment far(uo, q1);  // its b1 and b2 components are those of the other corners
   for (int c = 1; c < 4; ++c) {
-    Vector3d q = q0;
-    if (c & 1) q[b1] = q1[b1];
-    if (c & 2) q[b2] = q1[b2];
-    segments[c] = Segment(uo, q);
+    if (c & 1) segments[c].d[b1] = far.d[b1], segments[c].inv[b1] = far.inv[b1];
+    if (c & 2) segments[c].d[b2] = far.d[b2], segments[c].inv[b2] = far.inv[b2];
   }
   return segments;
 }
