@@ -318,6 +318,26 @@ SurfaceTargets::SurfaceTargets(const OccupancyGrid& grid, const std::vector<Voxe
   if (!bricks_.empty()) bricks_.back().end = uint32_t(targets_.size());
 }
 
+SolidBox SurfaceTargets::GrownBox(const VoxelIndex& h) const {
+  const VoxelIndex& m = grid_.min_index();
+  const uint64_t rx = uint64_t(int64_t(h.x) - m.x), ry = uint64_t(int64_t(h.y) - m.y), rz = uint64_t(int64_t(h.z) - m.z);
+  constexpr uint64_t kField = uint64_t{1} << 21;
+  if (rx >= kField || ry >= kField || rz >= kField) return GrowSolidBox(grid_, h, kGrowLimit);  // not packable
+  const uint64_t key = 1 + (rx | ry << 21 | rz << 42);
+  std::call_once(boxes_allocated_, [&] { boxes_.resize(kBoxSlots); });
+  const size_t slot = size_t((key * 0x9E3779B97F4A7C15ull) >> (64 - 18));
+  static_assert(kBoxSlots == size_t{1} << 18, "the hash takes 18 bits");
+  std::mutex& lock = box_locks_[slot % kBoxShards];
+  {
+    const std::lock_guard<std::mutex> guard(lock);
+    if (boxes_[slot].key == key) return boxes_[slot].box;
+  }
+  const SolidBox box = GrowSolidBox(grid_, h, kGrowLimit);
+  const std::lock_guard<std::mutex> guard(lock);
+  boxes_[slot] = {key, box};
+  return box;
+}
+
 // The walk over a brick's face groups shared by both uses. A face group is one plane of a
 // brick, held as a 64-bit mask over the plane's 8x8 positions p = u * 8 + w (u, w: the local
 // coordinates along the plane's axes b1 = (a+1) % 3 and b2 = (a+2) % 3). `Kind` says which
@@ -411,7 +431,7 @@ void SurfaceTargets::WalkGroups(const Vector3d& uo, const Brick& brick, GroupWal
             if (!cone_first && FreeCone(grid_, uo, a, sp == 1, plane, q0, q1, walk.around)) return seen_group();
           } else if (occluder) {
             const SolidBox* cached = cache.Find(*occluder);
-            const SolidBox box = cached ? *cached : GrowSolidBox(grid_, *occluder, kGrowLimit);
+            const SolidBox box = cached ? *cached : GrownBox(*occluder);
             if (!cached) cache.Add(box);
             if (blocks_all(box)) {
               undecided &= ~sub;

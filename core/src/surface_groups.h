@@ -6,7 +6,9 @@
 // the two on synthetic and real scenes.
 #pragma once
 
+#include <array>
 #include <cstdint>
+#include <mutex>
 #include <vector>
 
 #include "occluders.h"
@@ -81,9 +83,23 @@ class SurfaceTargets {
   template <typename Kind>
   void WalkGroups(const Eigen::Vector3d& uo, const Brick& brick, GroupWalk& walk, Kind& kind) const;
 
+  // GrowSolidBox(grid_, h, kGrowLimit), remembered across viewpoints and threads: a box depends
+  // only on the grid and h, and the same voxels are hit from many viewpoints (on the hall, 2.1 M
+  // growths come from 133k distinct voxels). A direct-mapped table; a slot holds the last box
+  // grown for a voxel that maps to it, and is read and written under its shard's lock.
+  SolidBox GrownBox(const VoxelIndex& h) const;
+
   const OccupancyGrid& grid_;
   std::vector<Target> targets_;
   std::vector<Brick> bricks_;
+  struct BoxSlot {
+    uint64_t key = 0;  // 0: empty; else 1 + the packed relative coordinates of h
+    SolidBox box;
+  };
+  static constexpr size_t kBoxSlots = size_t{1} << 18, kBoxShards = 64;
+  mutable std::once_flag boxes_allocated_;
+  mutable std::vector<BoxSlot> boxes_;
+  mutable std::array<std::mutex, kBoxShards> box_locks_;
 };
 
 // True if no occupied voxel on the viewer's side of the plane u[axis] = plane comes within
