@@ -43,6 +43,14 @@ constexpr double kConeMargin = 1e-4;
 
 int At(const VoxelIndex& v, int axis) { return axis == 0 ? v.x : axis == 1 ? v.y : v.z; }
 
+// The centre of voxel v's face on the plane u[axis] = plane (At(v, axis) or At(v, axis) + 1): the
+// end of the face's ray in surface visibility.
+Vector3d FaceCentre(const VoxelIndex& v, int axis, int plane) {
+  Vector3d c(v.x + 0.5, v.y + 0.5, v.z + 0.5);
+  c[axis] = plane;
+  return c;
+}
+
 // floor(x) as an int, for |x| well inside the int range (index-space coordinates here): cheaper
 // than std::floor without SSE4.1, and exact.
 int FloorInt(double x) {
@@ -316,6 +324,8 @@ SurfaceTargets::SurfaceTargets(const OccupancyGrid& grid, const std::vector<Voxe
     targets_.push_back({keyed[i].second, {uint8_t(lx), uint8_t(ly), uint8_t(lz)}, exposed});
   }
   if (!bricks_.empty()) bricks_.back().end = uint32_t(targets_.size());
+  // A hit voxel is a target's neighbour or a target: about one slot per target, at most 2^18.
+  while (box_bits_ < kMaxBoxBits && (size_t{1} << box_bits_) < targets_.size()) ++box_bits_;
 }
 
 SolidBox SurfaceTargets::GrownBox(const VoxelIndex& h) const {
@@ -324,9 +334,8 @@ SolidBox SurfaceTargets::GrownBox(const VoxelIndex& h) const {
   constexpr uint64_t kField = uint64_t{1} << 21;
   if (rx >= kField || ry >= kField || rz >= kField) return GrowSolidBox(grid_, h, kGrowLimit);  // not packable
   const uint64_t key = 1 + (rx | ry << 21 | rz << 42);
-  std::call_once(boxes_allocated_, [&] { boxes_.resize(kBoxSlots); });
-  const size_t slot = size_t((key * 0x9E3779B97F4A7C15ull) >> (64 - 18));
-  static_assert(kBoxSlots == size_t{1} << 18, "the hash takes 18 bits");
+  std::call_once(boxes_allocated_, [&] { boxes_.resize(size_t{1} << box_bits_); });
+  const size_t slot = size_t((key * 0x9E3779B97F4A7C15ull) >> (64 - box_bits_));
   std::mutex& lock = box_locks_[slot % kBoxShards];
   {
     const std::lock_guard<std::mutex> guard(lock);
@@ -493,8 +502,7 @@ struct SurfaceTargets::CentreKind {
   }
   bool Mid(int j, int a, int, int plane, OccluderCache& cache, std::optional<VoxelIndex>& occluder) {
     const VoxelIndex v = VoxelOf(j);
-    Vector3d target(v.x + 0.5, v.y + 0.5, v.z + 0.5);
-    target[a] = plane;
+    const Vector3d target = FaceCentre(v, a, plane);
     if (cache.Blocks(uo, target, v)) return false;
     occluder = FirstOccupied(grid, uo, target, &v);
     return !occluder;
@@ -572,9 +580,7 @@ class LeftoverRays {
 
   Vector3d Target(const Entry& e) const {
     const int f = std::countr_zero(unsigned(e.faces)), a = f >> 1;
-    Vector3d target(e.v.x + 0.5, e.v.y + 0.5, e.v.z + 0.5);
-    target[a] = At(e.v, a) + (f & 1);
-    return target;
+    return FaceCentre(e.v, a, At(e.v, a) + (f & 1));
   }
 
   // Drops the faces a cached occluder proves blocked, then queues the ray to the first face left.

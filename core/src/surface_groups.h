@@ -85,8 +85,9 @@ class SurfaceTargets {
 
   // GrowSolidBox(grid_, h, kGrowLimit), remembered across viewpoints and threads: a box depends
   // only on the grid and h, and the same voxels are hit from many viewpoints (on the hall, 2.1 M
-  // growths come from 133k distinct voxels). A direct-mapped table; a slot holds the last box
-  // grown for a voxel that maps to it, and is read and written under its shard's lock.
+  // growths come from 133k distinct voxels). A direct-mapped table of 2^box_bits_ slots (about
+  // one per target, at most 2^18: 8 MiB), allocated at the first growth; a slot holds the last
+  // box grown for a voxel that maps to it, and is read and written under its shard's lock.
   SolidBox GrownBox(const VoxelIndex& h) const;
 
   const OccupancyGrid& grid_;
@@ -96,7 +97,9 @@ class SurfaceTargets {
     uint64_t key = 0;  // 0: empty; else 1 + the packed relative coordinates of h
     SolidBox box;
   };
-  static constexpr size_t kBoxSlots = size_t{1} << 18, kBoxShards = 64;
+  static constexpr int kMaxBoxBits = 18;
+  static constexpr size_t kBoxShards = 64;
+  int box_bits_ = 6;
   mutable std::once_flag boxes_allocated_;
   mutable std::vector<BoxSlot> boxes_;
   mutable std::array<std::mutex, kBoxShards> box_locks_;

@@ -622,9 +622,10 @@ Result<Evaluation> Evaluate(const VoxelScene& scene, const std::vector<WorldPoin
     };
     const bool grouped = !options.per_corner && shortcuts[k] && !InsideOccupied(g, uo[k]);
     if (grouped) {
+      const internal::FreeBox around = internal::GrowFreeBox(g, uo[k]);  // once, for every chunk
       VC_RETURN_IF_ERROR(ParallelChunks(brick_chunks, 1, threads, ctx, [&](uint64_t task, uint64_t, uint64_t) {
         internal::GroupWalk walk;
-        walk.around = internal::GrowFreeBox(g, uo[k]);
+        walk.around = around;
         std::vector<internal::SurfaceTargets::CornerDecision> decisions;
         const size_t b0 = task * kBricksPerTask, b1 = std::min<size_t>(b0 + kBricksPerTask, targets.brick_count());
         targets.AppendCornerDecisions(uo[k], b0, b1, walk, decisions);
