@@ -19,14 +19,24 @@
 //   FirstOccupied, whose double parameters are within 10^-9 of exact. A decision closer than the
 //   margin (a near-tie, or an exact one: lattice-point rays have many) is not taken: the segment is
 //   marked and walked by FirstOccupied afterwards.
-// - Near-ties that no lane decision looks at lie strictly inside a free box the lane jumped across.
-//   FirstOccupied does not walk through them either: it jumps across the same box from the same
-//   voxel (walk.h), and where that jump lands depends only on decisions the lane certified.
+// - Near-ties that no lane decision looks at lie strictly inside a free box the lane jumped across
+//   (its exit is certified), so the voxel between the two crossings is in that box, whichever
+//   crossing comes first. FirstOccupied may walk through such a near-tie, or jump across another
+//   box around it (walk.h); either order of the two crossings passes through a free voxel and
+//   leaves the walk in the same voxel after both, so its answer is the lane's.
 // tests/core/ray_batch_test.cc compares every answer with FirstOccupied, near-ties included.
 //
-// A lane whose segment ends (a hit, leaving the grid's box, reaching the end, a near-tie) is
-// refilled with the next segment once kRefillBatch lanes of its group have ended, so lanes do not
-// wait for the slowest of their group.
+// The lanes' control flow depends on the gathers' answers as little as possible, so that the
+// out-of-order core can issue the next voxel's gathers before the last ones have answered (a
+// 16-lane gather takes about 13 ns to answer on the AMD EPYC of docs/BENCHMARKS.md):
+// - Every lane steps in every pass, whatever its voxel held. A lane whose segment ends (a hit,
+//   leaving the grid's box, reaching the end, a near-tie) is marked ended, and a hit's voxel is
+//   stored when it is found; the lane's later steps change nothing it reports. It is refilled with
+//   the next segment once kRefillBatch lanes of its group have ended, so lanes do not wait for the
+//   slowest of their group.
+// - The lanes in empty bricks jump across their free boxes of bricks in one pass of three, all
+//   of them, with no branch on the gathered entries; in the other passes they step, each step one
+//   more certified decision.
 
 #undef HWY_TARGET_INCLUDE
 #define HWY_TARGET_INCLUDE "ray_batch.cc"
@@ -57,12 +67,11 @@ inline constexpr float kMargin = 0x1p-20f;
 // exact in float and the products in int32), or with coordinates beyond +-2^30.
 inline constexpr int kMaxLaneSteps = 1 << 22;
 inline constexpr double kMaxLaneCoordinate = 0x1p30;
-// A lane that enters an empty brick waits (keeps its state) until this many of its group's
-// walking lanes are waiting too, or all of them are, so that one pass of the jump serves many
-// lanes. A group refills its ended lanes once this many have ended (or the segments run out).
-// Measured on the hall (docs/BENCHMARKS.md): 4 or 8 waiting and 1 or 2 ended are alike, 1.1-1.2x
-// over jumping and refilling at once; waiting for all 16 lanes is 3x slower.
-inline constexpr size_t kJumpBatch = 8;
+// Passes in which every lane steps, between two passes in which the lanes in empty bricks jump
+// across their free boxes; then a group refills its ended lanes if this many have ended (or the
+// segments run out). Measured on the hall (docs/BENCHMARKS.md): a jump pass after 2 step passes
+// beats 0, 1 and 3; 2 and 4 ended lanes are alike.
+inline constexpr int kStepPasses = 2;
 inline constexpr size_t kRefillBatch = 2;
 }  // namespace vc::internal
 #endif
@@ -218,8 +227,8 @@ struct GridView {
   const int32_t* payload;
 };
 
-// One vector of lanes, each walking its own segment. A lane whose segment has ended is frozen (its
-// state stays that of its last voxel, so a hit's voxel is still there) until it is refilled.
+// One vector of lanes, each walking its own segment. A lane whose segment has ended goes on stepping
+// until it is refilled; what it reports was recorded when it ended (a hit's voxel in State::h*).
 class LaneGroup {
  public:
   LaneGroup(const GridView& g, Source& src) : g_(g) {
@@ -229,7 +238,9 @@ class LaneGroup {
 
   size_t active() const { return active_; }
 
-  // One voxel per lane: the occupancy test (or the jump across an empty brick), then one step.
+  // One voxel per lane: the occupancy test (and, if kMayJump, the jump of the lanes in empty bricks
+  // across their free boxes), then one step.
+  template <bool kMayJump>
   void Advance();
 
   // Records the answers of the lanes whose segment ended and gives them new segments.
@@ -246,7 +257,7 @@ class LaneGroup {
         src.unsure->push_back(size_t(s_.id[l]));
       } else {
         src.out[s_.id[l]] = (hits & lane) ? std::optional<VoxelIndex>(VoxelIndex{
-                                                s_.x[l] + g_.lo[0], s_.y[l] + g_.lo[1], s_.z[l] + g_.lo[2]})
+                                                s_.hx[l] + g_.lo[0], s_.hy[l] + g_.lo[1], s_.hz[l] + g_.lo[2]})
                                           : std::nullopt;
       }
       --active_;
@@ -261,6 +272,7 @@ class LaneGroup {
     static constexpr size_t kMax = 16;
     alignas(64) int32_t x[kMax], y[kMax], z[kMax], lx[kMax], ly[kMax], lz[kMax];
     alignas(64) int32_t sx[kMax], sy[kMax], sz[kMax], was[kMax], id[kMax];
+    alignas(64) int32_t hx[kMax], hy[kMax], hz[kMax];  // the voxel a lane hit, stored when found
     alignas(64) float dx[kMax], dy[kMax], dz[kMax], ex[kMax], ey[kMax], ez[kMax];
   };
 
@@ -402,6 +414,7 @@ HWY_INLINE MI LaneGroup::JumpAcrossFreeBricks(MI jump, VI entry, const VI rel[3]
   return hn::Or(unsure, hn::And(jump, end_inside));
 }
 
+template <bool kMayJump>
 HWY_INLINE void LaneGroup::Advance() {
   const D d;
   const DI di;
@@ -421,20 +434,21 @@ HWY_INLINE void LaneGroup::Advance() {
                       hn::Add(hn::ShiftLeft<1>(hn::And(rel[2], seven)), hn::ShiftRight<2>(hn::And(rel[1], seven)))));
   const auto word = hn::BitCast(du, hn::GatherIndex(di, g_.payload, word_index));
   const auto bit = hn::BitCast(du, hn::Or(hn::ShiftLeft<3>(hn::And(rel[1], three)), hn::And(rel[0], seven)));
-  hit_ = hn::And(filled, hn::RebindMask(di, hn::Ne(hn::And(hn::operator>>(word, bit), hn::Set(du, 1)), hn::Zero(du))));
-  MI end = hn::Or(hit_, hn::AndNot(inside, was_));
+  // A hit of a lane still walking (an ended lane steps on, but reports what it found then).
+  const MI hit = hn::AndNot(
+      done_, hn::And(filled, hn::RebindMask(di, hn::Ne(hn::And(hn::operator>>(word, bit), hn::Set(du, 1)), hn::Zero(du)))));
+  hn::BlendedStore(x_, hit, di, s_.hx);
+  hn::BlendedStore(y_, hit, di, s_.hy);
+  hn::BlendedStore(z_, hit, di, s_.hz);
+  hit_ = hn::Or(hit_, hit);
+  MI end = hn::Or(hit, hn::AndNot(inside, was_));
   const MI empty = hn::AndNot(done_, hn::AndNot(filled, inside));
-  MI wait = hn::FirstN(di, 0);
-  const size_t waiting = hn::CountTrue(di, empty);
-  if (waiting >= std::min(internal::kJumpBatch, active_ - hn::CountTrue(di, done_))) {
-    end = hn::Or(end, JumpAcrossFreeBricks(empty, slot, rel));
-  } else {
-    wait = empty;
-  }
+  if constexpr (kMayJump) end = hn::Or(end, JumpAcrossFreeBricks(empty, slot, rel));
   done_ = hn::Or(done_, hn::Or(end, hn::Eq(hn::Or(lx_, hn::Or(ly_, lz_)), zero)));
 
-  // ---- One step for the lanes still walking: the axis whose crossing comes first, if no other
-  // comes within the margin (else the lane is unsure and ends).
+  // ---- One step for every lane: the axis whose crossing comes first. A lane still walking where
+  // another axis comes within the margin is unsure and ends. Ended lanes step too (their steps
+  // decide nothing), so the next voxel does not wait for this voxel's gathers.
   // Each axis's next crossing. An axis with no crossing left gives the one after its last, beyond
   // the segment's end (t >= 1, and every crossing left lies in [0, 1]), so it is never taken:
   // either another axis comes first by the margin, or the lane is unsure.
@@ -443,13 +457,12 @@ HWY_INLINE void LaneGroup::Advance() {
   const VF first = hn::Min(tx, hn::Min(ty, tz));
   const VF near = hn::Add(first, hn::Set(d, internal::kMargin));
   const auto nx = hn::Le(tx, near), ny = hn::Le(ty, near), nz = hn::Le(tz, near);
-  const MI still = hn::Or(done_, wait);
-  const MI tie = hn::AndNot(still, hn::RebindMask(di, hn::Or(hn::And(nx, ny), hn::Or(hn::And(nx, nz), hn::And(ny, nz)))));
+  const MI tie = hn::AndNot(done_, hn::RebindMask(di, hn::Or(hn::And(nx, ny), hn::Or(hn::And(nx, nz), hn::And(ny, nz)))));
   unsure_ = hn::Or(unsure_, tie);
   done_ = hn::Or(done_, tie);
-  const MI mz = hn::AndNot(still, hn::AndNot(tie, hn::RebindMask(di, hn::Eq(tz, first))));
-  const MI my = hn::AndNot(still, hn::AndNot(tie, hn::RebindMask(di, hn::Eq(ty, first))));
-  const MI mx = hn::AndNot(still, hn::AndNot(tie, hn::RebindMask(di, hn::Eq(tx, first))));
+  const MI mz = hn::RebindMask(di, hn::Eq(tz, first));
+  const MI my = hn::RebindMask(di, hn::Eq(ty, first));
+  const MI mx = hn::RebindMask(di, hn::Eq(tx, first));
   z_ = hn::IfThenElse(mz, hn::Add(z_, sz_), z_);
   y_ = hn::IfThenElse(my, hn::Add(y_, sy_), y_);
   x_ = hn::IfThenElse(mx, hn::Add(x_, sx_), x_);
@@ -474,11 +487,16 @@ int64_t FirstOccupiedBatchImpl(const OccupancyGrid& grid, const Eigen::Vector3d*
   HWY_ASSERT(hn::Lanes(D()) <= 16);
   const GridView view(grid);
   Source src{a, b, count, 0, out, unsure, view.lo, {}};
-  // Two independent groups, so that one group's gathers overlap the other's arithmetic.
+  // Two independent groups, so that one group's gathers overlap the other's arithmetic; the lanes
+  // in empty bricks jump in one pass of kStepPasses + 1 (see the top of this file).
   LaneGroup g0(view, src), g1(view, src);
   while (g0.active() + g1.active() > 0) {
-    g0.Advance();
-    g1.Advance();
+    for (int pass = 0; pass < internal::kStepPasses; ++pass) {
+      g0.Advance<false>();
+      g1.Advance<false>();
+    }
+    g0.Advance<true>();
+    g1.Advance<true>();
     g0.RefillIfEnded(src);
     g1.RefillIfEnded(src);
   }
