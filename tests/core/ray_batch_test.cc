@@ -221,6 +221,36 @@ TEST(FirstOccupiedBatchTest, ExactTiesAndOversizedSegmentsAreLeftToFirstOccupied
   hwy::SetSupportedTargetsForTest(0);
 }
 
+// Lanes step through empty bricks too (they jump across them only in some passes), and every such
+// step is a certified decision like any other: an exact tie met in an empty brick must go to
+// FirstOccupied even when the lane's next voxels are free. Here each segment runs diagonally
+// through voxel corners (x and y cross together at every step) out of an empty brick, whose
+// corner voxel (7,7) is followed, by FirstOccupied's tie rule (y before x), by (7,8), occupied. A
+// lane that stepped both axes at once, as it would if it did not treat the tie as one, would skip
+// (7,8) and hit (8,8) instead.
+TEST(FirstOccupiedBatchTest, TiesMetInEmptyBricksAreLeftToFirstOccupied) {
+  const std::vector<VoxelIndex> occ = {{7, 8, 0}, {8, 8, 0}, {20, 0, 0}};  // brick (0,0,0) is empty
+  auto grid = OccupancyGrid::Build(0.1, occ, 1 << 24);
+  ASSERT_TRUE(grid.ok());
+  ASSERT_EQ(grid->BrickSlot(grid->BrickLinear(0, 0, 0)), 0u);
+  Segments s;
+  for (int k = 1; k <= 6; ++k) s.Add({8.0 - k, 8.0 - k, 0.5}, {16.0, 16.0, 0.5});
+  for (size_t i = 0; i < s.a.size(); ++i) {
+    ASSERT_EQ(FirstOccupied(*grid, s.a[i], s.b[i]), (VoxelIndex{7, 8, 0})) << "segment " << i;
+  }
+  for (int64_t target : hwy::SupportedAndGeneratedTargets()) {
+    hwy::SetSupportedTargetsForTest(target);
+    std::vector<std::optional<VoxelIndex>> got(s.a.size());
+    size_t rechecked = 0;
+    FirstOccupiedBatch(*grid, s.a, s.b, got, BatchKernel::kLanes, &rechecked);
+    for (size_t i = 0; i < got.size(); ++i) {
+      EXPECT_EQ(got[i], (VoxelIndex{7, 8, 0})) << hwy::TargetName(target) << ", segment " << i;
+    }
+    EXPECT_EQ(rechecked, got.size()) << hwy::TargetName(target);
+  }
+  hwy::SetSupportedTargetsForTest(0);
+}
+
 // The lanes set segments up in double lanes, a chunk of 128 at a time: every batch size around a
 // vector's and a chunk's length gives FirstOccupied's answers, and a segment whose crossing
 // parameters do not fit a float (an axis crossed once over a length of 2^-130 voxels) is left to
