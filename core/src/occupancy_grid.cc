@@ -124,6 +124,66 @@ void OccupancyGrid::ComputeBrickDistances() {
   for (size_t i = 0; i < d.size(); ++i) {
     if (d[i] > 0) bricks_[i] = -std::min(d[i], kCap);
   }
+  ComputeFreeExtents();
+}
+
+void OccupancyGrid::ComputeFreeExtents() {
+  const int nx = bdims_.x(), ny = bdims_.y(), nz = bdims_.z();
+  // Counts of non-empty bricks in any box of bricks, from a 3-D prefix sum (a transient table of
+  // one uint32 per brick, skipped on grids too large for it: their boxes stay cubes).
+  const uint64_t px = uint64_t(nx) + 1, py = uint64_t(ny) + 1, pz = uint64_t(nz) + 1;
+  if (px * py * pz > kMaxExtentTable) return;
+  std::vector<uint32_t> sum(px * py * pz, 0);
+  auto at = [&](int x, int y, int z) -> uint32_t& { return sum[(uint64_t(z) * py + uint64_t(y)) * px + uint64_t(x)]; };
+  for (int z = 0; z < nz; ++z)
+    for (int y = 0; y < ny; ++y)
+      for (int x = 0; x < nx; ++x) {
+        at(x + 1, y + 1, z + 1) = uint32_t(bricks_[BrickLinear(x, y, z)] > 0) + at(x, y + 1, z + 1) + at(x + 1, y, z + 1) +
+                                  at(x + 1, y + 1, z) - at(x, y, z + 1) - at(x, y + 1, z) - at(x + 1, y, z) + at(x, y, z);
+      }
+  const int n[3] = {nx, ny, nz};
+  // Whether the box of bricks [lo, hi] holds no non-empty brick (bricks outside the grid are empty).
+  auto free = [&](const int lo[3], const int hi[3]) {
+    int a[3], b[3];
+    for (int i = 0; i < 3; ++i) {
+      a[i] = std::max(lo[i], 0), b[i] = std::min(hi[i], n[i] - 1);
+      if (a[i] > b[i]) return true;
+    }
+    const uint32_t count = at(b[0] + 1, b[1] + 1, b[2] + 1) - at(a[0], b[1] + 1, b[2] + 1) - at(b[0] + 1, a[1], b[2] + 1) -
+                           at(b[0] + 1, b[1] + 1, a[2]) + at(a[0], a[1], b[2] + 1) + at(a[0], b[1] + 1, a[2]) +
+                           at(b[0] + 1, a[1], a[2]) - at(a[0], a[1], a[2]);
+    return count == 0;
+  };
+  for (int z = 0; z < nz; ++z)
+    for (int y = 0; y < ny; ++y)
+      for (int x = 0; x < nx; ++x) {
+        int32_t& entry = bricks_[BrickLinear(x, y, z)];
+        if (entry >= 0) continue;  // non-empty
+        const int k = -entry - 1;  // the cube of bricks within k is free
+        int lo[3] = {x - k, y - k, z - k}, hi[3] = {x + k, y + k, z + k};
+        int extra[6] = {0, 0, 0, 0, 0, 0};
+        bool open[6] = {true, true, true, true, true, true};
+        // One layer at a time, round the six sides, while the layer is free.
+        for (bool grew = true; grew;) {
+          grew = false;
+          for (int side = 0; side < 6; ++side) {
+            if (!open[side]) continue;
+            const int axis = side / 2;
+            int llo[3] = {lo[0], lo[1], lo[2]}, lhi[3] = {hi[0], hi[1], hi[2]};
+            llo[axis] = lhi[axis] = side % 2 == 0 ? hi[axis] + 1 : lo[axis] - 1;
+            if (!free(llo, lhi)) {
+              open[side] = false;
+              continue;
+            }
+            (side % 2 == 0 ? hi[axis] : lo[axis]) = llo[axis];
+            grew = true;
+            if (++extra[side] == kMaxExtra) open[side] = false;
+          }
+        }
+        int32_t code = -entry;
+        for (int side = 0; side < 6; ++side) code |= extra[side] << (kExtraShift + kExtraBits * side);
+        entry = -code;
+      }
 }
 
 uint64_t OccupancyGrid::memory_bytes() const {

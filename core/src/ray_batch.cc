@@ -354,7 +354,8 @@ HWY_INLINE MI LaneGroup::JumpAcrossFreeBricks(MI jump, VI entry, const VI rel[3]
   const DI di;
   const VI zero = hn::Zero(di), one = hn::Set(di, 1);
   const VF inf = hn::Set(d, internal::kInf), margin = hn::Set(d, internal::kMargin);
-  const VI k = hn::Sub(hn::Neg(entry), one);  // the brick's distance - 1
+  const VI code = hn::Neg(entry);  // distance | extra layers << kExtraShift (occupancy_grid.h)
+  const VI k = hn::Sub(hn::And(code, hn::Set(di, 0xff)), one);  // the brick's distance - 1
   VI* cur[3] = {&x_, &y_, &z_};
   VI* left[3] = {&lx_, &ly_, &lz_};
   const VI step[3] = {sx_, sy_, sz_};
@@ -362,18 +363,22 @@ HWY_INLINE MI LaneGroup::JumpAcrossFreeBricks(MI jump, VI entry, const VI rel[3]
   MI end_inside = hn::Eq(zero, zero);
   VI ste[3];
   VF exit_t[3];  // parameter at which each axis leaves the box (inf if the walk ends first)
-  const VI k8 = hn::ShiftLeft<OccupancyGrid::kBrickShift>(k), seven = hn::Set(di, OccupancyGrid::kBrick - 1);
+  const VI seven = hn::Set(di, OccupancyGrid::kBrick - 1), max_extra = hn::Set(di, OccupancyGrid::kMaxExtra);
   for (int i = 0; i < 3; ++i) {
-    // In coordinates relative to the grid: the box spans bricks brick_i - k .. brick_i + k, so the
-    // walk's last voxel is in it iff its brick is within k of brick_i, and the steps to the box's
-    // face are 8k plus those to the brick's face.
+    // In coordinates relative to the grid: the box spans bricks brick_i - lo .. brick_i + hi, with
+    // lo and hi the cube's k plus the extra layers on the side of -axis i and +axis i. So the
+    // walk's last voxel is in it iff its brick is, and the steps to the box's face are 8 per brick
+    // beyond this one plus those to this brick's face.
+    const VI hi = hn::Add(k, hn::And(hn::ShiftRightSame(code, OccupancyGrid::kExtraShift + OccupancyGrid::kExtraBits * 2 * i), max_extra));
+    const VI lo = hn::Add(k, hn::And(hn::ShiftRightSame(code, OccupancyGrid::kExtraShift + OccupancyGrid::kExtraBits * (2 * i + 1)), max_extra));
     const VI brick_i = hn::ShiftRight<OccupancyGrid::kBrickShift>(rel[i]);
     const MI pos = hn::Gt(step[i], zero);
     const VI end_rel = hn::Add(rel[i], hn::IfThenElse(pos, *left[i], hn::Neg(*left[i])));  // left = 0 if no step
-    end_inside = hn::And(end_inside,
-                         hn::Lt(hn::Abs(hn::Sub(hn::ShiftRight<OccupancyGrid::kBrickShift>(end_rel), brick_i)), hn::Add(k, one)));
+    const VI end_off = hn::Sub(hn::ShiftRight<OccupancyGrid::kBrickShift>(end_rel), brick_i);  // in bricks
+    end_inside = hn::And(end_inside, hn::And(hn::Gt(hn::Add(end_off, lo), hn::Set(di, -1)), hn::Gt(hn::Add(hi, one), end_off)));
     const VI in_brick = hn::And(rel[i], seven);
-    ste[i] = hn::Add(k8, hn::IfThenElse(pos, hn::Sub(seven, in_brick), in_brick));
+    ste[i] = hn::IfThenElse(pos, hn::Add(hn::ShiftLeft<OccupancyGrid::kBrickShift>(hi), hn::Sub(seven, in_brick)),
+                            hn::Add(hn::ShiftLeft<OccupancyGrid::kBrickShift>(lo), in_brick));
     const MI leaves = hn::Gt(*left[i], ste[i]);
     exit_t[i] = hn::IfThenElse(hn::RebindMask(d, leaves), Crossing(hn::Sub(hn::Sub(*left[i], one), ste[i]), delta[i], last[i]),
                                inf);

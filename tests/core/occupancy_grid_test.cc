@@ -59,6 +59,56 @@ TEST(OccupancyGridTest, BrickDistancesAreTheExactChessboardDistanceBetweenBricks
   EXPECT_GT(max_seen, 3);
 }
 
+// Each empty brick's free box (the cube of its distance, widened by ExtraBricks layers a side)
+// holds no non-empty brick, and every side that stopped short of kMaxExtra stopped at a layer
+// that holds one: the boxes are free and cannot grow on any side.
+TEST(OccupancyGridTest, FreeBoxesAreFreeAndStopOnlyAtANonEmptyLayer) {
+  std::mt19937_64 rng(11);
+  std::uniform_int_distribution<int> c(0, 150);
+  std::vector<VoxelIndex> occ;
+  for (int x = 0; x <= 150; ++x)
+    for (int y = 0; y <= 100; ++y) occ.push_back({x, y, 0});  // a floor
+  for (int i = 0; i < 25; ++i) occ.push_back({c(rng), c(rng) * 2 / 3, c(rng) / 4});
+  auto g = OccupancyGrid::Build(0.1, occ, 1 << 24);
+  ASSERT_TRUE(g.ok());
+  const Eigen::Vector3i bd = g->brick_dims();
+  auto box_has_brick = [&](const int lo[3], const int hi[3]) {
+    for (int z = std::max(lo[2], 0); z <= std::min(hi[2], bd.z() - 1); ++z)
+      for (int y = std::max(lo[1], 0); y <= std::min(hi[1], bd.y() - 1); ++y)
+        for (int x = std::max(lo[0], 0); x <= std::min(hi[0], bd.x() - 1); ++x)
+          if (g->BrickOccupied(x, y, z)) return true;
+    return false;
+  };
+  int widened = 0, empty = 0;
+  for (int bz = 0; bz < bd.z(); ++bz)
+    for (int by = 0; by < bd.y(); ++by)
+      for (int bx = 0; bx < bd.x(); ++bx) {
+        const uint64_t b = g->BrickLinear(bx, by, bz);
+        if (g->BrickOccupied(bx, by, bz)) {
+          for (int side = 0; side < 6; ++side) ASSERT_EQ(g->ExtraBricks(b, side), 0);
+          continue;
+        }
+        ++empty;
+        const int k = g->BrickDistance(b) - 1, at[3] = {bx, by, bz};
+        int lo[3], hi[3];
+        for (int i = 0; i < 3; ++i) {
+          lo[i] = at[i] - k - g->ExtraBricks(b, 2 * i + 1);
+          hi[i] = at[i] + k + g->ExtraBricks(b, 2 * i);
+        }
+        ASSERT_FALSE(box_has_brick(lo, hi)) << "brick " << bx << "," << by << "," << bz;
+        for (int side = 0; side < 6; ++side) {
+          widened += g->ExtraBricks(b, side) > 0;
+          if (g->ExtraBricks(b, side) == OccupancyGrid::kMaxExtra) continue;
+          int llo[3] = {lo[0], lo[1], lo[2]}, lhi[3] = {hi[0], hi[1], hi[2]};
+          const int axis = side / 2;
+          llo[axis] = lhi[axis] = side % 2 == 0 ? hi[axis] + 1 : lo[axis] - 1;
+          EXPECT_TRUE(box_has_brick(llo, lhi)) << "brick " << bx << "," << by << "," << bz << " could grow on side " << side;
+        }
+      }
+  EXPECT_GT(empty, 100);
+  EXPECT_GT(widened, empty);  // most boxes above the floor widen along it
+}
+
 TEST(OccupancyGridTest, AnyOccupiedAgreesWithVoxelByVoxelOnRandomBoxes) {
   std::mt19937_64 rng(3);
   std::uniform_int_distribution<int> c(-20, 20), len(0, 19);

@@ -6,7 +6,9 @@
 // among the non-empty bricks); an empty brick's entry is, negated, its Chebyshev distance in bricks
 // to the nearest non-empty brick (capped at 255), for empty-space skipping: a ray in a brick at
 // distance k may jump across the (2k-1)^3-brick box around it untested. One load thus tells a ray
-// both whether to test bits and how far it may jump.
+// both whether to test bits and how far it may jump. The entry's higher bits widen that cube, side
+// by side, into a larger free box (ExtraBricks; used by the SIMD kernel, ray_batch.cc): a ray
+// along a floor or a wall jumps far along it, not just as far as the surface is near.
 // (A per-voxel distance field was tried and removed: its byte per voxel of the box falls out of
 // cache, and traversal was 1.2-2x slower in wall time than with these brick distances.) It answers "is voxel (x,y,z) occupied" exactly as the octree at resolution r does
 // (ALGORITHM.md section 1); anything outside the box is free. Memory is computed and checked
@@ -59,11 +61,21 @@ class OccupancyGrid {
   // Payload slot of a brick (0 = empty) and its distance to the nearest non-empty brick (0 for a
   // non-empty brick).
   uint32_t BrickSlot(uint64_t brick) const { return uint32_t(std::max(bricks_[brick], 0)); }
-  uint8_t BrickDistance(uint64_t brick) const { return uint8_t(std::max(-bricks_[brick], 0)); }
+  uint8_t BrickDistance(uint64_t brick) const { return uint8_t(std::max(-bricks_[brick], 0) & 0xff); }
+  // An empty brick's free box: the cube of bricks within BrickDistance - 1 of it, widened by
+  // ExtraBricks(brick, side) more layers of bricks on each side (side 2i: +axis i, 2i+1: -axis i),
+  // each 0..kMaxExtra; every brick in it is empty or outside the grid. The entry holds minus
+  // (distance | extras << kExtraShift), kExtraBits an extra. ExtraBricks is 0 for a non-empty
+  // brick. FirstOccupied jumps across the cube only (walk.h), so its answers, tie-breaks included,
+  // do not depend on the extras; the SIMD kernel uses the whole box (docs/VISIBILITY.md).
+  static constexpr int kExtraShift = 8, kExtraBits = 3, kMaxExtra = (1 << kExtraBits) - 1;
+  int ExtraBricks(uint64_t brick, int side) const {
+    return (std::max(-bricks_[brick], 0) >> (kExtraShift + kExtraBits * side)) & kMaxExtra;
+  }
   // The 8 words of a non-empty brick's bits (word z, bit y*8+x).
   const uint64_t* BrickBits(uint32_t slot) const { return &payload_[uint64_t(slot - 1) * kBrick]; }
   // Raw arrays for vectorised kernels: brick_count() entries, each the slot if positive, else
-  // minus the distance.
+  // minus (the distance | the extra layers << kExtraShift).
   uint64_t brick_count() const { return bricks_.size(); }
   const int32_t* brick_entries() const { return bricks_.data(); }
   const uint64_t* payload() const { return payload_.data(); }
@@ -127,6 +139,11 @@ class OccupancyGrid {
 
  private:
   void ComputeBrickDistances();
+  // The extra layers of each empty brick's free box (ExtraBricks), grown greedily one layer a side
+  // at a time, round the six sides, while the layer holds no non-empty brick. Skipped (boxes stay
+  // cubes) when its transient prefix-sum table would exceed kMaxExtentTable entries.
+  void ComputeFreeExtents();
+  static constexpr uint64_t kMaxExtentTable = uint64_t{1} << 24;
   // Calls fn(bits, mask, x0, y0, z) for each word (an 8x8 slice of a non-empty brick) that meets
   // the box [lo, hi], with mask the word's bits inside the box and bits the occupied ones among
   // them (bit y*8+x is voxel (x0 + x, y0 + y, z), in index space); true as soon as fn returns
