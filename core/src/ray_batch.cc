@@ -34,7 +34,7 @@
 //   stored when it is found; the lane's later steps change nothing it reports. It is refilled with
 //   the next segment once kRefillBatch lanes of its group have ended, so lanes do not wait for the
 //   slowest of their group.
-// - The lanes in empty bricks jump across their free boxes of bricks in one pass of three, all
+// - The lanes in empty bricks jump across their free boxes of bricks in one pass of five, all
 //   of them, with no branch on the gathered entries; in the other passes they step, each step one
 //   more certified decision.
 
@@ -69,9 +69,10 @@ inline constexpr int kMaxLaneSteps = 1 << 22;
 inline constexpr double kMaxLaneCoordinate = 0x1p30;
 // Passes in which every lane steps, between two passes in which the lanes in empty bricks jump
 // across their free boxes; then a group refills its ended lanes if this many have ended (or the
-// segments run out). Measured on the hall (docs/BENCHMARKS.md): a jump pass after 2 step passes
-// beats 0, 1 and 3; 2 and 4 ended lanes are alike.
-inline constexpr int kStepPasses = 2;
+// segments run out). Measured on the hall and geb079 with the widened free boxes
+// (docs/BENCHMARKS.md): a jump pass after 3, 4 or 5 step passes beats 0, 1 and 2 (4 kept); 2 and
+// 4 ended lanes are alike.
+inline constexpr int kStepPasses = 4;
 inline constexpr size_t kRefillBatch = 2;
 }  // namespace vc::internal
 #endif
