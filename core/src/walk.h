@@ -115,15 +115,16 @@ inline bool JumpAcrossBox(const int box_lo[3], const int box_hi[3], Walk& w) {
   return true;
 }
 
-// The free box of bricks around an empty brick (brick distance k: bricks within k-1 are empty).
+// The free box of bricks around an empty brick: the bricks within its distance - 1, widened on
+// each side by the grid's extra layers (OccupancyGrid::ExtraBricks), as the SIMD kernel's jump.
 inline bool JumpAcrossFreeBrickBox(const OccupancyGrid& grid, uint64_t brick, const uint32_t rel[3], const int lo3[3],
                             Walk& w) {
   const int k = grid.BrickDistance(brick) - 1;
   int box_lo[3], box_hi[3];
   for (int i = 0; i < 3; ++i) {
     const int brick_i = int(rel[i] >> OccupancyGrid::kBrickShift);
-    box_lo[i] = lo3[i] + (brick_i - k) * OccupancyGrid::kBrick;
-    box_hi[i] = lo3[i] + (brick_i + k + 1) * OccupancyGrid::kBrick - 1;
+    box_lo[i] = lo3[i] + (brick_i - k - grid.ExtraBricks(brick, 2 * i + 1)) * OccupancyGrid::kBrick;
+    box_hi[i] = lo3[i] + (brick_i + k + grid.ExtraBricks(brick, 2 * i) + 1) * OccupancyGrid::kBrick - 1;
   }
   return JumpAcrossBox(box_lo, box_hi, w);
 }

@@ -7,8 +7,8 @@
 // to the nearest non-empty brick (capped at 255), for empty-space skipping: a ray in a brick at
 // distance k may jump across the (2k-1)^3-brick box around it untested. One load thus tells a ray
 // both whether to test bits and how far it may jump. The entry's higher bits widen that cube, side
-// by side, into a larger free box (ExtraBricks; used by the SIMD kernel, ray_batch.cc): a ray
-// along a floor or a wall jumps far along it, not just as far as the surface is near.
+// by side, into a larger free box (ExtraBricks), which the rays jump across: a ray along a floor
+// or a wall jumps far along it, not just as far as the surface is near.
 // (A per-voxel distance field was tried and removed: its byte per voxel of the box falls out of
 // cache, and traversal was 1.2-2x slower in wall time than with these brick distances.) It answers "is voxel (x,y,z) occupied" exactly as the octree at resolution r does
 // (ALGORITHM.md section 1); anything outside the box is free. Memory is computed and checked
@@ -66,8 +66,7 @@ class OccupancyGrid {
   // ExtraBricks(brick, side) more layers of bricks on each side (side 2i: +axis i, 2i+1: -axis i),
   // each 0..kMaxExtra; every brick in it is empty or outside the grid. The entry holds minus
   // (distance | extras << kExtraShift), kExtraBits an extra. ExtraBricks is 0 for a non-empty
-  // brick. FirstOccupied jumps across the cube only (walk.h), so its answers, tie-breaks included,
-  // do not depend on the extras; the SIMD kernel uses the whole box (docs/VISIBILITY.md).
+  // brick. FirstOccupied (walk.h) and the SIMD kernel (ray_batch.cc) jump across the whole box.
   static constexpr int kExtraShift = 8, kExtraBits = 3, kMaxExtra = (1 << kExtraBits) - 1;
   int ExtraBricks(uint64_t brick, int side) const {
     return (std::max(-bricks_[brick], 0) >> (kExtraShift + kExtraBits * side)) & kMaxExtra;
