@@ -89,6 +89,7 @@ Result<OccupancyGrid> OccupancyGrid::Build(double resolution_m, const std::vecto
     g.payload_[uint64_t(slot - 1) * kBrick + (rz & 7)] |= uint64_t{1} << (((ry & 7) << 3) | (rx & 7));
   }
   g.ComputeBrickDistances();
+  g.ComputeFreeExtents();  // reads the distances
   return g;
 }
 
@@ -124,7 +125,6 @@ void OccupancyGrid::ComputeBrickDistances() {
   for (size_t i = 0; i < d.size(); ++i) {
     if (d[i] > 0) bricks_[i] = -std::min(d[i], kCap);
   }
-  ComputeFreeExtents();
 }
 
 void OccupancyGrid::ComputeFreeExtents() {

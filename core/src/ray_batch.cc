@@ -201,9 +201,9 @@ struct Source {
   }
 };
 
-// The grid as the kernel reads it: the brick entries (slot, or minus the distance) and the payload
-// as 32-bit words (word 2w + h of a brick holds rows y = 4h..4h+3 of its 64-bit word w; x86 is
-// little-endian).
+// The grid as the kernel reads it: the brick entries (slot, or minus the distance and the free
+// box's extra layers; OccupancyGrid::ExtraBricks) and the payload as 32-bit words (word 2w + h of
+// a brick holds rows y = 4h..4h+3 of its 64-bit word w; x86 is little-endian).
 struct GridView {
   explicit GridView(const OccupancyGrid& grid)
       : lo{grid.min_index().x, grid.min_index().y, grid.min_index().z},
