@@ -4,6 +4,7 @@
 #include <string>
 #include <utility>
 
+#include "huge_pages.h"
 #include "parallel.h"
 
 namespace vc::planner {
@@ -132,7 +133,7 @@ Result<ReductionRun> RunReduction(int num_stations, uint64_t faces_total, const 
   const bool use_cache = static_cast<uint64_t>(num_stations) * faces_total * sizeof(float) <=
                          options.cache_budget_bytes;
   std::vector<std::vector<float>> cache(use_cache ? num_stations : 0);
-  std::vector<FaceTop3> top3(faces_total);
+  std::vector<FaceTop3> top3 = internal::FilledOnHugePages(faces_total, FaceTop3{});
 
   // Streams every active station's values into a fresh top-3 table.
   auto build = [&](const std::vector<int>& stations, double progress_from, double progress_to) -> Status {

@@ -18,6 +18,7 @@
 #include <mutex>
 #include <random>
 
+#include "huge_pages.h"
 #include "occluders.h"
 #include "parallel.h"
 #include "surface_groups.h"
@@ -579,10 +580,14 @@ Result<Evaluation> Evaluate(const VoxelScene& scene, const std::vector<WorldPoin
       if (FaceInSet(g, index[i], Face(f), options.faces)) faces_in_set[i] |= uint8_t(1u << f);
     }
   }
-  // Sized here, in the calling thread, like every large allocation of this mode: running out of
-  // memory must not happen in a worker thread.
+  // Allocated here, in the calling thread, like every large allocation of this mode: running out
+  // of memory must not happen in a worker thread. Each viewpoint's values are filled by the
+  // thread that evaluates it (huge_pages.h: first touch is the costly part).
   if (options.keep_per_viewpoint_values) {
-    ev.per_viewpoint_face_values.assign(nv, std::vector<float>(n * kFacesPerVoxel, 0.0f));
+    ev.per_viewpoint_face_values.resize(nv);
+    for (std::vector<float>& values : ev.per_viewpoint_face_values) {
+      internal::ReserveOnHugePages(values, n * kFacesPerVoxel);
+    }
   }
   constexpr uint64_t kCornerChunk = 64 * 256;
   constexpr uint64_t kVoxelChunk = 4096;
@@ -597,8 +602,11 @@ Result<Evaluation> Evaluate(const VoxelScene& scene, const std::vector<WorldPoin
   // hand, and the best V (and its perception) of each face over the viewpoints evaluated so far.
   struct Work {
     Work(size_t corner_words, size_t slots, size_t voxel_chunks)
-        : visible_bits(corner_words), decided_bits(corner_words), tallies(voxel_chunks), best(slots, 0.0),
-          best_p(slots, 0) {}
+        : visible_bits(corner_words),
+          decided_bits(corner_words),
+          tallies(voxel_chunks),
+          best(internal::FilledOnHugePages(slots, 0.0)),
+          best_p(internal::FilledOnHugePages(slots, uint8_t{0})) {}
     std::vector<uint64_t> visible_bits, decided_bits;
     std::vector<Tally> tallies;  // per chunk of voxels, for the viewpoint at hand
     std::vector<double> best;
@@ -656,6 +664,7 @@ Result<Evaluation> Evaluate(const VoxelScene& scene, const std::vector<WorldPoin
     std::vector<Tally>& tallies = w.tallies;
     std::fill(tallies.begin(), tallies.end(), Tally{});
     std::vector<float>* keep = options.keep_per_viewpoint_values ? &ev.per_viewpoint_face_values[k] : nullptr;
+    if (keep) keep->resize(n * kFacesPerVoxel);  // zeros, in the capacity reserved above
     VC_RETURN_IF_ERROR(ParallelChunks(n, kVoxelChunk, threads, ctx, [&](uint64_t chunk, uint64_t b, uint64_t e) {
       Tally& t = tallies[chunk];
       for (uint64_t i = b; i < e; ++i) {
