@@ -207,7 +207,7 @@ FreeBox GrowFreeBox(const OccupancyGrid& grid, const Vector3d& uo) {
 }
 
 bool FreeCone(const OccupancyGrid& grid, const Vector3d& uo, int axis, bool viewer_above, int plane,
-              const Vector3d& q0, const Vector3d& q1, const FreeBox& around) {
+              const Vector3d& q0, const Vector3d& q1, const FreeBox& around, double from, double* failed_at) {
   double len = 0;
   for (int i = 0; i < 3; ++i) len = std::max({len, std::abs(q0[i] - uo[i]), std::abs(q1[i] - uo[i])});
   if (!(len > 0)) return false;
@@ -229,31 +229,37 @@ bool FreeCone(const OccupancyGrid& grid, const Vector3d& uo, int axis, bool view
       hi[axis] = std::min(hi[axis], plane - 1);
     }
   };
-  std::optional<ConeSides> sides;
-  double s0 = 0;
-  if (!around.empty()) {
-    // The part of the cone from o to parameter s lies inside the free box around o while its
-    // box does; the largest such s is solved for, then checked with the pieces' own rounding.
-    const int flo[3] = {around.lo.x, around.lo.y, around.lo.z};
-    const int fhi[3] = {around.hi.x, around.hi.y, around.hi.z};
-    double s = 1;
+  // The largest s >= s0 for which the piece from s0 to s lies inside the free box [flo, fhi]
+  // (so needs no test), or s0 if there is none. The box's bound is solved for, on the sides the
+  // cone leaves it by, then checked with the pieces' own rounding.
+  auto free_until = [&](double s0, const int flo[3], const int fhi[3]) {
+    double s = 1 / 0.999;
     for (int i = 0; i < 3; ++i) {
       if (q0[i] < uo[i]) s = std::min(s, (uo[i] - kConeMargin - flo[i]) / (uo[i] - q0[i]));
       if (q1[i] > uo[i]) s = std::min(s, (fhi[i] + 1 - kConeMargin - uo[i]) / (q1[i] - uo[i]));
     }
-    s *= 0.999;
-    if (s > 0) {
-      int lo[3], hi[3];
-      piece(0, s, lo, hi);
-      bool inside = true;
-      for (int i = 0; i < 3; ++i) inside = inside && lo[i] >= flo[i] && hi[i] <= fhi[i];
-      if (inside) s0 = s;
-    }
+    s = std::min(1.0, 0.999 * s);
+    if (!(s > s0)) return s0;
+    int lo[3], hi[3];
+    piece(s0, s, lo, hi);
+    for (int i = 0; i < 3; ++i)
+      if (lo[i] < flo[i] || hi[i] > fhi[i]) return s0;
+    return s;
+  };
+  std::optional<ConeSides> sides;
+  double s0 = std::max(0.0, from);
+  if (!around.empty()) {
+    // The part of the cone near o lies inside the free box around o.
+    const int flo[3] = {around.lo.x, around.lo.y, around.lo.z};
+    const int fhi[3] = {around.hi.x, around.hi.y, around.hi.z};
+    s0 = std::max(s0, free_until(0, flo, fhi));
   }
   while (s0 < 1) {
     int lo[3], hi[3];
-    // Empty-space skipping: a brick at distance k >= 2 from every non-empty brick sits in a free
-    // box of bricks reaching k - 1 bricks out; a piece whose box lies inside it needs no test.
+    // Empty-space skipping: an empty brick lies in a free box of bricks (the cube within its
+    // distance - 1, widened by its extra layers, as the walks jump across); a piece whose box
+    // lies inside it needs no test. A jump shorter than a voxel is not taken, which bounds the
+    // number of pieces by the cone's length.
     const Vector3d c = uo + s0 * (0.5 * (q0 + q1) - uo);
     int rel[3];
     bool in_grid = true;
@@ -262,17 +268,17 @@ bool FreeCone(const OccupancyGrid& grid, const Vector3d& uo, int axis, bool view
       in_grid = in_grid && rel[i] >= 0 && rel[i] < grid.dims()[i];
     }
     if (in_grid) {
-      const int k = grid.BrickDistance(grid.BrickLinear(uint32_t(rel[0]) >> 3, uint32_t(rel[1]) >> 3, uint32_t(rel[2]) >> 3)) - 1;
-      if (k >= 1) {
-        const double s1 = std::min(1.0, s0 + k * OccupancyGrid::kBrick / len);
-        piece(s0, s1, lo, hi);
-        bool inside = true;
+      const uint64_t brick = grid.BrickLinear(uint32_t(rel[0]) >> 3, uint32_t(rel[1]) >> 3, uint32_t(rel[2]) >> 3);
+      const int k = grid.BrickDistance(brick) - 1;
+      if (k >= 0) {
+        int flo[3], fhi[3];
         for (int i = 0; i < 3; ++i) {
-          const int free_lo = gmin3[i] + ((rel[i] >> 3) - k) * OccupancyGrid::kBrick;
-          const int free_hi = gmin3[i] + ((rel[i] >> 3) + k + 1) * OccupancyGrid::kBrick - 1;
-          inside = inside && lo[i] >= free_lo && hi[i] <= free_hi;
+          const int b = rel[i] >> OccupancyGrid::kBrickShift;
+          flo[i] = gmin3[i] + (b - k - grid.ExtraBricks(brick, 2 * i + 1)) * OccupancyGrid::kBrick;
+          fhi[i] = gmin3[i] + (b + k + grid.ExtraBricks(brick, 2 * i) + 1) * OccupancyGrid::kBrick - 1;
         }
-        if (inside) {
+        const double s1 = free_until(s0, flo, fhi);
+        if (s1 - s0 >= 1 / len) {
           s0 = s1;
           continue;
         }
@@ -286,6 +292,7 @@ bool FreeCone(const OccupancyGrid& grid, const Vector3d& uo, int axis, bool view
           if (!sides) sides.emplace(uo, axis, q0, q1);
           return !sides->Excludes(v);
         })) {
+      if (failed_at) *failed_at = s0;
       return false;
     }
     s0 = s1;
@@ -390,7 +397,9 @@ void SurfaceTargets::WalkGroups(const Vector3d& uo, const Brick& brick, GroupWal
         const int voxel_a = base[a] + layer;
         const int plane = sp ? voxel_a + 1 : voxel_a;
         // Decides the undecided faces inside the local rectangle [u0,u1] x [w0,w1].
-        auto decide = [&](auto&& self, int u0, int u1, int w0, int w1) -> void {
+        // cone_from: the cone parameter up to which an enclosing rectangle's cone test found no
+        // occupied voxel that counts; the rectangle's own cone, a part of that one, is free there too.
+        auto decide = [&](auto&& self, int u0, int u1, int w0, int w1, double cone_from) -> void {
           const uint64_t sub = undecided & RectMask(u0, u1, w0, w1);
           if (sub == 0) return;
           const int umin = std::countr_zero(sub) >> 3, umax = (63 - std::countl_zero(sub)) >> 3;
@@ -419,7 +428,9 @@ void SurfaceTargets::WalkGroups(const Vector3d& uo, const Brick& brick, GroupWal
             kind.SeenGroup(a, sp, plane, umin, umax, wmin, wmax, sub, at);
           };
           const bool cone_first = !single && walk.expect_seen;
-          if (cone_first && FreeCone(grid_, uo, a, sp == 1, plane, q0, q1, walk.around)) return seen_group();
+          if (cone_first && FreeCone(grid_, uo, a, sp == 1, plane, q0, q1, walk.around, cone_from, &cone_from)) {
+            return seen_group();
+          }
           // One exact ray to the face nearest the rectangle's middle.
           const int cu2 = umin + umax, cw2 = wmin + wmax;
           int mid = -1, best = 1 << 30;
@@ -437,7 +448,9 @@ void SurfaceTargets::WalkGroups(const Vector3d& uo, const Brick& brick, GroupWal
             if (single) return;
           }
           if (mid_seen) {
-            if (!cone_first && FreeCone(grid_, uo, a, sp == 1, plane, q0, q1, walk.around)) return seen_group();
+            if (!cone_first && FreeCone(grid_, uo, a, sp == 1, plane, q0, q1, walk.around, cone_from, &cone_from)) {
+              return seen_group();
+            }
           } else if (occluder) {
             const SolidBox* cached = cache.Find(*occluder);
             const SolidBox box = cached ? *cached : GrownBox(*occluder);
@@ -450,12 +463,12 @@ void SurfaceTargets::WalkGroups(const Vector3d& uo, const Brick& brick, GroupWal
           }
           if (single || !MoreThan(sub, kMinSplit)) return;
           const int um = (u0 + u1) / 2, wm = (w0 + w1) / 2;
-          self(self, u0, um, w0, wm);
-          if (um < u1) self(self, um + 1, u1, w0, wm);
-          if (wm < w1) self(self, u0, um, wm + 1, w1);
-          if (um < u1 && wm < w1) self(self, um + 1, u1, wm + 1, w1);
+          self(self, u0, um, w0, wm, cone_from);
+          if (um < u1) self(self, um + 1, u1, w0, wm, cone_from);
+          if (wm < w1) self(self, u0, um, wm + 1, w1, cone_from);
+          if (um < u1 && wm < w1) self(self, um + 1, u1, wm + 1, w1, cone_from);
         };
-        decide(decide, 0, 7, 0, 7);
+        decide(decide, 0, 7, 0, 7, 0.0);
         kind.Decided(a, sp, members[a][sp][layer] & ~undecided, seen, at);
       }
     }

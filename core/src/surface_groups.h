@@ -110,8 +110,13 @@ class SurfaceTargets {
 // viewer_above: uo[axis] > plane, else uo[axis] < plane). The rectangle normally lies on the
 // plane; the back-corner test passes one a layer beyond it, and still only o's side is tested.
 // Conservative: a false answer proves nothing. `around` must hold no occupied voxel (it is
-// trusted): the part of the cone inside it is not scanned.
+// trusted): the part of the cone inside it is not scanned. The cone is o + s (q - o), s in
+// [0, 1], q in the rectangle; its part with s < from is trusted to be free too (a caller passes
+// what an earlier call, on a rectangle holding this one, reported). On a false answer,
+// *failed_at (if given) receives an s >= from below which the cone holds no occupied voxel
+// that counts, nor does the cone of any rectangle inside this one.
 bool FreeCone(const OccupancyGrid& grid, const Eigen::Vector3d& uo, int axis, bool viewer_above, int plane,
-              const Eigen::Vector3d& q0, const Eigen::Vector3d& q1, const FreeBox& around = FreeBox());
+              const Eigen::Vector3d& q0, const Eigen::Vector3d& q1, const FreeBox& around = FreeBox(),
+              double from = 0, double* failed_at = nullptr);
 
 }  // namespace vc::internal
