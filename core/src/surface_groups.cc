@@ -37,7 +37,7 @@ namespace {
 using Eigen::Vector3d;
 
 constexpr int kMinSplit = 4;      // groups this small are not split further
-constexpr int kGrowLimit = 8;     // how far a solid occluder box grows from the voxel hit
+constexpr int kGrowLimit = 32;    // how far a solid occluder box grows from the voxel hit (8-64 measured: 32)
 constexpr double kConeStep = 8;   // length (voxels) of each box of the cone's cover (8 measured best of 2-32)
 constexpr double kConeMargin = 1e-4;
 
