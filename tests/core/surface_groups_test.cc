@@ -349,6 +349,77 @@ TEST(FreeConeTest, WhatItProvesFreeIsFreeOnRandomClutter) {
   EXPECT_GT(proven_boxed, 600);
 }
 
+// A refuted rectangle reports where its cone test failed; the parts it is split into (as the
+// group walk splits them) may start their own cone tests there. Whatever such a test proves free
+// is free: no walk from o to a point of the part meets an occupied voxel on o's side. Reporting
+// the end of the failing piece instead fails this test (and 5 others). At the time of writing:
+// 2,387 rectangles refuted (1,287 past the cone's middle), 1,720 parts proven, 7,828 refuted.
+TEST(FreeConeTest, PartsOfARefutedRectangleMayStartWhereItFailed) {
+  std::mt19937_64 rng(29);
+  std::uniform_int_distribution<int> c(0, 39);
+  std::uniform_real_distribution<double> u01(0, 1);
+  int refuted = 0, parts_proven = 0, parts_refuted = 0, late_failures = 0;
+  for (int scene = 0; scene < 6; ++scene) {
+    const int axis = scene % 3;
+    const bool above = scene < 3;
+    std::vector<VoxelIndex> v;
+    auto add = [&](int u, int w, int h) {
+      VoxelIndex g;
+      (axis == 0 ? g.y : axis == 1 ? g.z : g.x) = u;
+      (axis == 0 ? g.z : axis == 1 ? g.x : g.y) = w;
+      (axis == 0 ? g.x : axis == 1 ? g.y : g.z) = h;
+      v.push_back(g);
+    };
+    for (int u = 0; u < 40; ++u)
+      for (int w = 0; w < 40; ++w) add(u, w, 0);
+    // Clutter, most of it low over the plane, where the cones of neighbouring faces part.
+    for (int i = 0; i < 150; ++i) add(c(rng), c(rng), (above ? 1 : -1) * (1 + c(rng) % (i % 3 ? 3 : 12)));
+    const VoxelScene s = MakeScene(v);
+    const int plane = above ? 1 : 0;
+    const int b1 = (axis + 1) % 3, b2 = (axis + 2) % 3;
+    for (int trial = 0; trial < 400; ++trial) {
+      const int u0 = c(rng) % 32, w0 = c(rng) % 32;
+      Vector3d q0, q1, o;
+      q0[axis] = q1[axis] = plane;
+      q0[b1] = u0 + 0.5, q1[b1] = u0 + 7.5;
+      q0[b2] = w0 + 0.5, q1[b2] = w0 + 7.5;
+      o[b1] = 40 * u01(rng), o[b2] = 40 * u01(rng), o[axis] = plane + (above ? 1 : -1) * (2 + 28 * u01(rng));
+      if (s.grid.Occupied(int(std::floor(o.x())), int(std::floor(o.y())), int(std::floor(o.z())))) continue;
+      const FreeBox around = trial % 2 ? GrowFreeBox(s.grid, o) : FreeBox();
+      double failed_at = -1;
+      if (FreeCone(s.grid, o, axis, above, plane, q0, q1, around, 0, &failed_at)) continue;
+      ++refuted;
+      ASSERT_GE(failed_at, 0);
+      ASSERT_LT(failed_at, 1);
+      late_failures += failed_at > 0.5;
+      for (int part = 0; part < 4; ++part) {
+        Vector3d p0 = q0, p1 = q1;
+        (part & 1 ? p0 : p1)[b1] = u0 + (part & 1 ? 4.5 : 3.5);
+        (part & 2 ? p0 : p1)[b2] = w0 + (part & 2 ? 4.5 : 3.5);
+        if (!FreeCone(s.grid, o, axis, above, plane, p0, p1, around, failed_at)) {
+          ++parts_refuted;
+          continue;
+        }
+        ++parts_proven;
+        for (int k = 0; k < 30; ++k) {
+          const double fu = k < 4 ? (k & 1) : u01(rng), fw = k < 4 ? (k >> 1) : u01(rng);
+          Vector3d q = p0;
+          q[b1] += fu * (p1[b1] - p0[b1]);
+          q[b2] += fw * (p1[b2] - p0[b2]);
+          const auto hit = FirstOccupied(s.grid, o, q);
+          const int hit_h = hit ? (axis == 0 ? hit->x : axis == 1 ? hit->y : hit->z) : 0;
+          ASSERT_TRUE(!hit || (above ? hit_h < plane : hit_h >= plane))
+              << "scene " << scene << " trial " << trial << " part " << part << " point " << k;
+        }
+      }
+    }
+  }
+  EXPECT_GT(refuted, 800);
+  EXPECT_GT(late_failures, 200);
+  EXPECT_GT(parts_proven, 400);
+  EXPECT_GT(parts_refuted, 800);
+}
+
 // The free box around a viewpoint holds no occupied voxel, and none of its sides can move out by
 // one layer (each stops at an occupied voxel or one voxel beyond the grid).
 TEST(FreeBoxTest, HoldsNoOccupiedVoxelAndNoSideCanGrow) {
