@@ -550,8 +550,8 @@ namespace {
 // with v transparent.
 class LeftoverRays {
  public:
-  LeftoverRays(const OccupancyGrid& grid, const Vector3d& uo, OccluderCache& cache, std::vector<uint32_t>& visible_ids)
-      : grid_(grid), uo_(uo), cache_(cache), visible_ids_(visible_ids) {}
+  LeftoverRays(const OccupancyGrid& grid, const Vector3d& uo, OccluderCache& cache, const BitWriter& visible)
+      : grid_(grid), uo_(uo), cache_(cache), visible_(visible) {}
 
   // Voxel v (target id) with the faces `faces` (bit f: face f, exposed, facing o, not decided)
   // still to try.
@@ -572,7 +572,7 @@ class LeftoverRays {
         Entry& e = pending_[i];
         const std::optional<VoxelIndex>& hit = hits_[i];
         if (!hit || *hit == e.v) {
-          visible_ids_.push_back(e.id);
+          visible_.Set(e.id);
           continue;
         }
         cache_.Add(*hit);
@@ -611,7 +611,7 @@ class LeftoverRays {
   const OccupancyGrid& grid_;
   const Vector3d& uo_;
   OccluderCache& cache_;
-  std::vector<uint32_t>& visible_ids_;
+  const BitWriter& visible_;
   std::vector<Entry> pending_, next_;
   std::vector<Vector3d> from_, to_;
   std::vector<std::optional<VoxelIndex>> hits_;
@@ -620,8 +620,8 @@ class LeftoverRays {
 }  // namespace
 
 void SurfaceTargets::AppendVisible(const Vector3d& uo, size_t brick_begin, size_t brick_end, GroupWalk& walk,
-                                   std::vector<uint32_t>& visible_ids) const {
-  LeftoverRays rays(grid_, uo, walk.cache, visible_ids);
+                                   const BitWriter& visible) const {
+  LeftoverRays rays(grid_, uo, walk.cache, visible);
   for (size_t b = brick_begin; b < brick_end; ++b) {
     const Brick& brick = bricks_[b];
     const int base[3] = {brick.base.x, brick.base.y, brick.base.z};
@@ -636,7 +636,7 @@ void SurfaceTargets::AppendVisible(const Vector3d& uo, size_t brick_begin, size_
     const Target* t = kind.t;
     for (int j = 0; j < n; ++j) {
       if (kind.visible[j]) {
-        visible_ids.push_back(t[j].id);
+        visible.Set(t[j].id);
         continue;
       }
       uint8_t faces = 0;

@@ -7,6 +7,7 @@
 #pragma once
 
 #include <array>
+#include <atomic>
 #include <cstdint>
 #include <mutex>
 #include <vector>
@@ -38,6 +39,24 @@ struct GroupWalk {
   bool expect_seen = false;
 };
 
+// Where AppendVisible records the voxels it finds visible: bit `id` of `words`. When other tasks
+// may set bits of the same words at the same time (`shared`), bits are set atomically; the join
+// of the parallel loop orders them before any read.
+struct BitWriter {
+  uint64_t* words = nullptr;
+  bool shared = false;
+  void Set(uint32_t id) const {
+    const uint64_t bit = uint64_t{1} << (id & 63);
+    if (!shared) {
+      words[id >> 6] |= bit;
+      return;
+    }
+    std::atomic_ref<uint64_t> word(words[id >> 6]);
+    // A plain load first skips the locked instruction when the bit is set already.
+    if (!(word.load(std::memory_order_relaxed) & bit)) word.fetch_or(bit, std::memory_order_relaxed);
+  }
+};
+
 class SurfaceTargets {
  public:
   // The voxels `ids` (positions in `index`) that have at least one exposed face, brick by brick.
@@ -54,12 +73,12 @@ class SurfaceTargets {
     bool seen;
   };
 
-  // Appends to `visible` the id of every target in bricks [brick_begin, brick_end) that is
+  // Sets in `visible` the bit of every target in bricks [brick_begin, brick_end) that is
   // surface-visible from uo (index space; uo must not lie in an occupied voxel, and
   // ShortcutsHold(grid, uo) must be true). `walk` carries state between calls for the same
   // viewpoint.
   void AppendVisible(const Eigen::Vector3d& uo, size_t brick_begin, size_t brick_end, GroupWalk& walk,
-                     std::vector<uint32_t>& visible) const;
+                     const BitWriter& visible) const;
 
   // Appends corner-visibility decisions (ALGORITHM.md s.4, the 8-voxel corner rule) that groups
   // of faces facing uo in bricks [brick_begin, brick_end) prove; corners not mentioned are

@@ -74,16 +74,6 @@ bool InsideOccupied(const OccupancyGrid& g, const Vector3d& u) {
   return g.Occupied(int(std::floor(u.x())), int(std::floor(u.y())), int(std::floor(u.z())));
 }
 
-// Sets bit i of a bitset that other tasks may be setting bits of at the same time (the join of
-// the parallel loop orders it before any read).
-void SetBitConcurrently(std::vector<uint64_t>& words, uint64_t i) {
-  std::atomic_ref<uint64_t> word(words[i >> 6]);
-  const uint64_t bit = uint64_t{1} << (i & 63);
-  // A corner is often decided many times (it is shared by up to 24 faces): a plain load skips
-  // the locked instruction when the bit is set already.
-  if (!(word.load(std::memory_order_relaxed) & bit)) word.fetch_or(bit, std::memory_order_relaxed);
-}
-
 bool CompatibleCached(const OccupancyGrid& g, const Vector3d& uo, const VoxelIndex& v, OccluderCache& cache) {
   const Vector3d target(v.x + 0.5, v.y + 0.5, v.z + 0.5);
   if (cache.Blocks(uo, target, v)) return false;
@@ -383,14 +373,8 @@ Result<std::vector<VoxelSet>> ComputeVisibilitySets(const VoxelScene& scene, con
       if (shortcuts[k]) {
         internal::GroupWalk walk;
         walk.around = internal::GrowFreeBox(g, uo[k]);
-        std::vector<uint32_t> seen;
         const size_t b0 = c * bricks_per_task, b1 = std::min<size_t>(b0 + bricks_per_task, targets.brick_count());
-        targets.AppendVisible(uo[k], b0, b1, walk, seen);
-        if (brick_chunks == 1) {
-          for (uint32_t id : seen) sets[k].set(id);
-        } else {
-          for (uint32_t id : seen) SetBitConcurrently(sets[k].words(), id);
-        }
+        targets.AppendVisible(uo[k], b0, b1, walk, {sets[k].words().data(), brick_chunks > 1});
       }
       progress.Add(1);
     });
@@ -621,13 +605,9 @@ Result<Evaluation> Evaluate(const VoxelScene& scene, const std::vector<WorldPoin
     // workers, tasks share words of the bitsets, so the group pass sets bits atomically.
     std::fill(w.visible_bits.begin(), w.visible_bits.end(), 0);
     std::fill(w.decided_bits.begin(), w.decided_bits.end(), 0);
-    auto set_bit = [shared](std::vector<uint64_t>& words, uint32_t c) {
-      if (shared) {
-        SetBitConcurrently(words, c);
-      } else {
-        words[c >> 6] |= uint64_t{1} << (c & 63);
-      }
-    };
+    // A corner is often decided many times (it is shared by up to 24 faces), so BitWriter's
+    // plain load before the atomic one pays.
+    const internal::BitWriter decided_out{w.decided_bits.data(), shared}, visible_out{w.visible_bits.data(), shared};
     const bool grouped = !options.per_corner && shortcuts[k] && !InsideOccupied(g, uo[k]);
     if (grouped) {
       const internal::FreeBox around = internal::GrowFreeBox(g, uo[k]);  // once, for every chunk
@@ -640,8 +620,8 @@ Result<Evaluation> Evaluate(const VoxelScene& scene, const std::vector<WorldPoin
         for (const auto& d : decisions) {
           auto apply = [&](int q) {
             const uint32_t c = voxel_corners[d.id][q];
-            set_bit(w.decided_bits, c);
-            if (d.seen) set_bit(w.visible_bits, c);
+            decided_out.Set(c);
+            if (d.seen) visible_out.Set(c);
           };
           if (d.face == 0xff) {
             apply(d.corner);
