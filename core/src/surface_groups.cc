@@ -97,6 +97,21 @@ bool BlocksRect(const SolidBox& box, const std::array<Segment, 4>& corners, cons
   return true;
 }
 
+// True if the box holds none of the voxels [lo, hi] and the segments from uo to the 8 corners of
+// their bounding box all pass through its interior. Then every segment from uo to a point of
+// that bounding box does, as BlocksRect argues for a rectangle (the end points q for which
+// [uo, q] meets a convex body form a convex set). So the walk to a face centre there (a face
+// facing uo, whose own voxel the walk visits, if at all, last) meets an occupied voxel of the
+// box first: the face is hidden.
+bool Shadows(const SolidBox& box, const Vector3d& uo, const VoxelIndex& lo, const VoxelIndex& hi) {
+  if (box.Overlaps(lo, hi)) return false;
+  for (int c = 0; c < 8; ++c) {
+    const Vector3d q(c & 1 ? hi.x + 1 : lo.x, c & 2 ? hi.y + 1 : lo.y, c & 4 ? hi.z + 1 : lo.z);
+    if (!PassesThroughInterior(Segment(uo, q), box)) return false;
+  }
+  return true;
+}
+
 // The 4 side planes of the pyramid from uo to the rectangle q0..q1 on plane u[axis] = q0[axis],
 // each through uo and one edge of the rectangle. The box cover in FreeCone holds more than the
 // pyramid; a voxel of the cover that lies wholly outside one side plane, by more than the cone's
@@ -329,6 +344,11 @@ SurfaceTargets::SurfaceTargets(const OccupancyGrid& grid, const std::vector<Voxe
       bricks_.push_back({{v.x - lx, v.y - ly, v.z - lz}, at, at});
     }
     targets_.push_back({keyed[i].second, {uint8_t(lx), uint8_t(ly), uint8_t(lz)}, exposed});
+    Brick& brick = bricks_.back();
+    for (int a = 0; a < 3; ++a) {
+      brick.lo[a] = std::min(brick.lo[a], targets_.back().local[a]);
+      brick.hi[a] = std::max(brick.hi[a], targets_.back().local[a]);
+    }
   }
   if (!bricks_.empty()) bricks_.back().end = uint32_t(targets_.size());
   // A hit voxel is a target's neighbour or a target: about one slot per target, at most 2^18.
@@ -626,6 +646,11 @@ void SurfaceTargets::AppendVisible(const Vector3d& uo, size_t brick_begin, size_
     const Brick& brick = bricks_[b];
     const int base[3] = {brick.base.x, brick.base.y, brick.base.z};
     const int n = int(brick.end - brick.begin);
+    // A brick whose targets all lie in the shadow of a cached solid box has no visible voxel
+    // (Shadows): every face centre of a target lies in their bounding box.
+    const VoxelIndex lo{base[0] + brick.lo[0], base[1] + brick.lo[1], base[2] + brick.lo[2]};
+    const VoxelIndex hi{base[0] + brick.hi[0], base[1] + brick.hi[1], base[2] + brick.hi[2]};
+    if (walk.cache.FindIf([&](const SolidBox& box) { return Shadows(box, uo, lo, hi); })) continue;
     CentreKind kind{grid_, uo, &targets_[brick.begin], base, {}, {}, {}};
     FacingTable(uo, base, kind.facing);
     std::fill_n(kind.visible.begin(), n, 0);

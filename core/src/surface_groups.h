@@ -95,6 +95,7 @@ class SurfaceTargets {
   struct Brick {
     VoxelIndex base;  // smallest voxel index of the brick
     uint32_t begin, end;
+    uint8_t lo[3] = {7, 7, 7}, hi[3] = {0, 0, 0};  // bounding box of its targets, local coordinates
   };
 
   struct CentreKind;
