@@ -110,7 +110,9 @@ inline SolidBox GrowSolidBox(const OccupancyGrid& g, const VoxelIndex& h, int li
 }
 
 // A small cache of occluders recently hit by rays from one viewpoint. Targets are processed in
-// spatially coherent order, so neighbouring targets usually share their occluder.
+// spatially coherent order, so neighbouring targets usually share their occluder. Kept in
+// order of last use: a box that proves something moves to the front, where the next search
+// starts, and a new box replaces the least recently used one.
 class OccluderCache {
  public:
   // A disabled cache proves nothing and keeps nothing: for viewpoints where !ShortcutsHold.
@@ -120,36 +122,34 @@ class OccluderCache {
   // True if segment a->b provably passes through a cached occluder that contains no voxel of the
   // box [keep_lo, keep_hi] (the voxels that may be transparent for this segment).
   bool Blocks(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const VoxelIndex& keep_lo,
-              const VoxelIndex& keep_hi) const {
+              const VoxelIndex& keep_hi) {
     if (count_ == 0 || !enabled_) return false;
     const Segment seg(a, b);
-    for (int i = 0; i < count_; ++i) {
-      const SolidBox& box = boxes_[i];
-      if (!box.Overlaps(keep_lo, keep_hi) && PassesThroughInterior(seg, box)) return true;
-    }
-    return false;
+    return FindIf([&](const SolidBox& box) { return !box.Overlaps(keep_lo, keep_hi) && PassesThroughInterior(seg, box); });
   }
-  bool Blocks(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const VoxelIndex& keep) const {
+  bool Blocks(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const VoxelIndex& keep) {
     return Blocks(a, b, keep, keep);
   }
-  // A cached box for which pred(box) holds, or nullptr.
+  // A cached box for which pred(box) holds (now the front one), or nullptr.
   template <typename Pred>
-  const SolidBox* FindIf(Pred&& pred) const {
-    for (int i = 0; i < count_; ++i)
-      if (pred(boxes_[i])) return &boxes_[i];
+  const SolidBox* FindIf(Pred&& pred) {
+    for (int i = 0; i < count_; ++i) {
+      if (pred(boxes_[i])) {
+        std::rotate(boxes_, boxes_ + i, boxes_ + i + 1);
+        return &boxes_[0];
+      }
+    }
     return nullptr;
   }
-  // A cached box that contains voxel h, or nullptr.
-  const SolidBox* Find(const VoxelIndex& h) const {
-    for (int i = 0; i < count_; ++i)
-      if (boxes_[i].Contains(h)) return &boxes_[i];
-    return nullptr;
+  // A cached box that contains voxel h (now the front one), or nullptr.
+  const SolidBox* Find(const VoxelIndex& h) {
+    return FindIf([&](const SolidBox& box) { return box.Contains(h); });
   }
   void Add(const SolidBox& box) {
     if (!enabled_) return;
-    boxes_[next_] = box;
-    next_ = (next_ + 1) % kSize;
     count_ = std::min(count_ + 1, kSize);
+    std::copy_backward(boxes_, boxes_ + count_ - 1, boxes_ + count_);
+    boxes_[0] = box;
   }
   void Add(const VoxelIndex& h) {
     if (!Find(h)) Add(SolidBox{h, h});
@@ -160,7 +160,6 @@ class OccluderCache {
   SolidBox boxes_[kSize];
   bool enabled_ = true;
   int count_ = 0;
-  int next_ = 0;
 };
 
 }  // namespace vc::internal
