@@ -80,28 +80,45 @@ inline bool PassesThroughInterior(const Segment& s, const SolidBox& box) {
   return t0 > m && t1 < 1 - m;
 }
 
-// The box of occupied voxels grown greedily from occupied voxel h: each side moves out one
-// layer at a time while the whole new layer is occupied, at most `limit` voxels from h. A side
-// whose next layer is not all occupied is never tried again: that layer only grows as the other
-// sides move, so it keeps the free voxel that stopped it.
+// The box of occupied voxels grown greedily from occupied voxel h, at most `limit` voxels from h
+// each way. The sides take turns; each moves out by 1, 2, 4, ... (at most 64) layers at a time
+// while the whole new slab is occupied, and by half as many after a slab that is not. A side
+// whose next single layer is not all occupied is never tried again: that layer only grows as
+// the other sides move, so it keeps the free voxel that stopped it. So no side of the result
+// can move out by one layer within the limit. (Growing one layer at a time gave the same kind
+// of box at 4-6 % more visibility time on the hall, where walls let boxes grow 32 voxels.)
 inline SolidBox GrowSolidBox(const OccupancyGrid& g, const VoxelIndex& h, int limit) {
   SolidBox box{h, h};
   int* lo[3] = {&box.lo.x, &box.lo.y, &box.lo.z};
   int* hi[3] = {&box.hi.x, &box.hi.y, &box.hi.z};
   const int h3[3] = {h.x, h.y, h.z};
+  int step[6] = {1, 1, 1, 1, 1, 1};
   unsigned open = 0x3f;  // bit 2 * axis + side: that side may still move
   while (open) {
     for (int axis = 0; axis < 3; ++axis) {
       for (int side = 0; side < 2; ++side) {
-        const unsigned bit = 1u << (2 * axis + side);
+        const int k = 2 * axis + side;
+        const unsigned bit = 1u << k;
         if (!(open & bit)) continue;
-        const int layer = side == 0 ? *lo[axis] - 1 : *hi[axis] + 1;
+        const int room = side == 0 ? *lo[axis] - (h3[axis] - limit) : (h3[axis] + limit) - *hi[axis];
+        const int n = std::min(step[k], room);
+        if (n <= 0) {
+          open &= ~bit;
+          continue;
+        }
         int l[3] = {box.lo.x, box.lo.y, box.lo.z}, u[3] = {box.hi.x, box.hi.y, box.hi.z};
-        l[axis] = u[axis] = layer;
-        if (std::abs(layer - h3[axis]) > limit || !g.AllOccupied({l[0], l[1], l[2]}, {u[0], u[1], u[2]})) {
+        if (side == 0) {
+          l[axis] = *lo[axis] - n, u[axis] = *lo[axis] - 1;
+        } else {
+          l[axis] = *hi[axis] + 1, u[axis] = *hi[axis] + n;
+        }
+        if (g.AllOccupied({l[0], l[1], l[2]}, {u[0], u[1], u[2]})) {
+          (side == 0 ? *lo[axis] : *hi[axis]) += side == 0 ? -n : n;
+          step[k] = std::min(2 * step[k], 64);
+        } else if (n == 1) {
           open &= ~bit;
         } else {
-          (side == 0 ? *lo[axis] : *hi[axis]) = layer;
+          step[k] = n / 2;
         }
       }
     }

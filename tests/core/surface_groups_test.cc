@@ -485,38 +485,14 @@ TEST(FreeConeTest, SkipsThePartOfTheConeInsideTheFreeBox) {
   EXPECT_TRUE(FreeCone(s.grid, o, 2, true, 1, q0, q1, wrong));
 }
 
-// GrowSolidBox skips a side once its next layer was not all occupied; the old loop tried every
-// side in every round. Both give the same box, here on random dense clutter.
-TEST(SolidBoxTest, SameBoxAsRetryingEverySide) {
-  auto retrying = [](const OccupancyGrid& g, const VoxelIndex& h, int limit) {
-    SolidBox box{h, h};
-    int* lo[3] = {&box.lo.x, &box.lo.y, &box.lo.z};
-    int* hi[3] = {&box.hi.x, &box.hi.y, &box.hi.z};
-    const int h3[3] = {h.x, h.y, h.z};
-    for (bool grew = true; grew;) {
-      grew = false;
-      for (int axis = 0; axis < 3; ++axis)
-        for (int side = 0; side < 2; ++side) {
-          const int layer = side == 0 ? *lo[axis] - 1 : *hi[axis] + 1;
-          if (std::abs(layer - h3[axis]) > limit) continue;
-          int l[3] = {box.lo.x, box.lo.y, box.lo.z}, u[3] = {box.hi.x, box.hi.y, box.hi.z};
-          l[axis] = u[axis] = layer;
-          bool full = true;
-          for (int z = l[2]; z <= u[2] && full; ++z)
-            for (int y = l[1]; y <= u[1] && full; ++y)
-              for (int x = l[0]; x <= u[0] && full; ++x) full = g.Occupied(x, y, z);
-          if (full) {
-            (side == 0 ? *lo[axis] : *hi[axis]) = layer;
-            grew = true;
-          }
-        }
-    }
-    return box;
-  };
+// GrowSolidBox, on random dense clutter: the box holds h, lies within the limit, is all
+// occupied, and no side can move out by one layer within the limit (each side's next layer holds
+// a free voxel or lies beyond the limit).
+TEST(SolidBoxTest, AllOccupiedAndNoSideCanGrow) {
   std::mt19937_64 rng(9);
   std::uniform_int_distribution<int> c(0, 23);
   std::uniform_real_distribution<double> u01(0, 1);
-  int large = 0;
+  int large = 0, at_limit = 0;
   for (int scene = 0; scene < 4; ++scene) {
     // Slabs and blocks with random holes, so that boxes stop on every side at different rounds.
     std::vector<VoxelIndex> v;
@@ -526,17 +502,40 @@ TEST(SolidBoxTest, SameBoxAsRetryingEverySide) {
         for (int x = 0; x < 24; ++x)
           if ((scene % 2 == 0 || z % 6 < 3) && u01(rng) < density) v.push_back({x, y, z});
     const VoxelScene s = MakeScene(v);
+    auto all_occupied = [&](const int l[3], const int u[3]) {
+      for (int z = l[2]; z <= u[2]; ++z)
+        for (int y = l[1]; y <= u[1]; ++y)
+          for (int x = l[0]; x <= u[0]; ++x)
+            if (!s.grid.Occupied(x, y, z)) return false;
+      return true;
+    };
     for (int trial = 0; trial < 200; ++trial) {
       const VoxelIndex h{c(rng), c(rng), c(rng)};
       if (!s.grid.Occupied(h)) continue;
-      for (int limit : {2, 8}) {
-        const SolidBox want = retrying(s.grid, h, limit), got = GrowSolidBox(s.grid, h, limit);
-        ASSERT_TRUE(got.lo == want.lo && got.hi == want.hi) << "scene " << scene << " trial " << trial;
-        large += (got.hi.x - got.lo.x) * (got.hi.y - got.lo.y) * (got.hi.z - got.lo.z) >= 8;
+      for (int limit : {1, 2, 8, 32}) {
+        const SolidBox box = GrowSolidBox(s.grid, h, limit);
+        const int lo[3] = {box.lo.x, box.lo.y, box.lo.z}, hi[3] = {box.hi.x, box.hi.y, box.hi.z};
+        const int h3[3] = {h.x, h.y, h.z};
+        ASSERT_TRUE(box.Contains(h));
+        ASSERT_TRUE(all_occupied(lo, hi)) << "scene " << scene << " trial " << trial;
+        for (int side = 0; side < 6; ++side) {
+          const int a = side / 2;
+          const int layer = side % 2 ? hi[a] + 1 : lo[a] - 1;
+          ASSERT_LE(std::abs(layer - h3[a]), limit + 1);
+          if (std::abs(layer - h3[a]) > limit) {
+            ++at_limit;
+            continue;
+          }
+          int l[3] = {lo[0], lo[1], lo[2]}, u[3] = {hi[0], hi[1], hi[2]};
+          l[a] = u[a] = layer;
+          ASSERT_FALSE(all_occupied(l, u)) << "scene " << scene << " trial " << trial << " limit " << limit << " side " << side;
+        }
+        large += (box.hi.x - box.lo.x) * (box.hi.y - box.lo.y) * (box.hi.z - box.lo.z) >= 8;
       }
     }
   }
-  EXPECT_GT(large, 20);
+  EXPECT_GT(large, 100);
+  EXPECT_GT(at_limit, 100);
 }
 
 TEST(SolidBoxTest, GrowsAcrossAWallAndBlocksSegmentsThroughItsInterior) {
