@@ -516,11 +516,11 @@ struct SurfaceTargets::CentreKind {
   const Target* t;
   const int* base;
   int8_t facing[3][8];
-  std::array<uint8_t, 512> visible;
-  std::array<uint8_t, 512> tried;  // bit f: face f is decided blocked, or its own ray was cast
+  std::array<uint64_t, 8> visible;  // bit j: target j is visible
+  std::array<uint8_t, 512> tried;   // bit f: face f is decided blocked, or its own ray was cast
 
   VoxelIndex VoxelOf(int j) const { return {base[0] + t[j].local[0], base[1] + t[j].local[1], base[2] + t[j].local[2]}; }
-  bool Skip(int j) const { return visible[j]; }
+  bool Skip(int j) const { return (visible[j >> 6] >> (j & 63)) & 1; }
   void Rect(int a, const int b[3], int plane, int voxel_a, int umin, int umax, int wmin, int wmax, Vector3d& q0,
             Vector3d& q1, VoxelIndex& klo, VoxelIndex& khi) const {
     const int b1 = (a + 1) % 3, b2 = (a + 2) % 3;
@@ -547,7 +547,7 @@ struct SurfaceTargets::CentreKind {
     for (uint64_t m = decided; m; m &= m - 1) {
       const int p = std::countr_zero(m);
       if ((seen >> p) & 1) {
-        visible[at[p]] = 1;
+        visible[at[p] >> 6] |= uint64_t{1} << (at[p] & 63);
       } else {
         tried[at[p]] |= face_bit;
       }
@@ -653,24 +653,28 @@ void SurfaceTargets::AppendVisible(const Vector3d& uo, size_t brick_begin, size_
     if (walk.cache.FindIf([&](const SolidBox& box) { return Shadows(box, uo, lo, hi); })) continue;
     CentreKind kind{grid_, uo, &targets_[brick.begin], base, {}, {}, {}};
     FacingTable(uo, base, kind.facing);
-    std::fill_n(kind.visible.begin(), n, 0);
+    kind.visible.fill(0);
     std::fill_n(kind.tried.begin(), n, 0);
     WalkGroups(uo, brick, walk, kind);
 
-    // What no group decided: a ray per face, in batches.
+    // What no group decided: a ray per face, in batches. facing_bits[a][l]: the face of a
+    // voxel in layer l along axis a that faces o, as a face bit (0 if neither does).
+    uint8_t facing_bits[3][8];
+    for (int a = 0; a < 3; ++a)
+      for (int l = 0; l < 8; ++l) {
+        const int sp = kind.facing[a][l];
+        facing_bits[a][l] = sp >= 0 ? uint8_t(1u << (2 * a + sp)) : 0;
+      }
     const Target* t = kind.t;
-    for (int j = 0; j < n; ++j) {
-      if (kind.visible[j]) {
-        visible.Set(t[j].id);
-        continue;
+    for (int word = 0; word * 64 < n; ++word) {
+      const uint64_t in_brick = n - word * 64 >= 64 ? ~uint64_t{0} : (uint64_t{1} << (n - word * 64)) - 1;
+      for (uint64_t m = kind.visible[word]; m; m &= m - 1) visible.Set(t[word * 64 + std::countr_zero(m)].id);
+      for (uint64_t m = ~kind.visible[word] & in_brick; m; m &= m - 1) {
+        const int j = word * 64 + std::countr_zero(m);
+        const uint8_t faces = (facing_bits[0][t[j].local[0]] | facing_bits[1][t[j].local[1]] |
+                               facing_bits[2][t[j].local[2]]) & t[j].exposed & ~kind.tried[j];
+        if (faces) rays.Add(t[j].id, kind.VoxelOf(j), faces);
       }
-      uint8_t faces = 0;
-      for (int a = 0; a < 3; ++a) {
-        const int sp = kind.facing[a][t[j].local[a]];
-        if (sp >= 0) faces |= uint8_t(1u << (2 * a + sp));
-      }
-      faces &= t[j].exposed & ~kind.tried[j];
-      if (faces) rays.Add(t[j].id, kind.VoxelOf(j), faces);
     }
   }
   rays.Flush();
