@@ -173,6 +173,9 @@ constexpr int kFaceCorners[6][4] = {
     {4, 5, 6, 7},  // +z
 };
 
+// The same, as masks over the 8 corner numbers.
+constexpr unsigned kFaceCornerMask[6] = {0x55, 0xaa, 0x33, 0xcc, 0x0f, 0xf0};
+
 Perception FromCount(int visible) {
   return visible == 4 ? Perception::kFull : visible > 0 ? Perception::kPartial : Perception::kNone;
 }
@@ -648,14 +651,17 @@ Result<Evaluation> Evaluate(const VoxelScene& scene, const std::vector<WorldPoin
     VC_RETURN_IF_ERROR(ParallelChunks(n, kVoxelChunk, threads, ctx, [&](uint64_t chunk, uint64_t b, uint64_t e) {
       Tally& t = tallies[chunk];
       for (uint64_t i = b; i < e; ++i) {
+        unsigned corner_bits = 0;  // bit q: corner q of voxel i is visible
+        for (int q = 0; q < 8; ++q) {
+          const uint32_t c = voxel_corners[i][q];
+          corner_bits |= unsigned((w.visible_bits[c >> 6] >> (c & 63)) & 1) << q;
+        }
+        // No visible corner: every face is unperceived, V = 0, which adds nothing to the tally or
+        // the best values, and the kept values are zeros already.
+        if (corner_bits == 0) continue;
         for (int f = 0; f < kFacesPerVoxel; ++f) {
           if (!((faces_in_set[i] >> f) & 1)) continue;
-          int visible = 0;
-          for (int q : kFaceCorners[f]) {
-            const uint32_t c = voxel_corners[i][q];
-            visible += (w.visible_bits[c >> 6] >> (c & 63)) & 1;
-          }
-          const Perception p = FromCount(visible);
+          const Perception p = FromCount(std::popcount(corner_bits & kFaceCornerMask[f]));
           const double val = FaceValue(p, viewpoints[k], index[i], Face(f), r, options.scanner);
           t.Add(p, val);
           const size_t slot = i * kFacesPerVoxel + f;
