@@ -5,6 +5,8 @@
 #include <queue>
 #include <string>
 
+#include "popcount.h"
+
 namespace vc::planner {
 
 std::string_view GreedyStopName(GreedyStop stop) {
@@ -17,7 +19,7 @@ std::string_view GreedyStopName(GreedyStop stop) {
   return "unknown";
 }
 
-uint64_t CountAnd(const VoxelSet& a, const VoxelSet& b) {
+VC_POPCOUNT_CLONES uint64_t CountAnd(const VoxelSet& a, const VoxelSet& b) {
   const auto& wa = a.words();
   const auto& wb = b.words();
   uint64_t n = 0;
@@ -25,7 +27,7 @@ uint64_t CountAnd(const VoxelSet& a, const VoxelSet& b) {
   return n;
 }
 
-uint64_t CountBits(const VoxelSet& a) {
+VC_POPCOUNT_CLONES uint64_t CountBits(const VoxelSet& a) {
   uint64_t n = 0;
   for (uint64_t w : a.words()) n += std::popcount(w);
   return n;

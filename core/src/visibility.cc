@@ -21,6 +21,7 @@
 #include "huge_pages.h"
 #include "occluders.h"
 #include "parallel.h"
+#include "popcount.h"
 #include "surface_groups.h"
 #include "vc/core/ray_traversal.h"
 
@@ -319,13 +320,13 @@ double FaceVisibility(const OccupancyGrid& grid, const WorldPoint& o, const Voxe
   return FaceValue(PerceiveFace(grid, o, v, f), o, v, f, grid.resolution_m(), scanner);
 }
 
-size_t VoxelSet::count() const {
+VC_POPCOUNT_CLONES size_t VoxelSet::count() const {
   size_t n = 0;
   for (uint64_t w : words_) n += std::popcount(w);
   return n;
 }
 
-size_t VoxelSet::CountAnd(const VoxelSet& other) const {
+VC_POPCOUNT_CLONES size_t VoxelSet::CountAnd(const VoxelSet& other) const {
   size_t n = 0;
   const size_t m = std::min(words_.size(), other.words_.size());
   for (size_t i = 0; i < m; ++i) n += std::popcount(words_[i] & other.words_[i]);
