@@ -351,7 +351,7 @@ Result<std::vector<VoxelSet>> ComputeVisibilitySets(const VoxelScene& scene, con
   for (size_t i = 0; i < n; ++i) index[i] = KeyToIndex(scene.occupied[i]);
   // Voxels that can pass either test.
   const std::vector<uint32_t> candidates = NotEnclosed(g, index);
-  std::vector<VoxelSet> sets(viewpoints.size(), VoxelSet(n));
+  std::vector<VoxelSet> sets(viewpoints.size());
   std::vector<Vector3d> uo(viewpoints.size());
   std::vector<char> valid(viewpoints.size()), shortcuts(viewpoints.size());
   for (size_t k = 0; k < viewpoints.size(); ++k) {
@@ -368,12 +368,23 @@ Result<std::vector<VoxelSet>> ComputeVisibilitySets(const VoxelScene& scene, con
     // atomically.
     const internal::SurfaceTargets targets(g, index, candidates);
     const bool task_per_viewpoint = viewpoints.size() >= 8 * uint64_t(ResolveThreads(options.threads, viewpoints.size()));
+    // The sets are allocated here, in the calling thread (running out of memory must not happen
+    // in a worker), but a task that owns its viewpoint's set clears it: the first touch of fresh
+    // memory is most of the cost (0.14 s in one thread for the hall's 858 sets of 53 KB).
+    for (VoxelSet& set : sets) {
+      if (task_per_viewpoint) {
+        set.words().reserve((n + 63) / 64);
+      } else {
+        set.Resize(n);
+      }
+    }
     const uint64_t bricks_per_task = task_per_viewpoint ? std::max<uint64_t>(1, targets.brick_count()) : 256;
     const uint64_t brick_chunks = std::max<uint64_t>(1, (targets.brick_count() + bricks_per_task - 1) / bricks_per_task);
     const uint64_t tasks = viewpoints.size() * brick_chunks;
     StageProgress progress(ctx, "visibility", tasks);
     Status st = ParallelChunks(tasks, 1, options.threads, ctx, [&](uint64_t task, uint64_t, uint64_t) {
       const size_t k = task / brick_chunks, c = task % brick_chunks;
+      if (task_per_viewpoint) sets[k].Resize(n);  // in the capacity reserved above
       if (shortcuts[k]) {
         internal::GroupWalk walk;
         walk.around = internal::GrowFreeBox(g, uo[k]);
@@ -384,6 +395,8 @@ Result<std::vector<VoxelSet>> ComputeVisibilitySets(const VoxelScene& scene, con
     });
     VC_RETURN_IF_ERROR(st);
     if (std::equal(valid.begin(), valid.end(), shortcuts.begin())) return sets;
+  } else {
+    for (VoxelSet& set : sets) set.Resize(n);
   }
 
   // Per voxel: every viewpoint, or (after the grouped pass) those too far for the shortcuts, whose

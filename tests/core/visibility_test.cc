@@ -200,6 +200,8 @@ size_t ExpectSetsMatchOracle(const VoxelScene& s, const std::vector<WorldPoint>&
   if (!sets.ok()) return 0;
   size_t positives = 0;
   for (size_t k = 0; k < vps.size(); ++k) {
+    EXPECT_EQ((*sets)[k].size(), s.occupied.size()) << what << " vp " << k;
+    if ((*sets)[k].size() != s.occupied.size()) return positives;
     const Vector3d uo = vps[k] / s.resolution_m;
     for (size_t id = 0; id < s.occupied.size(); ++id) {
       const VoxelIndex v = KeyToIndex(s.occupied[id]);
@@ -227,6 +229,45 @@ TEST(ComputeVisibilitySetsTest, EqualsBruteForceOracleForBothTests) {
                 0u);
     }
   }
+}
+
+// With 8 or more viewpoints per thread a task owns its viewpoint and sizes its set itself; every
+// viewpoint, far (no shortcuts) or inside an occupied voxel (empty set) included, still gets a
+// full-size set with the oracle's answers.
+TEST(ComputeVisibilitySetsTest, TaskPerViewpointSetsMatchTheOracle) {
+  std::mt19937_64 rng(31);
+  const VoxelScene s = RandomScene(rng, 80, 10, 1.0);
+  std::vector<WorldPoint> vps = RandomViewpoints(rng, 18, 10, 1.0);
+  vps.push_back(WorldPoint(20000.5, 4.25, 6.5));  // far: walked plainly after the grouped pass
+  const VoxelIndex inside = KeyToIndex(s.occupied[3]);
+  vps.push_back(WorldPoint(inside.x + 0.5, inside.y + 0.5, inside.z + 0.5));
+  for (bool per_voxel : {false, true}) {
+    VisibilitySetsOptions opt;
+    opt.per_voxel = per_voxel;
+    opt.threads = 2;
+    EXPECT_GT(ExpectSetsMatchOracle(s, vps, opt, per_voxel ? "per voxel" : "grouped"), 0u);
+  }
+  auto sets = ComputeVisibilitySets(s, vps, {});
+  ASSERT_TRUE(sets.ok());
+  EXPECT_EQ(sets->back().count(), 0u);  // the viewpoint inside an occupied voxel sees nothing
+}
+
+TEST(VoxelSetTest, ResizeKeepsBitsBelowTheSizeAndClearsTheRest) {
+  VoxelSet s(130);
+  for (size_t i : {0, 63, 64, 100, 129}) s.set(i);
+  s.Resize(101);
+  EXPECT_EQ(s.size(), 101u);
+  EXPECT_EQ(s.count(), 4u);  // 129 dropped
+  s.Resize(200);
+  EXPECT_EQ(s.count(), 4u);  // nothing above 100 comes back
+  EXPECT_TRUE(s.test(0) && s.test(63) && s.test(64) && s.test(100));
+  EXPECT_FALSE(s.test(129));
+  VoxelSet r;
+  r.words().reserve(100);
+  const uint64_t* where = r.words().data();
+  r.Resize(64 * 100);
+  EXPECT_EQ(r.words().data(), where);  // in the reserved capacity
+  EXPECT_EQ(r.count(), 0u);
 }
 
 TEST(ComputeVisibilitySetsTest, FarViewpointsAreWalkedPlainlyAndMatchTheOracle) {

@@ -77,6 +77,13 @@ class VoxelSet {
   VoxelSet() = default;
   explicit VoxelSet(size_t n) : n_(n), words_((n + 63) / 64, 0) {}
   size_t size() const { return n_; }
+  // Makes the set hold n voxels: ids below the old size keep their bits, the others are clear.
+  // Allocates nothing when words().capacity() already holds (n + 63) / 64 words.
+  void Resize(size_t n) {
+    n_ = n;
+    words_.resize((n + 63) / 64, 0);
+    if (n % 64) words_.back() &= (uint64_t{1} << (n % 64)) - 1;
+  }
   bool test(size_t i) const { return (words_[i >> 6] >> (i & 63)) & 1u; }
   void set(size_t i) { words_[i >> 6] |= uint64_t{1} << (i & 63); }
   void reset(size_t i) { words_[i >> 6] &= ~(uint64_t{1} << (i & 63)); }
