@@ -4,9 +4,44 @@
 
 #include <atomic>
 #include <filesystem>
+#include <iostream>
+#include <mutex>
 #include <unistd.h>
+#include <vector>
 
 namespace vc::testing {
+namespace {
+
+// The directories MakeTempDir made in this process, removed at exit if every test passed.
+class TempDirs {
+ public:
+  void Add(const std::filesystem::path& dir) {
+    const std::lock_guard<std::mutex> lock(mu_);
+    dirs_.push_back(dir);
+  }
+  ~TempDirs() {
+    const bool failed = ::testing::UnitTest::GetInstance()->Failed();
+    for (const auto& dir : dirs_) {
+      if (failed) {
+        std::cerr << "kept for inspection: " << dir.string() << "\n";
+        continue;
+      }
+      std::error_code ignored;
+      std::filesystem::remove_all(dir, ignored);
+    }
+  }
+
+ private:
+  std::mutex mu_;
+  std::vector<std::filesystem::path> dirs_;
+};
+
+TempDirs& Made() {
+  static TempDirs dirs;
+  return dirs;
+}
+
+}  // namespace
 
 std::string SharedDataPath(const std::string& relative) { return std::string(VC_SHARED_DATA_DIR) + "/" + relative; }
 std::string TestDataPath(const std::string& relative) { return std::string(VC_TEST_DATA_DIR) + "/" + relative; }
@@ -23,6 +58,7 @@ std::string MakeTempDir() {
              ("vc-test-" + std::to_string(::getpid()) + "-" + std::to_string(counter++) + "-" + name);
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
+  Made().Add(dir);
   return dir.string();
 }
 

@@ -11,7 +11,8 @@ std::string SharedDataPath(const std::string& relative);
 std::string TestDataPath(const std::string& relative);
 // The build directory (where the binaries are).
 std::string BinaryDir();
-// A fresh, empty temporary directory unique to the calling test.
+// A fresh, empty temporary directory unique to the calling test. Removed when the test program
+// exits, unless a test failed (then they are kept for inspection, and their paths printed).
 std::string MakeTempDir();
 
 }  // namespace vc::testing
