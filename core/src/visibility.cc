@@ -710,7 +710,10 @@ Result<Evaluation> Evaluate(const VoxelScene& scene, const std::vector<WorldPoin
     }
     std::mutex mu;
     Status failed = Status::Ok();
-    VC_RETURN_IF_ERROR(ParallelChunks(nv, 1, workers, ctx, [&](uint64_t k, uint64_t, uint64_t) {
+    // The last nv % workers viewpoints are evaluated one after another on all threads, so that
+    // no thread ends with a whole viewpoint of its own while the others wait.
+    const uint64_t alone = nv - nv % uint64_t(workers);
+    VC_RETURN_IF_ERROR(ParallelChunks(alone, 1, workers, ctx, [&](uint64_t k, uint64_t, uint64_t) {
       Work* w = nullptr;
       {
         std::lock_guard<std::mutex> lock(mu);  // at most `workers` tasks run at once
@@ -723,6 +726,7 @@ Result<Evaluation> Evaluate(const VoxelScene& scene, const std::vector<WorldPoin
       idle.push_back(w);
     }, "evaluation"));
     VC_RETURN_IF_ERROR(failed);
+    for (size_t k = alone; k < nv; ++k) VC_RETURN_IF_ERROR(evaluate_viewpoint(k, workers, *works[0]));
   } else {
     works.push_back(std::make_unique<Work>(corner_words, n * kFacesPerVoxel, voxel_chunks));
     for (size_t k = 0; k < nv; ++k) VC_RETURN_IF_ERROR(evaluate_viewpoint(k, options.threads, *works[0]));
