@@ -18,6 +18,7 @@
 #include <string>
 #include <thread>
 
+#include "../core/src/candidates.h"
 #include "vc/core/octomap_adapter.h"
 #include "vc/core/planner.h"
 #include "vc/core/ray_traversal.h"
@@ -74,6 +75,61 @@ vc::Result<vc::SceneInput> LoadScene(const std::string& scene, double spacing, i
 // The issue's fine-evaluation target: a 10-station plan of the hall (planned at 0.1 m) evaluated
 // at 0.01 m, where the scene comes from the hall sampled at 0.005 m (about 1.7e8 points, streamed
 // into a voxel accumulator), by sampling faces until the 95 % interval of G is within +-0.5 %.
+// The two costliest stages on their own, for A/B runs of two builds (docs/BENCHMARKS.md, "The
+// machine"): the grouped surface-visibility sets of every `every`-th candidate of the plan's
+// grid, and the exact evaluation of 15 evenly spaced candidates keeping every station's face
+// values (what the reduction does). Each round's seconds, the best, and a check value.
+int VisibilityOnly(const vc::VoxelScene& s, double grid, int every, int threads, int repeat) {
+  vc::planner::CandidateOptions co;
+  co.grid_spacing_m = grid;
+  auto candidates = vc::planner::GenerateCandidates(s, co);
+  if (!candidates.ok()) {
+    std::fprintf(stderr, "vc-bench: %s\n", candidates.status().ToString().c_str());
+    return 2;
+  }
+  const std::vector<vc::WorldPoint>& all = candidates->positions;
+  std::vector<vc::WorldPoint> some, fifteen;
+  for (size_t i = 0; i < all.size(); i += size_t(every)) some.push_back(all[i]);
+  for (size_t i = 0; i < 15 && !all.empty(); ++i) fifteen.push_back(all[i * all.size() / 15]);
+  auto rounds = [&](const char* what, auto&& run) {
+    std::printf("%s:", what);
+    double best = 1e300;
+    std::string check;
+    for (int r = 0; r < repeat; ++r) {
+      const auto t0 = Clock::now();
+      check = run();
+      const double t = Seconds(t0);
+      best = std::min(best, t);
+      std::printf(" %.3f", t);
+    }
+    std::printf(" s; best %.3f s; %s\n", best, check.c_str());
+  };
+  char title[160];
+  std::snprintf(title, sizeof title, "visibility sets (surface, grouped), %zu of %zu candidates, %d threads", some.size(),
+                all.size(), threads);
+  rounds(title, [&] {
+    vc::VisibilitySetsOptions o;
+    o.threads = threads;
+    auto sets = vc::ComputeVisibilitySets(s, some, o);
+    size_t visible = 0;
+    for (const auto& set : *sets) visible += set.count();
+    return std::to_string(visible) + " visible";
+  });
+  std::snprintf(title, sizeof title, "exact evaluation of %zu candidates, per-station values kept, %d threads",
+                fifteen.size(), threads);
+  rounds(title, [&] {
+    vc::EvaluateOptions o;
+    o.threads = threads;
+    o.keep_face_values = true;
+    o.keep_per_viewpoint_values = true;
+    auto ev = vc::Evaluate(s, fifteen, o);
+    char g[64];
+    std::snprintf(g, sizeof g, "G = %.6f", ev->overall.global_visibility);
+    return std::string(g);
+  });
+  return 0;
+}
+
 int FineEvaluation(int threads) {
   const auto start = Clock::now();
   vc::SynthOptions coarse;
@@ -151,6 +207,8 @@ int main(int argc, char** argv) {
   double spacing = 0.05, resolution = 0.1, grid = 1.0;
   int rays = 200000, octomap_rays = 20000, threads = 2, repeat = 5;
   bool quick = false, scaling = true, rays_only = false, fine_eval = false, all_targets = false, sets = true;
+  bool visibility_only = false;
+  int every = 4;
   app.add_option("--scene", scene, "synthetic scene spec (hall, box, comb:5, ...) or a file path");
   app.add_option("--spacing", spacing, "point spacing of synthetic scenes, m");
   app.add_option("--resolution", resolution, "working resolution, m");
@@ -164,6 +222,10 @@ int main(int argc, char** argv) {
   app.add_flag("!--no-scaling", scaling, "skip the scaling tables");
   app.add_flag("!--no-sets", sets, "skip the three full visibility-set computations after the plan");
   app.add_flag("--rays-only", rays_only, "only the ray comparison with OctoMap");
+  app.add_flag("--visibility-only", visibility_only,
+               "only the grouped visibility sets of every --every-th candidate and the exact evaluation of 15 "
+               "candidates, best of --repeat rounds (A/B runs of two builds)");
+  app.add_option("--every", every, "with --visibility-only: every how many candidates")->check(CLI::Range(1, 1000000));
   app.add_flag("--all-targets", all_targets, "also time the SIMD batch kernel on every other instruction set");
   app.add_flag("--fine-eval", fine_eval,
                "only the fine evaluation: the hall sampled at 0.005 m, a 10-station plan evaluated at 0.01 m "
@@ -201,6 +263,7 @@ int main(int argc, char** argv) {
   std::printf("scene: %zu points, %zu occupied voxels at %.3f m, grid %.1f MiB; load %.2f s, voxelise %.2f s\n",
               input->points.size(), s.occupied.size(), s.resolution_m, double(s.grid.memory_bytes()) / (1 << 20),
               load_s, vox_s);
+  if (visibility_only) return VisibilityOnly(s, grid, every, threads, repeat);
 
   // ---- Rays: identical for both ----
   auto tree = input->octree ? std::const_pointer_cast<octomap::OcTree>(input->octree)
