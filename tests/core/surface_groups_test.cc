@@ -264,6 +264,25 @@ TEST(FreeConeTest, VoxelsOfTheBoxCoverOutsideThePyramidDoNotCount) {
   }
 }
 
+// Walks 30 segments from o to the rectangle q0..q1 on the plane u[axis] = plane (its 4 corners,
+// then random points of it). Returns the first k whose walk meets an occupied voxel on o's side
+// of the plane (above: index along axis >= plane; below: < plane), or -1 if none does.
+int FirstWalkMeetingTheViewersSide(const OccupancyGrid& grid, const Vector3d& o, int axis, bool above, int plane,
+                                   const Vector3d& q0, const Vector3d& q1, std::mt19937_64& rng) {
+  std::uniform_real_distribution<double> u01(0, 1);
+  const int b1 = (axis + 1) % 3, b2 = (axis + 2) % 3;
+  for (int k = 0; k < 30; ++k) {
+    const double fu = k < 4 ? (k & 1) : u01(rng), fw = k < 4 ? (k >> 1) : u01(rng);
+    Vector3d q = q0;
+    q[b1] += fu * (q1[b1] - q0[b1]);
+    q[b2] += fw * (q1[b2] - q0[b2]);
+    const auto hit = FirstOccupied(grid, o, q);
+    const int hit_a = hit ? (axis == 0 ? hit->x : axis == 1 ? hit->y : hit->z) : 0;
+    if (hit && (above ? hit_a >= plane : hit_a < plane)) return k;
+  }
+  return -1;
+}
+
 // Soundness on random clutter: whenever FreeCone proves a rectangle free, no walk from o to a
 // point of it meets an occupied voxel on o's side of the plane; and the test does prove many.
 // Every axis, both sides of the plane, near the origin and 20,000 voxels from it.
@@ -329,17 +348,8 @@ TEST(FreeConeTest, WhatItProvesFreeIsFreeOnRandomClutter) {
       ++proven;
       proven_far += far;
       proven_grazing += grazing;
-      for (int k = 0; k < 30; ++k) {
-        // Corners of the rectangle and random points of it.
-        const double fu = k < 4 ? (k & 1) : u01(rng), fw = k < 4 ? (k >> 1) : u01(rng);
-        Vector3d q = q0;
-        q[b1] += fu * (q1[b1] - q0[b1]);
-        q[b2] += fw * (q1[b2] - q0[b2]);
-        const auto hit = FirstOccupied(s.grid, o, q);
-        const int hit_h = hit ? (axis == 0 ? hit->x : axis == 1 ? hit->y : hit->z) - off : 0;
-        ASSERT_TRUE(!hit || (above ? hit_h < plane_h : hit_h >= plane_h))
-            << "scene " << scene << " trial " << trial << " point " << k;
-      }
+      const int k = FirstWalkMeetingTheViewersSide(s.grid, o, axis, above, plane_h + off, q0, q1, rng);
+      ASSERT_EQ(k, -1) << "scene " << scene << " trial " << trial << " point " << k;
     }
   }
   EXPECT_GT(proven, 600);
@@ -401,16 +411,8 @@ TEST(FreeConeTest, PartsOfARefutedRectangleMayStartWhereItFailed) {
           continue;
         }
         ++parts_proven;
-        for (int k = 0; k < 30; ++k) {
-          const double fu = k < 4 ? (k & 1) : u01(rng), fw = k < 4 ? (k >> 1) : u01(rng);
-          Vector3d q = p0;
-          q[b1] += fu * (p1[b1] - p0[b1]);
-          q[b2] += fw * (p1[b2] - p0[b2]);
-          const auto hit = FirstOccupied(s.grid, o, q);
-          const int hit_h = hit ? (axis == 0 ? hit->x : axis == 1 ? hit->y : hit->z) : 0;
-          ASSERT_TRUE(!hit || (above ? hit_h < plane : hit_h >= plane))
-              << "scene " << scene << " trial " << trial << " part " << part << " point " << k;
-        }
+        const int k = FirstWalkMeetingTheViewersSide(s.grid, o, axis, above, plane, p0, p1, rng);
+        ASSERT_EQ(k, -1) << "scene " << scene << " trial " << trial << " part " << part << " point " << k;
       }
     }
   }
