@@ -7,7 +7,11 @@
 // x86-64 CPU since 2008 has POPCNT): run-time dispatch, as Highway does for the ray kernel.
 #pragma once
 
-#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__)
+// Not under ThreadSanitizer: the clones are chosen by an IFUNC resolver that runs while the
+// program is being relocated, before the sanitizer's runtime is set up, and the instrumented
+// resolver crashes there (visibility_test, built with -fsanitize=thread, segfaulted at start).
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__) && \
+    !defined(__SANITIZE_THREAD__)
 #define VC_POPCOUNT_CLONES __attribute__((target_clones("popcnt", "default")))
 #else
 #define VC_POPCOUNT_CLONES
