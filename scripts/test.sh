@@ -34,8 +34,9 @@ for p in "${presets[@]}"; do
       cmake --build --preset "$p"
       echo "=== preset $p: tests"
       ctest --preset "$p" -j2
-      echo "=== preset $p: vc-bench --quick (figures only, no timing assertions)"
+      echo "=== preset $p: vc-bench --quick, and --visibility-only (figures only, no timing assertions)"
       "build/$p/bench/vc-bench" --quick
+      "build/$p/bench/vc-bench" --quick --visibility-only --repeat 1
       ;;
   esac
   echo "=== preset $p done after $(( $(date +%s) - start )) s"
