@@ -1,11 +1,8 @@
 #include "greedy.h"
 
 #include <algorithm>
-#include <bit>
 #include <queue>
 #include <string>
-
-#include "popcount.h"
 
 namespace vc::planner {
 
@@ -19,19 +16,9 @@ std::string_view GreedyStopName(GreedyStop stop) {
   return "unknown";
 }
 
-VC_POPCOUNT_CLONES uint64_t CountAnd(const VoxelSet& a, const VoxelSet& b) {
-  const auto& wa = a.words();
-  const auto& wb = b.words();
-  uint64_t n = 0;
-  for (size_t i = 0; i < wa.size(); ++i) n += std::popcount(wa[i] & wb[i]);
-  return n;
-}
+uint64_t CountAnd(const VoxelSet& a, const VoxelSet& b) { return a.CountAnd(b); }
 
-VC_POPCOUNT_CLONES uint64_t CountBits(const VoxelSet& a) {
-  uint64_t n = 0;
-  for (uint64_t w : a.words()) n += std::popcount(w);
-  return n;
-}
+uint64_t CountBits(const VoxelSet& a) { return a.count(); }
 
 void UnionInto(VoxelSet& a, const VoxelSet& b) {
   auto& wa = a.words();

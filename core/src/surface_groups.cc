@@ -30,6 +30,7 @@
 #include <Eigen/Geometry>
 
 #include "vc/core/ray_traversal.h"
+#include "walk.h"
 
 namespace vc::internal {
 namespace {
@@ -276,22 +277,18 @@ bool FreeCone(const OccupancyGrid& grid, const Vector3d& uo, int axis, bool view
     // lies inside it needs no test. A jump shorter than a voxel is not taken, which bounds the
     // number of pieces by the cone's length.
     const Vector3d c = uo + s0 * (0.5 * (q0 + q1) - uo);
-    int rel[3];
+    uint32_t rel[3];
     bool in_grid = true;
     for (int i = 0; i < 3; ++i) {
-      rel[i] = FloorInt(c[i]) - gmin3[i];
-      in_grid = in_grid && rel[i] >= 0 && rel[i] < grid.dims()[i];
+      const int r = FloorInt(c[i]) - gmin3[i];
+      in_grid = in_grid && r >= 0 && r < grid.dims()[i];
+      rel[i] = uint32_t(r);
     }
     if (in_grid) {
-      const uint64_t brick = grid.BrickLinear(uint32_t(rel[0]) >> 3, uint32_t(rel[1]) >> 3, uint32_t(rel[2]) >> 3);
-      const int k = grid.BrickDistance(brick) - 1;
-      if (k >= 0) {
+      const uint64_t brick = grid.BrickLinear(rel[0] >> 3, rel[1] >> 3, rel[2] >> 3);
+      if (grid.BrickDistance(brick) > 0) {  // an empty brick
         int flo[3], fhi[3];
-        for (int i = 0; i < 3; ++i) {
-          const int b = rel[i] >> OccupancyGrid::kBrickShift;
-          flo[i] = gmin3[i] + (b - k - grid.ExtraBricks(brick, 2 * i + 1)) * OccupancyGrid::kBrick;
-          fhi[i] = gmin3[i] + (b + k + grid.ExtraBricks(brick, 2 * i) + 1) * OccupancyGrid::kBrick - 1;
-        }
+        FreeBrickBox(grid, brick, rel, gmin3, flo, fhi);
         const double s1 = free_until(s0, flo, fhi);
         if (s1 - s0 >= 1 / len) {
           s0 = s1;

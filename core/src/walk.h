@@ -4,7 +4,8 @@
 // decides later tie-breaks. The SIMD kernel (ray_batch.cc) re-states Walk's set-up and
 // JumpAcrossBox lane-wise, operation for operation; a change here must be made there too, and
 // tests/core/ray_batch_test.cc fails if the two disagree. Plain scalar double code for the
-// baseline ISA. Re-entrant; no state beyond the Walk.
+// baseline ISA. Re-entrant; no state beyond the Walk. FreeCone (surface_groups.cc) uses
+// FreeBrickBox too, so that the cone test skips the same boxes the walks jump across.
 #pragma once
 
 #include <algorithm>
@@ -115,17 +116,26 @@ inline bool JumpAcrossBox(const int box_lo[3], const int box_hi[3], Walk& w) {
   return true;
 }
 
-// The free box of bricks around an empty brick: the bricks within its distance - 1, widened on
-// each side by the grid's extra layers (OccupancyGrid::ExtraBricks), as the SIMD kernel's jump.
-inline bool JumpAcrossFreeBrickBox(const OccupancyGrid& grid, uint64_t brick, const uint32_t rel[3], const int lo3[3],
-                            Walk& w) {
+// The free box of bricks around an empty brick, in voxel indices [box_lo, box_hi]: the bricks
+// within its distance - 1, widened on each side by the grid's extra layers
+// (OccupancyGrid::ExtraBricks). `brick` is the linear number of the brick holding the voxel at
+// rel (relative to the grid's smallest index lo3); the brick must be empty.
+inline void FreeBrickBox(const OccupancyGrid& grid, uint64_t brick, const uint32_t rel[3], const int lo3[3],
+                         int box_lo[3], int box_hi[3]) {
   const int k = grid.BrickDistance(brick) - 1;
-  int box_lo[3], box_hi[3];
   for (int i = 0; i < 3; ++i) {
     const int brick_i = int(rel[i] >> OccupancyGrid::kBrickShift);
     box_lo[i] = lo3[i] + (brick_i - k - grid.ExtraBricks(brick, 2 * i + 1)) * OccupancyGrid::kBrick;
     box_hi[i] = lo3[i] + (brick_i + k + grid.ExtraBricks(brick, 2 * i) + 1) * OccupancyGrid::kBrick - 1;
   }
+}
+
+// Jumps across the free box of bricks around an empty brick (FreeBrickBox), as the SIMD
+// kernel's jump does.
+inline bool JumpAcrossFreeBrickBox(const OccupancyGrid& grid, uint64_t brick, const uint32_t rel[3], const int lo3[3],
+                            Walk& w) {
+  int box_lo[3], box_hi[3];
+  FreeBrickBox(grid, brick, rel, lo3, box_lo, box_hi);
   return JumpAcrossBox(box_lo, box_hi, w);
 }
 
