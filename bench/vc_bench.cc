@@ -72,9 +72,6 @@ vc::Result<vc::SceneInput> LoadScene(const std::string& scene, double spacing, i
   return input;
 }
 
-// The issue's fine-evaluation target: a 10-station plan of the hall (planned at 0.1 m) evaluated
-// at 0.01 m, where the scene comes from the hall sampled at 0.005 m (about 1.7e8 points, streamed
-// into a voxel accumulator), by sampling faces until the 95 % interval of G is within +-0.5 %.
 // The two costliest stages on their own, for A/B runs of two builds (docs/BENCHMARKS.md, "The
 // machine"): the grouped surface-visibility sets of every `every`-th candidate of the plan's
 // grid, and the exact evaluation of 15 evenly spaced candidates keeping every station's face
@@ -130,6 +127,9 @@ int VisibilityOnly(const vc::VoxelScene& s, double grid, int every, int threads,
   return 0;
 }
 
+// The issue's fine-evaluation target: a 10-station plan of the hall (planned at 0.1 m) evaluated
+// at 0.01 m, where the scene comes from the hall sampled at 0.005 m (about 1.7e8 points, streamed
+// into a voxel accumulator), by sampling faces until the 95 % interval of G is within +-0.5 %.
 int FineEvaluation(int threads) {
   const auto start = Clock::now();
   vc::SynthOptions coarse;

@@ -4,9 +4,9 @@
 // face values, the evaluation's per-face best values, the top-3 table). Filling fresh memory
 // costs a page fault per 4 KiB page, and on a virtual machine a fault costs microseconds: on the
 // hall, zeroing 15 stations' face values (152 MB) took 0.42 s, and 0.10-0.28 s with huge pages
-// (docs/BENCHMARKS.md, "Memory"). Debian's default THP mode is "madvise", which backs only the
-// ranges a program asks for. The advice changes no value; where the kernel refuses it (no THP,
-// another OS), nothing changes at all.
+// (docs/BENCHMARKS.md, "Plan at `0543dbd`"). Debian's default THP mode is "madvise", which
+// backs only the ranges a program asks for. The advice changes no value; where the kernel
+// refuses it (no THP, another OS), nothing changes at all.
 #pragma once
 
 #include <cstddef>
