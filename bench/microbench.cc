@@ -4,10 +4,10 @@
 #include <random>
 #include <string>
 
-#include "vc/core/ray_traversal.h"
-#include "vc/core/synth.h"
-#include "vc/core/visibility.h"
-#include "vc/core/voxel_scene.h"
+#include "vc/raycast/ray_traversal.h"
+#include "vc/synth/synth.h"
+#include "vc/visibility/visibility.h"
+#include "vc/scene/voxel_scene.h"
 
 namespace {
 

@@ -18,14 +18,14 @@
 #include <string>
 #include <thread>
 
-#include "../core/src/candidates.h"
-#include "vc/core/octomap_adapter.h"
-#include "vc/core/planner.h"
-#include "vc/core/ray_traversal.h"
-#include "vc/core/scene_input.h"
-#include "vc/core/synth.h"
-#include "vc/core/visibility.h"
-#include "vc/core/voxel_scene.h"
+#include "vc/plan/candidates.h"
+#include "vc/scene/octomap_adapter.h"
+#include "vc/plan/planner.h"
+#include "vc/raycast/ray_traversal.h"
+#include "vc/scene/scene_input.h"
+#include "vc/synth/synth.h"
+#include "vc/visibility/visibility.h"
+#include "vc/scene/voxel_scene.h"
 
 namespace {
 
@@ -377,7 +377,8 @@ int main(int argc, char** argv) {
     }
     if (print) {
       std::printf("\n## End-to-end plan (%d threads)\n| stage | seconds |\n|---|---|\n", threads);
-      for (const auto& t : plan->timings) std::printf("| %s | %.3f |\n", t.stage.c_str(), t.seconds);
+      for (const auto& t : plan->timings) std::printf("| %s | %.3f |\n", std::string(vc::StageName(t.stage)).c_str(), t.seconds);
+      std::printf("| total | %.3f |\n", plan->total_seconds);
       std::printf("| **total (wall, incl. voxelise)** | **%.3f** |\n", total);
       std::printf("%zu stations from %llu candidates; %llu occupied, %llu coverable, %llu covered voxels; G = %.4f\n",
                   plan->stations.size(), (unsigned long long)plan->candidate_count,

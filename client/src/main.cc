@@ -11,9 +11,9 @@
 
 #include "vc/client/client.h"
 #include "vc/client/progress_display.h"
-#include "vc/core/plan_report.h"
-#include "vc/core/scene_input.h"
-#include "vc/core/scene_summary.h"
+#include "vc/report/plan_report.h"
+#include "vc/scene/scene_input.h"
+#include "vc/scene/scene_summary.h"
 #include "vc/server/status_mapping.h"
 
 namespace {

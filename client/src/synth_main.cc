@@ -8,7 +8,7 @@
 
 #include <CLI/CLI.hpp>
 
-#include "vc/core/synth.h"
+#include "vc/synth/synth.h"
 
 int main(int argc, char** argv) {
   CLI::App app{"Writes a synthetic scene with a known optimum as a binary PLY point cloud."};

@@ -197,15 +197,54 @@ Result<EvaluateJobOptions> FromProto(const v1::EvaluateParameters& p) {
   return o;
 }
 
+// vc::Stage and v1::Stage share their numbers (kRead = STAGE_READ = 1, ...).
+v1::Stage ToProto(Stage s) { return static_cast<v1::Stage>(s); }
+
+Stage FromProto(v1::Stage s) {
+  return s > v1::STAGE_UNSPECIFIED && s <= v1::STAGE_EVALUATION ? static_cast<Stage>(s) : Stage::kUnspecified;
+}
+
+v1::StopReason ToProto(StopReason r) {
+  switch (r) {
+    case StopReason::kExhausted: return v1::STOP_REASON_EXHAUSTED;
+    case StopReason::kTargetReached: return v1::STOP_REASON_TARGET_REACHED;
+    case StopReason::kMaxStations: return v1::STOP_REASON_MAX_STATIONS;
+    case StopReason::kMinGain: return v1::STOP_REASON_MIN_GAIN;
+  }
+  return v1::STOP_REASON_UNSPECIFIED;
+}
+
+Result<StopReason> FromProto(v1::StopReason r) {
+  switch (r) {
+    case v1::STOP_REASON_EXHAUSTED: return StopReason::kExhausted;
+    case v1::STOP_REASON_TARGET_REACHED: return StopReason::kTargetReached;
+    case v1::STOP_REASON_MAX_STATIONS: return StopReason::kMaxStations;
+    case v1::STOP_REASON_MIN_GAIN: return StopReason::kMinGain;
+    default: break;
+  }
+  return DataLossError("the server's result carries an unknown stop reason (" + std::to_string(int(r)) +
+                       "); update vc-client");
+}
+
+Result<SelectionTest> FromProto(v1::SelectionTest t) {
+  switch (t) {
+    case v1::SELECTION_TEST_SURFACE_VISIBILITY: return SelectionTest::kSurfaceVisibility;
+    case v1::SELECTION_TEST_COMPATIBILITY: return SelectionTest::kCompatibility;
+    default: break;
+  }
+  return InvalidArgumentError("unknown selection test value " + std::to_string(int(t)) +
+                              "; use SURFACE_VISIBILITY or COMPATIBILITY");
+}
+
 v1::Progress ToProto(const ProgressEvent& e) {
   v1::Progress p;
-  p.set_stage(e.stage);
+  p.set_stage(ToProto(e.stage));
   p.set_fraction(e.fraction);
   p.set_message(e.message);
   return p;
 }
 
-ProgressEvent FromProto(const v1::Progress& p) { return {p.stage(), p.fraction(), p.message()}; }
+ProgressEvent FromProto(const v1::Progress& p) { return {FromProto(p.stage()), p.fraction(), p.message()}; }
 
 v1::PlannedStation ToProto(const PlannedStation& s) {
   v1::PlannedStation p;
@@ -303,7 +342,7 @@ v1::PlanResult ToProto(const PlanResult& r) {
   v1::PlanResult p;
   *p.mutable_options() = ToProto(r.options);
   p.set_resolution_m(r.resolution_m);
-  p.set_selection_test(r.selection_test);
+  p.set_selection_test(ToProto(r.selection_test));
   for (const auto& s : r.stations) *p.add_stations() = ToProto(s);
   *p.mutable_reduction() = ToProto(r.reduction);
   p.set_candidate_count(r.candidate_count);
@@ -316,14 +355,15 @@ v1::PlanResult ToProto(const PlanResult& r) {
   }
   for (const auto& t : r.timings) {
     auto* pt = p.add_timings();
-    pt->set_stage(t.stage);
+    pt->set_stage(ToProto(t.stage));
     pt->set_seconds(t.seconds);
   }
   for (const auto& w : r.warnings) p.add_warnings(w);
   p.set_heat_map_candidates(r.heat_map.positions.size());
   p.set_voxel_count(r.voxel_centers.size());
   p.mutable_floor_levels_m()->Add(r.floor_levels_m.begin(), r.floor_levels_m.end());
-  p.set_stop_reason(r.stop_reason);
+  p.set_stop_reason(ToProto(r.stop_reason));
+  p.set_total_seconds(r.total_seconds);
   p.set_greedy_stations(r.greedy_stations);
   p.set_consolidated(r.consolidated);
   p.set_grid_cells(r.grid_cells);
@@ -388,7 +428,7 @@ Result<PlanResult> PlanResultAssembler::Finish(const v1::PlanResult& p) && {
   PlanResult r;
   VC_ASSIGN_OR_RETURN(r.options, FromProto(p.options()));
   r.resolution_m = p.resolution_m();
-  r.selection_test = p.selection_test();
+  VC_ASSIGN_OR_RETURN(r.selection_test, FromProto(p.selection_test()));
   for (const auto& s : p.stations()) r.stations.push_back(FromProto(s));
   r.heat_map = std::move(heat_map_);
   r.reduction = FromProto(p.reduction());
@@ -398,10 +438,11 @@ Result<PlanResult> PlanResultAssembler::Finish(const v1::PlanResult& p) && {
   r.covered_voxels = p.covered_voxels();
   r.evaluation = FromProto(p.evaluation());
   r.evaluation.best_face_values = std::move(face_values_);
-  for (const auto& t : p.timings()) r.timings.push_back({t.stage(), t.seconds()});
+  for (const auto& t : p.timings()) r.timings.push_back({FromProto(t.stage()), t.seconds()});
+  r.total_seconds = p.total_seconds();
   r.warnings.assign(p.warnings().begin(), p.warnings().end());
   r.floor_levels_m.assign(p.floor_levels_m().begin(), p.floor_levels_m().end());
-  r.stop_reason = p.stop_reason();
+  VC_ASSIGN_OR_RETURN(r.stop_reason, FromProto(p.stop_reason()));
   r.greedy_stations = p.greedy_stations();
   r.consolidated = p.consolidated();
   r.grid_cells = p.grid_cells();

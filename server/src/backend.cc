@@ -3,7 +3,7 @@
 #include <cmath>
 #include <string>
 
-#include "vc/core/voxel_scene.h"
+#include "vc/scene/voxel_scene.h"
 
 namespace vc::server {
 

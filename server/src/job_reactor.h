@@ -25,9 +25,9 @@
 #include <optional>
 #include <string>
 
-#include "vc/core/progress.h"
-#include "vc/core/scene_input.h"
-#include "vc/core/status.h"
+#include "vc/base/progress.h"
+#include "vc/scene/scene_input.h"
+#include "vc/base/status.h"
 #include "vc/server/backend.h"
 #include "vc/server/server_options.h"
 #include "vc/server/status_mapping.h"
@@ -183,9 +183,9 @@ class JobReactor : public grpc::ServerBidiReactor<Request, Response> {
   }
 
   // Notes a stage's duration for the log line.
-  void NoteTiming(const std::string& stage, double seconds) {
+  void NoteTiming(std::string_view stage, double seconds) {
     std::lock_guard lock(mu_);
-    timings_ += " " + stage + "=" + fmt::format("{:.3f}s", seconds);
+    timings_ += " " + std::string(stage) + "=" + fmt::format("{:.3f}s", seconds);
   }
 
   const ServerOptions& options() const { return state_->options; }
@@ -316,16 +316,16 @@ class JobReactor : public grpc::ServerBidiReactor<Request, Response> {
     ReadOptions read_options;
     read_options.max_decompressed_bytes = state_->options.max_memory_budget_bytes;
     const auto t0 = Clock::now();
-    ctx.Report("read", 0.0, "parsing " + HumanBytes(data_.size()));
+    ctx.Report(Stage::kRead, 0.0, "parsing " + HumanBytes(data_.size()));
     const std::string source = upload_.source_name().empty() ? "upload" : upload_.source_name();
     VC_ASSIGN_OR_RETURN(SceneInput input, state_->backend.read_scene(data_, source, read_options));
-    NoteTiming("read", std::chrono::duration<double>(Clock::now() - t0).count());
+    NoteTiming(StageName(Stage::kRead), std::chrono::duration<double>(Clock::now() - t0).count());
     if (upload_.format() != v1::INPUT_FORMAT_UNSPECIFIED && wire::ToProto(input.format) != upload_.format()) {
       return InvalidArgumentError(source + " is " + std::string(InputFormatName(input.format)) +
                                   " by its content, but the spec says " + v1::InputFormat_Name(upload_.format()) +
                                   "; fix the spec's format or leave it unspecified");
     }
-    ctx.Report("read", 1.0, std::string(InputFormatName(input.format)));
+    ctx.Report(Stage::kRead, 1.0, std::string(InputFormatName(input.format)));
     data_.clear();
     data_.shrink_to_fit();
     const auto t1 = Clock::now();

@@ -75,7 +75,7 @@ class PlanReactor final : public JobReactor<v1::PlanRequest, v1::PlanResponse> {
       Post(std::move(r));
     };
     VC_ASSIGN_OR_RETURN(const PlanResult result, backend().plan(input, options_, ctx, callbacks));
-    for (const auto& t : result.timings) NoteTiming(t.stage, t.seconds);
+    for (const auto& t : result.timings) NoteTiming(StageName(t.stage), t.seconds);
     stations_ = result.stations.size();
     // The final heat map, then the voxels, then the summary: together the whole PlanResult.
     PostHeatMap(result.heat_map);

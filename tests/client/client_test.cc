@@ -13,7 +13,7 @@ namespace {
 PlanResult BigResult() {
   PlanResult r;
   r.resolution_m = 0.05;
-  r.selection_test = "surface";
+  r.selection_test = SelectionTest::kSurfaceVisibility;
   const size_t n = 2 * wire::kVoxelsPerChunk + 123;  // three voxel chunks
   for (size_t i = 0; i < n; ++i) {
     r.voxel_centers.emplace_back(0.05 * double(i % 100), 0.05 * double(i / 100), 1.0);

@@ -51,7 +51,7 @@ server::Backend BlockingBackend::Make() {
       for (size_t i = 0; i < r.stations.size(); ++i) {
         if (cb.on_station) cb.on_station(r.stations[i], int(i));
       }
-      ctx.Report("greedy", 1.0, "done");
+      ctx.Report(Stage::kSelection, 1.0, "done");
       return r;
     }
     return wait(ctx);

@@ -63,7 +63,7 @@ TEST(PlanParameters, UnsetFieldsTakeTheDefaults) {
 PlanResult BigResult(size_t voxels, size_t candidates) {
   PlanResult r;
   r.resolution_m = 0.1;
-  r.selection_test = "surface";
+  r.selection_test = SelectionTest::kSurfaceVisibility;
   for (size_t i = 0; i < voxels; ++i) {
     r.voxel_centers.emplace_back(i * 0.1, -double(i), 0.5);
     std::array<float, kFacesPerVoxel> v{};
@@ -81,11 +81,12 @@ PlanResult BigResult(size_t voxels, size_t candidates) {
   r.occupied_voxels = voxels;
   r.evaluation.per_viewpoint.resize(1);
   r.evaluation.overall.global_visibility = 0.42;
-  r.timings.push_back({"greedy", 1.5});
+  r.timings.push_back({Stage::kSelection, 1.5});
+  r.total_seconds = 2.5;
   r.warnings.push_back("w");
   r.reduction.positions = {{1, 2, 3}};
   r.floor_levels_m = {0.0, 3.1};
-  r.stop_reason = "target_reached";
+  r.stop_reason = StopReason::kTargetReached;
   r.greedy_stations = 2;
   r.consolidated = 1;
   r.grid_cells = 11;
@@ -119,11 +120,12 @@ TEST(PlanResultChunks, ReassembleExactlyAndStayUnderOneMebibyte) {
   EXPECT_EQ(back->stations[0].candidate_index, 4);
   EXPECT_EQ(back->reduction.matrix, r.reduction.matrix);
   EXPECT_DOUBLE_EQ(back->evaluation.overall.global_visibility, 0.42);
-  EXPECT_EQ(back->timings[0].stage, "greedy");
+  EXPECT_EQ(back->timings[0].stage, Stage::kSelection);
+  EXPECT_EQ(back->total_seconds, 2.5);
   EXPECT_EQ(back->warnings, r.warnings);
   EXPECT_EQ(back->reduction.positions, r.reduction.positions);
   EXPECT_EQ(back->floor_levels_m, r.floor_levels_m);
-  EXPECT_EQ(back->stop_reason, "target_reached");
+  EXPECT_EQ(back->stop_reason, StopReason::kTargetReached);
   EXPECT_EQ(back->greedy_stations, 2);
   EXPECT_EQ(back->consolidated, 1);
   EXPECT_EQ(back->grid_cells, 11u);
@@ -134,7 +136,7 @@ TEST(PlanResultChunks, ReassembleExactlyAndStayUnderOneMebibyte) {
 // A tripwire: when a field is added to PlanResult or PlanOptions, its size changes; carry the new
 // field in proto/vc/v1/planner.proto and proto/src/convert.cc (both ways), then update the sizes.
 TEST(PlanResultChunks, EveryCoreFieldIsCarried) {
-  EXPECT_EQ(sizeof(PlanResult), 704u) << "PlanResult changed: update the vc.v1 PlanResult and vc::wire";
+  EXPECT_EQ(sizeof(PlanResult), 664u) << "PlanResult changed: update the vc.v1 PlanResult and vc::wire";
   EXPECT_EQ(sizeof(PlanOptions), 152u) << "PlanOptions changed: update vc.v1 PlanParameters and vc::wire";
 }
 

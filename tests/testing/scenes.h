@@ -3,8 +3,8 @@
 
 #include <vector>
 
-#include "vc/core/scene_input.h"
-#include "vc/core/voxel_scene.h"
+#include "vc/scene/scene_input.h"
+#include "vc/scene/voxel_scene.h"
 
 namespace vc::testing {
 

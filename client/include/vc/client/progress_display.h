@@ -6,8 +6,8 @@
 #include <cstdio>
 #include <string>
 
-#include "vc/core/planner.h"
-#include "vc/core/progress.h"
+#include "vc/plan/planner.h"
+#include "vc/base/progress.h"
 
 namespace vc::client {
 
@@ -28,7 +28,7 @@ class ProgressDisplay {
   std::FILE* out_;
   bool tty_;
   bool bar_shown_ = false;
-  std::string stage_;
+  Stage stage_ = Stage::kUnspecified;
   int last_quarter_ = -1;
 };
 

@@ -12,12 +12,12 @@
 #include <functional>
 #include <vector>
 
-#include "vc/core/planner.h"
-#include "vc/core/progress.h"
-#include "vc/core/scene_input.h"
-#include "vc/core/status.h"
-#include "vc/core/visibility.h"
-#include "vc/core/voxel_scene.h"
+#include "vc/plan/planner.h"
+#include "vc/base/progress.h"
+#include "vc/scene/scene_input.h"
+#include "vc/base/status.h"
+#include "vc/visibility/visibility.h"
+#include "vc/scene/voxel_scene.h"
 #include "vc/v1/planner.pb.h"
 
 namespace vc::wire {
@@ -35,6 +35,14 @@ v1::InputFormat ToProto(InputFormat f);
 Result<InputFormat> FromProto(v1::InputFormat f);
 
 v1::SelectionTest ToProto(SelectionTest t);
+// INVALID_ARGUMENT for UNSPECIFIED or an unknown value.
+Result<SelectionTest> FromProto(v1::SelectionTest t);
+v1::Stage ToProto(Stage s);
+// kUnspecified for UNSPECIFIED or a value this build does not know (a newer server's stage).
+Stage FromProto(v1::Stage s);
+v1::StopReason ToProto(StopReason r);
+// DATA_LOSS for UNSPECIFIED or an unknown value.
+Result<StopReason> FromProto(v1::StopReason r);
 v1::FaceSet ToProto(FaceSet f);
 
 // Every field set.

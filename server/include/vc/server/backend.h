@@ -6,11 +6,11 @@
 #include <functional>
 #include <string_view>
 
-#include "vc/core/planner.h"
-#include "vc/core/progress.h"
-#include "vc/core/scene_input.h"
-#include "vc/core/status.h"
-#include "vc/core/visibility.h"
+#include "vc/plan/planner.h"
+#include "vc/base/progress.h"
+#include "vc/scene/scene_input.h"
+#include "vc/base/status.h"
+#include "vc/visibility/visibility.h"
 #include "vc/wire/convert.h"
 
 namespace vc::server {

@@ -5,7 +5,7 @@
 #include <chrono>
 #include <memory>
 
-#include "vc/core/status.h"
+#include "vc/base/status.h"
 #include "vc/server/backend.h"
 #include "vc/server/server_options.h"
 #include "vc/server/worker_pool.h"

@@ -5,8 +5,8 @@
 #include <cstdint>
 #include <string>
 
-#include "vc/core/status.h"
-#include "vc/core/voxel_scene.h"
+#include "vc/base/status.h"
+#include "vc/scene/voxel_scene.h"
 
 namespace vc::server {
 

@@ -3,7 +3,7 @@
 
 #include <grpcpp/support/status.h>
 
-#include "vc/core/status.h"
+#include "vc/base/status.h"
 
 namespace vc::server {
 

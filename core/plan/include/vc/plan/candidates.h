@@ -1,0 +1,61 @@
+// Candidate stations on the operating plane (ALGORITHM.md s.7.1; paper s.3.2).
+//
+// Standing surfaces: in every voxel column, the top voxel of each occupied run with at least
+// tripod height + clearance of free space above it. Floor levels: the dominant heights of those
+// surfaces over the whole scene (a histogram of columns, smoothed over +-0.15 m (at least 2 voxels); a level needs at
+// least a quarter of the strongest level's columns and lies at least tripod height + clearance
+// from a stronger one, so desks and shelves under a floor's ceiling do not count). A level whose
+// surfaces are mostly roofs — nothing occupied above them, another occupied run below them in the
+// same column (the outside of a ceiling) — is dropped; an open room's floor (nothing below) stays. Candidates: for each level and each cell of a grid over the occupied
+// footprint, the standing surface within +-0.15 m of that level closest to it under the cell
+// centre (in the 3 x 3 voxel columns around it) is the cell's floor (uneven floors and ramps); the candidate stands at its top +
+// tripod height, and is kept if the voxels within the clearance radius are all free. So every
+// storey of a multi-level scene gets its own candidates, each with floor below it. Internal to
+// vc_core.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+#include "vc/base/geometry.h"
+#include "vc/base/progress.h"
+#include "vc/base/status.h"
+#include "vc/scene/voxel_scene.h"
+
+namespace vc::planner {
+
+struct CandidateOptions {
+  double grid_spacing_m = 1.0;   // grid cell size (m)
+  double tripod_height_m = 1.5;  // optical centre above the floor's top (m)
+  double clearance_m = 0.2;      // free radius around the optical centre (m)
+};
+
+struct FloorLevel {
+  double z_m = 0;        // top of the level's dominant floor voxels (m)
+  uint64_t columns = 0;  // voxel columns with a standing surface within the level's band
+};
+
+struct CandidateGrid {
+  std::vector<WorldPoint> positions;  // kept candidates, level by level, then y, then x
+  std::vector<double> floor_z_m;      // per candidate: top of the floor under it (m)
+  std::vector<int> level;             // per candidate: index into levels
+  std::vector<FloorLevel> levels;     // ascending z
+  uint64_t cells = 0;                 // grid cells x levels examined
+  uint64_t rejected_no_floor = 0;     // cells without a standing surface of the level below
+  uint64_t rejected_clearance = 0;    // cells with floor, but occupied voxels within the clearance
+};
+
+// Generates the candidate grid for `scene`. CANCELLED / DEADLINE_EXCEEDED from ctx.
+Result<CandidateGrid> GenerateCandidates(const VoxelScene& scene, const CandidateOptions& options,
+                                         const JobContext& ctx = {});
+
+// True if p's voxel is free and no occupied voxel's cube comes closer than clearance_m to p.
+bool HasClearance(const OccupancyGrid& grid, const WorldPoint& p, double clearance_m);
+
+// Top (m) of the standing surface closest to `near_z_m`, within +-0.15 m (at least 2 voxels),
+// under (x, y) (3 x 3 voxel columns), or nullopt. Used to move a station during refinement.
+std::optional<double> FloorTopNear(const OccupancyGrid& grid, double x_m, double y_m, double near_z_m,
+                                   const CandidateOptions& options);
+
+}  // namespace vc::planner

@@ -1,0 +1,135 @@
+// The station planner (ALGORITHM.md section 7; paper section 3): candidates on the operating plane,
+// visibility counts (the heat map), greedy selection, optional proximity refinement, reduction,
+// and evaluation, as one cancellable pipeline reporting progress per stage.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "vc/base/geometry.h"
+#include "vc/base/progress.h"
+#include "vc/base/status.h"
+#include "vc/plan/greedy.h"
+#include "vc/visibility/visibility.h"
+#include "vc/scene/voxel_scene.h"
+
+namespace vc {
+
+struct PlanOptions {
+  // Working resolution (m); 0 = the octree's own or 0.1 m for clouds.
+  double resolution_m = 0.0;
+  uint64_t memory_budget_bytes = kDefaultMemoryBudgetBytes;
+  SelectionTest test = SelectionTest::kSurfaceVisibility;
+  ScannerModel scanner;
+  // Candidate grid over the footprint (m), tripod height above the floor (m), clearance (m).
+  double grid_spacing_m = 1.0;
+  double tripod_height_m = 1.5;
+  double clearance_m = 0.2;
+  // User-supplied candidates (world frame, m). When non-empty, replaces the generated grid.
+  std::vector<WorldPoint> candidates;
+  // Stopping rules: at most this many stations (0 = no limit); stop when the best marginal gain
+  // is below this many voxels; stop when this fraction of coverable voxels is covered. The default
+  // 0.99 stops chasing the last voxels of scan noise: on geb079, 1.0 puts a station on every one
+  // of the 123 candidates, 0.99 needs 69 and 0.95 needs 37 (docs/PLANNING.md).
+  int max_stations = 0;
+  uint64_t min_marginal_gain_voxels = 1;
+  double target_coverage = 0.99;
+  // After greedy selection: drop picks the others cover and replace two picks by one candidate
+  // that sees all they alone covered (coverage never shrinks; docs/PLANNING.md).
+  bool consolidate = true;
+  // Proximity refinement (s.7.4): move each station to the best of a sub-grid around it.
+  bool refine = false;
+  double refine_radius_m = 0.5;
+  double refine_step_m = 0.25;
+  // Reduction (s.7.5): remove zero-loss stations (default); with reduce_to > 0, keep removing the
+  // cheapest single or pair until at most reduce_to stations remain.
+  bool reduce = true;
+  int reduce_to = 0;
+  int threads = 0;
+
+  // INVALID_ARGUMENT naming the first bad parameter (non-finite, zero or negative, out of range).
+  Status Validate() const;
+};
+
+struct PlannedStation {
+  WorldPoint position;
+  uint64_t visible_voxels = 0;      // voxels passing the selection test from here
+  uint64_t marginal_gain = 0;       // new voxels when picked (greedy order)
+  double cumulative_coverage = 0;   // covered / coverable after this pick
+  double global_visibility = 0;     // G of this station alone
+  int candidate_index = -1;         // index into PlanResult::candidates, or -1 if refined off-grid
+};
+
+struct HeatMap {
+  // Candidates with their visibility count (Fig. 10); cells without a candidate are absent.
+  std::vector<WorldPoint> positions;
+  std::vector<uint64_t> visible_voxels;
+  double grid_spacing_m = 0;
+};
+
+struct Reduction {
+  // |P| x |P|, row-major: diagonal = G(P) - G(P - {i}); off-diagonal = G(P) - G(P - {i, j}).
+  std::vector<double> matrix;
+  int size = 0;
+  // Stations removed, as positions in the greedy order (before removal).
+  std::vector<int> removed;
+  double global_visibility_before = 0;
+  double global_visibility_after = 0;
+  // P: the stations the matrix is about (greedy order, after refinement), world frame (m).
+  std::vector<WorldPoint> positions;
+};
+
+struct StageTiming {
+  Stage stage = Stage::kUnspecified;
+  double seconds = 0;
+};
+
+struct PlanResult {
+  PlanOptions options;
+  double resolution_m = 0;
+  SelectionTest selection_test = SelectionTest::kSurfaceVisibility;  // the test that ran
+  std::vector<PlannedStation> stations;  // final stations, in greedy order
+  HeatMap heat_map;
+  Reduction reduction;
+  uint64_t candidate_count = 0;
+  // Generated grid: cells examined (per floor level), those with no floor below, and those whose
+  // candidate failed the clearance (0 with user candidates).
+  uint64_t grid_cells = 0;
+  uint64_t cells_without_floor = 0;
+  uint64_t cells_failing_clearance = 0;
+  uint64_t occupied_voxels = 0;
+  uint64_t coverable_voxels = 0;
+  uint64_t covered_voxels = 0;
+  Evaluation evaluation;  // of the final stations at the working resolution (with face values)
+  std::vector<StageTiming> timings;  // the stages that ran, in order
+  double total_seconds = 0;          // the whole plan, from validation to the evaluation
+  std::vector<std::string> warnings;
+  // Floor levels found for the operating plane (top of the floor, m), ascending; empty with
+  // user-supplied candidates.
+  std::vector<double> floor_levels_m;
+  // Why selection stopped (StopReasonName: "exhausted", "target_reached", "max_stations", "min_gain").
+  StopReason stop_reason = StopReason::kExhausted;
+  // Greedy picks, and how many of them consolidation saved.
+  int greedy_stations = 0;
+  int consolidated = 0;
+  // Occupied voxel centres (world, m) in id order, for visibility.ply.
+  std::vector<WorldPoint> voxel_centers;
+};
+
+// Called once with the heat map, then for each station selected (greedy order, after
+// consolidation, before refinement and reduction, so global_visibility is still 0); for streaming.
+struct PlanCallbacks {
+  std::function<void(const HeatMap&)> on_heat_map;
+  std::function<void(const PlannedStation&, int index)> on_station;
+};
+
+// Runs the whole pipeline on an already-read input. INVALID_ARGUMENT for bad options,
+// FAILED_PRECONDITION when no candidate survives, RESOURCE_EXHAUSTED over budget, CANCELLED /
+// DEADLINE_EXCEEDED from ctx.
+Result<PlanResult> Plan(const SceneInput& input, const PlanOptions& options, const JobContext& ctx = {},
+                        const PlanCallbacks& callbacks = {});
+
+}  // namespace vc

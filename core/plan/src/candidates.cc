@@ -1,0 +1,230 @@
+#include "vc/plan/candidates.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace vc::planner {
+
+namespace {
+
+struct Surface {
+  int z;          // index of the top voxel of an occupied run
+  bool covered;   // another occupied run above it in the column
+  bool has_below; // another occupied run below it in the column
+  int run;        // the run's number from the top of the column
+  // The outside of a ceiling: nothing above, a room below.
+  bool roof() const { return !covered && has_below; }
+};
+
+// Voxels of free space a standing surface needs above it.
+int FreeVoxelsNeeded(double resolution_m, const CandidateOptions& o) {
+  return std::max(1, static_cast<int>(std::ceil((o.tripod_height_m + o.clearance_m) / resolution_m - 1e-9)));
+}
+
+// Half-width (voxels) of a level's height band: 0.15 m, at least 2 voxels.
+int BandVoxels(double resolution_m) {
+  return std::max(2, static_cast<int>(std::ceil(0.15 / resolution_m - 1e-9)));
+}
+
+// Standing surfaces of column (x, y) (voxel indices), top to bottom. Outside the box is free.
+void ColumnSurfaces(const OccupancyGrid& grid, int x, int y, int free_needed, std::vector<Surface>& out) {
+  out.clear();
+  const VoxelIndex& m = grid.min_index();
+  if (x < m.x || y < m.y || x >= m.x + grid.dims().x() || y >= m.y + grid.dims().y()) return;
+  // Occupied runs from the top: each run's top voxel and the free voxels above it.
+  int free_above = std::numeric_limits<int>::max();
+  int runs = 0;
+  bool in_run = false;
+  for (int z = m.z + grid.dims().z() - 1; z >= m.z; --z) {
+    if (grid.Occupied(x, y, z)) {
+      if (!in_run) {
+        if (free_above >= free_needed) out.push_back({z, runs > 0, false, runs});
+        ++runs;
+        in_run = true;
+      }
+      free_above = 0;
+    } else {
+      in_run = false;
+      if (free_above != std::numeric_limits<int>::max()) ++free_above;
+    }
+  }
+  for (Surface& s : out) s.has_below = s.run + 1 < runs;
+}
+
+constexpr int kNoSurface = std::numeric_limits<int>::min();
+
+// The standing surface with z in [ref - band, ref + band] closest to ref (the higher on a tie) in
+// the 3 x 3 columns around (cx, cy), or kNoSurface.
+int SurfaceNear(const OccupancyGrid& grid, int cx, int cy, int ref, int band, int free_needed,
+                std::vector<Surface>& scratch) {
+  int best = kNoSurface;
+  for (int dy = -1; dy <= 1; ++dy) {
+    for (int dx = -1; dx <= 1; ++dx) {
+      ColumnSurfaces(grid, cx + dx, cy + dy, free_needed, scratch);
+      for (const Surface& s : scratch) {
+        if (s.z < ref - band || s.z > ref + band) continue;
+        const int d = std::abs(s.z - ref), d_best = best == kNoSurface ? band + 1 : std::abs(best - ref);
+        if (d < d_best || (d == d_best && s.z > best)) best = s.z;
+      }
+    }
+  }
+  return best;
+}
+
+// Grid coordinates along one axis: n cells of `spacing` centred in [lo, hi].
+std::vector<double> AxisCells(double lo, double hi, double spacing) {
+  const double extent = hi - lo;
+  const int n = std::max(1, static_cast<int>(std::floor(extent / spacing + 1e-9)));
+  const double start = lo + (extent - (n - 1) * spacing) / 2;
+  std::vector<double> v(n);
+  for (int i = 0; i < n; ++i) v[i] = start + i * spacing;
+  return v;
+}
+
+}  // namespace
+
+bool HasClearance(const OccupancyGrid& grid, const WorldPoint& p, double clearance_m) {
+  const Eigen::Vector3d u = grid.WorldToIndexSpace(p);
+  const Eigen::Vector3i own(static_cast<int>(std::floor(u.x())), static_cast<int>(std::floor(u.y())),
+                            static_cast<int>(std::floor(u.z())));
+  if (grid.Occupied(own.x(), own.y(), own.z())) return false;
+  const double c = clearance_m / grid.resolution_m();
+  if (c <= 0) return true;
+  const double c2 = c * c;
+  const Eigen::Vector3i lo((u.array() - c).floor().cast<int>());
+  const Eigen::Vector3i hi((u.array() + c).floor().cast<int>());
+  for (int z = lo.z(); z <= hi.z(); ++z) {
+    const double dz = std::max({z - u.z(), 0.0, u.z() - (z + 1)});
+    for (int y = lo.y(); y <= hi.y(); ++y) {
+      const double dy = std::max({y - u.y(), 0.0, u.y() - (y + 1)});
+      for (int x = lo.x(); x <= hi.x(); ++x) {
+        const double dx = std::max({x - u.x(), 0.0, u.x() - (x + 1)});
+        if (dx * dx + dy * dy + dz * dz < c2 && grid.Occupied(x, y, z)) return false;
+      }
+    }
+  }
+  return true;
+}
+
+std::optional<double> FloorTopNear(const OccupancyGrid& grid, double x_m, double y_m, double near_z_m,
+                                   const CandidateOptions& options) {
+  const double r = grid.resolution_m();
+  const Eigen::Vector3d u = grid.WorldToIndexSpace(WorldPoint(x_m, y_m, near_z_m));
+  // near_z_m is a surface top, i.e. the boundary above voxel round(u.z) - 1.
+  const int z_ref = static_cast<int>(std::lround(u.z())) - 1;
+  const int band = BandVoxels(r);
+  std::vector<Surface> scratch;
+  const int z = SurfaceNear(grid, static_cast<int>(std::floor(u.x())), static_cast<int>(std::floor(u.y())), z_ref,
+                            band, FreeVoxelsNeeded(r, options), scratch);
+  if (z == kNoSurface) return std::nullopt;
+  return grid.IndexSpaceToWorld(Eigen::Vector3d(0, 0, z + 1)).z();
+}
+
+Result<CandidateGrid> GenerateCandidates(const VoxelScene& scene, const CandidateOptions& options,
+                                         const JobContext& ctx) {
+  const OccupancyGrid& grid = scene.grid;
+  const double r = grid.resolution_m();
+  const int free_needed = FreeVoxelsNeeded(r, options);
+  const int band = BandVoxels(r);
+  const Eigen::Vector3i dims = grid.dims();
+  CandidateGrid out;
+
+  // 1. Histogram of standing surfaces over all columns.
+  // Histograms are indexed by z - min.z.
+  const VoxelIndex m = grid.min_index();
+  std::vector<uint64_t> hist(dims.z(), 0), roofs(dims.z(), 0);
+  std::vector<Surface> scratch;
+  for (int y = 0; y < dims.y(); ++y) {
+    if ((y & 15) == 0) {
+      VC_RETURN_IF_ERROR(ctx.CheckCancelled("candidate generation"));
+      ctx.Report(Stage::kCandidates, 0.5 * y / std::max(1, dims.y()));
+    }
+    for (int x = 0; x < dims.x(); ++x) {
+      ColumnSurfaces(grid, m.x + x, m.y + y, free_needed, scratch);
+      for (const Surface& s : scratch) {
+        ++hist[s.z - m.z];
+        if (s.roof()) ++roofs[s.z - m.z];
+      }
+    }
+  }
+
+  // 2. Dominant levels, strongest first, with suppression of weaker ones nearby.
+  auto band_sum = [&](const std::vector<uint64_t>& h, int z) {
+    uint64_t s = 0;
+    for (int k = std::max(0, z - band); k <= std::min(dims.z() - 1, z + band); ++k) s += h[k];
+    return s;
+  };
+  std::vector<uint64_t> score(dims.z());
+  for (int z = 0; z < dims.z(); ++z) score[z] = band_sum(hist, z);
+  std::vector<bool> suppressed(dims.z(), false);
+  struct Level {
+    int z;
+    uint64_t columns;
+    uint64_t roofs;
+  };
+  std::vector<Level> levels;
+  uint64_t strongest = 0;
+  for (int iter = 0; iter < 32; ++iter) {
+    int best = -1;
+    for (int z = 0; z < dims.z(); ++z) {
+      if (!suppressed[z] && score[z] > 0 && (best < 0 || score[z] > score[best])) best = z;
+    }
+    if (best < 0) break;
+    if (levels.empty()) strongest = score[best];
+    if (score[best] * 4 < strongest) break;
+    // The level's height: the fullest bin within the band.
+    int mode = best;
+    for (int k = std::max(0, best - band); k <= std::min(dims.z() - 1, best + band); ++k) {
+      if (hist[k] > hist[mode]) mode = k;
+    }
+    levels.push_back({mode, band_sum(hist, mode), band_sum(roofs, mode)});
+    for (int z = std::max(0, mode - free_needed + 1); z <= std::min(dims.z() - 1, mode + free_needed - 1); ++z) {
+      suppressed[z] = true;
+    }
+  }
+  std::sort(levels.begin(), levels.end(), [](const Level& a, const Level& b) { return a.z < b.z; });
+  // Roofs: levels whose surfaces are mostly the outside of a ceiling.
+  std::vector<Level> kept;
+  for (const Level& l : levels) {
+    if (l.roofs * 2 <= l.columns) kept.push_back(l);
+  }
+  for (const Level& l : kept) {
+    out.levels.push_back({grid.IndexSpaceToWorld(Eigen::Vector3d(0, 0, m.z + l.z + 1)).z(), l.columns});
+  }
+
+  // 3. Cells of the grid over the footprint, per level.
+  const WorldPoint lo = scene.BoundsMin(), hi = scene.BoundsMax();
+  const std::vector<double> xs = AxisCells(lo.x(), hi.x(), options.grid_spacing_m);
+  const std::vector<double> ys = AxisCells(lo.y(), hi.y(), options.grid_spacing_m);
+  for (size_t li = 0; li < kept.size(); ++li) {
+    const int lz = m.z + kept[li].z;
+    for (size_t iy = 0; iy < ys.size(); ++iy) {
+      VC_RETURN_IF_ERROR(ctx.CheckCancelled("candidate generation"));
+      ctx.Report(Stage::kCandidates, 0.5 + 0.5 * (li + static_cast<double>(iy) / ys.size()) / kept.size());
+      for (size_t ix = 0; ix < xs.size(); ++ix) {
+        ++out.cells;
+        const Eigen::Vector3d u = grid.WorldToIndexSpace(WorldPoint(xs[ix], ys[iy], lo.z()));
+        const int z = SurfaceNear(grid, static_cast<int>(std::floor(u.x())), static_cast<int>(std::floor(u.y())),
+                                  lz, band, free_needed, scratch);
+        if (z == kNoSurface) {
+          ++out.rejected_no_floor;
+          continue;
+        }
+        const double top = grid.IndexSpaceToWorld(Eigen::Vector3d(0, 0, z + 1)).z();
+        const WorldPoint p(xs[ix], ys[iy], top + options.tripod_height_m);
+        if (!HasClearance(grid, p, options.clearance_m)) {
+          ++out.rejected_clearance;
+          continue;
+        }
+        out.positions.push_back(p);
+        out.floor_z_m.push_back(top);
+        out.level.push_back(static_cast<int>(li));
+      }
+    }
+  }
+  ctx.Report(Stage::kCandidates, 1.0);
+  return out;
+}
+
+}  // namespace vc::planner

@@ -1,0 +1,44 @@
+// The files a user gets from a plan or an evaluation (written by vc-client from the streamed
+// result, and usable directly from core): plan.json, stations.csv, visibility.ply, heatmap.png,
+// reduction.png, evaluation.json. Schemas are documented in docs/PLANNING.md and docs/PROTOCOL.md.
+#pragma once
+
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "vc/base/geometry.h"
+#include "vc/plan/planner.h"
+#include "vc/base/status.h"
+#include "vc/visibility/visibility.h"
+
+namespace vc {
+
+// plan.json's content (documented schema).
+std::string PlanToJson(const PlanResult& result);
+
+// Writes plan.json, stations.csv, visibility.ply, heatmap.png and reduction.png into `out_dir`
+// (created if missing). visibility.ply needs result.voxel_centers and
+// result.evaluation.best_face_values. INTERNAL / FAILED_PRECONDITION with the path on I/O errors.
+Status WritePlanOutputs(const PlanResult& result, const std::string& out_dir);
+
+// evaluation.json's content: resolution_m, global_visibility, per_viewpoint[...] and more.
+std::string EvaluationToJson(const Evaluation& evaluation, const std::vector<WorldPoint>& viewpoints);
+Status WriteEvaluationOutputs(const Evaluation& evaluation, const std::vector<WorldPoint>& viewpoints,
+                              const std::string& out_dir);
+
+// Pixel size of a picture.
+struct ImageSize {
+  int width = 0;
+  int height = 0;
+};
+// Size of heatmap.png for `result` (layout in docs/PLANNING.md: one panel per floor level).
+ImageSize HeatmapImageSize(const PlanResult& result);
+// Size of reduction.png for a |P| x |P| matrix.
+ImageSize ReductionImageSize(int stations);
+
+// Parses a stations CSV ("x,y,z" per line, optional header line, '#' comments). INVALID_ARGUMENT
+// naming `source` and the line on a malformed or non-finite row, or when there is no station.
+Result<std::vector<WorldPoint>> ParseStationsCsv(std::string_view text, std::string_view source);
+
+}  // namespace vc

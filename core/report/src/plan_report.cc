@@ -1,0 +1,566 @@
+#include "vc/report/plan_report.h"
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <map>
+
+#include <nlohmann/json.hpp>
+
+#include "raster.h"
+
+namespace vc {
+
+namespace {
+
+using Json = nlohmann::ordered_json;
+using raster::Image;
+using raster::Rgb;
+
+// ---------- plan.json ----------
+
+Json Point(const WorldPoint& p) { return Json::array({p.x(), p.y(), p.z()}); }
+
+Json FiguresJson(const VisibilityFigures& f) {
+  return Json{{"global_visibility", f.global_visibility},
+              {"fully_visible_fraction", f.fully_visible_fraction},
+              {"mean_full_visibility", f.mean_full_visibility},
+              {"partially_visible_fraction", f.partially_visible_fraction}};
+}
+
+Json ParametersJson(const PlanOptions& o) {
+  return Json{{"resolution_m", o.resolution_m},
+              {"memory_budget_bytes", o.memory_budget_bytes},
+              {"selection_test", std::string(SelectionTestName(o.test))},
+              {"scanner", {{"min_range_m", o.scanner.min_range_m}, {"max_range_m", o.scanner.max_range_m}}},
+              {"grid_spacing_m", o.grid_spacing_m},
+              {"tripod_height_m", o.tripod_height_m},
+              {"clearance_m", o.clearance_m},
+              {"user_candidates", o.candidates.size()},
+              {"max_stations", o.max_stations},
+              {"min_marginal_gain_voxels", o.min_marginal_gain_voxels},
+              {"target_coverage", o.target_coverage},
+              {"consolidate", o.consolidate},
+              {"refine", o.refine},
+              {"refine_radius_m", o.refine_radius_m},
+              {"refine_step_m", o.refine_step_m},
+              {"reduce", o.reduce},
+              {"reduce_to", o.reduce_to},
+              {"threads", o.threads}};
+}
+
+Status WriteFile(const std::filesystem::path& path, std::string_view bytes) {
+  std::ofstream f(path, std::ios::binary | std::ios::trunc);
+  if (!f) return FailedPreconditionError("cannot open " + path.string() + " for writing");
+  f.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+  f.close();
+  if (!f) return InternalError("writing " + path.string() + " failed");
+  return Status::Ok();
+}
+
+Status MakeDir(const std::string& dir) {
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec) return FailedPreconditionError("cannot create directory " + dir + ": " + ec.message());
+  return Status::Ok();
+}
+
+std::string Fixed(double v, int decimals) {
+  char buf[64];
+  std::snprintf(buf, sizeof(buf), "%.*f", decimals, v);
+  return buf;
+}
+
+std::string Short(double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof(buf), "%.3g", v);
+  return buf;
+}
+
+std::string StationsCsv(const std::vector<WorldPoint>& points) {
+  std::string out = "x,y,z\n";
+  for (const WorldPoint& p : points) out += Fixed(p.x(), 6) + "," + Fixed(p.y(), 6) + "," + Fixed(p.z(), 6) + "\n";
+  return out;
+}
+
+// ---------- visibility.ply ----------
+
+std::string VisibilityPly(const PlanResult& r) {
+  const size_t n = std::min(r.voxel_centers.size(), r.evaluation.best_face_values.size());
+  std::string out =
+      "ply\nformat binary_little_endian 1.0\n"
+      "comment vc visibility: occupied voxel centres (m); visibility = best V over the voxel's 6 faces\n"
+      "comment colour: viridis of visibility in [0, 1]; grey = seen by no station (V = 0)\n"
+      "comment resolution_m " + Fixed(r.resolution_m, 6) + "\n"
+      "element vertex " + std::to_string(n) + "\n"
+      "property float x\nproperty float y\nproperty float z\n"
+      "property uchar red\nproperty uchar green\nproperty uchar blue\n"
+      "property float visibility\nend_header\n";
+  out.reserve(out.size() + n * 19);
+  auto put_float = [&out](float f) {
+    char b[4];
+    std::memcpy(b, &f, 4);  // x86-64 and ARM64 hosts are little-endian
+    out.append(b, 4);
+  };
+  for (size_t i = 0; i < n; ++i) {
+    const auto& faces = r.evaluation.best_face_values[i];
+    const float v = *std::max_element(faces.begin(), faces.end());
+    const Rgb c = v > 0 ? raster::Viridis(v) : Rgb{128, 128, 128};
+    put_float(static_cast<float>(r.voxel_centers[i].x()));
+    put_float(static_cast<float>(r.voxel_centers[i].y()));
+    put_float(static_cast<float>(r.voxel_centers[i].z()));
+    out.append(reinterpret_cast<const char*>(c.data()), 3);
+    put_float(v);
+  }
+  return out;
+}
+
+// ---------- heatmap.png ----------
+
+// Layout constants (pixels), documented in docs/PLANNING.md.
+constexpr int kMarginLeft = 64, kMarginTop = 40, kMarginBottom = 48, kPanelRight = 24, kLegendWidth = 110;
+constexpr int kMinPlotHeight = 180, kTargetPlot = 720;
+
+struct HeatLayout {
+  double cell_m = 1;
+  double x0 = 0, y0 = 0, x1 = 1, y1 = 1;  // footprint (m)
+  double ppm = 10;                       // pixels per metre
+  int plot_w = 0, plot_h = 0;
+  std::vector<double> panel_z;           // representative z of each panel
+  std::vector<int> candidate_panel;      // per heat-map position
+  int width = 0, height = 0;
+};
+
+// Panels: positions grouped by z (a gap over 0.5 m starts a new group); at most 4, else one.
+HeatLayout ComputeHeatLayout(const PlanResult& r) {
+  HeatLayout L;
+  const auto& pos = r.heat_map.positions;
+  L.cell_m = r.heat_map.grid_spacing_m > 0 ? r.heat_map.grid_spacing_m : 1.0;
+  std::vector<double> zs;
+  for (const WorldPoint& p : pos) zs.push_back(p.z());
+  std::sort(zs.begin(), zs.end());
+  std::vector<std::pair<double, double>> groups;  // [lo, hi]
+  for (double z : zs) {
+    if (groups.empty() || z - groups.back().second > 0.5) groups.push_back({z, z});
+    groups.back().second = z;
+  }
+  if (groups.size() > 4) groups = {{zs.front(), zs.back()}};
+  for (const auto& g : groups) L.panel_z.push_back(0.5 * (g.first + g.second));
+  if (L.panel_z.empty()) L.panel_z.push_back(0.0);
+  for (const WorldPoint& p : pos) {
+    int k = 0;
+    while (k + 1 < static_cast<int>(groups.size()) && p.z() > groups[k].second + 1e-9) ++k;
+    L.candidate_panel.push_back(k);
+  }
+  bool any = false;
+  auto grow = [&](const WorldPoint& p, double pad) {
+    if (!any) L.x0 = p.x() - pad, L.x1 = p.x() + pad, L.y0 = p.y() - pad, L.y1 = p.y() + pad, any = true;
+    L.x0 = std::min(L.x0, p.x() - pad), L.x1 = std::max(L.x1, p.x() + pad);
+    L.y0 = std::min(L.y0, p.y() - pad), L.y1 = std::max(L.y1, p.y() + pad);
+  };
+  for (const WorldPoint& p : pos) grow(p, L.cell_m / 2);
+  for (const PlannedStation& s : r.stations) grow(s.position, L.cell_m / 2);
+  if (!any) L.x0 = 0, L.x1 = 1, L.y0 = 0, L.y1 = 1;
+  const double extent = std::max({L.x1 - L.x0, L.y1 - L.y0, 1e-3});
+  L.ppm = std::clamp(std::floor(kTargetPlot / extent), 4.0, 200.0);
+  L.plot_w = static_cast<int>(std::ceil((L.x1 - L.x0) * L.ppm));
+  L.plot_h = static_cast<int>(std::ceil((L.y1 - L.y0) * L.ppm));
+  const int panels = static_cast<int>(L.panel_z.size());
+  L.width = panels * (kMarginLeft + L.plot_w + kPanelRight) + kLegendWidth;
+  L.height = kMarginTop + std::max(L.plot_h, kMinPlotHeight) + kMarginBottom;
+  return L;
+}
+
+// A tick step from 1, 2, 5 x 10^k metres with at least `min_px` pixels between ticks.
+double TickStep(double ppm, double min_px) {
+  for (double decade = 0.01; decade < 1e6; decade *= 10) {
+    for (double m : {1.0, 2.0, 5.0}) {
+      if (m * decade * ppm >= min_px) return m * decade;
+    }
+  }
+  return 1e6;
+}
+
+std::string TickLabel(double v, double step) {
+  if (std::fabs(v) < step * 1e-6) v = 0;
+  return step >= 1 ? Fixed(v, 0) : Fixed(v, step >= 0.1 ? 1 : 2);
+}
+
+// A numbered station marker: white disc, black ring, black number.
+void StationMarker(Image& img, int cx, int cy, int number, Rgb ring) {
+  const std::string label = std::to_string(number);
+  const int radius = std::max(10, raster::TextWidth(label) / 2 + 5);
+  img.FillCircle(cx, cy, radius + 1, ring);
+  img.FillCircle(cx, cy, radius - 1, raster::kWhite);
+  img.Text(cx - raster::TextWidth(label) / 2, cy - raster::kGlyphH / 2, label, raster::kBlack);
+}
+
+// A vertical colour bar at (x, y) of size 16 x h from 0 (bottom) to max (top), with labels.
+void ColourBar(Image& img, int x, int y, int h, double max_value, const std::string& title, bool integer) {
+  for (int k = 0; k < h; ++k) img.HLine(x, x + 15, y + h - 1 - k, raster::Viridis(h > 1 ? double(k) / (h - 1) : 0));
+  img.StrokeRect(x, y, x + 16, y + h, raster::kBlack);
+  for (int i = 0; i <= 4; ++i) {
+    const double v = max_value * i / 4.0;
+    const int ty = y + h - 1 - static_cast<int>(std::lround((h - 1) * i / 4.0));
+    img.HLine(x + 16, x + 19, ty, raster::kBlack);
+    img.Text(x + 22, ty - 3, integer ? Fixed(std::round(v), 0) : Short(v), raster::kBlack);
+  }
+  img.Text(x - 2, y - 14, title, raster::kBlack);
+}
+
+Image DrawHeatmap(const PlanResult& r) {
+  const HeatLayout L = ComputeHeatLayout(r);
+  Image img(L.width, L.height);
+  uint64_t max_count = 0;
+  for (uint64_t c : r.heat_map.visible_voxels) max_count = std::max(max_count, c);
+  const double denom = max_count > 0 ? static_cast<double>(max_count) : 1.0;
+  const int top = kMarginTop;
+  auto px = [&](int panel, double x) {
+    return panel * (kMarginLeft + L.plot_w + kPanelRight) + kMarginLeft +
+           static_cast<int>(std::lround((x - L.x0) * L.ppm));
+  };
+  auto py = [&](double y) { return top + static_cast<int>(std::lround((L.y1 - y) * L.ppm)); };
+  const double step = TickStep(L.ppm, 48);
+  for (size_t p = 0; p < L.panel_z.size(); ++p) {
+    const int pl = static_cast<int>(p);
+    const int left = px(pl, L.x0);
+    img.FillRect(left, top, left + L.plot_w, top + L.plot_h, Rgb{235, 235, 235});
+    for (size_t i = 0; i < r.heat_map.positions.size(); ++i) {
+      if (L.candidate_panel[i] != pl) continue;
+      const WorldPoint& c = r.heat_map.positions[i];
+      const double h = L.cell_m / 2;
+      const uint64_t count = i < r.heat_map.visible_voxels.size() ? r.heat_map.visible_voxels[i] : 0;
+      img.FillRect(px(pl, c.x() - h), py(c.y() + h), px(pl, c.x() + h), py(c.y() - h), raster::Viridis(count / denom));
+    }
+    img.StrokeRect(left, top, left + L.plot_w, top + L.plot_h, raster::kBlack);
+    // Axes in metres.
+    for (double v = std::ceil(L.x0 / step) * step; v <= L.x1 + 1e-9; v += step) {
+      const int x = px(pl, v);
+      img.VLine(x, top + L.plot_h, top + L.plot_h + 4, raster::kBlack);
+      const std::string s = TickLabel(v, step);
+      img.Text(x - raster::TextWidth(s) / 2, top + L.plot_h + 8, s, raster::kBlack);
+    }
+    for (double v = std::ceil(L.y0 / step) * step; v <= L.y1 + 1e-9; v += step) {
+      const int y = py(v);
+      img.HLine(left - 5, left - 1, y, raster::kBlack);
+      const std::string s = TickLabel(v, step);
+      img.Text(left - 8 - raster::TextWidth(s), y - 3, s, raster::kBlack);
+    }
+    const std::string xl = "x (m)";
+    img.Text(left + L.plot_w / 2 - raster::TextWidth(xl) / 2, top + L.plot_h + 24, xl, raster::kBlack);
+    img.TextVertical(left - kMarginLeft + 4, top + L.plot_h / 2 - raster::TextWidth("y (m)") / 2, "y (m)", raster::kBlack);
+    std::string title = "VISIBLE VOXELS PER CANDIDATE";
+    if (L.panel_z.size() > 1 || !r.floor_levels_m.empty()) title += "  z = " + Fixed(L.panel_z[p], 2) + " m";
+    img.Text(left, 10, title, raster::kBlack, 2);
+  }
+  // Stations, numbered in plan order, on the panel of their height.
+  for (size_t k = 0; k < r.stations.size(); ++k) {
+    const WorldPoint& s = r.stations[k].position;
+    int panel = 0;
+    double best = 1e300;
+    for (size_t p = 0; p < L.panel_z.size(); ++p) {
+      if (std::fabs(L.panel_z[p] - s.z()) < best) best = std::fabs(L.panel_z[p] - s.z()), panel = static_cast<int>(p);
+    }
+    StationMarker(img, px(panel, s.x()), py(s.y()), static_cast<int>(k) + 1, raster::kRed);
+  }
+  const int bar_x = L.width - kLegendWidth + 20;
+  ColourBar(img, bar_x, top + 14, std::max(L.plot_h, kMinPlotHeight) - 14, static_cast<double>(max_count), "VOXELS", true);
+  return img;
+}
+
+// ---------- reduction.png ----------
+
+constexpr int kRedLeft = 56, kRedTop = 52, kRedBottom = 48, kRedLegend = 120, kRedMinH = 180;
+constexpr const char* kRedTitle = "REDUCTION POTENTIAL G(P) - G(P-T)";
+constexpr const char* kRedSubtitle = "DIAGONAL: T = [I]   OFF-DIAGONAL: T = [I, J]   RED: REMOVED";
+
+int ReductionCell(int n) { return std::clamp(480 / std::max(n, 1), 14, 48); }
+
+Image DrawReduction(const PlanResult& r) {
+  const int n = r.reduction.size;
+  const ImageSize size = ReductionImageSize(n);
+  Image img(size.width, size.height);
+  const int cell = ReductionCell(n);
+  double max_loss = 0;
+  for (double v : r.reduction.matrix) max_loss = std::max(max_loss, v);
+  const double denom = max_loss > 0 ? max_loss : 1.0;
+  std::vector<bool> removed(std::max(n, 0), false);
+  for (int k : r.reduction.removed) {
+    if (k >= 0 && k < n) removed[k] = true;
+  }
+  img.Text(kRedLeft, 8, kRedTitle, raster::kBlack, 2);
+  img.Text(kRedLeft, 28, kRedSubtitle, raster::kDarkGrey);
+  if (n == 0) {
+    img.Text(kRedLeft, kRedTop + 10, "NO STATIONS", raster::kBlack);
+    return img;
+  }
+  for (int i = 0; i < n; ++i) {
+    for (int j = 0; j < n; ++j) {
+      const size_t idx = static_cast<size_t>(i) * n + j;
+      const double v = idx < r.reduction.matrix.size() ? r.reduction.matrix[idx] : 0.0;
+      const Rgb c = raster::Viridis(v / denom);
+      const int x0 = kRedLeft + j * cell, y0 = kRedTop + i * cell;
+      img.FillRect(x0, y0, x0 + cell - 1, y0 + cell - 1, c);
+      // The value inside the cell when it fits, dark on light colours and light on dark ones.
+      const std::string label = Short(v);
+      if (raster::TextWidth(label) + 4 <= cell - 1) {
+        const bool light = 0.299 * c[0] + 0.587 * c[1] + 0.114 * c[2] > 140;
+        img.Text(x0 + (cell - 1 - raster::TextWidth(label)) / 2, y0 + (cell - 1 - raster::kGlyphH) / 2, label,
+                 light ? raster::kBlack : raster::kWhite);
+      }
+    }
+  }
+  img.StrokeRect(kRedLeft, kRedTop, kRedLeft + n * cell - 1, kRedTop + n * cell - 1, raster::kBlack);
+  const int label_every = std::max(1, (raster::TextWidth(std::to_string(n)) + 4 + cell - 1) / cell);
+  for (int i = 0; i < n; i += label_every) {
+    const std::string s = std::to_string(i + 1);
+    const Rgb c = removed[i] ? raster::kRed : raster::kBlack;
+    img.Text(kRedLeft + i * cell + cell / 2 - raster::TextWidth(s) / 2, kRedTop + n * cell + 6, s, c);
+    img.Text(kRedLeft - 6 - raster::TextWidth(s), kRedTop + i * cell + cell / 2 - 3, s, c);
+  }
+  for (int i = 0; i < n; ++i) {
+    if (removed[i]) {
+      img.StrokeRect(kRedLeft + i * cell + 1, kRedTop + i * cell + 1, kRedLeft + (i + 1) * cell - 2,
+                     kRedTop + (i + 1) * cell - 2, raster::kRed);
+    }
+  }
+  img.Text(kRedLeft, kRedTop + n * cell + 22, "STATION (GREEDY ORDER)", raster::kBlack);
+  const int bar_h = std::max(n * cell, kRedMinH) - 14;
+  ColourBar(img, kRedLeft + n * cell + 24, kRedTop + 14, bar_h, max_loss, "G LOST", false);
+  return img;
+}
+
+// ---------- evaluation.json ----------
+
+Json EvaluationJson(const Evaluation& e, const std::vector<WorldPoint>& viewpoints) {
+  Json per = Json::array();
+  for (size_t i = 0; i < e.per_viewpoint.size(); ++i) {
+    Json v{{"index", i}};
+    if (i < viewpoints.size()) {
+      v["x"] = viewpoints[i].x();
+      v["y"] = viewpoints[i].y();
+      v["z"] = viewpoints[i].z();
+    }
+    const Json figures = FiguresJson(e.per_viewpoint[i]);
+    for (const auto& item : figures.items()) v[item.key()] = item.value();
+    per.push_back(std::move(v));
+  }
+  Json j{{"resolution_m", e.resolution_m},
+         {"faces_total", e.faces_total},
+         {"faces_evaluated", e.faces_evaluated},
+         {"sampled", e.sampled},
+         {"global_visibility", e.overall.global_visibility},
+         {"global_visibility_ci95", e.global_visibility_ci95},
+         {"fully_visible_fraction", e.overall.fully_visible_fraction},
+         {"mean_full_visibility", e.overall.mean_full_visibility},
+         {"partially_visible_fraction", e.overall.partially_visible_fraction},
+         {"per_viewpoint", std::move(per)}};
+  return j;
+}
+
+// ---------- CSV parsing ----------
+
+std::string_view Trim(std::string_view s) {
+  while (!s.empty() && std::isspace(static_cast<unsigned char>(s.front()))) s.remove_prefix(1);
+  while (!s.empty() && std::isspace(static_cast<unsigned char>(s.back()))) s.remove_suffix(1);
+  return s;
+}
+
+bool ParseDouble(std::string_view s, double* out) {
+  s = Trim(s);
+  if (!s.empty() && s.front() == '+') s.remove_prefix(1);
+  if (s.empty()) return false;
+  const auto [ptr, ec] = std::from_chars(s.data(), s.data() + s.size(), *out);
+  return ec == std::errc() && ptr == s.data() + s.size();
+}
+
+std::vector<std::string_view> SplitFields(std::string_view line) {
+  std::vector<std::string_view> fields;
+  const bool commas = line.find(',') != std::string_view::npos || line.find(';') != std::string_view::npos;
+  size_t start = 0;
+  for (size_t i = 0; i <= line.size(); ++i) {
+    const bool sep = i == line.size() ||
+                     (commas ? (line[i] == ',' || line[i] == ';') : std::isspace(static_cast<unsigned char>(line[i])));
+    if (!sep) continue;
+    std::string_view f = Trim(line.substr(start, i - start));
+    if (commas || !f.empty()) fields.push_back(f);
+    start = i + 1;
+  }
+  return fields;
+}
+
+}  // namespace
+
+std::string PlanToJson(const PlanResult& r) {
+  Json viewpoints = Json::array();
+  for (size_t k = 0; k < r.stations.size(); ++k) {
+    const PlannedStation& s = r.stations[k];
+    Json v{{"index", k},
+           {"x", s.position.x()},
+           {"y", s.position.y()},
+           {"z", s.position.z()},
+           {"compatible_voxels", s.visible_voxels},
+           {"marginal_gain", s.marginal_gain},
+           {"cumulative_coverage", s.cumulative_coverage},
+           {"global_visibility", s.global_visibility},
+           {"candidate_index", s.candidate_index}};
+    if (k < r.evaluation.per_viewpoint.size()) {
+      v["fully_visible_fraction"] = r.evaluation.per_viewpoint[k].fully_visible_fraction;
+      v["partially_visible_fraction"] = r.evaluation.per_viewpoint[k].partially_visible_fraction;
+    }
+    viewpoints.push_back(std::move(v));
+  }
+  const double coverable = static_cast<double>(r.coverable_voxels);
+  const double occupied = static_cast<double>(r.occupied_voxels);
+  Json coverage{{"occupied_voxels", r.occupied_voxels},
+                {"coverable_voxels", r.coverable_voxels},
+                {"covered_voxels", r.covered_voxels},
+                {"uncovered_voxels", r.occupied_voxels - std::min(r.occupied_voxels, r.covered_voxels)},
+                {"uncoverable_voxels", r.occupied_voxels - std::min(r.occupied_voxels, r.coverable_voxels)},
+                {"covered_fraction_of_coverable", coverable > 0 ? r.covered_voxels / coverable : 0.0},
+                {"covered_fraction_of_occupied", occupied > 0 ? r.covered_voxels / occupied : 0.0},
+                {"global_visibility", r.evaluation.overall.global_visibility},
+                {"fully_visible_fraction", r.evaluation.overall.fully_visible_fraction},
+                {"mean_full_visibility", r.evaluation.overall.mean_full_visibility},
+                {"partially_visible_fraction", r.evaluation.overall.partially_visible_fraction},
+                {"faces_total", r.evaluation.faces_total}};
+  Json matrix = Json::array();
+  for (int i = 0; i < r.reduction.size; ++i) {
+    Json row = Json::array();
+    for (int j = 0; j < r.reduction.size; ++j) {
+      const size_t idx = static_cast<size_t>(i) * r.reduction.size + j;
+      row.push_back(idx < r.reduction.matrix.size() ? r.reduction.matrix[idx] : 0.0);
+    }
+    matrix.push_back(std::move(row));
+  }
+  Json reduction_positions = Json::array();
+  for (const WorldPoint& p : r.reduction.positions) reduction_positions.push_back(Point(p));
+  Json reduction{{"size", r.reduction.size},
+                 {"stations", std::move(reduction_positions)},
+                 {"matrix", std::move(matrix)},
+                 {"removed", r.reduction.removed},
+                 {"global_visibility_before", r.reduction.global_visibility_before},
+                 {"global_visibility_after", r.reduction.global_visibility_after}};
+  Json heat = Json::array();
+  for (size_t i = 0; i < r.heat_map.positions.size(); ++i) {
+    const WorldPoint& p = r.heat_map.positions[i];
+    heat.push_back({p.x(), p.y(), p.z(), i < r.heat_map.visible_voxels.size() ? r.heat_map.visible_voxels[i] : 0});
+  }
+  Json candidates{{"count", r.candidate_count},
+                  {"grid_spacing_m", r.heat_map.grid_spacing_m},
+                  {"floor_levels_m", r.floor_levels_m},
+                  {"grid_cells", r.grid_cells},
+                  {"cells_without_floor", r.cells_without_floor},
+                  {"cells_failing_clearance", r.cells_failing_clearance},
+                  {"visible_voxels", std::move(heat)}};
+  Json timings = Json::object();
+  for (const StageTiming& t : r.timings) timings[std::string(StageName(t.stage))] = t.seconds;
+  timings["total"] = r.total_seconds;
+  Json j{{"schema", "vc.plan/1"},
+         {"resolution_m", r.resolution_m},
+         {"selection_test", std::string(SelectionTestName(r.selection_test))},
+         {"stop_reason", std::string(StopReasonName(r.stop_reason))},
+         {"greedy_stations", r.greedy_stations},
+         {"consolidated", r.consolidated},
+         {"viewpoints", std::move(viewpoints)},
+         {"coverage", std::move(coverage)},
+         {"reduction", std::move(reduction)},
+         {"candidates", std::move(candidates)},
+         {"timings_s", std::move(timings)},
+         {"parameters", ParametersJson(r.options)},
+         {"warnings", r.warnings}};
+  return j.dump(2) + "\n";
+}
+
+ImageSize HeatmapImageSize(const PlanResult& result) {
+  const HeatLayout L = ComputeHeatLayout(result);
+  return {L.width, L.height};
+}
+
+ImageSize ReductionImageSize(int stations) {
+  const int n = std::max(stations, 0);
+  const int cell = ReductionCell(n);
+  const int title_w = std::max(raster::TextWidth(kRedTitle, 2), raster::TextWidth(kRedSubtitle)) + 2 * kRedLeft;
+  return {std::max(kRedLeft + n * cell + kRedLegend, title_w), kRedTop + std::max(n * cell, kRedMinH) + kRedBottom};
+}
+
+Status WritePlanOutputs(const PlanResult& result, const std::string& out_dir) {
+  VC_RETURN_IF_ERROR(MakeDir(out_dir));
+  const std::filesystem::path dir(out_dir);
+  VC_RETURN_IF_ERROR(WriteFile(dir / "plan.json", PlanToJson(result)));
+  std::vector<WorldPoint> stations;
+  for (const PlannedStation& s : result.stations) stations.push_back(s.position);
+  VC_RETURN_IF_ERROR(WriteFile(dir / "stations.csv", StationsCsv(stations)));
+  if (result.voxel_centers.size() != result.evaluation.best_face_values.size()) {
+    return FailedPreconditionError("visibility.ply needs one best_face_values entry per voxel centre (" +
+                                   std::to_string(result.voxel_centers.size()) + " centres, " +
+                                   std::to_string(result.evaluation.best_face_values.size()) + " face values)");
+  }
+  VC_RETURN_IF_ERROR(WriteFile(dir / "visibility.ply", VisibilityPly(result)));
+  VC_ASSIGN_OR_RETURN(std::string heat, raster::EncodePng(DrawHeatmap(result)));
+  VC_RETURN_IF_ERROR(WriteFile(dir / "heatmap.png", heat));
+  VC_ASSIGN_OR_RETURN(std::string red, raster::EncodePng(DrawReduction(result)));
+  VC_RETURN_IF_ERROR(WriteFile(dir / "reduction.png", red));
+  return Status::Ok();
+}
+
+std::string EvaluationToJson(const Evaluation& evaluation, const std::vector<WorldPoint>& viewpoints) {
+  return EvaluationJson(evaluation, viewpoints).dump(2) + "\n";
+}
+
+Status WriteEvaluationOutputs(const Evaluation& evaluation, const std::vector<WorldPoint>& viewpoints,
+                              const std::string& out_dir) {
+  VC_RETURN_IF_ERROR(MakeDir(out_dir));
+  const std::filesystem::path dir(out_dir);
+  VC_RETURN_IF_ERROR(WriteFile(dir / "evaluation.json", EvaluationToJson(evaluation, viewpoints)));
+  VC_RETURN_IF_ERROR(WriteFile(dir / "stations.csv", StationsCsv(viewpoints)));
+  return Status::Ok();
+}
+
+Result<std::vector<WorldPoint>> ParseStationsCsv(std::string_view text, std::string_view source) {
+  std::vector<WorldPoint> out;
+  bool seen_data_line = false;
+  size_t line_no = 0;
+  size_t pos = 0;
+  while (pos <= text.size()) {
+    const size_t end = std::min(text.find('\n', pos), text.size());
+    std::string_view line = text.substr(pos, end - pos);
+    pos = end + 1;
+    ++line_no;
+    if (const size_t hash = line.find('#'); hash != std::string_view::npos) line = line.substr(0, hash);
+    line = Trim(line);
+    if (line.empty()) {
+      if (end == text.size()) break;
+      continue;
+    }
+    const std::vector<std::string_view> fields = SplitFields(line);
+    double v[3];
+    const bool numeric = fields.size() == 3 && ParseDouble(fields[0], &v[0]) && ParseDouble(fields[1], &v[1]) &&
+                         ParseDouble(fields[2], &v[2]);
+    const std::string where = std::string(source) + ":" + std::to_string(line_no) + ": ";
+    if (!numeric) {
+      // One header line is allowed, before any station: fields without digits (e.g. "x,y,z").
+      const bool header = !seen_data_line &&
+                          std::none_of(line.begin(), line.end(), [](char c) { return std::isdigit(static_cast<unsigned char>(c)); });
+      if (header) {
+        seen_data_line = true;
+        continue;
+      }
+      return InvalidArgumentError(where + "expected 3 numbers \"x,y,z\" (metres), found \"" + std::string(line) + "\"");
+    }
+    if (!std::isfinite(v[0]) || !std::isfinite(v[1]) || !std::isfinite(v[2])) {
+      return InvalidArgumentError(where + "coordinates must be finite, found \"" + std::string(line) + "\"");
+    }
+    seen_data_line = true;
+    out.emplace_back(v[0], v[1], v[2]);
+    if (end == text.size()) break;
+  }
+  if (out.empty()) return InvalidArgumentError(std::string(source) + ": no station found (expected lines \"x,y,z\")");
+  return out;
+}
+
+}  // namespace vc

@@ -1,0 +1,67 @@
+// The one place that talks to OctoMap. Everything else in vc sees VoxelKey, WorldPoint and Status.
+//
+// OctoMap squeezes several outcomes into a bool (castRay), prints errors to stderr and uses float
+// points; this adapter turns those into explicit results. Thread-safety: functions taking a const
+// tree may run concurrently on the same tree; OctoMap's own tree classes are not thread-safe for
+// writing.
+#pragma once
+
+#include <functional>
+#include <memory>
+#include <string_view>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "vc/base/geometry.h"
+#include "vc/base/status.h"
+
+namespace octomap {
+class OcTree;
+}
+
+namespace vc {
+
+// Parses an OctoMap binary stream (.bt). INVALID_ARGUMENT naming `source` when malformed.
+Result<std::shared_ptr<octomap::OcTree>> ReadOctreeBinary(std::string_view bytes, std::string_view source);
+
+// Parses an OctoMap full stream (.ot) holding an OcTree. INVALID_ARGUMENT when malformed or when
+// the stream holds another tree type (e.g. ColorOcTree is accepted only as its occupancy).
+Result<std::shared_ptr<octomap::OcTree>> ReadOctreeText(std::string_view bytes, std::string_view source);
+
+// A scan graph (.graph): every node's points transformed to the world frame, and each node's origin.
+struct ScanGraphData {
+  std::vector<Eigen::Vector3f> points;
+  std::vector<Eigen::Vector3d> origins;
+  uint64_t dropped_nonfinite = 0;
+};
+Result<ScanGraphData> ReadScanGraph(std::string_view bytes, std::string_view source);
+
+// Resolution of a tree, in metres.
+double OctreeResolution(const octomap::OcTree& tree);
+
+// Number of occupied leaves of the tree (at any depth), as OctoMap counts them.
+size_t CountOccupiedLeaves(const octomap::OcTree& tree);
+
+// Calls fn(min_corner, edge_m) for every occupied leaf: the leaf's cube in world coordinates.
+void ForEachOccupiedLeaf(const octomap::OcTree& tree,
+                         const std::function<void(const WorldPoint& min_corner, double edge_m)>& fn);
+
+// Metric bounding box of the tree's occupied leaves. Empty tree: min > max.
+void OccupiedBoundingBox(const octomap::OcTree& tree, WorldPoint* min, WorldPoint* max);
+
+// Builds an OcTree of `resolution_m` with exactly `occupied` as occupied voxels (others unknown),
+// pruned. The key numbers are the same at equal resolution.
+std::shared_ptr<octomap::OcTree> BuildOctree(double resolution_m, const std::vector<VoxelKey>& occupied);
+
+// What octomap::OcTree::castRay reported, made explicit.
+struct CastRayOutcome {
+  enum class Kind { kHitOccupied, kNoHit };
+  Kind kind = Kind::kNoHit;
+  VoxelKey hit;  // valid when kind == kHitOccupied
+};
+// octomap::OcTree::castRay from `origin` along `direction` up to `max_range_m`, unknown cells free.
+CastRayOutcome OctomapCastRay(const octomap::OcTree& tree, const WorldPoint& origin,
+                              const Eigen::Vector3d& direction, double max_range_m);
+
+}  // namespace vc

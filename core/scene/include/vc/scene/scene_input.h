@@ -1,0 +1,79 @@
+// Reading every input format a user brings: point clouds and OctoMap octrees.
+//
+// The format is detected from the content (magic bytes, header), never from the file name.
+// gzip- and bzip2-compressed copies of the text formats are decompressed transparently. Every
+// failure is a Status whose message names the source, the byte offset or line, what was expected
+// and what was found. Non-finite points are dropped and counted. Sizes declared in headers are
+// checked against the bytes actually present before any allocation, so a lying header cannot
+// trigger a huge allocation. Thread-safe: functions here share no state.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "vc/base/status.h"
+
+namespace octomap {
+class OcTree;
+}
+
+namespace vc {
+
+enum class InputFormat {
+  kPly,
+  kPcd,
+  kXyz,            // ASCII x y z per line (space, comma or tab), optional header line
+  kLas,            // ASPRS LAS 1.0-1.4, uncompressed
+  kOctomapBinary,  // OctoMap .bt
+  kOctomapText,    // OctoMap .ot (full, any AbstractOcTree stream of type OcTree)
+  kOctomapGraph,   // OctoMap ScanGraph .graph (points plus each scan's origin)
+};
+
+// "ply", "pcd", "xyz", "las", "octomap-bt", "octomap-ot", "octomap-graph".
+std::string_view InputFormatName(InputFormat format);
+
+enum class Compression { kNone, kGzip, kBzip2 };
+std::string_view CompressionName(Compression c);  // "none", "gzip", "bzip2"
+
+// Limits that protect the process from hostile or broken inputs.
+struct ReadOptions {
+  // Refuse inputs that would decompress to more than this many bytes.
+  uint64_t max_decompressed_bytes = uint64_t{8} << 30;
+  // Refuse clouds with more points than this (checked against the header before reading).
+  uint64_t max_points = 1'000'000'000;
+};
+
+// What was read. Exactly one of `points` (point formats, .graph) or `octree` (.bt/.ot) is filled.
+struct SceneInput {
+  InputFormat format = InputFormat::kXyz;
+  Compression compression = Compression::kNone;
+  // Format specifics for people, e.g. "binary_little_endian 1.0", "binary_compressed", "LAS 1.2 PDRF 1".
+  std::string detail;
+  // Points in metres, world frame (LAS scale and offset applied). Non-finite points are not here.
+  std::vector<Eigen::Vector3f> points;
+  // .graph only: the sensor origin of each scan, in metres, world frame.
+  std::vector<Eigen::Vector3d> scan_origins;
+  // .bt/.ot only: the tree as read, at its own resolution.
+  std::shared_ptr<const octomap::OcTree> octree;
+  // Points dropped because a coordinate was NaN or infinite.
+  uint64_t dropped_nonfinite = 0;
+
+  bool is_octree() const { return octree != nullptr; }
+};
+
+// Detects the format of `bytes` (after decompression) and parses it. `source_name` only labels
+// error messages (a file name or "upload"). Errors: INVALID_ARGUMENT for malformed or unsupported
+// content (truncated, wrong counts, unknown types, LAZ, empty cloud), RESOURCE_EXHAUSTED when a
+// limit in `options` is exceeded.
+Result<SceneInput> ReadScene(std::string_view bytes, std::string_view source_name,
+                             const ReadOptions& options = {});
+
+// Reads a whole file and calls ReadScene. NOT_FOUND if it cannot be opened.
+Result<SceneInput> ReadSceneFile(const std::string& path, const ReadOptions& options = {});
+
+}  // namespace vc

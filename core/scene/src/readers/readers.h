@@ -1,0 +1,157 @@
+// Internal to vc_core: the per-format readers behind vc::ReadScene (scene_input.h).
+//
+// Each reader takes the whole (already decompressed) input as bytes and returns the points or a
+// Status whose message starts with the source name and names the line or byte offset, what was
+// expected and what was found. Readers never throw and never read outside `bytes`: every read is
+// bounds-checked, and counts declared in headers are checked against the bytes present before any
+// allocation. Thread-safe: no shared state.
+#pragma once
+
+#include <Eigen/Core>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "vc/scene/scene_input.h"
+#include "vc/base/status.h"
+
+namespace vc::readers {
+
+// Points read by a point-cloud reader.
+struct PointCloud {
+  // Finite points, in the file's units (metres by convention).
+  std::vector<Eigen::Vector3f> points;
+  // Points dropped because a coordinate was NaN, infinite or beyond float range.
+  uint64_t dropped_nonfinite = 0;
+  // Format specifics for people, e.g. "binary_little_endian 1.0".
+  std::string detail;
+
+  // Appends (x, y, z) if all are finite as floats, else counts it as dropped.
+  void Add(double x, double y, double z) {
+    const float fx = static_cast<float>(x), fy = static_cast<float>(y), fz = static_cast<float>(z);
+    if (std::isfinite(fx) && std::isfinite(fy) && std::isfinite(fz)) {
+      points.emplace_back(fx, fy, fz);
+    } else {
+      ++dropped_nonfinite;
+    }
+  }
+};
+
+// --- Compression (decompress.cc) ---
+
+// Compression recognised from the leading magic bytes; kNone if none.
+Compression DetectCompression(std::string_view bytes);
+// Name of an unsupported container/compressor recognised by its magic ("xz", "zstd", "zip"), or "".
+std::string_view DetectUnsupportedCompression(std::string_view bytes);
+// Inflates a gzip/zlib (possibly multi-member) or bzip2 (possibly multi-stream) input.
+// INVALID_ARGUMENT for truncated or corrupt streams, RESOURCE_EXHAUSTED past `max_bytes`.
+Result<std::string> Decompress(std::string_view bytes, Compression compression,
+                               std::string_view source, uint64_t max_bytes);
+// Decompresses one LZF block (liblzf format, as PCD binary_compressed uses) of exactly
+// `expected_size` bytes. INVALID_ARGUMENT (message without source) when corrupt or the size
+// differs.
+Result<std::string> LzfDecompress(std::string_view compressed, size_t expected_size);
+
+// --- Format readers ---
+
+// True if `bytes` starts with the PLY magic line.
+bool LooksLikePly(std::string_view bytes);
+// Reads PLY ascii / binary_little_endian / binary_big_endian (ply_reader.cc).
+Result<PointCloud> ReadPly(std::string_view bytes, std::string_view source,
+                           const ReadOptions& options);
+
+// True if the first non-comment header line is a PCD keyword (VERSION, FIELDS).
+bool LooksLikePcd(std::string_view bytes);
+// Reads PCD v0.7 ascii / binary / binary_compressed (pcd_reader.cc).
+Result<PointCloud> ReadPcd(std::string_view bytes, std::string_view source,
+                           const ReadOptions& options);
+
+// True if `bytes` starts with "LASF".
+bool LooksLikeLas(std::string_view bytes);
+// Reads ASPRS LAS 1.0-1.4, point formats 0-10, uncompressed (las_reader.cc).
+Result<PointCloud> ReadLas(std::string_view bytes, std::string_view source,
+                           const ReadOptions& options);
+
+// True if the start of `bytes` is plain text (printable ASCII, UTF-8 and whitespace, no NUL).
+bool LooksLikeText(std::string_view bytes);
+// Reads ASCII x y z per line, space/comma/tab separated, optional header line (xyz_reader.cc).
+Result<PointCloud> ReadXyz(std::string_view bytes, std::string_view source,
+                           const ReadOptions& options);
+
+// --- Shared helpers ---
+
+// "source: message" as an INVALID_ARGUMENT status.
+inline Status InvalidInput(std::string_view source, std::string_view message) {
+  std::string m(source);
+  m += ": ";
+  m += message;
+  return InvalidArgumentError(std::move(m));
+}
+
+// RESOURCE_EXHAUSTED when a declared point count is above options.max_points.
+inline Status CheckPointLimit(uint64_t declared, std::string_view what, std::string_view source,
+                              const ReadOptions& options) {
+  if (declared <= options.max_points) return Status::Ok();
+  return ResourceExhaustedError(std::string(source) + ": " + std::string(what) + " declares " +
+                                std::to_string(declared) + " points, more than the limit of " +
+                                std::to_string(options.max_points));
+}
+
+// Parses all of `token` as a decimal floating-point number (leading '+' allowed, "nan"/"inf" too).
+bool ParseDouble(std::string_view token, double* value);
+// Parses all of `token` as a non-negative decimal integer that fits in uint64.
+bool ParseUint64(std::string_view token, uint64_t* value);
+// `text` shortened to at most 40 characters for error messages, non-printables escaped.
+std::string Quote(std::string_view text);
+
+// Splits `text` at runs of space/tab characters.
+std::vector<std::string_view> SplitWhitespace(std::string_view text);
+
+// Reads a T stored at bytes[offset] (caller checked bounds) in little- or big-endian order.
+template <typename T>
+T LoadScalar(const char* p, bool big_endian) {
+  unsigned char b[sizeof(T)];
+  std::memcpy(b, p, sizeof(T));
+  if (big_endian) {
+    for (size_t i = 0; i < sizeof(T) / 2; ++i) std::swap(b[i], b[sizeof(T) - 1 - i]);
+  }
+  T v;
+  std::memcpy(&v, b, sizeof(T));
+  return v;
+}
+
+// A line cursor over text: yields lines without their "\n" / "\r\n", tracking 1-based numbers and
+// byte offsets.
+class LineCursor {
+ public:
+  explicit LineCursor(std::string_view text) : text_(text) {}
+  // Next line into *line; false at end of text.
+  bool Next(std::string_view* line) {
+    if (pos_ >= text_.size()) return false;
+    const size_t end = text_.find('\n', pos_);
+    const size_t stop = end == std::string_view::npos ? text_.size() : end;
+    *line = text_.substr(pos_, stop - pos_);
+    if (!line->empty() && line->back() == '\r') line->remove_suffix(1);
+    line_start_ = pos_;
+    pos_ = end == std::string_view::npos ? text_.size() : end + 1;
+    ++line_number_;
+    return true;
+  }
+  // 1-based number of the line last returned.
+  uint64_t line_number() const { return line_number_; }
+  // Byte offset of the line last returned.
+  size_t line_start() const { return line_start_; }
+  // Byte offset just past the line last returned (start of the next).
+  size_t position() const { return pos_; }
+
+ private:
+  std::string_view text_;
+  size_t pos_ = 0;
+  size_t line_start_ = 0;
+  uint64_t line_number_ = 0;
+};
+
+}  // namespace vc::readers

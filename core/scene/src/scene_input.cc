@@ -1,0 +1,189 @@
+// Format detection and dispatch for ReadScene (see scene_input.h); the readers are in readers/.
+//
+// Detection order: compression magic (gzip, bzip2; decompressed once, then detected again),
+// OctoMap headers, PLY, LAS, PCD, plain text (XYZ), and last the binary ScanGraph, which has no
+// magic of its own.
+#include "vc/scene/scene_input.h"
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <utility>
+
+#include "readers/readers.h"
+#include "vc/scene/octomap_adapter.h"
+
+namespace vc {
+namespace {
+
+constexpr std::string_view kSupported =
+    "supported: PLY, PCD v0.7, ASCII XYZ/CSV, LAS 1.0-1.4, OctoMap .bt/.ot, OctoMap ScanGraph "
+    ".graph, and gzip/bzip2 copies of these";
+
+bool StartsWith(std::string_view s, std::string_view prefix) {
+  return s.substr(0, prefix.size()) == prefix;
+}
+
+Result<SceneInput> FromCloud(Result<readers::PointCloud> read, InputFormat format,
+                             std::string_view source) {
+  if (!read.ok()) return read.status();
+  readers::PointCloud& cloud = *read;
+  if (cloud.points.empty()) {
+    return readers::InvalidInput(source, "all " + std::to_string(cloud.dropped_nonfinite) +
+                                             " points have non-finite coordinates; the cloud is "
+                                             "empty");
+  }
+  SceneInput in;
+  in.format = format;
+  in.detail = std::move(cloud.detail);
+  in.points = std::move(cloud.points);
+  in.dropped_nonfinite = cloud.dropped_nonfinite;
+  return in;
+}
+
+Result<SceneInput> FromOctree(Result<std::shared_ptr<octomap::OcTree>> read, InputFormat format) {
+  if (!read.ok()) return read.status();
+  SceneInput in;
+  in.format = format;
+  std::ostringstream detail;
+  detail << "resolution " << OctreeResolution(**read) << " m";
+  in.detail = detail.str();
+  in.octree = std::move(*read);
+  return in;
+}
+
+Result<SceneInput> ReadDecompressed(std::string_view bytes, std::string_view source,
+                                    const ReadOptions& options) {
+  if (bytes.empty()) return readers::InvalidInput(source, "input is empty (0 bytes)");
+  if (StartsWith(bytes, "# Octomap OcTree binary file")) {
+    return FromOctree(ReadOctreeBinary(bytes, source), InputFormat::kOctomapBinary);
+  }
+  if (StartsWith(bytes, "# Octomap OcTree file")) {
+    return FromOctree(ReadOctreeText(bytes, source), InputFormat::kOctomapText);
+  }
+  if (readers::LooksLikePly(bytes)) {
+    return FromCloud(readers::ReadPly(bytes, source, options), InputFormat::kPly, source);
+  }
+  if (readers::LooksLikeLas(bytes)) {
+    return FromCloud(readers::ReadLas(bytes, source, options), InputFormat::kLas, source);
+  }
+  if (readers::LooksLikePcd(bytes)) {
+    return FromCloud(readers::ReadPcd(bytes, source, options), InputFormat::kPcd, source);
+  }
+  if (readers::LooksLikeText(bytes)) {
+    return FromCloud(readers::ReadXyz(bytes, source, options), InputFormat::kXyz, source);
+  }
+  Result<ScanGraphData> graph = ReadScanGraph(bytes, source);
+  if (!graph.ok()) {
+    std::string why = graph.status().message();
+    const std::string prefix = std::string(source) + ": ";
+    if (why.compare(0, prefix.size(), prefix) == 0) why.erase(0, prefix.size());
+    return readers::InvalidInput(
+        source,
+        "unrecognised format: binary content that is not PLY, PCD, LAS or OctoMap "
+        "(" +
+            std::string(kSupported) + "); read as a ScanGraph: " + why);
+  }
+  if (graph->points.size() > options.max_points) {
+    return ResourceExhaustedError(
+        std::string(source) + ": ScanGraph holds " + std::to_string(graph->points.size()) +
+        " points, more than the limit of " + std::to_string(options.max_points));
+  }
+  if (graph->points.empty()) {
+    return readers::InvalidInput(source, "ScanGraph holds " +
+                                             std::to_string(graph->origins.size()) +
+                                             " scans but no finite points; the cloud is empty");
+  }
+  SceneInput in;
+  in.format = InputFormat::kOctomapGraph;
+  in.detail = std::to_string(graph->origins.size()) + " scans";
+  in.points = std::move(graph->points);
+  in.scan_origins = std::move(graph->origins);
+  in.dropped_nonfinite = graph->dropped_nonfinite;
+  return in;
+}
+
+}  // namespace
+
+std::string_view InputFormatName(InputFormat format) {
+  switch (format) {
+    case InputFormat::kPly:
+      return "ply";
+    case InputFormat::kPcd:
+      return "pcd";
+    case InputFormat::kXyz:
+      return "xyz";
+    case InputFormat::kLas:
+      return "las";
+    case InputFormat::kOctomapBinary:
+      return "octomap-bt";
+    case InputFormat::kOctomapText:
+      return "octomap-ot";
+    case InputFormat::kOctomapGraph:
+      return "octomap-graph";
+  }
+  return "unknown";
+}
+
+std::string_view CompressionName(Compression c) {
+  switch (c) {
+    case Compression::kNone:
+      return "none";
+    case Compression::kGzip:
+      return "gzip";
+    case Compression::kBzip2:
+      return "bzip2";
+  }
+  return "unknown";
+}
+
+Result<SceneInput> ReadScene(std::string_view bytes, std::string_view source_name,
+                             const ReadOptions& options) {
+  const std::string_view unsupported = readers::DetectUnsupportedCompression(bytes);
+  if (!unsupported.empty()) {
+    return readers::InvalidInput(source_name, std::string(unsupported) +
+                                                  "-compressed input is not supported; "
+                                                  "decompress it first (" +
+                                                  std::string(kSupported) + ")");
+  }
+  const Compression compression = readers::DetectCompression(bytes);
+  if (compression == Compression::kNone) {
+    if (bytes.size() > options.max_decompressed_bytes) {
+      return ResourceExhaustedError(
+          std::string(source_name) + ": input of " + std::to_string(bytes.size()) +
+          " bytes is more than the limit of " + std::to_string(options.max_decompressed_bytes));
+    }
+    return ReadDecompressed(bytes, source_name, options);
+  }
+  VC_ASSIGN_OR_RETURN(const std::string plain, readers::Decompress(bytes, compression, source_name,
+                                                                   options.max_decompressed_bytes));
+  if (readers::DetectCompression(plain) != Compression::kNone) {
+    return readers::InvalidInput(source_name, std::string(CompressionName(compression)) +
+                                                  " input holds another compressed stream; "
+                                                  "decompress it fully first");
+  }
+  const std::string label = std::string(source_name) + " (" +
+                            std::string(CompressionName(compression)) + "-decompressed)";
+  Result<SceneInput> in = ReadDecompressed(plain, label, options);
+  if (in.ok()) in->compression = compression;
+  return in;
+}
+
+Result<SceneInput> ReadSceneFile(const std::string& path, const ReadOptions& options) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) return NotFoundError(path + ": is a directory");
+  std::ifstream file(path, std::ios::binary);
+  if (!file) return NotFoundError(path + ": cannot open file");
+  const uintmax_t size = std::filesystem::file_size(path, ec);
+  if (!ec && size > options.max_decompressed_bytes) {
+    return ResourceExhaustedError(path + ": file of " + std::to_string(size) +
+                                  " bytes is more than the limit of " +
+                                  std::to_string(options.max_decompressed_bytes));
+  }
+  std::ostringstream stream;
+  stream << file.rdbuf();
+  if (file.bad()) return NotFoundError(path + ": read error");
+  return ReadScene(std::move(stream).str(), path, options);
+}
+
+}  // namespace vc

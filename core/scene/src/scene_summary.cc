@@ -1,0 +1,82 @@
+#include "vc/scene/scene_summary.h"
+
+#include <nlohmann/json.hpp>
+
+#include <iomanip>
+#include <sstream>
+
+#include "vc/scene/octomap_adapter.h"
+#include "vc/scene/voxel_scene.h"
+
+namespace vc {
+
+Result<SceneSummary> Summarize(const SceneInput& input, double resolution_m, uint64_t memory_budget_bytes,
+                               const JobContext& ctx) {
+  SceneSummary s;
+  s.format = std::string(InputFormatName(input.format));
+  s.compression = std::string(CompressionName(input.compression));
+  s.detail = input.detail;
+  s.points = input.points.size();
+  s.dropped_nonfinite = input.dropped_nonfinite;
+  s.scans = input.scan_origins.size();
+  if (input.octree) {
+    s.octree_leaves = CountOccupiedLeaves(*input.octree);
+    s.octree_resolution_m = OctreeResolution(*input.octree);
+    OccupiedBoundingBox(*input.octree, &s.bbox_min, &s.bbox_max);
+  } else if (!input.points.empty()) {
+    s.bbox_min = s.bbox_max = input.points.front().cast<double>();
+    for (const Eigen::Vector3f& p : input.points) {
+      s.bbox_min = s.bbox_min.cwiseMin(p.cast<double>());
+      s.bbox_max = s.bbox_max.cwiseMax(p.cast<double>());
+    }
+  }
+  VoxelizeOptions vo;
+  vo.resolution_m = resolution_m;
+  vo.memory_budget_bytes = memory_budget_bytes;
+  s.resolution_m = WorkingResolution(input, vo);
+  VC_ASSIGN_OR_RETURN(std::vector<VoxelKey> keys, OccupiedKeys(input, s.resolution_m, memory_budget_bytes, ctx));
+  s.occupied_voxels = keys.size();
+  return s;
+}
+
+std::string SummaryToJson(const SceneSummary& s) {
+  nlohmann::ordered_json j;
+  j["format"] = s.format;
+  j["compression"] = s.compression;
+  j["detail"] = s.detail;
+  j["points"] = s.points;
+  j["dropped_nonfinite"] = s.dropped_nonfinite;
+  j["scans"] = s.scans;
+  j["octree_leaves"] = s.octree_leaves;
+  j["octree_resolution_m"] = s.octree_resolution_m;
+  j["bbox_min"] = {s.bbox_min.x(), s.bbox_min.y(), s.bbox_min.z()};
+  j["bbox_max"] = {s.bbox_max.x(), s.bbox_max.y(), s.bbox_max.z()};
+  j["resolution_m"] = s.resolution_m;
+  j["occupied_voxels"] = s.occupied_voxels;
+  return j.dump();
+}
+
+std::string SummaryToText(const SceneSummary& s, const std::string& source) {
+  std::ostringstream os;
+  os << std::fixed << std::setprecision(3);
+  os << source << "\n";
+  os << "  format:            " << s.format;
+  if (!s.detail.empty()) os << " (" << s.detail << ")";
+  if (s.compression != "none") os << ", " << s.compression << "-compressed";
+  os << "\n";
+  if (s.octree_leaves > 0 || s.octree_resolution_m > 0) {
+    os << "  octree:            " << s.octree_leaves << " occupied leaves at " << s.octree_resolution_m << " m\n";
+  } else {
+    os << "  points:            " << s.points << "\n";
+    os << "  dropped (NaN/inf): " << s.dropped_nonfinite << "\n";
+  }
+  if (s.scans > 0) os << "  scans:             " << s.scans << " (with scanner origins)\n";
+  os << "  bounding box:      [" << s.bbox_min.x() << ", " << s.bbox_min.y() << ", " << s.bbox_min.z() << "] .. ["
+     << s.bbox_max.x() << ", " << s.bbox_max.y() << ", " << s.bbox_max.z() << "] m\n";
+  const WorldPoint e = s.bbox_max - s.bbox_min;
+  os << "  extent:            " << e.x() << " x " << e.y() << " x " << e.z() << " m\n";
+  os << "  occupied voxels:   " << s.occupied_voxels << " at " << s.resolution_m << " m\n";
+  return os.str();
+}
+
+}  // namespace vc

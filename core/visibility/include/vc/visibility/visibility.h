@@ -1,0 +1,176 @@
+// The visibility engine (ALGORITHM.md sections 3-6; paper section 2).
+//
+// - Compatibility (s.3): voxel v is compatible with viewpoint o iff the first occupied voxel on
+//   the ray from o to v's centre is v itself. The paper's selection test.
+// - Surface visibility (s.3b, our default selection test): v is visible from o iff some exposed
+//   face of v that faces o can be reached from o, the segment to that face's centre meeting no
+//   occupied voxel.
+// - Face perception (s.4): each face's 4 corner rays, the face's own voxel transparent; a corner is
+//   visible iff the first occupied voxel on its ray is one of the 8 voxels sharing the corner (or
+//   none). 4 visible corners: full; 1-3: partial; 0: none.
+// - Visibility value V (s.5) and global visibility G (s.6).
+//
+// All functions are deterministic (the traversal's tie rule) and thread-safe on a const scene.
+// Bulk computations run on `threads` worker threads, poll the cancel token in `ctx` at least
+// every few milliseconds per thread and report progress per stage.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "vc/base/geometry.h"
+#include "vc/base/progress.h"
+#include "vc/base/status.h"
+#include "vc/scene/voxel_scene.h"
+
+namespace vc {
+
+enum class SelectionTest {
+  kSurfaceVisibility,  // ALGORITHM.md 3b (default)
+  kCompatibility,      // ALGORITHM.md 3, the paper's test
+};
+std::string_view SelectionTestName(SelectionTest t);  // "surface", "compatibility"
+
+// The scanner's range (ALGORITHM.md s.5), in metres.
+struct ScannerModel {
+  double min_range_m = 0.5;
+  double max_range_m = 75.0;
+  Status Validate() const;
+};
+
+// Faces of a voxel, by outward normal.
+enum class Face : uint8_t { kNegX = 0, kPosX, kNegY, kPosY, kNegZ, kPosZ };
+inline constexpr int kFacesPerVoxel = 6;
+
+enum class Perception : uint8_t { kNone = 0, kPartial, kFull };
+
+// --- Single queries (grid index space for voxels, world frame for viewpoints) ---
+
+// s.3. False if o is inside an occupied voxel.
+bool IsCompatible(const OccupancyGrid& grid, const WorldPoint& o, const VoxelIndex& v);
+// s.3b. False if o is inside an occupied voxel.
+bool IsSurfaceVisible(const OccupancyGrid& grid, const WorldPoint& o, const VoxelIndex& v);
+
+// s.4: full, partial or no perception of face `f` of voxel v from o.
+Perception PerceiveFace(const OccupancyGrid& grid, const WorldPoint& o, const VoxelIndex& v, Face f);
+
+// s.5: V from a perception class, the distance d (m) to the face centre and the angle theta
+// (radians, 0..pi) between the ray to the face centre and the face normal.
+double VisibilityValue(Perception p, double distance_m, double theta_rad, const ScannerModel& scanner);
+
+// s.5 for one face: perception, then V with d and theta measured to the face centre.
+double FaceVisibility(const OccupancyGrid& grid, const WorldPoint& o, const VoxelIndex& v, Face f,
+                      const ScannerModel& scanner);
+
+// Viewpoints farther than this many voxels from the origin along an axis are refused (Evaluate,
+// Plan) or see nothing (ComputeVisibilitySets): ray arithmetic uses int voxel indices, and a
+// scene's own voxels lie within OctoMap's 16-bit key range (+-32768).
+inline constexpr double kMaxViewpointIndex = 1 << 20;
+bool ViewpointInRange(const WorldPoint& o, double resolution_m);
+
+// --- Bulk: many viewpoints x all occupied voxels ---
+
+// A set of occupied-voxel ids (VoxelScene::occupied positions) as a bitset.
+class VoxelSet {
+ public:
+  VoxelSet() = default;
+  explicit VoxelSet(size_t n) : n_(n), words_((n + 63) / 64, 0) {}
+  size_t size() const { return n_; }
+  // Makes the set hold n voxels: ids below the old size keep their bits, the others are clear.
+  // Allocates nothing when words().capacity() already holds (n + 63) / 64 words.
+  void Resize(size_t n) {
+    n_ = n;
+    words_.resize((n + 63) / 64, 0);
+    if (n % 64) words_.back() &= (uint64_t{1} << (n % 64)) - 1;
+  }
+  bool test(size_t i) const { return (words_[i >> 6] >> (i & 63)) & 1u; }
+  void set(size_t i) { words_[i >> 6] |= uint64_t{1} << (i & 63); }
+  void reset(size_t i) { words_[i >> 6] &= ~(uint64_t{1} << (i & 63)); }
+  size_t count() const;
+  // |this AND other|.
+  size_t CountAnd(const VoxelSet& other) const;
+  // this &= ~other.
+  void Subtract(const VoxelSet& other);
+  // this |= other.
+  void Union(const VoxelSet& other);
+  const std::vector<uint64_t>& words() const { return words_; }
+  std::vector<uint64_t>& words() { return words_; }
+
+ private:
+  size_t n_ = 0;
+  std::vector<uint64_t> words_;
+};
+
+struct VisibilitySetsOptions {
+  SelectionTest test = SelectionTest::kSurfaceVisibility;
+  // Worker threads; 0 = hardware concurrency.
+  int threads = 0;
+  // Surface test only: decide every voxel by its own rays instead of by groups of faces (same
+  // answers, slower; kept as the reference for tests and benchmarks).
+  bool per_voxel = false;
+};
+
+// For each viewpoint, the occupied voxels that pass the selection test. Viewpoints inside an
+// occupied voxel get an empty set. CANCELLED / DEADLINE_EXCEEDED from ctx.
+Result<std::vector<VoxelSet>> ComputeVisibilitySets(const VoxelScene& scene,
+                                                    const std::vector<WorldPoint>& viewpoints,
+                                                    const VisibilitySetsOptions& options,
+                                                    const JobContext& ctx = {});
+
+// Per-viewpoint and overall figures of s.6.
+struct VisibilityFigures {
+  double global_visibility = 0;           // G = mean over faces of the (best) V
+  double fully_visible_fraction = 0;      // faces with full perception / |F|
+  double mean_full_visibility = 0;        // mean V over fully visible faces (0 if none)
+  double partially_visible_fraction = 0;  // faces with partial (and no full) perception / |F|
+};
+
+// Which faces make up F.
+enum class FaceSet {
+  kAll,      // all 6 faces of every occupied voxel (the paper's |F| = 6 |occupied|)
+  kExposed,  // only faces whose neighbour across is free
+};
+
+struct EvaluateOptions {
+  ScannerModel scanner;
+  FaceSet faces = FaceSet::kAll;
+  int threads = 0;
+  // 0 = exact (every face). Otherwise an unbiased uniform random sample of this many faces (with
+  // replacement), reporting a 95 % confidence interval.
+  uint64_t sample_faces = 0;
+  uint64_t seed = 1;
+  // Keep each face's best V (needed by visibility.ply). Exact mode only.
+  bool keep_face_values = false;
+  // Keep every viewpoint's V of every face (needed by reduction). Exact mode only; costs
+  // 24 bytes per occupied voxel and viewpoint.
+  bool keep_per_viewpoint_values = false;
+  // Exact mode: decide every lattice corner on its own (its ray, after the per-ray shortcuts: the
+  // occluder cache and the grazing-layer test) instead of first by groups of faces (same answers,
+  // slower; kept as the reference for tests and benchmarks).
+  bool per_corner = false;
+};
+
+struct Evaluation {
+  double resolution_m = 0;
+  uint64_t faces_total = 0;      // |F|
+  uint64_t faces_evaluated = 0;  // |F| in exact mode, the sample size otherwise
+  bool sampled = false;
+  VisibilityFigures overall;
+  // 95 % confidence half-width of overall.global_visibility (sampling mode; 0 when exact).
+  double global_visibility_ci95 = 0;
+  std::vector<VisibilityFigures> per_viewpoint;
+  // With keep_face_values: per voxel id, the best V of each of its 6 faces (F order: voxel id, then Face).
+  std::vector<std::array<float, kFacesPerVoxel>> best_face_values;
+  // With keep_per_viewpoint_values: per viewpoint, V of every face at index voxel_id * 6 + face.
+  // Faces outside F hold 0.
+  std::vector<std::vector<float>> per_viewpoint_face_values;
+};
+
+// Evaluates a set of viewpoints on `scene` (s.6): G of the whole set and figures per viewpoint.
+// INVALID_ARGUMENT for a non-finite or out-of-range viewpoint, a bad scanner range, or (exact
+// mode) a scene whose voxels are not sorted and unique as VoxelScene requires.
+Result<Evaluation> Evaluate(const VoxelScene& scene, const std::vector<WorldPoint>& viewpoints,
+                            const EvaluateOptions& options, const JobContext& ctx = {});
+
+}  // namespace vc

@@ -1,0 +1,187 @@
+// Candidate generation on hand-built voxel scenes: floor levels, roofs, desks, holes, clearance.
+#include "vc/plan/candidates.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <set>
+
+namespace vc::planner {
+namespace {
+
+constexpr double kR = 0.1;
+
+struct Builder {
+  std::set<std::tuple<int, int, int>> cells;
+  // Fills the inclusive index box.
+  void Box(int x0, int y0, int z0, int x1, int y1, int z1) {
+    for (int z = z0; z <= z1; ++z)
+      for (int y = y0; y <= y1; ++y)
+        for (int x = x0; x <= x1; ++x) cells.insert({x, y, z});
+  }
+  void Erase(int x0, int y0, int z0, int x1, int y1, int z1) {
+    for (int z = z0; z <= z1; ++z)
+      for (int y = y0; y <= y1; ++y)
+        for (int x = x0; x <= x1; ++x) cells.erase({x, y, z});
+  }
+  // A 5 x 4 m room: floor slab at z index 0, walls up to `top`, and a ceiling at `top` if asked.
+  void Room(int top, bool ceiling) {
+    Box(0, 0, 0, 49, 39, 0);
+    Box(0, 0, 0, 0, 39, top);
+    Box(49, 0, 0, 49, 39, top);
+    Box(0, 0, 0, 49, 0, top);
+    Box(0, 39, 0, 49, 39, top);
+    if (ceiling) Box(0, 0, top, 49, 39, top);
+  }
+  VoxelScene Build(int shift_z = 0) const {
+    VoxelScene s;
+    s.resolution_m = kR;
+    std::vector<VoxelIndex> idx;
+    for (const auto& [x, y, z] : cells) idx.push_back({x - 20, y - 17, z + shift_z});
+    for (const VoxelIndex& v : idx) s.occupied.push_back(IndexToKey(v));
+    std::sort(s.occupied.begin(), s.occupied.end());
+    Result<OccupancyGrid> g = OccupancyGrid::Build(kR, idx, uint64_t{1} << 30);
+    EXPECT_TRUE(g.ok()) << g.status().ToString();
+    s.grid = std::move(*g);
+    return s;
+  }
+};
+
+CandidateGrid Generate(const VoxelScene& s, CandidateOptions o = {}) {
+  Result<CandidateGrid> r = GenerateCandidates(s, o);
+  EXPECT_TRUE(r.ok()) << r.status().ToString();
+  return r.ok() ? *r : CandidateGrid{};
+}
+
+TEST(CandidatesTest, ClosedRoomHasOneLevelAndCandidatesAtTripodHeight) {
+  Builder b;
+  b.Room(25, true);
+  const CandidateGrid c = Generate(b.Build());
+  ASSERT_EQ(c.levels.size(), 1u);  // the ceiling's outside is a roof
+  EXPECT_NEAR(c.levels[0].z_m, 0.1, 1e-9);
+  ASSERT_EQ(c.positions.size(), 20u);  // 5 x 4 cells of 1 m, all 0.4 m from the walls
+  for (size_t i = 0; i < c.positions.size(); ++i) {
+    EXPECT_NEAR(c.positions[i].z(), 1.6, 1e-9);
+    EXPECT_NEAR(c.floor_z_m[i], 0.1, 1e-9);
+    EXPECT_GT(c.positions[i].x(), -1.9);
+    EXPECT_LT(c.positions[i].x(), 2.9);
+    EXPECT_GT(c.positions[i].y(), -1.6);
+    EXPECT_LT(c.positions[i].y(), 2.2);
+  }
+  EXPECT_EQ(c.rejected_no_floor + c.rejected_clearance + c.positions.size(), c.cells);
+}
+
+TEST(CandidatesTest, FloorBelowZeroWorksToo) {
+  Builder b;
+  b.Room(25, true);
+  const CandidateGrid c = Generate(b.Build(/*shift_z=*/-4));  // floor top at -0.3 m
+  ASSERT_EQ(c.levels.size(), 1u);
+  EXPECT_NEAR(c.levels[0].z_m, -0.3, 1e-9);
+  ASSERT_EQ(c.positions.size(), 20u);
+  EXPECT_NEAR(c.positions[0].z(), 1.2, 1e-9);
+}
+
+TEST(CandidatesTest, OpenRoomKeepsItsFloorButNotTheWallTops) {
+  Builder b;
+  b.Room(25, false);
+  const CandidateGrid c = Generate(b.Build());
+  ASSERT_EQ(c.levels.size(), 1u);
+  EXPECT_NEAR(c.levels[0].z_m, 0.1, 1e-9);
+  EXPECT_EQ(c.positions.size(), 20u);
+}
+
+TEST(CandidatesTest, LargerClearanceDropsCellsNearWalls) {
+  Builder b;
+  b.Room(25, true);
+  CandidateOptions o;
+  o.clearance_m = 0.45;  // cells 0.4 m from a wall fail
+  const CandidateGrid c = Generate(b.Build(), o);
+  EXPECT_EQ(c.positions.size(), 6u);
+  EXPECT_EQ(c.rejected_clearance, 14u);
+  o.clearance_m = 1.2;  // wider than half the room: nothing survives
+  EXPECT_TRUE(Generate(b.Build(), o).positions.empty());
+}
+
+TEST(CandidatesTest, TwoStoreysGetCandidatesOnBothFloors) {
+  Builder b;
+  b.Room(55, true);
+  b.Box(0, 0, 27, 49, 39, 28);  // slab: ceiling below, floor above (top at 2.9 m)
+  const CandidateGrid c = Generate(b.Build());
+  ASSERT_EQ(c.levels.size(), 2u);
+  EXPECT_NEAR(c.levels[0].z_m, 0.1, 1e-9);
+  EXPECT_NEAR(c.levels[1].z_m, 2.9, 1e-9);
+  int lower = 0, upper = 0;
+  for (const WorldPoint& p : c.positions) {
+    if (std::fabs(p.z() - 1.6) < 1e-9) ++lower;
+    if (std::fabs(p.z() - 4.4) < 1e-9) ++upper;
+  }
+  EXPECT_EQ(lower, 20);
+  EXPECT_EQ(upper, 20);
+  EXPECT_EQ(c.positions.size(), 40u);
+}
+
+TEST(CandidatesTest, NoStationOnOrUnderALowDesk) {
+  Builder b;
+  b.Room(25, true);
+  b.Box(10, 10, 4, 25, 20, 4);  // a desk top at 0.4-0.5 m over x 1.0-2.6 m, y 1.0-2.1 m
+  const CandidateGrid c = Generate(b.Build());
+  ASSERT_EQ(c.levels.size(), 1u);
+  EXPECT_NEAR(c.levels[0].z_m, 0.1, 1e-9);
+  for (const WorldPoint& p : c.positions) {
+    EXPECT_NEAR(p.z(), 1.6, 1e-9);
+    EXPECT_FALSE(std::fabs(p.x() - -0.5) < 1e-9 && std::fabs(p.y() - -0.2) < 1e-9) << "candidate above the desk";
+  }
+  EXPECT_EQ(c.positions.size(), 19u);
+}
+
+TEST(CandidatesTest, NoStationOverAHoleInTheFloor) {
+  Builder b;
+  b.Room(25, true);
+  b.Erase(20, 10, 0, 29, 19, 0);  // a 1 x 1 m hole under the cell centred at (2.5, 1.5)
+  const CandidateGrid c = Generate(b.Build());
+  for (const WorldPoint& p : c.positions) {
+    EXPECT_FALSE(std::fabs(p.x() - 0.5) < 1e-9 && std::fabs(p.y() - -0.2) < 1e-9) << "candidate over the hole";
+  }
+  EXPECT_EQ(c.positions.size(), 19u);
+  EXPECT_EQ(c.rejected_no_floor, 1u);
+}
+
+TEST(CandidatesTest, HasClearanceMeasuresToTheNearestVoxelCube) {
+  Builder b;
+  b.Room(25, true);
+  const VoxelScene s = b.Build();
+  // Builder coordinates are shifted by (-2.0, -1.7) m: the west wall's cube ends at x = -1.9.
+  EXPECT_FALSE(HasClearance(s.grid, WorldPoint(-1.75, 0.3, 1.6), 0.2));
+  EXPECT_TRUE(HasClearance(s.grid, WorldPoint(-1.65, 0.3, 1.6), 0.2));
+  EXPECT_FALSE(HasClearance(s.grid, WorldPoint(0.0, 0.3, 0.05), 0.0));  // inside the floor
+  EXPECT_TRUE(HasClearance(s.grid, WorldPoint(0.0, 0.3, 0.15), 0.0));
+  EXPECT_FALSE(HasClearance(s.grid, WorldPoint(0.0, 0.3, 0.15), 0.1));
+}
+
+TEST(CandidatesTest, FloorTopNearFindsTheLevelUnderAPoint) {
+  Builder b;
+  b.Room(55, true);
+  b.Box(0, 0, 27, 49, 39, 28);
+  b.Erase(20, 10, 0, 29, 19, 0);
+  const VoxelScene s = b.Build();
+  const CandidateOptions o;
+  ASSERT_TRUE(FloorTopNear(s.grid, -1.0, -0.7, 0.1, o).has_value());
+  EXPECT_NEAR(*FloorTopNear(s.grid, -1.0, -0.7, 0.1, o), 0.1, 1e-9);
+  EXPECT_NEAR(*FloorTopNear(s.grid, -1.0, -0.7, 2.9, o), 2.9, 1e-9);
+  EXPECT_FALSE(FloorTopNear(s.grid, 0.5, -0.2, 0.1, o).has_value());  // the hole
+  EXPECT_FALSE(FloorTopNear(s.grid, -1.0, -0.7, 1.5, o).has_value());  // no floor near 1.5 m
+}
+
+TEST(CandidatesTest, Cancelled) {
+  Builder b;
+  b.Room(25, true);
+  CancelToken token;
+  token.Cancel();
+  JobContext ctx;
+  ctx.cancel = &token;
+  EXPECT_EQ(GenerateCandidates(b.Build(), {}, ctx).status().code(), StatusCode::kCancelled);
+}
+
+}  // namespace
+}  // namespace vc::planner

@@ -1,0 +1,262 @@
+// The files a plan produces: plan.json keys and values, stations.csv round trip, visibility.ply,
+// PNG signature and size, evaluation.json, and ParseStationsCsv's errors.
+#include "vc/report/plan_report.h"
+
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "testing/test_paths.h"
+
+namespace vc {
+namespace {
+
+using nlohmann::json;
+
+std::string ReadAll(const std::string& path) {
+  std::ifstream f(path, std::ios::binary);
+  std::stringstream ss;
+  ss << f.rdbuf();
+  return ss.str();
+}
+
+uint32_t BigEndian32(const std::string& s, size_t at) {
+  return (uint32_t(uint8_t(s[at])) << 24) | (uint32_t(uint8_t(s[at + 1])) << 16) | (uint32_t(uint8_t(s[at + 2])) << 8) |
+         uint32_t(uint8_t(s[at + 3]));
+}
+
+// A small plan: 12 candidates on a 4 x 3 grid of 1 m, 3 stations (one removed by reduction).
+PlanResult SamplePlan() {
+  PlanResult r;
+  r.resolution_m = 0.1;
+  r.selection_test = SelectionTest::kSurfaceVisibility;
+  r.stop_reason = StopReason::kExhausted;
+  r.options.grid_spacing_m = 1.0;
+  r.floor_levels_m = {0.1};
+  for (int y = 0; y < 3; ++y) {
+    for (int x = 0; x < 4; ++x) {
+      r.heat_map.positions.emplace_back(0.5 + x, 0.5 + y, 1.6);
+      r.heat_map.visible_voxels.push_back(static_cast<uint64_t>(100 + 10 * x + y));
+    }
+  }
+  r.heat_map.grid_spacing_m = 1.0;
+  r.candidate_count = 12;
+  const WorldPoint s0(0.5, 0.5, 1.6), s1(3.5, 2.5, 1.6);
+  r.stations.push_back({s0, 100, 100, 0.8, 0.41, 0});
+  r.stations.push_back({s1, 132, 25, 1.0, 0.37, 11});
+  r.reduction.size = 3;
+  r.reduction.matrix = {0.2, 0.3, 0.25, 0.3, 0.1, 0.12, 0.25, 0.12, 0.0};
+  r.reduction.removed = {2};
+  r.reduction.positions = {s0, s1, WorldPoint(1.5, 1.5, 1.6)};
+  r.reduction.global_visibility_before = 0.5;
+  r.reduction.global_visibility_after = 0.5;
+  r.occupied_voxels = 5;
+  r.coverable_voxels = 4;
+  r.covered_voxels = 4;
+  r.evaluation.resolution_m = 0.1;
+  r.evaluation.faces_total = 30;
+  r.evaluation.faces_evaluated = 30;
+  r.evaluation.overall = {0.5, 0.4, 0.8, 0.1};
+  r.evaluation.per_viewpoint = {{0.41, 0.3, 0.7, 0.1}, {0.37, 0.2, 0.75, 0.05}};
+  for (int i = 0; i < 5; ++i) {
+    r.voxel_centers.emplace_back(0.05 + 0.1 * i, 0.05, 0.05);
+    std::array<float, 6> v{};
+    v[i % 6] = 0.2f * i;  // voxel 0 is seen by nobody
+    r.evaluation.best_face_values.push_back(v);
+  }
+  r.timings = {{Stage::kVoxelize, 0.5}, {Stage::kSelection, 0.01}};
+  r.total_seconds = 1.0;
+  r.warnings = {"20.0 % of occupied voxels (1) are visible from no candidate"};
+  return r;
+}
+
+TEST(PlanReportTest, PlanJsonHasEveryDocumentedKey) {
+  const json j = json::parse(PlanToJson(SamplePlan()));
+  for (const char* key : {"schema", "resolution_m", "selection_test", "stop_reason", "viewpoints", "coverage", "reduction",
+                          "candidates", "timings_s", "parameters", "warnings"}) {
+    EXPECT_TRUE(j.contains(key)) << key;
+  }
+  ASSERT_EQ(j["viewpoints"].size(), 2u);
+  for (const char* key : {"index", "x", "y", "z", "compatible_voxels", "marginal_gain", "cumulative_coverage",
+                          "global_visibility", "candidate_index", "fully_visible_fraction", "partially_visible_fraction"}) {
+    EXPECT_TRUE(j["viewpoints"][1].contains(key)) << key;
+  }
+  EXPECT_DOUBLE_EQ(j["viewpoints"][1]["x"].get<double>(), 3.5);
+  EXPECT_EQ(j["viewpoints"][1]["compatible_voxels"].get<int>(), 132);
+  EXPECT_EQ(j["viewpoints"][1]["marginal_gain"].get<int>(), 25);
+  EXPECT_DOUBLE_EQ(j["viewpoints"][0]["cumulative_coverage"].get<double>(), 0.8);
+  EXPECT_DOUBLE_EQ(j["viewpoints"][1]["global_visibility"].get<double>(), 0.37);
+  for (const char* key : {"occupied_voxels", "coverable_voxels", "covered_voxels", "uncovered_voxels", "uncoverable_voxels",
+                          "covered_fraction_of_coverable", "covered_fraction_of_occupied", "global_visibility",
+                          "fully_visible_fraction", "mean_full_visibility", "partially_visible_fraction", "faces_total"}) {
+    EXPECT_TRUE(j["coverage"].contains(key)) << key;
+  }
+  EXPECT_EQ(j["coverage"]["uncovered_voxels"].get<int>(), 1);
+  EXPECT_DOUBLE_EQ(j["coverage"]["covered_fraction_of_coverable"].get<double>(), 1.0);
+  EXPECT_DOUBLE_EQ(j["coverage"]["global_visibility"].get<double>(), 0.5);
+  for (const char* key : {"size", "stations", "matrix", "removed", "global_visibility_before", "global_visibility_after"}) {
+    EXPECT_TRUE(j["reduction"].contains(key)) << key;
+  }
+  ASSERT_EQ(j["reduction"]["matrix"].size(), 3u);
+  EXPECT_DOUBLE_EQ(j["reduction"]["matrix"][1][2].get<double>(), 0.12);
+  EXPECT_EQ(j["reduction"]["removed"], json::array({2}));
+  EXPECT_EQ(j["candidates"]["count"].get<int>(), 12);
+  for (const char* key : {"grid_spacing_m", "floor_levels_m", "grid_cells", "cells_without_floor",
+                          "cells_failing_clearance", "visible_voxels"}) {
+    EXPECT_TRUE(j["candidates"].contains(key)) << key;
+  }
+  for (const char* key : {"greedy_stations", "consolidated"}) EXPECT_TRUE(j.contains(key)) << key;
+  EXPECT_EQ(j["candidates"]["visible_voxels"].size(), 12u);
+  EXPECT_EQ(j["candidates"]["visible_voxels"][11][3].get<int>(), 132);
+  EXPECT_DOUBLE_EQ(j["timings_s"]["voxelize"].get<double>(), 0.5);
+  EXPECT_DOUBLE_EQ(j["parameters"]["grid_spacing_m"].get<double>(), 1.0);
+  EXPECT_DOUBLE_EQ(j["parameters"]["tripod_height_m"].get<double>(), 1.5);
+  EXPECT_EQ(j["parameters"]["selection_test"], "surface");
+  EXPECT_EQ(j["warnings"].size(), 1u);
+  EXPECT_DOUBLE_EQ(j["resolution_m"].get<double>(), 0.1);
+}
+
+TEST(PlanReportTest, WritesAllFilesWithPngsOfTheExpectedSize) {
+  const PlanResult plan = SamplePlan();
+  const std::string dir = testing::MakeTempDir() + "/out";  // created by the writer
+  ASSERT_TRUE(WritePlanOutputs(plan, dir).ok());
+  const ImageSize heat = HeatmapImageSize(plan);
+  const ImageSize red = ReductionImageSize(3);
+  // Layout (docs/PLANNING.md): footprint 4 x 3 m -> 180 px/m, plot 720 x 540; one panel.
+  EXPECT_EQ(heat.width, 64 + 720 + 24 + 110);
+  EXPECT_EQ(heat.height, 40 + 540 + 48);
+  for (const auto& [name, size] : {std::pair{"heatmap.png", heat}, std::pair{"reduction.png", red}}) {
+    const std::string png = ReadAll(dir + "/" + name);
+    ASSERT_GT(png.size(), 33u) << name;
+    EXPECT_EQ(png.substr(0, 8), std::string("\x89PNG\r\n\x1a\n", 8)) << name;
+    EXPECT_EQ(png.substr(12, 4), "IHDR");
+    EXPECT_EQ(BigEndian32(png, 16), static_cast<uint32_t>(size.width)) << name;
+    EXPECT_EQ(BigEndian32(png, 20), static_cast<uint32_t>(size.height)) << name;
+  }
+  EXPECT_TRUE(std::filesystem::exists(dir + "/plan.json"));
+  EXPECT_EQ(json::parse(ReadAll(dir + "/plan.json"))["viewpoints"].size(), 2u);
+}
+
+TEST(PlanReportTest, ReductionImageGrowsWithTheMatrix) {
+  const ImageSize a = ReductionImageSize(2), b = ReductionImageSize(20), c = ReductionImageSize(0);
+  EXPECT_GT(b.height, a.height - 1);
+  EXPECT_GT(b.width, 0);
+  EXPECT_GT(c.width, 0);
+  EXPECT_EQ(ReductionImageSize(10).height, 52 + 10 * 48 + 48);  // cells of 48 px up to 10 stations
+}
+
+TEST(PlanReportTest, StationsCsvRoundTrips) {
+  const PlanResult plan = SamplePlan();
+  const std::string dir = testing::MakeTempDir();
+  ASSERT_TRUE(WritePlanOutputs(plan, dir).ok());
+  const std::string csv = ReadAll(dir + "/stations.csv");
+  EXPECT_EQ(csv.substr(0, 6), "x,y,z\n");
+  Result<std::vector<WorldPoint>> parsed = ParseStationsCsv(csv, "stations.csv");
+  ASSERT_TRUE(parsed.ok()) << parsed.status().ToString();
+  ASSERT_EQ(parsed->size(), plan.stations.size());
+  for (size_t i = 0; i < parsed->size(); ++i) {
+    EXPECT_NEAR(((*parsed)[i] - plan.stations[i].position).norm(), 0.0, 1e-6);
+  }
+}
+
+TEST(PlanReportTest, VisibilityPlyHoldsOneColouredVertexPerVoxel) {
+  const PlanResult plan = SamplePlan();
+  const std::string dir = testing::MakeTempDir();
+  ASSERT_TRUE(WritePlanOutputs(plan, dir).ok());
+  const std::string ply = ReadAll(dir + "/visibility.ply");
+  const size_t end = ply.find("end_header\n");
+  ASSERT_NE(end, std::string::npos);
+  const std::string header = ply.substr(0, end);
+  EXPECT_NE(header.find("format binary_little_endian 1.0"), std::string::npos);
+  EXPECT_NE(header.find("element vertex 5"), std::string::npos);
+  EXPECT_NE(header.find("property float visibility"), std::string::npos);
+  EXPECT_NE(header.find("property uchar red"), std::string::npos);
+  const size_t body = end + std::strlen("end_header\n");
+  ASSERT_EQ(ply.size() - body, 5u * 19u);
+  // Vertex 4: best V = 0.8; vertex 0: seen by nobody -> grey.
+  float v4;
+  std::memcpy(&v4, ply.data() + body + 4 * 19 + 15, 4);
+  EXPECT_FLOAT_EQ(v4, 0.8f);
+  EXPECT_EQ(uint8_t(ply[body + 12]), 128);
+  EXPECT_EQ(uint8_t(ply[body + 13]), 128);
+  float x1;
+  std::memcpy(&x1, ply.data() + body + 19, 4);
+  EXPECT_FLOAT_EQ(x1, 0.15f);
+}
+
+TEST(PlanReportTest, RefusesMissingFaceValues) {
+  PlanResult plan = SamplePlan();
+  plan.evaluation.best_face_values.pop_back();
+  const Status s = WritePlanOutputs(plan, testing::MakeTempDir());
+  EXPECT_EQ(s.code(), StatusCode::kFailedPrecondition);
+}
+
+TEST(PlanReportTest, UnwritableDirectoryNamesThePath) {
+  const std::string dir = testing::MakeTempDir();
+  std::ofstream(dir + "/file") << "x";
+  const Status s = WritePlanOutputs(SamplePlan(), dir + "/file/sub");
+  EXPECT_FALSE(s.ok());
+  EXPECT_NE(s.message().find(dir + "/file/sub"), std::string::npos) << s.message();
+}
+
+TEST(PlanReportTest, EvaluationJsonHasItsKeys) {
+  const PlanResult plan = SamplePlan();
+  const std::vector<WorldPoint> vps = {plan.stations[0].position, plan.stations[1].position};
+  const json j = json::parse(EvaluationToJson(plan.evaluation, vps));
+  for (const char* key : {"resolution_m", "faces_total", "faces_evaluated", "sampled", "global_visibility",
+                          "global_visibility_ci95", "fully_visible_fraction", "mean_full_visibility",
+                          "partially_visible_fraction", "per_viewpoint"}) {
+    EXPECT_TRUE(j.contains(key)) << key;
+  }
+  ASSERT_EQ(j["per_viewpoint"].size(), 2u);
+  for (const char* key : {"global_visibility", "fully_visible_fraction", "mean_full_visibility",
+                          "partially_visible_fraction", "x", "y", "z"}) {
+    EXPECT_TRUE(j["per_viewpoint"][0].contains(key)) << key;
+  }
+  EXPECT_DOUBLE_EQ(j["per_viewpoint"][1]["global_visibility"].get<double>(), 0.37);
+  EXPECT_DOUBLE_EQ(j["per_viewpoint"][1]["x"].get<double>(), 3.5);
+  const std::string dir = testing::MakeTempDir();
+  ASSERT_TRUE(WriteEvaluationOutputs(plan.evaluation, vps, dir).ok());
+  EXPECT_EQ(json::parse(ReadAll(dir + "/evaluation.json"))["faces_total"].get<int>(), 30);
+}
+
+TEST(ParseStationsCsvTest, AcceptsHeaderCommentsBlankLinesAndSpaces) {
+  const std::string text = "# stations\nx, y, z\n\n1, 2, 3\n  4.5,-5,6e-1  # trailing comment\n7 8 9\r\n";
+  Result<std::vector<WorldPoint>> r = ParseStationsCsv(text, "my.csv");
+  ASSERT_TRUE(r.ok()) << r.status().ToString();
+  ASSERT_EQ(r->size(), 3u);
+  EXPECT_EQ((*r)[1], WorldPoint(4.5, -5, 0.6));
+  EXPECT_EQ((*r)[2], WorldPoint(7, 8, 9));
+}
+
+TEST(ParseStationsCsvTest, RejectsBadRowsNamingTheLine) {
+  struct Case {
+    std::string text;
+    std::string line;
+  };
+  for (const Case& c : {Case{"x,y,z\n1,2,3\n1,2\n", "my.csv:3:"}, Case{"1,2,3\n1,2,abc\n", "my.csv:2:"},
+                        Case{"1,2,3\n1,2,3,4\n", "my.csv:2:"}, Case{"1,2,nan\n", "my.csv:1:"},
+                        Case{"1,2,3\n1,inf,3\n", "my.csv:2:"}, Case{"1,2,3\nx,y,z\n", "my.csv:2:"},
+                        Case{"1,,3\n", "my.csv:1:"}}) {
+    Result<std::vector<WorldPoint>> r = ParseStationsCsv(c.text, "my.csv");
+    ASSERT_FALSE(r.ok()) << c.text;
+    EXPECT_EQ(r.status().code(), StatusCode::kInvalidArgument);
+    EXPECT_NE(r.status().message().find(c.line), std::string::npos) << r.status().message();
+  }
+}
+
+TEST(ParseStationsCsvTest, RejectsAFileWithoutStations) {
+  for (const std::string text : {"", "x,y,z\n", "# nothing\n\n"}) {
+    Result<std::vector<WorldPoint>> r = ParseStationsCsv(text, "empty.csv");
+    ASSERT_FALSE(r.ok());
+    EXPECT_NE(r.status().message().find("empty.csv"), std::string::npos);
+  }
+}
+
+}  // namespace
+}  // namespace vc

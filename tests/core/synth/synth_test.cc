@@ -1,0 +1,411 @@
+#include "vc/synth/synth.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <iostream>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "testing/test_paths.h"
+
+namespace vc {
+namespace {
+
+const char* const kSmallScenes[] = {"box", "lroom", "comb:3", "rooms:3", "twofloor"};
+
+// A dense voxel grid over a scene's bounds (plus a margin), filled from its points; keys are
+// floor(p / resolution) as in OctoMap.
+class VoxelGrid {
+ public:
+  VoxelGrid(const SceneInfo& info, double resolution) : r_(resolution) {
+    for (int a = 0; a < 3; ++a) {
+      origin_[a] = static_cast<int>(std::floor(info.bounds_min[a] / r_)) - 2;
+      dims_[a] = static_cast<int>(std::floor(info.bounds_max[a] / r_)) + 3 - origin_[a];
+    }
+    cells_.assign(static_cast<size_t>(dims_[0]) * dims_[1] * dims_[2], 0);
+  }
+
+  void Add(const Eigen::Vector3f& p) {
+    std::array<int, 3> k;
+    for (int a = 0; a < 3; ++a) k[a] = static_cast<int>(std::floor(static_cast<double>(p[a]) / r_)) - origin_[a];
+    if (k[0] < 0 || k[1] < 0 || k[2] < 0 || k[0] >= dims_[0] || k[1] >= dims_[1] || k[2] >= dims_[2]) {
+      ++outside_;
+      return;
+    }
+    cells_[Index(k)] = 1;
+  }
+
+  uint64_t Occupied() const { return std::count(cells_.begin(), cells_.end(), 1); }
+  uint64_t outside() const { return outside_; }
+
+  std::array<int, 3> KeyOf(const WorldPoint& p) const {
+    std::array<int, 3> k;
+    for (int a = 0; a < 3; ++a) k[a] = static_cast<int>(std::floor(p[a] / r_)) - origin_[a];
+    return k;
+  }
+  bool IsOccupied(const std::array<int, 3>& k) const { return cells_[Index(k)] == 1; }
+
+  // 6-connected flood fill over free voxels from `seed`; marks reached voxels with 2. Returns
+  // whether it reached the grid's border (i.e. escaped the scene's bounds).
+  bool FloodEscapes(const std::array<int, 3>& seed) {
+    std::vector<std::array<int, 3>> stack = {seed};
+    cells_[Index(seed)] = 2;
+    bool escaped = false;
+    while (!stack.empty()) {
+      const std::array<int, 3> k = stack.back();
+      stack.pop_back();
+      for (int a = 0; a < 3; ++a) {
+        for (int d : {-1, 1}) {
+          std::array<int, 3> n = k;
+          n[a] += d;
+          if (n[a] < 0 || n[a] >= dims_[a]) {
+            escaped = true;
+            continue;
+          }
+          uint8_t& c = cells_[Index(n)];
+          if (c != 0) continue;
+          c = 2;
+          stack.push_back(n);
+        }
+      }
+    }
+    return escaped;
+  }
+  bool Reached(const std::array<int, 3>& k) const { return cells_[Index(k)] == 2; }
+
+  // Occupied voxels per z layer, and the layer index of world height z.
+  std::vector<uint64_t> LayerCounts() const {
+    std::vector<uint64_t> counts(dims_[2], 0);
+    for (size_t i = 0; i < cells_.size(); ++i) {
+      if (cells_[i] == 1) ++counts[i / (static_cast<size_t>(dims_[0]) * dims_[1])];
+    }
+    return counts;
+  }
+  int LayerOf(double z) const { return static_cast<int>(std::floor(z / r_)) - origin_[2]; }
+
+ private:
+  size_t Index(const std::array<int, 3>& k) const {
+    return (static_cast<size_t>(k[2]) * dims_[1] + k[1]) * dims_[0] + k[0];
+  }
+  double r_;
+  std::array<int, 3> origin_{}, dims_{};
+  std::vector<uint8_t> cells_;
+  uint64_t outside_ = 0;
+};
+
+VoxelGrid Voxelize(std::string_view spec, double spacing, double resolution) {
+  Result<SceneInfo> info = DescribeScene(spec);
+  EXPECT_TRUE(info.ok()) << info.status().ToString();
+  VoxelGrid grid(*info, resolution);
+  SynthOptions options;
+  options.spacing_m = spacing;
+  EXPECT_TRUE(ForEachScenePoint(spec, options, [&grid](const Eigen::Vector3f& p) { grid.Add(p); }).ok());
+  return grid;
+}
+
+// A point in free space inside a room: its centre in x and y, 1.7 m above its floor.
+WorldPoint SeedPoint(const AxisBox& room) {
+  return {(room.min.x() + room.max.x()) / 2, (room.min.y() + room.max.y()) / 2, room.min.z() + 1.7};
+}
+
+bool Disjoint(const AxisBox& a, const AxisBox& b) {
+  for (int i = 0; i < 3; ++i) {
+    if (a.max[i] <= b.min[i] || b.max[i] <= a.min[i]) return true;
+  }
+  return false;
+}
+
+TEST(SynthOptionsTest, ValidateRejectsSpacingOutsideRangeOrNotFinite) {
+  for (double bad : {0.0, 0.004, 1.01, -0.1, std::nan(""), static_cast<double>(INFINITY)}) {
+    SynthOptions o;
+    o.spacing_m = bad;
+    EXPECT_EQ(o.Validate().code(), StatusCode::kInvalidArgument) << bad;
+  }
+  for (double good : {0.005, 0.05, 1.0}) {
+    SynthOptions o;
+    o.spacing_m = good;
+    EXPECT_TRUE(o.Validate().ok()) << good;
+  }
+}
+
+TEST(DescribeSceneTest, BadSpecsAreInvalidArgumentListingValidNames) {
+  for (const char* bad : {"", "castle", "Box", "comb", "comb:", "comb:0", "comb:51", "comb:x", "comb:2x",
+                          "rooms:-1", "rooms:1.5", "box:2", "hall:1"}) {
+    Result<SceneInfo> info = DescribeScene(bad);
+    ASSERT_FALSE(info.ok()) << bad;
+    EXPECT_EQ(info.status().code(), StatusCode::kInvalidArgument) << bad;
+    EXPECT_NE(info.status().message().find("comb:K"), std::string::npos) << info.status().message();
+  }
+}
+
+TEST(DescribeSceneTest, KnownScenesReportTheirOptimumRoomsAndFloors) {
+  const std::vector<std::pair<std::string, int>> expected = {
+      {"box", 1}, {"lroom", 1}, {"comb:1", 1}, {"comb:7", 7}, {"comb:50", 50}, {"rooms:1", 2},
+      {"rooms:4", 5}, {"twofloor", 2}, {"hall", 0}};
+  for (const auto& [spec, optimum] : expected) {
+    Result<SceneInfo> info = DescribeScene(spec);
+    ASSERT_TRUE(info.ok()) << spec << ": " << info.status().ToString();
+    EXPECT_EQ(info->name, spec);
+    EXPECT_FALSE(info->description.empty());
+    EXPECT_EQ(info->optimum_stations, optimum) << spec;
+    if (optimum > 0) {
+      EXPECT_EQ(static_cast<int>(info->rooms.size()), optimum) << spec;
+    }
+    EXPECT_FALSE(info->rooms.empty()) << spec;
+    ASSERT_FALSE(info->floor_heights_m.empty()) << spec;
+    EXPECT_TRUE(std::is_sorted(info->floor_heights_m.begin(), info->floor_heights_m.end()));
+    for (double f : info->floor_heights_m) {
+      EXPECT_GT(f, info->bounds_min.z()) << spec;
+      EXPECT_LT(f + 2.0, info->bounds_max.z()) << spec;
+    }
+    for (size_t i = 0; i < info->rooms.size(); ++i) {
+      const AxisBox& room = info->rooms[i];
+      EXPECT_TRUE((room.min.array() < room.max.array()).all()) << spec << " room " << i;
+      EXPECT_TRUE((room.min.array() >= info->bounds_min.array()).all()) << spec << " room " << i;
+      EXPECT_TRUE((room.max.array() <= info->bounds_max.array()).all()) << spec << " room " << i;
+      for (size_t j = 0; j < i; ++j) {
+        EXPECT_TRUE(Disjoint(room, info->rooms[j])) << spec << " " << i << "," << j;
+      }
+    }
+  }
+  EXPECT_EQ(DescribeScene("twofloor")->floor_heights_m.size(), 2u);
+}
+
+TEST(DescribeSceneTest, ListNamesEveryScene) {
+  const std::string list = ListScenes();
+  for (const char* name : {"box", "lroom", "comb", "rooms", "twofloor", "hall"}) {
+    EXPECT_NE(list.find(name), std::string::npos) << name;
+  }
+}
+
+TEST(GenerateSceneTest, SameSeedGivesIdenticalPointsOtherSeedDiffers) {
+  SynthOptions a;
+  a.spacing_m = 0.1;
+  a.seed = 7;
+  Result<std::vector<Eigen::Vector3f>> first = GenerateScene("rooms:2", a);
+  Result<std::vector<Eigen::Vector3f>> second = GenerateScene("rooms:2", a);
+  ASSERT_TRUE(first.ok() && second.ok());
+  ASSERT_GT(first->size(), 1000u);
+  EXPECT_TRUE(*first == *second);
+  SynthOptions b = a;
+  b.seed = 8;
+  Result<std::vector<Eigen::Vector3f>> third = GenerateScene("rooms:2", b);
+  ASSERT_TRUE(third.ok());
+  ASSERT_EQ(third->size(), first->size());  // jitter moves points, never adds or drops them
+  size_t moved = 0;
+  for (size_t i = 0; i < first->size(); ++i) moved += (*first)[i] != (*third)[i];
+  EXPECT_GT(moved, first->size() / 2);
+}
+
+TEST(GenerateSceneTest, CountMatchesTheStream) {
+  for (const char* spec : {"box", "lroom", "comb:2", "rooms:2", "twofloor"}) {
+    for (double spacing : {0.07, 0.2}) {
+      SynthOptions o;
+      o.spacing_m = spacing;
+      Result<uint64_t> count = CountScenePoints(spec, o);
+      Result<std::vector<Eigen::Vector3f>> points = GenerateScene(spec, o);
+      ASSERT_TRUE(count.ok() && points.ok()) << spec;
+      EXPECT_EQ(*count, points->size()) << spec << " " << spacing;
+    }
+  }
+}
+
+TEST(GenerateSceneTest, EveryPointIsFiniteAndInsideTheBounds) {
+  for (const char* spec : {"box", "lroom", "comb:3", "rooms:3", "twofloor", "hall"}) {
+    SynthOptions o;
+    o.spacing_m = 0.2;
+    Result<SceneInfo> info = DescribeScene(spec);
+    Result<std::vector<Eigen::Vector3f>> points = GenerateScene(spec, o);
+    ASSERT_TRUE(info.ok() && points.ok()) << spec;
+    ASSERT_FALSE(points->empty());
+    size_t bad = 0;
+    for (const Eigen::Vector3f& p : *points) {
+      const Eigen::Vector3d q = p.cast<double>();
+      bad += !q.allFinite() || (q.array() < info->bounds_min.array()).any() ||
+             (q.array() > info->bounds_max.array()).any();
+    }
+    EXPECT_EQ(bad, 0u) << spec;
+  }
+}
+
+// Nearest-neighbour distances (brute force within a hash grid of cell `spacing`).
+std::vector<double> NearestNeighbourDistances(const std::vector<Eigen::Vector3f>& points, double cell) {
+  auto key = [cell](const Eigen::Vector3f& p) {
+    return std::array<int64_t, 3>{static_cast<int64_t>(std::floor(p.x() / cell)),
+                                  static_cast<int64_t>(std::floor(p.y() / cell)),
+                                  static_cast<int64_t>(std::floor(p.z() / cell))};
+  };
+  auto hash = [](const std::array<int64_t, 3>& k) { return (k[0] * 73856093) ^ (k[1] * 19349663) ^ (k[2] * 83492791); };
+  std::unordered_map<int64_t, std::vector<int>> buckets;
+  std::vector<std::array<int64_t, 3>> keys(points.size());
+  for (size_t i = 0; i < points.size(); ++i) {
+    keys[i] = key(points[i]);
+    buckets[hash(keys[i])].push_back(static_cast<int>(i));
+  }
+  std::vector<double> nn;
+  nn.reserve(points.size());
+  for (size_t i = 0; i < points.size(); ++i) {
+    double best = 1e9;
+    for (int dx = -1; dx <= 1; ++dx) {
+      for (int dy = -1; dy <= 1; ++dy) {
+        for (int dz = -1; dz <= 1; ++dz) {
+          auto it = buckets.find(hash({keys[i][0] + dx, keys[i][1] + dy, keys[i][2] + dz}));
+          if (it == buckets.end()) continue;
+          for (int j : it->second) {
+            if (j != static_cast<int>(i)) best = std::min(best, static_cast<double>((points[j] - points[i]).norm()));
+          }
+        }
+      }
+    }
+    nn.push_back(best);
+  }
+  std::sort(nn.begin(), nn.end());
+  return nn;
+}
+
+TEST(GenerateSceneTest, NearestNeighbourDistancesFollowTheSpacing) {
+  for (const auto& [spec, spacing] : std::vector<std::pair<const char*, double>>{{"box", 0.1}, {"lroom", 0.13}}) {
+    SynthOptions o;
+    o.spacing_m = spacing;
+    Result<std::vector<Eigen::Vector3f>> points = GenerateScene(spec, o);
+    ASSERT_TRUE(points.ok());
+    const std::vector<double> nn = NearestNeighbourDistances(*points, 1.5 * spacing);
+    const double median = nn[nn.size() / 2], p99 = nn[nn.size() * 99 / 100];
+    const double close = std::lower_bound(nn.begin(), nn.end(), 0.5 * spacing) - nn.begin();
+    EXPECT_GT(median, 0.8 * spacing) << spec;
+    EXPECT_LE(median, 1.0 * spacing) << spec;
+    EXPECT_LE(p99, 1.2 * spacing) << spec;
+    EXPECT_LT(close / nn.size(), 0.03) << spec << ": too many points closer than half the spacing";
+  }
+}
+
+TEST(GenerateSceneTest, TooManyPointsIsResourceExhausted) {
+  SynthOptions o;
+  o.spacing_m = 0.005;
+  Result<uint64_t> count = CountScenePoints("hall", o);
+  ASSERT_TRUE(count.ok());
+  EXPECT_GT(*count, kMaxGeneratedPoints);
+  Result<std::vector<Eigen::Vector3f>> points = GenerateScene("hall", o);
+  ASSERT_FALSE(points.ok());
+  EXPECT_EQ(points.status().code(), StatusCode::kResourceExhausted);
+}
+
+TEST(ForEachScenePointTest, BadSpecOrOptionsAreInvalidArgument) {
+  int calls = 0;
+  auto fn = [&calls](const Eigen::Vector3f&) { ++calls; };
+  EXPECT_EQ(ForEachScenePoint("nope", SynthOptions{}, fn).code(), StatusCode::kInvalidArgument);
+  SynthOptions o;
+  o.spacing_m = 0.001;
+  EXPECT_EQ(ForEachScenePoint("box", o, fn).code(), StatusCode::kInvalidArgument);
+  EXPECT_EQ(CountScenePoints("box", o).status().code(), StatusCode::kInvalidArgument);
+  EXPECT_EQ(GenerateScene("rooms:0", SynthOptions{}).status().code(), StatusCode::kInvalidArgument);
+  EXPECT_EQ(calls, 0);
+}
+
+// Checks a scene voxelised at 0.1 m (spacing 0.05 m): closed (a flood fill from a room never
+// leaves the bounds), connected (it reaches every room, through doors and openings), and its ground
+// floor is the largest horizontal layer of occupied voxels. Returns the occupied voxel count.
+uint64_t CheckClosedConnectedFloorDominant(const char* spec) {
+  Result<SceneInfo> info = DescribeScene(spec);
+  EXPECT_TRUE(info.ok());
+  if (!info.ok()) return 0;
+  VoxelGrid grid = Voxelize(spec, 0.05, 0.1);
+  const uint64_t occupied = grid.Occupied();
+  std::cout << spec << ": " << occupied << " occupied voxels at 0.1 m\n";
+  EXPECT_EQ(grid.outside(), 0u) << spec;
+  const std::vector<uint64_t> layers = grid.LayerCounts();
+  const int floor_layer = grid.LayerOf(info->floor_heights_m[0]);
+  for (int z = 0; z < static_cast<int>(layers.size()); ++z) {
+    if (z != floor_layer) {
+      EXPECT_LT(layers[z], layers[floor_layer]) << spec << " layer " << z;
+    }
+  }
+  const auto seed = grid.KeyOf(SeedPoint(info->rooms[0]));
+  EXPECT_FALSE(grid.IsOccupied(seed)) << spec;
+  EXPECT_FALSE(grid.FloodEscapes(seed)) << spec << " leaks";
+  for (size_t i = 0; i < info->rooms.size(); ++i) {
+    EXPECT_TRUE(grid.Reached(grid.KeyOf(SeedPoint(info->rooms[i])))) << spec << " room " << i;
+  }
+  return occupied;
+}
+
+TEST(SceneVoxelsTest, HallHasAbout400kVoxelsIsClosedConnectedAndFloorDominant) {
+  const uint64_t occupied = CheckClosedConnectedFloorDominant("hall");
+  EXPECT_GE(occupied, 300000u);
+  EXPECT_LE(occupied, 500000u);
+}
+
+TEST(SceneVoxelsTest, SmallScenesAreClosedConnectedAndFloorDominant) {
+  for (const char* spec : kSmallScenes) CheckClosedConnectedFloorDominant(spec);
+}
+
+TEST(SceneVoxelsTest, BoxIsWatertightAtTwiceTheSpacing) {
+  for (const auto& [spacing, resolution] : std::vector<std::pair<double, double>>{{0.02, 0.04}, {0.04, 0.08}, {0.1, 0.2}}) {
+    Result<SceneInfo> info = DescribeScene("box");
+    ASSERT_TRUE(info.ok());
+    VoxelGrid grid = Voxelize("box", spacing, resolution);
+    const auto seed = grid.KeyOf(SeedPoint(info->rooms[0]));
+    ASSERT_FALSE(grid.IsOccupied(seed));
+    EXPECT_FALSE(grid.FloodEscapes(seed)) << "box leaks at " << resolution << " m";
+  }
+}
+
+TEST(SceneVoxelsTest, RoomsAreJoinedOnlyThroughTheirDoors) {
+  Result<SceneInfo> info = DescribeScene("rooms:4");
+  ASSERT_TRUE(info.ok());
+  ASSERT_EQ(info->rooms.size(), 5u);  // four rooms, then the corridor
+  VoxelGrid grid = Voxelize("rooms:4", 0.05, 0.1);
+  const auto seed = grid.KeyOf(SeedPoint(info->rooms[0]));
+  EXPECT_FALSE(grid.FloodEscapes(seed));
+  for (const AxisBox& room : info->rooms) {
+    EXPECT_TRUE(grid.Reached(grid.KeyOf(SeedPoint(room))));
+  }
+  // The door of room 0 is 1 m wide and 2.1 m high: above it, the wall is solid.
+  const AxisBox& r0 = info->rooms[0];
+  const WorldPoint door_centre((r0.min.x() + r0.max.x()) / 2, r0.min.y() - 0.125, r0.min.z() + 1.0);
+  EXPECT_TRUE(grid.Reached(grid.KeyOf(door_centre)));
+  EXPECT_FALSE(grid.Reached(grid.KeyOf(door_centre + WorldPoint(0, 0, 1.5))));
+  EXPECT_FALSE(grid.Reached(grid.KeyOf(door_centre + WorldPoint(1.0, 0, 0))));
+}
+
+TEST(WritePlyBinaryTest, HeaderAndBodyMatchGenerateScene) {
+  SynthOptions o;
+  o.spacing_m = 0.25;
+  o.seed = 3;
+  Result<std::vector<Eigen::Vector3f>> points = GenerateScene("rooms:1", o);
+  ASSERT_TRUE(points.ok());
+  const std::string path = testing::MakeTempDir() + "/rooms.ply";
+  ASSERT_TRUE(WritePlyBinary(path, "rooms:1", o).ok());
+  std::ifstream in(path, std::ios::binary);
+  ASSERT_TRUE(in);
+  std::string line, header;
+  uint64_t vertices = 0;
+  while (std::getline(in, line) && line != "end_header") {
+    header += line + "\n";
+    if (line.rfind("element vertex ", 0) == 0) vertices = std::stoull(line.substr(15));
+  }
+  EXPECT_EQ(header.rfind("ply\nformat binary_little_endian 1.0\n", 0), 0u) << header;
+  EXPECT_NE(header.find("property float x\nproperty float y\nproperty float z\n"), std::string::npos);
+  ASSERT_EQ(vertices, points->size());
+  std::vector<float> body(3 * vertices + 1);
+  in.read(reinterpret_cast<char*>(body.data()), static_cast<std::streamsize>(body.size() * sizeof(float)));
+  ASSERT_EQ(static_cast<uint64_t>(in.gcount()), 3 * vertices * sizeof(float)) << "body size";
+  for (size_t i = 0; i < vertices; ++i) {
+    ASSERT_EQ(Eigen::Vector3f(body[3 * i], body[3 * i + 1], body[3 * i + 2]), (*points)[i]) << i;
+  }
+}
+
+TEST(WritePlyBinaryTest, UnwritablePathIsFailedPrecondition) {
+  const Status s = WritePlyBinary(testing::MakeTempDir() + "/no/such/dir/x.ply", "box", SynthOptions{});
+  EXPECT_EQ(s.code(), StatusCode::kFailedPrecondition);
+}
+
+}  // namespace
+}  // namespace vc

@@ -1,0 +1,431 @@
+#include "vc/visibility/visibility.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "vc/raycast/occluders.h"
+#include "testing/scenes.h"
+#include "vc/raycast/ray_traversal.h"
+
+namespace vc {
+namespace {
+
+using Eigen::Vector3d;
+constexpr double kPi = 3.14159265358979323846;
+
+// A scene at resolution 1 m from voxel indices (index = world metres, so hand computation is easy).
+VoxelScene MakeScene(const std::vector<VoxelIndex>& voxels, double r = 1.0) {
+  return testing::SceneOfVoxels(voxels, r);
+}
+
+// ---- Hand-computed cases ----
+
+TEST(PerceiveFaceTest, LoneVoxelIsTransparentSoEveryFaceIsFull) {
+  // A single voxel seen from straight above: with the voxel itself transparent (paper s.2.1),
+  // every corner ray ends in one of the 8 voxels around its corner, so all 6 faces are full.
+  const VoxelScene s = MakeScene({{0, 0, 0}});
+  const WorldPoint o(0.5, 0.5, 5.5);
+  for (int f = 0; f < 6; ++f) EXPECT_EQ(PerceiveFace(s.grid, o, {0, 0, 0}, Face(f)), Perception::kFull) << f;
+}
+
+TEST(PerceiveFaceTest, FaceBehindAWallIsNotVisible) {
+  std::vector<VoxelIndex> v = {{0, 0, 0}};
+  for (int x = -5; x <= 5; ++x)
+    for (int y = -5; y <= 5; ++y) v.push_back({x, y, 2});  // a plate at z in [2,3)
+  const VoxelScene s = MakeScene(v);
+  const WorldPoint o(0.5, 0.5, 5.5);
+  EXPECT_EQ(PerceiveFace(s.grid, o, {0, 0, 0}, Face::kPosZ), Perception::kNone);
+  EXPECT_EQ(FaceVisibility(s.grid, o, {0, 0, 0}, Face::kPosZ, {}), 0.0);
+  EXPECT_FALSE(IsCompatible(s.grid, o, {0, 0, 0}));
+  EXPECT_FALSE(IsSurfaceVisible(s.grid, o, {0, 0, 0}));
+}
+
+TEST(PerceiveFaceTest, HalfHiddenFaceIsPartial) {
+  // Viewpoint (2.5, 0.5, 8.5). In the layer z in [2,3), the rays to the top corners with x = 0
+  // run at x = (z - 1) / 3, in column 0; those to the corners with x = 1 run at
+  // x = 1 + (z - 1) / 5, in column 1. A bar of voxels (0, -1..1, 2) hides exactly the two x = 0
+  // corners: 2 of 4 visible -> partial, V = 0.3.
+  std::vector<VoxelIndex> v = {{0, 0, 0}};
+  for (int y = -1; y <= 1; ++y) v.push_back({0, y, 2});
+  const VoxelScene s = MakeScene(v);
+  const WorldPoint o(2.5, 0.5, 8.5);
+  EXPECT_EQ(PerceiveFace(s.grid, o, {0, 0, 0}, Face::kPosZ), Perception::kPartial);
+  EXPECT_DOUBLE_EQ(FaceVisibility(s.grid, o, {0, 0, 0}, Face::kPosZ, {}), 0.3);
+  // Without the bar the same face is full.
+  const VoxelScene bare = MakeScene({{0, 0, 0}});
+  EXPECT_EQ(PerceiveFace(bare.grid, o, {0, 0, 0}, Face::kPosZ), Perception::kFull);
+}
+
+TEST(VisibilityValueTest, HandValues) {
+  const ScannerModel s;  // [0.5, 75] m
+  // d = 10.5 m, theta = 60 deg: D = 10/74.5, A = 1/3.
+  EXPECT_NEAR(VisibilityValue(Perception::kFull, 10.5, kPi / 3, s), 0.5 + 0.3 * (1 - 10.0 / 74.5) + 0.2 / 3, 1e-12);
+  // Head-on from either side (theta = 0 or pi) gives A = 1; grazing (pi/2) gives A = 0.
+  EXPECT_NEAR(VisibilityValue(Perception::kFull, 0.5, 0.0, s), 1.0, 1e-12);
+  EXPECT_NEAR(VisibilityValue(Perception::kFull, 0.5, kPi, s), 1.0, 1e-12);
+  EXPECT_NEAR(VisibilityValue(Perception::kFull, 0.5, kPi / 2, s), 0.8, 1e-12);
+  // At Rmax, D = 1: only the class constant and the angle term remain.
+  EXPECT_NEAR(VisibilityValue(Perception::kFull, 75.0, 0.0, s), 0.7, 1e-12);
+  EXPECT_DOUBLE_EQ(VisibilityValue(Perception::kPartial, 20.0, 1.0, s), 0.3);
+  EXPECT_DOUBLE_EQ(VisibilityValue(Perception::kNone, 20.0, 0.0, s), 0.0);
+  // Outside [Rmin, Rmax]: not visible, whatever the class.
+  EXPECT_DOUBLE_EQ(VisibilityValue(Perception::kFull, 0.49, 0.0, s), 0.0);
+  EXPECT_DOUBLE_EQ(VisibilityValue(Perception::kFull, 75.01, 0.0, s), 0.0);
+  EXPECT_DOUBLE_EQ(VisibilityValue(Perception::kPartial, 80, 0.0, s), 0.0);
+}
+
+TEST(FaceVisibilityTest, DistanceAndAngleMeasuredToFaceCentre) {
+  const VoxelScene s = MakeScene({{0, 0, 0}});
+  // Top face centre (0.5, 0.5, 1); viewpoint 4 m straight above: d = 4, head-on.
+  EXPECT_NEAR(FaceVisibility(s.grid, WorldPoint(0.5, 0.5, 5.0), {0, 0, 0}, Face::kPosZ, {}),
+              0.5 + 0.3 * (1 - 3.5 / 74.5) + 0.2, 1e-12);
+  // +x face centre (1, 0.5, 0.5) from (4, 0.5, 3.5): ray (-3, 0, -3), 45 deg off the normal.
+  EXPECT_NEAR(FaceVisibility(s.grid, WorldPoint(4, 0.5, 3.5), {0, 0, 0}, Face::kPosX, {}),
+              0.5 + 0.3 * (1 - (std::sqrt(18.0) - 0.5) / 74.5) + 0.2 * 0.5, 1e-12);
+}
+
+TEST(ScannerModelTest, RejectsBadRanges) {
+  EXPECT_TRUE(ScannerModel{}.Validate().ok());
+  EXPECT_FALSE((ScannerModel{2.0, 1.0}).Validate().ok());
+  EXPECT_FALSE((ScannerModel{std::nan(""), 1.0}).Validate().ok());
+  EXPECT_FALSE((ScannerModel{-1.0, 10.0}).Validate().ok());
+}
+
+TEST(SelectionTestsTest, CompatibilityHasThe45DegreeConeSurfaceVisibilityDoesNot) {
+  // A floor plate one voxel thick; viewpoint 1.5 m above voxel (0,0,0)'s centre.
+  std::vector<VoxelIndex> v;
+  for (int x = -45; x <= 45; ++x)
+    for (int y = -5; y <= 5; ++y) v.push_back({x, y, 0});
+  const VoxelScene s = MakeScene(v, 0.1);
+  const WorldPoint o(0.05, 0.05, 1.6);
+  EXPECT_TRUE(IsCompatible(s.grid, o, {0, 0, 0}));
+  EXPECT_TRUE(IsSurfaceVisible(s.grid, o, {0, 0, 0}));
+  // 0.9 m off (about 30 deg from the normal): still inside the cone.
+  EXPECT_TRUE(IsCompatible(s.grid, o, {9, 0, 0}));
+  // 4 m off (about 69 deg): the ray to the centre enters the layer through a neighbour.
+  EXPECT_FALSE(IsCompatible(s.grid, o, {-40, 0, 0}));
+  EXPECT_TRUE(IsSurfaceVisible(s.grid, o, {-40, 0, 0}));
+  // A viewpoint inside an occupied voxel sees nothing.
+  EXPECT_FALSE(IsSurfaceVisible(s.grid, WorldPoint(0.05, 0.05, 0.05), {1, 0, 0}));
+  EXPECT_FALSE(IsCompatible(s.grid, WorldPoint(0.05, 0.05, 0.05), {1, 0, 0}));
+}
+
+// ---- Oracles written plainly from the definitions ----
+
+std::optional<VoxelIndex> PlainFirstHit(const OccupancyGrid& g, const Vector3d& a, const Vector3d& b,
+                                        const VoxelIndex* transparent) {
+  for (const VoxelIndex& v : RayTraversal(a, b)) {
+    if (transparent && v == *transparent) continue;
+    if (g.Occupied(v)) return v;
+  }
+  return std::nullopt;
+}
+
+bool PlainCompatible(const OccupancyGrid& g, const Vector3d& uo, const VoxelIndex& v) {
+  if (g.Occupied(int(std::floor(uo.x())), int(std::floor(uo.y())), int(std::floor(uo.z())))) return false;
+  auto h = PlainFirstHit(g, uo, Vector3d(v.x + 0.5, v.y + 0.5, v.z + 0.5), nullptr);
+  return h && *h == v;
+}
+
+bool PlainSurfaceVisible(const OccupancyGrid& g, const Vector3d& uo, const VoxelIndex& v) {
+  if (g.Occupied(int(std::floor(uo.x())), int(std::floor(uo.y())), int(std::floor(uo.z())))) return false;
+  for (int axis = 0; axis < 3; ++axis) {
+    for (int side = 0; side < 2; ++side) {
+      const double plane = (axis == 0 ? v.x : axis == 1 ? v.y : v.z) + side;
+      const bool facing = side ? uo[axis] > plane : uo[axis] < plane;
+      if (!facing) continue;
+      VoxelIndex n = v;
+      (axis == 0 ? n.x : axis == 1 ? n.y : n.z) += side ? 1 : -1;
+      if (g.Occupied(n)) continue;
+      Vector3d c(v.x + 0.5, v.y + 0.5, v.z + 0.5);
+      c[axis] = plane;
+      if (!PlainFirstHit(g, uo, c, &v)) return true;
+    }
+  }
+  return false;
+}
+
+double PlainFaceValue(const OccupancyGrid& g, const WorldPoint& o, const VoxelIndex& v, int face) {
+  const Vector3d uo = o / g.resolution_m();
+  const int axis = face / 2, side = face % 2;
+  int visible = 0;
+  for (int a = 0; a < 2; ++a)
+    for (int b = 0; b < 2; ++b) {
+      Vector3d c(v.x, v.y, v.z);
+      c[axis] += side;
+      c[(axis + 1) % 3] += a;
+      c[(axis + 2) % 3] += b;
+      auto h = PlainFirstHit(g, uo, c, &v);
+      const bool near = h && std::abs(h->x + 0.5 - c.x()) < 1 && std::abs(h->y + 0.5 - c.y()) < 1 &&
+                        std::abs(h->z + 0.5 - c.z()) < 1;
+      visible += (!h || near);
+    }
+  if (visible == 0) return 0;
+  Vector3d center(v.x + 0.5, v.y + 0.5, v.z + 0.5);
+  center[axis] += side ? 0.5 : -0.5;
+  center *= g.resolution_m();
+  const double d = (center - o).norm();
+  if (d < 0.5 || d > 75) return 0;
+  if (visible < 4) return 0.3;
+  Vector3d n = Vector3d::Zero();
+  n[axis] = side ? 1 : -1;
+  const double theta = std::acos(std::clamp((center - o).dot(n) / d, -1.0, 1.0));
+  return 0.5 + 0.3 * (1 - (d - 0.5) / 74.5) + 0.2 * std::abs(theta - kPi / 2) / (kPi / 2);
+}
+
+VoxelScene RandomScene(std::mt19937_64& rng, int count, int extent, double r) {
+  std::uniform_int_distribution<int> c(0, extent - 1);
+  std::vector<VoxelIndex> v;
+  for (int i = 0; i < count; ++i) v.push_back({c(rng), c(rng), c(rng)});
+  // A floor, so some voxels are enclosed or half-hidden.
+  for (int x = 0; x < extent; ++x)
+    for (int y = 0; y < extent; ++y) v.push_back({x, y, 0});
+  return MakeScene(v, r);
+}
+
+std::vector<WorldPoint> RandomViewpoints(std::mt19937_64& rng, int count, int extent, double r) {
+  std::uniform_real_distribution<double> u(0.2, extent - 0.2);
+  std::vector<WorldPoint> out;
+  for (int i = 0; i < count; ++i) out.emplace_back(u(rng) * r, u(rng) * r, u(rng) * r);
+  return out;
+}
+
+// The sets of `opt` against the plain oracles, voxel by voxel; returns how many are in a set.
+size_t ExpectSetsMatchOracle(const VoxelScene& s, const std::vector<WorldPoint>& vps, const VisibilitySetsOptions& opt,
+                             const std::string& what) {
+  auto sets = ComputeVisibilitySets(s, vps, opt);
+  EXPECT_TRUE(sets.ok()) << what;
+  if (!sets.ok()) return 0;
+  size_t positives = 0;
+  for (size_t k = 0; k < vps.size(); ++k) {
+    EXPECT_EQ((*sets)[k].size(), s.occupied.size()) << what << " vp " << k;
+    if ((*sets)[k].size() != s.occupied.size()) return positives;
+    const Vector3d uo = vps[k] / s.resolution_m;
+    for (size_t id = 0; id < s.occupied.size(); ++id) {
+      const VoxelIndex v = KeyToIndex(s.occupied[id]);
+      const bool want = opt.test == SelectionTest::kCompatibility ? PlainCompatible(s.grid, uo, v)
+                                                                  : PlainSurfaceVisible(s.grid, uo, v);
+      EXPECT_EQ((*sets)[k].test(id), want) << what << " vp " << k << " voxel " << id;
+      if ((*sets)[k].test(id) != want) return positives;
+      positives += want;
+    }
+  }
+  return positives;
+}
+
+TEST(ComputeVisibilitySetsTest, EqualsBruteForceOracleForBothTests) {
+  std::mt19937_64 rng(42);
+  for (int trial = 0; trial < 6; ++trial) {
+    const VoxelScene s = RandomScene(rng, 120, 12, 0.1);
+    const auto vps = RandomViewpoints(rng, 5, 12, 0.1);
+    for (SelectionTest test : {SelectionTest::kCompatibility, SelectionTest::kSurfaceVisibility}) {
+      VisibilitySetsOptions opt;
+      opt.test = test;
+      opt.threads = 2;
+      EXPECT_GT(ExpectSetsMatchOracle(s, vps, opt, "trial " + std::to_string(trial) + " test " +
+                                                       std::string(SelectionTestName(test))),
+                0u);
+    }
+  }
+}
+
+// With 8 or more viewpoints per thread a task owns its viewpoint and sizes its set itself; every
+// viewpoint, far (no shortcuts) or inside an occupied voxel (empty set) included, still gets a
+// full-size set with the oracle's answers.
+TEST(ComputeVisibilitySetsTest, TaskPerViewpointSetsMatchTheOracle) {
+  std::mt19937_64 rng(31);
+  const VoxelScene s = RandomScene(rng, 80, 10, 1.0);
+  std::vector<WorldPoint> vps = RandomViewpoints(rng, 18, 10, 1.0);
+  vps.push_back(WorldPoint(20000.5, 4.25, 6.5));  // far: walked plainly after the grouped pass
+  const VoxelIndex inside = KeyToIndex(s.occupied[3]);
+  vps.push_back(WorldPoint(inside.x + 0.5, inside.y + 0.5, inside.z + 0.5));
+  for (bool per_voxel : {false, true}) {
+    VisibilitySetsOptions opt;
+    opt.per_voxel = per_voxel;
+    opt.threads = 2;
+    EXPECT_GT(ExpectSetsMatchOracle(s, vps, opt, per_voxel ? "per voxel" : "grouped"), 0u);
+  }
+  auto sets = ComputeVisibilitySets(s, vps, {});
+  ASSERT_TRUE(sets.ok());
+  EXPECT_EQ(sets->back().count(), 0u);  // the viewpoint inside an occupied voxel sees nothing
+}
+
+TEST(VoxelSetTest, ResizeKeepsBitsBelowTheSizeAndClearsTheRest) {
+  VoxelSet s(130);
+  for (size_t i : {0, 63, 64, 100, 129}) s.set(i);
+  s.Resize(101);
+  EXPECT_EQ(s.size(), 101u);
+  EXPECT_EQ(s.count(), 4u);  // 129 dropped
+  s.Resize(200);
+  EXPECT_EQ(s.count(), 4u);  // nothing above 100 comes back
+  EXPECT_TRUE(s.test(0) && s.test(63) && s.test(64) && s.test(100));
+  EXPECT_FALSE(s.test(129));
+  VoxelSet r;
+  r.words().reserve(100);
+  const uint64_t* where = r.words().data();
+  r.Resize(64 * 100);
+  EXPECT_EQ(r.words().data(), where);  // in the reserved capacity
+  EXPECT_EQ(r.count(), 0u);
+}
+
+TEST(ComputeVisibilitySetsTest, FarViewpointsAreWalkedPlainlyAndMatchTheOracle) {
+  // Beyond kMaxShortcutLength voxels the shortcuts' margins are not argued; such viewpoints must
+  // still get the plain walk's answers (grouped default and per-voxel alike).
+  std::mt19937_64 rng(23);
+  const VoxelScene s = RandomScene(rng, 60, 10, 1.0);
+  const std::vector<WorldPoint> vps = {WorldPoint(20000.5, 4.25, 6.5), WorldPoint(4.5, -17000.25, 30.5),
+                                       WorldPoint(5.25, 5.5, 8.75)};
+  EXPECT_FALSE(internal::ShortcutsHold(s.grid, vps[0] / 1.0));
+  EXPECT_TRUE(internal::ShortcutsHold(s.grid, vps[2] / 1.0));
+  for (bool per_voxel : {false, true}) {
+    VisibilitySetsOptions opt;
+    opt.per_voxel = per_voxel;
+    opt.threads = 2;
+    EXPECT_GT(ExpectSetsMatchOracle(s, vps, opt, per_voxel ? "per voxel" : "grouped"), 0u);
+  }
+}
+
+TEST(EvaluateTest, GlobalVisibilityEqualsBruteForce) {
+  std::mt19937_64 rng(7);
+  for (int trial = 0; trial < 4; ++trial) {
+    const VoxelScene s = RandomScene(rng, 60, 9, 1.0);
+    const auto vps = RandomViewpoints(rng, 3, 9, 1.0);
+    EvaluateOptions opt;
+    opt.keep_face_values = true;
+    opt.keep_per_viewpoint_values = true;
+    auto ev = Evaluate(s, vps, opt);
+    ASSERT_TRUE(ev.ok()) << ev.status().ToString();
+    const size_t n = s.occupied.size();
+    ASSERT_EQ(ev->faces_total, 6 * n);
+    double sum_best = 0;
+    std::vector<double> sum_vp(vps.size(), 0);
+    for (size_t id = 0; id < n; ++id) {
+      const VoxelIndex v = KeyToIndex(s.occupied[id]);
+      for (int f = 0; f < 6; ++f) {
+        double best = 0;
+        for (size_t k = 0; k < vps.size(); ++k) {
+          const double val = PlainFaceValue(s.grid, vps[k], v, f);
+          ASSERT_NEAR(ev->per_viewpoint_face_values[k][id * 6 + f], val, 1e-6);
+          sum_vp[k] += val;
+          best = std::max(best, val);
+        }
+        ASSERT_NEAR(ev->best_face_values[id][f], best, 1e-6);
+        sum_best += best;
+      }
+    }
+    EXPECT_NEAR(ev->overall.global_visibility, sum_best / double(6 * n), 1e-9);
+    EXPECT_GT(ev->overall.global_visibility, 0.0);
+    for (size_t k = 0; k < vps.size(); ++k)
+      EXPECT_NEAR(ev->per_viewpoint[k].global_visibility, sum_vp[k] / double(6 * n), 1e-9);
+  }
+}
+
+// With enough viewpoints per thread each thread evaluates whole viewpoints and the threads' best
+// values are merged; with fewer, each viewpoint runs on all threads. Both must give the same
+// figures, bit for bit, as one thread; on the small scene also the brute-force values. The large
+// one has several chunks of bricks, corners and voxels, so that with 3 threads the work within a
+// viewpoint is shared (and the group pass sets its bits atomically).
+TEST(EvaluateTest, TaskPerViewpointGivesTheSameFiguresAsOneThread) {
+  std::mt19937_64 rng(31);
+  for (const int extent : {14, 150}) {
+    const VoxelScene s = RandomScene(rng, extent == 14 ? 300 : 3000, extent, 0.1);
+    const auto vps = RandomViewpoints(rng, 11, extent, 0.1);  // 2 threads: a task per viewpoint; 3: not
+    const std::string scene = "extent " + std::to_string(extent);
+    auto run = [&](int threads) {
+      EvaluateOptions opt;
+      opt.threads = threads;
+      opt.keep_face_values = true;
+      opt.keep_per_viewpoint_values = true;
+      auto ev = Evaluate(s, vps, opt);
+      EXPECT_TRUE(ev.ok()) << ev.status().ToString();
+      return *ev;
+    };
+    const Evaluation one = run(1);
+    EXPECT_GT(one.overall.global_visibility, 0.0) << scene;
+    const size_t n = s.occupied.size();
+    for (size_t id = 0; extent == 14 && id < n; ++id) {
+      const VoxelIndex v = KeyToIndex(s.occupied[id]);
+      for (int f = 0; f < 6; ++f) {
+        double best = 0;
+        for (size_t k = 0; k < vps.size(); ++k) best = std::max(best, PlainFaceValue(s.grid, vps[k], v, f));
+        ASSERT_NEAR(one.best_face_values[id][f], best, 1e-6) << "voxel " << id << " face " << f;
+      }
+    }
+    for (int threads : {2, 3}) {
+      const Evaluation other = run(threads);
+      const std::string what = scene + ", " + std::to_string(threads) + " threads";
+      EXPECT_EQ(other.overall.global_visibility, one.overall.global_visibility) << what;
+      EXPECT_EQ(other.overall.fully_visible_fraction, one.overall.fully_visible_fraction) << what;
+      EXPECT_EQ(other.overall.mean_full_visibility, one.overall.mean_full_visibility) << what;
+      EXPECT_EQ(other.overall.partially_visible_fraction, one.overall.partially_visible_fraction) << what;
+      ASSERT_EQ(other.per_viewpoint.size(), vps.size());
+      for (size_t k = 0; k < vps.size(); ++k) {
+        EXPECT_EQ(other.per_viewpoint[k].global_visibility, one.per_viewpoint[k].global_visibility) << what << ", " << k;
+        EXPECT_EQ(other.per_viewpoint[k].fully_visible_fraction, one.per_viewpoint[k].fully_visible_fraction) << what;
+        EXPECT_EQ(other.per_viewpoint_face_values[k], one.per_viewpoint_face_values[k]) << what << ", viewpoint " << k;
+      }
+      EXPECT_EQ(other.best_face_values, one.best_face_values) << what;
+    }
+  }
+}
+
+TEST(EvaluateTest, SamplingIsUnbiasedWithinItsConfidenceInterval) {
+  std::mt19937_64 rng(99);
+  const VoxelScene s = RandomScene(rng, 400, 20, 0.1);
+  const auto vps = RandomViewpoints(rng, 3, 20, 0.1);
+  auto exact = Evaluate(s, vps, {});
+  ASSERT_TRUE(exact.ok());
+  EvaluateOptions opt;
+  opt.sample_faces = 20000;
+  opt.seed = 5;
+  auto est = Evaluate(s, vps, opt);
+  ASSERT_TRUE(est.ok());
+  EXPECT_TRUE(est->sampled);
+  EXPECT_GT(est->global_visibility_ci95, 0.0);
+  EXPECT_LT(est->global_visibility_ci95, 0.01);
+  EXPECT_NEAR(est->overall.global_visibility, exact->overall.global_visibility, 1.5 * est->global_visibility_ci95);
+}
+
+TEST(EvaluateTest, ExposedFaceSetExcludesSharedFaces) {
+  const VoxelScene s = MakeScene({{0, 0, 0}, {1, 0, 0}});
+  EvaluateOptions opt;
+  opt.faces = FaceSet::kExposed;
+  auto ev = Evaluate(s, {WorldPoint(0.5, 0.5, 5.5)}, opt);
+  ASSERT_TRUE(ev.ok());
+  EXPECT_EQ(ev->faces_total, 10u);
+  opt.faces = FaceSet::kAll;
+  EXPECT_EQ(Evaluate(s, {WorldPoint(0.5, 0.5, 5.5)}, opt)->faces_total, 12u);
+}
+
+TEST(EvaluateTest, RejectsNonFiniteViewpointAndBadRange) {
+  const VoxelScene s = MakeScene({{0, 0, 0}});
+  EXPECT_EQ(Evaluate(s, {WorldPoint(std::nan(""), 0, 0)}, {}).status().code(), StatusCode::kInvalidArgument);
+  EvaluateOptions opt;
+  opt.scanner.max_range_m = 0.1;
+  EXPECT_EQ(Evaluate(s, {WorldPoint(0, 0, 3)}, opt).status().code(), StatusCode::kInvalidArgument);
+  // Absurdly far (beyond 2^20 voxels): refused by Evaluate, sees nothing in the selection sets.
+  const WorldPoint far(0, 0, 1e12);
+  const Status st = Evaluate(s, {far}, {}).status();
+  EXPECT_EQ(st.code(), StatusCode::kInvalidArgument);
+  EXPECT_NE(st.message().find("from the origin"), std::string::npos) << st.ToString();
+  auto sets = ComputeVisibilitySets(s, {far, WorldPoint(0.5, 0.5, 3)}, {});
+  ASSERT_TRUE(sets.ok());
+  EXPECT_EQ((*sets)[0].count(), 0u);
+  EXPECT_EQ((*sets)[1].count(), 1u);
+}
+
+TEST(ComputeVisibilitySetsTest, CancellationStopsTheJob) {
+  std::mt19937_64 rng(1);
+  const VoxelScene s = RandomScene(rng, 100, 10, 0.1);
+  CancelToken token;
+  token.Cancel();
+  JobContext ctx;
+  ctx.cancel = &token;
+  auto r = ComputeVisibilitySets(s, RandomViewpoints(rng, 3, 10, 0.1), {}, ctx);
+  EXPECT_EQ(r.status().code(), StatusCode::kCancelled);
+}
+
+}  // namespace
+}  // namespace vc
