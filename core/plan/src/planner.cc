@@ -410,6 +410,7 @@ Result<PlanResult> Plan(const SceneInput& input, const PlanOptions& options, con
     final_positions.push_back(ps.position);
   }
   result.covered_voxels = covered_count;
+  if (callbacks.on_final_stations) callbacks.on_final_stations(result.stations);
   if (greedy.stop == StopReason::kMaxStations) {
     result.warnings.push_back("stopped at max_stations = " + std::to_string(options.max_stations) + " with " +
                               Percent(greedy.coverable ? double(greedy.covered) / greedy.coverable : 0.0) +

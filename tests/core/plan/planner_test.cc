@@ -249,8 +249,16 @@ TEST(PlannerTest, ProgressCallbacksAndTimings) {
     station_indices.push_back(index);
     EXPECT_GT(s.marginal_gain, 0u);
   };
+  std::vector<std::vector<PlannedStation>> finals;
+  cb.on_final_stations = [&](const std::vector<PlannedStation>& s) { finals.push_back(s); };
   Result<PlanResult> r = Plan(Synthetic("comb:3"), TestOptions(), ctx, cb);
   ASSERT_TRUE(r.ok());
+  ASSERT_EQ(finals.size(), 1u);
+  ASSERT_EQ(finals[0].size(), r->stations.size());
+  for (size_t k = 0; k < r->stations.size(); ++k) {
+    EXPECT_EQ(finals[0][k].position, r->stations[k].position);
+    EXPECT_EQ(finals[0][k].marginal_gain, r->stations[k].marginal_gain);
+  }
   EXPECT_FALSE(bad_fraction);
   EXPECT_EQ(heat_maps, 1);
   EXPECT_EQ(station_indices, std::vector<int>({0, 1, 2}));

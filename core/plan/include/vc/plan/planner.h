@@ -119,11 +119,18 @@ struct PlanResult {
   std::vector<WorldPoint> voxel_centers;
 };
 
-// Called once with the heat map, then for each station selected (greedy order, after
-// consolidation, before refinement and reduction, so global_visibility is still 0); for streaming.
+// What a plan reports while it runs, for streaming; every member optional, called on the thread
+// that runs Plan.
 struct PlanCallbacks {
+  // Once, when the visibility stage has counted every candidate (the heat map is final then:
+  // refinement's trial positions are not candidates).
   std::function<void(const HeatMap&)> on_heat_map;
+  // Provisional: each station as selection picks it (greedy order, after consolidation), before
+  // refinement and reduction may move or remove it; global_visibility is still 0.
   std::function<void(const PlannedStation&, int index)> on_station;
+  // Once, after refinement and reduction: the final stations, in the order of PlanResult::stations
+  // (marginal gain and coverage final; global_visibility still 0 until the evaluation).
+  std::function<void(const std::vector<PlannedStation>&)> on_final_stations;
 };
 
 // Runs the whole pipeline on an already-read input. INVALID_ARGUMENT for bad options,
