@@ -159,7 +159,7 @@ CallResult<PlanResult> Client::Plan(const Upload& upload, const PlanOptions& opt
   return out;
 }
 
-CallResult<Evaluation> Client::Evaluate(const Upload& upload, const wire::EvaluateJobOptions& options,
+CallResult<Evaluation> Client::Evaluate(const Upload& upload, const EvaluateJobOptions& options,
                                         const JobObserver& observer) {
   auto stub = v1::StationPlanner::NewStub(channel_);
   v1::EvaluateRequest spec;

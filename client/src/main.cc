@@ -10,6 +10,7 @@
 #include <string>
 
 #include "vc/client/client.h"
+#include "vc/client/parameter_flags.h"
 #include "vc/client/progress_display.h"
 #include "vc/report/plan_report.h"
 #include "vc/scene/scene_input.h"
@@ -29,8 +30,6 @@ int Fail(const std::string& what, const grpc::Status& s, const std::string& serv
   std::cerr << "vc-client: " << what << " failed (" << int(s.error_code()) << "): " << msg << "\n";
   return int(s.error_code());
 }
-
-const std::vector<std::string> kSelectionTests = {"surface", "compatibility"};
 
 void PrintStations(const vc::PlanResult& r) {
   std::printf("%zu station(s), coverage %.1f%% of %llu coverable voxels, global visibility G = %.3f\n",
@@ -83,57 +82,23 @@ int main(int argc, char** argv) {
   app.add_option("--retries", conn.max_attempts, "attempts when the server is unavailable")->capture_default_str();
   app.add_option("--timeout", timeout_s, "deadline per call in seconds (0 = none)")->capture_default_str();
 
-  // submit
-  const vc::PlanOptions defaults;
-  vc::PlanOptions plan = defaults;
-  std::string file, out_dir = "./vc-out", test_name = "surface", candidates_csv;
+  // submit: every planning parameter's flag comes from the parameter table (parameter_flags.h).
+  vc::PlanOptions plan;
+  std::string file, out_dir = "./vc-out", candidates_csv;
   auto* submit = app.add_subcommand("submit", "plan stations for a scene on the server; write the reports");
   submit->add_option("FILE", file, "scene: PLY, PCD, XYZ, LAS, or OctoMap .bt/.ot/.graph")->required();
   submit->add_option("--out", out_dir, "output directory")->capture_default_str();
-  submit->add_option("--resolution", plan.resolution_m, "working resolution in m (0 = the octree's own, or 0.1 m)")
-      ->capture_default_str();
-  submit->add_option("--memory-budget-bytes", plan.memory_budget_bytes, "memory budget of the job in bytes")
-      ->capture_default_str();
-  submit->add_option("--test", test_name, "selection test")->check(CLI::IsMember(kSelectionTests))->capture_default_str();
-  submit->add_option("--min-range", plan.scanner.min_range_m, "scanner minimum range in m")->capture_default_str();
-  submit->add_option("--max-range", plan.scanner.max_range_m, "scanner maximum range in m")->capture_default_str();
-  submit->add_option("--grid-spacing", plan.grid_spacing_m, "candidate grid spacing in m")->capture_default_str();
-  submit->add_option("--tripod-height", plan.tripod_height_m, "scanner height above the floor in m")->capture_default_str();
-  submit->add_option("--clearance", plan.clearance_m, "clearance around a candidate in m")->capture_default_str();
   submit->add_option("--candidates", candidates_csv, "CSV of candidate positions x,y,z (replaces the grid)");
-  submit->add_option("--max-stations", plan.max_stations, "at most this many stations (0 = no limit)")->capture_default_str();
-  submit->add_option("--min-gain", plan.min_marginal_gain_voxels, "stop when a station adds fewer voxels")
-      ->capture_default_str();
-  submit->add_option("--target-coverage", plan.target_coverage, "stop at this covered fraction (0..1]")->capture_default_str();
-  submit->add_flag("--consolidate,!--no-consolidate", plan.consolidate,
-                   "drop covered picks and merge pairs after greedy selection")->capture_default_str();
-  submit->add_flag("--refine,!--no-refine", plan.refine, "refine each station on a local sub-grid")->capture_default_str();
-  submit->add_option("--refine-radius", plan.refine_radius_m, "refinement radius in m")->capture_default_str();
-  submit->add_option("--refine-step", plan.refine_step_m, "refinement step in m")->capture_default_str();
-  submit->add_flag("--reduce,!--no-reduce", plan.reduce, "remove redundant stations")->capture_default_str();
-  submit->add_option("--reduce-to", plan.reduce_to, "reduce to at most this many stations (0 = zero-loss only)")
-      ->capture_default_str();
-  submit->add_option("--threads", plan.threads, "threads for the job (0 = the server's share)")->capture_default_str();
+  vc::client::AddPlanFlags(submit, &plan);
 
   // evaluate
-  vc::wire::EvaluateJobOptions eval;
-  std::string viewpoints_csv, faces_name = "all";
+  vc::EvaluateJobOptions eval;
+  std::string viewpoints_csv;
   auto* evaluate = app.add_subcommand("evaluate", "evaluate viewpoints on a scene on the server; write evaluation.json");
   evaluate->add_option("FILE", file, "scene file")->required();
   evaluate->add_option("--viewpoints", viewpoints_csv, "CSV of viewpoints x,y,z (e.g. stations.csv)")->required();
-  evaluate->add_option("--resolution", eval.voxelize.resolution_m, "working resolution in m (0 = default)")
-      ->capture_default_str();
-  evaluate->add_option("--sample", eval.evaluate.sample_faces, "evaluate a random sample of N faces (0 = all)")
-      ->capture_default_str();
-  evaluate->add_option("--seed", eval.evaluate.seed, "sampling seed")->capture_default_str();
-  evaluate->add_option("--faces", faces_name, "faces counted in F")->check(CLI::IsMember(std::vector<std::string>{"all", "exposed"}))
-      ->capture_default_str();
-  evaluate->add_option("--min-range", eval.evaluate.scanner.min_range_m, "scanner minimum range in m")->capture_default_str();
-  evaluate->add_option("--max-range", eval.evaluate.scanner.max_range_m, "scanner maximum range in m")->capture_default_str();
-  evaluate->add_option("--memory-budget-bytes", eval.voxelize.memory_budget_bytes, "memory budget in bytes")
-      ->capture_default_str();
-  evaluate->add_option("--threads", eval.evaluate.threads, "threads (0 = the server's share)")->capture_default_str();
   evaluate->add_option("--out", out_dir, "output directory")->capture_default_str();
+  vc::client::AddEvaluateFlags(evaluate, &eval);
 
   // health
   std::string health_service;
@@ -177,7 +142,6 @@ int main(int argc, char** argv) {
   display.Uploading(upload->source_name, upload->bytes.size(), conn.server);
 
   if (*submit) {
-    plan.test = test_name == "compatibility" ? vc::SelectionTest::kCompatibility : vc::SelectionTest::kSurfaceVisibility;
     if (!candidates_csv.empty()) {
       auto text = vc::client::ReadUpload(candidates_csv);
       if (!text.ok()) return Fail("cannot read the candidates", text.status());
@@ -196,7 +160,6 @@ int main(int argc, char** argv) {
   }
 
   // evaluate
-  eval.evaluate.faces = faces_name == "exposed" ? vc::FaceSet::kExposed : vc::FaceSet::kAll;
   auto text = vc::client::ReadUpload(viewpoints_csv);
   if (!text.ok()) return Fail("cannot read the viewpoints", text.status());
   auto points = vc::ParseStationsCsv(text->bytes, viewpoints_csv);

@@ -52,16 +52,51 @@ v1::FaceSet ToProto(FaceSet f) { return f == FaceSet::kExposed ? v1::FACE_SET_EX
 
 namespace {
 
-v1::ScannerModel ToProto(const ScannerModel& s) {
-  v1::ScannerModel out;
-  out.set_min_range_m(s.min_range_m);
-  out.set_max_range_m(s.max_range_m);
-  return out;
+// A parameter row's value to its proto field's type and back (vc/base/parameter.h). Numbers and
+// bools are the same on both sides; enums map through ToProto / FromProto, and an UNSPECIFIED
+// enum leaves the default in place.
+template <typename T>
+T ToWire(T v) {
+  return v;
+}
+v1::SelectionTest ToWire(SelectionTest t) { return ToProto(t); }
+v1::FaceSet ToWire(FaceSet f) { return ToProto(f); }
+
+template <typename T>
+Status FromWire(T wire, T* out) {
+  *out = wire;
+  return Status::Ok();
+}
+Status FromWire(v1::SelectionTest wire, SelectionTest* out) {
+  if (wire == v1::SELECTION_TEST_UNSPECIFIED) return Status::Ok();
+  VC_ASSIGN_OR_RETURN(*out, FromProto(wire));
+  return Status::Ok();
+}
+Status FromWire(v1::FaceSet wire, FaceSet* out) {
+  switch (wire) {
+    case v1::FACE_SET_UNSPECIFIED: return Status::Ok();
+    case v1::FACE_SET_ALL: *out = FaceSet::kAll; return Status::Ok();
+    case v1::FACE_SET_EXPOSED: *out = FaceSet::kExposed; return Status::Ok();
+    default: break;
+  }
+  return InvalidArgumentError("unknown face set value " + std::to_string(int(wire)) + "; use ALL or EXPOSED");
 }
 
-void Apply(const v1::ScannerModel& p, ScannerModel* s) {
-  if (p.has_min_range_m()) s->min_range_m = p.min_range_m();
-  if (p.has_max_range_m()) s->max_range_m = p.max_range_m();
+// Every row of a table to the message `p` from the options `o`, and back (only the fields set).
+#define VC_ROW_TO_PROTO(type, name, ...) p.set_##name(ToWire(o.name));
+#define VC_ROW_FROM_PROTO(type, name, ...) \
+  if (p.has_##name()) VC_RETURN_IF_ERROR(FromWire(p.name(), &o.name));
+
+v1::ScannerModel ToProto(const ScannerModel& o) {
+  v1::ScannerModel p;
+  VC_SCANNER_PARAMETERS(VC_ROW_TO_PROTO)
+  return p;
+}
+
+Status Apply(const v1::ScannerModel& p, ScannerModel* scanner) {
+  ScannerModel& o = *scanner;
+  VC_SCANNER_PARAMETERS(VC_ROW_FROM_PROTO)
+  return Status::Ok();
 }
 
 v1::VisibilityFigures ToProto(const VisibilityFigures& f) {
@@ -113,87 +148,33 @@ Status ChunkError(const std::string& what) {
 
 v1::PlanParameters ToProto(const PlanOptions& o) {
   v1::PlanParameters p;
-  p.set_resolution_m(o.resolution_m);
-  p.set_memory_budget_bytes(o.memory_budget_bytes);
-  p.set_test(ToProto(o.test));
+  VC_PLAN_PARAMETERS(VC_ROW_TO_PROTO)
   *p.mutable_scanner() = ToProto(o.scanner);
-  p.set_grid_spacing_m(o.grid_spacing_m);
-  p.set_tripod_height_m(o.tripod_height_m);
-  p.set_clearance_m(o.clearance_m);
   for (const auto& c : o.candidates) *p.add_candidates() = ToProto(c);
-  p.set_max_stations(o.max_stations);
-  p.set_min_marginal_gain_voxels(o.min_marginal_gain_voxels);
-  p.set_target_coverage(o.target_coverage);
-  p.set_refine(o.refine);
-  p.set_refine_radius_m(o.refine_radius_m);
-  p.set_refine_step_m(o.refine_step_m);
-  p.set_reduce(o.reduce);
-  p.set_reduce_to(o.reduce_to);
-  p.set_threads(o.threads);
-  p.set_consolidate(o.consolidate);
   return p;
 }
 
 Result<PlanOptions> FromProto(const v1::PlanParameters& p) {
   PlanOptions o;
-  if (p.has_resolution_m()) o.resolution_m = p.resolution_m();
-  if (p.has_memory_budget_bytes()) o.memory_budget_bytes = p.memory_budget_bytes();
-  switch (p.test()) {
-    case v1::SELECTION_TEST_UNSPECIFIED: break;
-    case v1::SELECTION_TEST_SURFACE_VISIBILITY: o.test = SelectionTest::kSurfaceVisibility; break;
-    case v1::SELECTION_TEST_COMPATIBILITY: o.test = SelectionTest::kCompatibility; break;
-    default:
-      return InvalidArgumentError("unknown selection test value " + std::to_string(int(p.test())) +
-                                  "; use SURFACE_VISIBILITY or COMPATIBILITY");
-  }
-  if (p.has_scanner()) Apply(p.scanner(), &o.scanner);
-  if (p.has_grid_spacing_m()) o.grid_spacing_m = p.grid_spacing_m();
-  if (p.has_tripod_height_m()) o.tripod_height_m = p.tripod_height_m();
-  if (p.has_clearance_m()) o.clearance_m = p.clearance_m();
+  VC_PLAN_PARAMETERS(VC_ROW_FROM_PROTO)
+  if (p.has_scanner()) VC_RETURN_IF_ERROR(Apply(p.scanner(), &o.scanner));
   for (const auto& c : p.candidates()) o.candidates.push_back(FromProto(c));
-  if (p.has_max_stations()) o.max_stations = p.max_stations();
-  if (p.has_min_marginal_gain_voxels()) o.min_marginal_gain_voxels = p.min_marginal_gain_voxels();
-  if (p.has_target_coverage()) o.target_coverage = p.target_coverage();
-  if (p.has_refine()) o.refine = p.refine();
-  if (p.has_refine_radius_m()) o.refine_radius_m = p.refine_radius_m();
-  if (p.has_refine_step_m()) o.refine_step_m = p.refine_step_m();
-  if (p.has_reduce()) o.reduce = p.reduce();
-  if (p.has_reduce_to()) o.reduce_to = p.reduce_to();
-  if (p.has_threads()) o.threads = p.threads();
-  if (p.has_consolidate()) o.consolidate = p.consolidate();
   return o;
 }
 
 v1::EvaluateParameters ToProto(const EvaluateJobOptions& o) {
   v1::EvaluateParameters p;
+  VC_EVALUATE_PARAMETERS(VC_ROW_TO_PROTO)
+  *p.mutable_scanner() = ToProto(o.scanner);
   for (const auto& v : o.viewpoints) *p.add_viewpoints() = ToProto(v);
-  p.set_resolution_m(o.voxelize.resolution_m);
-  p.set_memory_budget_bytes(o.voxelize.memory_budget_bytes);
-  *p.mutable_scanner() = ToProto(o.evaluate.scanner);
-  p.set_faces(ToProto(o.evaluate.faces));
-  p.set_sample_faces(o.evaluate.sample_faces);
-  p.set_seed(o.evaluate.seed);
-  p.set_threads(o.evaluate.threads);
   return p;
 }
 
 Result<EvaluateJobOptions> FromProto(const v1::EvaluateParameters& p) {
   EvaluateJobOptions o;
+  VC_EVALUATE_PARAMETERS(VC_ROW_FROM_PROTO)
+  if (p.has_scanner()) VC_RETURN_IF_ERROR(Apply(p.scanner(), &o.scanner));
   for (const auto& v : p.viewpoints()) o.viewpoints.push_back(FromProto(v));
-  if (p.has_resolution_m()) o.voxelize.resolution_m = p.resolution_m();
-  if (p.has_memory_budget_bytes()) o.voxelize.memory_budget_bytes = p.memory_budget_bytes();
-  if (p.has_scanner()) Apply(p.scanner(), &o.evaluate.scanner);
-  switch (p.faces()) {
-    case v1::FACE_SET_UNSPECIFIED: break;
-    case v1::FACE_SET_ALL: o.evaluate.faces = FaceSet::kAll; break;
-    case v1::FACE_SET_EXPOSED: o.evaluate.faces = FaceSet::kExposed; break;
-    default:
-      return InvalidArgumentError("unknown face set value " + std::to_string(int(p.faces())) +
-                                  "; use ALL or EXPOSED");
-  }
-  if (p.has_sample_faces()) o.evaluate.sample_faces = p.sample_faces();
-  if (p.has_seed()) o.evaluate.seed = p.seed();
-  if (p.has_threads()) o.evaluate.threads = p.threads();
   return o;
 }
 

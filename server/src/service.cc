@@ -111,11 +111,9 @@ class EvaluateReactor final : public JobReactor<v1::EvaluateRequest, v1::Evaluat
  private:
   Result<v1::UploadSpec> TakeSpec(const v1::EvaluateRequest& request) override {
     VC_ASSIGN_OR_RETURN(options_, wire::FromProto(request.spec().parameters()));
-    options_.voxelize.memory_budget_bytes =
-        std::min(options_.voxelize.memory_budget_bytes, options().max_memory_budget_bytes);
-    VC_RETURN_IF_ERROR(ValidateEvaluateJob(options_));
-    options_.evaluate.threads = JobThreads(options_.evaluate.threads, options());
-    options_.evaluate.keep_face_values = false;
+    options_.memory_budget_bytes = std::min(options_.memory_budget_bytes, options().max_memory_budget_bytes);
+    VC_RETURN_IF_ERROR(options_.Validate());
+    options_.threads = JobThreads(options_.threads, options());
     return request.spec().upload();
   }
 
@@ -129,7 +127,7 @@ class EvaluateReactor final : public JobReactor<v1::EvaluateRequest, v1::Evaluat
 
   std::string LogDetails() const override { return fmt::format(" viewpoints={}", options_.viewpoints.size()); }
 
-  wire::EvaluateJobOptions options_;
+  EvaluateJobOptions options_;
 };
 
 }  // namespace

@@ -91,8 +91,8 @@ TEST(EvaluateRpc, ViewpointInsideTheBoxSeesItsWalls) {
   conn.server = testing::Address(*server);
   auto c = client::Client::Create(conn);
   ASSERT_TRUE(c.ok());
-  wire::EvaluateJobOptions o;
-  o.voxelize.resolution_m = 0.2;
+  EvaluateJobOptions o;
+  o.resolution_m = 0.2;
   o.viewpoints = {{2.0, 1.5, 1.2}};
   auto r = (*c)->Evaluate({testing::BoxRoomPly(), "box.ply"}, o);
   ASSERT_TRUE(r.ok()) << r.status.error_message();
@@ -218,7 +218,7 @@ INSTANTIATE_TEST_SUITE_P(
                                [](v1::PlanParameters* p) { p->set_target_coverage(std::nan("")); }},
                       BadParam{"NegativeThreads", [](v1::PlanParameters* p) { p->set_threads(-2); }},
                       BadParam{"UnknownSelectionTest",
-                               [](v1::PlanParameters* p) { p->set_test(static_cast<v1::SelectionTest>(7)); }}),
+                               [](v1::PlanParameters* p) { p->set_selection_test(static_cast<v1::SelectionTest>(7)); }}),
     [](const auto& info) { return std::string(info.param.name); });
 
 TEST(EvaluateErrors, InvalidParametersAreRefused) {

@@ -56,7 +56,7 @@ server::Backend BlockingBackend::Make() {
     }
     return wait(ctx);
   };
-  b.evaluate = [wait](const SceneInput&, const wire::EvaluateJobOptions&, const JobContext& ctx) -> Result<Evaluation> {
+  b.evaluate = [wait](const SceneInput&, const EvaluateJobOptions&, const JobContext& ctx) -> Result<Evaluation> {
     return wait(ctx);
   };
   return b;

@@ -29,7 +29,7 @@ TEST(PlanParameters, RoundTripKeepsEveryField) {
   PlanOptions o;
   o.resolution_m = 0.07;
   o.memory_budget_bytes = 12345;
-  o.test = SelectionTest::kCompatibility;
+  o.selection_test = SelectionTest::kCompatibility;
   o.scanner.min_range_m = 0.3;
   o.scanner.max_range_m = 40;
   o.grid_spacing_m = 0.7;
@@ -50,7 +50,7 @@ TEST(PlanParameters, RoundTripKeepsEveryField) {
   ASSERT_TRUE(back.ok());
   // Compare through the proto (every field), so a field added to one side only shows up here.
   EXPECT_EQ(ToProto(*back).SerializeAsString(), ToProto(o).SerializeAsString());
-  EXPECT_EQ(back->test, SelectionTest::kCompatibility);
+  EXPECT_EQ(back->selection_test, SelectionTest::kCompatibility);
   EXPECT_EQ(back->candidates.size(), 2u);
 }
 

@@ -18,8 +18,6 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-bool Finite(double v) { return std::isfinite(v); }
-
 std::string Num(double v) {
   char buf[64];
   std::snprintf(buf, sizeof(buf), "%g", v);
@@ -83,60 +81,13 @@ Status CheckSetBudget(uint64_t count, uint64_t voxels, uint64_t budget, const ch
 
 }  // namespace
 
-Status PlanOptions::Validate() const {
-  auto bad = [](const std::string& m) { return InvalidArgumentError(m); };
-  if (!Finite(resolution_m) || resolution_m < 0) {
-    return bad("resolution_m must be a finite number >= 0 (0 = default), got " + Num(resolution_m));
-  }
-  if (memory_budget_bytes == 0) return bad("memory_budget_bytes must be > 0");
-  if (!Finite(scanner.min_range_m) || scanner.min_range_m < 0) {
-    return bad("scanner.min_range_m must be a finite number >= 0, got " + Num(scanner.min_range_m));
-  }
-  if (!Finite(scanner.max_range_m) || scanner.max_range_m <= scanner.min_range_m) {
-    return bad("scanner.max_range_m must be finite and greater than min_range_m, got " +
-               Num(scanner.max_range_m));
-  }
-  if (!Finite(grid_spacing_m) || grid_spacing_m <= 0) {
-    return bad("grid_spacing_m must be a finite number > 0 (metres), got " + Num(grid_spacing_m));
-  }
-  if (!Finite(tripod_height_m) || tripod_height_m <= 0) {
-    return bad("tripod_height_m must be a finite number > 0 (metres), got " + Num(tripod_height_m));
-  }
-  if (!Finite(clearance_m) || clearance_m < 0) {
-    return bad("clearance_m must be a finite number >= 0 (metres), got " + Num(clearance_m));
-  }
-  if (clearance_m >= tripod_height_m) {
-    return bad("clearance_m (" + Num(clearance_m) + " m) must be smaller than tripod_height_m (" +
-               Num(tripod_height_m) + " m): the scanner would touch the floor");
-  }
-  for (size_t i = 0; i < candidates.size(); ++i) {
-    if (!candidates[i].allFinite()) return bad("candidates[" + std::to_string(i) + "] is not finite");
-  }
-  if (max_stations < 0) return bad("max_stations must be >= 0 (0 = no limit), got " + std::to_string(max_stations));
-  if (!Finite(target_coverage) || target_coverage <= 0 || target_coverage > 1) {
-    return bad("target_coverage must be in (0, 1], got " + Num(target_coverage));
-  }
-  if (!Finite(refine_radius_m) || refine_radius_m <= 0) {
-    return bad("refine_radius_m must be a finite number > 0 (metres), got " + Num(refine_radius_m));
-  }
-  if (!Finite(refine_step_m) || refine_step_m <= 0) {
-    return bad("refine_step_m must be a finite number > 0 (metres), got " + Num(refine_step_m));
-  }
-  if (refine && refine_step_m > refine_radius_m) {
-    return bad("refine_step_m (" + Num(refine_step_m) + " m) must not exceed refine_radius_m (" +
-               Num(refine_radius_m) + " m)");
-  }
-  if (reduce_to < 0) return bad("reduce_to must be >= 0 (0 = zero-loss rule only), got " + std::to_string(reduce_to));
-  if (threads < 0) return bad("threads must be >= 0 (0 = all cores), got " + std::to_string(threads));
-  return Status::Ok();
-}
 
 Result<PlanResult> Plan(const SceneInput& input, const PlanOptions& options, const JobContext& ctx,
                         const PlanCallbacks& callbacks) {
   VC_RETURN_IF_ERROR(options.Validate());
   PlanResult result;
   result.options = options;
-  result.selection_test = options.test;
+  result.selection_test = options.selection_test;
   StageTimer timer(&result);
 
   // 1. Voxelize.
@@ -208,7 +159,7 @@ Result<PlanResult> Plan(const SceneInput& input, const PlanOptions& options, con
   // 3. Visibility sets and the heat map.
   VC_RETURN_IF_ERROR(CheckSetBudget(candidates.size(), n_voxels, options.memory_budget_bytes, "visibility counts"));
   VC_RETURN_IF_ERROR(BeginStage(ctx, Stage::kVisibility));
-  const VisibilitySetsOptions set_options{options.test, options.threads};
+  const VisibilitySetsOptions set_options{options.selection_test, options.threads};
   VC_ASSIGN_OR_RETURN(std::vector<VoxelSet> sets,
                       ComputeVisibilitySets(scene, candidates, set_options, StageContext(ctx, Stage::kVisibility)));
   result.heat_map.positions = candidates;

@@ -32,26 +32,31 @@ Json FiguresJson(const VisibilityFigures& f) {
               {"partially_visible_fraction", f.partially_visible_fraction}};
 }
 
-Json ParametersJson(const PlanOptions& o) {
-  return Json{{"resolution_m", o.resolution_m},
-              {"memory_budget_bytes", o.memory_budget_bytes},
-              {"selection_test", std::string(SelectionTestName(o.test))},
-              {"scanner", {{"min_range_m", o.scanner.min_range_m}, {"max_range_m", o.scanner.max_range_m}}},
-              {"grid_spacing_m", o.grid_spacing_m},
-              {"tripod_height_m", o.tripod_height_m},
-              {"clearance_m", o.clearance_m},
-              {"user_candidates", o.candidates.size()},
-              {"max_stations", o.max_stations},
-              {"min_marginal_gain_voxels", o.min_marginal_gain_voxels},
-              {"target_coverage", o.target_coverage},
-              {"consolidate", o.consolidate},
-              {"refine", o.refine},
-              {"refine_radius_m", o.refine_radius_m},
-              {"refine_step_m", o.refine_step_m},
-              {"reduce", o.reduce},
-              {"reduce_to", o.reduce_to},
-              {"threads", o.threads}};
+// A parameter row's value in plan.json: numbers and bools as they are, enums by name.
+template <typename T>
+Json ParameterJson(T v) {
+  return Json(v);
 }
+Json ParameterJson(SelectionTest t) { return std::string(SelectionTestName(t)); }
+
+#define VC_ROW_TO_JSON(type, name, ...) j[#name] = ParameterJson(o.name);
+
+Json ScannerJson(const ScannerModel& o) {
+  Json j = Json::object();
+  VC_SCANNER_PARAMETERS(VC_ROW_TO_JSON)
+  return j;
+}
+
+// Every row of VC_PLAN_PARAMETERS, the scanner, and the number of user candidates.
+Json ParametersJson(const PlanOptions& o) {
+  Json j = Json::object();
+  VC_PLAN_PARAMETERS(VC_ROW_TO_JSON)
+  j["scanner"] = ScannerJson(o.scanner);
+  j["user_candidates"] = o.candidates.size();
+  return j;
+}
+
+#undef VC_ROW_TO_JSON
 
 Status WriteFile(const std::filesystem::path& path, std::string_view bytes) {
   std::ofstream f(path, std::ios::binary | std::ios::trunc);

@@ -275,9 +275,13 @@ std::string_view SelectionTestName(SelectionTest t) {
 }
 
 Status ScannerModel::Validate() const {
-  if (!std::isfinite(min_range_m) || !std::isfinite(max_range_m) || min_range_m < 0 || max_range_m <= min_range_m) {
-    return InvalidArgumentError("scanner range must satisfy 0 <= min_range_m < max_range_m (finite), got [" +
-                                std::to_string(min_range_m) + ", " + std::to_string(max_range_m) + "] m");
+#define VC_CHECK_ROW(type, name, ...) \
+  VC_RETURN_IF_ERROR(CheckParameter(VC_PARAMETER_INFO(type, name, __VA_ARGS__), name, "scanner."));
+  VC_SCANNER_PARAMETERS(VC_CHECK_ROW)
+#undef VC_CHECK_ROW
+  if (max_range_m <= min_range_m) {
+    return InvalidArgumentError("scanner.max_range_m (" + std::to_string(max_range_m) +
+                                " m) must be greater than scanner.min_range_m (" + std::to_string(min_range_m) + " m)");
   }
   return Status::Ok();
 }

@@ -97,7 +97,7 @@ INSTANTIATE_TEST_SUITE_P(Scenes, KnownOptimumTest,
 TEST(PlannerTest, CompatibilityNeedsMoreStationsThanSurfaceVisibility) {
   for (const char* spec : {"box", "lroom", "comb:3"}) {
     PlanOptions o = TestOptions();
-    o.test = SelectionTest::kCompatibility;
+    o.selection_test = SelectionTest::kCompatibility;
     o.target_coverage = 1.0;  // compare station counts at full coverage
     Result<PlanResult> r = Plan(Synthetic(spec), o);
     ASSERT_TRUE(r.ok()) << r.status().ToString();

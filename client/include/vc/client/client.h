@@ -79,7 +79,7 @@ class Client {
   static Result<std::unique_ptr<Client>> Create(const ConnectionOptions& options);
 
   CallResult<PlanResult> Plan(const Upload& upload, const PlanOptions& options, const JobObserver& observer = {});
-  CallResult<Evaluation> Evaluate(const Upload& upload, const wire::EvaluateJobOptions& options,
+  CallResult<Evaluation> Evaluate(const Upload& upload, const EvaluateJobOptions& options,
                                   const JobObserver& observer = {});
   // grpc.health.v1.Health/Check of `service` ("" = the whole server). The value is the serving
   // status name ("SERVING"); a server that is not serving gives UNAVAILABLE.

@@ -12,6 +12,7 @@
 #include <functional>
 #include <vector>
 
+#include "vc/plan/evaluate_job.h"
 #include "vc/plan/planner.h"
 #include "vc/base/progress.h"
 #include "vc/scene/scene_input.h"
@@ -45,18 +46,11 @@ v1::StopReason ToProto(StopReason r);
 Result<StopReason> FromProto(v1::StopReason r);
 v1::FaceSet ToProto(FaceSet f);
 
-// Every field set.
+// Parameters (generated from the parameter tables, vc/base/parameter.h). ToProto sets every field;
+// FromProto applies the fields present in `p` to a default-constructed struct. INVALID_ARGUMENT
+// for unknown enum values; the values themselves are checked by Validate().
 v1::PlanParameters ToProto(const PlanOptions& options);
-// A default-constructed PlanOptions with the fields present in `p` applied. INVALID_ARGUMENT for
-// unknown enum values; the values themselves are checked by PlanOptions::Validate.
 Result<PlanOptions> FromProto(const v1::PlanParameters& p);
-
-// What an Evaluate call runs: the viewpoints, the voxelisation and the evaluation options.
-struct EvaluateJobOptions {
-  std::vector<WorldPoint> viewpoints;
-  VoxelizeOptions voxelize;
-  EvaluateOptions evaluate;
-};
 v1::EvaluateParameters ToProto(const EvaluateJobOptions& options);
 Result<EvaluateJobOptions> FromProto(const v1::EvaluateParameters& p);
 

@@ -1,11 +1,12 @@
 // Backend: the core functions a job calls. The service calls them through this struct so tests
 // can substitute a function that blocks until cancelled (to prove cancellation frees a worker);
-// production uses the defaults, which are vc::ReadScene, vc::Plan and RunEvaluation.
+// production uses the defaults, which are vc::ReadScene, vc::Plan and vc::RunEvaluation.
 #pragma once
 
 #include <functional>
 #include <string_view>
 
+#include "vc/plan/evaluate_job.h"
 #include "vc/plan/planner.h"
 #include "vc/base/progress.h"
 #include "vc/scene/scene_input.h"
@@ -15,21 +16,13 @@
 
 namespace vc::server {
 
-// INVALID_ARGUMENT naming the first bad parameter of an Evaluate call (no viewpoint, a non-finite
-// viewpoint, a bad resolution or scanner model).
-Status ValidateEvaluateJob(const wire::EvaluateJobOptions& options);
-
-// Voxelize at the requested resolution, then vc::Evaluate. Errors as those two.
-Result<Evaluation> RunEvaluation(const SceneInput& input, const wire::EvaluateJobOptions& options,
-                                 const JobContext& ctx);
-
 struct Backend {
   std::function<Result<SceneInput>(std::string_view bytes, std::string_view source, const ReadOptions&)>
       read_scene;
   std::function<Result<PlanResult>(const SceneInput&, const PlanOptions&, const JobContext&,
                                    const PlanCallbacks&)>
       plan;
-  std::function<Result<Evaluation>(const SceneInput&, const wire::EvaluateJobOptions&, const JobContext&)>
+  std::function<Result<Evaluation>(const SceneInput&, const EvaluateJobOptions&, const JobContext&)>
       evaluate;
 
   // The production backend.

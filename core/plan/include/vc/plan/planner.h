@@ -13,46 +13,12 @@
 #include "vc/base/progress.h"
 #include "vc/base/status.h"
 #include "vc/plan/greedy.h"
+#include "vc/plan/plan_options.h"
 #include "vc/visibility/visibility.h"
 #include "vc/scene/voxel_scene.h"
 
 namespace vc {
 
-struct PlanOptions {
-  // Working resolution (m); 0 = the octree's own or 0.1 m for clouds.
-  double resolution_m = 0.0;
-  uint64_t memory_budget_bytes = kDefaultMemoryBudgetBytes;
-  SelectionTest test = SelectionTest::kSurfaceVisibility;
-  ScannerModel scanner;
-  // Candidate grid over the footprint (m), tripod height above the floor (m), clearance (m).
-  double grid_spacing_m = 1.0;
-  double tripod_height_m = 1.5;
-  double clearance_m = 0.2;
-  // User-supplied candidates (world frame, m). When non-empty, replaces the generated grid.
-  std::vector<WorldPoint> candidates;
-  // Stopping rules: at most this many stations (0 = no limit); stop when the best marginal gain
-  // is below this many voxels; stop when this fraction of coverable voxels is covered. The default
-  // 0.99 stops chasing the last voxels of scan noise: on geb079, 1.0 puts a station on every one
-  // of the 123 candidates, 0.99 needs 69 and 0.95 needs 37 (docs/PLANNING.md).
-  int max_stations = 0;
-  uint64_t min_marginal_gain_voxels = 1;
-  double target_coverage = 0.99;
-  // After greedy selection: drop picks the others cover and replace two picks by one candidate
-  // that sees all they alone covered (coverage never shrinks; docs/PLANNING.md).
-  bool consolidate = true;
-  // Proximity refinement (s.7.4): move each station to the best of a sub-grid around it.
-  bool refine = false;
-  double refine_radius_m = 0.5;
-  double refine_step_m = 0.25;
-  // Reduction (s.7.5): remove zero-loss stations (default); with reduce_to > 0, keep removing the
-  // cheapest single or pair until at most reduce_to stations remain.
-  bool reduce = true;
-  int reduce_to = 0;
-  int threads = 0;
-
-  // INVALID_ARGUMENT naming the first bad parameter (non-finite, zero or negative, out of range).
-  Status Validate() const;
-};
 
 struct PlannedStation {
   WorldPoint position;

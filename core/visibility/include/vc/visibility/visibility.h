@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "vc/base/geometry.h"
+#include "vc/base/parameter.h"
 #include "vc/base/progress.h"
 #include "vc/base/status.h"
 #include "vc/scene/voxel_scene.h"
@@ -32,10 +33,17 @@ enum class SelectionTest {
 };
 std::string_view SelectionTestName(SelectionTest t);  // "surface", "compatibility"
 
-// The scanner's range (ALGORITHM.md s.5), in metres.
+// The scanner model's parameters (vc/base/parameter.h): X(type, name, default, unit, flag, check, help).
+// The range of ALGORITHM.md s.5; V = 0 outside [min_range_m, max_range_m].
+#define VC_SCANNER_PARAMETERS(X)                                                            \
+  X(double, min_range_m, 0.5, "m", "min-range", kNonNegative, "scanner minimum range")      \
+  X(double, max_range_m, 75.0, "m", "max-range", kPositive, "scanner maximum range")
+
+// The scanner (ALGORITHM.md s.5).
 struct ScannerModel {
-  double min_range_m = 0.5;
-  double max_range_m = 75.0;
+  VC_SCANNER_PARAMETERS(VC_DECLARE_PARAMETER)
+  // INVALID_ARGUMENT naming the field ("scanner.max_range_m ..."): a row's check, or
+  // min_range_m >= max_range_m.
   Status Validate() const;
 };
 

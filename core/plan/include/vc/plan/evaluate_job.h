@@ -1,0 +1,51 @@
+// An Evaluate job: given viewpoints (e.g. stations already scanned) evaluated on a scene at a
+// chosen resolution. Its parameters are declared once in VC_EVALUATE_PARAMETERS (as PlanOptions'
+// are, vc/base/parameter.h); RunEvaluation is the one core function the Evaluate RPC calls, as
+// Plan is for the Plan RPC.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "vc/base/geometry.h"
+#include "vc/base/parameter.h"
+#include "vc/base/progress.h"
+#include "vc/base/status.h"
+#include "vc/scene/scene_input.h"
+#include "vc/scene/voxel_scene.h"
+#include "vc/visibility/visibility.h"
+
+// X(type, name, default, unit, flag, check, help).
+#define VC_EVALUATE_PARAMETERS(X)                                                                    \
+  X(double, resolution_m, 0.0, "m", "resolution", kNonNegative,                                      \
+    "working resolution (0 = the octree's own, or 0.1 m for clouds)")                                \
+  X(uint64_t, memory_budget_bytes, ::vc::kDefaultMemoryBudgetBytes, "bytes", "memory-budget-bytes",  \
+    kPositive, "memory budget of the job (capped by the server's --max-memory-budget-bytes)")        \
+  X(::vc::FaceSet, faces, ::vc::FaceSet::kAll, "", "faces", kAny, "faces counted in F: all or exposed") \
+  X(uint64_t, sample_faces, 0, "faces", "sample", kAny,                                              \
+    "evaluate a uniform random sample of this many faces, with a 95 % interval (0 = every face)")   \
+  X(uint64_t, seed, 1, "", "seed", kAny, "sampling seed")                                            \
+  X(int32_t, threads, 0, "threads", "threads", kNonNegative, "threads for the job (0 = all, or the server's share)")
+
+namespace vc {
+
+struct EvaluateJobOptions {
+  VC_EVALUATE_PARAMETERS(VC_DECLARE_PARAMETER)
+  // The scanner (VC_SCANNER_PARAMETERS), nested as "scanner" in the proto.
+  ScannerModel scanner;
+  // The viewpoints to evaluate, world frame (m); at least one.
+  std::vector<WorldPoint> viewpoints;
+
+  // INVALID_ARGUMENT naming the first bad parameter: no viewpoint, a non-finite viewpoint, a row's
+  // check or the scanner's.
+  Status Validate() const;
+  // The voxelisation and evaluation options this job runs with (exact mode keeps no face values).
+  VoxelizeOptions voxelize_options() const;
+  EvaluateOptions evaluate_options() const;
+};
+
+// Validates, voxelises `input` at options.resolution_m, then vc::Evaluate. Errors as those.
+Result<Evaluation> RunEvaluation(const SceneInput& input, const EvaluateJobOptions& options,
+                                 const JobContext& ctx = {});
+
+}  // namespace vc

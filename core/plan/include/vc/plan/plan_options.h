@@ -1,0 +1,63 @@
+// PlanOptions: every parameter of a plan, declared once in VC_PLAN_PARAMETERS (vc/base/parameter.h
+// explains the table and the places derived from it: validation, the proto conversion, vc-client's
+// flags, plan.json). docs/PLANNING.md, "Parameters", has one line per row.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "vc/base/geometry.h"
+#include "vc/base/parameter.h"
+#include "vc/base/status.h"
+#include "vc/scene/voxel_scene.h"
+#include "vc/visibility/visibility.h"
+
+// X(type, name, default, unit, flag, check, help). Notes on some rows:
+// - target_coverage: the default 0.99 stops chasing the last voxels of scan noise: on geb079, 1.0
+//   puts a station on every one of the 123 candidates, 0.99 needs 69 and 0.95 needs 37.
+// - consolidate: after greedy selection, drop picks the others cover and replace two picks by one
+//   candidate that sees all they alone covered (coverage never shrinks; docs/PLANNING.md).
+// - refine: proximity refinement (ALGORITHM.md s.7.4), each station to the best of a sub-grid.
+// - reduce / reduce_to: reduction (s.7.5) removes zero-loss stations; with reduce_to > 0 it keeps
+//   removing the cheapest single or pair until at most reduce_to stations remain.
+#define VC_PLAN_PARAMETERS(X)                                                                              \
+  X(double, resolution_m, 0.0, "m", "resolution", kNonNegative,                                            \
+    "working resolution (0 = the octree's own, or 0.1 m for clouds)")                                      \
+  X(uint64_t, memory_budget_bytes, ::vc::kDefaultMemoryBudgetBytes, "bytes", "memory-budget-bytes",        \
+    kPositive, "memory budget of the job (capped by the server's --max-memory-budget-bytes)")              \
+  X(::vc::SelectionTest, selection_test, ::vc::SelectionTest::kSurfaceVisibility, "", "test", kAny,        \
+    "selection test: surface or compatibility")                                                            \
+  X(double, grid_spacing_m, 1.0, "m", "grid-spacing", kPositive, "candidate grid spacing")                \
+  X(double, tripod_height_m, 1.5, "m", "tripod-height", kPositive, "scanner height above the floor")       \
+  X(double, clearance_m, 0.2, "m", "clearance", kNonNegative, "free space required around a candidate")   \
+  X(int32_t, max_stations, 0, "stations", "max-stations", kNonNegative,                                    \
+    "at most this many stations (0 = no limit)")                                                           \
+  X(uint64_t, min_marginal_gain_voxels, 1, "voxels", "min-gain", kAny,                                     \
+    "stop when the best station adds fewer voxels")                                                        \
+  X(double, target_coverage, 0.99, "fraction", "target-coverage", kFraction,                               \
+    "stop at this covered fraction of the coverable voxels")                                               \
+  X(bool, consolidate, true, "", "consolidate", kAny, "drop covered picks and merge pairs after greedy")   \
+  X(bool, refine, false, "", "refine", kAny, "refine each station on a local sub-grid")                    \
+  X(double, refine_radius_m, 0.5, "m", "refine-radius", kPositive, "refinement radius")                   \
+  X(double, refine_step_m, 0.25, "m", "refine-step", kPositive, "refinement step")                         \
+  X(bool, reduce, true, "", "reduce", kAny, "remove redundant stations")                                   \
+  X(int32_t, reduce_to, 0, "stations", "reduce-to", kNonNegative,                                          \
+    "reduce to at most this many stations (0 = zero-loss removals only)")                                  \
+  X(int32_t, threads, 0, "threads", "threads", kNonNegative, "threads for the job (0 = all, or the server's share)")
+
+namespace vc {
+
+struct PlanOptions {
+  VC_PLAN_PARAMETERS(VC_DECLARE_PARAMETER)
+  // The scanner (VC_SCANNER_PARAMETERS); plan.json and the proto nest it as "scanner".
+  ScannerModel scanner;
+  // User-supplied candidates (world frame, m). When non-empty, replaces the generated grid.
+  std::vector<WorldPoint> candidates;
+
+  // INVALID_ARGUMENT naming the first bad parameter: a row's check (non-finite, negative, zero,
+  // out of range), the scanner's, a non-finite candidate, clearance_m >= tripod_height_m, or
+  // refine_step_m > refine_radius_m with refine on.
+  Status Validate() const;
+};
+
+}  // namespace vc

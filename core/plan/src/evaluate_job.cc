@@ -1,0 +1,41 @@
+#include "vc/plan/evaluate_job.h"
+
+#include <string>
+
+namespace vc {
+
+Status EvaluateJobOptions::Validate() const {
+  if (viewpoints.empty()) {
+    return InvalidArgumentError("no viewpoint to evaluate; give at least one (e.g. --viewpoints stations.csv)");
+  }
+  for (size_t i = 0; i < viewpoints.size(); ++i) {
+    if (!viewpoints[i].allFinite()) {
+      return InvalidArgumentError("viewpoint " + std::to_string(i) + " has a non-finite coordinate");
+    }
+  }
+#define VC_CHECK_ROW(type, name, ...) \
+  VC_RETURN_IF_ERROR(CheckParameter(VC_PARAMETER_INFO(type, name, __VA_ARGS__), name));
+  VC_EVALUATE_PARAMETERS(VC_CHECK_ROW)
+#undef VC_CHECK_ROW
+  return scanner.Validate();
+}
+
+VoxelizeOptions EvaluateJobOptions::voxelize_options() const { return {resolution_m, memory_budget_bytes}; }
+
+EvaluateOptions EvaluateJobOptions::evaluate_options() const {
+  EvaluateOptions o;
+  o.scanner = scanner;
+  o.faces = faces;
+  o.threads = threads;
+  o.sample_faces = sample_faces;
+  o.seed = seed;
+  return o;
+}
+
+Result<Evaluation> RunEvaluation(const SceneInput& input, const EvaluateJobOptions& options, const JobContext& ctx) {
+  VC_RETURN_IF_ERROR(options.Validate());
+  VC_ASSIGN_OR_RETURN(VoxelScene scene, Voxelize(input, options.voxelize_options(), ctx));
+  return Evaluate(scene, options.viewpoints, options.evaluate_options(), ctx);
+}
+
+}  // namespace vc

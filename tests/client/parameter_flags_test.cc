@@ -1,0 +1,212 @@
+// The parameter tables (vc/base/parameter.h) and every place derived from them: vc-client's flags
+// (parameter_flags.h), the proto conversion (vc/wire/convert.h), validation and plan.json. For
+// each row: a value other than the default goes through the flag, the proto and plan.json, and a
+// value the row's check refuses is refused naming the row. And the other way round: every proto
+// field and every plan.json parameter belongs to a row (or to the few non-row members).
+#include "vc/client/parameter_flags.h"
+
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <set>
+#include <string>
+
+#include "vc/report/plan_report.h"
+#include "vc/wire/convert.h"
+
+namespace vc {
+namespace {
+
+using nlohmann::json;
+
+// A valid value of the row's type other than `v`.
+double Other(double v, ParamCheck c) { return c == ParamCheck::kFraction ? v / 2 : v + 0.375; }
+uint64_t Other(uint64_t v, ParamCheck) { return v + 3; }
+int32_t Other(int32_t v, ParamCheck) { return v + 3; }
+bool Other(bool v, ParamCheck) { return !v; }
+SelectionTest Other(SelectionTest v, ParamCheck) {
+  return v == SelectionTest::kCompatibility ? SelectionTest::kSurfaceVisibility : SelectionTest::kCompatibility;
+}
+FaceSet Other(FaceSet v, ParamCheck) { return v == FaceSet::kAll ? FaceSet::kExposed : FaceSet::kAll; }
+
+// A value the row's check refuses, if there is one.
+std::optional<double> Bad(double, ParamCheck c) {
+  switch (c) {
+    case ParamCheck::kAny: return std::numeric_limits<double>::quiet_NaN();
+    case ParamCheck::kNonNegative: return -0.5;
+    case ParamCheck::kPositive: return 0.0;
+    case ParamCheck::kFraction: return 1.5;
+  }
+  return std::nullopt;
+}
+std::optional<uint64_t> Bad(uint64_t, ParamCheck c) {
+  if (c == ParamCheck::kPositive || c == ParamCheck::kFraction) return 0;
+  return std::nullopt;
+}
+std::optional<int32_t> Bad(int32_t, ParamCheck c) {
+  if (c == ParamCheck::kAny) return std::nullopt;
+  return c == ParamCheck::kNonNegative ? -1 : 0;
+}
+template <typename T>
+  requires(std::is_enum_v<T> || std::is_same_v<T, bool>)
+std::optional<T> Bad(T, ParamCheck) {
+  return std::nullopt;
+}
+
+// The command-line words that set a flag to `v`.
+std::string Args(std::string_view flag, double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.17g", v);
+  return "--" + std::string(flag) + " " + buf;
+}
+std::string Args(std::string_view flag, uint64_t v) { return "--" + std::string(flag) + " " + std::to_string(v); }
+std::string Args(std::string_view flag, int32_t v) { return "--" + std::string(flag) + " " + std::to_string(v); }
+std::string Args(std::string_view flag, bool v) { return (v ? "--" : "--no-") + std::string(flag); }
+std::string Args(std::string_view flag, SelectionTest v) {
+  return "--" + std::string(flag) + " " + std::string(SelectionTestName(v));
+}
+std::string Args(std::string_view flag, FaceSet v) {
+  return "--" + std::string(flag) + (v == FaceSet::kExposed ? " exposed" : " all");
+}
+
+// How plan.json writes a value.
+template <typename T>
+json JsonValue(T v) {
+  return json(v);
+}
+json JsonValue(SelectionTest v) { return std::string(SelectionTestName(v)); }
+
+std::set<std::string> FieldNames(const google::protobuf::Descriptor* d) {
+  std::set<std::string> names;
+  for (int i = 0; i < d->field_count(); ++i) names.insert(d->field(i)->name());
+  return names;
+}
+
+#define VC_ROW_NAME(type, name, ...) #name,
+
+TEST(ParameterTablesTest, EveryPlanRowIsAFlagAProtoFieldAPlanJsonKeyAndChecked) {
+  const PlanOptions defaults;
+#define VC_PLAN_ROW(type, name, default_value, unit, flag, check, help)                     \
+  {                                                                                         \
+    SCOPED_TRACE(#name);                                                                    \
+    const type other = Other(defaults.name, ParamCheck::check);                             \
+    ASSERT_NE(other, defaults.name);                                                        \
+    PlanOptions parsed;                                                                     \
+    CLI::App app;                                                                           \
+    client::AddPlanFlags(&app, &parsed);                                                    \
+    app.parse(Args(flag, other), false);                                                    \
+    EXPECT_EQ(parsed.name, other) << "flag --" << flag;                                     \
+    PlanOptions o;                                                                          \
+    o.name = other;                                                                         \
+    Result<PlanOptions> back = wire::FromProto(wire::ToProto(o));                           \
+    ASSERT_TRUE(back.ok()) << back.status().ToString();                                     \
+    EXPECT_EQ(back->name, other) << "proto field " #name;                                   \
+    PlanResult r;                                                                           \
+    r.options = o;                                                                          \
+    EXPECT_EQ(json::parse(PlanToJson(r))["parameters"][#name], JsonValue(other));           \
+    if (const auto bad = Bad(defaults.name, ParamCheck::check)) {                           \
+      PlanOptions b;                                                                        \
+      b.name = *bad;                                                                        \
+      const Status s = b.Validate();                                                        \
+      EXPECT_EQ(s.code(), StatusCode::kInvalidArgument);                                    \
+      EXPECT_NE(s.message().find(#name), std::string::npos) << s.message();                 \
+    }                                                                                       \
+  }
+  VC_PLAN_PARAMETERS(VC_PLAN_ROW)
+#undef VC_PLAN_ROW
+}
+
+TEST(ParameterTablesTest, EveryScannerRowIsAFlagOfBothCommandsAProtoFieldAndChecked) {
+  const ScannerModel defaults;
+#define VC_SCANNER_ROW(type, name, default_value, unit, flag, check, help)                  \
+  {                                                                                         \
+    SCOPED_TRACE(#name);                                                                    \
+    const type other = Other(defaults.name, ParamCheck::check);                             \
+    PlanOptions plan;                                                                       \
+    CLI::App plan_app;                                                                      \
+    client::AddPlanFlags(&plan_app, &plan);                                                 \
+    plan_app.parse(Args(flag, other), false);                                               \
+    EXPECT_EQ(plan.scanner.name, other);                                                    \
+    EvaluateJobOptions eval;                                                                \
+    CLI::App eval_app;                                                                      \
+    client::AddEvaluateFlags(&eval_app, &eval);                                             \
+    eval_app.parse(Args(flag, other), false);                                               \
+    EXPECT_EQ(eval.scanner.name, other);                                                    \
+    EXPECT_EQ(wire::FromProto(wire::ToProto(plan))->scanner.name, other);                   \
+    EXPECT_EQ(wire::FromProto(wire::ToProto(eval))->scanner.name, other);                   \
+    PlanResult r;                                                                           \
+    r.options = plan;                                                                       \
+    EXPECT_EQ(json::parse(PlanToJson(r))["parameters"]["scanner"][#name], JsonValue(other)); \
+    if (const auto bad = Bad(defaults.name, ParamCheck::check)) {                           \
+      ScannerModel b;                                                                       \
+      b.name = *bad;                                                                        \
+      EXPECT_NE(b.Validate().message().find("scanner." #name), std::string::npos);          \
+    }                                                                                       \
+  }
+  VC_SCANNER_PARAMETERS(VC_SCANNER_ROW)
+#undef VC_SCANNER_ROW
+}
+
+TEST(ParameterTablesTest, EveryEvaluateRowIsAFlagAProtoFieldAndChecked) {
+  EvaluateJobOptions defaults;
+  defaults.viewpoints = {{0, 0, 0}};
+#define VC_EVALUATE_ROW(type, name, default_value, unit, flag, check, help)                 \
+  {                                                                                         \
+    SCOPED_TRACE(#name);                                                                    \
+    const type other = Other(defaults.name, ParamCheck::check);                             \
+    EvaluateJobOptions parsed;                                                              \
+    CLI::App app;                                                                           \
+    client::AddEvaluateFlags(&app, &parsed);                                                \
+    app.parse(Args(flag, other), false);                                                    \
+    EXPECT_EQ(parsed.name, other) << "flag --" << flag;                                     \
+    EvaluateJobOptions o = defaults;                                                        \
+    o.name = other;                                                                         \
+    EXPECT_EQ(wire::FromProto(wire::ToProto(o))->name, other) << "proto field " #name;      \
+    if (const auto bad = Bad(defaults.name, ParamCheck::check)) {                           \
+      EvaluateJobOptions b = defaults;                                                      \
+      b.name = *bad;                                                                        \
+      const Status s = b.Validate();                                                        \
+      EXPECT_EQ(s.code(), StatusCode::kInvalidArgument);                                    \
+      EXPECT_NE(s.message().find(#name), std::string::npos) << s.message();                 \
+    }                                                                                       \
+  }
+  VC_EVALUATE_PARAMETERS(VC_EVALUATE_ROW)
+#undef VC_EVALUATE_ROW
+}
+
+// The other direction: a proto field or a plan.json parameter that no row declares.
+TEST(ParameterTablesTest, EveryProtoFieldAndPlanJsonParameterHasARow) {
+  std::set<std::string> plan_rows = {VC_PLAN_PARAMETERS(VC_ROW_NAME)};
+  std::set<std::string> scanner_rows = {VC_SCANNER_PARAMETERS(VC_ROW_NAME)};
+  std::set<std::string> evaluate_rows = {VC_EVALUATE_PARAMETERS(VC_ROW_NAME)};
+
+  std::set<std::string> want = plan_rows;
+  want.insert({"scanner", "candidates"});
+  EXPECT_EQ(FieldNames(v1::PlanParameters::descriptor()), want);
+  EXPECT_EQ(FieldNames(v1::ScannerModel::descriptor()), scanner_rows);
+  want = evaluate_rows;
+  want.insert({"scanner", "viewpoints"});
+  EXPECT_EQ(FieldNames(v1::EvaluateParameters::descriptor()), want);
+
+  std::set<std::string> keys;
+  const json plan = json::parse(PlanToJson(PlanResult{}));
+  for (const auto& [key, value] : plan["parameters"].items()) keys.insert(key);
+  want = plan_rows;
+  want.insert({"scanner", "user_candidates"});
+  EXPECT_EQ(keys, want);
+}
+
+#undef VC_ROW_NAME
+
+TEST(ParameterTablesTest, UnknownEnumNamesAreRefusedByTheFlag) {
+  PlanOptions o;
+  CLI::App app;
+  client::AddPlanFlags(&app, &o);
+  EXPECT_THROW(app.parse("--test visible", false), CLI::ValidationError);
+  EXPECT_EQ(o.selection_test, SelectionTest::kSurfaceVisibility);
+}
+
+}  // namespace
+}  // namespace vc
