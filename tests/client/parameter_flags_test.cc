@@ -49,8 +49,7 @@ std::optional<int32_t> Bad(int32_t, ParamCheck c) {
   if (c == ParamCheck::kAny) return std::nullopt;
   return c == ParamCheck::kNonNegative ? -1 : 0;
 }
-template <typename T>
-  requires(std::is_enum_v<T> || std::is_same_v<T, bool>)
+template <UncheckedParameter T>
 std::optional<T> Bad(T, ParamCheck) {
   return std::nullopt;
 }

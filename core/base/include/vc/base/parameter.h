@@ -50,9 +50,10 @@ Status CheckParameter(const ParamInfo& info, uint64_t value, std::string_view pr
 inline Status CheckParameter(const ParamInfo& info, int32_t value, std::string_view prefix = "") {
   return CheckParameter(info, int64_t{value}, prefix);
 }
-// Bools and enums take any value of their type.
+// Parameters that take any value of their type: bools and enums.
 template <typename T>
-  requires(std::is_enum_v<T> || std::is_same_v<T, bool>)
+concept UncheckedParameter = std::is_enum_v<T> || std::is_same_v<T, bool>;
+template <UncheckedParameter T>
 Status CheckParameter(const ParamInfo&, T, std::string_view = "") {
   return Status::Ok();
 }
