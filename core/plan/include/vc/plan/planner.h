@@ -13,6 +13,7 @@
 #include "vc/base/progress.h"
 #include "vc/base/status.h"
 #include "vc/plan/greedy.h"
+#include "vc/plan/stage_runner.h"
 #include "vc/visibility/visibility.h"
 #include "vc/scene/voxel_scene.h"
 
@@ -80,11 +81,6 @@ struct Reduction {
   double global_visibility_after = 0;
   // P: the stations the matrix is about (greedy order, after refinement), world frame (m).
   std::vector<WorldPoint> positions;
-};
-
-struct StageTiming {
-  Stage stage = Stage::kUnspecified;
-  double seconds = 0;
 };
 
 struct PlanResult {
