@@ -12,7 +12,7 @@
 #include "vc/base/geometry.h"
 #include "vc/base/progress.h"
 #include "vc/base/status.h"
-#include "vc/plan/greedy.h"
+#include "vc/plan/selector.h"
 #include "vc/plan/stage_runner.h"
 #include "vc/visibility/visibility.h"
 #include "vc/scene/voxel_scene.h"
