@@ -1,6 +1,7 @@
 // The station planner (ALGORITHM.md section 7; paper section 3): candidates on the operating plane,
-// visibility counts (the heat map), greedy selection, optional proximity refinement, reduction,
-// and evaluation, as one cancellable pipeline reporting progress per stage.
+// visibility counts (the heat map), selection (a Selector: lazy greedy, then consolidation),
+// optional proximity refinement, reduction, and evaluation, as one cancellable pipeline reporting
+// progress per stage. The stages are stages.h's functions, run by one StageRunner (stage_runner.h).
 #pragma once
 
 #include <cstdint>
