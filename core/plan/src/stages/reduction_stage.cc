@@ -39,7 +39,8 @@ Result<ReductionOutput> RunReductionStage(const ReductionInput& in, const PlanOp
     EvaluateOptions single_options = eval_options;
     single_options.keep_face_values = false;
     single_options.keep_per_viewpoint_values = true;
-    values = [&](int s, const JobContext& sub) -> Result<std::vector<float>> {
+    // single_options by value: this block ends before RunReduction calls `values`.
+    values = [&in, &stations, single_options](int s, const JobContext& sub) -> Result<std::vector<float>> {
       VC_ASSIGN_OR_RETURN(Evaluation e, Evaluate(in.scene, {stations[s]}, single_options, sub));
       return std::move(e.per_viewpoint_face_values[0]);
     };
