@@ -4,20 +4,6 @@
 #include <queue>
 #include <string>
 
-namespace vc {
-
-std::string_view StopReasonName(StopReason reason) {
-  switch (reason) {
-    case StopReason::kExhausted: return "exhausted";
-    case StopReason::kTargetReached: return "target_reached";
-    case StopReason::kMaxStations: return "max_stations";
-    case StopReason::kMinGain: return "min_gain";
-  }
-  return "unknown";
-}
-
-}  // namespace vc
-
 namespace vc::planner {
 
 uint64_t CountAnd(const VoxelSet& a, const VoxelSet& b) { return a.CountAnd(b); }

@@ -194,6 +194,30 @@ TEST(PlannerTest, ReduceToKeepsTheRequestedNumberOfStations) {
   EXPECT_NEAR(r->evaluation.overall.global_visibility, r->reduction.global_visibility_after, 1e-6);
 }
 
+// With a memory budget too small to keep every station's face values, reduction evaluates each
+// station alone, as often as it needs; the plan is the one the batch evaluation gives.
+TEST(PlannerTest, ReductionOneStationAtATimeMatchesTheBatch) {
+  PlanOptions o = TestOptions();
+  o.target_coverage = 1.0;
+  o.reduce_to = 3;
+  Result<PlanResult> batch = Plan(Synthetic("comb:5"), o);
+  o.memory_budget_bytes = 16'000'000;  // cache budget 4 MB < 5 stations x 1.07 MB of face values
+  Result<PlanResult> single = Plan(Synthetic("comb:5"), o);
+  ASSERT_TRUE(batch.ok()) << batch.status().ToString();
+  ASSERT_TRUE(single.ok()) << single.status().ToString();
+  ASSERT_GE(single->reduction.size, 5);
+  EXPECT_GT(single->reduction.size * single->occupied_voxels * kFacesPerVoxel * sizeof(float),
+            o.memory_budget_bytes / 4);
+  EXPECT_EQ(single->stations.size(), 3u);
+  ASSERT_EQ(single->stations.size(), batch->stations.size());
+  for (size_t k = 0; k < single->stations.size(); ++k) {
+    EXPECT_EQ(single->stations[k].position, batch->stations[k].position) << k;
+  }
+  EXPECT_EQ(single->reduction.removed, batch->reduction.removed);
+  EXPECT_DOUBLE_EQ(single->reduction.global_visibility_after, batch->reduction.global_visibility_after);
+  EXPECT_DOUBLE_EQ(single->evaluation.overall.global_visibility, batch->evaluation.overall.global_visibility);
+}
+
 TEST(PlannerTest, UserCandidatesWithADuplicateAreReducedToDistinctStations) {
   // Greedy never picks a duplicate (it adds nothing), so every plan it makes has no zero-loss
   // station; with max_stations and the candidates given, it still cannot pick one twice.

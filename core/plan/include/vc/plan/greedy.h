@@ -5,7 +5,8 @@
 // recounts every candidate each round; the lazy version (CELF, Leskovec et al. 2007) keeps stale
 // gains as upper bounds in a max-heap, which is exact because gains only shrink as coverage grows,
 // and the heap orders (gain desc, index asc) so both versions pick identically. Internal to
-// vc_core (tests include it by path). Thread-compatible: no shared state.
+// vc::plan; the planner reaches it through GreedySelector (selector.h). Thread-compatible: no
+// shared state.
 #pragma once
 
 #include <cstdint>
@@ -14,21 +15,8 @@
 
 #include "vc/base/progress.h"
 #include "vc/base/status.h"
+#include "vc/plan/selector.h"
 #include "vc/visibility/visibility.h"
-
-namespace vc {
-
-// Why station selection stopped.
-enum class StopReason : uint8_t {
-  kExhausted,       // every coverable voxel is covered (or nothing was coverable)
-  kTargetReached,   // target_coverage reached
-  kMaxStations,     // max_stations picks made
-  kMinGain,         // best marginal gain below min_marginal_gain
-};
-// "exhausted", "target_reached", "max_stations", "min_gain".
-std::string_view StopReasonName(StopReason reason);
-
-}  // namespace vc
 
 namespace vc::planner {
 
@@ -42,8 +30,6 @@ struct GreedyOptions {
   // CELF lazy evaluation (true) or the plain recount of every candidate per round (false).
   bool lazy = true;
 };
-
-
 
 struct GreedyPick {
   int candidate = -1;          // index into the sets

@@ -1,6 +1,7 @@
 // The station planner (ALGORITHM.md section 7; paper section 3): candidates on the operating plane,
-// visibility counts (the heat map), greedy selection, optional proximity refinement, reduction,
-// and evaluation, as one cancellable pipeline reporting progress per stage.
+// visibility counts (the heat map), selection (a Selector: lazy greedy, then consolidation),
+// optional proximity refinement, reduction, and evaluation, as one cancellable pipeline reporting
+// progress per stage. The stages are stages.h's functions, run by one StageRunner (stage_runner.h).
 #pragma once
 
 #include <cstdint>
@@ -12,8 +13,9 @@
 #include "vc/base/geometry.h"
 #include "vc/base/progress.h"
 #include "vc/base/status.h"
-#include "vc/plan/greedy.h"
 #include "vc/plan/plan_options.h"
+#include "vc/plan/selector.h"
+#include "vc/plan/stage_runner.h"
 #include "vc/visibility/visibility.h"
 #include "vc/scene/voxel_scene.h"
 
@@ -46,11 +48,6 @@ struct Reduction {
   double global_visibility_after = 0;
   // P: the stations the matrix is about (greedy order, after refinement), world frame (m).
   std::vector<WorldPoint> positions;
-};
-
-struct StageTiming {
-  Stage stage = Stage::kUnspecified;
-  double seconds = 0;
 };
 
 struct PlanResult {

@@ -1,0 +1,159 @@
+// The stages of a plan (docs/PLANNING.md, "Pipeline"), each a function from a typed input to a
+// typed output: voxelize -> candidates -> visibility -> selection -> refine -> reduction ->
+// evaluation. vc::Plan (planner.h) runs them through one StageRunner (stage_runner.h), which does
+// the begin report, the cancellation check, the progress relabelling and the timing, and assembles
+// PlanResult from their outputs; the stages themselves only compute. Each takes the context the
+// runner gives it (progress already relabelled to the stage) and the plan's options, and returns
+// a Result. Inputs hold references to earlier outputs (which must outlive the call) or take over
+// what the stage consumes (visibility sets, stations), so that memory is freed where the
+// monolithic planner freed it. Thread-compatible: a stage shares nothing between calls.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "vc/base/geometry.h"
+#include "vc/base/progress.h"
+#include "vc/base/status.h"
+#include "vc/plan/planner.h"
+#include "vc/plan/selector.h"
+#include "vc/scene/scene_input.h"
+#include "vc/scene/voxel_scene.h"
+#include "vc/visibility/visibility.h"
+
+namespace vc::planner {
+
+// The stations between selection and the final evaluation, in greedy order, one entry each.
+struct Stations {
+  std::vector<WorldPoint> positions;  // optical centres, world frame (m)
+  std::vector<double> floor_z_m;      // top of the floor below (m); NaN for user candidates
+  std::vector<int> candidate;         // index into the candidates; -1 once refined off-grid
+  std::vector<VoxelSet> sets;         // each station's visibility set (selection test)
+  // Number of stations.
+  [[nodiscard]] size_t size() const { return positions.size(); }
+  // True when there is no station.
+  [[nodiscard]] bool empty() const { return positions.empty(); }
+};
+
+// --- Stage::kVoxelize: the input at the working resolution ---
+struct VoxelizeInput {
+  const SceneInput& input;
+};
+struct VoxelizeOutput {
+  VoxelScene scene;
+};
+// Voxelize with options.resolution_m and memory_budget_bytes; RESOURCE_EXHAUSTED over budget.
+[[nodiscard]] Result<VoxelizeOutput> RunVoxelizeStage(const VoxelizeInput& in, const PlanOptions& options,
+                                                      const JobContext& ctx);
+
+// --- Stage::kCandidates: tripod positions on the operating plane, or the user's ---
+struct CandidatesInput {
+  const VoxelScene& scene;
+};
+struct CandidatesOutput {
+  std::vector<WorldPoint> positions;   // world frame (m)
+  std::vector<double> floor_z_m;       // per candidate (m); NaN for user candidates
+  std::vector<double> floor_levels_m;  // floor levels found (m), ascending; empty for user candidates
+  uint64_t grid_cells = 0;             // grid cells x levels examined
+  uint64_t cells_without_floor = 0;
+  uint64_t cells_failing_clearance = 0;
+  std::vector<std::string> warnings;   // for PlanResult::warnings, in order
+};
+// INVALID_ARGUMENT for a user candidate out of range or inside an occupied voxel;
+// FAILED_PRECONDITION when no floor is found or no candidate survives.
+[[nodiscard]] Result<CandidatesOutput> RunCandidatesStage(const CandidatesInput& in, const PlanOptions& options,
+                                                          const JobContext& ctx);
+
+// RESOURCE_EXHAUSTED (naming `what`) when `positions` visibility sets over `voxels` voxels need
+// more than half of `budget_bytes`; checked before a stage computes that many sets.
+[[nodiscard]] Status CheckVisibilitySetBudget(uint64_t positions, uint64_t voxels, uint64_t budget_bytes,
+                                              const char* what);
+
+// --- Stage::kVisibility: each candidate's visibility set and the heat map ---
+struct VisibilityInput {
+  const VoxelScene& scene;
+  const std::vector<WorldPoint>& candidates;
+  const PlanCallbacks& callbacks;  // on_heat_map is called once, when the heat map is final
+};
+struct VisibilityOutput {
+  std::vector<VoxelSet> sets;  // per candidate
+  HeatMap heat_map;            // per candidate: |set|
+};
+// CANCELLED / DEADLINE_EXCEEDED from ctx.
+[[nodiscard]] Result<VisibilityOutput> RunVisibilityStage(const VisibilityInput& in, const PlanOptions& options,
+                                                          const JobContext& ctx);
+
+// --- Stage::kSelection: the Selector's picks as stations ---
+struct SelectionInput {
+  const Selector& selector;
+  std::vector<VoxelSet> sets;                  // per candidate; consumed (freed when done)
+  const std::vector<WorldPoint>& candidates;
+  const std::vector<double>& floor_z_m;        // per candidate
+  const std::vector<uint64_t>& visible_voxels;  // per candidate: |set| (the heat map's counts)
+  const PlanCallbacks& callbacks;              // on_station is called per pick, in pick order
+};
+struct SelectionOutput {
+  Stations stations;    // the picks, in pick order
+  VoxelSet coverable;   // union of every candidate's set
+  Selection selection;  // what the selector reported
+};
+// Errors of the selector (CANCELLED / DEADLINE_EXCEEDED from ctx).
+[[nodiscard]] Result<SelectionOutput> RunSelectionStage(SelectionInput in, const PlanOptions& options,
+                                                        const JobContext& ctx);
+
+// The Selector a plan with `options` uses: GreedySelector with its stopping rules.
+[[nodiscard]] GreedySelectorOptions SelectorOptionsFor(const PlanOptions& options);
+
+// --- Stage::kRefine: each station to the best position of a sub-grid around it (s.7.4) ---
+struct RefineInput {
+  const VoxelScene& scene;
+  Stations stations;   // consumed
+  VoxelSet coverable;  // consumed; grows by what the trial positions see
+};
+struct RefineOutput {
+  Stations stations;
+  VoxelSet coverable;
+};
+// RESOURCE_EXHAUSTED when the trial positions' sets exceed the budget; CANCELLED from ctx.
+[[nodiscard]] Result<RefineOutput> RunRefineStage(RefineInput in, const PlanOptions& options, const JobContext& ctx);
+
+// --- Stage::kReduction: the reduction matrix and the stations to keep (s.7.5) ---
+struct ReductionInput {
+  const VoxelScene& scene;
+  const Stations& stations;
+};
+struct ReductionOutput {
+  Reduction reduction;     // the matrix, the removed stations and G before and after
+  std::vector<int> keep;   // indices into the stations kept, ascending
+  // The evaluation of all stations (with face values), when it was computed and nothing was
+  // removed, so the evaluation stage reuses it.
+  std::optional<Evaluation> evaluation;
+};
+// Every one of `count` stations kept, nothing evaluated: the output when reduction does not run.
+[[nodiscard]] ReductionOutput KeepAllStations(size_t count);
+// Errors of Evaluate and RunReduction (CANCELLED / DEADLINE_EXCEEDED from ctx).
+[[nodiscard]] Result<ReductionOutput> RunReductionStage(const ReductionInput& in, const PlanOptions& options,
+                                                        const JobContext& ctx);
+
+// --- Stage::kEvaluation: V of every face from the final stations, and G ---
+struct EvaluationInput {
+  const VoxelScene& scene;
+  const std::vector<WorldPoint>& positions;  // the final stations, world frame (m)
+  std::optional<Evaluation> reusable;        // the same stations' evaluation, if one exists
+};
+struct EvaluationOutput {
+  Evaluation evaluation;
+  std::vector<WorldPoint> voxel_centers;  // occupied voxel centres (world, m) in id order
+  std::vector<std::string> warnings;      // for PlanResult::warnings, in order
+};
+// Errors of Evaluate (CANCELLED / DEADLINE_EXCEEDED from ctx).
+[[nodiscard]] Result<EvaluationOutput> RunEvaluationStage(EvaluationInput in, const PlanOptions& options,
+                                                          const JobContext& ctx);
+
+// What reduction and the final evaluation evaluate stations with: the plan's scanner and
+// threads, all faces, each face's best V kept.
+[[nodiscard]] EvaluateOptions StationEvaluateOptions(const PlanOptions& options);
+
+}  // namespace vc::planner

@@ -1,0 +1,43 @@
+#include "vc/plan/selector.h"
+
+#include <utility>
+
+#include "vc/plan/greedy.h"
+
+namespace vc {
+
+std::string_view StopReasonName(StopReason reason) {
+  switch (reason) {
+    case StopReason::kExhausted: return "exhausted";
+    case StopReason::kTargetReached: return "target_reached";
+    case StopReason::kMaxStations: return "max_stations";
+    case StopReason::kMinGain: return "min_gain";
+  }
+  return "unknown";
+}
+
+}  // namespace vc
+
+namespace vc::planner {
+
+Result<Selection> GreedySelector::Select(const std::vector<VoxelSet>& sets, const JobContext& ctx) const {
+  GreedyOptions greedy_options;
+  greedy_options.max_stations = options_.max_stations;
+  greedy_options.min_marginal_gain = options_.min_marginal_gain_voxels;
+  greedy_options.target_coverage = options_.target_coverage;
+  VC_ASSIGN_OR_RETURN(GreedyResult greedy, SelectGreedy(sets, greedy_options, ctx));
+  Selection out;
+  out.stop = greedy.stop;
+  out.coverable = greedy.coverable;
+  out.covered = greedy.covered;
+  for (const GreedyPick& pick : greedy.picks) out.picks.push_back(pick.candidate);
+  out.first_pass_picks = static_cast<int>(out.picks.size());
+  if (options_.consolidate) {
+    VC_ASSIGN_OR_RETURN(ConsolidateResult merged, ConsolidatePicks(sets, std::move(out.picks), ctx));
+    out.picks = std::move(merged.picks);
+    out.saved_by_improvement = merged.dropped + merged.merged;
+  }
+  return out;
+}
+
+}  // namespace vc::planner

@@ -1,0 +1,88 @@
+#include <cmath>
+#include <optional>
+#include <utility>
+
+#include "vc/plan/candidates.h"
+#include "vc/plan/greedy.h"
+#include "vc/plan/stage_runner.h"
+#include "vc/plan/stages.h"
+
+namespace vc::planner {
+namespace {
+
+// Positions of the sub-grids around the stations, grouped by station in station order.
+struct TrialPositions {
+  std::vector<WorldPoint> positions;  // world frame (m)
+  std::vector<int> station;           // per position: the station it may replace
+};
+
+// Every sub-grid point within options.refine_radius_m of a station (not the station itself),
+// moved onto the floor near the station's and kept if it has the clearance.
+TrialPositions TrialsAround(const OccupancyGrid& grid, const Stations& stations, const PlanOptions& options) {
+  const CandidateOptions cand_options{options.grid_spacing_m, options.tripod_height_m, options.clearance_m};
+  const int steps = static_cast<int>(std::floor(options.refine_radius_m / options.refine_step_m + 1e-9));
+  TrialPositions trials;
+  for (size_t k = 0; k < stations.size(); ++k) {
+    for (int iy = -steps; iy <= steps; ++iy) {
+      for (int ix = -steps; ix <= steps; ++ix) {
+        if (ix == 0 && iy == 0) continue;
+        WorldPoint p = stations.positions[k] + WorldPoint(ix * options.refine_step_m, iy * options.refine_step_m, 0);
+        if (!std::isnan(stations.floor_z_m[k])) {
+          std::optional<double> top = FloorTopNear(grid, p.x(), p.y(), stations.floor_z_m[k], cand_options);
+          if (!top) continue;
+          p.z() = *top + options.tripod_height_m;
+        }
+        if (!HasClearance(grid, p, options.clearance_m)) continue;
+        trials.positions.push_back(p);
+        trials.station.push_back(static_cast<int>(k));
+      }
+    }
+  }
+  return trials;
+}
+
+}  // namespace
+
+Result<RefineOutput> RunRefineStage(RefineInput in, const PlanOptions& options, const JobContext& ctx) {
+  const size_t n_voxels = in.scene.occupied.size();
+  Stations& stations = in.stations;
+  TrialPositions trials = TrialsAround(in.scene.grid, stations, options);
+  VC_RETURN_IF_ERROR(CheckVisibilitySetBudget(trials.positions.size(), n_voxels, options.memory_budget_bytes,
+                                              "refinement"));
+  const VisibilitySetsOptions set_options{options.selection_test, options.threads};
+  VC_ASSIGN_OR_RETURN(std::vector<VoxelSet> trial_sets,
+                      ComputeVisibilitySets(in.scene, trials.positions, set_options, ProgressRange(ctx, 0.0, 0.9)));
+  for (const VoxelSet& s : trial_sets) UnionInto(in.coverable, s);
+  // Each station in turn moves to its best trial position if that covers more together with the
+  // other stations (then sees more alone); the others stay where they are meanwhile.
+  size_t t = 0;
+  for (size_t k = 0; k < stations.size(); ++k) {
+    VC_RETURN_IF_ERROR(ctx.CheckCancelled("refinement"));
+    VoxelSet others(n_voxels);
+    for (size_t j = 0; j < stations.size(); ++j) {
+      if (j != k) UnionInto(others, stations.sets[j]);
+    }
+    const uint64_t others_count = CountBits(others);
+    auto score = [&](const VoxelSet& s) {
+      return std::make_pair(others_count + CountBits(s) - CountAnd(others, s), CountBits(s));
+    };
+    auto best = score(stations.sets[k]);
+    int best_trial = -1;
+    for (; t < trials.positions.size() && trials.station[t] == static_cast<int>(k); ++t) {
+      const auto sc = score(trial_sets[t]);
+      if (sc > best) {
+        best = sc;
+        best_trial = static_cast<int>(t);
+      }
+    }
+    if (best_trial >= 0) {
+      stations.positions[k] = trials.positions[best_trial];
+      if (!std::isnan(stations.floor_z_m[k])) stations.floor_z_m[k] = stations.positions[k].z() - options.tripod_height_m;
+      stations.candidate[k] = -1;
+      stations.sets[k] = std::move(trial_sets[best_trial]);
+    }
+  }
+  return RefineOutput{std::move(in.stations), std::move(in.coverable)};
+}
+
+}  // namespace vc::planner

@@ -1,0 +1,34 @@
+#include <string>
+
+#include "format.h"
+#include "vc/plan/greedy.h"
+#include "vc/plan/stages.h"
+
+namespace vc::planner {
+
+Status CheckVisibilitySetBudget(uint64_t positions, uint64_t voxels, uint64_t budget_bytes, const char* what) {
+  const uint64_t need = positions * ((voxels + 63) / 64) * 8;
+  if (need > budget_bytes / 2) {
+    return ResourceExhaustedError(std::string(what) + ": " + std::to_string(positions) + " positions x " +
+                                  std::to_string(voxels) + " occupied voxels need " +
+                                  Num(need / 1073741824.0) + " GiB of visibility sets (budget " +
+                                  Num(budget_bytes / 1073741824.0) +
+                                  " GiB); raise grid_spacing_m or resolution_m");
+  }
+  return Status::Ok();
+}
+
+Result<VisibilityOutput> RunVisibilityStage(const VisibilityInput& in, const PlanOptions& options,
+                                            const JobContext& ctx) {
+  const VisibilitySetsOptions set_options{options.selection_test, options.threads};
+  VisibilityOutput out;
+  VC_ASSIGN_OR_RETURN(out.sets, ComputeVisibilitySets(in.scene, in.candidates, set_options, ctx));
+  out.heat_map.positions = in.candidates;
+  out.heat_map.grid_spacing_m = options.grid_spacing_m;
+  out.heat_map.visible_voxels.reserve(out.sets.size());
+  for (const VoxelSet& s : out.sets) out.heat_map.visible_voxels.push_back(CountBits(s));
+  if (in.callbacks.on_heat_map) in.callbacks.on_heat_map(out.heat_map);
+  return out;
+}
+
+}  // namespace vc::planner

@@ -1,0 +1,472 @@
+// vc::Evaluate (ALGORITHM.md s.6; docs/VISIBILITY.md): the exact mode (every face of F, one ray per
+// distinct lattice corner and viewpoint, corners first decided by groups of faces) and the sampled
+// mode (a uniform random sample of F with replacement, with a 95 % confidence interval) are two
+// functions over shared pieces: viewpoint validation, the scene's voxel indices and |F|, the
+// viewpoints in index space with their shortcut margins, and the tallies of s.6. Evaluate
+// validates, prepares and dispatches. Thread-safe on a const scene (see visibility.h).
+#include <algorithm>
+#include <array>
+#include <bit>
+#include <cmath>
+#include <memory>
+#include <mutex>
+#include <random>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "vc/base/huge_pages.h"
+#include "vc/base/parallel.h"
+#include "vc/raycast/occluders.h"
+#include "vc/visibility/surface_groups.h"
+#include "vc/visibility/visibility.h"
+#include "visibility_internal.h"
+
+namespace vc {
+namespace {
+
+using Eigen::Vector3d;
+using internal::Corner;
+using internal::CornerVisibleCached;
+using internal::FaceValue;
+using internal::FromCount;
+using internal::InsideOccupied;
+using internal::kFaceCornerMask;
+using internal::kFaceCorners;
+using internal::Neighbour;
+using internal::NotEnclosed;
+using internal::OccluderCache;
+using internal::StageProgress;
+using planner::ParallelChunks;
+using planner::ResolveThreads;
+
+// Exact evaluation gives each thread whole viewpoints once there are this many per thread (fewer
+// leave threads idle at the end; see Evaluate).
+constexpr uint64_t kEvaluateViewpointsPerThread = 4;
+constexpr uint64_t kEvaluateExtraWorkBytes = uint64_t{256} << 20;
+
+uint64_t PackCorner(const VoxelIndex& c) {
+  constexpr int kBias = 1 << 20;
+  return (uint64_t(c.z + kBias) << 42) | (uint64_t(c.y + kBias) << 21) | uint64_t(c.x + kBias);
+}
+
+VoxelIndex UnpackCorner(uint64_t p) {
+  constexpr int kBias = 1 << 20;
+  constexpr uint64_t kMask = (uint64_t{1} << 21) - 1;
+  return {int(p & kMask) - kBias, int((p >> 21) & kMask) - kBias, int(p >> 42) - kBias};
+}
+
+// Accumulates the figures of s.6 over faces.
+struct Tally {
+  double sum_v = 0;
+  double sum_full_v = 0;
+  uint64_t full = 0;
+  uint64_t partial = 0;
+  void Add(Perception p, double v) {
+    sum_v += v;
+    if (p == Perception::kFull && v > 0) {
+      ++full;
+      sum_full_v += v;
+    } else if (p != Perception::kNone && v > 0) {
+      ++partial;
+    }
+  }
+  void Merge(const Tally& o) {
+    sum_v += o.sum_v;
+    sum_full_v += o.sum_full_v;
+    full += o.full;
+    partial += o.partial;
+  }
+  VisibilityFigures Figures(uint64_t faces) const {
+    VisibilityFigures f;
+    if (faces == 0) return f;
+    f.global_visibility = sum_v / double(faces);
+    f.fully_visible_fraction = double(full) / double(faces);
+    f.mean_full_visibility = full ? sum_full_v / double(full) : 0.0;
+    f.partially_visible_fraction = double(partial) / double(faces);
+    return f;
+  }
+};
+
+bool FaceInSet(const OccupancyGrid& g, const VoxelIndex& v, Face f, FaceSet set) {
+  return set == FaceSet::kAll || !g.Occupied(Neighbour(v, f));
+}
+
+// A face's best (V, perception) so far: the larger V, and on equal V the better perception. The
+// result does not depend on the order in which the viewpoints' values arrive.
+template <typename P>
+void KeepBest(double val, P p, double& best, P& best_p) {
+  if (val > best || (val == best && p > best_p)) {
+    best = val;
+    best_p = p;
+  }
+}
+
+// INVALID_ARGUMENT naming the first viewpoint (1-based) that is not finite or lies out of range.
+Status ValidateViewpoints(const std::vector<WorldPoint>& viewpoints, double resolution_m) {
+  for (size_t k = 0; k < viewpoints.size(); ++k) {
+    if (!viewpoints[k].allFinite()) {
+      return InvalidArgumentError("viewpoint " + std::to_string(k + 1) + " has a non-finite coordinate");
+    }
+    if (!ViewpointInRange(viewpoints[k], resolution_m)) {
+      return InvalidArgumentError("viewpoint " + std::to_string(k + 1) + " is more than " +
+                                  std::to_string(int64_t(kMaxViewpointIndex * resolution_m)) +
+                                  " m from the origin along an axis; use coordinates in the scene's frame");
+    }
+  }
+  return Status::Ok();
+}
+
+// What both modes work on: the scene's grid, resolution (m) and voxel count, the viewpoints and
+// options, the occupied voxels in index space (id order), |F|, and each viewpoint in index space
+// with whether the shortcuts' margins hold for rays from it.
+struct EvaluationJob {
+  const OccupancyGrid& g;
+  double r;
+  size_t n;
+  size_t nv;
+  const std::vector<WorldPoint>& viewpoints;
+  const EvaluateOptions& options;
+  const JobContext& ctx;
+  std::vector<VoxelIndex> index;
+  uint64_t faces_total;
+  std::vector<Vector3d> uo;
+  std::vector<char> shortcuts;
+};
+
+// The job of evaluating `viewpoints` on `scene`: voxel indices and |F| always, the viewpoints in
+// index space only when |F| > 0.
+EvaluationJob Prepare(const VoxelScene& scene, const std::vector<WorldPoint>& viewpoints,
+                      const EvaluateOptions& options, const JobContext& ctx) {
+  const OccupancyGrid& g = scene.grid;
+  const size_t n = scene.occupied.size();
+  EvaluationJob job{g, scene.resolution_m, n, viewpoints.size(), viewpoints, options, ctx, {}, 0, {}, {}};
+  job.index.resize(n);
+  for (size_t i = 0; i < n; ++i) job.index[i] = KeyToIndex(scene.occupied[i]);
+  for (size_t i = 0; i < n; ++i)
+    for (int f = 0; f < kFacesPerVoxel; ++f) job.faces_total += FaceInSet(g, job.index[i], Face(f), options.faces);
+  if (job.faces_total == 0) return job;
+  job.uo.resize(viewpoints.size());
+  job.shortcuts.resize(viewpoints.size());
+  for (size_t k = 0; k < viewpoints.size(); ++k) {
+    job.uo[k] = g.WorldToIndexSpace(viewpoints[k]);
+    job.shortcuts[k] = internal::ShortcutsHold(g, job.uo[k]);
+  }
+  return job;
+}
+
+// The distinct lattice corners of the voxels (packed, ascending) and each voxel's 8 corner ids.
+struct LatticeCorners {
+  std::vector<uint64_t> corners;
+  std::vector<std::array<uint32_t, 8>> voxel_corners;
+};
+
+// The voxels are sorted by (z, y, x), so for each corner number q the corners of voxels in id
+// order form a sorted stream (a fixed offset keeps the order). Merging the 8 streams lists the
+// distinct corners in order and gives each voxel its 8 corner ids, without a sort or a search.
+// `index` must come from sorted, unique voxels.
+LatticeCorners ListCorners(const std::vector<VoxelIndex>& index) {
+  constexpr uint64_t kDone = ~uint64_t{0};
+  const size_t n = index.size();
+  LatticeCorners out;
+  out.corners.reserve(n * 3);
+  out.voxel_corners.resize(n);
+  size_t pos[8] = {0, 0, 0, 0, 0, 0, 0, 0};
+  uint64_t head[8];
+  for (int q = 0; q < 8; ++q) head[q] = n ? PackCorner(Corner(index[0], q)) : kDone;
+  while (true) {
+    const uint64_t next = *std::min_element(head, head + 8);
+    if (next == kDone) break;
+    const uint32_t id = uint32_t(out.corners.size());
+    out.corners.push_back(next);
+    for (int q = 0; q < 8; ++q) {
+      while (head[q] == next) {
+        out.voxel_corners[pos[q]][q] = id;
+        head[q] = ++pos[q] < n ? PackCorner(Corner(index[pos[q]], q)) : kDone;
+      }
+    }
+  }
+  return out;
+}
+
+// Bit f of entry i: face f of voxel i is in `faces` (the same for every viewpoint).
+std::vector<uint8_t> FacesInSetMask(const OccupancyGrid& g, const std::vector<VoxelIndex>& index, FaceSet faces) {
+  const size_t n = index.size();
+  std::vector<uint8_t> faces_in_set(n, 0);
+  for (size_t i = 0; i < n; ++i) {
+    for (int f = 0; f < kFacesPerVoxel; ++f) {
+      if (FaceInSet(g, index[i], Face(f), faces)) faces_in_set[i] |= uint8_t(1u << f);
+    }
+  }
+  return faces_in_set;
+}
+
+// Sampled mode into `ev` (resolution, |F| and per_viewpoint's size already set).
+Result<Evaluation> EvaluateSampled(const EvaluationJob& job, Evaluation ev) {
+  const auto& [g, r, n, nv, viewpoints, options, ctx, index, faces_total, uo, shortcuts] = job;
+  // Unbiased uniform sample of F with replacement: pick a voxel id and a face uniformly, and
+  // re-draw faces outside F (rejection keeps the distribution uniform over F).
+  ev.sampled = true;
+  ev.faces_evaluated = options.sample_faces;
+  std::mt19937_64 rng(options.seed);
+  std::uniform_int_distribution<uint64_t> pick(0, n * kFacesPerVoxel - 1);
+  std::vector<std::pair<uint32_t, uint8_t>> sample(options.sample_faces);
+  for (auto& s : sample) {
+    while (true) {
+      const uint64_t p = pick(rng);
+      const uint32_t id = uint32_t(p / kFacesPerVoxel);
+      const uint8_t f = uint8_t(p % kFacesPerVoxel);
+      if (FaceInSet(g, index[id], Face(f), options.faces)) {
+        s = {id, f};
+        break;
+      }
+    }
+  }
+  constexpr uint64_t kChunk = 256;
+  const uint64_t chunks = (sample.size() + kChunk - 1) / kChunk;
+  std::vector<Tally> overall(chunks);
+  std::vector<double> sum_sq(chunks, 0.0);
+  std::vector<std::vector<Tally>> per(chunks, std::vector<Tally>(nv));
+  StageProgress progress(ctx, Stage::kEvaluation, chunks);
+  VC_RETURN_IF_ERROR(ParallelChunks(sample.size(), kChunk, options.threads, ctx, [&](uint64_t c, uint64_t b, uint64_t e) {
+    for (uint64_t i = b; i < e; ++i) {
+      const VoxelIndex& v = index[sample[i].first];
+      const Face f = Face(sample[i].second);
+      double best = 0;
+      Perception best_p = Perception::kNone;
+      for (size_t k = 0; k < nv; ++k) {
+        int visible = 0;
+        OccluderCache cache(shortcuts[k]);
+        for (int q : kFaceCorners[int(f)]) visible += CornerVisibleCached(g, uo[k], Corner(v, q), cache);
+        const Perception p = FromCount(visible);
+        const double val = FaceValue(p, viewpoints[k], v, f, r, options.scanner);
+        per[c][k].Add(p, val);
+        KeepBest(val, p, best, best_p);
+      }
+      overall[c].Add(best_p, best);
+      sum_sq[c] += best * best;
+    }
+    progress.Add(1);
+  }));
+  Tally total;
+  double sq = 0;
+  std::vector<Tally> per_total(nv);
+  for (uint64_t c = 0; c < chunks; ++c) {
+    total.Merge(overall[c]);
+    sq += sum_sq[c];
+    for (size_t k = 0; k < nv; ++k) per_total[k].Merge(per[c][k]);
+  }
+  const double m = double(sample.size());
+  ev.overall = total.Figures(sample.size());
+  const double mean = ev.overall.global_visibility;
+  const double var = m > 1 ? std::max(0.0, (sq - m * mean * mean) / (m - 1)) : 0.0;
+  ev.global_visibility_ci95 = 1.96 * std::sqrt(var / m);
+  for (size_t k = 0; k < nv; ++k) ev.per_viewpoint[k] = per_total[k].Figures(sample.size());
+  return ev;
+}
+
+// Exact mode into `ev` (resolution, |F| and per_viewpoint's size already set); the scene's
+// voxels are sorted and unique.
+Result<Evaluation> EvaluateExact(const EvaluationJob& job, Evaluation ev) {
+  const auto& [g, r, n, nv, viewpoints, options, ctx, index, faces_total, uo, shortcuts] = job;
+  ev.faces_evaluated = faces_total;
+  // Distinct lattice corners of all occupied voxels, and each voxel's 8 corner ids.
+  const LatticeCorners lattice = ListCorners(index);
+  const std::vector<uint64_t>& corners = lattice.corners;
+  const std::vector<std::array<uint32_t, 8>>& voxel_corners = lattice.voxel_corners;
+  VC_RETURN_IF_ERROR(ctx.CheckCancelled("evaluation"));
+  const std::vector<uint8_t> faces_in_set = FacesInSetMask(g, index, options.faces);
+  // Allocated here, in the calling thread, like every large allocation of this mode: running out
+  // of memory must not happen in a worker thread. Each viewpoint's values are filled by the
+  // thread that evaluates it (huge_pages.h: first touch is the costly part).
+  if (options.keep_per_viewpoint_values) {
+    ev.per_viewpoint_face_values.resize(nv);
+    for (std::vector<float>& values : ev.per_viewpoint_face_values) {
+      internal::ReserveOnHugePages(values, n * kFacesPerVoxel);
+    }
+  }
+  constexpr uint64_t kCornerChunk = 64 * 256;
+  constexpr uint64_t kVoxelChunk = 4096;
+  const uint64_t voxel_chunks = (n + kVoxelChunk - 1) / kVoxelChunk;
+  StageProgress progress(ctx, Stage::kEvaluation, nv);
+  // Corners that groups of faces decide at once (surface_groups.h), per viewpoint.
+  const internal::SurfaceTargets targets(g, index, NotEnclosed(g, index));
+  constexpr uint64_t kBricksPerTask = 256;
+  const uint64_t brick_chunks = (targets.brick_count() + kBricksPerTask - 1) / kBricksPerTask;
+
+  // What evaluating viewpoints needs besides the scene: the corner bitsets of the viewpoint at
+  // hand, and the best V (and its perception) of each face over the viewpoints evaluated so far.
+  struct Work {
+    Work(size_t corner_words, size_t slots, size_t voxel_chunks)
+        : visible_bits(corner_words),
+          decided_bits(corner_words),
+          tallies(voxel_chunks),
+          best(internal::FilledOnHugePages(slots, 0.0)),
+          best_p(internal::FilledOnHugePages(slots, uint8_t{0})) {}
+    std::vector<uint64_t> visible_bits, decided_bits;
+    std::vector<Tally> tallies;  // per chunk of voxels, for the viewpoint at hand
+    std::vector<double> best;
+    std::vector<uint8_t> best_p;
+  };
+  const size_t corner_words = (corners.size() + 63) / 64;
+  // Viewpoint k into `w`, on `threads` workers (1: all in the calling thread, with no atomics).
+  // Its figures do not depend on `threads`: partial sums are merged in chunk order.
+  auto evaluate_viewpoint = [&](size_t k, int threads, Work& w) -> Status {
+    const bool shared = ResolveThreads(threads, brick_chunks) > 1;  // the group pass runs on several threads
+    // 1. Corners decided by face groups, then one ray per remaining corner. With several
+    // workers, tasks share words of the bitsets, so the group pass sets bits atomically.
+    std::fill(w.visible_bits.begin(), w.visible_bits.end(), 0);
+    std::fill(w.decided_bits.begin(), w.decided_bits.end(), 0);
+    // A corner is often decided many times (it is shared by up to 24 faces), so BitWriter's
+    // plain load before the atomic one pays.
+    const internal::BitWriter decided_out{w.decided_bits.data(), shared}, visible_out{w.visible_bits.data(), shared};
+    const bool grouped = !options.per_corner && shortcuts[k] && !InsideOccupied(g, uo[k]);
+    if (grouped) {
+      const internal::FreeBox around = internal::GrowFreeBox(g, uo[k]);  // once, for every chunk
+      VC_RETURN_IF_ERROR(ParallelChunks(brick_chunks, 1, threads, ctx, [&](uint64_t task, uint64_t, uint64_t) {
+        internal::GroupWalk walk;
+        walk.around = around;
+        std::vector<internal::SurfaceTargets::CornerDecision> decisions;
+        const size_t b0 = task * kBricksPerTask, b1 = std::min<size_t>(b0 + kBricksPerTask, targets.brick_count());
+        targets.AppendCornerDecisions(uo[k], b0, b1, walk, decisions);
+        for (const auto& d : decisions) {
+          auto apply = [&](int q) {
+            const uint32_t c = voxel_corners[d.id][q];
+            decided_out.Set(c);
+            if (d.seen) visible_out.Set(c);
+          };
+          if (d.face == 0xff) {
+            apply(d.corner);
+          } else {
+            for (int q : kFaceCorners[d.face]) apply(q);
+          }
+        }
+      }));
+    }
+    VC_RETURN_IF_ERROR(ParallelChunks(corners.size(), kCornerChunk, threads, ctx, [&](uint64_t, uint64_t b, uint64_t e) {
+      OccluderCache cache(shortcuts[k]);
+      for (uint64_t c = b; c < e; ++c) {
+        if ((w.decided_bits[c >> 6] >> (c & 63)) & 1) continue;
+        if (CornerVisibleCached(g, uo[k], UnpackCorner(corners[c]), cache)) {
+          w.visible_bits[c >> 6] |= uint64_t{1} << (c & 63);
+        }
+      }
+    }));
+    // 2. Faces from their corners.
+    std::vector<Tally>& tallies = w.tallies;
+    std::fill(tallies.begin(), tallies.end(), Tally{});
+    std::vector<float>* keep = options.keep_per_viewpoint_values ? &ev.per_viewpoint_face_values[k] : nullptr;
+    if (keep) keep->resize(n * kFacesPerVoxel);  // zeros, in the capacity reserved above
+    VC_RETURN_IF_ERROR(ParallelChunks(n, kVoxelChunk, threads, ctx, [&](uint64_t chunk, uint64_t b, uint64_t e) {
+      Tally& t = tallies[chunk];
+      for (uint64_t i = b; i < e; ++i) {
+        unsigned corner_bits = 0;  // bit q: corner q of voxel i is visible
+        for (int q = 0; q < 8; ++q) {
+          const uint32_t c = voxel_corners[i][q];
+          corner_bits |= unsigned((w.visible_bits[c >> 6] >> (c & 63)) & 1) << q;
+        }
+        // No visible corner: every face is unperceived, V = 0, which adds nothing to the tally or
+        // the best values, and the kept values are zeros already.
+        if (corner_bits == 0) continue;
+        for (int f = 0; f < kFacesPerVoxel; ++f) {
+          if (!((faces_in_set[i] >> f) & 1)) continue;
+          const Perception p = FromCount(std::popcount(corner_bits & kFaceCornerMask[f]));
+          const double val = FaceValue(p, viewpoints[k], index[i], Face(f), r, options.scanner);
+          t.Add(p, val);
+          const size_t slot = i * kFacesPerVoxel + f;
+          if (keep) (*keep)[slot] = float(val);
+          KeepBest(val, uint8_t(p), w.best[slot], w.best_p[slot]);
+        }
+      }
+    }));
+    Tally total;
+    for (const Tally& t : tallies) total.Merge(t);
+    ev.per_viewpoint[k] = total.Figures(faces_total);
+    progress.Add(1);
+    return Status::Ok();
+  };
+
+  // With enough viewpoints per thread, a task is one viewpoint, evaluated by one thread into
+  // that thread's Work (no joins within a viewpoint, no atomics); the threads' best values are
+  // merged at the end. Otherwise the viewpoints are evaluated one after another, each on all
+  // threads. Both give the same figures: the best (V, perception) pair of a face is the same
+  // whatever the order of the viewpoints.
+  // Each extra thread's Work costs 9 bytes per face; beyond kEvaluateExtraWorkBytes in all, the
+  // viewpoints are evaluated one after another instead.
+  const int workers = ResolveThreads(options.threads, nv);
+  const uint64_t extra_bytes = uint64_t(workers - 1) * n * kFacesPerVoxel * (sizeof(double) + sizeof(uint8_t));
+  std::vector<std::unique_ptr<Work>> works;
+  if (workers > 1 && nv >= kEvaluateViewpointsPerThread * uint64_t(workers) && extra_bytes <= kEvaluateExtraWorkBytes) {
+    // Allocated here, in the calling thread, so that running out of memory is not a worker's.
+    std::vector<Work*> idle;
+    for (int t = 0; t < workers; ++t) {
+      works.push_back(std::make_unique<Work>(corner_words, n * kFacesPerVoxel, voxel_chunks));
+      idle.push_back(works.back().get());
+    }
+    std::mutex mu;
+    Status failed = Status::Ok();
+    // The last nv % workers viewpoints are evaluated one after another on all threads, so that
+    // no thread ends with a whole viewpoint of its own while the others wait.
+    const uint64_t alone = nv - nv % uint64_t(workers);
+    VC_RETURN_IF_ERROR(ParallelChunks(alone, 1, workers, ctx, [&](uint64_t k, uint64_t, uint64_t) {
+      Work* w = nullptr;
+      {
+        std::lock_guard<std::mutex> lock(mu);  // at most `workers` tasks run at once
+        w = idle.back();
+        idle.pop_back();
+      }
+      const Status st = evaluate_viewpoint(k, 1, *w);
+      std::lock_guard<std::mutex> lock(mu);
+      if (!st.ok() && failed.ok()) failed = st;
+      idle.push_back(w);
+    }, "evaluation"));
+    VC_RETURN_IF_ERROR(failed);
+    for (size_t k = alone; k < nv; ++k) VC_RETURN_IF_ERROR(evaluate_viewpoint(k, workers, *works[0]));
+  } else {
+    works.push_back(std::make_unique<Work>(corner_words, n * kFacesPerVoxel, voxel_chunks));
+    for (size_t k = 0; k < nv; ++k) VC_RETURN_IF_ERROR(evaluate_viewpoint(k, options.threads, *works[0]));
+  }
+  std::vector<double>& best = works[0]->best;
+  std::vector<uint8_t>& best_p = works[0]->best_p;
+  for (size_t t = 1; t < works.size(); ++t) {
+    for (size_t slot = 0; slot < best.size(); ++slot) KeepBest(works[t]->best[slot], works[t]->best_p[slot], best[slot], best_p[slot]);
+  }
+  // Overall: the best V of each face over all viewpoints.
+  Tally total;
+  for (size_t i = 0; i < n; ++i)
+    for (int f = 0; f < kFacesPerVoxel; ++f) {
+      if (!((faces_in_set[i] >> f) & 1)) continue;
+      const size_t slot = i * kFacesPerVoxel + f;
+      total.Add(Perception(best_p[slot]), best[slot]);
+    }
+  ev.overall = total.Figures(faces_total);
+  if (options.keep_face_values) {
+    ev.best_face_values.resize(n);
+    for (size_t i = 0; i < n; ++i)
+      for (int f = 0; f < kFacesPerVoxel; ++f) ev.best_face_values[i][f] = float(best[i * kFacesPerVoxel + f]);
+  }
+  return ev;
+}
+
+}  // namespace
+
+Result<Evaluation> Evaluate(const VoxelScene& scene, const std::vector<WorldPoint>& viewpoints,
+                            const EvaluateOptions& options, const JobContext& ctx) {
+  VC_RETURN_IF_ERROR(options.scanner.Validate());
+  VC_RETURN_IF_ERROR(ValidateViewpoints(viewpoints, scene.resolution_m));
+  const EvaluationJob job = Prepare(scene, viewpoints, options, ctx);
+  Evaluation ev;
+  ev.resolution_m = scene.resolution_m;
+  ev.faces_total = job.faces_total;
+  ev.per_viewpoint.resize(viewpoints.size());
+  if (job.faces_total == 0) return ev;
+  if (options.sample_faces > 0) return EvaluateSampled(job, std::move(ev));
+  // Exact mode lists lattice corners by merging sorted streams, so it needs VoxelScene's order.
+  if (std::adjacent_find(scene.occupied.begin(), scene.occupied.end(),
+                         [](const VoxelKey& a, const VoxelKey& b) { return !(a < b); }) != scene.occupied.end()) {
+    return InvalidArgumentError("the scene's voxels must be sorted and unique (VoxelScene::occupied)");
+  }
+  return EvaluateExact(job, std::move(ev));
+}
+
+}  // namespace vc

@@ -1,0 +1,198 @@
+// The Selector interface: GreedySelector picks exactly what SelectGreedy (lazy) followed by
+// ConsolidatePicks picks, on the real visibility sets of comb:5 and on random sets, and reports
+// the greedy pass's stop reason and coverage; the selection stage turns any selector's picks into
+// stations.
+#include "vc/plan/selector.h"
+
+#include <gtest/gtest.h>
+
+#include <random>
+#include <vector>
+
+#include "vc/plan/greedy.h"
+#include "vc/plan/stages.h"
+#include "vc/synth/synth.h"
+
+namespace vc::planner {
+namespace {
+
+// What the planner did before the Selector interface: lazy greedy, then consolidation.
+Selection Reference(const std::vector<VoxelSet>& sets, const GreedySelectorOptions& o) {
+  GreedyOptions g;
+  g.max_stations = o.max_stations;
+  g.min_marginal_gain = o.min_marginal_gain_voxels;
+  g.target_coverage = o.target_coverage;
+  Result<GreedyResult> greedy = SelectGreedy(sets, g);
+  EXPECT_TRUE(greedy.ok()) << greedy.status().ToString();
+  Selection s;
+  if (!greedy.ok()) return s;
+  for (const GreedyPick& p : greedy->picks) s.picks.push_back(p.candidate);
+  s.stop = greedy->stop;
+  s.coverable = greedy->coverable;
+  s.covered = greedy->covered;
+  s.first_pass_picks = static_cast<int>(s.picks.size());
+  if (o.consolidate) {
+    Result<ConsolidateResult> merged = ConsolidatePicks(sets, s.picks);
+    EXPECT_TRUE(merged.ok()) << merged.status().ToString();
+    if (!merged.ok()) return s;
+    s.picks = merged->picks;
+    s.saved_by_improvement = merged->dropped + merged->merged;
+  }
+  return s;
+}
+
+void ExpectSame(const Selection& got, const Selection& want, const std::string& what) {
+  EXPECT_EQ(got.picks, want.picks) << what;
+  EXPECT_EQ(got.stop, want.stop) << what;
+  EXPECT_EQ(got.coverable, want.coverable) << what;
+  EXPECT_EQ(got.covered, want.covered) << what;
+  EXPECT_EQ(got.first_pass_picks, want.first_pass_picks) << what;
+  EXPECT_EQ(got.saved_by_improvement, want.saved_by_improvement) << what;
+}
+
+// The candidates' visibility sets of a synthetic scene, as the planner computes them.
+std::vector<VoxelSet> SceneSets(const std::string& spec) {
+  SynthOptions so;
+  so.spacing_m = 0.05;
+  Result<std::vector<Eigen::Vector3f>> points = GenerateScene(spec, so);
+  EXPECT_TRUE(points.ok()) << points.status().ToString();
+  if (!points.ok()) return {};
+  SceneInput input;
+  input.points = std::move(*points);
+  PlanOptions options;
+  options.resolution_m = 0.1;
+  Result<VoxelizeOutput> voxels = RunVoxelizeStage({input}, options, {});
+  EXPECT_TRUE(voxels.ok()) << voxels.status().ToString();
+  if (!voxels.ok()) return {};
+  Result<CandidatesOutput> candidates = RunCandidatesStage({voxels->scene}, options, {});
+  EXPECT_TRUE(candidates.ok()) << candidates.status().ToString();
+  if (!candidates.ok()) return {};
+  const PlanCallbacks callbacks;
+  Result<VisibilityOutput> visibility =
+      RunVisibilityStage({voxels->scene, candidates->positions, callbacks}, options, {});
+  EXPECT_TRUE(visibility.ok()) << visibility.status().ToString();
+  return visibility.ok() ? std::move(visibility->sets) : std::vector<VoxelSet>{};
+}
+
+TEST(GreedySelectorTest, PicksWhatGreedyThenConsolidationPickOnComb5) {
+  const std::vector<VoxelSet> sets = SceneSets("comb:5");
+  ASSERT_GT(sets.size(), 10u);
+  for (double target : {1.0, 0.99, 0.9}) {
+    for (bool consolidate : {true, false}) {
+      GreedySelectorOptions o;
+      o.target_coverage = target;
+      o.consolidate = consolidate;
+      Result<Selection> got = GreedySelector(o).Select(sets, {});
+      ASSERT_TRUE(got.ok()) << got.status().ToString();
+      const Selection want = Reference(sets, o);
+      ExpectSame(*got, want, "target " + std::to_string(target) + (consolidate ? " consolidated" : ""));
+      EXPECT_FALSE(got->picks.empty());
+      if (!consolidate) {
+        EXPECT_EQ(got->saved_by_improvement, 0);
+      }
+    }
+  }
+  // At full coverage greedy needs more picks than the optimum 5 and consolidation repairs it.
+  GreedySelectorOptions full;
+  full.target_coverage = 1.0;
+  Result<Selection> got = GreedySelector(full).Select(sets, {});
+  ASSERT_TRUE(got.ok());
+  EXPECT_EQ(got->picks.size(), 5u);
+  EXPECT_GT(got->first_pass_picks, 5);
+  EXPECT_EQ(got->saved_by_improvement, got->first_pass_picks - 5);
+}
+
+TEST(GreedySelectorTest, PicksWhatGreedyThenConsolidationPickOnRandomSets) {
+  std::mt19937 rng(2014);
+  int saved = 0;
+  for (int trial = 0; trial < 200; ++trial) {
+    const size_t n = 20 + rng() % 300;
+    std::vector<VoxelSet> sets;
+    for (size_t i = 0; i < 3 + rng() % 40; ++i) {
+      VoxelSet s(n);
+      const size_t start = rng() % n, len = 1 + rng() % (n / 3);
+      for (size_t v = 0; v < len; ++v) s.set((start + v) % n);
+      sets.push_back(s);
+    }
+    GreedySelectorOptions o;
+    o.max_stations = static_cast<int>(rng() % 4);  // 0 = no limit
+    o.min_marginal_gain_voxels = 1 + rng() % 3;
+    o.target_coverage = (rng() % 2) ? 1.0 : 0.8;
+    o.consolidate = rng() % 4 != 0;
+    Result<Selection> got = GreedySelector(o).Select(sets, {});
+    ASSERT_TRUE(got.ok()) << got.status().ToString();
+    ExpectSame(*got, Reference(sets, o), "trial " + std::to_string(trial));
+    saved += got->saved_by_improvement;
+  }
+  EXPECT_GT(saved, 0);  // the instances exercise consolidation, not only greedy
+}
+
+TEST(GreedySelectorTest, StopReasonComesFromTheGreedyPass) {
+  std::vector<VoxelSet> sets(3, VoxelSet(30));
+  for (int v = 0; v < 10; ++v) sets[0].set(v), sets[1].set(10 + v), sets[2].set(20 + v);
+  GreedySelectorOptions o;
+  o.max_stations = 2;
+  Result<Selection> got = GreedySelector(o).Select(sets, {});
+  ASSERT_TRUE(got.ok());
+  EXPECT_EQ(got->stop, StopReason::kMaxStations);
+  EXPECT_EQ(got->picks, (std::vector<int>{0, 1}));
+  EXPECT_EQ(got->covered, 20u);
+  EXPECT_EQ(got->coverable, 30u);
+}
+
+TEST(GreedySelectorTest, RejectsSetsOfDifferentSizesAndStopsWhenCancelled) {
+  const GreedySelector selector(GreedySelectorOptions{});
+  EXPECT_EQ(selector.Select({VoxelSet(10), VoxelSet(11)}, {}).status().code(), StatusCode::kInvalidArgument);
+  CancelToken token;
+  token.Cancel();
+  JobContext ctx;
+  ctx.cancel = &token;
+  std::vector<VoxelSet> sets(2, VoxelSet(10));
+  sets[0].set(1);
+  EXPECT_EQ(selector.Select(sets, ctx).status().code(), StatusCode::kCancelled);
+}
+
+// Another selector (the way an ILP or a local search would plug in): always the last candidate.
+class LastCandidateSelector final : public Selector {
+ public:
+  Result<Selection> Select(const std::vector<VoxelSet>& sets, const JobContext&) const override {
+    Selection s;
+    s.picks = {static_cast<int>(sets.size()) - 1};
+    s.first_pass_picks = 1;
+    s.coverable = 4;
+    return s;
+  }
+};
+
+TEST(SelectionStageTest, TurnsAnySelectorsPicksIntoStationsAndReportsEach) {
+  std::vector<VoxelSet> sets(3, VoxelSet(8));
+  sets[0].set(0);
+  sets[1].set(1);
+  for (int v = 0; v < 4; ++v) sets[2].set(v);
+  const std::vector<WorldPoint> candidates = {{0, 0, 1}, {1, 0, 1}, {2, 0, 1}};
+  const std::vector<double> floor_z = {0.0, 0.1, 0.2};
+  const std::vector<uint64_t> visible = {1, 1, 4};
+  std::vector<PlannedStation> reported;
+  PlanCallbacks callbacks;
+  callbacks.on_station = [&](const PlannedStation& s, int index) {
+    EXPECT_EQ(index, static_cast<int>(reported.size()));
+    reported.push_back(s);
+  };
+  const LastCandidateSelector selector;
+  Result<SelectionOutput> out =
+      RunSelectionStage({selector, sets, candidates, floor_z, visible, callbacks}, PlanOptions{}, {});
+  ASSERT_TRUE(out.ok()) << out.status().ToString();
+  ASSERT_EQ(out->stations.size(), 1u);
+  EXPECT_EQ(out->stations.candidate, (std::vector<int>{2}));
+  EXPECT_EQ(out->stations.positions[0], candidates[2]);
+  EXPECT_EQ(out->stations.floor_z_m[0], 0.2);
+  EXPECT_EQ(out->stations.sets[0].count(), 4u);
+  EXPECT_EQ(out->coverable.count(), 4u);  // the union of every candidate's set
+  ASSERT_EQ(reported.size(), 1u);
+  EXPECT_EQ(reported[0].marginal_gain, 4u);
+  EXPECT_EQ(reported[0].cumulative_coverage, 1.0);
+  EXPECT_EQ(reported[0].candidate_index, 2);
+}
+
+}  // namespace
+}  // namespace vc::planner
