@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # The main job: plan the scanner stations for one real office floor (geb079, OctoMap) end to end.
-# Installs the dependencies, builds the release preset, starts vc-server on a free loopback port,
+# Installs the dependencies, builds vc-server and vc-client only (release preset: no tests, no
+# benchmarks, no vc-synth; README records the first run's time), starts vc-server on a free loopback port,
 # inspects the scene locally, submits it with vc-client (live progress), prints the stations,
 # leaves plan.json, stations.csv, visibility.ply, heatmap.png and reduction.png in vc-out/, and
 # stops the server.
@@ -12,8 +13,10 @@ scene=../shared/data/geb079/geb079.bt
 out=vc-out
 
 bash scripts/install-deps.sh
-cmake --preset release
-cmake --build --preset release
+build_start=$(date +%s)
+cmake --preset release >/dev/null
+cmake --build --preset release --target vc-server vc-client
+echo "=== built vc-server and vc-client in $(( $(date +%s) - build_start )) s"
 
 bin=build/release
 server="$bin/server/vc-server"
