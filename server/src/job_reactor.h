@@ -30,11 +30,11 @@
 #include "vc/base/status.h"
 #include "vc/server/backend.h"
 #include "vc/server/server_options.h"
-#include "vc/server/status_mapping.h"
 #include "vc/server/worker_pool.h"
 #include "vc/v1/planner.pb.h"
 #include "vc/wire/convert.h"
 #include "vc/wire/crc32c.h"
+#include "vc/wire/status_mapping.h"
 
 namespace vc::server::internal {
 
@@ -88,7 +88,7 @@ class JobReactor : public grpc::ServerBidiReactor<Request, Response> {
     }
     Status s = OnMessage();
     if (!s.ok()) {
-      Reject(ToGrpcStatus(s));
+      Reject(wire::ToGrpcStatus(s));
       return;
     }
     this->StartRead(&request_);
@@ -247,7 +247,7 @@ class JobReactor : public grpc::ServerBidiReactor<Request, Response> {
     }
     Status s = VerifyUpload();
     if (!s.ok()) {
-      Reject(ToGrpcStatus(s));
+      Reject(wire::ToGrpcStatus(s));
       return;
     }
     submitted_at_ = Clock::now();
@@ -305,7 +305,7 @@ class JobReactor : public grpc::ServerBidiReactor<Request, Response> {
     }
     data_.clear();
     data_.shrink_to_fit();
-    Complete(ToGrpcStatus(s));  // last touch of this reactor by the worker
+    Complete(wire::ToGrpcStatus(s));  // last touch of this reactor by the worker
   }
 
   Status RunJob() {

@@ -51,14 +51,14 @@ TEST(Client, PlanRebuildsAChunkedResultExactlyAndReportsEvents) {
   PlanOptions options;
   options.max_stations = 7;
   auto r = (*c)->Plan({"some scene bytes", "x.ply"}, options, obs);
-  ASSERT_TRUE(r.ok()) << r.status.error_message();
+  ASSERT_TRUE(r.ok()) << r.status().ToString();
   const PlanResult& want = backend.plan_result;
-  EXPECT_EQ(r.value.voxel_centers, want.voxel_centers);
-  EXPECT_EQ(r.value.evaluation.best_face_values, want.evaluation.best_face_values);
-  EXPECT_EQ(r.value.heat_map.positions, want.heat_map.positions);
-  ASSERT_EQ(r.value.stations.size(), 2u);
-  EXPECT_EQ(r.value.stations[1].marginal_gain, 5u);
-  EXPECT_EQ(r.value.options.max_stations, 7) << "the options that ran come back";
+  EXPECT_EQ(r->voxel_centers, want.voxel_centers);
+  EXPECT_EQ(r->evaluation.best_face_values, want.evaluation.best_face_values);
+  EXPECT_EQ(r->heat_map.positions, want.heat_map.positions);
+  ASSERT_EQ(r->stations.size(), 2u);
+  EXPECT_EQ(r->stations[1].marginal_gain, 5u);
+  EXPECT_EQ(r->options.max_stations, 7) << "the options that ran come back";
   EXPECT_EQ(accepted, 1);
   EXPECT_GE(heat_maps, 1);
   EXPECT_GE(progress, 1);
@@ -83,12 +83,12 @@ TEST(Client, UnavailableServerIsRetriedWithBackoffThenReported) {
   ASSERT_TRUE(c.ok());
   std::vector<std::chrono::milliseconds> waits;
   client::JobObserver obs;
-  obs.on_retry = [&](const grpc::Status& s, std::chrono::milliseconds w) {
-    EXPECT_EQ(s.error_code(), grpc::StatusCode::UNAVAILABLE);
+  obs.on_retry = [&](const Status& s, std::chrono::milliseconds w) {
+    EXPECT_EQ(s.code(), StatusCode::kUnavailable);
     waits.push_back(w);
   };
   auto r = (*c)->Plan({"x", "x.ply"}, PlanOptions{}, obs);
-  EXPECT_EQ(r.status.error_code(), grpc::StatusCode::UNAVAILABLE);
+  EXPECT_EQ(r.status().code(), StatusCode::kUnavailable);
   EXPECT_EQ(waits, (std::vector<std::chrono::milliseconds>{std::chrono::milliseconds(10),
                                                            std::chrono::milliseconds(20)}));
 }

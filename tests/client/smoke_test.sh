@@ -72,5 +72,13 @@ kill -TERM "$server_pid"
 wait "$server_pid" && rc=0 || rc=$?
 server_pid=""
 [[ $rc -eq 0 ]] || fail "vc-server exited $rc after SIGTERM"
+
+# Nothing listens now: UNAVAILABLE (14), worded for people.
+set +e
+"$client_bin" submit "$work/box.ply" --server "$addr" --retries 1 --out "$work/out3" >/dev/null 2>"$work/err3"
+rc=$?
+set -e
+[[ $rc -eq 14 ]] || fail "an unreachable server exited $rc, expected 14 ($(cat "$work/err3"))"
+grep -q "cannot reach vc-server at $addr" "$work/err3" || fail "unreachable server message: $(cat "$work/err3")"
 grep -q "job .* status=OK" "$work/server.log" || fail "no job log line"
 echo "smoke: OK"

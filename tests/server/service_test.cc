@@ -76,12 +76,12 @@ TEST(PlanRpc, ClientRebuildsTheWholePlanResult) {
   client::JobObserver obs;
   obs.on_accepted = [&](const std::string&, uint32_t) { ++accepted; };
   auto r = (*c)->Plan({testing::BoxRoomPly(), "box.ply"}, o, obs);
-  ASSERT_TRUE(r.ok()) << r.status.error_message();
+  ASSERT_TRUE(r.ok()) << r.status().ToString();
   EXPECT_EQ(accepted, 1);
-  EXPECT_GE(r.value.stations.size(), 1u);
-  EXPECT_EQ(r.value.voxel_centers.size(), r.value.occupied_voxels);
-  EXPECT_EQ(r.value.heat_map.positions.size(), r.value.heat_map.visible_voxels.size());
-  EXPECT_GT(r.value.heat_map.positions.size(), 0u);
+  EXPECT_GE(r->stations.size(), 1u);
+  EXPECT_EQ(r->voxel_centers.size(), r->occupied_voxels);
+  EXPECT_EQ(r->heat_map.positions.size(), r->heat_map.visible_voxels.size());
+  EXPECT_GT(r->heat_map.positions.size(), 0u);
 }
 
 TEST(EvaluateRpc, ViewpointInsideTheBoxSeesItsWalls) {
@@ -95,10 +95,10 @@ TEST(EvaluateRpc, ViewpointInsideTheBoxSeesItsWalls) {
   o.voxelize.resolution_m = 0.2;
   o.viewpoints = {{2.0, 1.5, 1.2}};
   auto r = (*c)->Evaluate({testing::BoxRoomPly(), "box.ply"}, o);
-  ASSERT_TRUE(r.ok()) << r.status.error_message();
-  ASSERT_EQ(r.value.per_viewpoint.size(), 1u);
-  EXPECT_GT(r.value.overall.global_visibility, 0.0);
-  EXPECT_GT(r.value.faces_total, 0u);
+  ASSERT_TRUE(r.ok()) << r.status().ToString();
+  ASSERT_EQ(r->per_viewpoint.size(), 1u);
+  EXPECT_GT(r->overall.global_visibility, 0.0);
+  EXPECT_GT(r->faces_total, 0u);
 }
 
 // --- Protocol errors ---
@@ -413,8 +413,8 @@ TEST(Health, ServingWhileUpAndHealthNeedsNoToken) {
   auto c = client::Client::Create(conn);
   ASSERT_TRUE(c.ok());
   auto h = (*c)->Health();
-  ASSERT_TRUE(h.ok()) << h.status.error_message();
-  EXPECT_EQ(h.value, "SERVING");
+  ASSERT_TRUE(h.ok()) << h.status().ToString();
+  EXPECT_EQ(*h, "SERVING");
 }
 
 }  // namespace
