@@ -68,123 +68,104 @@ struct FakeStream {
   }
 };
 
-TEST(Outbox, OneWriteAtATimeInOrder) {
-  CancelToken token;
-  FakeStream stream;
-  Outbox<Message> box(stream.StartWrite(), stream.Finish(), &token);
-  EXPECT_TRUE(box.Post(Accepted("a")));
-  EXPECT_TRUE(box.Post(Accepted("b")));
-  EXPECT_EQ(stream.written.size(), 1u) << "the second waits for the first write";
-  stream.Ack(box);
-  ASSERT_EQ(stream.written.size(), 2u);
-  EXPECT_EQ(stream.written[1].accepted().job_id(), "b");
-  stream.Ack(box);
-  EXPECT_EQ(box.queued_bytes(), 0u);
+// An outbox over a FakeStream, with the default byte limit.
+class OutboxTest : public ::testing::Test {
+ protected:
+  CancelToken token_;
+  FakeStream stream_;
+  Outbox<Message> box_{stream_.StartWrite(), stream_.Finish(), &token_};
+};
+
+TEST_F(OutboxTest, OneWriteAtATimeInOrder) {
+  EXPECT_TRUE(box_.Post(Accepted("a")));
+  EXPECT_TRUE(box_.Post(Accepted("b")));
+  EXPECT_EQ(stream_.written.size(), 1u) << "the second waits for the first write";
+  stream_.Ack(box_);
+  ASSERT_EQ(stream_.written.size(), 2u);
+  EXPECT_EQ(stream_.written[1].accepted().job_id(), "b");
+  stream_.Ack(box_);
+  EXPECT_EQ(box_.queued_bytes(), 0u);
 }
 
-TEST(Outbox, CompleteFinishesOnlyOnceTheQueueIsWritten) {
-  CancelToken token;
-  FakeStream stream;
-  Outbox<Message> box(stream.StartWrite(), stream.Finish(), &token);
-  ASSERT_TRUE(box.Post(Accepted("a")));
-  ASSERT_TRUE(box.Post(Accepted("b")));
-  box.Complete(Status::Ok());
-  EXPECT_FALSE(stream.finished) << "finished with writes pending";
-  stream.Ack(box);
-  EXPECT_FALSE(stream.finished);
-  stream.Ack(box);
-  ASSERT_TRUE(stream.finished);
-  EXPECT_TRUE(stream.finished->ok());
-  box.Complete(InternalError("late"));
-  EXPECT_EQ(stream.finishes, 1) << "only the first Complete counts";
+TEST_F(OutboxTest, CompleteFinishesOnlyOnceTheQueueIsWritten) {
+  ASSERT_TRUE(box_.Post(Accepted("a")));
+  ASSERT_TRUE(box_.Post(Accepted("b")));
+  box_.Complete(Status::Ok());
+  EXPECT_FALSE(stream_.finished) << "finished with writes pending";
+  stream_.Ack(box_);
+  EXPECT_FALSE(stream_.finished);
+  stream_.Ack(box_);
+  ASSERT_TRUE(stream_.finished);
+  EXPECT_TRUE(stream_.finished->ok());
+  box_.Complete(InternalError("late"));
+  EXPECT_EQ(stream_.finishes, 1) << "only the first Complete counts";
 }
 
-TEST(Outbox, CompleteWhenIdleFinishesAtOnce) {
-  CancelToken token;
-  FakeStream stream;
-  Outbox<Message> box(stream.StartWrite(), stream.Finish(), &token);
-  box.Complete(UnauthenticatedError("no token"));
-  ASSERT_TRUE(stream.finished);
-  EXPECT_EQ(stream.finished->code(), StatusCode::kUnauthenticated);
-  EXPECT_TRUE(stream.written.empty());
+TEST_F(OutboxTest, CompleteWhenIdleFinishesAtOnce) {
+  box_.Complete(UnauthenticatedError("no token"));
+  ASSERT_TRUE(stream_.finished);
+  EXPECT_EQ(stream_.finished->code(), StatusCode::kUnauthenticated);
+  EXPECT_TRUE(stream_.written.empty());
 }
 
-TEST(Outbox, ErrorReplacesWhatHasNotStartedWriting) {
-  CancelToken token;
-  FakeStream stream;
-  Outbox<Message> box(stream.StartWrite(), stream.Finish(), &token);
-  ASSERT_TRUE(box.Post(Accepted("a")));
-  ASSERT_TRUE(box.Post(Accepted("b")));
-  ASSERT_TRUE(box.Post(Accepted("c")));
-  box.Complete(InternalError("boom"));
-  stream.Ack(box);
-  EXPECT_EQ(stream.written.size(), 1u) << "b and c were dropped";
-  ASSERT_TRUE(stream.finished);
-  EXPECT_EQ(stream.finished->code(), StatusCode::kInternal);
-  EXPECT_EQ(box.queued_bytes(), 0u);
+TEST_F(OutboxTest, ErrorReplacesWhatHasNotStartedWriting) {
+  ASSERT_TRUE(box_.Post(Accepted("a")));
+  ASSERT_TRUE(box_.Post(Accepted("b")));
+  ASSERT_TRUE(box_.Post(Accepted("c")));
+  box_.Complete(InternalError("boom"));
+  stream_.Ack(box_);
+  EXPECT_EQ(stream_.written.size(), 1u) << "b and c were dropped";
+  ASSERT_TRUE(stream_.finished);
+  EXPECT_EQ(stream_.finished->code(), StatusCode::kInternal);
+  EXPECT_EQ(box_.queued_bytes(), 0u);
 }
 
-TEST(Outbox, WaitingProgressIsReplacedByTheNewer) {
-  CancelToken token;
-  FakeStream stream;
-  Outbox<Message> box(stream.StartWrite(), stream.Finish(), &token);
-  ASSERT_TRUE(box.Post(Accepted("a")));
-  box.PostProgress(Progress(0.1));
-  box.PostProgress(Progress(0.2));
-  box.PostProgress(Progress(0.3));
-  stream.Ack(box);
-  stream.Ack(box);
-  ASSERT_EQ(stream.written.size(), 2u);
-  EXPECT_DOUBLE_EQ(stream.written[1].progress().fraction(), 0.3);
+TEST_F(OutboxTest, WaitingProgressIsReplacedByTheNewer) {
+  ASSERT_TRUE(box_.Post(Accepted("a")));
+  box_.PostProgress(Progress(0.1));
+  box_.PostProgress(Progress(0.2));
+  box_.PostProgress(Progress(0.3));
+  stream_.Ack(box_);
+  stream_.Ack(box_);
+  ASSERT_EQ(stream_.written.size(), 2u);
+  EXPECT_DOUBLE_EQ(stream_.written[1].progress().fraction(), 0.3);
 }
 
-TEST(Outbox, ProgressBeingWrittenIsNotReplaced) {
-  CancelToken token;
-  FakeStream stream;
-  Outbox<Message> box(stream.StartWrite(), stream.Finish(), &token);
-  box.PostProgress(Progress(0.1));
-  box.PostProgress(Progress(0.2));
-  stream.Ack(box);
-  stream.Ack(box);
-  ASSERT_EQ(stream.written.size(), 2u);
-  EXPECT_DOUBLE_EQ(stream.written[0].progress().fraction(), 0.1);
-  EXPECT_DOUBLE_EQ(stream.written[1].progress().fraction(), 0.2);
+TEST_F(OutboxTest, ProgressBeingWrittenIsNotReplaced) {
+  box_.PostProgress(Progress(0.1));
+  box_.PostProgress(Progress(0.2));
+  stream_.Ack(box_);
+  stream_.Ack(box_);
+  ASSERT_EQ(stream_.written.size(), 2u);
+  EXPECT_DOUBLE_EQ(stream_.written[0].progress().fraction(), 0.1);
+  EXPECT_DOUBLE_EQ(stream_.written[1].progress().fraction(), 0.2);
 }
 
-TEST(Outbox, ProgressDoesNotReplaceOtherMessages) {
-  CancelToken token;
-  FakeStream stream;
-  Outbox<Message> box(stream.StartWrite(), stream.Finish(), &token);
-  ASSERT_TRUE(box.Post(Accepted("a")));
-  ASSERT_TRUE(box.Post(Accepted("b")));
-  box.PostProgress(Progress(0.5));
-  stream.Ack(box);
-  stream.Ack(box);
-  stream.Ack(box);
-  ASSERT_EQ(stream.written.size(), 3u);
-  EXPECT_EQ(stream.written[1].accepted().job_id(), "b");
+TEST_F(OutboxTest, ProgressDoesNotReplaceOtherMessages) {
+  ASSERT_TRUE(box_.Post(Accepted("a")));
+  ASSERT_TRUE(box_.Post(Accepted("b")));
+  box_.PostProgress(Progress(0.5));
+  stream_.Ack(box_);
+  stream_.Ack(box_);
+  stream_.Ack(box_);
+  ASSERT_EQ(stream_.written.size(), 3u);
+  EXPECT_EQ(stream_.written[1].accepted().job_id(), "b");
 }
 
-TEST(Outbox, FailedWriteDropsTheQueueAndStopsProducers) {
-  CancelToken token;
-  FakeStream stream;
-  Outbox<Message> box(stream.StartWrite(), stream.Finish(), &token);
-  ASSERT_TRUE(box.Post(Accepted("a")));
-  ASSERT_TRUE(box.Post(Accepted("b")));
-  stream.Ack(box, /*ok=*/false);
-  EXPECT_EQ(stream.written.size(), 1u);
-  EXPECT_FALSE(box.Post(Accepted("c")));
-  box.Complete(CancelledError("gone"));
-  ASSERT_TRUE(stream.finished) << "nothing in flight: finish at once";
+TEST_F(OutboxTest, FailedWriteDropsTheQueueAndStopsProducers) {
+  ASSERT_TRUE(box_.Post(Accepted("a")));
+  ASSERT_TRUE(box_.Post(Accepted("b")));
+  stream_.Ack(box_, /*ok=*/false);
+  EXPECT_EQ(stream_.written.size(), 1u);
+  EXPECT_FALSE(box_.Post(Accepted("c")));
+  box_.Complete(CancelledError("gone"));
+  ASSERT_TRUE(stream_.finished) << "nothing in flight: finish at once";
 }
 
-TEST(Outbox, CancelledTokenStopsProducers) {
-  CancelToken token;
-  FakeStream stream;
-  Outbox<Message> box(stream.StartWrite(), stream.Finish(), &token);
-  token.Cancel();
-  EXPECT_FALSE(box.Post(Accepted("a")));
-  EXPECT_TRUE(stream.written.empty());
+TEST_F(OutboxTest, CancelledTokenStopsProducers) {
+  token_.Cancel();
+  EXPECT_FALSE(box_.Post(Accepted("a")));
+  EXPECT_TRUE(stream_.written.empty());
 }
 
 // gRPC's side in a thread: completes each write shortly after it starts.

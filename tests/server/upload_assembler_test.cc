@@ -24,51 +24,51 @@ v1::UploadSpec SpecFor(const std::string& bytes) {
 
 constexpr uint64_t kLimit = 1 << 20;
 
-TEST(UploadAssembler, ChunksAddUpToTheVerifiedUploadAndItsTicket) {
-  WorkerPool pool(1, 0);
-  UploadAssembler a(kLimit, &pool);
+// An assembler with a one-worker pool and no queue; Begin sends the spec for `bytes`.
+class UploadAssemblerTest : public ::testing::Test {
+ protected:
+  Status Begin(const std::string& bytes) {
+    VC_RETURN_IF_ERROR(assembler_.StartSpec());
+    return assembler_.AcceptSpec(SpecFor(bytes));
+  }
+  WorkerPool pool_{1, 0};
+  UploadAssembler assembler_{kLimit, &pool_};
+};
+
+TEST_F(UploadAssemblerTest, ChunksAddUpToTheVerifiedUploadAndItsTicket) {
   const std::string bytes = "some scene bytes";
-  ASSERT_TRUE(a.StartSpec().ok());
-  ASSERT_TRUE(a.AcceptSpec(SpecFor(bytes)).ok());
-  EXPECT_EQ(pool.admitted(), 1);
-  for (size_t off = 0; off < bytes.size(); off += 3) ASSERT_TRUE(a.AddChunk(bytes.substr(off, 3)).ok());
-  EXPECT_TRUE(a.Finish().ok());
-  EXPECT_EQ(a.TakeData(), bytes);
-  EXPECT_TRUE(a.TakeTicket().has_value());
+  ASSERT_TRUE(Begin(bytes).ok());
+  EXPECT_EQ(pool_.admitted(), 1);
+  for (size_t off = 0; off < bytes.size(); off += 3) ASSERT_TRUE(assembler_.AddChunk(bytes.substr(off, 3)).ok());
+  EXPECT_TRUE(assembler_.Finish().ok());
+  EXPECT_EQ(assembler_.TakeData(), bytes);
+  EXPECT_TRUE(assembler_.TakeTicket().has_value());
 }
 
-TEST(UploadAssembler, SecondSpecIsInvalidArgument) {
-  WorkerPool pool(1, 0);
-  UploadAssembler a(kLimit, &pool);
-  ASSERT_TRUE(a.StartSpec().ok());
-  const Status s = a.StartSpec();
+TEST_F(UploadAssemblerTest, SecondSpecIsInvalidArgument) {
+  ASSERT_TRUE(assembler_.StartSpec().ok());
+  const Status s = assembler_.StartSpec();
   EXPECT_EQ(s.code(), StatusCode::kInvalidArgument);
   EXPECT_THAT(s.message(), HasSubstr("second spec"));
 }
 
-TEST(UploadAssembler, ChunkBeforeTheSpecIsInvalidArgument) {
-  WorkerPool pool(1, 0);
-  UploadAssembler a(kLimit, &pool);
-  const Status s = a.AddChunk("abc");
+TEST_F(UploadAssemblerTest, ChunkBeforeTheSpecIsInvalidArgument) {
+  const Status s = assembler_.AddChunk("abc");
   EXPECT_EQ(s.code(), StatusCode::kInvalidArgument);
   EXPECT_THAT(s.message(), HasSubstr("before the spec"));
 }
 
-TEST(UploadAssembler, EmptyUploadIsInvalidArgument) {
-  WorkerPool pool(1, 0);
-  UploadAssembler a(kLimit, &pool);
-  ASSERT_TRUE(a.StartSpec().ok());
-  EXPECT_EQ(a.AcceptSpec(SpecFor("")).code(), StatusCode::kInvalidArgument);
-  EXPECT_EQ(pool.admitted(), 0) << "refused before admission";
+TEST_F(UploadAssemblerTest, EmptyUploadIsInvalidArgument) {
+  ASSERT_TRUE(assembler_.StartSpec().ok());
+  EXPECT_EQ(assembler_.AcceptSpec(SpecFor("")).code(), StatusCode::kInvalidArgument);
+  EXPECT_EQ(pool_.admitted(), 0) << "refused before admission";
 }
 
-TEST(UploadAssembler, UnknownFormatIsInvalidArgument) {
-  WorkerPool pool(1, 0);
-  UploadAssembler a(kLimit, &pool);
+TEST_F(UploadAssemblerTest, UnknownFormatIsInvalidArgument) {
   v1::UploadSpec spec = SpecFor("abc");
   spec.set_format(v1::InputFormat(99));
-  ASSERT_TRUE(a.StartSpec().ok());
-  EXPECT_EQ(a.AcceptSpec(spec).code(), StatusCode::kInvalidArgument);
+  ASSERT_TRUE(assembler_.StartSpec().ok());
+  EXPECT_EQ(assembler_.AcceptSpec(spec).code(), StatusCode::kInvalidArgument);
 }
 
 TEST(UploadAssembler, UploadOverTheLimitIsResourceExhaustedNamingTheFlag) {
@@ -106,43 +106,32 @@ TEST(UploadAssembler, TicketIsReleasedWhenTheCallEndsBeforeSubmission) {
   EXPECT_EQ(pool.admitted(), 0);
 }
 
-TEST(UploadAssembler, BytesBeyondTheDeclaredSizeAreInvalidArgument) {
-  WorkerPool pool(1, 0);
-  UploadAssembler a(kLimit, &pool);
-  ASSERT_TRUE(a.StartSpec().ok());
-  ASSERT_TRUE(a.AcceptSpec(SpecFor("123456789")).ok());
-  ASSERT_TRUE(a.AddChunk("12345").ok());
-  const Status s = a.AddChunk("67890");
+TEST_F(UploadAssemblerTest, BytesBeyondTheDeclaredSizeAreInvalidArgument) {
+  ASSERT_TRUE(Begin("123456789").ok());
+  ASSERT_TRUE(assembler_.AddChunk("12345").ok());
+  const Status s = assembler_.AddChunk("67890");
   EXPECT_EQ(s.code(), StatusCode::kInvalidArgument);
   EXPECT_THAT(s.message(), HasSubstr("more than the 9 bytes"));
 }
 
-TEST(UploadAssembler, ShortUploadIsInvalidArgumentWithTheCounts) {
-  WorkerPool pool(1, 0);
-  UploadAssembler a(kLimit, &pool);
-  ASSERT_TRUE(a.StartSpec().ok());
-  ASSERT_TRUE(a.AcceptSpec(SpecFor("12345678901")).ok());
-  ASSERT_TRUE(a.AddChunk("1234567890").ok());
-  const Status s = a.Finish();
+TEST_F(UploadAssemblerTest, ShortUploadIsInvalidArgumentWithTheCounts) {
+  ASSERT_TRUE(Begin("12345678901").ok());
+  ASSERT_TRUE(assembler_.AddChunk("1234567890").ok());
+  const Status s = assembler_.Finish();
   EXPECT_EQ(s.code(), StatusCode::kInvalidArgument);
   EXPECT_THAT(s.message(), HasSubstr("10 of the 11 bytes"));
 }
 
-TEST(UploadAssembler, CorruptedBytesAreDataLoss) {
-  WorkerPool pool(1, 0);
-  UploadAssembler a(kLimit, &pool);
-  ASSERT_TRUE(a.StartSpec().ok());
-  ASSERT_TRUE(a.AcceptSpec(SpecFor("abcdef")).ok());
-  ASSERT_TRUE(a.AddChunk("abcdeF").ok());
-  const Status s = a.Finish();
+TEST_F(UploadAssemblerTest, CorruptedBytesAreDataLoss) {
+  ASSERT_TRUE(Begin("abcdef").ok());
+  ASSERT_TRUE(assembler_.AddChunk("abcdeF").ok());
+  const Status s = assembler_.Finish();
   EXPECT_EQ(s.code(), StatusCode::kDataLoss);
   EXPECT_THAT(s.message(), HasSubstr("CRC32C"));
 }
 
-TEST(UploadAssembler, StreamWithoutSpecIsInvalidArgument) {
-  WorkerPool pool(1, 0);
-  UploadAssembler a(kLimit, &pool);
-  const Status s = a.Finish();
+TEST_F(UploadAssemblerTest, StreamWithoutSpecIsInvalidArgument) {
+  const Status s = assembler_.Finish();
   EXPECT_EQ(s.code(), StatusCode::kInvalidArgument);
   EXPECT_THAT(s.message(), HasSubstr("before any spec"));
 }
