@@ -131,6 +131,13 @@ Result<PlanResult> Client::Plan(const Upload& upload, const PlanOptions& options
         case v1::PlanResponse::kStation:
           if (observer.on_station) observer.on_station(wire::FromProto(r.station().station()), r.station().index());
           break;
+        case v1::PlanResponse::kFinalStations:
+          if (observer.on_final_stations) {
+            std::vector<PlannedStation> stations;
+            for (const auto& s : r.final_stations().stations()) stations.push_back(wire::FromProto(s));
+            observer.on_final_stations(stations);
+          }
+          break;
         case v1::PlanResponse::kHeatMap:
           if (broken.ok()) broken = assembler.AddHeatMap(r.heat_map());
           if (broken.ok() && observer.on_heat_map &&

@@ -53,10 +53,9 @@ vc::client::JobObserver Observe(vc::client::ProgressDisplay& display) {
   o.on_accepted = [&](const std::string& id, uint32_t pos) { display.Accepted(id, pos); };
   o.on_progress = [&](const vc::ProgressEvent& e) { display.Update(e); };
   o.on_station = [&](const vc::PlannedStation& s, int i) { display.Station(s, i); };
-  // The server sends the heat map when it is ready and again with the final result; note it once.
-  o.on_heat_map = [&display, shown = false](const vc::HeatMap& h) mutable {
-    if (!shown) display.Note("heat map ready: " + std::to_string(h.positions.size()) + " candidate positions");
-    shown = true;
+  o.on_final_stations = [&](const std::vector<vc::PlannedStation>& s) { display.FinalStations(s); };
+  o.on_heat_map = [&](const vc::HeatMap& h) {
+    display.Note("heat map ready: " + std::to_string(h.positions.size()) + " candidate positions");
   };
   o.on_retry = [&](const vc::Status& s, std::chrono::milliseconds wait) {
     display.Note("server unavailable (" + s.message() + "); retrying in " + std::to_string(wait.count()) + " ms");

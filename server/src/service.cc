@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <random>
+#include <vector>
 
 #include "job_reactor.h"
 
@@ -67,14 +68,21 @@ class PlanReactor final : public JobReactor<v1::PlanRequest, v1::PlanResponse> {
     callbacks.on_station = [this](const PlannedStation& s, int index) {
       v1::PlanResponse r;
       r.mutable_station()->set_index(index);
+      r.mutable_station()->set_provisional(true);
       *r.mutable_station()->mutable_station() = wire::ToProto(s);
+      outbox().Post(std::move(r));
+    };
+    callbacks.on_final_stations = [this](const std::vector<PlannedStation>& stations) {
+      v1::PlanResponse r;
+      for (const PlannedStation& s : stations) *r.mutable_final_stations()->add_stations() = wire::ToProto(s);
       outbox().Post(std::move(r));
     };
     VC_ASSIGN_OR_RETURN(const PlanResult result, backend().plan(input, options_, ctx, callbacks));
     for (const auto& t : result.timings) log.NoteTiming(StageName(t.stage), t.seconds);
     log.set_details(fmt::format(" stations={}", result.stations.size()));
-    // The final heat map, then the voxels, then the summary: together the whole PlanResult.
-    PostHeatMap(result.heat_map);
+    // The heat map went out once, when ready (unless the plan never reported it); then the voxels
+    // and the summary: together the whole PlanResult.
+    if (!heat_map_sent_) PostHeatMap(result.heat_map);
     wire::ForEachVoxelChunk(result, [this](v1::VoxelChunk&& c) {
       v1::PlanResponse r;
       *r.mutable_voxels() = std::move(c);
@@ -87,6 +95,7 @@ class PlanReactor final : public JobReactor<v1::PlanRequest, v1::PlanResponse> {
   }
 
   void PostHeatMap(const HeatMap& h) {
+    heat_map_sent_ = true;
     for (auto& c : wire::HeatMapChunks(h)) {
       v1::PlanResponse r;
       *r.mutable_heat_map() = std::move(c);
@@ -95,6 +104,7 @@ class PlanReactor final : public JobReactor<v1::PlanRequest, v1::PlanResponse> {
   }
 
   PlanOptions options_;
+  bool heat_map_sent_ = false;  // on the worker thread
 };
 
 class EvaluateReactor final : public JobReactor<v1::EvaluateRequest, v1::EvaluateResponse> {

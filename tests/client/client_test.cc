@@ -43,11 +43,17 @@ TEST(Client, PlanRebuildsAChunkedResultExactlyAndReportsEvents) {
   ASSERT_TRUE(c.ok());
   int accepted = 0, heat_maps = 0, progress = 0;
   std::vector<int> station_indices;
+  size_t final_stations = 0;
+  int final_lists = 0;
   client::JobObserver obs;
   obs.on_accepted = [&](const std::string& id, uint32_t) { accepted += !id.empty(); };
   obs.on_heat_map = [&](const HeatMap& h) { heat_maps += h.positions.size() == 2; };
   obs.on_progress = [&](const ProgressEvent&) { ++progress; };
   obs.on_station = [&](const PlannedStation&, int i) { station_indices.push_back(i); };
+  obs.on_final_stations = [&](const std::vector<PlannedStation>& s) {
+    final_stations = s.size();
+    ++final_lists;
+  };
   PlanOptions options;
   options.max_stations = 7;
   auto r = (*c)->Plan({"some scene bytes", "x.ply"}, options, obs);
@@ -63,6 +69,8 @@ TEST(Client, PlanRebuildsAChunkedResultExactlyAndReportsEvents) {
   EXPECT_GE(heat_maps, 1);
   EXPECT_GE(progress, 1);
   EXPECT_EQ(station_indices, (std::vector<int>{0, 1}));
+  EXPECT_EQ(final_lists, 1);
+  EXPECT_EQ(final_stations, 2u);
 }
 
 TEST(Client, UnavailableServerIsRetriedWithBackoffThenReported) {

@@ -34,6 +34,9 @@ addr="127.0.0.1:$port"
   || { cat "$work/client.err" >&2; fail "vc-client submit failed"; }
 grep -q "progress:" "$work/client.err" || fail "no progress lines on a non-terminal"
 grep -q "station(s)" "$work/client.out" || fail "no station list printed"
+grep -q "heat map ready" "$work/client.err" || fail "no heat map line"
+[[ $(grep -c "heat map ready" "$work/client.err") -eq 1 ]] || fail "the heat map was noted more than once"
+grep -q "final stations:" "$work/client.err" || fail "no final stations line"
 
 for f in plan.json stations.csv visibility.ply heatmap.png reduction.png; do
   [[ -s "$work/out/$f" ]] || fail "missing or empty $f"

@@ -63,6 +63,41 @@ TEST(PlanRpc, BoxRoomStreamsAcceptedProgressChunksAndResultInOrder) {
   EXPECT_DOUBLE_EQ(result.resolution_m(), 0.2);
 }
 
+TEST(PlanRpc, HeatMapOnceProvisionalPicksThenFinalStationsOnce) {
+  auto server = testing::StartServer(SmallServer());
+  ASSERT_TRUE(server);
+  const auto call = RawPlan(testing::Address(*server), PlanRequests(testing::BoxRoomPly(), FastParams()));
+  ASSERT_TRUE(call.status.ok()) << call.status.error_message();
+  ASSERT_TRUE(call.responses.back().has_result());
+  const auto& result = call.responses.back().result();
+  int heat_map_starts = 0, final_lists = 0;
+  uint64_t heat_map_candidates = 0;
+  bool final_seen = false;
+  for (const auto& r : call.responses) {
+    if (r.has_heat_map()) {
+      heat_map_starts += r.heat_map().first_index() == 0;
+      heat_map_candidates += r.heat_map().positions_size();
+    }
+    if (r.has_station()) {
+      EXPECT_TRUE(r.station().provisional()) << "a selection pick is provisional";
+      EXPECT_FALSE(final_seen) << "a provisional pick after the final list";
+    }
+    if (r.has_final_stations()) {
+      ++final_lists;
+      final_seen = true;
+      ASSERT_EQ(r.final_stations().stations_size(), result.stations_size());
+      for (int i = 0; i < result.stations_size(); ++i) {  // global_visibility comes with the evaluation
+        v1::PlannedStation want = result.stations(i);
+        want.clear_global_visibility();
+        EXPECT_EQ(r.final_stations().stations(i).SerializeAsString(), want.SerializeAsString());
+      }
+    }
+  }
+  EXPECT_EQ(heat_map_starts, 1) << "the heat map is sent exactly once";
+  EXPECT_EQ(heat_map_candidates, result.heat_map_candidates());
+  EXPECT_EQ(final_lists, 1);
+}
+
 TEST(PlanRpc, ClientRebuildsTheWholePlanResult) {
   auto server = testing::StartServer(SmallServer());
   ASSERT_TRUE(server);

@@ -15,6 +15,7 @@
 #include <memory>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "vc/plan/planner.h"
 #include "vc/base/progress.h"
@@ -52,8 +53,13 @@ struct ConnectionOptions {
 struct JobObserver {
   std::function<void(const std::string& job_id, uint32_t queue_position)> on_accepted;
   std::function<void(const ProgressEvent&)> on_progress;
+  // The heat map, once, when the candidates' visibility is known.
   std::function<void(const HeatMap&)> on_heat_map;
+  // Provisional: a station as the greedy selection picks it (refinement and reduction may still
+  // move or drop it); `index` in greedy order.
   std::function<void(const PlannedStation&, int index)> on_station;
+  // Final: the stations that stand, once, after refinement and reduction (as in the PlanResult).
+  std::function<void(const std::vector<PlannedStation>&)> on_final_stations;
   // Called before each retry, with the failed attempt's status (UNAVAILABLE) and the wait.
   std::function<void(const Status&, std::chrono::milliseconds)> on_retry;
 };
