@@ -16,7 +16,7 @@ double SecondsSince(Job::Clock::time_point t) { return std::chrono::duration<dou
 }  // namespace
 
 void JobLog::NoteTiming(std::string_view stage, double seconds) {
-  timings_ += " " + std::string(stage) + "=" + fmt::format("{:.3f}s", seconds);
+  timings_ += fmt::format(" {}={:.3f}s", stage, seconds);
 }
 
 Status JobRunner::Run(Job job, const CancelToken& cancel, ProgressFn progress, const JobFn& fn) const {
