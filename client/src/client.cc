@@ -1,5 +1,7 @@
 #include "vc/client/client.h"
 
+#include <grpcpp/grpcpp.h>
+
 #include <fstream>
 #include <sstream>
 #include <thread>

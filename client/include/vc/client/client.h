@@ -8,8 +8,6 @@
 // backoff; every other status is returned as it came. Not thread-safe; use one per thread.
 #pragma once
 
-#include <grpcpp/grpcpp.h>
-
 #include <chrono>
 #include <functional>
 #include <memory>
@@ -22,6 +20,11 @@
 #include "vc/base/status.h"
 #include "vc/visibility/visibility.h"
 #include "vc/wire/convert.h"
+
+namespace grpc {
+class Channel;
+class ClientContext;
+}  // namespace grpc
 
 namespace vc::client {
 
