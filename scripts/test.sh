@@ -3,7 +3,8 @@
 #   release  - build everything, run every test (including the `slow` ones) and vc-bench --quick
 #   asan     - AddressSanitizer + UndefinedBehaviorSanitizer: every test except the `slow` label
 #   tsan     - ThreadSanitizer on the tests whose concurrency is all ours (label `tsan`): the worker
-#              pool, status mapping, wire code and the multi-threaded visibility engine. The gRPC
+#              pool, upload assembler, outbox, job runner, status mapping, wire code and the
+#              multi-threaded visibility engine. The gRPC
 #              service tests are not run here: Debian's gRPC, absl and protobuf are not instrumented,
 #              so tsan cannot see the ordering gRPC provides between its threads (README, Testing).
 # Usage: scripts/test.sh [--quick]   (--quick: the release preset only)
@@ -21,7 +22,8 @@ for p in "${presets[@]}"; do
   case "$p" in
     tsan)
       # Only the service and its tests: the core is covered by the other presets.
-      cmake --build --preset "$p" --target status_mapping_test worker_pool_test wire_test visibility_test
+      cmake --build --preset "$p" --target status_mapping_test worker_pool_test upload_assembler_test outbox_test job_runner_test wire_test \
+        visibility_test
       echo "=== preset $p: tests labelled tsan"
       ctest --preset "$p" -L tsan
       ;;

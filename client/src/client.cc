@@ -1,5 +1,7 @@
 #include "vc/client/client.h"
 
+#include <grpcpp/grpcpp.h>
+
 #include <fstream>
 #include <sstream>
 #include <thread>
@@ -7,6 +9,7 @@
 #include "grpc/health/v1/health.grpc.pb.h"
 #include "vc/v1/planner.grpc.pb.h"
 #include "vc/wire/crc32c.h"
+#include "vc/wire/status_mapping.h"
 
 namespace vc::client {
 namespace {
@@ -43,9 +46,9 @@ void SendUpload(Stream& stream, Request spec_request, const Upload& upload, size
   stream.WritesDone();
 }
 
-grpc::Status Local(const Status& s) {
-  return grpc::Status(s.code() == StatusCode::kDataLoss ? grpc::StatusCode::DATA_LOSS : grpc::StatusCode::INTERNAL,
-                      s.message());
+// A stream that does not add up: DATA_LOSS stays, anything else is INTERNAL.
+Status Local(const Status& s) {
+  return Status(s.code() == StatusCode::kDataLoss ? StatusCode::kDataLoss : StatusCode::kInternal, s.message());
 }
 
 }  // namespace
@@ -91,25 +94,25 @@ void Client::Prepare(grpc::ClientContext* ctx) const {
 }
 
 template <typename Fn>
-grpc::Status Client::WithRetries(const JobObserver& observer, Fn&& attempt) {
+Status Client::WithRetries(const JobObserver& observer, Fn&& attempt) {
   auto backoff = options_.initial_backoff;
   for (int i = 1;; ++i) {
     bool accepted = false;
-    grpc::Status s = attempt(&accepted);
-    if (s.error_code() != grpc::StatusCode::UNAVAILABLE || accepted || i >= options_.max_attempts) return s;
+    Status s = attempt(&accepted);
+    if (s.code() != StatusCode::kUnavailable || accepted || i >= options_.max_attempts) return s;
     if (observer.on_retry) observer.on_retry(s, backoff);
     std::this_thread::sleep_for(backoff);
     backoff *= 2;
   }
 }
 
-CallResult<PlanResult> Client::Plan(const Upload& upload, const PlanOptions& options, const JobObserver& observer) {
+Result<PlanResult> Client::Plan(const Upload& upload, const PlanOptions& options, const JobObserver& observer) {
   auto stub = v1::StationPlanner::NewStub(channel_);
   v1::PlanRequest spec;
   *spec.mutable_spec()->mutable_upload() = MakeUploadSpec(upload);
   *spec.mutable_spec()->mutable_parameters() = wire::ToProto(options);
-  CallResult<PlanResult> out;
-  out.status = WithRetries(observer, [&](bool* accepted) {
+  PlanResult out;
+  const Status status = WithRetries(observer, [&](bool* accepted) -> Status {
     grpc::ClientContext ctx;
     Prepare(&ctx);
     auto stream = stub->Plan(&ctx);
@@ -130,6 +133,13 @@ CallResult<PlanResult> Client::Plan(const Upload& upload, const PlanOptions& opt
         case v1::PlanResponse::kStation:
           if (observer.on_station) observer.on_station(wire::FromProto(r.station().station()), r.station().index());
           break;
+        case v1::PlanResponse::kFinalStations:
+          if (observer.on_final_stations) {
+            std::vector<PlannedStation> stations;
+            for (const auto& s : r.final_stations().stations()) stations.push_back(wire::FromProto(s));
+            observer.on_final_stations(stations);
+          }
+          break;
         case v1::PlanResponse::kHeatMap:
           if (broken.ok()) broken = assembler.AddHeatMap(r.heat_map());
           if (broken.ok() && observer.on_heat_map &&
@@ -147,26 +157,26 @@ CallResult<PlanResult> Client::Plan(const Upload& upload, const PlanOptions& opt
           break;
       }
     }
-    grpc::Status s = stream->Finish();
-    if (!s.ok()) return s;
+    VC_RETURN_IF_ERROR(wire::FromGrpcStatus(stream->Finish()));
     if (!broken.ok()) return Local(broken);
-    if (!summary) return grpc::Status(grpc::StatusCode::INTERNAL, "the server ended the plan without a result");
+    if (!summary) return InternalError("the server ended the plan without a result");
     auto result = std::move(assembler).Finish(*summary);
     if (!result.ok()) return Local(result.status());
-    out.value = std::move(result).value();
-    return grpc::Status::OK;
+    out = std::move(result).value();
+    return Status::Ok();
   });
+  if (!status.ok()) return status;
   return out;
 }
 
-CallResult<Evaluation> Client::Evaluate(const Upload& upload, const EvaluateJobOptions& options,
+Result<Evaluation> Client::Evaluate(const Upload& upload, const EvaluateJobOptions& options,
                                         const JobObserver& observer) {
   auto stub = v1::StationPlanner::NewStub(channel_);
   v1::EvaluateRequest spec;
   *spec.mutable_spec()->mutable_upload() = MakeUploadSpec(upload);
   *spec.mutable_spec()->mutable_parameters() = wire::ToProto(options);
-  CallResult<Evaluation> out;
-  out.status = WithRetries(observer, [&](bool* accepted) {
+  Evaluation out;
+  const Status status = WithRetries(observer, [&](bool* accepted) -> Status {
     grpc::ClientContext ctx;
     Prepare(&ctx);
     auto stream = stub->Evaluate(&ctx);
@@ -189,34 +199,34 @@ CallResult<Evaluation> Client::Evaluate(const Upload& upload, const EvaluateJobO
           break;
       }
     }
-    grpc::Status s = stream->Finish();
-    if (!s.ok()) return s;
-    if (!result) return grpc::Status(grpc::StatusCode::INTERNAL, "the server ended the evaluation without a result");
-    out.value = wire::FromProto(result->evaluation());
-    return grpc::Status::OK;
+    VC_RETURN_IF_ERROR(wire::FromGrpcStatus(stream->Finish()));
+    if (!result) return InternalError("the server ended the evaluation without a result");
+    out = wire::FromProto(result->evaluation());
+    return Status::Ok();
   });
+  if (!status.ok()) return status;
   return out;
 }
 
-CallResult<std::string> Client::Health(const std::string& service) {
+Result<std::string> Client::Health(const std::string& service) {
   auto stub = grpc::health::v1::Health::NewStub(channel_);
   grpc::health::v1::HealthCheckRequest req;
   req.set_service(service);
-  CallResult<std::string> out;
-  out.status = WithRetries({}, [&](bool*) {
+  std::string out;
+  const Status status = WithRetries({}, [&](bool*) -> Status {
     grpc::ClientContext ctx;
     if (!options_.token.empty()) ctx.AddMetadata("authorization", "Bearer " + options_.token);
     ctx.set_deadline(std::chrono::system_clock::now() +
                      (options_.timeout.count() > 0 ? options_.timeout : std::chrono::milliseconds(5000)));
     grpc::health::v1::HealthCheckResponse resp;
-    grpc::Status s = stub->Check(&ctx, req, &resp);
-    if (!s.ok()) return s;
-    out.value = grpc::health::v1::HealthCheckResponse::ServingStatus_Name(resp.status());
+    VC_RETURN_IF_ERROR(wire::FromGrpcStatus(stub->Check(&ctx, req, &resp)));
+    out = grpc::health::v1::HealthCheckResponse::ServingStatus_Name(resp.status());
     if (resp.status() != grpc::health::v1::HealthCheckResponse::SERVING) {
-      return grpc::Status(grpc::StatusCode::UNAVAILABLE, "the server is " + out.value);
+      return UnavailableError("the server is " + out);
     }
-    return grpc::Status::OK;
+    return Status::Ok();
   });
+  if (!status.ok()) return status;
   return out;
 }
 

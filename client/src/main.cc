@@ -15,20 +15,23 @@
 #include "vc/report/plan_report.h"
 #include "vc/scene/scene_input.h"
 #include "vc/scene/scene_summary.h"
-#include "vc/server/status_mapping.h"
+#include "vc/wire/status_mapping.h"
 
 namespace {
 
+// A local failure; the exit status is its gRPC code number.
 int Fail(const std::string& what, const vc::Status& s) {
   std::cerr << "vc-client: " << what << ": " << s.message() << "\n";
-  return int(vc::server::ToGrpcCode(s.code()));
+  return int(vc::wire::ToGrpcCode(s.code()));
 }
 
-int Fail(const std::string& what, const grpc::Status& s, const std::string& server) {
-  std::string msg = s.error_message();
-  if (s.error_code() == grpc::StatusCode::UNAVAILABLE) msg = "cannot reach vc-server at " + server + " (" + msg + ")";
-  std::cerr << "vc-client: " << what << " failed (" << int(s.error_code()) << "): " << msg << "\n";
-  return int(s.error_code());
+// A failed call to `server`; the exit status is its gRPC code number.
+int FailCall(const std::string& what, const vc::Status& s, const std::string& server) {
+  const int code = int(vc::wire::ToGrpcCode(s.code()));
+  std::string msg = s.message();
+  if (s.code() == vc::StatusCode::kUnavailable) msg = "cannot reach vc-server at " + server + " (" + msg + ")";
+  std::cerr << "vc-client: " << what << " failed (" << code << "): " << msg << "\n";
+  return code;
 }
 
 void PrintStations(const vc::PlanResult& r) {
@@ -49,13 +52,12 @@ vc::client::JobObserver Observe(vc::client::ProgressDisplay& display) {
   o.on_accepted = [&](const std::string& id, uint32_t pos) { display.Accepted(id, pos); };
   o.on_progress = [&](const vc::ProgressEvent& e) { display.Update(e); };
   o.on_station = [&](const vc::PlannedStation& s, int i) { display.Station(s, i); };
-  // The server sends the heat map when it is ready and again with the final result; note it once.
-  o.on_heat_map = [&display, shown = false](const vc::HeatMap& h) mutable {
-    if (!shown) display.Note("heat map ready: " + std::to_string(h.positions.size()) + " candidate positions");
-    shown = true;
+  o.on_final_stations = [&](const std::vector<vc::PlannedStation>& s) { display.FinalStations(s); };
+  o.on_heat_map = [&](const vc::HeatMap& h) {
+    display.Note("heat map ready: " + std::to_string(h.positions.size()) + " candidate positions");
   };
-  o.on_retry = [&](const grpc::Status& s, std::chrono::milliseconds wait) {
-    display.Note("server unavailable (" + s.error_message() + "); retrying in " + std::to_string(wait.count()) + " ms");
+  o.on_retry = [&](const vc::Status& s, std::chrono::milliseconds wait) {
+    display.Note("server unavailable (" + s.message() + "); retrying in " + std::to_string(wait.count()) + " ms");
   };
   return o;
 }
@@ -131,8 +133,8 @@ int main(int argc, char** argv) {
 
   if (*health) {
     auto r = (*client)->Health(health_service);
-    if (!r.ok()) return Fail("health check", r.status, conn.server);
-    std::cout << r.value << "\n";
+    if (!r.ok()) return FailCall("health check", r.status(), conn.server);
+    std::cout << *r << "\n";
     return 0;
   }
 
@@ -151,10 +153,10 @@ int main(int argc, char** argv) {
     }
     auto r = (*client)->Plan(*upload, plan, Observe(display));
     display.Done();
-    if (!r.ok()) return Fail("plan", r.status, conn.server);
-    vc::Status written = vc::WritePlanOutputs(r.value, out_dir);
+    if (!r.ok()) return FailCall("plan", r.status(), conn.server);
+    vc::Status written = vc::WritePlanOutputs(*r, out_dir);
     if (!written.ok()) return Fail("cannot write the reports", written);
-    PrintStations(r.value);
+    PrintStations(*r);
     std::printf("wrote plan.json, stations.csv, visibility.ply, heatmap.png, reduction.png to %s\n", out_dir.c_str());
     return 0;
   }
@@ -167,12 +169,12 @@ int main(int argc, char** argv) {
   eval.viewpoints = std::move(points).value();
   auto r = (*client)->Evaluate(*upload, eval, Observe(display));
   display.Done();
-  if (!r.ok()) return Fail("evaluate", r.status, conn.server);
-  vc::Status written = vc::WriteEvaluationOutputs(r.value, eval.viewpoints, out_dir);
+  if (!r.ok()) return FailCall("evaluate", r.status(), conn.server);
+  vc::Status written = vc::WriteEvaluationOutputs(*r, eval.viewpoints, out_dir);
   if (!written.ok()) return Fail("cannot write evaluation.json", written);
   std::printf("global visibility G = %.4f%s over %llu faces; wrote %s/evaluation.json\n",
-              r.value.overall.global_visibility,
-              r.value.sampled ? (" (+/- " + std::to_string(r.value.global_visibility_ci95) + ", sampled)").c_str() : "",
-              static_cast<unsigned long long>(r.value.faces_evaluated), out_dir.c_str());
+              r->overall.global_visibility,
+              r->sampled ? (" (+/- " + std::to_string(r->global_visibility_ci95) + ", sampled)").c_str() : "",
+              static_cast<unsigned long long>(r->faces_evaluated), out_dir.c_str());
   return 0;
 }

@@ -46,9 +46,17 @@ void ProgressDisplay::Update(const ProgressEvent& e) {
 
 void ProgressDisplay::Station(const PlannedStation& s, int index) {
   char line[160];
-  std::snprintf(line, sizeof line, "picked station %d at (%.2f, %.2f, %.2f): +%llu voxels, coverage %.1f%%",
+  std::snprintf(line, sizeof line, "picked station %d (provisional) at (%.2f, %.2f, %.2f): +%llu voxels, coverage %.1f%%",
                 index + 1, s.position.x(), s.position.y(), s.position.z(),
                 static_cast<unsigned long long>(s.marginal_gain), 100.0 * s.cumulative_coverage);
+  Note(line);
+}
+
+void ProgressDisplay::FinalStations(const std::vector<PlannedStation>& stations) {
+  const double coverage = stations.empty() ? 0.0 : stations.back().cumulative_coverage;
+  char line[160];
+  std::snprintf(line, sizeof line, "final stations: %zu after refinement and reduction, coverage %.1f%%",
+                stations.size(), 100.0 * coverage);
   Note(line);
 }
 

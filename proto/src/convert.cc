@@ -354,10 +354,9 @@ v1::PlanResult ToProto(const PlanResult& r) {
 }
 
 Status PlanResultAssembler::AddHeatMap(const v1::HeatMapChunk& c) {
-  if (c.first_index() != heat_map_.positions.size()) {
-    if (c.first_index() != 0) return ChunkError("heat map chunk out of order");
-    heat_map_ = HeatMap{};  // a fresh heat map replaces an earlier one
-  }
+  if (c.first_index() == 0 && heat_map_started_) return ChunkError("a second heat map arrived (it is sent once)");
+  if (c.first_index() != heat_map_.positions.size()) return ChunkError("heat map chunk out of order");
+  heat_map_started_ = true;
   if (c.positions_size() != c.visible_voxels_size()) return ChunkError("heat map chunk sizes differ");
   heat_map_total_ = c.total_candidates();
   heat_map_.grid_spacing_m = c.grid_spacing_m();

@@ -1,7 +1,10 @@
 #include "vc/server/service.h"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <random>
+#include <vector>
 
 #include "job_reactor.h"
 
@@ -36,13 +39,6 @@ std::string NewJobId(ServiceState& state) {
   return fmt::format("j-{:012x}", (salt ^ (n * 0x9E3779B97F4A7C15ull)) & 0xFFFFFFFFFFFFull);
 }
 
-std::string HumanBytes(uint64_t bytes) {
-  if (bytes < 1024) return std::to_string(bytes) + " B";
-  if (bytes < (uint64_t{1} << 20)) return fmt::format("{:.1f} KiB", bytes / 1024.0);
-  if (bytes < (uint64_t{1} << 30)) return fmt::format("{:.1f} MiB", bytes / 1048576.0);
-  return fmt::format("{:.2f} GiB", bytes / 1073741824.0);
-}
-
 namespace {
 
 // The job's thread count: the request's, capped by the server's per-job share (0 = the share).
@@ -65,43 +61,50 @@ class PlanReactor final : public JobReactor<v1::PlanRequest, v1::PlanResponse> {
     return request.spec().upload();
   }
 
-  Status Run(const SceneInput& input, const JobContext& ctx) override {
+  Status Run(const SceneInput& input, const JobContext& ctx, JobLog& log) override {
+    log.set_details(" stations=0");
     PlanCallbacks callbacks;
     callbacks.on_heat_map = [this](const HeatMap& h) { PostHeatMap(h); };
     callbacks.on_station = [this](const PlannedStation& s, int index) {
       v1::PlanResponse r;
       r.mutable_station()->set_index(index);
+      r.mutable_station()->set_provisional(true);
       *r.mutable_station()->mutable_station() = wire::ToProto(s);
-      Post(std::move(r));
+      outbox().Post(std::move(r));
+    };
+    callbacks.on_final_stations = [this](const std::vector<PlannedStation>& stations) {
+      v1::PlanResponse r;
+      for (const PlannedStation& s : stations) *r.mutable_final_stations()->add_stations() = wire::ToProto(s);
+      outbox().Post(std::move(r));
     };
     VC_ASSIGN_OR_RETURN(const PlanResult result, backend().plan(input, options_, ctx, callbacks));
-    for (const auto& t : result.timings) NoteTiming(StageName(t.stage), t.seconds);
-    stations_ = result.stations.size();
-    // The final heat map, then the voxels, then the summary: together the whole PlanResult.
-    PostHeatMap(result.heat_map);
+    for (const auto& t : result.timings) log.NoteTiming(StageName(t.stage), t.seconds);
+    log.set_details(fmt::format(" stations={}", result.stations.size()));
+    // The heat map went out once, when ready (unless the plan never reported it); then the voxels
+    // and the summary: together the whole PlanResult.
+    if (!heat_map_sent_) PostHeatMap(result.heat_map);
     wire::ForEachVoxelChunk(result, [this](v1::VoxelChunk&& c) {
       v1::PlanResponse r;
       *r.mutable_voxels() = std::move(c);
-      return Post(std::move(r), /*bulk=*/true);
+      return outbox().Post(std::move(r), /*bulk=*/true);
     });
     v1::PlanResponse r;
     *r.mutable_result() = wire::ToProto(result);
-    Post(std::move(r), /*bulk=*/true);
+    outbox().Post(std::move(r), /*bulk=*/true);
     return ctx.CheckCancelled("the plan (while sending the result)");
   }
 
   void PostHeatMap(const HeatMap& h) {
+    heat_map_sent_ = true;
     for (auto& c : wire::HeatMapChunks(h)) {
       v1::PlanResponse r;
       *r.mutable_heat_map() = std::move(c);
-      if (!Post(std::move(r), /*bulk=*/true)) return;
+      if (!outbox().Post(std::move(r), /*bulk=*/true)) return;
     }
   }
 
-  std::string LogDetails() const override { return fmt::format(" stations={}", stations_); }
-
   PlanOptions options_;
-  size_t stations_ = 0;
+  bool heat_map_sent_ = false;  // on the worker thread
 };
 
 class EvaluateReactor final : public JobReactor<v1::EvaluateRequest, v1::EvaluateResponse> {
@@ -117,15 +120,14 @@ class EvaluateReactor final : public JobReactor<v1::EvaluateRequest, v1::Evaluat
     return request.spec().upload();
   }
 
-  Status Run(const SceneInput& input, const JobContext& ctx) override {
+  Status Run(const SceneInput& input, const JobContext& ctx, JobLog& log) override {
+    log.set_details(fmt::format(" viewpoints={}", options_.viewpoints.size()));
     VC_ASSIGN_OR_RETURN(const Evaluation evaluation, backend().evaluate(input, options_, ctx));
     v1::EvaluateResponse r;
     *r.mutable_result() = wire::ToProto(evaluation, options_.viewpoints);
-    Post(std::move(r));
+    outbox().Post(std::move(r));
     return ctx.CheckCancelled("the evaluation (while sending the result)");
   }
-
-  std::string LogDetails() const override { return fmt::format(" viewpoints={}", options_.viewpoints.size()); }
 
   EvaluateJobOptions options_;
 };

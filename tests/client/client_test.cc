@@ -43,26 +43,34 @@ TEST(Client, PlanRebuildsAChunkedResultExactlyAndReportsEvents) {
   ASSERT_TRUE(c.ok());
   int accepted = 0, heat_maps = 0, progress = 0;
   std::vector<int> station_indices;
+  size_t final_stations = 0;
+  int final_lists = 0;
   client::JobObserver obs;
   obs.on_accepted = [&](const std::string& id, uint32_t) { accepted += !id.empty(); };
   obs.on_heat_map = [&](const HeatMap& h) { heat_maps += h.positions.size() == 2; };
   obs.on_progress = [&](const ProgressEvent&) { ++progress; };
   obs.on_station = [&](const PlannedStation&, int i) { station_indices.push_back(i); };
+  obs.on_final_stations = [&](const std::vector<PlannedStation>& s) {
+    final_stations = s.size();
+    ++final_lists;
+  };
   PlanOptions options;
   options.max_stations = 7;
   auto r = (*c)->Plan({"some scene bytes", "x.ply"}, options, obs);
-  ASSERT_TRUE(r.ok()) << r.status.error_message();
+  ASSERT_TRUE(r.ok()) << r.status().ToString();
   const PlanResult& want = backend.plan_result;
-  EXPECT_EQ(r.value.voxel_centers, want.voxel_centers);
-  EXPECT_EQ(r.value.evaluation.best_face_values, want.evaluation.best_face_values);
-  EXPECT_EQ(r.value.heat_map.positions, want.heat_map.positions);
-  ASSERT_EQ(r.value.stations.size(), 2u);
-  EXPECT_EQ(r.value.stations[1].marginal_gain, 5u);
-  EXPECT_EQ(r.value.options.max_stations, 7) << "the options that ran come back";
+  EXPECT_EQ(r->voxel_centers, want.voxel_centers);
+  EXPECT_EQ(r->evaluation.best_face_values, want.evaluation.best_face_values);
+  EXPECT_EQ(r->heat_map.positions, want.heat_map.positions);
+  ASSERT_EQ(r->stations.size(), 2u);
+  EXPECT_EQ(r->stations[1].marginal_gain, 5u);
+  EXPECT_EQ(r->options.max_stations, 7) << "the options that ran come back";
   EXPECT_EQ(accepted, 1);
   EXPECT_GE(heat_maps, 1);
   EXPECT_GE(progress, 1);
   EXPECT_EQ(station_indices, (std::vector<int>{0, 1}));
+  EXPECT_EQ(final_lists, 1);
+  EXPECT_EQ(final_stations, 2u);
 }
 
 TEST(Client, UnavailableServerIsRetriedWithBackoffThenReported) {
@@ -83,12 +91,12 @@ TEST(Client, UnavailableServerIsRetriedWithBackoffThenReported) {
   ASSERT_TRUE(c.ok());
   std::vector<std::chrono::milliseconds> waits;
   client::JobObserver obs;
-  obs.on_retry = [&](const grpc::Status& s, std::chrono::milliseconds w) {
-    EXPECT_EQ(s.error_code(), grpc::StatusCode::UNAVAILABLE);
+  obs.on_retry = [&](const Status& s, std::chrono::milliseconds w) {
+    EXPECT_EQ(s.code(), StatusCode::kUnavailable);
     waits.push_back(w);
   };
   auto r = (*c)->Plan({"x", "x.ply"}, PlanOptions{}, obs);
-  EXPECT_EQ(r.status.error_code(), grpc::StatusCode::UNAVAILABLE);
+  EXPECT_EQ(r.status().code(), StatusCode::kUnavailable);
   EXPECT_EQ(waits, (std::vector<std::chrono::milliseconds>{std::chrono::milliseconds(10),
                                                            std::chrono::milliseconds(20)}));
 }

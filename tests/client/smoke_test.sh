@@ -34,6 +34,9 @@ addr="127.0.0.1:$port"
   || { cat "$work/client.err" >&2; fail "vc-client submit failed"; }
 grep -q "progress:" "$work/client.err" || fail "no progress lines on a non-terminal"
 grep -q "station(s)" "$work/client.out" || fail "no station list printed"
+grep -q "heat map ready" "$work/client.err" || fail "no heat map line"
+[[ $(grep -c "heat map ready" "$work/client.err") -eq 1 ]] || fail "the heat map was noted more than once"
+grep -q "final stations:" "$work/client.err" || fail "no final stations line"
 
 for f in plan.json stations.csv visibility.ply heatmap.png reduction.png; do
   [[ -s "$work/out/$f" ]] || fail "missing or empty $f"
@@ -72,5 +75,13 @@ kill -TERM "$server_pid"
 wait "$server_pid" && rc=0 || rc=$?
 server_pid=""
 [[ $rc -eq 0 ]] || fail "vc-server exited $rc after SIGTERM"
+
+# Nothing listens now: UNAVAILABLE (14), worded for people.
+set +e
+"$client_bin" submit "$work/box.ply" --server "$addr" --retries 1 --out "$work/out3" >/dev/null 2>"$work/err3"
+rc=$?
+set -e
+[[ $rc -eq 14 ]] || fail "an unreachable server exited $rc, expected 14 ($(cat "$work/err3"))"
+grep -q "cannot reach vc-server at $addr" "$work/err3" || fail "unreachable server message: $(cat "$work/err3")"
 grep -q "job .* status=OK" "$work/server.log" || fail "no job log line"
 echo "smoke: OK"

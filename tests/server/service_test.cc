@@ -63,6 +63,41 @@ TEST(PlanRpc, BoxRoomStreamsAcceptedProgressChunksAndResultInOrder) {
   EXPECT_DOUBLE_EQ(result.resolution_m(), 0.2);
 }
 
+TEST(PlanRpc, HeatMapOnceProvisionalPicksThenFinalStationsOnce) {
+  auto server = testing::StartServer(SmallServer());
+  ASSERT_TRUE(server);
+  const auto call = RawPlan(testing::Address(*server), PlanRequests(testing::BoxRoomPly(), FastParams()));
+  ASSERT_TRUE(call.status.ok()) << call.status.error_message();
+  ASSERT_TRUE(call.responses.back().has_result());
+  const auto& result = call.responses.back().result();
+  int heat_map_starts = 0, final_lists = 0;
+  uint64_t heat_map_candidates = 0;
+  bool final_seen = false;
+  for (const auto& r : call.responses) {
+    if (r.has_heat_map()) {
+      heat_map_starts += r.heat_map().first_index() == 0;
+      heat_map_candidates += r.heat_map().positions_size();
+    }
+    if (r.has_station()) {
+      EXPECT_TRUE(r.station().provisional()) << "a selection pick is provisional";
+      EXPECT_FALSE(final_seen) << "a provisional pick after the final list";
+    }
+    if (r.has_final_stations()) {
+      ++final_lists;
+      final_seen = true;
+      ASSERT_EQ(r.final_stations().stations_size(), result.stations_size());
+      for (int i = 0; i < result.stations_size(); ++i) {  // global_visibility comes with the evaluation
+        v1::PlannedStation want = result.stations(i);
+        want.clear_global_visibility();
+        EXPECT_EQ(r.final_stations().stations(i).SerializeAsString(), want.SerializeAsString());
+      }
+    }
+  }
+  EXPECT_EQ(heat_map_starts, 1) << "the heat map is sent exactly once";
+  EXPECT_EQ(heat_map_candidates, result.heat_map_candidates());
+  EXPECT_EQ(final_lists, 1);
+}
+
 TEST(PlanRpc, ClientRebuildsTheWholePlanResult) {
   auto server = testing::StartServer(SmallServer());
   ASSERT_TRUE(server);
@@ -76,12 +111,12 @@ TEST(PlanRpc, ClientRebuildsTheWholePlanResult) {
   client::JobObserver obs;
   obs.on_accepted = [&](const std::string&, uint32_t) { ++accepted; };
   auto r = (*c)->Plan({testing::BoxRoomPly(), "box.ply"}, o, obs);
-  ASSERT_TRUE(r.ok()) << r.status.error_message();
+  ASSERT_TRUE(r.ok()) << r.status().ToString();
   EXPECT_EQ(accepted, 1);
-  EXPECT_GE(r.value.stations.size(), 1u);
-  EXPECT_EQ(r.value.voxel_centers.size(), r.value.occupied_voxels);
-  EXPECT_EQ(r.value.heat_map.positions.size(), r.value.heat_map.visible_voxels.size());
-  EXPECT_GT(r.value.heat_map.positions.size(), 0u);
+  EXPECT_GE(r->stations.size(), 1u);
+  EXPECT_EQ(r->voxel_centers.size(), r->occupied_voxels);
+  EXPECT_EQ(r->heat_map.positions.size(), r->heat_map.visible_voxels.size());
+  EXPECT_GT(r->heat_map.positions.size(), 0u);
 }
 
 TEST(EvaluateRpc, ViewpointInsideTheBoxSeesItsWalls) {
@@ -95,10 +130,10 @@ TEST(EvaluateRpc, ViewpointInsideTheBoxSeesItsWalls) {
   o.resolution_m = 0.2;
   o.viewpoints = {{2.0, 1.5, 1.2}};
   auto r = (*c)->Evaluate({testing::BoxRoomPly(), "box.ply"}, o);
-  ASSERT_TRUE(r.ok()) << r.status.error_message();
-  ASSERT_EQ(r.value.per_viewpoint.size(), 1u);
-  EXPECT_GT(r.value.overall.global_visibility, 0.0);
-  EXPECT_GT(r.value.faces_total, 0u);
+  ASSERT_TRUE(r.ok()) << r.status().ToString();
+  ASSERT_EQ(r->per_viewpoint.size(), 1u);
+  EXPECT_GT(r->overall.global_visibility, 0.0);
+  EXPECT_GT(r->faces_total, 0u);
 }
 
 // --- Protocol errors ---
@@ -413,8 +448,8 @@ TEST(Health, ServingWhileUpAndHealthNeedsNoToken) {
   auto c = client::Client::Create(conn);
   ASSERT_TRUE(c.ok());
   auto h = (*c)->Health();
-  ASSERT_TRUE(h.ok()) << h.status.error_message();
-  EXPECT_EQ(h.value, "SERVING");
+  ASSERT_TRUE(h.ok()) << h.status().ToString();
+  EXPECT_EQ(*h, "SERVING");
 }
 
 }  // namespace

@@ -51,6 +51,7 @@ server::Backend BlockingBackend::Make() {
       for (size_t i = 0; i < r.stations.size(); ++i) {
         if (cb.on_station) cb.on_station(r.stations[i], int(i));
       }
+      if (cb.on_final_stations) cb.on_final_stations(r.stations);
       ctx.Report(Stage::kSelection, 1.0, "done");
       return r;
     }

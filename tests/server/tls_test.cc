@@ -6,6 +6,7 @@
 #include "server/test_server.h"
 #include "testing/test_paths.h"
 #include "vc/client/client.h"
+#include "vc/wire/status_mapping.h"
 
 namespace vc {
 namespace {
@@ -33,7 +34,7 @@ class Tls : public ::testing::Test {
     auto c = client::Client::Create(conn);
     EXPECT_TRUE(c.ok()) << c.status().ToString();
     if (!c.ok()) return grpc::StatusCode::UNKNOWN;
-    return (*c)->Health().status.error_code();
+    return wire::ToGrpcCode((*c)->Health().status().code());
   }
   std::string dir_;
 };

@@ -155,6 +155,22 @@ TEST(PlanResultChunks, MissingChunkIsDataLoss) {
   EXPECT_EQ(back.status().code(), StatusCode::kDataLoss);
 }
 
+TEST(PlanResultChunks, SecondHeatMapIsDataLoss) {
+  const PlanResult r = BigResult(1, 3);
+  PlanResultAssembler a;
+  for (const auto& c : HeatMapChunks(r.heat_map)) ASSERT_TRUE(a.AddHeatMap(c).ok());
+  EXPECT_EQ(a.AddHeatMap(HeatMapChunks(r.heat_map).front()).code(), StatusCode::kDataLoss);
+}
+
+TEST(PlanResultChunks, MissingHeatMapIsDataLoss) {
+  const PlanResult r = BigResult(1, 3);
+  PlanResultAssembler a;
+  ForEachVoxelChunk(r, [&](v1::VoxelChunk&& c) { return a.AddVoxels(c).ok(); });
+  auto back = std::move(a).Finish(ToProto(r));
+  ASSERT_FALSE(back.ok());
+  EXPECT_EQ(back.status().code(), StatusCode::kDataLoss);
+}
+
 TEST(PlanResultChunks, OutOfOrderChunkIsDataLoss) {
   const PlanResult r = BigResult(2 * kVoxelsPerChunk, 0);
   std::vector<v1::VoxelChunk> chunks;

@@ -2,23 +2,29 @@
 //
 // Uploads a scene in chunks (with its CRC32C), follows the event stream, and returns the core
 // types (vc::PlanResult, vc::Evaluation) rebuilt by vc::wire, ready for vc::WritePlanOutputs.
+// Failures are vc::Status values: the call's gRPC status mapped by vc::wire::FromGrpcStatus (same
+// google.rpc.Code, same message), or DATA_LOSS / INTERNAL for a stream that does not add up.
 // Transient UNAVAILABLE failures before the server accepted the job are retried with exponential
 // backoff; every other status is returned as it came. Not thread-safe; use one per thread.
 #pragma once
-
-#include <grpcpp/grpcpp.h>
 
 #include <chrono>
 #include <functional>
 #include <memory>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "vc/plan/planner.h"
 #include "vc/base/progress.h"
 #include "vc/base/status.h"
 #include "vc/visibility/visibility.h"
 #include "vc/wire/convert.h"
+
+namespace grpc {
+class Channel;
+class ClientContext;
+}  // namespace grpc
 
 namespace vc::client {
 
@@ -50,18 +56,15 @@ struct ConnectionOptions {
 struct JobObserver {
   std::function<void(const std::string& job_id, uint32_t queue_position)> on_accepted;
   std::function<void(const ProgressEvent&)> on_progress;
+  // The heat map, once, when the candidates' visibility is known.
   std::function<void(const HeatMap&)> on_heat_map;
+  // Provisional: a station as the greedy selection picks it (refinement and reduction may still
+  // move or drop it); `index` in greedy order.
   std::function<void(const PlannedStation&, int index)> on_station;
-  // Called before each retry, with the failed attempt's status and the wait.
-  std::function<void(const grpc::Status&, std::chrono::milliseconds)> on_retry;
-};
-
-// A value, or the gRPC status of the call that failed.
-template <typename T>
-struct [[nodiscard]] CallResult {
-  grpc::Status status;
-  T value{};
-  bool ok() const { return status.ok(); }
+  // Final: the stations that stand, once, after refinement and reduction (as in the PlanResult).
+  std::function<void(const std::vector<PlannedStation>&)> on_final_stations;
+  // Called before each retry, with the failed attempt's status (UNAVAILABLE) and the wait.
+  std::function<void(const Status&, std::chrono::milliseconds)> on_retry;
 };
 
 // A scene to upload: its bytes and a label for error messages (the file name).
@@ -78,18 +81,18 @@ class Client {
   // Reads the TLS files and makes the channel (connecting lazily). NOT_FOUND for a missing file.
   static Result<std::unique_ptr<Client>> Create(const ConnectionOptions& options);
 
-  CallResult<PlanResult> Plan(const Upload& upload, const PlanOptions& options, const JobObserver& observer = {});
-  CallResult<Evaluation> Evaluate(const Upload& upload, const EvaluateJobOptions& options,
-                                  const JobObserver& observer = {});
+  Result<PlanResult> Plan(const Upload& upload, const PlanOptions& options, const JobObserver& observer = {});
+  Result<Evaluation> Evaluate(const Upload& upload, const EvaluateJobOptions& options,
+                              const JobObserver& observer = {});
   // grpc.health.v1.Health/Check of `service` ("" = the whole server). The value is the serving
   // status name ("SERVING"); a server that is not serving gives UNAVAILABLE.
-  CallResult<std::string> Health(const std::string& service = "");
+  Result<std::string> Health(const std::string& service = "");
 
  private:
   Client() = default;
   void Prepare(grpc::ClientContext* ctx) const;
   template <typename Fn>
-  grpc::Status WithRetries(const JobObserver& observer, Fn&& attempt);
+  Status WithRetries(const JobObserver& observer, Fn&& attempt);
 
   ConnectionOptions options_;
   std::shared_ptr<grpc::Channel> channel_;

@@ -5,6 +5,7 @@
 
 #include <cstdio>
 #include <string>
+#include <vector>
 
 #include "vc/plan/planner.h"
 #include "vc/base/progress.h"
@@ -18,7 +19,10 @@ class ProgressDisplay {
   void Uploading(const std::string& source, uint64_t bytes, const std::string& server);
   void Accepted(const std::string& job_id, uint32_t queue_position);
   void Update(const ProgressEvent& e);
+  // A provisional pick of the greedy selection (`index` from 0).
   void Station(const PlannedStation& s, int index);
+  // The final stations, after refinement and reduction.
+  void FinalStations(const std::vector<PlannedStation>& stations);
   void Note(const std::string& line);
   // Ends the bar's line.
   void Done();

@@ -75,16 +75,18 @@ v1::PlanResult ToProto(const PlanResult& result);
 // Rebuilds a vc::PlanResult from the chunks and the final summary of a Plan stream.
 class PlanResultAssembler {
  public:
-  // DATA_LOSS if a chunk is out of order or inconsistent with the previous ones.
+  // DATA_LOSS if a chunk is out of order or inconsistent with the previous ones, or starts a second
+  // heat map (a stream carries exactly one).
   Status AddHeatMap(const v1::HeatMapChunk& chunk);
   Status AddVoxels(const v1::VoxelChunk& chunk);
   // The heat map received so far (complete once all its chunks arrived).
   const HeatMap& heat_map() const { return heat_map_; }
-  // DATA_LOSS if the chunks received do not add up to what `summary` declares.
+  // DATA_LOSS if the chunks received do not add up to what `summary` declares (e.g. no heat map).
   Result<PlanResult> Finish(const v1::PlanResult& summary) &&;
 
  private:
   HeatMap heat_map_;
+  bool heat_map_started_ = false;
   uint64_t heat_map_total_ = 0;
   std::vector<WorldPoint> centers_;
   std::vector<std::array<float, kFacesPerVoxel>> face_values_;

@@ -2,8 +2,8 @@
 //
 // Shaped like absl::Status / std::expected. Core functions never throw for bad input, never log
 // an error they also return, and never crash on a predictable failure (bad file, scene too large,
-// cancellation): they return one of these. The server maps StatusCode to grpc::StatusCode in one
-// place (server/src/status_mapping.cc). Exceptions are reserved for bugs.
+// cancellation): they return one of these. StatusCode and grpc::StatusCode map to each other in
+// one place (proto/src/status_mapping.cc). Exceptions are reserved for bugs.
 #pragma once
 
 #include <cassert>
@@ -14,7 +14,8 @@
 
 namespace vc {
 
-// Canonical codes, a subset of google.rpc.Code with the same meanings.
+// Canonical codes: google.rpc.Code's, with the same meanings. The core returns the first eleven;
+// the last six also describe failures of a remote call (vc::client).
 enum class StatusCode {
   kOk = 0,
   kCancelled,
@@ -27,6 +28,12 @@ enum class StatusCode {
   kUnimplemented,
   kInternal,
   kDataLoss,
+  kUnknown,
+  kAlreadyExists,
+  kPermissionDenied,
+  kAborted,
+  kUnavailable,
+  kUnauthenticated,
 };
 
 // Human-readable name of a code ("INVALID_ARGUMENT").
@@ -67,6 +74,8 @@ inline Status OutOfRangeError(std::string m) { return {StatusCode::kOutOfRange, 
 inline Status UnimplementedError(std::string m) { return {StatusCode::kUnimplemented, std::move(m)}; }
 inline Status InternalError(std::string m) { return {StatusCode::kInternal, std::move(m)}; }
 inline Status DataLossError(std::string m) { return {StatusCode::kDataLoss, std::move(m)}; }
+inline Status UnavailableError(std::string m) { return {StatusCode::kUnavailable, std::move(m)}; }
+inline Status UnauthenticatedError(std::string m) { return {StatusCode::kUnauthenticated, std::move(m)}; }
 
 // A value of type T or a non-OK Status.
 template <typename T>

@@ -1,0 +1,73 @@
+// JobRunner: what a worker does with one verified upload, whatever the RPC.
+//
+// Parses the scene through Backend::read_scene (the stated format must match the content), hands
+// it to the RPC's function (plan or evaluate, posting its responses itself), and writes the one
+// log line per job: method, peer, upload size and time, queueing, per-stage timings, the RPC's
+// details and the status. An exception escaping the core is a bug: it is logged and becomes
+// INTERNAL naming the job id, so a worker never dies.
+//
+// Thread-safe: Run may be called on several workers at once (the runner is immutable).
+#pragma once
+
+#include <chrono>
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <string_view>
+
+#include "vc/base/progress.h"
+#include "vc/base/status.h"
+#include "vc/scene/scene_input.h"
+#include "vc/server/backend.h"
+#include "vc/v1/planner.pb.h"
+
+namespace vc::server {
+
+// One job as the RPC adapter hands it to a worker.
+struct Job {
+  using Clock = std::chrono::steady_clock;
+  std::string id;              // "j-" + 12 hex digits
+  std::string method;          // "Plan", "Evaluate"
+  std::string peer;            // the client's address, for the log
+  v1::UploadSpec upload;       // source name, stated format, size
+  std::string data;            // the verified upload
+  Clock::time_point started;   // the call began
+  Clock::time_point submitted; // the upload was verified and queued
+};
+
+// The RPC function's additions to the log line (on the worker thread).
+class JobLog {
+ public:
+  // Adds " stage=1.234s".
+  void NoteTiming(std::string_view stage, double seconds);
+  // Extra fields, e.g. " stations=7".
+  void set_details(std::string details) { details_ = std::move(details); }
+  const std::string& timings() const { return timings_; }
+  const std::string& details() const { return details_; }
+
+ private:
+  std::string timings_;
+  std::string details_;
+};
+
+// Runs the RPC's core function on the parsed scene; posts its responses itself.
+using JobFn = std::function<Status(const SceneInput& input, const JobContext& ctx, JobLog& log)>;
+
+class JobRunner {
+ public:
+  // `backend` must outlive the runner. Scenes decompressing past `max_memory_budget_bytes` are refused.
+  JobRunner(const Backend* backend, uint64_t max_memory_budget_bytes)
+      : backend_(backend), max_memory_budget_bytes_(max_memory_budget_bytes) {}
+
+  // On a worker thread: reads job.data, runs `fn`, logs the line; the job's status. CANCELLED or
+  // DEADLINE_EXCEEDED when `cancel` fired while queued; the reader's and fn's errors as they are.
+  Status Run(Job job, const CancelToken& cancel, ProgressFn progress, const JobFn& fn) const;
+
+ private:
+  Status Execute(Job& job, const JobContext& ctx, JobLog& log, const JobFn& fn) const;
+
+  const Backend* const backend_;
+  const uint64_t max_memory_budget_bytes_;
+};
+
+}  // namespace vc::server

@@ -1,0 +1,77 @@
+#include "vc/server/upload_assembler.h"
+
+#include <fmt/format.h>
+
+#include "vc/wire/convert.h"
+
+namespace vc::server {
+
+std::string HumanBytes(uint64_t bytes) {
+  if (bytes < 1024) return std::to_string(bytes) + " B";
+  if (bytes < (uint64_t{1} << 20)) return fmt::format("{:.1f} KiB", bytes / 1024.0);
+  if (bytes < (uint64_t{1} << 30)) return fmt::format("{:.1f} MiB", bytes / 1048576.0);
+  return fmt::format("{:.2f} GiB", bytes / 1073741824.0);
+}
+
+Status UploadAssembler::StartSpec() {
+  if (has_spec_) return InvalidArgumentError("a second spec arrived; send exactly one spec, first");
+  has_spec_ = true;
+  return Status::Ok();
+}
+
+Status UploadAssembler::AcceptSpec(const v1::UploadSpec& upload) {
+  upload_ = upload;
+  if (upload.format() != v1::INPUT_FORMAT_UNSPECIFIED) {
+    VC_RETURN_IF_ERROR(wire::FromProto(upload.format()).status());
+  }
+  if (upload.total_size_bytes() == 0) {
+    return InvalidArgumentError("the spec declares an empty upload (total_size_bytes = 0); send the file's size");
+  }
+  if (upload.total_size_bytes() > max_upload_bytes_) {
+    return ResourceExhaustedError("the upload of " + HumanBytes(upload.total_size_bytes()) +
+                                  " exceeds this server's limit of " + HumanBytes(max_upload_bytes_) +
+                                  " (--max-upload-bytes); send a smaller or downsampled scene");
+  }
+  ticket_ = pool_->TryAdmit();
+  if (!ticket_) {
+    busy_ = true;
+    return ResourceExhaustedError("the server is busy: all " + std::to_string(pool_->workers()) +
+                                  " workers are running and the " + std::to_string(pool_->queue_capacity()) +
+                                  "-job queue is full; retry in a few seconds");
+  }
+  data_.reserve(upload_.total_size_bytes());
+  return Status::Ok();
+}
+
+Status UploadAssembler::AddChunk(std::string_view data) {
+  if (!has_spec_) {
+    return InvalidArgumentError("a data chunk arrived before the spec; the first message must be the spec");
+  }
+  if (data.size() > upload_.total_size_bytes() - data_.size()) {
+    return InvalidArgumentError("the upload carries more than the " + std::to_string(upload_.total_size_bytes()) +
+                                " bytes its spec declares; fix total_size_bytes");
+  }
+  data_.append(data);
+  crc_.Update(data);
+  return Status::Ok();
+}
+
+Status UploadAssembler::Finish() const {
+  if (!has_spec_) {
+    return InvalidArgumentError("the stream ended before any spec; send a spec message first, then the data");
+  }
+  if (data_.size() != upload_.total_size_bytes()) {
+    return InvalidArgumentError("the upload ended after " + std::to_string(data_.size()) + " of the " +
+                                std::to_string(upload_.total_size_bytes()) +
+                                " bytes its spec declares; send all the data or fix total_size_bytes");
+  }
+  if (crc_.value() != upload_.crc32c()) {
+    return DataLossError(fmt::format(
+        "the upload's CRC32C is {:08x} but its spec declares {:08x}; the data was corrupted or the spec is "
+        "wrong: retry the upload",
+        crc_.value(), upload_.crc32c()));
+  }
+  return Status::Ok();
+}
+
+}  // namespace vc::server

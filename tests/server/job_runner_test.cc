@@ -1,0 +1,148 @@
+// JobRunner with a fake backend: the scene reaches the RPC's function, the stated format is
+// checked against the content, cancellation while queued skips the work, and a bug is INTERNAL.
+#include "vc/server/job_runner.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <stdexcept>
+#include <vector>
+
+namespace vc::server {
+namespace {
+
+using ::testing::HasSubstr;
+
+struct Fixture {
+  int reads = 0;
+  std::string read_source;
+  Backend backend;
+  Fixture() {
+    backend.read_scene = [this](std::string_view bytes, std::string_view source,
+                                const ReadOptions&) -> Result<SceneInput> {
+      ++reads;
+      read_source = std::string(source);
+      if (bytes == "bad") return InvalidArgumentError("line 1: not a number");
+      SceneInput in;
+      in.format = InputFormat::kPly;
+      in.points.resize(bytes.size());
+      return in;
+    };
+  }
+  Job MakeJob(std::string data, v1::InputFormat format = v1::INPUT_FORMAT_UNSPECIFIED) const {
+    Job job;
+    job.id = "j-000000000001";
+    job.method = "Plan";
+    job.peer = "ipv4:127.0.0.1:1";
+    job.upload.set_source_name("room.ply");
+    job.upload.set_format(format);
+    job.upload.set_total_size_bytes(data.size());
+    job.data = std::move(data);
+    job.started = job.submitted = Job::Clock::now();
+    return job;
+  }
+};
+
+TEST(JobRunner, TheParsedSceneReachesTheFunctionWithProgressAndTimings) {
+  Fixture f;
+  JobRunner runner(&f.backend, 1 << 20);
+  CancelToken token;
+  std::vector<ProgressEvent> events;
+  size_t points = 0;
+  const Status s = runner.Run(
+      f.MakeJob("12345", v1::INPUT_FORMAT_PLY), token, [&](const ProgressEvent& e) { events.push_back(e); },
+      [&](const SceneInput& in, const JobContext& ctx, JobLog& log) {
+        points = in.points.size();
+        EXPECT_EQ(ctx.cancel, &token);
+        log.NoteTiming("selection", 0.5);
+        log.set_details(" stations=3");
+        EXPECT_THAT(log.timings(), HasSubstr("read="));
+        EXPECT_THAT(log.timings(), HasSubstr("selection=0.500s"));
+        return Status::Ok();
+      });
+  EXPECT_TRUE(s.ok()) << s.ToString();
+  EXPECT_EQ(points, 5u);
+  EXPECT_EQ(f.read_source, "room.ply");
+  ASSERT_EQ(events.size(), 2u);
+  EXPECT_EQ(events[0].stage, Stage::kRead);
+  EXPECT_DOUBLE_EQ(events[0].fraction, 0.0);
+  EXPECT_DOUBLE_EQ(events[1].fraction, 1.0);
+}
+
+TEST(JobRunner, UnnamedUploadIsCalledUpload) {
+  Fixture f;
+  JobRunner runner(&f.backend, 1 << 20);
+  CancelToken token;
+  Job job = f.MakeJob("1");
+  job.upload.clear_source_name();
+  ASSERT_TRUE(runner.Run(std::move(job), token, {}, [](const SceneInput&, const JobContext&, JobLog&) {
+                      return Status::Ok();
+                    }).ok());
+  EXPECT_EQ(f.read_source, "upload");
+}
+
+TEST(JobRunner, CancelledWhileQueuedSkipsTheWork) {
+  Fixture f;
+  JobRunner runner(&f.backend, 1 << 20);
+  CancelToken token;
+  token.Cancel();
+  bool ran = false;
+  const Status s = runner.Run(f.MakeJob("1"), token, {}, [&](const SceneInput&, const JobContext&, JobLog&) {
+    ran = true;
+    return Status::Ok();
+  });
+  EXPECT_EQ(s.code(), StatusCode::kCancelled);
+  EXPECT_EQ(f.reads, 0);
+  EXPECT_FALSE(ran);
+}
+
+TEST(JobRunner, StatedFormatDisagreeingWithTheContentIsInvalidArgument) {
+  Fixture f;
+  JobRunner runner(&f.backend, 1 << 20);
+  CancelToken token;
+  bool ran = false;
+  const Status s = runner.Run(f.MakeJob("1", v1::INPUT_FORMAT_PCD), token, {},
+                              [&](const SceneInput&, const JobContext&, JobLog&) {
+                                ran = true;
+                                return Status::Ok();
+                              });
+  EXPECT_EQ(s.code(), StatusCode::kInvalidArgument);
+  EXPECT_THAT(s.message(), HasSubstr("by its content"));
+  EXPECT_THAT(s.message(), HasSubstr("INPUT_FORMAT_PCD"));
+  EXPECT_FALSE(ran);
+}
+
+TEST(JobRunner, ReaderErrorIsReturnedAsItIs) {
+  Fixture f;
+  JobRunner runner(&f.backend, 1 << 20);
+  CancelToken token;
+  const Status s = runner.Run(f.MakeJob("bad"), token, {}, [](const SceneInput&, const JobContext&, JobLog&) {
+    return Status::Ok();
+  });
+  EXPECT_EQ(s, InvalidArgumentError("line 1: not a number"));
+}
+
+TEST(JobRunner, FunctionErrorIsReturnedAsItIs) {
+  Fixture f;
+  JobRunner runner(&f.backend, 1 << 20);
+  CancelToken token;
+  const Status s = runner.Run(f.MakeJob("1"), token, {}, [](const SceneInput&, const JobContext&, JobLog&) {
+    return FailedPreconditionError("no candidate position");
+  });
+  EXPECT_EQ(s, FailedPreconditionError("no candidate position"));
+}
+
+TEST(JobRunner, ExceptionIsInternalNamingTheJob) {
+  Fixture f;
+  JobRunner runner(&f.backend, 1 << 20);
+  CancelToken token;
+  const Status s = runner.Run(f.MakeJob("1"), token, {}, [](const SceneInput&, const JobContext&, JobLog&) -> Status {
+    throw std::logic_error("a bug");
+  });
+  EXPECT_EQ(s.code(), StatusCode::kInternal);
+  EXPECT_THAT(s.message(), HasSubstr("j-000000000001"));
+  EXPECT_THAT(s.message(), ::testing::Not(HasSubstr("a bug"))) << "no internal details to the client";
+}
+
+}  // namespace
+}  // namespace vc::server
