@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Runs every test. Installs the dependencies, then:
+# Runs every test. Installs the dependencies, checks the layering and the formatting, then:
 #   release  - build everything, run every test (including the `slow` ones) and vc-bench --quick
 #   asan     - AddressSanitizer + UndefinedBehaviorSanitizer: every test except the `slow` label
 #   tsan     - ThreadSanitizer on the tests whose concurrency is all ours (label `tsan`): the worker
@@ -16,6 +16,10 @@ presets=(release asan tsan)
 if [[ "${1:-}" == "--quick" ]]; then presets=(release); fi
 
 start=$(date +%s)
+echo "=== layering (scripts/check-layers.py) and formatting (.clang-format)"
+python3 scripts/check-layers.py
+git ls-files '*.h' '*.cc' | xargs clang-format --dry-run --Werror
+echo "clang-format: every tracked .h/.cc file is formatted"
 for p in "${presets[@]}"; do
   echo "=== preset $p: configure and build"
   cmake --preset "$p" >/dev/null
