@@ -1,18 +1,12 @@
 #include "vc/plan/plan_options.h"
 
-#include <cstdio>
 #include <string>
 
+#include "format.h"
+
 namespace vc {
-namespace {
 
-std::string Num(double v) {
-  char buf[64];
-  std::snprintf(buf, sizeof(buf), "%g", v);
-  return buf;
-}
-
-}  // namespace
+using planner::Num;
 
 Status PlanOptions::Validate() const {
 #define VC_CHECK_ROW(type, name, ...) \
