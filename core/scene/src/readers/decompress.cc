@@ -39,17 +39,30 @@ bool AllZero(std::string_view s) {
   return std::all_of(s.begin(), s.end(), [](char c) { return c == 0; });
 }
 
-// Bytes to add to an output of `size` bytes: a chunk, or up to one byte past the limit, so that
-// exceeding the limit is detected without growing far beyond it.
-size_t GrowBy(size_t size, uint64_t max_bytes) {
+// Grows `out` by a chunk, or by up to one byte past the limit, so that exceeding the limit is
+// detected without growing far beyond it; returns the bytes added. The capacity doubles (so
+// appends stay amortised O(1)) but never past the limit plus one byte: std::string's own growth
+// would reserve up to twice the limit.
+size_t Grow(std::string* out, uint64_t max_bytes) {
+  const size_t size = out->size();
   const uint64_t left = max_bytes - std::min<uint64_t>(size, max_bytes);
-  return left >= kChunk ? kChunk : static_cast<size_t>(left + 1);
+  const size_t grow = left >= kChunk ? kChunk : static_cast<size_t>(left + 1);
+  if (out->capacity() < size + grow) {
+    const uint64_t cap = std::max<uint64_t>(uint64_t{2} * out->capacity(), size + grow);
+    // libstdc++'s reserve on a non-empty string doubles anyway; a fresh one reserves exactly.
+    std::string bigger;
+    bigger.reserve(static_cast<size_t>(std::min<uint64_t>(cap, max_bytes + 1)));
+    bigger.append(*out);
+    out->swap(bigger);
+  }
+  out->resize(size + grow);
+  return grow;
 }
 
 Status TooLarge(std::string_view source, std::string_view kind, uint64_t max_bytes) {
   return ResourceExhaustedError(std::string(source) + ": " + std::string(kind) +
                                 " input decompresses to more than the limit of " +
-                                std::to_string(max_bytes) + " bytes");
+                                std::to_string(max_bytes) + " bytes" + std::string(kRaiseInputLimit));
 }
 
 Result<std::string> Gunzip(std::string_view in, std::string_view source, uint64_t max_bytes) {
@@ -61,8 +74,7 @@ Result<std::string> Gunzip(std::string_view in, std::string_view source, uint64_
   Status status = Status::Ok();
   while (true) {
     const size_t old = out.size();
-    const size_t grow = GrowBy(old, max_bytes);
-    out.resize(old + grow);
+    const size_t grow = Grow(&out, max_bytes);
     const size_t in_avail = std::min<size_t>(in.size() - in_pos, UINT_MAX);
     zs.next_in = reinterpret_cast<Bytef*>(const_cast<char*>(in.data() + in_pos));
     zs.avail_in = static_cast<uInt>(in_avail);
@@ -127,8 +139,7 @@ Result<std::string> Bunzip2(std::string_view in, std::string_view source, uint64
   Status status = Status::Ok();
   while (true) {
     const size_t old = out.size();
-    const size_t grow = GrowBy(old, max_bytes);
-    out.resize(old + grow);
+    const size_t grow = Grow(&out, max_bytes);
     const size_t in_avail = std::min<size_t>(in.size() - in_pos, UINT_MAX);
     bz.next_in = const_cast<char*>(in.data() + in_pos);
     bz.avail_in = static_cast<unsigned>(in_avail);
