@@ -11,7 +11,8 @@ BUILD_PKGS=(
   libgtest-dev libgmock-dev libbenchmark-dev
   libcli11-dev nlohmann-json3-dev libhwy-dev
   zlib1g-dev libbz2-dev libpng-dev
-  openssl python3 bzip2 gzip clang-format
+  openssl python3 bzip2 gzip
+  clang clang-format libfuzzer-14-dev
 )
 RUNTIME_PKGS=(
   libgrpc++1.51 libgrpc29 libprotobuf32 liboctomap1.9 libspdlog1.10 libfmt9 libhwy1

@@ -120,7 +120,8 @@ int main(int argc, char** argv) {
   conn.timeout = std::chrono::milliseconds(int64_t(timeout_s * 1000));
 
   if (*inspect) {
-    auto input = vc::ReadSceneFile(file);
+    // The limits vc-server applies with its defaults, so inspect accepts what a plan would.
+    auto input = vc::ReadSceneFile(file, vc::ReadLimits(vc::kDefaultMaxUploadBytes, vc::kDefaultMemoryBudgetBytes));
     if (!input.ok()) return Fail("cannot read " + file, input.status());
     auto summary = vc::Summarize(*input, inspect_resolution, vc::kDefaultMemoryBudgetBytes);
     if (!summary.ok()) return Fail("cannot summarise " + file, summary.status());

@@ -40,7 +40,7 @@ struct ServiceState {
   ServiceState(const ServerOptions& o, Backend b)
       : options(o),
         backend(std::move(b)),
-        runner(&backend, o.max_memory_budget_bytes),
+        runner(&backend, o.max_upload_bytes),
         pool(o.EffectiveWorkers(), o.queue) {}
   const ServerOptions options;
   const Backend backend;
@@ -110,6 +110,8 @@ class JobReactor : public grpc::ServerBidiReactor<Request, Response> {
  protected:
   // Takes the spec message: stores the parameters (checked) and returns the upload spec.
   virtual Result<v1::UploadSpec> TakeSpec(const Request& spec) = 0;
+  // The job's memory budget, as TakeSpec capped it; bounds the reading of its upload.
+  virtual uint64_t MemoryBudgetBytes() const = 0;
   // Runs the RPC's core function on the parsed input, posting responses; on a worker thread.
   virtual Status Run(const SceneInput& input, const JobContext& ctx, JobLog& log) = 0;
 
@@ -145,6 +147,7 @@ class JobReactor : public grpc::ServerBidiReactor<Request, Response> {
     job_.peer = ctx_->peer();
     job_.upload = upload_.spec();
     job_.data = upload_.TakeData();
+    job_.memory_budget_bytes = MemoryBudgetBytes();
     job_.started = start_;
     job_.submitted = Clock::now();
     state_->pool.Submit(

@@ -4,6 +4,7 @@
 #include <spdlog/spdlog.h>
 
 #include <exception>
+#include <new>
 
 #include "vc/server/upload_assembler.h"
 #include "vc/wire/convert.h"
@@ -29,6 +30,9 @@ Status JobRunner::Run(Job job, const CancelToken& cancel, ProgressFn progress, c
   Status s;
   try {
     s = Execute(job, ctx, log, fn);
+  } catch (const std::bad_alloc&) {
+    s = ResourceExhaustedError("the job (" + job.id + ") ran out of memory on this server; lower its memory_budget_bytes "
+                               "(--memory-budget-bytes), raise resolution_m or grid_spacing_m, or retry later");
   } catch (const std::exception& e) {
     spdlog::error("job {}: unexpected exception: {}", job.id, e.what());
     s = InternalError("the server failed unexpectedly (job " + job.id + "); retry or report it");
@@ -44,8 +48,7 @@ Status JobRunner::Run(Job job, const CancelToken& cancel, ProgressFn progress, c
 
 Status JobRunner::Execute(Job& job, const JobContext& ctx, JobLog& log, const JobFn& fn) const {
   VC_RETURN_IF_ERROR(ctx.CheckCancelled("the job (while queued)"));
-  ReadOptions read_options;
-  read_options.max_decompressed_bytes = max_memory_budget_bytes_;
+  const ReadOptions read_options = ReadLimits(max_upload_bytes_, job.memory_budget_bytes);
   const auto t0 = Job::Clock::now();
   ctx.Report(Stage::kRead, 0.0, "parsing " + HumanBytes(job.data.size()));
   const v1::UploadSpec& upload = job.upload;

@@ -61,6 +61,8 @@ class PlanReactor final : public JobReactor<v1::PlanRequest, v1::PlanResponse> {
     return request.spec().upload();
   }
 
+  uint64_t MemoryBudgetBytes() const override { return options_.memory_budget_bytes; }
+
   Status Run(const SceneInput& input, const JobContext& ctx, JobLog& log) override {
     log.set_details(" stations=0");
     PlanCallbacks callbacks;
@@ -119,6 +121,8 @@ class EvaluateReactor final : public JobReactor<v1::EvaluateRequest, v1::Evaluat
     options_.threads = JobThreads(options_.threads, options());
     return request.spec().upload();
   }
+
+  uint64_t MemoryBudgetBytes() const override { return options_.memory_budget_bytes; }
 
   Status Run(const SceneInput& input, const JobContext& ctx, JobLog& log) override {
     log.set_details(fmt::format(" viewpoints={}", options_.viewpoints.size()));

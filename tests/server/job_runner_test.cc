@@ -16,12 +16,14 @@ using ::testing::HasSubstr;
 struct Fixture {
   int reads = 0;
   std::string read_source;
+  ReadOptions read_options;
   Backend backend;
   Fixture() {
     backend.read_scene = [this](std::string_view bytes, std::string_view source,
-                                const ReadOptions&) -> Result<SceneInput> {
+                                const ReadOptions& o) -> Result<SceneInput> {
       ++reads;
       read_source = std::string(source);
+      read_options = o;
       if (bytes == "bad") return InvalidArgumentError("line 1: not a number");
       SceneInput in;
       in.format = InputFormat::kPly;
@@ -130,6 +132,34 @@ TEST(JobRunner, FunctionErrorIsReturnedAsItIs) {
     return FailedPreconditionError("no candidate position");
   });
   EXPECT_EQ(s, FailedPreconditionError("no candidate position"));
+}
+
+TEST(JobRunner, TheUploadIsReadWithinTheLimitsOfTheUploadAndTheJobsBudget) {
+  Fixture f;
+  JobRunner runner(&f.backend, uint64_t{1} << 20);
+  CancelToken token;
+  Job job = f.MakeJob("1");
+  job.memory_budget_bytes = uint64_t{64} << 20;
+  ASSERT_TRUE(runner.Run(std::move(job), token, {}, [](const SceneInput&, const JobContext&, JobLog&) {
+                return Status::Ok();
+              }).ok());
+  const ReadOptions want = ReadLimits(uint64_t{1} << 20, uint64_t{64} << 20);
+  EXPECT_EQ(f.read_options.max_decompressed_bytes, want.max_decompressed_bytes);
+  EXPECT_EQ(f.read_options.max_points, want.max_points);
+  EXPECT_EQ(f.read_options.max_result_bytes, want.max_result_bytes);
+  EXPECT_EQ(want.max_decompressed_bytes, uint64_t{16} << 20) << "16 x the upload limit, under half the budget";
+}
+
+TEST(JobRunner, OutOfMemoryIsResourceExhaustedNamingTheJob) {
+  Fixture f;
+  JobRunner runner(&f.backend, 1 << 20);
+  CancelToken token;
+  const Status s = runner.Run(f.MakeJob("1"), token, {}, [](const SceneInput&, const JobContext&, JobLog&) -> Status {
+    throw std::bad_alloc();
+  });
+  EXPECT_EQ(s.code(), StatusCode::kResourceExhausted);
+  EXPECT_THAT(s.message(), HasSubstr("j-000000000001"));
+  EXPECT_THAT(s.message(), HasSubstr("--memory-budget-bytes"));
 }
 
 TEST(JobRunner, ExceptionIsInternalNamingTheJob) {

@@ -1,6 +1,7 @@
 // In-process tests of the StationPlanner service: each RPC's happy path and every protocol error.
 #include "vc/server/service.h"
 
+#include <bzlib.h>
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -134,6 +135,29 @@ TEST(EvaluateRpc, ViewpointInsideTheBoxSeesItsWalls) {
   ASSERT_EQ(r->per_viewpoint.size(), 1u);
   EXPECT_GT(r->overall.global_visibility, 0.0);
   EXPECT_GT(r->faces_total, 0u);
+}
+
+// A decompression bomb through the real reader: the upload limit bounds what it may decompress
+// to (ReadLimits: 16 x --max-upload-bytes), so a few hundred bytes of bzip2 that inflate to 8 MiB
+// are refused with RESOURCE_EXHAUSTED naming the flag, and the server keeps serving.
+TEST(ServiceLimits, DecompressionBombIsResourceExhaustedNamingTheUploadLimit) {
+  auto o = SmallServer();
+  o.max_upload_bytes = 4096;
+  auto server = testing::StartServer(o);
+  ASSERT_TRUE(server);
+  std::string zeros(size_t{8} << 20, '\0');
+  std::string bomb(4096, '\0');
+  unsigned int bomb_size = bomb.size();
+  ASSERT_EQ(BZ2_bzBuffToBuffCompress(bomb.data(), &bomb_size, zeros.data(), zeros.size(), 9, 0, 0), BZ_OK);
+  bomb.resize(bomb_size);
+  auto requests = PlanRequests(bomb);
+  requests[0].mutable_spec()->mutable_upload()->set_source_name("bomb.xyz.bz2");
+  const auto call = RawPlan(testing::Address(*server), requests);
+  EXPECT_EQ(call.status.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED) << call.status.error_message();
+  EXPECT_THAT(call.status.error_message(), HasSubstr("--max-upload-bytes"));
+  // The next job reaches a worker and the reader again (a 10-byte file that is no scene).
+  const auto again = RawPlan(testing::Address(*server), PlanRequests("0123456789"));
+  EXPECT_EQ(again.status.error_code(), grpc::StatusCode::INVALID_ARGUMENT) << again.status.error_message();
 }
 
 // --- Protocol errors ---

@@ -162,6 +162,15 @@ class QuietCerr {
   std::streambuf* saved_;
 };
 
+// RESOURCE_EXHAUSTED when a tree of `nodes` nodes would take more than `max_tree_bytes`.
+Status CheckTreeSize(uint64_t nodes, uint64_t max_tree_bytes, std::string_view source) {
+  if (nodes <= max_tree_bytes / kOctreeNodeBytes) return Status::Ok();
+  return ResourceExhaustedError(std::string(source) + ": the OctoMap tree has " + std::to_string(nodes) +
+                                " nodes, about " + std::to_string(nodes * kOctreeNodeBytes) +
+                                " bytes in memory, more than the limit of " + std::to_string(max_tree_bytes) +
+                                " bytes");
+}
+
 template <typename T>
 bool ReadPod(std::string_view bytes, size_t* pos, T* out) {
   if (*pos + sizeof(T) > bytes.size()) return false;
@@ -172,7 +181,8 @@ bool ReadPod(std::string_view bytes, size_t* pos, T* out) {
 
 }  // namespace
 
-Result<std::shared_ptr<octomap::OcTree>> ReadOctreeBinary(std::string_view bytes, std::string_view source) {
+Result<std::shared_ptr<octomap::OcTree>> ReadOctreeBinary(std::string_view bytes, std::string_view source,
+                                                          uint64_t max_tree_bytes) {
   VC_ASSIGN_OR_RETURN(Header h, ParseHeader(bytes, "# Octomap OcTree binary file", source));
   if (h.id != "OcTree" && h.id != "ColorOcTree" && h.id != "OcTreeStamped") {
     return InvalidArgumentError(std::string(source) + ": unsupported OctoMap tree type \"" + h.id +
@@ -183,6 +193,12 @@ Result<std::shared_ptr<octomap::OcTree>> ReadOctreeBinary(std::string_view bytes
   if (h.size > 0 && !walker.Node(0)) {
     return InvalidArgumentError(std::string(source) + ": corrupt OctoMap binary data: " + walker.error);
   }
+  if (walker.nodes != h.size) {  // OctoMap refuses this too, but only on stderr
+    return InvalidArgumentError(std::string(source) + ": the header declares size " + std::to_string(h.size) +
+                                " but the node data holds " + std::to_string(walker.nodes) +
+                                " nodes; header and data do not match (corrupt file?)");
+  }
+  VC_RETURN_IF_ERROR(CheckTreeSize(walker.nodes, max_tree_bytes, source));
   // Re-emit a canonical header (the .bt node data is the same for every occupancy tree type).
   std::ostringstream header;
   header.precision(17);
@@ -196,7 +212,8 @@ Result<std::shared_ptr<octomap::OcTree>> ReadOctreeBinary(std::string_view bytes
   return tree;
 }
 
-Result<std::shared_ptr<octomap::OcTree>> ReadOctreeText(std::string_view bytes, std::string_view source) {
+Result<std::shared_ptr<octomap::OcTree>> ReadOctreeText(std::string_view bytes, std::string_view source,
+                                                        uint64_t max_tree_bytes) {
   VC_ASSIGN_OR_RETURN(Header h, ParseHeader(bytes, "# Octomap OcTree file", source));
   size_t value_bytes = 0;
   if (h.id == "OcTree") value_bytes = 4;
@@ -214,6 +231,7 @@ Result<std::shared_ptr<octomap::OcTree>> ReadOctreeText(std::string_view bytes, 
   if (h.size > 0 && !walker.Node(0)) {
     return InvalidArgumentError(std::string(source) + ": corrupt OctoMap tree data: " + walker.error);
   }
+  VC_RETURN_IF_ERROR(CheckTreeSize(walker.nodes, max_tree_bytes, source));
   std::string stream_text;
   if (h.id == "OcTree") {
     stream_text = std::string(bytes);

@@ -5,6 +5,7 @@
 // magic of its own.
 #include "vc/scene/scene_input.h"
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -42,7 +43,10 @@ Result<SceneInput> FromCloud(Result<readers::PointCloud> read, InputFormat forma
 }
 
 Result<SceneInput> FromOctree(Result<std::shared_ptr<octomap::OcTree>> read, InputFormat format) {
-  if (!read.ok()) return read.status();
+  if (!read.ok()) {
+    if (read.status().code() != StatusCode::kResourceExhausted) return read.status();
+    return ResourceExhaustedError(read.status().message() + std::string(readers::kRaiseResultLimit));
+  }
   SceneInput in;
   in.format = format;
   std::ostringstream detail;
@@ -56,10 +60,12 @@ Result<SceneInput> ReadDecompressed(std::string_view bytes, std::string_view sou
                                     const ReadOptions& options) {
   if (bytes.empty()) return readers::InvalidInput(source, "input is empty (0 bytes)");
   if (StartsWith(bytes, "# Octomap OcTree binary file")) {
-    return FromOctree(ReadOctreeBinary(bytes, source), InputFormat::kOctomapBinary);
+    return FromOctree(ReadOctreeBinary(bytes, source, options.max_result_bytes),
+                      InputFormat::kOctomapBinary);
   }
   if (StartsWith(bytes, "# Octomap OcTree file")) {
-    return FromOctree(ReadOctreeText(bytes, source), InputFormat::kOctomapText);
+    return FromOctree(ReadOctreeText(bytes, source, options.max_result_bytes),
+                      InputFormat::kOctomapText);
   }
   if (readers::LooksLikePly(bytes)) {
     return FromCloud(readers::ReadPly(bytes, source, options), InputFormat::kPly, source);
@@ -87,7 +93,8 @@ Result<SceneInput> ReadDecompressed(std::string_view bytes, std::string_view sou
   if (graph->points.size() > options.max_points) {
     return ResourceExhaustedError(
         std::string(source) + ": ScanGraph holds " + std::to_string(graph->points.size()) +
-        " points, more than the limit of " + std::to_string(options.max_points));
+        " points, more than the limit of " + std::to_string(options.max_points) +
+        std::string(readers::kRaiseResultLimit));
   }
   if (graph->points.empty()) {
     return readers::InvalidInput(source, "ScanGraph holds " +
@@ -137,8 +144,23 @@ std::string_view CompressionName(Compression c) {
   return "unknown";
 }
 
-Result<SceneInput> ReadScene(std::string_view bytes, std::string_view source_name,
-                             const ReadOptions& options) {
+ReadOptions ReadLimits(uint64_t max_upload_bytes, uint64_t memory_budget_bytes) {
+  const uint64_t upload = std::max<uint64_t>(max_upload_bytes, 1);
+  const uint64_t half_budget = std::max<uint64_t>(memory_budget_bytes / 2, 1);
+  const uint64_t by_upload = upload > UINT64_MAX / kMaxDecompressionRatio
+                                 ? UINT64_MAX
+                                 : upload * kMaxDecompressionRatio;
+  ReadOptions o;
+  o.max_decompressed_bytes = std::min(by_upload, half_budget);
+  o.max_result_bytes = half_budget;
+  o.max_points = half_budget / kBytesPerPoint;
+  return o;
+}
+
+namespace {
+
+Result<SceneInput> ReadSceneUnguarded(std::string_view bytes, std::string_view source_name,
+                                      const ReadOptions& options) {
   const std::string_view unsupported = readers::DetectUnsupportedCompression(bytes);
   if (!unsupported.empty()) {
     return readers::InvalidInput(source_name, std::string(unsupported) +
@@ -151,7 +173,8 @@ Result<SceneInput> ReadScene(std::string_view bytes, std::string_view source_nam
     if (bytes.size() > options.max_decompressed_bytes) {
       return ResourceExhaustedError(
           std::string(source_name) + ": input of " + std::to_string(bytes.size()) +
-          " bytes is more than the limit of " + std::to_string(options.max_decompressed_bytes));
+          " bytes is more than the limit of " + std::to_string(options.max_decompressed_bytes) +
+          std::string(readers::kRaiseInputLimit));
     }
     return ReadDecompressed(bytes, source_name, options);
   }
@@ -169,6 +192,15 @@ Result<SceneInput> ReadScene(std::string_view bytes, std::string_view source_nam
   return in;
 }
 
+}  // namespace
+
+Result<SceneInput> ReadScene(std::string_view bytes, std::string_view source_name,
+                             const ReadOptions& options) {
+  return CatchOutOfMemory(
+      std::string(source_name) + ": reading " + std::to_string(bytes.size()) + " bytes",
+      [&] { return ReadSceneUnguarded(bytes, source_name, options); });
+}
+
 Result<SceneInput> ReadSceneFile(const std::string& path, const ReadOptions& options) {
   std::error_code ec;
   if (std::filesystem::is_directory(path, ec)) return NotFoundError(path + ": is a directory");
@@ -178,7 +210,8 @@ Result<SceneInput> ReadSceneFile(const std::string& path, const ReadOptions& opt
   if (!ec && size > options.max_decompressed_bytes) {
     return ResourceExhaustedError(path + ": file of " + std::to_string(size) +
                                   " bytes is more than the limit of " +
-                                  std::to_string(options.max_decompressed_bytes));
+                                  std::to_string(options.max_decompressed_bytes) +
+                                  std::string(readers::kRaiseInputLimit));
   }
   std::ostringstream stream;
   stream << file.rdbuf();

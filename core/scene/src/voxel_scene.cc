@@ -179,10 +179,12 @@ Result<std::vector<VoxelKey>> OccupiedKeys(const SceneInput& input, double r, ui
 Result<VoxelScene> Voxelize(const SceneInput& input, const VoxelizeOptions& options, const JobContext& ctx) {
   const double r = WorkingResolution(input, options);
   ctx.Report(Stage::kVoxelize, 0.0, "voxelising at " + std::to_string(r) + " m");
-  VC_ASSIGN_OR_RETURN(std::vector<VoxelKey> occupied, OccupiedKeys(input, r, options.memory_budget_bytes, ctx));
-  VC_ASSIGN_OR_RETURN(VoxelScene scene, SceneFromKeys(r, std::move(occupied), options.memory_budget_bytes, ctx));
-  scene.scan_origins = input.scan_origins;
-  return scene;
+  return CatchOutOfMemory("voxelising at " + std::to_string(r) + " m", [&]() -> Result<VoxelScene> {
+    VC_ASSIGN_OR_RETURN(std::vector<VoxelKey> occupied, OccupiedKeys(input, r, options.memory_budget_bytes, ctx));
+    VC_ASSIGN_OR_RETURN(VoxelScene scene, SceneFromKeys(r, std::move(occupied), options.memory_budget_bytes, ctx));
+    scene.scan_origins = input.scan_origins;
+    return scene;
+  });
 }
 
 VoxelAccumulator::VoxelAccumulator(double resolution_m, uint64_t memory_budget_bytes)

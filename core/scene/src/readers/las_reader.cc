@@ -66,7 +66,9 @@ Result<PointCloud> ReadLas(std::string_view bytes, std::string_view source,
   // Variable length records: look for the LASzip VLR (user "laszip encoded", record 22204).
   size_t pos = header_size;
   for (uint32_t i = 0; i < vlr_count; ++i) {
-    if (bytes.size() - pos < kVlrHeaderSize || pos + kVlrHeaderSize > point_offset) {
+    // pos can pass the end: the previous record's length is not checked against the file.
+    if (pos > bytes.size() || bytes.size() - pos < kVlrHeaderSize ||
+        pos + kVlrHeaderSize > point_offset) {
       return InvalidInput(source, "LAS header declares " + std::to_string(vlr_count) +
                                       " variable length records but record " + std::to_string(i) +
                                       " at byte " + std::to_string(pos) +

@@ -325,15 +325,16 @@ Status ReadCompressed(std::string_view bytes, std::string_view source, const Hea
                                     " bytes but the body ends after " + std::to_string(left) +
                                     "; file truncated?");
   }
-  if (uncompressed > options.max_decompressed_bytes) {
-    return ResourceExhaustedError(std::string(source) + ": PCD compressed block decompresses to " +
-                                  std::to_string(uncompressed) + " bytes, more than the limit of " +
-                                  std::to_string(options.max_decompressed_bytes));
-  }
   if (uncompressed > compressed * kMaxLzfRatio + 64) {
     return InvalidInput(source, "PCD compressed block of " + std::to_string(compressed) +
                                     " bytes cannot decompress to the declared " +
                                     std::to_string(uncompressed) + " bytes; corrupt header?");
+  }
+  if (uncompressed > options.max_decompressed_bytes) {
+    return ResourceExhaustedError(std::string(source) + ": PCD compressed block decompresses to " +
+                                  std::to_string(uncompressed) + " bytes, more than the limit of " +
+                                  std::to_string(options.max_decompressed_bytes) +
+                                  std::string(kRaiseInputLimit));
   }
   Result<std::string> raw = LzfDecompress(bytes.substr(pos + 8, compressed), uncompressed);
   if (!raw.ok()) {

@@ -91,13 +91,22 @@ inline Status InvalidInput(std::string_view source, std::string_view message) {
   return InvalidArgumentError(std::move(m));
 }
 
+// Ends a message about ReadOptions::max_decompressed_bytes: how the user raises it (ReadLimits).
+static_assert(kMaxDecompressionRatio == 16, "kRaiseInputLimit names the ratio");
+inline constexpr std::string_view kRaiseInputLimit =
+    " (16 x --max-upload-bytes, at most half of --memory-budget-bytes); send a smaller or less "
+    "compressible scene, or raise --max-upload-bytes or --memory-budget-bytes";
+// Ends a message about max_points / max_result_bytes: how the user raises them (ReadLimits).
+inline constexpr std::string_view kRaiseResultLimit =
+    " (set by --memory-budget-bytes); send a smaller scene or raise --memory-budget-bytes";
+
 // RESOURCE_EXHAUSTED when a declared point count is above options.max_points.
 inline Status CheckPointLimit(uint64_t declared, std::string_view what, std::string_view source,
                               const ReadOptions& options) {
   if (declared <= options.max_points) return Status::Ok();
   return ResourceExhaustedError(std::string(source) + ": " + std::string(what) + " declares " +
                                 std::to_string(declared) + " points, more than the limit of " +
-                                std::to_string(options.max_points));
+                                std::to_string(options.max_points) + std::string(kRaiseResultLimit));
 }
 
 // Parses all of `token` as a decimal floating-point number (leading '+' allowed, "nan"/"inf" too).

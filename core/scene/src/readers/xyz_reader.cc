@@ -128,7 +128,8 @@ Result<PointCloud> ReadXyz(std::string_view bytes, std::string_view source,
     ++total;
     if (total > options.max_points) {
       return ResourceExhaustedError(std::string(source) + ": more than the limit of " +
-                                    std::to_string(options.max_points) + " points");
+                                    std::to_string(options.max_points) + " points" +
+                                    std::string(kRaiseResultLimit));
     }
     cloud.Add(v[0], v[1], v[2]);
   }

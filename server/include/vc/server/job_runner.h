@@ -18,6 +18,7 @@
 #include "vc/base/progress.h"
 #include "vc/base/status.h"
 #include "vc/scene/scene_input.h"
+#include "vc/scene/voxel_scene.h"
 #include "vc/server/backend.h"
 #include "vc/v1/planner.pb.h"
 
@@ -31,6 +32,8 @@ struct Job {
   std::string peer;            // the client's address, for the log
   v1::UploadSpec upload;       // source name, stated format, size
   std::string data;            // the verified upload
+  // The job's memory budget (already capped by --max-memory-budget-bytes); bounds the reading.
+  uint64_t memory_budget_bytes = kDefaultMemoryBudgetBytes;
   Clock::time_point started;   // the call began
   Clock::time_point submitted; // the upload was verified and queued
 };
@@ -55,19 +58,21 @@ using JobFn = std::function<Status(const SceneInput& input, const JobContext& ct
 
 class JobRunner {
  public:
-  // `backend` must outlive the runner. Scenes decompressing past `max_memory_budget_bytes` are refused.
-  JobRunner(const Backend* backend, uint64_t max_memory_budget_bytes)
-      : backend_(backend), max_memory_budget_bytes_(max_memory_budget_bytes) {}
+  // `backend` must outlive the runner. Each job is read with ReadLimits(max_upload_bytes, the
+  // job's memory_budget_bytes) (vc/scene/scene_input.h): a decompression bomb or a lying header is
+  // refused before it is allocated.
+  JobRunner(const Backend* backend, uint64_t max_upload_bytes) : backend_(backend), max_upload_bytes_(max_upload_bytes) {}
 
   // On a worker thread: reads job.data, runs `fn`, logs the line; the job's status. CANCELLED or
-  // DEADLINE_EXCEEDED when `cancel` fired while queued; the reader's and fn's errors as they are.
+  // DEADLINE_EXCEEDED when `cancel` fired while queued; the reader's and fn's errors as they are;
+  // RESOURCE_EXHAUSTED when memory ran out (std::bad_alloc), INTERNAL for any other exception.
   Status Run(Job job, const CancelToken& cancel, ProgressFn progress, const JobFn& fn) const;
 
  private:
   Status Execute(Job& job, const JobContext& ctx, JobLog& log, const JobFn& fn) const;
 
   const Backend* const backend_;
-  const uint64_t max_memory_budget_bytes_;
+  const uint64_t max_upload_bytes_;
 };
 
 }  // namespace vc::server

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "vc/base/status.h"
+#include "vc/scene/scene_input.h"
 #include "vc/scene/voxel_scene.h"
 
 namespace vc::server {
@@ -18,7 +19,7 @@ struct ServerOptions {
   // Jobs that may wait for a worker (beyond those running); more get RESOURCE_EXHAUSTED.
   int queue = 16;
   // Largest upload accepted, in bytes.
-  uint64_t max_upload_bytes = uint64_t{1} << 30;
+  uint64_t max_upload_bytes = kDefaultMaxUploadBytes;
   // Upper bound on a job's memory budget (PlanOptions::memory_budget_bytes), in bytes; requests
   // above it are capped to it.
   uint64_t max_memory_budget_bytes = kDefaultMemoryBudgetBytes;

@@ -207,7 +207,9 @@ TEST(PcdReaderTest, ImplausibleUncompressedSizeIsRejectedBeforeAllocating) {
   Put<uint32_t>(&pcd, 2);
   Put<uint32_t>(&pcd, 3'600'000'000u);
   pcd += std::string(2, '\0');
-  Result<SceneInput> r = ReadScene(pcd, "bomb.pcd");
+  ReadOptions options;  // above the default max_points: raise it to reach the size check
+  options.max_points = uint64_t{1} << 40;
+  Result<SceneInput> r = ReadScene(pcd, "bomb.pcd", options);
   ASSERT_FALSE(r.ok());
   EXPECT_EQ(r.status().code(), StatusCode::kInvalidArgument);
   EXPECT_THAT(r.status().message(),

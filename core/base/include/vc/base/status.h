@@ -7,6 +7,7 @@
 #pragma once
 
 #include <cassert>
+#include <new>
 #include <string>
 #include <string_view>
 #include <utility>
@@ -102,6 +103,23 @@ class [[nodiscard]] Result {
  private:
   std::variant<T, Status> v_;
 };
+
+// Calls fn() (returning a Status or Result) and turns a std::bad_alloc thrown inside into
+// RESOURCE_EXHAUSTED "<what> ran out of memory ...; <advice>". For the boundaries where a job
+// allocates in proportion to its input (reading, voxelising): the limits there are checked before
+// allocating, and this backstop covers a machine with less free memory than the limits allow.
+template <typename F>
+auto CatchOutOfMemory(std::string_view what, F&& fn) -> decltype(fn()) {
+  try {
+    return fn();
+  } catch (const std::bad_alloc&) {
+    return Status(StatusCode::kResourceExhausted,
+                  std::string(what) +
+                      " ran out of memory, within the limits but beyond the memory free now; "
+                      "retry later, send a smaller scene or use a coarser resolution, or lower "
+                      "--memory-budget-bytes to what the machine can hold");
+  }
+}
 
 }  // namespace vc
 

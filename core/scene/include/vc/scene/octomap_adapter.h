@@ -6,6 +6,7 @@
 // writing.
 #pragma once
 
+#include <cstdint>
 #include <functional>
 #include <memory>
 #include <string_view>
@@ -22,12 +23,21 @@ class OcTree;
 
 namespace vc {
 
-// Parses an OctoMap binary stream (.bt). INVALID_ARGUMENT naming `source` when malformed.
-Result<std::shared_ptr<octomap::OcTree>> ReadOctreeBinary(std::string_view bytes, std::string_view source);
+// Bytes OctoMap takes per tree node, as ReadOctree* estimate it (a 16-byte node, an eighth of an
+// inner node's 64-byte child array, allocator overhead).
+inline constexpr uint64_t kOctreeNodeBytes = 48;
+
+// Parses an OctoMap binary stream (.bt). INVALID_ARGUMENT naming `source` when malformed;
+// RESOURCE_EXHAUSTED, before OctoMap allocates, when the tree would take more than
+// `max_tree_bytes` (kOctreeNodeBytes per node).
+Result<std::shared_ptr<octomap::OcTree>> ReadOctreeBinary(std::string_view bytes, std::string_view source,
+                                                          uint64_t max_tree_bytes = UINT64_MAX);
 
 // Parses an OctoMap full stream (.ot) holding an OcTree. INVALID_ARGUMENT when malformed or when
 // the stream holds another tree type (e.g. ColorOcTree is accepted only as its occupancy).
-Result<std::shared_ptr<octomap::OcTree>> ReadOctreeText(std::string_view bytes, std::string_view source);
+// RESOURCE_EXHAUSTED as ReadOctreeBinary.
+Result<std::shared_ptr<octomap::OcTree>> ReadOctreeText(std::string_view bytes, std::string_view source,
+                                                        uint64_t max_tree_bytes = UINT64_MAX);
 
 // A scan graph (.graph): every node's points transformed to the world frame, and each node's origin.
 struct ScanGraphData {

@@ -40,13 +40,32 @@ std::string_view InputFormatName(InputFormat format);
 enum class Compression { kNone, kGzip, kBzip2 };
 std::string_view CompressionName(Compression c);  // "none", "gzip", "bzip2"
 
-// Limits that protect the process from hostile or broken inputs.
+// Decompressed bytes allowed per byte of the upload limit (see ReadLimits). Real scans compress
+// 2-8x (the hall scan's bzip2: 2.9x); a zero-filled bomb compresses up to 1000x (gzip) or far more
+// (bzip2), so 16 leaves room for compressible clouds and refuses bombs.
+inline constexpr uint64_t kMaxDecompressionRatio = 16;
+// vc-server's default --max-upload-bytes, in bytes.
+inline constexpr uint64_t kDefaultMaxUploadBytes = uint64_t{1} << 30;
+// Bytes one read point takes in SceneInput::points.
+inline constexpr uint64_t kBytesPerPoint = sizeof(Eigen::Vector3f);
+
+// Limits that protect the process from hostile or broken inputs. Every limit is checked before
+// the memory it guards is allocated (decompression is checked while streaming). The defaults are
+// ReadLimits(kDefaultMaxUploadBytes, kDefaultMemoryBudgetBytes) (voxel_scene.h: 4 GiB).
 struct ReadOptions {
-  // Refuse inputs that would decompress to more than this many bytes.
-  uint64_t max_decompressed_bytes = uint64_t{8} << 30;
+  // Refuse inputs that are, or decompress to, more than this many bytes.
+  uint64_t max_decompressed_bytes = uint64_t{2} << 30;
   // Refuse clouds with more points than this (checked against the header before reading).
-  uint64_t max_points = 1'000'000'000;
+  uint64_t max_points = (uint64_t{2} << 30) / kBytesPerPoint;
+  // Refuse inputs whose parsed form (points, OctoMap nodes) would take more than this many bytes.
+  uint64_t max_result_bytes = uint64_t{2} << 30;
 };
+
+// The read limits for a job allowed `max_upload_bytes` of (compressed) upload and a memory budget
+// of `memory_budget_bytes`: decompressed bytes at most min(kMaxDecompressionRatio x the upload
+// limit, half the budget); the parsed result at most half the budget. vc-server and vc-client
+// inspect both call this, so they accept the same inputs. Zero arguments are treated as 1.
+ReadOptions ReadLimits(uint64_t max_upload_bytes, uint64_t memory_budget_bytes);
 
 // What was read. Exactly one of `points` (point formats, .graph) or `octree` (.bt/.ot) is filled.
 struct SceneInput {
@@ -69,7 +88,7 @@ struct SceneInput {
 // Detects the format of `bytes` (after decompression) and parses it. `source_name` only labels
 // error messages (a file name or "upload"). Errors: INVALID_ARGUMENT for malformed or unsupported
 // content (truncated, wrong counts, unknown types, LAZ, empty cloud), RESOURCE_EXHAUSTED when a
-// limit in `options` is exceeded.
+// limit in `options` is exceeded, or when memory runs out while reading (never an exception).
 Result<SceneInput> ReadScene(std::string_view bytes, std::string_view source_name,
                              const ReadOptions& options = {});
 

@@ -1,0 +1,71 @@
+#!/usr/bin/env bash
+# Builds the libFuzzer targets (the `fuzz` preset: clang++, ASan + UBSan) and runs each in turn,
+# one process at a time, from the checked-in seeds plus slices of ../shared/data.
+# Usage: scripts/fuzz.sh [--seconds N] [--only TARGET]   (default 180 s per target; CI: --seconds 10)
+# Findings (crash-*, leak-*, timeout-*, oom-*) land in build/fuzz/findings/<target>/; the script
+# exits non-zero if any target found one. Turn each into a regression test (docs/RELIABILITY.md).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+seconds=180
+only=""
+while (($#)); do
+  case "$1" in
+    --seconds) seconds="$2"; shift 2 ;;
+    --only) only="$2"; shift 2 ;;
+    *) echo "usage: scripts/fuzz.sh [--seconds N] [--only TARGET]" >&2; exit 2 ;;
+  esac
+done
+
+targets=(read_scene_fuzzer ply_fuzzer pcd_fuzzer xyz_fuzzer las_fuzzer octomap_bt_fuzzer
+         octomap_ot_fuzzer octomap_graph_fuzzer gzip_fuzzer bzip2_fuzzer lzf_fuzzer stations_csv_fuzzer)
+if [[ -n "$only" ]]; then targets=("$only"); fi
+
+cmake --preset fuzz >/dev/null
+cmake --build --preset fuzz --target "${targets[@]}"
+
+build=build/fuzz
+data=../shared/data
+work="$build/corpus"
+mkdir -p "$work"
+# Slices of the real data: the first KiB of each file (headers and the first records), and a
+# compressed slice of the hall scan for the decompressors.
+slices="$build/slices"
+mkdir -p "$slices"
+if [[ -d "$data" ]]; then
+  head -c 4096 "$data/geb079/geb079.bt" >"$slices/geb079-head.bt" || true
+  for f in "$data"/room-2scans/*.pcd; do head -c 4096 "$f" >"$slices/$(basename "$f" .pcd)-head.pcd"; done
+  bzcat "$data/hall-scan/scan.dat.bz2" | head -c 4096 >"$slices/hall-head.xyz" || true
+  gzip -9 -c "$slices/hall-head.xyz" >"$slices/hall-head.xyz.gz"
+  bzip2 -9 -c "$slices/hall-head.xyz" >"$slices/hall-head.xyz.bz2"
+fi
+slice_for() {  # the slices that suit a target
+  case "$1" in
+    read_scene_fuzzer) ls "$slices"/* ;;
+    pcd_fuzzer) ls "$slices"/*.pcd ;;
+    xyz_fuzzer) ls "$slices"/*.xyz ;;
+    octomap_bt_fuzzer) ls "$slices"/*.bt ;;
+    gzip_fuzzer) ls "$slices"/*.gz ;;
+    bzip2_fuzzer) ls "$slices"/*.bz2 ;;
+  esac 2>/dev/null || true
+}
+
+failed=0
+for t in "${targets[@]}"; do
+  corpus="$work/$t"
+  findings="$build/findings/$t"
+  mkdir -p "$corpus" "$findings"
+  cp -n fuzz/corpus/"$t"/* "$corpus"/ 2>/dev/null || true
+  for s in $(slice_for "$t"); do cp -n "$s" "$corpus"/; done
+  echo "== $t: ${seconds}s"
+  # -malloc_limit_mb: the targets read with 1 MiB decompressed / 32 MiB result limits
+  # (fuzz/fuzz_options.h); any single allocation above 256 MiB is a missing bound.
+  if ! "$build/fuzz/$t" "$corpus" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 \
+      -malloc_limit_mb=256 -max_len=65536 -artifact_prefix="$findings/" -print_final_stats=1 \
+      2>"$build/$t.log"; then
+    failed=1
+    echo "   FOUND: $(ls "$findings")"
+  fi
+  grep -E "^stat::number_of_executed_units|^#[0-9]+.*DONE" "$build/$t.log" | tail -2 | sed 's/^/   /'
+done
+exit "$failed"
