@@ -2,6 +2,7 @@
 # Runs every test. Installs the dependencies, checks the layering and the formatting, then:
 #   release  - build everything, run every test (including the `slow` ones) and vc-bench --quick
 #   asan     - AddressSanitizer + UndefinedBehaviorSanitizer: every test except the `slow` label
+#   fuzz     - every libFuzzer target (fuzz/, clang + ASan + UBSan) for 10 s each
 #   tsan     - ThreadSanitizer on the tests whose concurrency is all ours (label `tsan`): the worker
 #              pool, upload assembler, outbox, job runner, status mapping, wire code and the
 #              multi-threaded visibility engine. The gRPC
@@ -12,7 +13,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh
 
-presets=(release asan tsan)
+presets=(release asan tsan fuzz)
 if [[ "${1:-}" == "--quick" ]]; then presets=(release); fi
 
 start=$(date +%s)
@@ -22,7 +23,7 @@ git ls-files '*.h' '*.cc' | xargs clang-format --dry-run --Werror
 echo "clang-format: every tracked .h/.cc file is formatted"
 for p in "${presets[@]}"; do
   echo "=== preset $p: configure and build"
-  cmake --preset "$p" >/dev/null
+  [[ "$p" == fuzz ]] || cmake --preset "$p" >/dev/null
   case "$p" in
     tsan)
       # Only the service and its tests: the core is covered by the other presets.
@@ -30,6 +31,10 @@ for p in "${presets[@]}"; do
         visibility_test
       echo "=== preset $p: tests labelled tsan"
       ctest --preset "$p" -L tsan
+      ;;
+    fuzz)
+      # Every libFuzzer target for 10 s from its seeds (scripts/fuzz.sh; long runs: docs/RELIABILITY.md).
+      bash scripts/fuzz.sh --seconds 10
       ;;
     asan)
       cmake --build --preset "$p"
