@@ -5,9 +5,9 @@
 #include <string>
 
 #include "vc/raycast/ray_traversal.h"
+#include "vc/scene/voxel_scene.h"
 #include "vc/synth/synth.h"
 #include "vc/visibility/visibility.h"
-#include "vc/scene/voxel_scene.h"
 
 namespace {
 
@@ -29,7 +29,9 @@ void BM_FirstOccupied(benchmark::State& state) {
   const vc::WorldPoint lo = s.BoundsMin(), hi = s.BoundsMax();
   std::uniform_real_distribution<double> ux(lo.x(), hi.x()), uy(lo.y(), hi.y()), uz(lo.z(), hi.z());
   std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> rays(4096);
-  for (auto& r : rays) r = {vc::WorldPoint(ux(rng), uy(rng), uz(rng)) / s.resolution_m, vc::WorldPoint(ux(rng), uy(rng), uz(rng)) / s.resolution_m};
+  for (auto& r : rays)
+    r = {vc::WorldPoint(ux(rng), uy(rng), uz(rng)) / s.resolution_m,
+         vc::WorldPoint(ux(rng), uy(rng), uz(rng)) / s.resolution_m};
   size_t i = 0;
   for (auto _ : state) {
     const auto& r = rays[i++ & 4095];

@@ -5,11 +5,10 @@
 // end-to-end plan per stage; peak RSS; and scaling tables against footprint and candidate
 // spacing. No assertions on time: figures are printed for docs/BENCHMARKS.md. `--quick` runs a
 // small scene in seconds so CI keeps the tool building and running.
+#include <hwy/targets.h>
 #include <sys/resource.h>
 
 #include <CLI/CLI.hpp>
-#include <hwy/targets.h>
-
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -19,13 +18,13 @@
 #include <thread>
 
 #include "vc/plan/candidates.h"
-#include "vc/scene/octomap_adapter.h"
 #include "vc/plan/planner.h"
 #include "vc/raycast/ray_traversal.h"
+#include "vc/scene/octomap_adapter.h"
 #include "vc/scene/scene_input.h"
+#include "vc/scene/voxel_scene.h"
 #include "vc/synth/synth.h"
 #include "vc/visibility/visibility.h"
-#include "vc/scene/voxel_scene.h"
 
 namespace {
 
@@ -102,8 +101,8 @@ int VisibilityOnly(const vc::VoxelScene& s, double grid, int every, int threads,
     std::printf(" s; best %.3f s; %s\n", best, check.c_str());
   };
   char title[160];
-  std::snprintf(title, sizeof title, "visibility sets (surface, grouped), %zu of %zu candidates, %d threads", some.size(),
-                all.size(), threads);
+  std::snprintf(title, sizeof title, "visibility sets (surface, grouped), %zu of %zu candidates, %d threads",
+                some.size(), all.size(), threads);
   rounds(title, [&] {
     vc::VisibilitySetsOptions o;
     o.threads = threads;
@@ -187,9 +186,10 @@ int FineEvaluation(int threads) {
     const double scale = ev->global_visibility_ci95 / 0.005;
     eo.sample_faces = uint64_t(double(eo.sample_faces) * scale * scale * 1.1) + 1;
   }
-  std::printf("| figure | seconds |\n|---|---|\n| stream and voxelise 0.005 m -> 0.01 m | %.1f |\n"
-              "| sampled evaluation, 10 stations | %.1f |\n| **total** | **%.1f** |\n",
-              Seconds(figure_start) - eval_s, eval_s, Seconds(figure_start));
+  std::printf(
+      "| figure | seconds |\n|---|---|\n| stream and voxelise 0.005 m -> 0.01 m | %.1f |\n"
+      "| sampled evaluation, 10 stations | %.1f |\n| **total** | **%.1f** |\n",
+      Seconds(figure_start) - eval_s, eval_s, Seconds(figure_start));
   std::printf("peak RSS: %.1f MiB (whole run %.1f s)\n", PeakRssMiB(), Seconds(start));
   return ev->global_visibility_ci95 <= 0.005 ? 0 : 1;
 }
@@ -346,8 +346,8 @@ int main(int argc, char** argv) {
       const std::string name = vc::FirstOccupiedBatch(s.grid, seg_a, seg_b, forced, vc::BatchKernel::kLanes);
       const double rps = double(ray_set.size()) / Seconds(t0);
       const bool same = forced == ours;
-      std::printf("| vc FirstOccupiedBatch (%s, forced) | %zu | %.0f | %.1fx | one round |%s\n", name.c_str(), ray_set.size(), rps,
-                  rps / theirs_rps, same ? "" : " DIFFERENT");
+      std::printf("| vc FirstOccupiedBatch (%s, forced) | %zu | %.0f | %.1fx | one round |%s\n", name.c_str(),
+                  ray_set.size(), rps, rps / theirs_rps, same ? "" : " DIFFERENT");
       forced_differ += !same;
     }
     hwy::SetSupportedTargetsForTest(0);
@@ -377,7 +377,8 @@ int main(int argc, char** argv) {
     }
     if (print) {
       std::printf("\n## End-to-end plan (%d threads)\n| stage | seconds |\n|---|---|\n", threads);
-      for (const auto& t : plan->timings) std::printf("| %s | %.3f |\n", std::string(vc::StageName(t.stage)).c_str(), t.seconds);
+      for (const auto& t : plan->timings)
+        std::printf("| %s | %.3f |\n", std::string(vc::StageName(t.stage)).c_str(), t.seconds);
       std::printf("| total | %.3f |\n", plan->total_seconds);
       std::printf("| **total (wall, incl. voxelise)** | **%.3f** |\n", total);
       std::printf("%zu stations from %llu candidates; %llu occupied, %llu coverable, %llu covered voxels; G = %.4f\n",
@@ -404,7 +405,9 @@ int main(int argc, char** argv) {
   std::printf("\npeak RSS: %.1f MiB\n", PeakRssMiB());
 
   if (scaling && !input->octree) {
-    std::printf("\n## Scaling: footprint (candidate grid %.2f m)\n| footprint | occupied voxels | plan s |\n|---|---|---|\n", grid);
+    std::printf(
+        "\n## Scaling: footprint (candidate grid %.2f m)\n| footprint | occupied voxels | plan s |\n|---|---|---|\n",
+        grid);
     for (int tiles : {1, 2, 4}) {
       auto in = LoadScene(scene, spacing, tiles);
       if (!in.ok()) continue;

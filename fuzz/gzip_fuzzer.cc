@@ -8,7 +8,6 @@
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::string_view bytes(reinterpret_cast<const char*>(data), size);
-  (void)vc::readers::Decompress(bytes, vc::Compression::kGzip, "fuzz",
-                                vc::fuzz::Limits().max_decompressed_bytes);
+  (void)vc::readers::Decompress(bytes, vc::Compression::kGzip, "fuzz", vc::fuzz::Limits().max_decompressed_bytes);
   return 0;
 }

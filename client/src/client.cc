@@ -170,7 +170,7 @@ Result<PlanResult> Client::Plan(const Upload& upload, const PlanOptions& options
 }
 
 Result<Evaluation> Client::Evaluate(const Upload& upload, const EvaluateJobOptions& options,
-                                        const JobObserver& observer) {
+                                    const JobObserver& observer) {
   auto stub = v1::StationPlanner::NewStub(channel_);
   v1::EvaluateRequest spec;
   *spec.mutable_spec()->mutable_upload() = MakeUploadSpec(upload);

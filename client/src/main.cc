@@ -2,9 +2,9 @@
 // Exit status: 0 on success, else the gRPC status code number of the failure (3 invalid
 // argument, 5 not found, 8 resource exhausted, 14 unavailable, 16 unauthenticated, ...; local
 // errors use the same numbers); command-line mistakes give CLI11's codes (>= 100).
-#include <CLI/CLI.hpp>
 #include <unistd.h>
 
+#include <CLI/CLI.hpp>
 #include <cstdio>
 #include <iostream>
 #include <string>
@@ -36,7 +36,8 @@ int FailCall(const std::string& what, const vc::Status& s, const std::string& se
 
 void PrintStations(const vc::PlanResult& r) {
   std::printf("%zu station(s), coverage %.1f%% of %llu coverable voxels, global visibility G = %.3f\n",
-              r.stations.size(), r.coverable_voxels ? 100.0 * double(r.covered_voxels) / double(r.coverable_voxels) : 0.0,
+              r.stations.size(),
+              r.coverable_voxels ? 100.0 * double(r.covered_voxels) / double(r.coverable_voxels) : 0.0,
               static_cast<unsigned long long>(r.coverable_voxels), r.evaluation.overall.global_visibility);
   std::printf("  %3s %10s %10s %10s %12s %9s\n", "#", "x_m", "y_m", "z_m", "gain_voxels", "coverage");
   for (size_t i = 0; i < r.stations.size(); ++i) {
@@ -96,7 +97,8 @@ int main(int argc, char** argv) {
   // evaluate
   vc::EvaluateJobOptions eval;
   std::string viewpoints_csv;
-  auto* evaluate = app.add_subcommand("evaluate", "evaluate viewpoints on a scene on the server; write evaluation.json");
+  auto* evaluate =
+      app.add_subcommand("evaluate", "evaluate viewpoints on a scene on the server; write evaluation.json");
   evaluate->add_option("FILE", file, "scene file")->required();
   evaluate->add_option("--viewpoints", viewpoints_csv, "CSV of viewpoints x,y,z (e.g. stations.csv)")->required();
   evaluate->add_option("--out", out_dir, "output directory")->capture_default_str();
@@ -173,8 +175,7 @@ int main(int argc, char** argv) {
   if (!r.ok()) return FailCall("evaluate", r.status(), conn.server);
   vc::Status written = vc::WriteEvaluationOutputs(*r, eval.viewpoints, out_dir);
   if (!written.ok()) return Fail("cannot write evaluation.json", written);
-  std::printf("global visibility G = %.4f%s over %llu faces; wrote %s/evaluation.json\n",
-              r->overall.global_visibility,
+  std::printf("global visibility G = %.4f%s over %llu faces; wrote %s/evaluation.json\n", r->overall.global_visibility,
               r->sampled ? (" (+/- " + std::to_string(r->global_visibility_ci95) + ", sampled)").c_str() : "",
               static_cast<unsigned long long>(r->faces_evaluated), out_dir.c_str());
   return 0;

@@ -28,15 +28,16 @@ void ProgressDisplay::Update(const ProgressEvent& e) {
     std::string bar(size_t(filled), '#');
     bar.append(size_t(kWidth - filled), '-');
     std::string msg = e.message.size() > 40 ? e.message.substr(0, 37) + "..." : e.message;
-    std::fprintf(out_, "\r\033[K[%s] %3d%% %-12s %s", bar.c_str(), int(f * 100), std::string(StageName(e.stage)).c_str(), msg.c_str());
+    std::fprintf(out_, "\r\033[K[%s] %3d%% %-12s %s", bar.c_str(), int(f * 100),
+                 std::string(StageName(e.stage)).c_str(), msg.c_str());
     std::fflush(out_);
     bar_shown_ = true;
     return;
   }
   const int quarter = int(f * 4);
   if (e.stage != stage_ || quarter > last_quarter_) {
-    std::fprintf(out_, "progress: %-12s %3d%%%s%s\n", std::string(StageName(e.stage)).c_str(), int(f * 100), e.message.empty() ? "" : "  ",
-                 e.message.c_str());
+    std::fprintf(out_, "progress: %-12s %3d%%%s%s\n", std::string(StageName(e.stage)).c_str(), int(f * 100),
+                 e.message.empty() ? "" : "  ", e.message.c_str());
     std::fflush(out_);
   }
   if (e.stage != stage_) last_quarter_ = -1;
@@ -46,9 +47,10 @@ void ProgressDisplay::Update(const ProgressEvent& e) {
 
 void ProgressDisplay::Station(const PlannedStation& s, int index) {
   char line[160];
-  std::snprintf(line, sizeof line, "picked station %d (provisional) at (%.2f, %.2f, %.2f): +%llu voxels, coverage %.1f%%",
-                index + 1, s.position.x(), s.position.y(), s.position.z(),
-                static_cast<unsigned long long>(s.marginal_gain), 100.0 * s.cumulative_coverage);
+  std::snprintf(line, sizeof line,
+                "picked station %d (provisional) at (%.2f, %.2f, %.2f): +%llu voxels, coverage %.1f%%", index + 1,
+                s.position.x(), s.position.y(), s.position.z(), static_cast<unsigned long long>(s.marginal_gain),
+                100.0 * s.cumulative_coverage);
   Note(line);
 }
 

@@ -2,11 +2,10 @@
 //   vc-synth SCENE [--spacing S] [--seed N] --out FILE.ply
 //   vc-synth --list
 // Exit codes: 0 success, 2 bad usage or failure (one sentence on stderr).
+#include <CLI/CLI.hpp>
 #include <cstdint>
 #include <cstdio>
 #include <string>
-
-#include <CLI/CLI.hpp>
 
 #include "vc/synth/synth.h"
 

@@ -17,35 +17,49 @@ WorldPoint FromProto(const v1::Point& p) { return {p.x_m(), p.y_m(), p.z_m()}; }
 
 v1::InputFormat ToProto(InputFormat f) {
   switch (f) {
-    case InputFormat::kPly: return v1::INPUT_FORMAT_PLY;
-    case InputFormat::kPcd: return v1::INPUT_FORMAT_PCD;
-    case InputFormat::kXyz: return v1::INPUT_FORMAT_XYZ;
-    case InputFormat::kLas: return v1::INPUT_FORMAT_LAS;
-    case InputFormat::kOctomapBinary: return v1::INPUT_FORMAT_OCTOMAP_BT;
-    case InputFormat::kOctomapText: return v1::INPUT_FORMAT_OCTOMAP_OT;
-    case InputFormat::kOctomapGraph: return v1::INPUT_FORMAT_OCTOMAP_GRAPH;
+    case InputFormat::kPly:
+      return v1::INPUT_FORMAT_PLY;
+    case InputFormat::kPcd:
+      return v1::INPUT_FORMAT_PCD;
+    case InputFormat::kXyz:
+      return v1::INPUT_FORMAT_XYZ;
+    case InputFormat::kLas:
+      return v1::INPUT_FORMAT_LAS;
+    case InputFormat::kOctomapBinary:
+      return v1::INPUT_FORMAT_OCTOMAP_BT;
+    case InputFormat::kOctomapText:
+      return v1::INPUT_FORMAT_OCTOMAP_OT;
+    case InputFormat::kOctomapGraph:
+      return v1::INPUT_FORMAT_OCTOMAP_GRAPH;
   }
   return v1::INPUT_FORMAT_UNSPECIFIED;
 }
 
 Result<InputFormat> FromProto(v1::InputFormat f) {
   switch (f) {
-    case v1::INPUT_FORMAT_PLY: return InputFormat::kPly;
-    case v1::INPUT_FORMAT_PCD: return InputFormat::kPcd;
-    case v1::INPUT_FORMAT_XYZ: return InputFormat::kXyz;
-    case v1::INPUT_FORMAT_LAS: return InputFormat::kLas;
-    case v1::INPUT_FORMAT_OCTOMAP_BT: return InputFormat::kOctomapBinary;
-    case v1::INPUT_FORMAT_OCTOMAP_OT: return InputFormat::kOctomapText;
-    case v1::INPUT_FORMAT_OCTOMAP_GRAPH: return InputFormat::kOctomapGraph;
-    default: break;
+    case v1::INPUT_FORMAT_PLY:
+      return InputFormat::kPly;
+    case v1::INPUT_FORMAT_PCD:
+      return InputFormat::kPcd;
+    case v1::INPUT_FORMAT_XYZ:
+      return InputFormat::kXyz;
+    case v1::INPUT_FORMAT_LAS:
+      return InputFormat::kLas;
+    case v1::INPUT_FORMAT_OCTOMAP_BT:
+      return InputFormat::kOctomapBinary;
+    case v1::INPUT_FORMAT_OCTOMAP_OT:
+      return InputFormat::kOctomapText;
+    case v1::INPUT_FORMAT_OCTOMAP_GRAPH:
+      return InputFormat::kOctomapGraph;
+    default:
+      break;
   }
   return InvalidArgumentError("unknown input format value " + std::to_string(int(f)) +
                               " in the upload spec; leave it unset to detect the format from the content");
 }
 
 v1::SelectionTest ToProto(SelectionTest t) {
-  return t == SelectionTest::kCompatibility ? v1::SELECTION_TEST_COMPATIBILITY
-                                            : v1::SELECTION_TEST_SURFACE_VISIBILITY;
+  return t == SelectionTest::kCompatibility ? v1::SELECTION_TEST_COMPATIBILITY : v1::SELECTION_TEST_SURFACE_VISIBILITY;
 }
 
 v1::FaceSet ToProto(FaceSet f) { return f == FaceSet::kExposed ? v1::FACE_SET_EXPOSED : v1::FACE_SET_ALL; }
@@ -74,10 +88,16 @@ Status FromWire(v1::SelectionTest wire, SelectionTest* out) {
 }
 Status FromWire(v1::FaceSet wire, FaceSet* out) {
   switch (wire) {
-    case v1::FACE_SET_UNSPECIFIED: return Status::Ok();
-    case v1::FACE_SET_ALL: *out = FaceSet::kAll; return Status::Ok();
-    case v1::FACE_SET_EXPOSED: *out = FaceSet::kExposed; return Status::Ok();
-    default: break;
+    case v1::FACE_SET_UNSPECIFIED:
+      return Status::Ok();
+    case v1::FACE_SET_ALL:
+      *out = FaceSet::kAll;
+      return Status::Ok();
+    case v1::FACE_SET_EXPOSED:
+      *out = FaceSet::kExposed;
+      return Status::Ok();
+    default:
+      break;
   }
   return InvalidArgumentError("unknown face set value " + std::to_string(int(wire)) + "; use ALL or EXPOSED");
 }
@@ -187,21 +207,30 @@ Stage FromProto(v1::Stage s) {
 
 v1::StopReason ToProto(StopReason r) {
   switch (r) {
-    case StopReason::kExhausted: return v1::STOP_REASON_EXHAUSTED;
-    case StopReason::kTargetReached: return v1::STOP_REASON_TARGET_REACHED;
-    case StopReason::kMaxStations: return v1::STOP_REASON_MAX_STATIONS;
-    case StopReason::kMinGain: return v1::STOP_REASON_MIN_GAIN;
+    case StopReason::kExhausted:
+      return v1::STOP_REASON_EXHAUSTED;
+    case StopReason::kTargetReached:
+      return v1::STOP_REASON_TARGET_REACHED;
+    case StopReason::kMaxStations:
+      return v1::STOP_REASON_MAX_STATIONS;
+    case StopReason::kMinGain:
+      return v1::STOP_REASON_MIN_GAIN;
   }
   return v1::STOP_REASON_UNSPECIFIED;
 }
 
 Result<StopReason> FromProto(v1::StopReason r) {
   switch (r) {
-    case v1::STOP_REASON_EXHAUSTED: return StopReason::kExhausted;
-    case v1::STOP_REASON_TARGET_REACHED: return StopReason::kTargetReached;
-    case v1::STOP_REASON_MAX_STATIONS: return StopReason::kMaxStations;
-    case v1::STOP_REASON_MIN_GAIN: return StopReason::kMinGain;
-    default: break;
+    case v1::STOP_REASON_EXHAUSTED:
+      return StopReason::kExhausted;
+    case v1::STOP_REASON_TARGET_REACHED:
+      return StopReason::kTargetReached;
+    case v1::STOP_REASON_MAX_STATIONS:
+      return StopReason::kMaxStations;
+    case v1::STOP_REASON_MIN_GAIN:
+      return StopReason::kMinGain;
+    default:
+      break;
   }
   return DataLossError("the server's result carries an unknown stop reason (" + std::to_string(int(r)) +
                        "); update vc-client");
@@ -209,9 +238,12 @@ Result<StopReason> FromProto(v1::StopReason r) {
 
 Result<SelectionTest> FromProto(v1::SelectionTest t) {
   switch (t) {
-    case v1::SELECTION_TEST_SURFACE_VISIBILITY: return SelectionTest::kSurfaceVisibility;
-    case v1::SELECTION_TEST_COMPATIBILITY: return SelectionTest::kCompatibility;
-    default: break;
+    case v1::SELECTION_TEST_SURFACE_VISIBILITY:
+      return SelectionTest::kSurfaceVisibility;
+    case v1::SELECTION_TEST_COMPATIBILITY:
+      return SelectionTest::kCompatibility;
+    default:
+      break;
   }
   return InvalidArgumentError("unknown selection test value " + std::to_string(int(t)) +
                               "; use SURFACE_VISIBILITY or COMPATIBILITY");
@@ -398,8 +430,7 @@ Result<PlanResult> PlanResultAssembler::Finish(const v1::PlanResult& p) && {
                       std::to_string(p.heat_map_candidates()));
   }
   if (centers_.size() != p.voxel_count()) {
-    return ChunkError("received " + std::to_string(centers_.size()) + " voxels of " +
-                      std::to_string(p.voxel_count()));
+    return ChunkError("received " + std::to_string(centers_.size()) + " voxels of " + std::to_string(p.voxel_count()));
   }
   if (p.evaluation().face_value_voxels() != 0 && face_values_.size() != p.evaluation().face_value_voxels()) {
     return ChunkError("received face values for " + std::to_string(face_values_.size()) + " voxels of " +

@@ -38,10 +38,7 @@ namespace vc::server::internal {
 // Shared by every call of a service.
 struct ServiceState {
   ServiceState(const ServerOptions& o, Backend b)
-      : options(o),
-        backend(std::move(b)),
-        runner(&backend, o.max_upload_bytes),
-        pool(o.EffectiveWorkers(), o.queue) {}
+      : options(o), backend(std::move(b)), runner(&backend, o.max_upload_bytes), pool(o.EffectiveWorkers(), o.queue) {}
   const ServerOptions options;
   const Backend backend;
   const JobRunner runner;
@@ -72,8 +69,8 @@ class JobReactor : public grpc::ServerBidiReactor<Request, Response> {
   void Start() {
     const auto deadline = ctx_->deadline();
     if (deadline != std::chrono::system_clock::time_point::max()) {
-      token_.SetDeadline(Clock::now() + std::chrono::duration_cast<Clock::duration>(
-                                            deadline - std::chrono::system_clock::now()));
+      token_.SetDeadline(Clock::now() +
+                         std::chrono::duration_cast<Clock::duration>(deadline - std::chrono::system_clock::now()));
     }
     std::string why;
     if (!TokenMatches(*ctx_, state_->options.token, &why)) {

@@ -31,15 +31,16 @@ Status JobRunner::Run(Job job, const CancelToken& cancel, ProgressFn progress, c
   try {
     s = Execute(job, ctx, log, fn);
   } catch (const std::bad_alloc&) {
-    s = ResourceExhaustedError("the job (" + job.id + ") ran out of memory on this server; lower its memory_budget_bytes "
+    s = ResourceExhaustedError("the job (" + job.id +
+                               ") ran out of memory on this server; lower its memory_budget_bytes "
                                "(--memory-budget-bytes), raise resolution_m or grid_spacing_m, or retry later");
   } catch (const std::exception& e) {
     spdlog::error("job {}: unexpected exception: {}", job.id, e.what());
     s = InternalError("the server failed unexpectedly (job " + job.id + "); retry or report it");
   }
   const auto level = s.ok() || s.code() == StatusCode::kInvalidArgument ? spdlog::level::info
-                     : s.code() == StatusCode::kInternal                  ? spdlog::level::err
-                                                                          : spdlog::level::warn;
+                     : s.code() == StatusCode::kInternal                ? spdlog::level::err
+                                                                        : spdlog::level::warn;
   spdlog::log(level, "job {} {} peer={} upload={} upload={:.3f}s queued={:.3f}s{} elapsed={:.3f}s{} status={}", job.id,
               job.method, job.peer, HumanBytes(job.upload.total_size_bytes()), upload_s, wait_s, log.timings(),
               SecondsSince(job.started), log.details(), s.ok() ? std::string("OK") : s.ToString());

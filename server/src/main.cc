@@ -1,7 +1,7 @@
 // vc-server: flags and environment to ServerOptions, start, wait for SIGTERM/SIGINT, drain, exit 0.
-#include <CLI/CLI.hpp>
 #include <spdlog/spdlog.h>
 
+#include <CLI/CLI.hpp>
 #include <csignal>
 #include <cstdlib>
 #include <iostream>
@@ -14,29 +14,35 @@ int main(int argc, char** argv) {
   std::string log_level = "info";
   CLI::App app{"vc-server: plans laser-scanner stations over gRPC (vc.v1.StationPlanner)"};
   app.add_option("--listen", o.listen, "host:port to listen on (port 0 = any free port)")
-      ->envname("VC_LISTEN")->capture_default_str();
+      ->envname("VC_LISTEN")
+      ->capture_default_str();
   app.add_option("--workers", o.workers, "jobs running at once (0 = one per core)")
-      ->envname("VC_WORKERS")->capture_default_str();
+      ->envname("VC_WORKERS")
+      ->capture_default_str();
   app.add_option("--queue", o.queue, "jobs that may wait for a worker; more get RESOURCE_EXHAUSTED")
-      ->envname("VC_QUEUE")->capture_default_str();
+      ->envname("VC_QUEUE")
+      ->capture_default_str();
   app.add_option("--max-upload-bytes", o.max_upload_bytes, "largest upload accepted, in bytes")
-      ->envname("VC_MAX_UPLOAD_BYTES")->capture_default_str();
+      ->envname("VC_MAX_UPLOAD_BYTES")
+      ->capture_default_str();
   app.add_option("--max-memory-budget-bytes", o.max_memory_budget_bytes,
                  "upper bound on a job's memory budget, in bytes")
-      ->envname("VC_MAX_MEMORY_BUDGET_BYTES")->capture_default_str();
+      ->envname("VC_MAX_MEMORY_BUDGET_BYTES")
+      ->capture_default_str();
   app.add_option("--threads-per-job", o.threads_per_job, "threads per job (0 = cores / workers)")
-      ->envname("VC_THREADS_PER_JOB")->capture_default_str();
-  app.add_option("--tls-cert", o.tls_cert_file, "server certificate chain (PEM); enables TLS")
-      ->envname("VC_TLS_CERT");
+      ->envname("VC_THREADS_PER_JOB")
+      ->capture_default_str();
+  app.add_option("--tls-cert", o.tls_cert_file, "server certificate chain (PEM); enables TLS")->envname("VC_TLS_CERT");
   app.add_option("--tls-key", o.tls_key_file, "server private key (PEM)")->envname("VC_TLS_KEY");
   app.add_option("--tls-client-ca", o.tls_client_ca_file, "CA (PEM) for client certificates; enables mutual TLS")
       ->envname("VC_TLS_CLIENT_CA");
-  app.add_option("--token", o.token, "require 'authorization: Bearer TOKEN' on vc.v1 calls")
-      ->envname("VC_TOKEN");
+  app.add_option("--token", o.token, "require 'authorization: Bearer TOKEN' on vc.v1 calls")->envname("VC_TOKEN");
   app.add_option("--shutdown-grace", grace_s, "seconds running jobs get after SIGTERM before they are cancelled")
-      ->envname("VC_SHUTDOWN_GRACE")->capture_default_str();
+      ->envname("VC_SHUTDOWN_GRACE")
+      ->capture_default_str();
   app.add_option("--log-level", log_level, "trace, debug, info, warn, error")
-      ->envname("VC_LOG_LEVEL")->capture_default_str();
+      ->envname("VC_LOG_LEVEL")
+      ->capture_default_str();
   CLI11_PARSE(app, argc, argv);
   o.shutdown_grace = std::chrono::milliseconds(int64_t(grace_s * 1000));
   spdlog::set_level(spdlog::level::from_str(log_level));

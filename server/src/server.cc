@@ -58,8 +58,8 @@ Result<std::unique_ptr<Server>> Server::Start(const ServerOptions& options, Back
   }
   s->server_->GetHealthCheckService()->SetServingStatus(true);
   spdlog::info("vc-server listening on {} (port {}), {} workers x {} threads, queue {}, tls={}, token={}",
-               options.listen, s->port_, options.EffectiveWorkers(), options.EffectiveThreadsPerJob(),
-               options.queue, options.tls_cert_file.empty() ? "off" : (options.tls_client_ca_file.empty() ? "on" : "mutual"),
+               options.listen, s->port_, options.EffectiveWorkers(), options.EffectiveThreadsPerJob(), options.queue,
+               options.tls_cert_file.empty() ? "off" : (options.tls_client_ca_file.empty() ? "on" : "mutual"),
                options.token.empty() ? "off" : "on");
   return s;
 }

@@ -66,10 +66,10 @@ Status UploadAssembler::Finish() const {
                                 " bytes its spec declares; send all the data or fix total_size_bytes");
   }
   if (crc_.value() != upload_.crc32c()) {
-    return DataLossError(fmt::format(
-        "the upload's CRC32C is {:08x} but its spec declares {:08x}; the data was corrupted or the spec is "
-        "wrong: retry the upload",
-        crc_.value(), upload_.crc32c()));
+    return DataLossError(
+        fmt::format("the upload's CRC32C is {:08x} but its spec declares {:08x}; the data was corrupted or the spec is "
+                    "wrong: retry the upload",
+                    crc_.value(), upload_.crc32c()));
   }
   return Status::Ok();
 }

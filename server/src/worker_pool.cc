@@ -31,8 +31,7 @@ std::optional<WorkerPool::Ticket> WorkerPool::TryAdmit() {
   return Ticket(this);
 }
 
-void WorkerPool::Submit(Ticket ticket, const std::function<void(uint32_t)>& on_queued,
-                        std::function<void()> task) {
+void WorkerPool::Submit(Ticket ticket, const std::function<void(uint32_t)>& on_queued, std::function<void()> task) {
   ticket.pool_ = nullptr;  // the place is released when the task has run
   std::lock_guard lock(mu_);
   // Idle workers take the first `idle` queued tasks; the new task is at index queue_.size().

@@ -4,7 +4,6 @@
 
 #include <gtest/gtest.h>
 
-
 #include "server/test_server.h"
 
 namespace vc {
@@ -97,8 +96,8 @@ TEST(Client, UnavailableServerIsRetriedWithBackoffThenReported) {
   };
   auto r = (*c)->Plan({"x", "x.ply"}, PlanOptions{}, obs);
   EXPECT_EQ(r.status().code(), StatusCode::kUnavailable);
-  EXPECT_EQ(waits, (std::vector<std::chrono::milliseconds>{std::chrono::milliseconds(10),
-                                                           std::chrono::milliseconds(20)}));
+  EXPECT_EQ(waits,
+            (std::vector<std::chrono::milliseconds>{std::chrono::milliseconds(10), std::chrono::milliseconds(20)}));
 }
 
 TEST(Client, MissingTlsFileIsNotFound) {

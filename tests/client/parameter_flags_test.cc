@@ -34,10 +34,14 @@ FaceSet Other(FaceSet v, ParamCheck) { return v == FaceSet::kAll ? FaceSet::kExp
 // A value the row's check refuses, if there is one.
 std::optional<double> Bad(double, ParamCheck c) {
   switch (c) {
-    case ParamCheck::kAny: return std::numeric_limits<double>::quiet_NaN();
-    case ParamCheck::kNonNegative: return -0.5;
-    case ParamCheck::kPositive: return 0.0;
-    case ParamCheck::kFraction: return 1.5;
+    case ParamCheck::kAny:
+      return std::numeric_limits<double>::quiet_NaN();
+    case ParamCheck::kNonNegative:
+      return -0.5;
+    case ParamCheck::kPositive:
+      return 0.0;
+    case ParamCheck::kFraction:
+      return 1.5;
   }
   return std::nullopt;
 }
@@ -87,31 +91,31 @@ std::set<std::string> FieldNames(const google::protobuf::Descriptor* d) {
 
 TEST(ParameterTablesTest, EveryPlanRowIsAFlagAProtoFieldAPlanJsonKeyAndChecked) {
   const PlanOptions defaults;
-#define VC_PLAN_ROW(type, name, default_value, unit, flag, check, help)                     \
-  {                                                                                         \
-    SCOPED_TRACE(#name);                                                                    \
-    const type other = Other(defaults.name, ParamCheck::check);                             \
-    ASSERT_NE(other, defaults.name);                                                        \
-    PlanOptions parsed;                                                                     \
-    CLI::App app;                                                                           \
-    client::AddPlanFlags(&app, &parsed);                                                    \
-    app.parse(Args(flag, other), false);                                                    \
-    EXPECT_EQ(parsed.name, other) << "flag --" << flag;                                     \
-    PlanOptions o;                                                                          \
-    o.name = other;                                                                         \
-    Result<PlanOptions> back = wire::FromProto(wire::ToProto(o));                           \
-    ASSERT_TRUE(back.ok()) << back.status().ToString();                                     \
-    EXPECT_EQ(back->name, other) << "proto field " #name;                                   \
-    PlanResult r;                                                                           \
-    r.options = o;                                                                          \
-    EXPECT_EQ(json::parse(PlanToJson(r))["parameters"][#name], JsonValue(other));           \
-    if (const auto bad = Bad(defaults.name, ParamCheck::check)) {                           \
-      PlanOptions b;                                                                        \
-      b.name = *bad;                                                                        \
-      const Status s = b.Validate();                                                        \
-      EXPECT_EQ(s.code(), StatusCode::kInvalidArgument);                                    \
-      EXPECT_NE(s.message().find(#name), std::string::npos) << s.message();                 \
-    }                                                                                       \
+#define VC_PLAN_ROW(type, name, default_value, unit, flag, check, help)           \
+  {                                                                               \
+    SCOPED_TRACE(#name);                                                          \
+    const type other = Other(defaults.name, ParamCheck::check);                   \
+    ASSERT_NE(other, defaults.name);                                              \
+    PlanOptions parsed;                                                           \
+    CLI::App app;                                                                 \
+    client::AddPlanFlags(&app, &parsed);                                          \
+    app.parse(Args(flag, other), false);                                          \
+    EXPECT_EQ(parsed.name, other) << "flag --" << flag;                           \
+    PlanOptions o;                                                                \
+    o.name = other;                                                               \
+    Result<PlanOptions> back = wire::FromProto(wire::ToProto(o));                 \
+    ASSERT_TRUE(back.ok()) << back.status().ToString();                           \
+    EXPECT_EQ(back->name, other) << "proto field " #name;                         \
+    PlanResult r;                                                                 \
+    r.options = o;                                                                \
+    EXPECT_EQ(json::parse(PlanToJson(r))["parameters"][#name], JsonValue(other)); \
+    if (const auto bad = Bad(defaults.name, ParamCheck::check)) {                 \
+      PlanOptions b;                                                              \
+      b.name = *bad;                                                              \
+      const Status s = b.Validate();                                              \
+      EXPECT_EQ(s.code(), StatusCode::kInvalidArgument);                          \
+      EXPECT_NE(s.message().find(#name), std::string::npos) << s.message();       \
+    }                                                                             \
   }
   VC_PLAN_PARAMETERS(VC_PLAN_ROW)
 #undef VC_PLAN_ROW
@@ -119,30 +123,30 @@ TEST(ParameterTablesTest, EveryPlanRowIsAFlagAProtoFieldAPlanJsonKeyAndChecked) 
 
 TEST(ParameterTablesTest, EveryScannerRowIsAFlagOfBothCommandsAProtoFieldAndChecked) {
   const ScannerModel defaults;
-#define VC_SCANNER_ROW(type, name, default_value, unit, flag, check, help)                  \
-  {                                                                                         \
-    SCOPED_TRACE(#name);                                                                    \
-    const type other = Other(defaults.name, ParamCheck::check);                             \
-    PlanOptions plan;                                                                       \
-    CLI::App plan_app;                                                                      \
-    client::AddPlanFlags(&plan_app, &plan);                                                 \
-    plan_app.parse(Args(flag, other), false);                                               \
-    EXPECT_EQ(plan.scanner.name, other);                                                    \
-    EvaluateJobOptions eval;                                                                \
-    CLI::App eval_app;                                                                      \
-    client::AddEvaluateFlags(&eval_app, &eval);                                             \
-    eval_app.parse(Args(flag, other), false);                                               \
-    EXPECT_EQ(eval.scanner.name, other);                                                    \
-    EXPECT_EQ(wire::FromProto(wire::ToProto(plan))->scanner.name, other);                   \
-    EXPECT_EQ(wire::FromProto(wire::ToProto(eval))->scanner.name, other);                   \
-    PlanResult r;                                                                           \
-    r.options = plan;                                                                       \
+#define VC_SCANNER_ROW(type, name, default_value, unit, flag, check, help)                   \
+  {                                                                                          \
+    SCOPED_TRACE(#name);                                                                     \
+    const type other = Other(defaults.name, ParamCheck::check);                              \
+    PlanOptions plan;                                                                        \
+    CLI::App plan_app;                                                                       \
+    client::AddPlanFlags(&plan_app, &plan);                                                  \
+    plan_app.parse(Args(flag, other), false);                                                \
+    EXPECT_EQ(plan.scanner.name, other);                                                     \
+    EvaluateJobOptions eval;                                                                 \
+    CLI::App eval_app;                                                                       \
+    client::AddEvaluateFlags(&eval_app, &eval);                                              \
+    eval_app.parse(Args(flag, other), false);                                                \
+    EXPECT_EQ(eval.scanner.name, other);                                                     \
+    EXPECT_EQ(wire::FromProto(wire::ToProto(plan))->scanner.name, other);                    \
+    EXPECT_EQ(wire::FromProto(wire::ToProto(eval))->scanner.name, other);                    \
+    PlanResult r;                                                                            \
+    r.options = plan;                                                                        \
     EXPECT_EQ(json::parse(PlanToJson(r))["parameters"]["scanner"][#name], JsonValue(other)); \
-    if (const auto bad = Bad(defaults.name, ParamCheck::check)) {                           \
-      ScannerModel b;                                                                       \
-      b.name = *bad;                                                                        \
-      EXPECT_NE(b.Validate().message().find("scanner." #name), std::string::npos);          \
-    }                                                                                       \
+    if (const auto bad = Bad(defaults.name, ParamCheck::check)) {                            \
+      ScannerModel b;                                                                        \
+      b.name = *bad;                                                                         \
+      EXPECT_NE(b.Validate().message().find("scanner." #name), std::string::npos);           \
+    }                                                                                        \
   }
   VC_SCANNER_PARAMETERS(VC_SCANNER_ROW)
 #undef VC_SCANNER_ROW
@@ -151,25 +155,25 @@ TEST(ParameterTablesTest, EveryScannerRowIsAFlagOfBothCommandsAProtoFieldAndChec
 TEST(ParameterTablesTest, EveryEvaluateRowIsAFlagAProtoFieldAndChecked) {
   EvaluateJobOptions defaults;
   defaults.viewpoints = {{0, 0, 0}};
-#define VC_EVALUATE_ROW(type, name, default_value, unit, flag, check, help)                 \
-  {                                                                                         \
-    SCOPED_TRACE(#name);                                                                    \
-    const type other = Other(defaults.name, ParamCheck::check);                             \
-    EvaluateJobOptions parsed;                                                              \
-    CLI::App app;                                                                           \
-    client::AddEvaluateFlags(&app, &parsed);                                                \
-    app.parse(Args(flag, other), false);                                                    \
-    EXPECT_EQ(parsed.name, other) << "flag --" << flag;                                     \
-    EvaluateJobOptions o = defaults;                                                        \
-    o.name = other;                                                                         \
-    EXPECT_EQ(wire::FromProto(wire::ToProto(o))->name, other) << "proto field " #name;      \
-    if (const auto bad = Bad(defaults.name, ParamCheck::check)) {                           \
-      EvaluateJobOptions b = defaults;                                                      \
-      b.name = *bad;                                                                        \
-      const Status s = b.Validate();                                                        \
-      EXPECT_EQ(s.code(), StatusCode::kInvalidArgument);                                    \
-      EXPECT_NE(s.message().find(#name), std::string::npos) << s.message();                 \
-    }                                                                                       \
+#define VC_EVALUATE_ROW(type, name, default_value, unit, flag, check, help)            \
+  {                                                                                    \
+    SCOPED_TRACE(#name);                                                               \
+    const type other = Other(defaults.name, ParamCheck::check);                        \
+    EvaluateJobOptions parsed;                                                         \
+    CLI::App app;                                                                      \
+    client::AddEvaluateFlags(&app, &parsed);                                           \
+    app.parse(Args(flag, other), false);                                               \
+    EXPECT_EQ(parsed.name, other) << "flag --" << flag;                                \
+    EvaluateJobOptions o = defaults;                                                   \
+    o.name = other;                                                                    \
+    EXPECT_EQ(wire::FromProto(wire::ToProto(o))->name, other) << "proto field " #name; \
+    if (const auto bad = Bad(defaults.name, ParamCheck::check)) {                      \
+      EvaluateJobOptions b = defaults;                                                 \
+      b.name = *bad;                                                                   \
+      const Status s = b.Validate();                                                   \
+      EXPECT_EQ(s.code(), StatusCode::kInvalidArgument);                               \
+      EXPECT_NE(s.message().find(#name), std::string::npos) << s.message();            \
+    }                                                                                  \
   }
   VC_EVALUATE_PARAMETERS(VC_EVALUATE_ROW)
 #undef VC_EVALUATE_ROW

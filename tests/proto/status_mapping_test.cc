@@ -6,12 +6,23 @@ namespace vc::wire {
 namespace {
 
 TEST(StatusMapping, EveryCodeKeepsItsCanonicalNumberAndName) {
-  const StatusCode codes[] = {StatusCode::kOk, StatusCode::kCancelled, StatusCode::kInvalidArgument,
-                              StatusCode::kDeadlineExceeded, StatusCode::kNotFound, StatusCode::kResourceExhausted,
-                              StatusCode::kFailedPrecondition, StatusCode::kOutOfRange, StatusCode::kUnimplemented,
-                              StatusCode::kInternal, StatusCode::kDataLoss, StatusCode::kUnknown,
-                              StatusCode::kAlreadyExists, StatusCode::kPermissionDenied, StatusCode::kAborted,
-                              StatusCode::kUnavailable, StatusCode::kUnauthenticated};
+  const StatusCode codes[] = {StatusCode::kOk,
+                              StatusCode::kCancelled,
+                              StatusCode::kInvalidArgument,
+                              StatusCode::kDeadlineExceeded,
+                              StatusCode::kNotFound,
+                              StatusCode::kResourceExhausted,
+                              StatusCode::kFailedPrecondition,
+                              StatusCode::kOutOfRange,
+                              StatusCode::kUnimplemented,
+                              StatusCode::kInternal,
+                              StatusCode::kDataLoss,
+                              StatusCode::kUnknown,
+                              StatusCode::kAlreadyExists,
+                              StatusCode::kPermissionDenied,
+                              StatusCode::kAborted,
+                              StatusCode::kUnavailable,
+                              StatusCode::kUnauthenticated};
   const int expected[] = {0, 1, 3, 4, 5, 8, 9, 11, 12, 13, 15, 2, 6, 7, 10, 14, 16};  // google.rpc.Code
   for (size_t i = 0; i < std::size(codes); ++i) {
     EXPECT_EQ(int(ToGrpcCode(codes[i])), expected[i]) << StatusCodeName(codes[i]);

@@ -77,9 +77,9 @@ TEST(JobRunner, UnnamedUploadIsCalledUpload) {
   CancelToken token;
   Job job = f.MakeJob("1");
   job.upload.clear_source_name();
-  ASSERT_TRUE(runner.Run(std::move(job), token, {}, [](const SceneInput&, const JobContext&, JobLog&) {
-                      return Status::Ok();
-                    }).ok());
+  ASSERT_TRUE(
+      runner.Run(std::move(job), token, {}, [](const SceneInput&, const JobContext&, JobLog&) { return Status::Ok(); })
+          .ok());
   EXPECT_EQ(f.read_source, "upload");
 }
 
@@ -103,11 +103,11 @@ TEST(JobRunner, StatedFormatDisagreeingWithTheContentIsInvalidArgument) {
   JobRunner runner(&f.backend, 1 << 20);
   CancelToken token;
   bool ran = false;
-  const Status s = runner.Run(f.MakeJob("1", v1::INPUT_FORMAT_PCD), token, {},
-                              [&](const SceneInput&, const JobContext&, JobLog&) {
-                                ran = true;
-                                return Status::Ok();
-                              });
+  const Status s =
+      runner.Run(f.MakeJob("1", v1::INPUT_FORMAT_PCD), token, {}, [&](const SceneInput&, const JobContext&, JobLog&) {
+        ran = true;
+        return Status::Ok();
+      });
   EXPECT_EQ(s.code(), StatusCode::kInvalidArgument);
   EXPECT_THAT(s.message(), HasSubstr("by its content"));
   EXPECT_THAT(s.message(), HasSubstr("INPUT_FORMAT_PCD"));
@@ -118,9 +118,8 @@ TEST(JobRunner, ReaderErrorIsReturnedAsItIs) {
   Fixture f;
   JobRunner runner(&f.backend, 1 << 20);
   CancelToken token;
-  const Status s = runner.Run(f.MakeJob("bad"), token, {}, [](const SceneInput&, const JobContext&, JobLog&) {
-    return Status::Ok();
-  });
+  const Status s = runner.Run(f.MakeJob("bad"), token, {},
+                              [](const SceneInput&, const JobContext&, JobLog&) { return Status::Ok(); });
   EXPECT_EQ(s, InvalidArgumentError("line 1: not a number"));
 }
 
@@ -140,9 +139,9 @@ TEST(JobRunner, TheUploadIsReadWithinTheLimitsOfTheUploadAndTheJobsBudget) {
   CancelToken token;
   Job job = f.MakeJob("1");
   job.memory_budget_bytes = uint64_t{64} << 20;
-  ASSERT_TRUE(runner.Run(std::move(job), token, {}, [](const SceneInput&, const JobContext&, JobLog&) {
-                return Status::Ok();
-              }).ok());
+  ASSERT_TRUE(
+      runner.Run(std::move(job), token, {}, [](const SceneInput&, const JobContext&, JobLog&) { return Status::Ok(); })
+          .ok());
   const ReadOptions want = ReadLimits(uint64_t{1} << 20, uint64_t{64} << 20);
   EXPECT_EQ(f.read_options.max_decompressed_bytes, want.max_decompressed_bytes);
   EXPECT_EQ(f.read_options.max_points, want.max_points);
@@ -154,9 +153,8 @@ TEST(JobRunner, OutOfMemoryIsResourceExhaustedNamingTheJob) {
   Fixture f;
   JobRunner runner(&f.backend, 1 << 20);
   CancelToken token;
-  const Status s = runner.Run(f.MakeJob("1"), token, {}, [](const SceneInput&, const JobContext&, JobLog&) -> Status {
-    throw std::bad_alloc();
-  });
+  const Status s = runner.Run(f.MakeJob("1"), token, {},
+                              [](const SceneInput&, const JobContext&, JobLog&) -> Status { throw std::bad_alloc(); });
   EXPECT_EQ(s.code(), StatusCode::kResourceExhausted);
   EXPECT_THAT(s.message(), HasSubstr("j-000000000001"));
   EXPECT_THAT(s.message(), HasSubstr("--memory-budget-bytes"));

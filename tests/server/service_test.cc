@@ -267,17 +267,16 @@ TEST_P(PlanInvalidParameters, AreRefusedBeforeTheUpload) {
 
 INSTANTIATE_TEST_SUITE_P(
     Each, PlanInvalidParameters,
-    ::testing::Values(BadParam{"NegativeResolution", [](v1::PlanParameters* p) { p->set_resolution_m(-0.1); }},
-                      BadParam{"NanResolution", [](v1::PlanParameters* p) { p->set_resolution_m(std::nan("")); }},
-                      BadParam{"InfiniteResolution",
-                               [](v1::PlanParameters* p) { p->set_resolution_m(INFINITY); }},
-                      BadParam{"ZeroGridSpacing", [](v1::PlanParameters* p) { p->set_grid_spacing_m(0); }},
-                      BadParam{"NegativeGridSpacing", [](v1::PlanParameters* p) { p->set_grid_spacing_m(-1); }},
-                      BadParam{"NanTargetCoverage",
-                               [](v1::PlanParameters* p) { p->set_target_coverage(std::nan("")); }},
-                      BadParam{"NegativeThreads", [](v1::PlanParameters* p) { p->set_threads(-2); }},
-                      BadParam{"UnknownSelectionTest",
-                               [](v1::PlanParameters* p) { p->set_selection_test(static_cast<v1::SelectionTest>(7)); }}),
+    ::testing::Values(
+        BadParam{"NegativeResolution", [](v1::PlanParameters* p) { p->set_resolution_m(-0.1); }},
+        BadParam{"NanResolution", [](v1::PlanParameters* p) { p->set_resolution_m(std::nan("")); }},
+        BadParam{"InfiniteResolution", [](v1::PlanParameters* p) { p->set_resolution_m(INFINITY); }},
+        BadParam{"ZeroGridSpacing", [](v1::PlanParameters* p) { p->set_grid_spacing_m(0); }},
+        BadParam{"NegativeGridSpacing", [](v1::PlanParameters* p) { p->set_grid_spacing_m(-1); }},
+        BadParam{"NanTargetCoverage", [](v1::PlanParameters* p) { p->set_target_coverage(std::nan("")); }},
+        BadParam{"NegativeThreads", [](v1::PlanParameters* p) { p->set_threads(-2); }},
+        BadParam{"UnknownSelectionTest",
+                 [](v1::PlanParameters* p) { p->set_selection_test(static_cast<v1::SelectionTest>(7)); }}),
     [](const auto& info) { return std::string(info.param.name); });
 
 TEST(EvaluateErrors, InvalidParametersAreRefused) {

@@ -79,7 +79,6 @@ struct RawCall {
 // Sends `requests` on a Plan stream, half-closes, reads everything and finishes.
 RawCall<v1::PlanResponse> RawPlan(const std::string& address, const std::vector<v1::PlanRequest>& requests,
                                   const std::string& token = "");
-RawCall<v1::EvaluateResponse> RawEvaluate(const std::string& address,
-                                          const std::vector<v1::EvaluateRequest>& requests);
+RawCall<v1::EvaluateResponse> RawEvaluate(const std::string& address, const std::vector<v1::EvaluateRequest>& requests);
 
 }  // namespace vc::testing

@@ -16,7 +16,8 @@ class Tls : public ::testing::Test {
  protected:
   void SetUp() override {
     dir_ = testing::MakeTempDir();
-    const std::string script = "set -e; cd '" + dir_ + "'; " +
+    const std::string script =
+        "set -e; cd '" + dir_ + "'; " +
         "openssl req -x509 -newkey rsa:2048 -nodes -keyout ca.key -out ca.pem -days 2 -subj /CN=vc-test-ca; "
         "printf 'subjectAltName=IP:127.0.0.1,DNS:localhost\\n' > san.ext; "
         "openssl req -newkey rsa:2048 -nodes -keyout server.key -out server.csr -subj /CN=localhost; "

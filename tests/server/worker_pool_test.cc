@@ -30,7 +30,8 @@ TEST(WorkerPool, QueuePositionsAndRelease) {
   auto submit = [&](std::function<void()> task) {
     auto t = pool.TryAdmit();
     ASSERT_TRUE(t.has_value());
-    pool.Submit(std::move(*t), [&](uint32_t p) { positions.push_back(p); }, std::move(task));
+    pool.Submit(
+        std::move(*t), [&](uint32_t p) { positions.push_back(p); }, std::move(task));
   };
   submit([&] {
     first_running.set_value();

@@ -1,12 +1,12 @@
 #include "testing/test_paths.h"
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <atomic>
 #include <filesystem>
 #include <iostream>
 #include <mutex>
-#include <unistd.h>
 #include <vector>
 
 namespace vc::testing {

@@ -42,7 +42,8 @@ Status CheckParameter(const ParamInfo& info, double v, std::string_view prefix) 
 
 Status CheckParameter(const ParamInfo& info, int64_t v, std::string_view prefix) {
   switch (info.check) {
-    case ParamCheck::kAny: break;
+    case ParamCheck::kAny:
+      break;
     case ParamCheck::kNonNegative:
       if (v < 0) return Refuse(info, prefix, ">= 0", std::to_string(v));
       break;

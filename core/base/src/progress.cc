@@ -4,15 +4,24 @@ namespace vc {
 
 std::string_view StageName(Stage stage) {
   switch (stage) {
-    case Stage::kUnspecified: return "unspecified";
-    case Stage::kRead: return "read";
-    case Stage::kVoxelize: return "voxelize";
-    case Stage::kCandidates: return "candidates";
-    case Stage::kVisibility: return "visibility";
-    case Stage::kSelection: return "selection";
-    case Stage::kRefine: return "refine";
-    case Stage::kReduction: return "reduction";
-    case Stage::kEvaluation: return "evaluation";
+    case Stage::kUnspecified:
+      return "unspecified";
+    case Stage::kRead:
+      return "read";
+    case Stage::kVoxelize:
+      return "voxelize";
+    case Stage::kCandidates:
+      return "candidates";
+    case Stage::kVisibility:
+      return "visibility";
+    case Stage::kSelection:
+      return "selection";
+    case Stage::kRefine:
+      return "refine";
+    case Stage::kReduction:
+      return "reduction";
+    case Stage::kEvaluation:
+      return "evaluation";
   }
   return "unspecified";
 }

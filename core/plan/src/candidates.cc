@@ -9,10 +9,10 @@ namespace vc::planner {
 namespace {
 
 struct Surface {
-  int z;          // index of the top voxel of an occupied run
-  bool covered;   // another occupied run above it in the column
-  bool has_below; // another occupied run below it in the column
-  int run;        // the run's number from the top of the column
+  int z;           // index of the top voxel of an occupied run
+  bool covered;    // another occupied run above it in the column
+  bool has_below;  // another occupied run below it in the column
+  int run;         // the run's number from the top of the column
   // The outside of a ceiling: nothing above, a room below.
   bool roof() const { return !covered && has_below; }
 };
@@ -23,9 +23,7 @@ int FreeVoxelsNeeded(double resolution_m, const CandidateOptions& o) {
 }
 
 // Half-width (voxels) of a level's height band: 0.15 m, at least 2 voxels.
-int BandVoxels(double resolution_m) {
-  return std::max(2, static_cast<int>(std::ceil(0.15 / resolution_m - 1e-9)));
-}
+int BandVoxels(double resolution_m) { return std::max(2, static_cast<int>(std::ceil(0.15 / resolution_m - 1e-9))); }
 
 // Standing surfaces of column (x, y) (voxel indices), top to bottom. Outside the box is free.
 void ColumnSurfaces(const OccupancyGrid& grid, int x, int y, int free_needed, std::vector<Surface>& out) {
@@ -115,8 +113,8 @@ std::optional<double> FloorTopNear(const OccupancyGrid& grid, double x_m, double
   const int z_ref = static_cast<int>(std::lround(u.z())) - 1;
   const int band = BandVoxels(r);
   std::vector<Surface> scratch;
-  const int z = SurfaceNear(grid, static_cast<int>(std::floor(u.x())), static_cast<int>(std::floor(u.y())), z_ref,
-                            band, FreeVoxelsNeeded(r, options), scratch);
+  const int z = SurfaceNear(grid, static_cast<int>(std::floor(u.x())), static_cast<int>(std::floor(u.y())), z_ref, band,
+                            FreeVoxelsNeeded(r, options), scratch);
   if (z == kNoSurface) return std::nullopt;
   return grid.IndexSpaceToWorld(Eigen::Vector3d(0, 0, z + 1)).z();
 }
@@ -205,8 +203,8 @@ Result<CandidateGrid> GenerateCandidates(const VoxelScene& scene, const Candidat
       for (size_t ix = 0; ix < xs.size(); ++ix) {
         ++out.cells;
         const Eigen::Vector3d u = grid.WorldToIndexSpace(WorldPoint(xs[ix], ys[iy], lo.z()));
-        const int z = SurfaceNear(grid, static_cast<int>(std::floor(u.x())), static_cast<int>(std::floor(u.y())),
-                                  lz, band, free_needed, scratch);
+        const int z = SurfaceNear(grid, static_cast<int>(std::floor(u.x())), static_cast<int>(std::floor(u.y())), lz,
+                                  band, free_needed, scratch);
         if (z == kNoSurface) {
           ++out.rejected_no_floor;
           continue;

@@ -52,9 +52,8 @@ Result<GreedyResult> SelectGreedy(const std::vector<VoxelSet>& sets, const Greed
   const size_t n = sets[0].size();
   for (size_t i = 1; i < sets.size(); ++i) {
     if (sets[i].size() != n) {
-      return InvalidArgumentError("visibility set " + std::to_string(i) + " has " +
-                                  std::to_string(sets[i].size()) + " voxels, expected " +
-                                  std::to_string(n));
+      return InvalidArgumentError("visibility set " + std::to_string(i) + " has " + std::to_string(sets[i].size()) +
+                                  " voxels, expected " + std::to_string(n));
     }
   }
   VoxelSet uncovered(n);

@@ -104,8 +104,8 @@ Result<PlanResult> Plan(const SceneInput& input, const PlanOptions& options, con
 
   const planner::GreedySelector selector(planner::SelectorOptionsFor(options));
   VC_ASSIGN_OR_RETURN(planner::SelectionOutput selected, runner.Run(Stage::kSelection, [&](const JobContext& c) {
-    return planner::RunSelectionStage({selector, std::move(visibility.sets), candidates.positions,
-                                       candidates.floor_z_m, result.heat_map.visible_voxels, callbacks},
+    return planner::RunSelectionStage({selector, std::move(visibility.sets), candidates.positions, candidates.floor_z_m,
+                                       result.heat_map.visible_voxels, callbacks},
                                       options, c);
   }));
   result.stop_reason = selected.selection.stop;

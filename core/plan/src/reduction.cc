@@ -27,8 +27,8 @@ void InsertTop3(FaceTop3& t, float value, int32_t station) {
   }
 }
 
-ReductionMatrix ComputeReductionMatrix(const std::vector<FaceTop3>& top3, int num_stations,
-                                       uint64_t faces_total, int threads) {
+ReductionMatrix ComputeReductionMatrix(const std::vector<FaceTop3>& top3, int num_stations, uint64_t faces_total,
+                                       int threads) {
   ReductionMatrix m;
   m.size = num_stations;
   const size_t n = static_cast<size_t>(num_stations);
@@ -90,9 +90,8 @@ std::vector<int> ChooseRemoval(const ReductionMatrix& m, const std::vector<int>&
   std::vector<int> best;
   double best_per = 0;
   auto consider = [&](std::vector<int> t, double per) {
-    const bool better =
-        best.empty() || per < best_per ||
-        (per == best_per && (t.size() > best.size() || (t.size() == best.size() && t > best)));
+    const bool better = best.empty() || per < best_per ||
+                        (per == best_per && (t.size() > best.size() || (t.size() == best.size() && t > best)));
     if (better) {
       best = std::move(t);
       best_per = per;
@@ -130,8 +129,8 @@ Result<ReductionRun> RunReduction(int num_stations, uint64_t faces_total, const 
                                   const ReductionRunOptions& options, const JobContext& ctx) {
   ReductionRun run;
   if (num_stations <= 0) return run;
-  const bool use_cache = static_cast<uint64_t>(num_stations) * faces_total * sizeof(float) <=
-                         options.cache_budget_bytes;
+  const bool use_cache =
+      static_cast<uint64_t>(num_stations) * faces_total * sizeof(float) <= options.cache_budget_bytes;
   std::vector<std::vector<float>> cache(use_cache ? num_stations : 0);
   std::vector<FaceTop3> top3 = internal::FilledOnHugePages(faces_total, FaceTop3{});
 
@@ -143,7 +142,9 @@ Result<ReductionRun> RunReduction(int num_stations, uint64_t faces_total, const 
       JobContext sub = ctx;
       const double lo = progress_from + (progress_to - progress_from) * k / stations.size();
       const double hi = progress_from + (progress_to - progress_from) * (k + 1) / stations.size();
-      sub.progress = [&ctx, lo, hi](const ProgressEvent& e) { ctx.Report(Stage::kReduction, lo + (hi - lo) * e.fraction); };
+      sub.progress = [&ctx, lo, hi](const ProgressEvent& e) {
+        ctx.Report(Stage::kReduction, lo + (hi - lo) * e.fraction);
+      };
       if (!ctx.progress) sub.progress = nullptr;
       Result<std::vector<float>> v = values(s, sub);
       if (!v.ok()) return v.status();
@@ -152,9 +153,10 @@ Result<ReductionRun> RunReduction(int num_stations, uint64_t faces_total, const 
                              " face values, expected " + std::to_string(faces_total));
       }
       const std::vector<float>& vals = *v;
-      VC_RETURN_IF_ERROR(ParallelChunks(faces_total, kChunk, options.threads, ctx, [&](uint64_t, uint64_t b, uint64_t e) {
-        for (uint64_t f = b; f < e; ++f) InsertTop3(top3[f], vals[f], s);
-      }));
+      VC_RETURN_IF_ERROR(
+          ParallelChunks(faces_total, kChunk, options.threads, ctx, [&](uint64_t, uint64_t b, uint64_t e) {
+            for (uint64_t f = b; f < e; ++f) InsertTop3(top3[f], vals[f], s);
+          }));
       if (use_cache) cache[s] = std::move(*v);
       ctx.Report(Stage::kReduction, hi);
     }

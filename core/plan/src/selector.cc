@@ -8,10 +8,14 @@ namespace vc {
 
 std::string_view StopReasonName(StopReason reason) {
   switch (reason) {
-    case StopReason::kExhausted: return "exhausted";
-    case StopReason::kTargetReached: return "target_reached";
-    case StopReason::kMaxStations: return "max_stations";
-    case StopReason::kMinGain: return "min_gain";
+    case StopReason::kExhausted:
+      return "exhausted";
+    case StopReason::kTargetReached:
+      return "target_reached";
+    case StopReason::kMaxStations:
+      return "max_stations";
+    case StopReason::kMinGain:
+      return "min_gain";
   }
   return "unknown";
 }

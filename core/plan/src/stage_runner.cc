@@ -27,9 +27,7 @@ JobContext ProgressRange(const JobContext& ctx, double lo, double hi) {
   return sub;
 }
 
-double StageRunner::elapsed_seconds() const {
-  return std::chrono::duration<double>(Clock::now() - start_).count();
-}
+double StageRunner::elapsed_seconds() const { return std::chrono::duration<double>(Clock::now() - start_).count(); }
 
 Status StageRunner::Begin(Stage stage) const {
   ctx_.Report(stage, 0.0);

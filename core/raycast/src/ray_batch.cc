@@ -136,7 +136,8 @@ struct Source {
     const size_t N = hn::Lanes(dd);
     HWY_ASSERT(N <= kMaxD);
     const VD zero = hn::Zero(dd), one = hn::Set(dd, 1.0), inf = hn::Set(dd, internal::kInf);
-    const VD max_coordinate = hn::Set(dd, internal::kMaxLaneCoordinate), max_steps = hn::Set(dd, internal::kMaxLaneSteps);
+    const VD max_coordinate = hn::Set(dd, internal::kMaxLaneCoordinate),
+             max_steps = hn::Set(dd, internal::kMaxLaneSteps);
     const VD max_float = hn::Set(dd, 0x1p126);  // below it, a double rounds to a finite float
     prep.size = prep.pos = 0;
     while (next < count && prep.size + N <= Prepared::kChunk) {
@@ -257,9 +258,10 @@ class LaneGroup {
       if (unsure & lane) {
         src.unsure->push_back(size_t(s_.id[l]));
       } else {
-        src.out[s_.id[l]] = (hits & lane) ? std::optional<VoxelIndex>(VoxelIndex{
-                                                s_.hx[l] + g_.lo[0], s_.hy[l] + g_.lo[1], s_.hz[l] + g_.lo[2]})
-                                          : std::nullopt;
+        src.out[s_.id[l]] =
+            (hits & lane)
+                ? std::optional<VoxelIndex>(VoxelIndex{s_.hx[l] + g_.lo[0], s_.hy[l] + g_.lo[1], s_.hz[l] + g_.lo[2]})
+                : std::nullopt;
       }
       --active_;
       Take(l, src);
@@ -370,19 +372,24 @@ HWY_INLINE MI LaneGroup::JumpAcrossFreeBricks(MI jump, VI entry, const VI rel[3]
     // lo and hi the cube's k plus the extra layers on the side of -axis i and +axis i. So the
     // walk's last voxel is in it iff its brick is, and the steps to the box's face are 8 per brick
     // beyond this one plus those to this brick's face.
-    const VI hi = hn::Add(k, hn::And(hn::ShiftRightSame(code, OccupancyGrid::kExtraShift + OccupancyGrid::kExtraBits * 2 * i), max_extra));
-    const VI lo = hn::Add(k, hn::And(hn::ShiftRightSame(code, OccupancyGrid::kExtraShift + OccupancyGrid::kExtraBits * (2 * i + 1)), max_extra));
+    const VI hi = hn::Add(
+        k,
+        hn::And(hn::ShiftRightSame(code, OccupancyGrid::kExtraShift + OccupancyGrid::kExtraBits * 2 * i), max_extra));
+    const VI lo = hn::Add(
+        k, hn::And(hn::ShiftRightSame(code, OccupancyGrid::kExtraShift + OccupancyGrid::kExtraBits * (2 * i + 1)),
+                   max_extra));
     const VI brick_i = hn::ShiftRight<OccupancyGrid::kBrickShift>(rel[i]);
     const MI pos = hn::Gt(step[i], zero);
-    const VI end_rel = hn::Add(rel[i], hn::IfThenElse(pos, *left[i], hn::Neg(*left[i])));  // left = 0 if no step
+    const VI end_rel = hn::Add(rel[i], hn::IfThenElse(pos, *left[i], hn::Neg(*left[i])));      // left = 0 if no step
     const VI end_off = hn::Sub(hn::ShiftRight<OccupancyGrid::kBrickShift>(end_rel), brick_i);  // in bricks
-    end_inside = hn::And(end_inside, hn::And(hn::Gt(hn::Add(end_off, lo), hn::Set(di, -1)), hn::Gt(hn::Add(hi, one), end_off)));
+    end_inside =
+        hn::And(end_inside, hn::And(hn::Gt(hn::Add(end_off, lo), hn::Set(di, -1)), hn::Gt(hn::Add(hi, one), end_off)));
     const VI in_brick = hn::And(rel[i], seven);
     ste[i] = hn::IfThenElse(pos, hn::Add(hn::ShiftLeft<OccupancyGrid::kBrickShift>(hi), hn::Sub(seven, in_brick)),
                             hn::Add(hn::ShiftLeft<OccupancyGrid::kBrickShift>(lo), in_brick));
     const MI leaves = hn::Gt(*left[i], ste[i]);
-    exit_t[i] = hn::IfThenElse(hn::RebindMask(d, leaves), Crossing(hn::Sub(hn::Sub(*left[i], one), ste[i]), delta[i], last[i]),
-                               inf);
+    exit_t[i] = hn::IfThenElse(hn::RebindMask(d, leaves),
+                               Crossing(hn::Sub(hn::Sub(*left[i], one), ste[i]), delta[i], last[i]), inf);
   }
   const VF t_exit = hn::Min(exit_t[0], hn::Min(exit_t[1], exit_t[2]));
   const VF near = hn::Add(t_exit, margin), below = hn::Sub(t_exit, margin);
@@ -402,9 +409,10 @@ HWY_INLINE MI LaneGroup::JumpAcrossFreeBricks(MI jump, VI entry, const VI rel[3]
     const VF nf = hn::IfThenElseZero(hn::Gt(q, hn::Zero(d)), hn::Min(q, hn::ConvertTo(d, limit)));
     n[i] = hn::IfThenElse(hn::RebindMask(di, is_exit), limit, hn::ConvertTo(di, nf));
     const VI after = hn::Sub(*left[i], n[i]);  // crossings left after the jump
-    const auto next_late = hn::Or(hn::RebindMask(d, hn::Eq(after, zero)),
-                                  hn::Gt(Crossing(hn::Sub(after, one), delta[i], last[i]), near));
-    const auto prev_early = hn::Or(hn::RebindMask(d, hn::Eq(n[i], zero)), hn::Lt(Crossing(after, delta[i], last[i]), below));
+    const auto next_late =
+        hn::Or(hn::RebindMask(d, hn::Eq(after, zero)), hn::Gt(Crossing(hn::Sub(after, one), delta[i], last[i]), near));
+    const auto prev_early =
+        hn::Or(hn::RebindMask(d, hn::Eq(n[i], zero)), hn::Lt(Crossing(after, delta[i], last[i]), below));
     const auto moving = hn::RebindMask(d, hn::Ne(*left[i], zero));
     tie = hn::Or(tie, hn::AndNot(is_exit, hn::And(moving, hn::Not(hn::And(next_late, prev_early)))));
   }
@@ -428,9 +436,9 @@ HWY_INLINE void LaneGroup::Advance() {
   const VI zero = hn::Zero(di), one = hn::Set(di, 1), three = hn::Set(di, 3), seven = hn::Set(di, 7);
   // ---- The current voxel: occupied, an empty brick to jump across, or outside the box.
   const VI rel[3] = {x_, y_, z_};
-  const MI inside = hn::RebindMask(di, hn::And(hn::Lt(hn::BitCast(du, rel[0]), g_.dims[0]),
-                                               hn::And(hn::Lt(hn::BitCast(du, rel[1]), g_.dims[1]),
-                                                       hn::Lt(hn::BitCast(du, rel[2]), g_.dims[2]))));
+  const MI inside = hn::RebindMask(
+      di, hn::And(hn::Lt(hn::BitCast(du, rel[0]), g_.dims[0]),
+                  hn::And(hn::Lt(hn::BitCast(du, rel[1]), g_.dims[1]), hn::Lt(hn::BitCast(du, rel[2]), g_.dims[2]))));
   was_ = hn::Or(was_, inside);
   const VI brick = hn::IfThenElseZero(inside, g_.BrickNumber(rel[0], rel[1], rel[2]));
   const VI slot = hn::GatherIndex(di, g_.entries, brick);
@@ -442,7 +450,8 @@ HWY_INLINE void LaneGroup::Advance() {
   const auto bit = hn::BitCast(du, hn::Or(hn::ShiftLeft<3>(hn::And(rel[1], three)), hn::And(rel[0], seven)));
   // A hit of a lane still walking (an ended lane steps on, but reports what it found then).
   const MI hit = hn::AndNot(
-      done_, hn::And(filled, hn::RebindMask(di, hn::Ne(hn::And(hn::operator>>(word, bit), hn::Set(du, 1)), hn::Zero(du)))));
+      done_,
+      hn::And(filled, hn::RebindMask(di, hn::Ne(hn::And(hn::operator>>(word, bit), hn::Set(du, 1)), hn::Zero(du)))));
   hn::BlendedStore(x_, hit, di, s_.hx);
   hn::BlendedStore(y_, hit, di, s_.hy);
   hn::BlendedStore(z_, hit, di, s_.hz);
@@ -463,7 +472,8 @@ HWY_INLINE void LaneGroup::Advance() {
   const VF first = hn::Min(tx, hn::Min(ty, tz));
   const VF near = hn::Add(first, hn::Set(d, internal::kMargin));
   const auto nx = hn::Le(tx, near), ny = hn::Le(ty, near), nz = hn::Le(tz, near);
-  const MI tie = hn::AndNot(done_, hn::RebindMask(di, hn::Or(hn::And(nx, ny), hn::Or(hn::And(nx, nz), hn::And(ny, nz)))));
+  const MI tie =
+      hn::AndNot(done_, hn::RebindMask(di, hn::Or(hn::And(nx, ny), hn::Or(hn::And(nx, nz), hn::And(ny, nz)))));
   unsure_ = hn::Or(unsure_, tie);
   done_ = hn::Or(done_, tie);
   const MI mz = hn::RebindMask(di, hn::Eq(tz, first));
@@ -529,13 +539,12 @@ std::string FirstOccupiedBatch(const OccupancyGrid& grid, std::span<const Eigen:
   // relative to the box's corner (a voxel within +-2^30, plus at most kMaxLaneSteps, minus the
   // corner) in int32: so the box must lie within +-2^29.
   const VoxelIndex lo = grid.min_index();
-  const bool near = std::abs(int64_t(lo.x)) < (int64_t{1} << 29) && std::abs(int64_t(lo.y)) < (int64_t{1} << 29) &&
-                    std::abs(int64_t(lo.z)) < (int64_t{1} << 29) &&
-                    int64_t(lo.x) + grid.dims().x() < (int64_t{1} << 29) &&
-                    int64_t(lo.y) + grid.dims().y() < (int64_t{1} << 29) &&
-                    int64_t(lo.z) + grid.dims().z() < (int64_t{1} << 29);
-  const bool fits = grid.brick_count() < (uint64_t{1} << 31) && grid.occupied_bricks() < (uint64_t{1} << 26) &&
-                    near && n < (size_t{1} << 31);
+  const bool near =
+      std::abs(int64_t(lo.x)) < (int64_t{1} << 29) && std::abs(int64_t(lo.y)) < (int64_t{1} << 29) &&
+      std::abs(int64_t(lo.z)) < (int64_t{1} << 29) && int64_t(lo.x) + grid.dims().x() < (int64_t{1} << 29) &&
+      int64_t(lo.y) + grid.dims().y() < (int64_t{1} << 29) && int64_t(lo.z) + grid.dims().z() < (int64_t{1} << 29);
+  const bool fits = grid.brick_count() < (uint64_t{1} << 31) && grid.occupied_bricks() < (uint64_t{1} << 26) && near &&
+                    n < (size_t{1} << 31);
   if (!fits || grid.brick_count() == 0) {
     for (size_t i = 0; i < n; ++i) out[i] = FirstOccupied(grid, a[i], b[i]);
     return "per segment (grid too large or too far out for the lanes)";

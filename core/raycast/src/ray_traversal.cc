@@ -48,8 +48,8 @@ RayTraversal::Iterator& RayTraversal::Iterator::operator++() {
 
 using internal::JumpAcrossFreeBrickBox;
 
-std::optional<VoxelIndex> FirstOccupied(const OccupancyGrid& grid, const Eigen::Vector3d& a,
-                                        const Eigen::Vector3d& b, const VoxelIndex* transparent) {
+std::optional<VoxelIndex> FirstOccupied(const OccupancyGrid& grid, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                                        const VoxelIndex* transparent) {
   Walk w(a, b);
   const VoxelIndex skip = transparent ? *transparent : VoxelIndex{INT32_MIN, INT32_MIN, INT32_MIN};
   const VoxelIndex& lo = grid.min_index();

@@ -8,7 +8,6 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
-
 #include <nlohmann/json.hpp>
 
 #include "raster.h"
@@ -100,8 +99,12 @@ std::string VisibilityPly(const PlanResult& r) {
       "ply\nformat binary_little_endian 1.0\n"
       "comment vc visibility: occupied voxel centres (m); visibility = best V over the voxel's 6 faces\n"
       "comment colour: viridis of visibility in [0, 1]; grey = seen by no station (V = 0)\n"
-      "comment resolution_m " + Fixed(r.resolution_m, 6) + "\n"
-      "element vertex " + std::to_string(n) + "\n"
+      "comment resolution_m " +
+      Fixed(r.resolution_m, 6) +
+      "\n"
+      "element vertex " +
+      std::to_string(n) +
+      "\n"
       "property float x\nproperty float y\nproperty float z\n"
       "property uchar red\nproperty uchar green\nproperty uchar blue\n"
       "property float visibility\nend_header\n";
@@ -133,10 +136,10 @@ constexpr int kMinPlotHeight = 180, kTargetPlot = 720;
 struct HeatLayout {
   double cell_m = 1;
   double x0 = 0, y0 = 0, x1 = 1, y1 = 1;  // footprint (m)
-  double ppm = 10;                       // pixels per metre
+  double ppm = 10;                        // pixels per metre
   int plot_w = 0, plot_h = 0;
-  std::vector<double> panel_z;           // representative z of each panel
-  std::vector<int> candidate_panel;      // per heat-map position
+  std::vector<double> panel_z;       // representative z of each panel
+  std::vector<int> candidate_panel;  // per heat-map position
   int width = 0, height = 0;
 };
 
@@ -257,7 +260,8 @@ Image DrawHeatmap(const PlanResult& r) {
     }
     const std::string xl = "x (m)";
     img.Text(left + L.plot_w / 2 - raster::TextWidth(xl) / 2, top + L.plot_h + 24, xl, raster::kBlack);
-    img.TextVertical(left - kMarginLeft + 4, top + L.plot_h / 2 - raster::TextWidth("y (m)") / 2, "y (m)", raster::kBlack);
+    img.TextVertical(left - kMarginLeft + 4, top + L.plot_h / 2 - raster::TextWidth("y (m)") / 2, "y (m)",
+                     raster::kBlack);
     std::string title = "VISIBLE VOXELS PER CANDIDATE";
     if (L.panel_z.size() > 1 || !r.floor_levels_m.empty()) title += "  z = " + Fixed(L.panel_z[p], 2) + " m";
     img.Text(left, 10, title, raster::kBlack, 2);
@@ -273,7 +277,8 @@ Image DrawHeatmap(const PlanResult& r) {
     StationMarker(img, px(panel, s.x()), py(s.y()), static_cast<int>(k) + 1, raster::kRed);
   }
   const int bar_x = L.width - kLegendWidth + 20;
-  ColourBar(img, bar_x, top + 14, std::max(L.plot_h, kMinPlotHeight) - 14, static_cast<double>(max_count), "VOXELS", true);
+  ColourBar(img, bar_x, top + 14, std::max(L.plot_h, kMinPlotHeight) - 14, static_cast<double>(max_count), "VOXELS",
+            true);
   return img;
 }
 
@@ -549,8 +554,9 @@ Result<std::vector<WorldPoint>> ParseStationsCsv(std::string_view text, std::str
     const std::string where = std::string(source) + ":" + std::to_string(line_no) + ": ";
     if (!numeric) {
       // One header line is allowed, before any station: fields without digits (e.g. "x,y,z").
-      const bool header = !seen_data_line &&
-                          std::none_of(line.begin(), line.end(), [](char c) { return std::isdigit(static_cast<unsigned char>(c)); });
+      const bool header = !seen_data_line && std::none_of(line.begin(), line.end(), [](char c) {
+        return std::isdigit(static_cast<unsigned char>(c));
+      });
       if (header) {
         seen_data_line = true;
         continue;

@@ -147,7 +147,8 @@ void Image::Text(int x, int y, std::string_view text, Rgb c, int scale) {
     const int gx = x + static_cast<int>(k) * kAdvance * scale;
     for (int r = 0; r < kGlyphH; ++r) {
       for (int col = 0; col < kGlyphW; ++col) {
-        if (g.rows[r][col] == '#') FillRect(gx + col * scale, y + r * scale, gx + (col + 1) * scale, y + (r + 1) * scale, c);
+        if (g.rows[r][col] == '#')
+          FillRect(gx + col * scale, y + r * scale, gx + (col + 1) * scale, y + (r + 1) * scale, c);
       }
     }
   }

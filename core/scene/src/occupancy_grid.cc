@@ -11,8 +11,10 @@ namespace {
 std::string FormatBytes(uint64_t b) {
   std::ostringstream os;
   os.precision(3);
-  if (b >= (uint64_t{1} << 30)) os << double(b) / double(uint64_t{1} << 30) << " GiB";
-  else os << double(b) / double(1 << 20) << " MiB";
+  if (b >= (uint64_t{1} << 30))
+    os << double(b) / double(uint64_t{1} << 30) << " GiB";
+  else
+    os << double(b) / double(1 << 20) << " MiB";
   return os.str();
 }
 
@@ -30,8 +32,7 @@ uint64_t OccupancyGrid::BytesNeeded(const VoxelIndex& min, const VoxelIndex& max
 Result<OccupancyGrid> OccupancyGrid::Build(double resolution_m, const std::vector<VoxelIndex>& occupied,
                                            uint64_t memory_budget_bytes) {
   if (!std::isfinite(resolution_m) || resolution_m <= 0) {
-    return InvalidArgumentError("resolution must be a positive number of metres, got " +
-                                std::to_string(resolution_m));
+    return InvalidArgumentError("resolution must be a positive number of metres, got " + std::to_string(resolution_m));
   }
   if (occupied.empty()) return InvalidArgumentError("the scene has no occupied voxels");
   VoxelIndex lo = occupied.front(), hi = occupied.front();
@@ -74,7 +75,7 @@ Result<OccupancyGrid> OccupancyGrid::Build(double resolution_m, const std::vecto
   uint64_t used = 0;
   for (const VoxelIndex& v : occupied) {
     int32_t& slot = g.bricks_[g.BrickLinear(uint32_t(v.x - lo.x) >> kBrickShift, uint32_t(v.y - lo.y) >> kBrickShift,
-                                             uint32_t(v.z - lo.z) >> kBrickShift)];
+                                            uint32_t(v.z - lo.z) >> kBrickShift)];
     if (slot == 0) {
       if (used + 1 >= uint64_t(std::numeric_limits<int32_t>::max())) return refuse(~uint64_t{0});
       slot = int32_t(++used);
@@ -138,8 +139,9 @@ void OccupancyGrid::ComputeFreeExtents() {
   for (int z = 0; z < nz; ++z)
     for (int y = 0; y < ny; ++y)
       for (int x = 0; x < nx; ++x) {
-        at(x + 1, y + 1, z + 1) = uint32_t(bricks_[BrickLinear(x, y, z)] > 0) + at(x, y + 1, z + 1) + at(x + 1, y, z + 1) +
-                                  at(x + 1, y + 1, z) - at(x, y, z + 1) - at(x, y + 1, z) - at(x + 1, y, z) + at(x, y, z);
+        at(x + 1, y + 1, z + 1) = uint32_t(bricks_[BrickLinear(x, y, z)] > 0) + at(x, y + 1, z + 1) +
+                                  at(x + 1, y, z + 1) + at(x + 1, y + 1, z) - at(x, y, z + 1) - at(x, y + 1, z) -
+                                  at(x + 1, y, z) + at(x, y, z);
       }
   const int n[3] = {nx, ny, nz};
   // Whether the box of bricks [lo, hi] holds no non-empty brick (bricks outside the grid are empty).
@@ -149,9 +151,9 @@ void OccupancyGrid::ComputeFreeExtents() {
       a[i] = std::max(lo[i], 0), b[i] = std::min(hi[i], n[i] - 1);
       if (a[i] > b[i]) return true;
     }
-    const uint32_t count = at(b[0] + 1, b[1] + 1, b[2] + 1) - at(a[0], b[1] + 1, b[2] + 1) - at(b[0] + 1, a[1], b[2] + 1) -
-                           at(b[0] + 1, b[1] + 1, a[2]) + at(a[0], a[1], b[2] + 1) + at(a[0], b[1] + 1, a[2]) +
-                           at(b[0] + 1, a[1], a[2]) - at(a[0], a[1], a[2]);
+    const uint32_t count = at(b[0] + 1, b[1] + 1, b[2] + 1) - at(a[0], b[1] + 1, b[2] + 1) -
+                           at(b[0] + 1, a[1], b[2] + 1) - at(b[0] + 1, b[1] + 1, a[2]) + at(a[0], a[1], b[2] + 1) +
+                           at(a[0], b[1] + 1, a[2]) + at(b[0] + 1, a[1], a[2]) - at(a[0], a[1], a[2]);
     return count == 0;
   };
   for (int z = 0; z < nz; ++z)
@@ -213,7 +215,8 @@ bool CoordToKey(double resolution_m, const WorldPoint& p, VoxelKey* key) {
 
 WorldPoint KeyToCoord(double resolution_m, const VoxelKey& key) {
   // OctoMap: ((double)((int)key - (int)tree_max_val) + 0.5) * resolution
-  return {(double(int(key.x) - kKeyOffset) + 0.5) * resolution_m, (double(int(key.y) - kKeyOffset) + 0.5) * resolution_m,
+  return {(double(int(key.x) - kKeyOffset) + 0.5) * resolution_m,
+          (double(int(key.y) - kKeyOffset) + 0.5) * resolution_m,
           (double(int(key.z) - kKeyOffset) + 0.5) * resolution_m};
 }
 

@@ -10,7 +10,6 @@
 #include <octomap/OcTree.h>
 
 #include <Eigen/Geometry>
-
 #include <cmath>
 #include <cstring>
 #include <iostream>
@@ -54,7 +53,8 @@ Result<Header> ParseHeader(std::string_view bytes, std::string_view magic, std::
     std::string token;
     ls >> token;
     if (token == "data") {
-      if (!have_id || !have_size || !have_res) return err("header line " + std::to_string(line_no) + ": \"data\" before id, size and res");
+      if (!have_id || !have_size || !have_res)
+        return err("header line " + std::to_string(line_no) + ": \"data\" before id, size and res");
       h.data_offset = pos;
       return h;
     }
@@ -65,7 +65,8 @@ Result<Header> ParseHeader(std::string_view bytes, std::string_view magic, std::
     } else if (token == "res") {
       have_res = bool(ls >> h.res);
       if (have_res && (!std::isfinite(h.res) || h.res <= 0 || h.res > 1000)) {
-        return err("header line " + std::to_string(line_no) + ": resolution must be a positive number of metres, found " + line);
+        return err("header line " + std::to_string(line_no) +
+                   ": resolution must be a positive number of metres, found " + line);
       }
     } else {
       return err("header line " + std::to_string(line_no) + ": unknown keyword \"" + token + "\"");
@@ -84,7 +85,8 @@ struct BinaryWalker {
 
   bool Node(int depth) {
     if (pos + 2 > data.size()) {
-      error = "node data ends at byte " + std::to_string(pos) + " of " + std::to_string(data.size()) + " (file truncated?)";
+      error =
+          "node data ends at byte " + std::to_string(pos) + " of " + std::to_string(data.size()) + " (file truncated?)";
       return false;
     }
     const uint8_t c[2] = {uint8_t(data[pos]), uint8_t(data[pos + 1])};
@@ -124,7 +126,8 @@ struct FullWalker {
       return false;
     }
     if (pos + value_bytes + 1 > data.size()) {
-      error = "node data ends at byte " + std::to_string(pos) + " of " + std::to_string(data.size()) + " (file truncated?)";
+      error =
+          "node data ends at byte " + std::to_string(pos) + " of " + std::to_string(data.size()) + " (file truncated?)";
       return false;
     }
     if (rewrite) rewrite->append(data.substr(pos, sizeof(float)));
@@ -216,9 +219,12 @@ Result<std::shared_ptr<octomap::OcTree>> ReadOctreeText(std::string_view bytes, 
                                                         uint64_t max_tree_bytes) {
   VC_ASSIGN_OR_RETURN(Header h, ParseHeader(bytes, "# Octomap OcTree file", source));
   size_t value_bytes = 0;
-  if (h.id == "OcTree") value_bytes = 4;
-  else if (h.id == "ColorOcTree") value_bytes = 4 + 3;
-  else if (h.id == "OcTreeStamped") value_bytes = 4 + 4;
+  if (h.id == "OcTree")
+    value_bytes = 4;
+  else if (h.id == "ColorOcTree")
+    value_bytes = 4 + 3;
+  else if (h.id == "OcTreeStamped")
+    value_bytes = 4 + 4;
   else {
     return InvalidArgumentError(std::string(source) + ": unsupported OctoMap tree type \"" + h.id +
                                 "\" (supported: OcTree, ColorOcTree, OcTreeStamped)");
@@ -282,7 +288,8 @@ Result<ScanGraphData> ReadScanGraph(std::string_view bytes, std::string_view sou
   for (uint32_t n = 0; n < nodes; ++n) {
     const size_t node_pos = pos;
     uint32_t count = 0;
-    if (!ReadPod(bytes, &pos, &count)) return err(pos, "scan " + std::to_string(n) + ": truncated before its point count");
+    if (!ReadPod(bytes, &pos, &count))
+      return err(pos, "scan " + std::to_string(n) + ": truncated before its point count");
     constexpr size_t kPoint = 4 + 3 * sizeof(double);
     if (uint64_t(count) * kPoint > bytes.size() - pos) {
       return err(pos, "scan " + std::to_string(n) + " declares " + std::to_string(count) + " points but only " +
@@ -291,7 +298,8 @@ Result<ScanGraphData> ReadScanGraph(std::string_view bytes, std::string_view sou
     std::vector<Eigen::Vector3d> local(count);
     for (uint32_t i = 0; i < count; ++i) {
       double p[3];
-      if (!read_vec(3, p)) return err(pos, "scan " + std::to_string(n) + ", point " + std::to_string(i) + ": malformed");
+      if (!read_vec(3, p))
+        return err(pos, "scan " + std::to_string(n) + ", point " + std::to_string(i) + ": malformed");
       // OctoMap keeps points as float.
       local[i] = Eigen::Vector3d{double(float(p[0])), double(float(p[1])), double(float(p[2]))};
     }
@@ -343,7 +351,8 @@ void ForEachOccupiedLeaf(const octomap::OcTree& tree,
     // The leaf's cube from its key and depth, exactly (not from the float centre).
     const octomap::OcTreeKey key = it.getIndexKey();
     const double r = tree.getResolution();
-    fn(WorldPoint((int(key[0]) - kKeyOffset) * r, (int(key[1]) - kKeyOffset) * r, (int(key[2]) - kKeyOffset) * r), size);
+    fn(WorldPoint((int(key[0]) - kKeyOffset) * r, (int(key[1]) - kKeyOffset) * r, (int(key[2]) - kKeyOffset) * r),
+       size);
   }
 }
 

@@ -21,12 +21,9 @@ constexpr std::string_view kSupported =
     "supported: PLY, PCD v0.7, ASCII XYZ/CSV, LAS 1.0-1.4, OctoMap .bt/.ot, OctoMap ScanGraph "
     ".graph, and gzip/bzip2 copies of these";
 
-bool StartsWith(std::string_view s, std::string_view prefix) {
-  return s.substr(0, prefix.size()) == prefix;
-}
+bool StartsWith(std::string_view s, std::string_view prefix) { return s.substr(0, prefix.size()) == prefix; }
 
-Result<SceneInput> FromCloud(Result<readers::PointCloud> read, InputFormat format,
-                             std::string_view source) {
+Result<SceneInput> FromCloud(Result<readers::PointCloud> read, InputFormat format, std::string_view source) {
   if (!read.ok()) return read.status();
   readers::PointCloud& cloud = *read;
   if (cloud.points.empty()) {
@@ -56,16 +53,13 @@ Result<SceneInput> FromOctree(Result<std::shared_ptr<octomap::OcTree>> read, Inp
   return in;
 }
 
-Result<SceneInput> ReadDecompressed(std::string_view bytes, std::string_view source,
-                                    const ReadOptions& options) {
+Result<SceneInput> ReadDecompressed(std::string_view bytes, std::string_view source, const ReadOptions& options) {
   if (bytes.empty()) return readers::InvalidInput(source, "input is empty (0 bytes)");
   if (StartsWith(bytes, "# Octomap OcTree binary file")) {
-    return FromOctree(ReadOctreeBinary(bytes, source, options.max_result_bytes),
-                      InputFormat::kOctomapBinary);
+    return FromOctree(ReadOctreeBinary(bytes, source, options.max_result_bytes), InputFormat::kOctomapBinary);
   }
   if (StartsWith(bytes, "# Octomap OcTree file")) {
-    return FromOctree(ReadOctreeText(bytes, source, options.max_result_bytes),
-                      InputFormat::kOctomapText);
+    return FromOctree(ReadOctreeText(bytes, source, options.max_result_bytes), InputFormat::kOctomapText);
   }
   if (readers::LooksLikePly(bytes)) {
     return FromCloud(readers::ReadPly(bytes, source, options), InputFormat::kPly, source);
@@ -84,21 +78,18 @@ Result<SceneInput> ReadDecompressed(std::string_view bytes, std::string_view sou
     std::string why = graph.status().message();
     const std::string prefix = std::string(source) + ": ";
     if (why.compare(0, prefix.size(), prefix) == 0) why.erase(0, prefix.size());
-    return readers::InvalidInput(
-        source,
-        "unrecognised format: binary content that is not PLY, PCD, LAS or OctoMap "
-        "(" +
-            std::string(kSupported) + "); read as a ScanGraph: " + why);
+    return readers::InvalidInput(source,
+                                 "unrecognised format: binary content that is not PLY, PCD, LAS or OctoMap "
+                                 "(" +
+                                     std::string(kSupported) + "); read as a ScanGraph: " + why);
   }
   if (graph->points.size() > options.max_points) {
-    return ResourceExhaustedError(
-        std::string(source) + ": ScanGraph holds " + std::to_string(graph->points.size()) +
-        " points, more than the limit of " + std::to_string(options.max_points) +
-        std::string(readers::kRaiseResultLimit));
+    return ResourceExhaustedError(std::string(source) + ": ScanGraph holds " + std::to_string(graph->points.size()) +
+                                  " points, more than the limit of " + std::to_string(options.max_points) +
+                                  std::string(readers::kRaiseResultLimit));
   }
   if (graph->points.empty()) {
-    return readers::InvalidInput(source, "ScanGraph holds " +
-                                             std::to_string(graph->origins.size()) +
+    return readers::InvalidInput(source, "ScanGraph holds " + std::to_string(graph->origins.size()) +
                                              " scans but no finite points; the cloud is empty");
   }
   SceneInput in;
@@ -147,9 +138,8 @@ std::string_view CompressionName(Compression c) {
 ReadOptions ReadLimits(uint64_t max_upload_bytes, uint64_t memory_budget_bytes) {
   const uint64_t upload = std::max<uint64_t>(max_upload_bytes, 1);
   const uint64_t half_budget = std::max<uint64_t>(memory_budget_bytes / 2, 1);
-  const uint64_t by_upload = upload > UINT64_MAX / kMaxDecompressionRatio
-                                 ? UINT64_MAX
-                                 : upload * kMaxDecompressionRatio;
+  const uint64_t by_upload =
+      upload > UINT64_MAX / kMaxDecompressionRatio ? UINT64_MAX : upload * kMaxDecompressionRatio;
   ReadOptions o;
   o.max_decompressed_bytes = std::min(by_upload, half_budget);
   o.max_result_bytes = half_budget;
@@ -171,22 +161,22 @@ Result<SceneInput> ReadSceneUnguarded(std::string_view bytes, std::string_view s
   const Compression compression = readers::DetectCompression(bytes);
   if (compression == Compression::kNone) {
     if (bytes.size() > options.max_decompressed_bytes) {
-      return ResourceExhaustedError(
-          std::string(source_name) + ": input of " + std::to_string(bytes.size()) +
-          " bytes is more than the limit of " + std::to_string(options.max_decompressed_bytes) +
-          std::string(readers::kRaiseInputLimit));
+      return ResourceExhaustedError(std::string(source_name) + ": input of " + std::to_string(bytes.size()) +
+                                    " bytes is more than the limit of " +
+                                    std::to_string(options.max_decompressed_bytes) +
+                                    std::string(readers::kRaiseInputLimit));
     }
     return ReadDecompressed(bytes, source_name, options);
   }
-  VC_ASSIGN_OR_RETURN(const std::string plain, readers::Decompress(bytes, compression, source_name,
-                                                                   options.max_decompressed_bytes));
+  VC_ASSIGN_OR_RETURN(const std::string plain,
+                      readers::Decompress(bytes, compression, source_name, options.max_decompressed_bytes));
   if (readers::DetectCompression(plain) != Compression::kNone) {
     return readers::InvalidInput(source_name, std::string(CompressionName(compression)) +
                                                   " input holds another compressed stream; "
                                                   "decompress it fully first");
   }
-  const std::string label = std::string(source_name) + " (" +
-                            std::string(CompressionName(compression)) + "-decompressed)";
+  const std::string label =
+      std::string(source_name) + " (" + std::string(CompressionName(compression)) + "-decompressed)";
   Result<SceneInput> in = ReadDecompressed(plain, label, options);
   if (in.ok()) in->compression = compression;
   return in;
@@ -194,11 +184,9 @@ Result<SceneInput> ReadSceneUnguarded(std::string_view bytes, std::string_view s
 
 }  // namespace
 
-Result<SceneInput> ReadScene(std::string_view bytes, std::string_view source_name,
-                             const ReadOptions& options) {
-  return CatchOutOfMemory(
-      std::string(source_name) + ": reading " + std::to_string(bytes.size()) + " bytes",
-      [&] { return ReadSceneUnguarded(bytes, source_name, options); });
+Result<SceneInput> ReadScene(std::string_view bytes, std::string_view source_name, const ReadOptions& options) {
+  return CatchOutOfMemory(std::string(source_name) + ": reading " + std::to_string(bytes.size()) + " bytes",
+                          [&] { return ReadSceneUnguarded(bytes, source_name, options); });
 }
 
 Result<SceneInput> ReadSceneFile(const std::string& path, const ReadOptions& options) {
@@ -208,8 +196,7 @@ Result<SceneInput> ReadSceneFile(const std::string& path, const ReadOptions& opt
   if (!file) return NotFoundError(path + ": cannot open file");
   const uintmax_t size = std::filesystem::file_size(path, ec);
   if (!ec && size > options.max_decompressed_bytes) {
-    return ResourceExhaustedError(path + ": file of " + std::to_string(size) +
-                                  " bytes is more than the limit of " +
+    return ResourceExhaustedError(path + ": file of " + std::to_string(size) + " bytes is more than the limit of " +
                                   std::to_string(options.max_decompressed_bytes) +
                                   std::string(readers::kRaiseInputLimit));
   }

@@ -1,8 +1,7 @@
 #include "vc/scene/scene_summary.h"
 
-#include <nlohmann/json.hpp>
-
 #include <iomanip>
+#include <nlohmann/json.hpp>
 #include <sstream>
 
 #include "vc/scene/octomap_adapter.h"
@@ -34,13 +33,12 @@ Result<SceneSummary> Summarize(const SceneInput& input, double resolution_m, uin
   vo.resolution_m = resolution_m;
   vo.memory_budget_bytes = memory_budget_bytes;
   s.resolution_m = WorkingResolution(input, vo);
-  VC_ASSIGN_OR_RETURN(const uint64_t occupied,
-                      CatchOutOfMemory("voxelising at " + std::to_string(s.resolution_m) + " m",
-                                       [&]() -> Result<uint64_t> {
-                                         VC_ASSIGN_OR_RETURN(std::vector<VoxelKey> keys,
-                                                             OccupiedKeys(input, s.resolution_m, memory_budget_bytes, ctx));
-                                         return uint64_t{keys.size()};
-                                       }));
+  VC_ASSIGN_OR_RETURN(
+      const uint64_t occupied,
+      CatchOutOfMemory("voxelising at " + std::to_string(s.resolution_m) + " m", [&]() -> Result<uint64_t> {
+        VC_ASSIGN_OR_RETURN(std::vector<VoxelKey> keys, OccupiedKeys(input, s.resolution_m, memory_budget_bytes, ctx));
+        return uint64_t{keys.size()};
+      }));
   s.occupied_voxels = occupied;
   return s;
 }

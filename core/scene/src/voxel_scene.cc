@@ -37,9 +37,9 @@ Status CheckExtent(const Eigen::Vector3d& lo_m, const Eigen::Vector3d& hi_m, dou
     const double needed = std::max(lo_m.cwiseAbs().maxCoeff(), hi_m.cwiseAbs().maxCoeff()) / (kKeyOffset - 1);
     std::ostringstream os;
     os << "the scene (extent " << ext.str() << ", bounding box " << lo_m.transpose() << " .. " << hi_m.transpose()
-       << " m) does not fit OctoMap's 65536-voxel key range at resolution " << r
-       << " m; coordinates must lie within +-" << kKeyOffset * r << " m of the origin. Use a resolution of at least "
-       << std::ceil(needed * 1000) / 1000 << " m or move the scene near the origin";
+       << " m) does not fit OctoMap's 65536-voxel key range at resolution " << r << " m; coordinates must lie within +-"
+       << kKeyOffset * r << " m of the origin. Use a resolution of at least " << std::ceil(needed * 1000) / 1000
+       << " m or move the scene near the origin";
     return InvalidArgumentError(os.str());
   }
   const VoxelIndex a{int(lo.x()), int(lo.y()), int(lo.z())}, b{int(hi.x()), int(hi.y()), int(hi.z())};
@@ -132,9 +132,10 @@ Result<std::vector<VoxelKey>> OccupiedKeys(const SceneInput& input, double r, ui
       total += n;
     });
     if (total * sizeof(uint64_t) > budget) {
-      return ResourceExhaustedError("resampling the octree at " + std::to_string(r) + " m gives " + std::to_string(total) +
-                                    " occupied voxels, over the memory budget; use a coarser resolution (the tree's own is " +
-                                    std::to_string(tree.getResolution()) + " m)");
+      return ResourceExhaustedError(
+          "resampling the octree at " + std::to_string(r) + " m gives " + std::to_string(total) +
+          " occupied voxels, over the memory budget; use a coarser resolution (the tree's own is " +
+          std::to_string(tree.getResolution()) + " m)");
     }
     packed.reserve(total);
     ForEachOccupiedLeaf(tree, [&](const WorldPoint& m, double s) {
@@ -198,9 +199,7 @@ VoxelAccumulator::VoxelAccumulator(double resolution_m, uint64_t memory_budget_b
   NotePeak(memory_bytes());
 }
 
-uint64_t VoxelAccumulator::memory_bytes() const {
-  return (keys_.capacity() + recent_.capacity()) * sizeof(uint64_t);
-}
+uint64_t VoxelAccumulator::memory_bytes() const { return (keys_.capacity() + recent_.capacity()) * sizeof(uint64_t); }
 
 void VoxelAccumulator::Add(const Eigen::Vector3f& p) {
   if (!p.allFinite()) {
@@ -295,7 +294,8 @@ void VoxelAccumulator::Grow() {
   std::ostringstream os;
   os.precision(4);
   os << "the cloud spans " << ext.x() << " x " << ext.y() << " x " << ext.z() << " m and has more than " << n
-     << " occupied voxels at resolution " << resolution_m_ << " m; streaming their keys needs more than the memory budget of "
+     << " occupied voxels at resolution " << resolution_m_
+     << " m; streaming their keys needs more than the memory budget of "
      << double(memory_budget_bytes_) / double(1 << 20) << " MiB; use a resolution of at least "
      << std::ceil(resolution_m_ * factor * 1000) / 1000 << " m, raise the budget, or crop the scene";
   status_ = ResourceExhaustedError(os.str());
@@ -306,10 +306,10 @@ Result<VoxelScene> VoxelAccumulator::Finish(const JobContext& ctx) {
   finished_ = true;
   VC_RETURN_IF_ERROR(status_);
   if (points_added_ == 0) {
-    return InvalidArgumentError(dropped_nonfinite_ == 0 ? std::string("the point cloud is empty")
-                                                        : "the point cloud has no finite point (" +
-                                                              std::to_string(dropped_nonfinite_) +
-                                                              " non-finite points dropped)");
+    return InvalidArgumentError(dropped_nonfinite_ == 0
+                                    ? std::string("the point cloud is empty")
+                                    : "the point cloud has no finite point (" + std::to_string(dropped_nonfinite_) +
+                                          " non-finite points dropped)");
   }
   VC_RETURN_IF_ERROR(CheckExtent(lo_m_.cast<double>(), hi_m_.cast<double>(), resolution_m_, memory_budget_bytes_));
   ctx.Report(Stage::kVoxelize, 0.0, "voxelising at " + std::to_string(resolution_m_) + " m");

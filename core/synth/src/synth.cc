@@ -13,8 +13,8 @@
 #include <algorithm>
 #include <array>
 #include <bit>
-#include <charconv>
 #include <cerrno>
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -26,10 +26,10 @@
 namespace vc {
 namespace {
 
-constexpr double kEnvelopeM = 0.3;        // wall thickness around the free space, for the bounds
-constexpr double kCorniceM = 0.2;         // cornice (crown moulding) section, m
-constexpr double kJitterFraction = 0.1;   // in-plane jitter, fraction of the local grid step
-constexpr int kMaxCount = 50;             // largest K of comb:K and N of rooms:N
+constexpr double kEnvelopeM = 0.3;       // wall thickness around the free space, for the bounds
+constexpr double kCorniceM = 0.2;        // cornice (crown moulding) section, m
+constexpr double kJitterFraction = 0.1;  // in-plane jitter, fraction of the local grid step
+constexpr int kMaxCount = 50;            // largest K of comb:K and N of rooms:N
 
 double Snap(double v) { return std::round(v * 1e6) / 1e6; }  // micrometres: equal edges compare equal
 
@@ -44,13 +44,19 @@ Box Cuboid(double x0, double y0, double z0, double x1, double y1, double z1) {
 
 // A scene in design coordinates (floor of the ground storey at z = 0, before kSceneOffsetM).
 struct Model {
-  std::vector<Box> air;        // free space: rooms and openings
-  std::vector<bool> is_room;   // air boxes that get a cornice along their walls
-  std::vector<Box> solid;      // obstacles inside the free space
-  SceneInfo info;              // rooms, floors and bounds still in design coordinates
+  std::vector<Box> air;       // free space: rooms and openings
+  std::vector<bool> is_room;  // air boxes that get a cornice along their walls
+  std::vector<Box> solid;     // obstacles inside the free space
+  SceneInfo info;             // rooms, floors and bounds still in design coordinates
 
-  void Room(const Box& b) { air.push_back(b); is_room.push_back(true); }
-  void Opening(const Box& b) { air.push_back(b); is_room.push_back(false); }
+  void Room(const Box& b) {
+    air.push_back(b);
+    is_room.push_back(true);
+  }
+  void Opening(const Box& b) {
+    air.push_back(b);
+    is_room.push_back(false);
+  }
   void Solid(const Box& b) { solid.push_back(b); }
 };
 
@@ -362,9 +368,7 @@ uint64_t SplitMix64(uint64_t& state) {
 }
 
 // Uniform in [-1, 1).
-double SignedUnit(uint64_t& state) {
-  return static_cast<double>(SplitMix64(state) >> 11) * 0x1.0p-52 - 1.0;
-}
+double SignedUnit(uint64_t& state) { return static_cast<double>(SplitMix64(state) >> 11) * 0x1.0p-52 - 1.0; }
 
 // Offset used to probe the cells on either side of a border; box coordinates are multiples of
 // 1e-6 m (Snap), so this never crosses another border.
@@ -415,8 +419,8 @@ class Sampler {
       const bool minus = InBox(b, a, c, false, u, q[u], v, q[v]);
       (o < num_air_ ? air_plus : solid_plus) |= plus;
       (o < num_air_ ? air_minus : solid_minus) |= minus;
-      if (o != box && (b.lo[a] == c || b.hi[a] == c) && b.lo[u] < q[u] && q[u] < b.hi[u] &&
-          b.lo[v] < q[v] && q[v] < b.hi[v] && FaceIndex(o, a, b.hi[a] == c ? 1 : 0) < face_index) {
+      if (o != box && (b.lo[a] == c || b.hi[a] == c) && b.lo[u] < q[u] && q[u] < b.hi[u] && b.lo[v] < q[v] &&
+          q[v] < b.hi[v] && FaceIndex(o, a, b.hi[a] == c ? 1 : 0) < face_index) {
         return false;  // an earlier coplanar face samples this part
       }
     }
@@ -603,16 +607,14 @@ Result<std::vector<Eigen::Vector3f>> GenerateScene(std::string_view spec, const 
   const Sampler sampler(m, options.spacing_m);
   const uint64_t count = sampler.Run(options.seed, nullptr);
   if (count > kMaxGeneratedPoints) {
-    return ResourceExhaustedError("scene '" + std::string(spec) + "' at spacing " +
-                                  std::to_string(options.spacing_m) + " m has " + std::to_string(count) +
-                                  " points, more than the " + std::to_string(kMaxGeneratedPoints) +
+    return ResourceExhaustedError("scene '" + std::string(spec) + "' at spacing " + std::to_string(options.spacing_m) +
+                                  " m has " + std::to_string(count) + " points, more than the " +
+                                  std::to_string(kMaxGeneratedPoints) +
                                   " GenerateScene holds in memory; use ForEachScenePoint or WritePlyBinary");
   }
   std::vector<Eigen::Vector3f> points;
   points.reserve(count);
-  const std::function<void(const Eigen::Vector3f&)> fn = [&points](const Eigen::Vector3f& p) {
-    points.push_back(p);
-  };
+  const std::function<void(const Eigen::Vector3f&)> fn = [&points](const Eigen::Vector3f& p) { points.push_back(p); };
   sampler.Run(options.seed, &fn);
   return points;
 }
@@ -625,10 +627,9 @@ Status WritePlyBinary(const std::string& path, std::string_view spec, const Synt
   if (!file) {
     return FailedPreconditionError("cannot open '" + path + "' for writing: " + std::strerror(errno));
   }
-  const std::string header = "ply\nformat binary_little_endian 1.0\ncomment vc synthetic scene " +
-                             std::string(spec) + " spacing " + std::to_string(options.spacing_m) +
-                             " seed " + std::to_string(options.seed) + "\nelement vertex " +
-                             std::to_string(count) +
+  const std::string header = "ply\nformat binary_little_endian 1.0\ncomment vc synthetic scene " + std::string(spec) +
+                             " spacing " + std::to_string(options.spacing_m) + " seed " + std::to_string(options.seed) +
+                             "\nelement vertex " + std::to_string(count) +
                              "\nproperty float x\nproperty float y\nproperty float z\nend_header\n";
   bool ok = std::fwrite(header.data(), 1, header.size(), file.get()) == header.size();
   std::vector<float> buffer;

@@ -228,26 +228,27 @@ Result<Evaluation> EvaluateSampled(const EvaluationJob& job, Evaluation ev) {
   std::vector<double> sum_sq(chunks, 0.0);
   std::vector<std::vector<Tally>> per(chunks, std::vector<Tally>(nv));
   StageProgress progress(ctx, Stage::kEvaluation, chunks);
-  VC_RETURN_IF_ERROR(ParallelChunks(sample.size(), kChunk, options.threads, ctx, [&](uint64_t c, uint64_t b, uint64_t e) {
-    for (uint64_t i = b; i < e; ++i) {
-      const VoxelIndex& v = index[sample[i].first];
-      const Face f = Face(sample[i].second);
-      double best = 0;
-      Perception best_p = Perception::kNone;
-      for (size_t k = 0; k < nv; ++k) {
-        int visible = 0;
-        OccluderCache cache(shortcuts[k]);
-        for (int q : kFaceCorners[int(f)]) visible += CornerVisibleCached(g, uo[k], Corner(v, q), cache);
-        const Perception p = FromCount(visible);
-        const double val = FaceValue(p, viewpoints[k], v, f, r, options.scanner);
-        per[c][k].Add(p, val);
-        KeepBest(val, p, best, best_p);
-      }
-      overall[c].Add(best_p, best);
-      sum_sq[c] += best * best;
-    }
-    progress.Add(1);
-  }));
+  VC_RETURN_IF_ERROR(
+      ParallelChunks(sample.size(), kChunk, options.threads, ctx, [&](uint64_t c, uint64_t b, uint64_t e) {
+        for (uint64_t i = b; i < e; ++i) {
+          const VoxelIndex& v = index[sample[i].first];
+          const Face f = Face(sample[i].second);
+          double best = 0;
+          Perception best_p = Perception::kNone;
+          for (size_t k = 0; k < nv; ++k) {
+            int visible = 0;
+            OccluderCache cache(shortcuts[k]);
+            for (int q : kFaceCorners[int(f)]) visible += CornerVisibleCached(g, uo[k], Corner(v, q), cache);
+            const Perception p = FromCount(visible);
+            const double val = FaceValue(p, viewpoints[k], v, f, r, options.scanner);
+            per[c][k].Add(p, val);
+            KeepBest(val, p, best, best_p);
+          }
+          overall[c].Add(best_p, best);
+          sum_sq[c] += best * best;
+        }
+        progress.Add(1);
+      }));
   Tally total;
   double sq = 0;
   std::vector<Tally> per_total(nv);
@@ -343,15 +344,16 @@ Result<Evaluation> EvaluateExact(const EvaluationJob& job, Evaluation ev) {
         }
       }));
     }
-    VC_RETURN_IF_ERROR(ParallelChunks(corners.size(), kCornerChunk, threads, ctx, [&](uint64_t, uint64_t b, uint64_t e) {
-      OccluderCache cache(shortcuts[k]);
-      for (uint64_t c = b; c < e; ++c) {
-        if ((w.decided_bits[c >> 6] >> (c & 63)) & 1) continue;
-        if (CornerVisibleCached(g, uo[k], UnpackCorner(corners[c]), cache)) {
-          w.visible_bits[c >> 6] |= uint64_t{1} << (c & 63);
-        }
-      }
-    }));
+    VC_RETURN_IF_ERROR(
+        ParallelChunks(corners.size(), kCornerChunk, threads, ctx, [&](uint64_t, uint64_t b, uint64_t e) {
+          OccluderCache cache(shortcuts[k]);
+          for (uint64_t c = b; c < e; ++c) {
+            if ((w.decided_bits[c >> 6] >> (c & 63)) & 1) continue;
+            if (CornerVisibleCached(g, uo[k], UnpackCorner(corners[c]), cache)) {
+              w.visible_bits[c >> 6] |= uint64_t{1} << (c & 63);
+            }
+          }
+        }));
     // 2. Faces from their corners.
     std::vector<Tally>& tallies = w.tallies;
     std::fill(tallies.begin(), tallies.end(), Tally{});
@@ -408,18 +410,21 @@ Result<Evaluation> EvaluateExact(const EvaluationJob& job, Evaluation ev) {
     // The last nv % workers viewpoints are evaluated one after another on all threads, so that
     // no thread ends with a whole viewpoint of its own while the others wait.
     const uint64_t alone = nv - nv % uint64_t(workers);
-    VC_RETURN_IF_ERROR(ParallelChunks(alone, 1, workers, ctx, [&](uint64_t k, uint64_t, uint64_t) {
-      Work* w = nullptr;
-      {
-        std::lock_guard<std::mutex> lock(mu);  // at most `workers` tasks run at once
-        w = idle.back();
-        idle.pop_back();
-      }
-      const Status st = evaluate_viewpoint(k, 1, *w);
-      std::lock_guard<std::mutex> lock(mu);
-      if (!st.ok() && failed.ok()) failed = st;
-      idle.push_back(w);
-    }, "evaluation"));
+    VC_RETURN_IF_ERROR(ParallelChunks(
+        alone, 1, workers, ctx,
+        [&](uint64_t k, uint64_t, uint64_t) {
+          Work* w = nullptr;
+          {
+            std::lock_guard<std::mutex> lock(mu);  // at most `workers` tasks run at once
+            w = idle.back();
+            idle.pop_back();
+          }
+          const Status st = evaluate_viewpoint(k, 1, *w);
+          std::lock_guard<std::mutex> lock(mu);
+          if (!st.ok() && failed.ok()) failed = st;
+          idle.push_back(w);
+        },
+        "evaluation"));
     VC_RETURN_IF_ERROR(failed);
     for (size_t k = alone; k < nv; ++k) VC_RETURN_IF_ERROR(evaluate_viewpoint(k, workers, *works[0]));
   } else {
@@ -429,7 +434,8 @@ Result<Evaluation> EvaluateExact(const EvaluationJob& job, Evaluation ev) {
   std::vector<double>& best = works[0]->best;
   std::vector<uint8_t>& best_p = works[0]->best_p;
   for (size_t t = 1; t < works.size(); ++t) {
-    for (size_t slot = 0; slot < best.size(); ++slot) KeepBest(works[t]->best[slot], works[t]->best_p[slot], best[slot], best_p[slot]);
+    for (size_t slot = 0; slot < best.size(); ++slot)
+      KeepBest(works[t]->best[slot], works[t]->best_p[slot], best[slot], best_p[slot]);
   }
   // Overall: the best V of each face over all viewpoints.
   Tally total;

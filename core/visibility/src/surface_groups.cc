@@ -21,13 +21,12 @@
 // as IsSurfaceVisible does.
 #include "vc/visibility/surface_groups.h"
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <array>
 #include <bit>
 #include <cmath>
 #include <optional>
-
-#include <Eigen/Geometry>
 
 #include "vc/raycast/ray_traversal.h"
 #include "vc/raycast/walk.h"
@@ -37,9 +36,9 @@ namespace {
 
 using Eigen::Vector3d;
 
-constexpr int kMinSplit = 4;      // groups this small are not split further
-constexpr int kGrowLimit = 32;    // how far a solid occluder box grows from the voxel hit (8-64 measured: 32)
-constexpr double kConeStep = 8;   // length (voxels) of each box of the cone's cover (8 measured best of 2-32)
+constexpr int kMinSplit = 4;     // groups this small are not split further
+constexpr int kGrowLimit = 32;   // how far a solid occluder box grows from the voxel hit (8-64 measured: 32)
+constexpr double kConeStep = 8;  // length (voxels) of each box of the cone's cover (8 measured best of 2-32)
 constexpr double kConeMargin = 1e-4;
 
 int At(const VoxelIndex& v, int axis) { return axis == 0 ? v.x : axis == 1 ? v.y : v.z; }
@@ -68,7 +67,8 @@ bool MoreThan(uint64_t mask, int k) {
 // Positions p = u * 8 + w with u in [u0, u1] and w in [w0, w1].
 uint64_t RectMask(int u0, int u1, int w0, int w1) {
   const uint64_t row = ((uint64_t{2} << w1) - (uint64_t{1} << w0)) * 0x0101010101010101ull;
-  const uint64_t rows = (u1 == 7 ? ~uint64_t{0} : (uint64_t{1} << (8 * (u1 + 1))) - 1) & ~((uint64_t{1} << (8 * u0)) - 1);
+  const uint64_t rows =
+      (u1 == 7 ? ~uint64_t{0} : (uint64_t{1} << (8 * (u1 + 1))) - 1) & ~((uint64_t{1} << (8 * u0)) - 1);
   return row & rows;
 }
 
@@ -222,8 +222,8 @@ FreeBox GrowFreeBox(const OccupancyGrid& grid, const Vector3d& uo) {
   return box;
 }
 
-bool FreeCone(const OccupancyGrid& grid, const Vector3d& uo, int axis, bool viewer_above, int plane,
-              const Vector3d& q0, const Vector3d& q1, const FreeBox& around, double from, double* failed_at) {
+bool FreeCone(const OccupancyGrid& grid, const Vector3d& uo, int axis, bool viewer_above, int plane, const Vector3d& q0,
+              const Vector3d& q1, const FreeBox& around, double from, double* failed_at) {
   double len = 0;
   for (int i = 0; i < 3; ++i) len = std::max({len, std::abs(q0[i] - uo[i]), std::abs(q1[i] - uo[i])});
   if (!(len > 0)) return false;
@@ -300,7 +300,8 @@ bool FreeCone(const OccupancyGrid& grid, const Vector3d& uo, int axis, bool view
     piece(s0, s1, lo, hi);
     // A box of the cover holds more than the cone: its occupied voxels are tested against the
     // cone's side planes before they count.
-    if (lo[axis] <= hi[axis] && grid.AnyOccupiedWhere({lo[0], lo[1], lo[2]}, {hi[0], hi[1], hi[2]}, [&](const VoxelIndex& v) {
+    if (lo[axis] <= hi[axis] &&
+        grid.AnyOccupiedWhere({lo[0], lo[1], lo[2]}, {hi[0], hi[1], hi[2]}, [&](const VoxelIndex& v) {
           if (!sides) sides.emplace(uo, axis, q0, q1);
           return !sides->Excludes(v);
         })) {
@@ -354,7 +355,8 @@ SurfaceTargets::SurfaceTargets(const OccupancyGrid& grid, const std::vector<Voxe
 
 SolidBox SurfaceTargets::GrownBox(const VoxelIndex& h) const {
   const VoxelIndex& m = grid_.min_index();
-  const uint64_t rx = uint64_t(int64_t(h.x) - m.x), ry = uint64_t(int64_t(h.y) - m.y), rz = uint64_t(int64_t(h.z) - m.z);
+  const uint64_t rx = uint64_t(int64_t(h.x) - m.x), ry = uint64_t(int64_t(h.y) - m.y),
+                 rz = uint64_t(int64_t(h.z) - m.z);
   constexpr uint64_t kField = uint64_t{1} << 21;
   if (rx >= kField || ry >= kField || rz >= kField) return GrowSolidBox(grid_, h, kGrowLimit);  // not packable
   const uint64_t key = 1 + (rx | ry << 21 | rz << 42);
@@ -516,7 +518,9 @@ struct SurfaceTargets::CentreKind {
   std::array<uint64_t, 8> visible;  // bit j: target j is visible
   std::array<uint8_t, 512> tried;   // bit f: face f is decided blocked, or its own ray was cast
 
-  VoxelIndex VoxelOf(int j) const { return {base[0] + t[j].local[0], base[1] + t[j].local[1], base[2] + t[j].local[2]}; }
+  VoxelIndex VoxelOf(int j) const {
+    return {base[0] + t[j].local[0], base[1] + t[j].local[1], base[2] + t[j].local[2]};
+  }
   bool Skip(int j) const { return (visible[j >> 6] >> (j & 63)) & 1; }
   void Rect(int a, const int b[3], int plane, int voxel_a, int umin, int umax, int wmin, int wmax, Vector3d& q0,
             Vector3d& q1, VoxelIndex& klo, VoxelIndex& khi) const {
@@ -668,8 +672,9 @@ void SurfaceTargets::AppendVisible(const Vector3d& uo, size_t brick_begin, size_
       for (uint64_t m = kind.visible[word]; m; m &= m - 1) visible.Set(t[word * 64 + std::countr_zero(m)].id);
       for (uint64_t m = ~kind.visible[word] & in_brick; m; m &= m - 1) {
         const int j = word * 64 + std::countr_zero(m);
-        const uint8_t faces = (facing_bits[0][t[j].local[0]] | facing_bits[1][t[j].local[1]] |
-                               facing_bits[2][t[j].local[2]]) & t[j].exposed & ~kind.tried[j];
+        const uint8_t faces =
+            (facing_bits[0][t[j].local[0]] | facing_bits[1][t[j].local[1]] | facing_bits[2][t[j].local[2]]) &
+            t[j].exposed & ~kind.tried[j];
         if (faces) rays.Add(t[j].id, kind.VoxelOf(j), faces);
       }
     }
@@ -753,7 +758,8 @@ struct SurfaceTargets::CornerKind {
     return true;
   }
   void BackDecided(int a, int sp, uint64_t sub, const uint16_t* at, bool seen) {
-    for (uint64_t m = sub; m; m &= m - 1) out.push_back({t[at[std::countr_zero(m)]].id, 0, uint8_t(2 * a + (1 - sp)), seen});
+    for (uint64_t m = sub; m; m &= m - 1)
+      out.push_back({t[at[std::countr_zero(m)]].id, 0, uint8_t(2 * a + (1 - sp)), seen});
   }
   void SeenGroup(int a, int sp, int plane, int umin, int umax, int wmin, int wmax, uint64_t sub, const uint16_t* at) {
     Vector3d q0, q1;

@@ -195,7 +195,8 @@ Result<std::vector<VoxelSet>> ComputeVisibilitySets(const VoxelScene& scene, con
     // (viewpoint, run of bricks); tasks of one viewpoint share its set's words, so bits are set
     // atomically.
     const internal::SurfaceTargets targets(g, index, candidates);
-    const bool task_per_viewpoint = viewpoints.size() >= 8 * uint64_t(ResolveThreads(options.threads, viewpoints.size()));
+    const bool task_per_viewpoint =
+        viewpoints.size() >= 8 * uint64_t(ResolveThreads(options.threads, viewpoints.size()));
     // The sets are allocated here, in the calling thread (running out of memory must not happen
     // in a worker), but a task that owns its viewpoint's set clears it: the first touch of fresh
     // memory is most of the cost (0.14 s in one thread for the hall's 858 sets of 53 KB).
@@ -207,7 +208,8 @@ Result<std::vector<VoxelSet>> ComputeVisibilitySets(const VoxelScene& scene, con
       }
     }
     const uint64_t bricks_per_task = task_per_viewpoint ? std::max<uint64_t>(1, targets.brick_count()) : 256;
-    const uint64_t brick_chunks = std::max<uint64_t>(1, (targets.brick_count() + bricks_per_task - 1) / bricks_per_task);
+    const uint64_t brick_chunks =
+        std::max<uint64_t>(1, (targets.brick_count() + bricks_per_task - 1) / bricks_per_task);
     const uint64_t tasks = viewpoints.size() * brick_chunks;
     StageProgress progress(ctx, Stage::kVisibility, tasks);
     Status st = ParallelChunks(tasks, 1, options.threads, ctx, [&](uint64_t task, uint64_t, uint64_t) {
@@ -235,8 +237,9 @@ Result<std::vector<VoxelSet>> ComputeVisibilitySets(const VoxelScene& scene, con
   // Start offsets into `candidates` for each id chunk.
   std::vector<size_t> chunk_start(id_chunks + 1);
   for (uint64_t c = 0; c <= id_chunks; ++c) {
-    chunk_start[c] = std::lower_bound(candidates.begin(), candidates.end(), uint32_t(std::min<uint64_t>(c * kIdsPerChunk, n))) -
-                     candidates.begin();
+    chunk_start[c] =
+        std::lower_bound(candidates.begin(), candidates.end(), uint32_t(std::min<uint64_t>(c * kIdsPerChunk, n))) -
+        candidates.begin();
   }
   const uint64_t tasks = viewpoints.size() * id_chunks;
   StageProgress progress(ctx, Stage::kVisibility, tasks);

@@ -83,7 +83,8 @@ inline bool LastLayerBlocksCorner(const OccupancyGrid& g, const Eigen::Vector3d&
   return false;
 }
 
-inline bool CornerVisibleCached(const OccupancyGrid& g, const Eigen::Vector3d& uo, const VoxelIndex& c, OccluderCache& cache) {
+inline bool CornerVisibleCached(const OccupancyGrid& g, const Eigen::Vector3d& uo, const VoxelIndex& c,
+                                OccluderCache& cache) {
   if (cache.enabled() && LastLayerBlocksCorner(g, uo, c)) return false;  // shortcuts hold (occluders.h)
   // Occluders in the 2x2x2 block around c do not count: once a segment enters that (convex)
   // block it stays inside it up to c, so every voxel outside it is visited first.
@@ -98,7 +99,9 @@ inline bool CornerVisibleCached(const OccupancyGrid& g, const Eigen::Vector3d& u
 }
 
 // Corner k (bit 0: +x, bit 1: +y, bit 2: +z) of voxel v.
-inline VoxelIndex Corner(const VoxelIndex& v, int k) { return {v.x + (k & 1), v.y + ((k >> 1) & 1), v.z + ((k >> 2) & 1)}; }
+inline VoxelIndex Corner(const VoxelIndex& v, int k) {
+  return {v.x + (k & 1), v.y + ((k >> 1) & 1), v.z + ((k >> 2) & 1)};
+}
 
 // The 4 corner numbers of each face.
 inline constexpr int kFaceCorners[6][4] = {
@@ -118,7 +121,8 @@ inline Perception FromCount(int visible) {
 }
 
 // V of a face given its perception, from world viewpoint o (s.5).
-inline double FaceValue(Perception p, const WorldPoint& o, const VoxelIndex& v, Face f, double r, const ScannerModel& s) {
+inline double FaceValue(Perception p, const WorldPoint& o, const VoxelIndex& v, Face f, double r,
+                        const ScannerModel& s) {
   if (p == Perception::kNone) return 0.0;
   const WorldPoint center = FaceCenterIS(v, f) * r;
   const Eigen::Vector3d ray = center - o;

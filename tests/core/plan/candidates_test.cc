@@ -169,7 +169,7 @@ TEST(CandidatesTest, FloorTopNearFindsTheLevelUnderAPoint) {
   ASSERT_TRUE(FloorTopNear(s.grid, -1.0, -0.7, 0.1, o).has_value());
   EXPECT_NEAR(*FloorTopNear(s.grid, -1.0, -0.7, 0.1, o), 0.1, 1e-9);
   EXPECT_NEAR(*FloorTopNear(s.grid, -1.0, -0.7, 2.9, o), 2.9, 1e-9);
-  EXPECT_FALSE(FloorTopNear(s.grid, 0.5, -0.2, 0.1, o).has_value());  // the hole
+  EXPECT_FALSE(FloorTopNear(s.grid, 0.5, -0.2, 0.1, o).has_value());   // the hole
   EXPECT_FALSE(FloorTopNear(s.grid, -1.0, -0.7, 1.5, o).has_value());  // no floor near 1.5 m
 }
 

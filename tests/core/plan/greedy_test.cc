@@ -100,8 +100,8 @@ TEST(GreedyTest, ThreeRoomsMatchesExhaustiveMinimum) {
 
 TEST(GreedyTest, NestedAndDisjointSetsMatchExhaustive) {
   // Nested sets: the largest covers everything -> 1 pick.
-  std::vector<VoxelSet> nested = {MakeSet(16, {0, 1}), MakeSet(16, {0, 1, 2, 3, 4}), MakeSet(16, {0, 1, 2, 3, 4, 5, 6, 7}),
-                                  MakeSet(16, {3, 4})};
+  std::vector<VoxelSet> nested = {MakeSet(16, {0, 1}), MakeSet(16, {0, 1, 2, 3, 4}),
+                                  MakeSet(16, {0, 1, 2, 3, 4, 5, 6, 7}), MakeSet(16, {3, 4})};
   EXPECT_EQ(Greedy(nested).picks.size(), static_cast<size_t>(MinimumCover(nested)));
   EXPECT_EQ(Picks(Greedy(nested)), std::vector<int>({2}));
   // Disjoint sets: all are needed, largest first.
@@ -148,7 +148,8 @@ TEST(GreedyTest, IsGreedyNotOptimalOnTheClassicTrap) {
 }
 
 TEST(GreedyTest, TiesGoToTheLowestIndex) {
-  std::vector<VoxelSet> sets = {MakeSet(8, {0, 1}), MakeSet(8, {2, 3, 4}), MakeSet(8, {5, 6, 7}), MakeSet(8, {2, 3, 4})};
+  std::vector<VoxelSet> sets = {MakeSet(8, {0, 1}), MakeSet(8, {2, 3, 4}), MakeSet(8, {5, 6, 7}),
+                                MakeSet(8, {2, 3, 4})};
   for (bool lazy : {false, true}) {
     GreedyOptions o;
     o.lazy = lazy;

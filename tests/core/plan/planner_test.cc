@@ -46,8 +46,9 @@ std::string Describe(const PlanResult& r) {
   std::string s = std::to_string(r.stations.size()) + " stations, covered " + std::to_string(r.covered_voxels) + "/" +
                   std::to_string(r.coverable_voxels) + " coverable of " + std::to_string(r.occupied_voxels) +
                   " occupied, " + std::to_string(r.candidate_count) + " candidates, " +
-                  std::to_string(r.greedy_stations) + " greedy picks, G = " +
-                  std::to_string(r.evaluation.overall.global_visibility) + ", stop " + std::string(StopReasonName(r.stop_reason));
+                  std::to_string(r.greedy_stations) +
+                  " greedy picks, G = " + std::to_string(r.evaluation.overall.global_visibility) + ", stop " +
+                  std::string(StopReasonName(r.stop_reason));
   for (const auto& t : r.timings) s += ", " + std::string(StageName(t.stage)) + " " + std::to_string(t.seconds) + " s";
   for (const auto& w : r.warnings) s += "\n  warning: " + w;
   return s;
@@ -140,8 +141,8 @@ TEST(PlannerTest, TwoFloorsGetCandidatesAndStationsOnBothStoreys) {
     const double z = info->floor_heights_m[f] + 1.5;
     const auto near = [&](const WorldPoint& p) { return std::fabs(p.z() - z) < 0.15; };
     EXPECT_TRUE(std::any_of(r->heat_map.positions.begin(), r->heat_map.positions.end(), near)) << "floor " << f;
-    EXPECT_TRUE(std::any_of(r->stations.begin(), r->stations.end(),
-                            [&](const PlannedStation& s) { return near(s.position); }))
+    EXPECT_TRUE(
+        std::any_of(r->stations.begin(), r->stations.end(), [&](const PlannedStation& s) { return near(s.position); }))
         << "no station on floor " << f;
   }
   EXPECT_EQ(r->covered_voxels, r->coverable_voxels);
@@ -312,7 +313,8 @@ TEST(PlannerTest, CancelledBeforeAndDuringEveryStage) {
     ctx.cancel = &token;
     EXPECT_EQ(Plan(in, TestOptions(), ctx).status().code(), StatusCode::kCancelled);
   }
-  for (const Stage stage : {Stage::kCandidates, Stage::kVisibility, Stage::kSelection, Stage::kReduction, Stage::kEvaluation}) {
+  for (const Stage stage :
+       {Stage::kCandidates, Stage::kVisibility, Stage::kSelection, Stage::kReduction, Stage::kEvaluation}) {
     CancelToken token;
     JobContext ctx;
     ctx.cancel = &token;

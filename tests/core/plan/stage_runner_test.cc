@@ -110,22 +110,28 @@ TEST(StageRunnerTest, ProgressIsRelabelledToTheStageAndMonotoneInZeroOne) {
   Recorder rec;
   const JobContext ctx = rec.Context();
   StageRunner runner(ctx);
-  ASSERT_TRUE(runner.Run(Stage::kVisibility, [](const JobContext& c) -> Result<int> {
-                      // Work that reports under another stage's name and overshoots [0, 1].
-                      c.Report(Stage::kEvaluation, -0.5);
-                      c.Report(Stage::kEvaluation, 0.25, "a quarter");
-                      c.Report(Stage::kUnspecified, 1.5);
-                      return 1;
-                    }).ok());
-  ASSERT_TRUE(runner.Run(Stage::kRefine, [](const JobContext& c) -> Result<int> {
-                      // Two parts of the stage: [0, 0.9] and [0.9, 1].
-                      const JobContext first = ProgressRange(c, 0.0, 0.9);
-                      first.Report(Stage::kVisibility, 0.5);
-                      first.Report(Stage::kVisibility, 1.0);
-                      const JobContext second = ProgressRange(c, 0.9, 1.0);
-                      second.Report(Stage::kReduction, 0.5);
-                      return 1;
-                    }).ok());
+  ASSERT_TRUE(runner
+                  .Run(Stage::kVisibility,
+                       [](const JobContext& c) -> Result<int> {
+                         // Work that reports under another stage's name and overshoots [0, 1].
+                         c.Report(Stage::kEvaluation, -0.5);
+                         c.Report(Stage::kEvaluation, 0.25, "a quarter");
+                         c.Report(Stage::kUnspecified, 1.5);
+                         return 1;
+                       })
+                  .ok());
+  ASSERT_TRUE(runner
+                  .Run(Stage::kRefine,
+                       [](const JobContext& c) -> Result<int> {
+                         // Two parts of the stage: [0, 0.9] and [0.9, 1].
+                         const JobContext first = ProgressRange(c, 0.0, 0.9);
+                         first.Report(Stage::kVisibility, 0.5);
+                         first.Report(Stage::kVisibility, 1.0);
+                         const JobContext second = ProgressRange(c, 0.9, 1.0);
+                         second.Report(Stage::kReduction, 0.5);
+                         return 1;
+                       })
+                  .ok());
   std::vector<double> visibility, refine;
   for (const ProgressEvent& e : rec.events) {
     ASSERT_TRUE(e.stage == Stage::kVisibility || e.stage == Stage::kRefine) << StageName(e.stage);
@@ -150,9 +156,7 @@ TEST(StageRunnerTest, ProgressIsRelabelledToTheStageAndMonotoneInZeroOne) {
 TEST(StageRunnerTest, WithoutAProgressCallbackStagesGetNone) {
   const JobContext ctx;
   StageRunner runner(ctx);
-  Result<int> r = runner.Run(Stage::kVoxelize, [](const JobContext& c) -> Result<int> {
-    return c.progress ? 1 : 0;
-  });
+  Result<int> r = runner.Run(Stage::kVoxelize, [](const JobContext& c) -> Result<int> { return c.progress ? 1 : 0; });
   ASSERT_TRUE(r.ok());
   EXPECT_EQ(*r, 0);
 }

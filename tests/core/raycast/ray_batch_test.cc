@@ -106,8 +106,8 @@ TEST(FirstOccupiedBatchTest, MatchesFirstOccupiedOnTiesAndEdgeCases) {
   std::vector<VoxelIndex> occ;
   for (int x = -8; x <= 8; ++x)
     for (int y = -8; y <= 8; ++y) {
-      occ.push_back({x, y, -8});                        // floor
-      if ((x + y) % 3 == 0) occ.push_back({x, y, 4});   // a perforated slab
+      occ.push_back({x, y, -8});                       // floor
+      if ((x + y) % 3 == 0) occ.push_back({x, y, 4});  // a perforated slab
     }
   for (int z = -8; z <= 8; ++z) occ.push_back({0, 0, z});  // a post
   auto grid = OccupancyGrid::Build(0.1, occ, 1 << 24);
@@ -122,10 +122,10 @@ TEST(FirstOccupiedBatchTest, MatchesFirstOccupiedOnTiesAndEdgeCases) {
   for (int i = -20; i <= 20; ++i) {
     const double k = i;
     s.Add({k + 0.5, 0.5, 20.5}, {k + 0.5, 0.5, -20.5});  // straight down
-    s.Add({-20.0, k, k}, {20.0, -k, -k});                 // through edges and corners
-    s.Add({k, k, k}, {k, k, k});                          // zero length
-    s.Add({0.5, 0.5, 0.5}, {k, 20.0, 3.0});               // starts inside the post
-    s.Add({-3e4, k, 2.5}, {3e4, -k, 2.5});                // far outside at both ends
+    s.Add({-20.0, k, k}, {20.0, -k, -k});                // through edges and corners
+    s.Add({k, k, k}, {k, k, k});                         // zero length
+    s.Add({0.5, 0.5, 0.5}, {k, 20.0, 3.0});              // starts inside the post
+    s.Add({-3e4, k, 2.5}, {3e4, -k, 2.5});               // far outside at both ends
   }
   EXPECT_GT(ExpectSameOnEveryTarget(*grid, s, "ties and edge cases"), 1000);  // seen: 1664
 }
@@ -159,9 +159,12 @@ TEST(FirstOccupiedBatchTest, MatchesFirstOccupiedOnNearTies) {
   const double nudges[] = {0.0, 0x1p-50, 0x1p-30, 1e-7, 3e-6};
   auto nudge = [&](double v) {
     switch (way(rng)) {
-      case 0: return std::nextafter(v, 1e9);
-      case 1: return std::nextafter(std::nextafter(v, -1e9), -1e9);
-      default: return v + (way(rng) % 2 ? 1 : -1) * nudges[way(rng) % 5];
+      case 0:
+        return std::nextafter(v, 1e9);
+      case 1:
+        return std::nextafter(std::nextafter(v, -1e9), -1e9);
+      default:
+        return v + (way(rng) % 2 ? 1 : -1) * nudges[way(rng) % 5];
     }
   };
   Segments s;
@@ -192,9 +195,9 @@ TEST(FirstOccupiedBatchTest, ExactTiesAndOversizedSegmentsAreLeftToFirstOccupied
   // or hits the floor within a few dozen steps, so FirstOccupied is quick on them (it walks a
   // segment that starts far outside the box voxel by voxel up to the box).
   occ.push_back({0, 0, 20});
-  oversized.Add({0.5, 0.5, 10.5}, {5e6, 0.5, -1e4});    // 5e6 steps along x (> 2^22)
-  oversized.Add({0.5, 0.5, 10.5}, {0.5, 0.5, -6e6});    // 6e6 steps along z, hits the floor
-  oversized.Add({0.5, 0.5, 10.5}, {2e9, 0.5, 10.5});    // an end beyond 2^30
+  oversized.Add({0.5, 0.5, 10.5}, {5e6, 0.5, -1e4});  // 5e6 steps along x (> 2^22)
+  oversized.Add({0.5, 0.5, 10.5}, {0.5, 0.5, -6e6});  // 6e6 steps along z, hits the floor
+  oversized.Add({0.5, 0.5, 10.5}, {2e9, 0.5, 10.5});  // an end beyond 2^30
   oversized.Add({0.5, 0.5, 10.5}, {0.5, -2e9, -30.5});
   std::mt19937_64 rng(4);
   std::uniform_real_distribution<double> u(-45, 45);
@@ -273,9 +276,9 @@ TEST(FirstOccupiedBatchTest, EveryBatchSizeAndAxesTooSteepForFloats) {
     all.a[i] = {u(rng), u(rng), -tiny};
     all.b[i] = {u(rng), u(rng), tiny / 2};
   }
-  for (size_t n : {size_t{1}, size_t{2}, size_t{3}, size_t{7}, size_t{8}, size_t{9}, size_t{15}, size_t{16},
-                   size_t{17}, size_t{31}, size_t{33}, size_t{127}, size_t{128}, size_t{129}, size_t{255},
-                   size_t{256}, size_t{257}, size_t{400}}) {
+  for (size_t n : {size_t{1}, size_t{2}, size_t{3}, size_t{7}, size_t{8}, size_t{9}, size_t{15}, size_t{16}, size_t{17},
+                   size_t{31}, size_t{33}, size_t{127}, size_t{128}, size_t{129}, size_t{255}, size_t{256}, size_t{257},
+                   size_t{400}}) {
     Segments s;
     s.a.assign(all.a.begin(), all.a.begin() + long(n));
     s.b.assign(all.b.begin(), all.b.begin() + long(n));

@@ -211,7 +211,10 @@ TEST(FirstOccupiedTest, AgreesWithOctomapCastRayOnGeb079) {
     const auto ours = FirstOccupied(scene->grid, a / r, (a + dir * kLength) / r);
     const CastRayOutcome theirs = OctomapCastRay(tree, a, Vector3d(d.x(), d.y(), d.z()), kLength);
     const bool they_hit = theirs.kind == CastRayOutcome::Kind::kHitOccupied;
-    if (they_hit) ++hits; else ++misses;
+    if (they_hit)
+      ++hits;
+    else
+      ++misses;
     if (they_hit != ours.has_value() || (they_hit && IndexToKey(*ours) != theirs.hit)) ++mismatches;
   }
   EXPECT_EQ(mismatches, 0) << "of " << kRays << " rays (" << hits << " hits, " << misses << " misses)";

@@ -7,9 +7,8 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
-#include <sstream>
-
 #include <nlohmann/json.hpp>
+#include <sstream>
 
 #include "testing/test_paths.h"
 
@@ -77,13 +76,14 @@ PlanResult SamplePlan() {
 
 TEST(PlanReportTest, PlanJsonHasEveryDocumentedKey) {
   const json j = json::parse(PlanToJson(SamplePlan()));
-  for (const char* key : {"schema", "resolution_m", "selection_test", "stop_reason", "viewpoints", "coverage", "reduction",
-                          "candidates", "timings_s", "parameters", "warnings"}) {
+  for (const char* key : {"schema", "resolution_m", "selection_test", "stop_reason", "viewpoints", "coverage",
+                          "reduction", "candidates", "timings_s", "parameters", "warnings"}) {
     EXPECT_TRUE(j.contains(key)) << key;
   }
   ASSERT_EQ(j["viewpoints"].size(), 2u);
-  for (const char* key : {"index", "x", "y", "z", "compatible_voxels", "marginal_gain", "cumulative_coverage",
-                          "global_visibility", "candidate_index", "fully_visible_fraction", "partially_visible_fraction"}) {
+  for (const char* key :
+       {"index", "x", "y", "z", "compatible_voxels", "marginal_gain", "cumulative_coverage", "global_visibility",
+        "candidate_index", "fully_visible_fraction", "partially_visible_fraction"}) {
     EXPECT_TRUE(j["viewpoints"][1].contains(key)) << key;
   }
   EXPECT_DOUBLE_EQ(j["viewpoints"][1]["x"].get<double>(), 3.5);
@@ -91,15 +91,17 @@ TEST(PlanReportTest, PlanJsonHasEveryDocumentedKey) {
   EXPECT_EQ(j["viewpoints"][1]["marginal_gain"].get<int>(), 25);
   EXPECT_DOUBLE_EQ(j["viewpoints"][0]["cumulative_coverage"].get<double>(), 0.8);
   EXPECT_DOUBLE_EQ(j["viewpoints"][1]["global_visibility"].get<double>(), 0.37);
-  for (const char* key : {"occupied_voxels", "coverable_voxels", "covered_voxels", "uncovered_voxels", "uncoverable_voxels",
-                          "covered_fraction_of_coverable", "covered_fraction_of_occupied", "global_visibility",
-                          "fully_visible_fraction", "mean_full_visibility", "partially_visible_fraction", "faces_total"}) {
+  for (const char* key :
+       {"occupied_voxels", "coverable_voxels", "covered_voxels", "uncovered_voxels", "uncoverable_voxels",
+        "covered_fraction_of_coverable", "covered_fraction_of_occupied", "global_visibility", "fully_visible_fraction",
+        "mean_full_visibility", "partially_visible_fraction", "faces_total"}) {
     EXPECT_TRUE(j["coverage"].contains(key)) << key;
   }
   EXPECT_EQ(j["coverage"]["uncovered_voxels"].get<int>(), 1);
   EXPECT_DOUBLE_EQ(j["coverage"]["covered_fraction_of_coverable"].get<double>(), 1.0);
   EXPECT_DOUBLE_EQ(j["coverage"]["global_visibility"].get<double>(), 0.5);
-  for (const char* key : {"size", "stations", "matrix", "removed", "global_visibility_before", "global_visibility_after"}) {
+  for (const char* key :
+       {"size", "stations", "matrix", "removed", "global_visibility_before", "global_visibility_after"}) {
     EXPECT_TRUE(j["reduction"].contains(key)) << key;
   }
   ASSERT_EQ(j["reduction"]["matrix"].size(), 3u);
@@ -208,9 +210,9 @@ TEST(PlanReportTest, EvaluationJsonHasItsKeys) {
   const PlanResult plan = SamplePlan();
   const std::vector<WorldPoint> vps = {plan.stations[0].position, plan.stations[1].position};
   const json j = json::parse(EvaluationToJson(plan.evaluation, vps));
-  for (const char* key : {"resolution_m", "faces_total", "faces_evaluated", "sampled", "global_visibility",
-                          "global_visibility_ci95", "fully_visible_fraction", "mean_full_visibility",
-                          "partially_visible_fraction", "per_viewpoint"}) {
+  for (const char* key :
+       {"resolution_m", "faces_total", "faces_evaluated", "sampled", "global_visibility", "global_visibility_ci95",
+        "fully_visible_fraction", "mean_full_visibility", "partially_visible_fraction", "per_viewpoint"}) {
     EXPECT_TRUE(j.contains(key)) << key;
   }
   ASSERT_EQ(j["per_viewpoint"].size(), 2u);
@@ -239,10 +241,10 @@ TEST(ParseStationsCsvTest, RejectsBadRowsNamingTheLine) {
     std::string text;
     std::string line;
   };
-  for (const Case& c : {Case{"x,y,z\n1,2,3\n1,2\n", "my.csv:3:"}, Case{"1,2,3\n1,2,abc\n", "my.csv:2:"},
-                        Case{"1,2,3\n1,2,3,4\n", "my.csv:2:"}, Case{"1,2,nan\n", "my.csv:1:"},
-                        Case{"1,2,3\n1,inf,3\n", "my.csv:2:"}, Case{"1,2,3\nx,y,z\n", "my.csv:2:"},
-                        Case{"1,,3\n", "my.csv:1:"}}) {
+  for (const Case& c :
+       {Case{"x,y,z\n1,2,3\n1,2\n", "my.csv:3:"}, Case{"1,2,3\n1,2,abc\n", "my.csv:2:"},
+        Case{"1,2,3\n1,2,3,4\n", "my.csv:2:"}, Case{"1,2,nan\n", "my.csv:1:"}, Case{"1,2,3\n1,inf,3\n", "my.csv:2:"},
+        Case{"1,2,3\nx,y,z\n", "my.csv:2:"}, Case{"1,,3\n", "my.csv:1:"}}) {
     Result<std::vector<WorldPoint>> r = ParseStationsCsv(c.text, "my.csv");
     ASSERT_FALSE(r.ok()) << c.text;
     EXPECT_EQ(r.status().code(), StatusCode::kInvalidArgument);

@@ -40,16 +40,15 @@ TEST_P(FuzzRegressionTest, GivesACleanError) {
   EXPECT_THAT(read.status().message(), HasSubstr(r.message));
 }
 
-INSTANTIATE_TEST_SUITE_P(
-    Found, FuzzRegressionTest,
-    ::testing::Values(
-        // read_scene_fuzzer: a VLR length past the end of the file made the next VLR's bounds check
-        // underflow, and substr threw std::out_of_range (uncaught: abort).
-        Regression{"las-vlr-past-end.las", StatusCode::kInvalidArgument,
-                   "variable length records but record 5 at byte 66032 runs past"},
-        // las_fuzzer, the same bug from a LAS 1.2 header.
-        Regression{"las-vlr-past-end-2.las", StatusCode::kInvalidArgument,
-                   "variable length records but record 1 at byte 381 runs past"}));
+INSTANTIATE_TEST_SUITE_P(Found, FuzzRegressionTest,
+                         ::testing::Values(
+                             // read_scene_fuzzer: a VLR length past the end of the file made the next VLR's bounds
+                             // check underflow, and substr threw std::out_of_range (uncaught: abort).
+                             Regression{"las-vlr-past-end.las", StatusCode::kInvalidArgument,
+                                        "variable length records but record 5 at byte 66032 runs past"},
+                             // las_fuzzer, the same bug from a LAS 1.2 header.
+                             Regression{"las-vlr-past-end-2.las", StatusCode::kInvalidArgument,
+                                        "variable length records but record 1 at byte 381 runs past"}));
 
 }  // namespace
 }  // namespace vc

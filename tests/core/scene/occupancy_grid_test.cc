@@ -102,7 +102,8 @@ TEST(OccupancyGridTest, FreeBoxesAreFreeAndStopOnlyAtANonEmptyLayer) {
           int llo[3] = {lo[0], lo[1], lo[2]}, lhi[3] = {hi[0], hi[1], hi[2]};
           const int axis = side / 2;
           llo[axis] = lhi[axis] = side % 2 == 0 ? hi[axis] + 1 : lo[axis] - 1;
-          EXPECT_TRUE(box_has_brick(llo, lhi)) << "brick " << bx << "," << by << "," << bz << " could grow on side " << side;
+          EXPECT_TRUE(box_has_brick(llo, lhi))
+              << "brick " << bx << "," << by << "," << bz << " could grow on side " << side;
         }
       }
   EXPECT_GT(empty, 100);

@@ -95,9 +95,9 @@ std::string Bzip2Zeros(size_t n) {
   const std::string zeros(n, '\0');
   std::string out(n / 100 + 1024, '\0');
   unsigned size = static_cast<unsigned>(out.size());
-  EXPECT_EQ(BZ2_bzBuffToBuffCompress(out.data(), &size, const_cast<char*>(zeros.data()),
-                                     static_cast<unsigned>(n), 9, 0, 0),
-            BZ_OK);
+  EXPECT_EQ(
+      BZ2_bzBuffToBuffCompress(out.data(), &size, const_cast<char*>(zeros.data()), static_cast<unsigned>(n), 9, 0, 0),
+      BZ_OK);
   out.resize(size);
   return out;
 }
@@ -195,8 +195,8 @@ ReadOptions Unlimited() {
 TEST(LyingHeaderTest, Ply) {
   for (const char* encoding : {"ascii", "binary_little_endian", "binary_big_endian"}) {
     std::string ply = std::string("ply\nformat ") + encoding +
-                            " 1.0\nelement vertex 2147483648\nproperty float x\nproperty float "
-                            "y\nproperty float z\nend_header\n";
+                      " 1.0\nelement vertex 2147483648\nproperty float x\nproperty float "
+                      "y\nproperty float z\nend_header\n";
     for (int i = 0; i < 100; ++i) ply += "0 0 0\n";
     ExpectRefusedSmall(ply, "lie.ply", StatusCode::kResourceExhausted, "2147483648 points");
     ExpectRefusedSmall(ply, "lie.ply", StatusCode::kInvalidArgument, "file truncated?", Unlimited());
@@ -205,13 +205,14 @@ TEST(LyingHeaderTest, Ply) {
   const std::string faces =
       "ply\nformat binary_little_endian 1.0\nelement vertex 1\nproperty float x\nproperty float "
       "y\nproperty float z\nelement face 4611686018427387904\nproperty list uchar int v\n"
-      "end_header\n" + std::string(12 + 64, '\0');
+      "end_header\n" +
+      std::string(12 + 64, '\0');
   ExpectRefusedSmall(faces, "faces.ply", StatusCode::kInvalidArgument, "file truncated?");
 }
 
 std::string PcdHeader(const std::string& points, const std::string& data) {
-  return "VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH " + points +
-         "\nHEIGHT 1\nPOINTS " + points + "\nDATA " + data + "\n";
+  return "VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH " + points + "\nHEIGHT 1\nPOINTS " +
+         points + "\nDATA " + data + "\n";
 }
 
 TEST(LyingHeaderTest, Pcd) {
@@ -225,8 +226,7 @@ TEST(LyingHeaderTest, Pcd) {
   Put<uint32_t>(&lzf, 1024);
   Put<uint32_t>(&lzf, 1'200'000'000u);
   lzf += std::string(1024, '\x1f');
-  ExpectRefusedSmall(lzf, "lzf.pcd", StatusCode::kInvalidArgument, "cannot decompress to",
-                     Unlimited());
+  ExpectRefusedSmall(lzf, "lzf.pcd", StatusCode::kInvalidArgument, "cannot decompress to", Unlimited());
   // A declared size the ratio allows but the limit does not.
   ReadOptions small = Unlimited();
   small.max_decompressed_bytes = 1000;
@@ -234,8 +234,7 @@ TEST(LyingHeaderTest, Pcd) {
   Put<uint32_t>(&fits, 1024);
   Put<uint32_t>(&fits, 12000);
   fits += std::string(1024, '\x1f');
-  ExpectRefusedSmall(fits, "lzf.pcd", StatusCode::kResourceExhausted, "more than the limit of 1000",
-                     small);
+  ExpectRefusedSmall(fits, "lzf.pcd", StatusCode::kResourceExhausted, "more than the limit of 1000", small);
 }
 
 std::string Las(uint32_t count, uint16_t record_length) {
@@ -253,12 +252,11 @@ std::string Las(uint32_t count, uint16_t record_length) {
 }
 
 TEST(LyingHeaderTest, Las) {
-  ExpectRefusedSmall(Las(2'147'483'648u, 20), "lie.las", StatusCode::kResourceExhausted,
-                     "2147483648 points");
-  ExpectRefusedSmall(Las(2'147'483'648u, 20), "lie.las", StatusCode::kInvalidArgument,
-                     "but the body ends after 2", Unlimited());
-  ExpectRefusedSmall(Las(2, 65535), "long-records.las", StatusCode::kInvalidArgument,
-                     "but the body ends after 0", Unlimited());
+  ExpectRefusedSmall(Las(2'147'483'648u, 20), "lie.las", StatusCode::kResourceExhausted, "2147483648 points");
+  ExpectRefusedSmall(Las(2'147'483'648u, 20), "lie.las", StatusCode::kInvalidArgument, "but the body ends after 2",
+                     Unlimited());
+  ExpectRefusedSmall(Las(2, 65535), "long-records.las", StatusCode::kInvalidArgument, "but the body ends after 0",
+                     Unlimited());
 }
 
 TEST(LyingHeaderTest, ScanGraph) {
@@ -275,8 +273,9 @@ TEST(LyingHeaderTest, ScanGraph) {
 
 TEST(LyingHeaderTest, OctomapSizeLineMustMatchTheNodes) {
   // "size" claims 2^40 nodes; the node data holds 5 (root, leaf, inner, two leaves).
-  const std::string bt = std::string("# Octomap OcTree binary file\nid OcTree\nsize 1099511627776\n"
-                                     "res 0.1\ndata\n") +
+  const std::string bt = std::string(
+                             "# Octomap OcTree binary file\nid OcTree\nsize 1099511627776\n"
+                             "res 0.1\ndata\n") +
                          std::string("\x0d\x00\x06\x00", 4);
   ExpectRefusedSmall(bt, "lie.bt", StatusCode::kInvalidArgument,
                      "lie.bt: the header declares size 1099511627776 but the node data holds 5 nodes");
@@ -288,8 +287,7 @@ TEST(LyingHeaderTest, OctreeLargerThanTheResultLimit) {
   for (int x = 0; x < 32; ++x) {
     for (int y = 0; y < 32; ++y) {
       for (int z = 0; z < 32; ++z) {
-        tree.updateNode(octomap::point3d(x * 0.1f + 0.05f, y * 0.1f + 0.05f, z * 0.1f + 0.05f),
-                        (x + y + z) % 2 == 0);
+        tree.updateNode(octomap::point3d(x * 0.1f + 0.05f, y * 0.1f + 0.05f, z * 0.1f + 0.05f), (x + y + z) % 2 == 0);
       }
     }
   }
@@ -298,8 +296,7 @@ TEST(LyingHeaderTest, OctreeLargerThanTheResultLimit) {
   const std::string bt = stream.str();
   ReadOptions options;
   options.max_result_bytes = 1000 * kOctreeNodeBytes;
-  ExpectRefusedSmall(bt, "big.bt", StatusCode::kResourceExhausted, "more than the limit of 48000 bytes",
-                     options);
+  ExpectRefusedSmall(bt, "big.bt", StatusCode::kResourceExhausted, "more than the limit of 48000 bytes", options);
   Result<SceneInput> ok = ReadScene(bt, "big.bt");
   ASSERT_TRUE(ok.ok()) << ok.status().ToString();
   EXPECT_EQ(CountOccupiedLeaves(*ok->octree), 32u * 32u * 32u / 2u);
@@ -313,8 +310,8 @@ TEST(OutOfMemoryTest, BadAllocWhileReadingIsResourceExhausted) {
   g_fail_above = SIZE_MAX;
   ASSERT_FALSE(r.ok());
   EXPECT_EQ(r.status().code(), StatusCode::kResourceExhausted);
-  EXPECT_THAT(r.status().message(), AllOf(HasSubstr("big.xyz: reading"), HasSubstr("ran out of memory"),
-                                          HasSubstr("--memory-budget-bytes")));
+  EXPECT_THAT(r.status().message(),
+              AllOf(HasSubstr("big.xyz: reading"), HasSubstr("ran out of memory"), HasSubstr("--memory-budget-bytes")));
 }
 
 TEST(OutOfMemoryTest, BadAllocWhileVoxelisingIsResourceExhausted) {

@@ -183,8 +183,7 @@ TEST(SceneInputTest, UnrecognisedBinaryListsSupportedFormats) {
 
 std::shared_ptr<octomap::OcTree> SmallTree() {
   auto tree = std::make_shared<octomap::OcTree>(0.1);
-  for (int i = 0; i < 10; ++i)
-    tree->updateNode(octomap::point3d(0.05f + 0.1f * i, 0.05f, 0.05f), true);
+  for (int i = 0; i < 10; ++i) tree->updateNode(octomap::point3d(0.05f + 0.1f * i, 0.05f, 0.05f), true);
   tree->updateNode(octomap::point3d(-1, -1, -1), false);
   return tree;
 }
@@ -273,8 +272,7 @@ TEST(SceneInputTest, ReadSceneFileUsesThePathAsSource) {
   }
   Result<SceneInput> r = ReadSceneFile(path);
   ASSERT_FALSE(r.ok());
-  EXPECT_EQ(r.status().message(),
-            path + ": line 2: expected at least 3 columns (x y z), found 2 in \"4 5\"");
+  EXPECT_EQ(r.status().message(), path + ": line 2: expected at least 3 columns (x y z), found 2 in \"4 5\"");
 }
 
 // Flips random bytes of valid inputs of every format: every result is a value or a clean error.

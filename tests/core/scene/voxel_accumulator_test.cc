@@ -5,8 +5,8 @@
 #include <random>
 
 #include "testing/scenes.h"
-#include "vc/synth/synth.h"
 #include "vc/scene/voxel_scene.h"
+#include "vc/synth/synth.h"
 
 namespace vc {
 namespace {
@@ -33,9 +33,9 @@ void ExpectSameScene(const VoxelScene& a, const VoxelScene& b) {
   // Every occupied voxel and its 6 neighbours answer alike.
   for (const VoxelKey& k : a.occupied) {
     const VoxelIndex v = KeyToIndex(k);
-    for (const VoxelIndex& n : {v, VoxelIndex{v.x - 1, v.y, v.z}, VoxelIndex{v.x + 1, v.y, v.z},
-                                VoxelIndex{v.x, v.y - 1, v.z}, VoxelIndex{v.x, v.y + 1, v.z},
-                                VoxelIndex{v.x, v.y, v.z - 1}, VoxelIndex{v.x, v.y, v.z + 1}}) {
+    for (const VoxelIndex& n :
+         {v, VoxelIndex{v.x - 1, v.y, v.z}, VoxelIndex{v.x + 1, v.y, v.z}, VoxelIndex{v.x, v.y - 1, v.z},
+          VoxelIndex{v.x, v.y + 1, v.z}, VoxelIndex{v.x, v.y, v.z - 1}, VoxelIndex{v.x, v.y, v.z + 1}}) {
       ASSERT_EQ(a.grid.Occupied(n), b.grid.Occupied(n));
     }
   }
@@ -94,7 +94,8 @@ TEST(VoxelAccumulatorTest, MergesAtFullCapacityWithRepeatedKeysGiveTheSameScene)
   std::vector<Eigen::Vector3f> pts;
   for (int i = 0; i < 2000000; ++i) {
     const int c = cell(rng);
-    pts.emplace_back(float(c % 50) * 0.1f + u(rng), float((c / 50) % 30) * 0.1f + u(rng), float(c / 1500) * 0.1f + u(rng));
+    pts.emplace_back(float(c % 50) * 0.1f + u(rng), float((c / 50) % 30) * 0.1f + u(rng),
+                     float(c / 1500) * 0.1f + u(rng));
   }
   VoxelAccumulator acc(0.1, uint64_t{1} << 20);
   for (const auto& p : pts) acc.Add(p);

@@ -1,5 +1,7 @@
 #include "vc/synth/synth.h"
 
+#include <gtest/gtest.h>
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -10,8 +12,6 @@
 #include <string>
 #include <unordered_map>
 #include <vector>
-
-#include <gtest/gtest.h>
 
 #include "testing/test_paths.h"
 
@@ -136,8 +136,8 @@ TEST(SynthOptionsTest, ValidateRejectsSpacingOutsideRangeOrNotFinite) {
 }
 
 TEST(DescribeSceneTest, BadSpecsAreInvalidArgumentListingValidNames) {
-  for (const char* bad : {"", "castle", "Box", "comb", "comb:", "comb:0", "comb:51", "comb:x", "comb:2x",
-                          "rooms:-1", "rooms:1.5", "box:2", "hall:1"}) {
+  for (const char* bad : {"", "castle", "Box", "comb", "comb:", "comb:0", "comb:51", "comb:x", "comb:2x", "rooms:-1",
+                          "rooms:1.5", "box:2", "hall:1"}) {
     Result<SceneInfo> info = DescribeScene(bad);
     ASSERT_FALSE(info.ok()) << bad;
     EXPECT_EQ(info.status().code(), StatusCode::kInvalidArgument) << bad;
@@ -146,9 +146,9 @@ TEST(DescribeSceneTest, BadSpecsAreInvalidArgumentListingValidNames) {
 }
 
 TEST(DescribeSceneTest, KnownScenesReportTheirOptimumRoomsAndFloors) {
-  const std::vector<std::pair<std::string, int>> expected = {
-      {"box", 1}, {"lroom", 1}, {"comb:1", 1}, {"comb:7", 7}, {"comb:50", 50}, {"rooms:1", 2},
-      {"rooms:4", 5}, {"twofloor", 2}, {"hall", 0}};
+  const std::vector<std::pair<std::string, int>> expected = {{"box", 1},     {"lroom", 1},    {"comb:1", 1},
+                                                             {"comb:7", 7},  {"comb:50", 50}, {"rooms:1", 2},
+                                                             {"rooms:4", 5}, {"twofloor", 2}, {"hall", 0}};
   for (const auto& [spec, optimum] : expected) {
     Result<SceneInfo> info = DescribeScene(spec);
     ASSERT_TRUE(info.ok()) << spec << ": " << info.status().ToString();
@@ -347,7 +347,8 @@ TEST(SceneVoxelsTest, SmallScenesAreClosedConnectedAndFloorDominant) {
 }
 
 TEST(SceneVoxelsTest, BoxIsWatertightAtTwiceTheSpacing) {
-  for (const auto& [spacing, resolution] : std::vector<std::pair<double, double>>{{0.02, 0.04}, {0.04, 0.08}, {0.1, 0.2}}) {
+  for (const auto& [spacing, resolution] :
+       std::vector<std::pair<double, double>>{{0.02, 0.04}, {0.04, 0.08}, {0.1, 0.2}}) {
     Result<SceneInfo> info = DescribeScene("box");
     ASSERT_TRUE(info.ok());
     VoxelGrid grid = Voxelize("box", spacing, resolution);

@@ -11,9 +11,9 @@
 #include <cmath>
 #include <cstdio>
 
+#include "vc/scene/voxel_scene.h"
 #include "vc/synth/synth.h"
 #include "vc/visibility/visibility.h"
-#include "vc/scene/voxel_scene.h"
 
 namespace vc {
 namespace {
@@ -70,8 +70,9 @@ std::vector<Row> Figures(const VoxelScene& fine, const VoxelScene& coarse, const
 
 void Print(const char* title, const std::vector<WorldPoint>& vps, const std::vector<Row>& rows) {
   std::printf("%s\n", title);
-  std::printf("  vp  position (m)               G(0.01 m) +- 95%% CI    G(0.1 m)   diff     full(0.01) "
-              "full(0.1)  part(0.01) part(0.1)\n");
+  std::printf(
+      "  vp  position (m)               G(0.01 m) +- 95%% CI    G(0.1 m)   diff     full(0.01) "
+      "full(0.1)  part(0.01) part(0.1)\n");
   for (size_t k = 0; k < rows.size(); ++k) {
     const Row& r = rows[k];
     std::printf("  %zu   (%6.3f, %6.3f, %5.3f)   %.4f +- %.4f       %.4f     %+.4f   %.4f     %.4f     %.4f     %.4f\n",
@@ -111,14 +112,15 @@ TEST(PaperResultTest, VisibilityAtTheTestResolutionIsHigherForEveryViewpoint) {
   ASSERT_TRUE(fine.ok()) << fine.status().ToString();
   auto coarse = coarse_acc.Finish();
   ASSERT_TRUE(coarse.ok()) << coarse.status().ToString();
-  std::printf("hall sampled at %.3f m: %llu points streamed in %.1f s; %zu voxels at %.2f m (accumulator peak %.0f MiB), "
-              "%zu voxels at %.1f m\n",
-              kSpacingM, (unsigned long long)*count, Seconds(t), fine->occupied.size(), kFineM,
-              double(fine_acc.peak_memory_bytes()) / double(1 << 20), coarse->occupied.size(), kCoarseM);
+  std::printf(
+      "hall sampled at %.3f m: %llu points streamed in %.1f s; %zu voxels at %.2f m (accumulator peak %.0f MiB), "
+      "%zu voxels at %.1f m\n",
+      kSpacingM, (unsigned long long)*count, Seconds(t), fine->occupied.size(), kFineM,
+      double(fine_acc.peak_memory_bytes()) / double(1 << 20), coarse->occupied.size(), kCoarseM);
 
   std::printf("grid at %.2f m: %d x %d x %d voxels, %.0f MiB; at %.1f m: %.1f MiB\n", kFineM, fine->grid.dims().x(),
-              fine->grid.dims().y(), fine->grid.dims().z(), double(fine->grid.memory_bytes()) / double(1 << 20), kCoarseM,
-              double(coarse->grid.memory_bytes()) / double(1 << 20));
+              fine->grid.dims().y(), fine->grid.dims().z(), double(fine->grid.memory_bytes()) / double(1 << 20),
+              kCoarseM, double(coarse->grid.memory_bytes()) / double(1 << 20));
 
   // At 0.1 m the 0.05 m cloud gives the same voxels as the 0.005 m stream (both are watertight at
   // 0.1 m), so the working-resolution scene is the planner's usual one.

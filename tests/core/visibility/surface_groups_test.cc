@@ -8,22 +8,22 @@
 #include <cmath>
 #include <random>
 
-#include "vc/plan/candidates.h"
 #include "testing/scenes.h"
 #include "testing/test_paths.h"
-#include "vc/scene/scene_input.h"
+#include "vc/plan/candidates.h"
 #include "vc/raycast/ray_traversal.h"
+#include "vc/scene/scene_input.h"
+#include "vc/scene/voxel_scene.h"
 #include "vc/synth/synth.h"
 #include "vc/visibility/visibility.h"
-#include "vc/scene/voxel_scene.h"
 
 namespace vc {
 namespace {
 
 using Eigen::Vector3d;
 using internal::FreeBox;
-using internal::GrowFreeBox;
 using internal::FreeCone;
+using internal::GrowFreeBox;
 using internal::GrowSolidBox;
 using internal::PassesThroughInterior;
 using internal::Segment;
@@ -121,9 +121,9 @@ TEST(GroupedSurfaceVisibilityTest, SameSetsAsPerVoxelOnClutteredPlanes) {
     std::uniform_int_distribution<int> c(0, 47), hole(0, 9);
     for (int x = 0; x < 48; ++x)
       for (int y = 0; y < 48; ++y) {
-        v.push_back({x, y, 0});                         // floor
-        if (hole(rng) != 0) v.push_back({x, 47, y});    // wall with holes
-        if (x % 12 == 5 && y % 12 == 5)                 // posts
+        v.push_back({x, y, 0});                       // floor
+        if (hole(rng) != 0) v.push_back({x, 47, y});  // wall with holes
+        if (x % 12 == 5 && y % 12 == 5)               // posts
           for (int z = 1; z < 20; ++z) v.push_back({x, y, z});
       }
     for (int i = 0; i < 200; ++i) v.push_back({c(rng), c(rng), c(rng) / 2});  // clutter
@@ -163,7 +163,7 @@ TEST(GroupedCornersTest, SameFaceValuesAsPerCornerOnClutteredPlanesAndGeb079) {
   for (int x = 0; x < 40; ++x)
     for (int y = 0; y < 40; ++y) {
       v.push_back({x, y, 0});
-      v.push_back({x, y, 25});             // ceiling
+      v.push_back({x, y, 25});                       // ceiling
       if ((x + y) % 7) v.push_back({0, x, y % 25});  // wall with slots
     }
   for (int i = 0; i < 150; ++i) v.push_back({c(rng), c(rng), 1 + c(rng) / 2});
@@ -446,7 +446,8 @@ TEST(FreeBoxTest, HoldsNoOccupiedVoxelAndNoSideCanGrow) {
                   box.lo.z <= o.z() && o.z() < box.hi.z + 1);
       for (int z = box.lo.z; z <= box.hi.z; ++z)
         for (int y = box.lo.y; y <= box.hi.y; ++y)
-          for (int x = box.lo.x; x <= box.hi.x; ++x) ASSERT_FALSE(s.grid.Occupied(x, y, z)) << x << " " << y << " " << z;
+          for (int x = box.lo.x; x <= box.hi.x; ++x)
+            ASSERT_FALSE(s.grid.Occupied(x, y, z)) << x << " " << y << " " << z;
       const int lo[3] = {box.lo.x, box.lo.y, box.lo.z}, hi[3] = {box.hi.x, box.hi.y, box.hi.z};
       const int glo[3] = {gmin.x - 1, gmin.y - 1, gmin.z - 1};
       const int ghi[3] = {gmin.x + s.grid.dims()[0], gmin.y + s.grid.dims()[1], gmin.z + s.grid.dims()[2]};
@@ -476,7 +477,7 @@ TEST(FreeConeTest, SkipsThePartOfTheConeInsideTheFreeBox) {
   std::vector<VoxelIndex> v;
   for (int x = 0; x < 40; ++x)
     for (int y = 0; y < 40; ++y) v.push_back({x, y, 0});  // a floor, faces up on z = 1
-  v.push_back({20, 20, 28});                             // an occluder just below o
+  v.push_back({20, 20, 28});                              // an occluder just below o
   const VoxelScene s = MakeScene(v);
   const Vector3d o(20.5, 20.5, 29.5), q0(18.5, 18.5, 1), q1(22.5, 22.5, 1);
   EXPECT_FALSE(FreeCone(s.grid, o, 2, true, 1, q0, q1));
@@ -530,7 +531,8 @@ TEST(SolidBoxTest, AllOccupiedAndNoSideCanGrow) {
           }
           int l[3] = {lo[0], lo[1], lo[2]}, u[3] = {hi[0], hi[1], hi[2]};
           l[a] = u[a] = layer;
-          ASSERT_FALSE(all_occupied(l, u)) << "scene " << scene << " trial " << trial << " limit " << limit << " side " << side;
+          ASSERT_FALSE(all_occupied(l, u))
+              << "scene " << scene << " trial " << trial << " limit " << limit << " side " << side;
         }
         large += (box.hi.x - box.lo.x) * (box.hi.y - box.lo.y) * (box.hi.z - box.lo.z) >= 8;
       }

@@ -5,8 +5,8 @@
 #include <cmath>
 #include <random>
 
-#include "vc/raycast/occluders.h"
 #include "testing/scenes.h"
+#include "vc/raycast/occluders.h"
 #include "vc/raycast/ray_traversal.h"
 
 namespace vc {
@@ -158,8 +158,8 @@ double PlainFaceValue(const OccupancyGrid& g, const WorldPoint& o, const VoxelIn
       c[(axis + 1) % 3] += a;
       c[(axis + 2) % 3] += b;
       auto h = PlainFirstHit(g, uo, c, &v);
-      const bool near = h && std::abs(h->x + 0.5 - c.x()) < 1 && std::abs(h->y + 0.5 - c.y()) < 1 &&
-                        std::abs(h->z + 0.5 - c.z()) < 1;
+      const bool near =
+          h && std::abs(h->x + 0.5 - c.x()) < 1 && std::abs(h->y + 0.5 - c.y()) < 1 && std::abs(h->z + 0.5 - c.z()) < 1;
       visible += (!h || near);
     }
   if (visible == 0) return 0;
@@ -224,8 +224,8 @@ TEST(ComputeVisibilitySetsTest, EqualsBruteForceOracleForBothTests) {
       VisibilitySetsOptions opt;
       opt.test = test;
       opt.threads = 2;
-      EXPECT_GT(ExpectSetsMatchOracle(s, vps, opt, "trial " + std::to_string(trial) + " test " +
-                                                       std::string(SelectionTestName(test))),
+      EXPECT_GT(ExpectSetsMatchOracle(
+                    s, vps, opt, "trial " + std::to_string(trial) + " test " + std::string(SelectionTestName(test))),
                 0u);
     }
   }
@@ -362,7 +362,8 @@ TEST(EvaluateTest, TaskPerViewpointGivesTheSameFiguresAsOneThread) {
       EXPECT_EQ(other.overall.partially_visible_fraction, one.overall.partially_visible_fraction) << what;
       ASSERT_EQ(other.per_viewpoint.size(), vps.size());
       for (size_t k = 0; k < vps.size(); ++k) {
-        EXPECT_EQ(other.per_viewpoint[k].global_visibility, one.per_viewpoint[k].global_visibility) << what << ", " << k;
+        EXPECT_EQ(other.per_viewpoint[k].global_visibility, one.per_viewpoint[k].global_visibility)
+            << what << ", " << k;
         EXPECT_EQ(other.per_viewpoint[k].fully_visible_fraction, one.per_viewpoint[k].fully_visible_fraction) << what;
         EXPECT_EQ(other.per_viewpoint_face_values[k], one.per_viewpoint_face_values[k]) << what << ", viewpoint " << k;
       }

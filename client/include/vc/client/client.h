@@ -15,9 +15,9 @@
 #include <string_view>
 #include <vector>
 
-#include "vc/plan/planner.h"
 #include "vc/base/progress.h"
 #include "vc/base/status.h"
+#include "vc/plan/planner.h"
 #include "vc/visibility/visibility.h"
 #include "vc/wire/convert.h"
 

@@ -7,8 +7,8 @@
 #include <string>
 #include <vector>
 
-#include "vc/plan/planner.h"
 #include "vc/base/progress.h"
+#include "vc/plan/planner.h"
 
 namespace vc::client {
 

@@ -19,8 +19,8 @@ Result<CandidatesOutput> UserCandidates(const VoxelScene& scene, const std::vect
                                   " m from the origin along an axis; use coordinates in the scene's frame");
     }
     if (scene.grid.Occupied(scene.grid.WorldToIndex(p))) {
-      return InvalidArgumentError("candidates[" + std::to_string(i) + "] (" + Num(p.x()) + ", " + Num(p.y()) +
-                                  ", " + Num(p.z()) + ") lies inside an occupied voxel");
+      return InvalidArgumentError("candidates[" + std::to_string(i) + "] (" + Num(p.x()) + ", " + Num(p.y()) + ", " +
+                                  Num(p.z()) + ") lies inside an occupied voxel");
     }
   }
   CandidatesOutput out;
@@ -40,23 +40,24 @@ Result<CandidatesOutput> GridCandidates(const VoxelScene& scene, const PlanOptio
   out.cells_failing_clearance = grid.rejected_clearance;
   if (grid.positions.empty()) {
     if (grid.levels.empty()) {
-      return FailedPreconditionError(
-          "no floor found: no occupied voxel has tripod_height_m + clearance_m = " +
-          Num(options.tripod_height_m + options.clearance_m) +
-          " m of free space above it; lower them or pass candidates");
+      return FailedPreconditionError("no floor found: no occupied voxel has tripod_height_m + clearance_m = " +
+                                     Num(options.tripod_height_m + options.clearance_m) +
+                                     " m of free space above it; lower them or pass candidates");
     }
     std::string levels;
     for (double z : out.floor_levels_m) levels += (levels.empty() ? "" : ", ") + Num(z);
-    return FailedPreconditionError(
-        "no candidate survived: of " + std::to_string(grid.cells) + " grid cells, " +
-        std::to_string(grid.rejected_no_floor) + " had no floor below (floor levels at z = " + levels +
-        " m) and " + std::to_string(grid.rejected_clearance) + " had occupied voxels within clearance_m = " +
-        Num(options.clearance_m) + " m; lower clearance_m or grid_spacing_m, or pass candidates");
+    return FailedPreconditionError("no candidate survived: of " + std::to_string(grid.cells) + " grid cells, " +
+                                   std::to_string(grid.rejected_no_floor) +
+                                   " had no floor below (floor levels at z = " + levels + " m) and " +
+                                   std::to_string(grid.rejected_clearance) +
+                                   " had occupied voxels within clearance_m = " + Num(options.clearance_m) +
+                                   " m; lower clearance_m or grid_spacing_m, or pass candidates");
   }
   if (grid.positions.size() < 5) {
-    out.warnings.push_back("only " + std::to_string(grid.positions.size()) + " candidates survived the clearance filter (" +
-                           std::to_string(grid.rejected_clearance) + " cells with floor failed clearance_m = " +
-                           Num(options.clearance_m) + " m, " + std::to_string(grid.rejected_no_floor) +
+    out.warnings.push_back("only " + std::to_string(grid.positions.size()) +
+                           " candidates survived the clearance filter (" + std::to_string(grid.rejected_clearance) +
+                           " cells with floor failed clearance_m = " + Num(options.clearance_m) + " m, " +
+                           std::to_string(grid.rejected_no_floor) +
                            " had no floor below) — lower clearance_m or grid_spacing_m, or check the floor estimate");
   }
   out.positions = std::move(grid.positions);

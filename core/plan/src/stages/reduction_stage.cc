@@ -19,8 +19,7 @@ ReductionOutput KeepAllStations(size_t count) {
 // Reduction on every station's V of every face. One Evaluate of all stations keeps them when
 // they fit the cache budget (and is the final evaluation if nothing is removed); otherwise each
 // station is evaluated alone, as often as the reduction needs.
-Result<ReductionOutput> RunReductionStage(const ReductionInput& in, const PlanOptions& options,
-                                          const JobContext& ctx) {
+Result<ReductionOutput> RunReductionStage(const ReductionInput& in, const PlanOptions& options, const JobContext& ctx) {
   const std::vector<WorldPoint>& stations = in.stations.positions;
   const EvaluateOptions eval_options = StationEvaluateOptions(options);
   const uint64_t faces_total = in.scene.occupied.size() * kFacesPerVoxel;

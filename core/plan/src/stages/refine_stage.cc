@@ -47,8 +47,8 @@ Result<RefineOutput> RunRefineStage(RefineInput in, const PlanOptions& options, 
   const size_t n_voxels = in.scene.occupied.size();
   Stations& stations = in.stations;
   TrialPositions trials = TrialsAround(in.scene.grid, stations, options);
-  VC_RETURN_IF_ERROR(CheckVisibilitySetBudget(trials.positions.size(), n_voxels, options.memory_budget_bytes,
-                                              "refinement"));
+  VC_RETURN_IF_ERROR(
+      CheckVisibilitySetBudget(trials.positions.size(), n_voxels, options.memory_budget_bytes, "refinement"));
   const VisibilitySetsOptions set_options{options.selection_test, options.threads};
   VC_ASSIGN_OR_RETURN(std::vector<VoxelSet> trial_sets,
                       ComputeVisibilitySets(in.scene, trials.positions, set_options, ProgressRange(ctx, 0.0, 0.9)));
@@ -77,7 +77,8 @@ Result<RefineOutput> RunRefineStage(RefineInput in, const PlanOptions& options, 
     }
     if (best_trial >= 0) {
       stations.positions[k] = trials.positions[best_trial];
-      if (!std::isnan(stations.floor_z_m[k])) stations.floor_z_m[k] = stations.positions[k].z() - options.tripod_height_m;
+      if (!std::isnan(stations.floor_z_m[k]))
+        stations.floor_z_m[k] = stations.positions[k].z() - options.tripod_height_m;
       stations.candidate[k] = -1;
       stations.sets[k] = std::move(trial_sets[best_trial]);
     }

@@ -10,9 +10,8 @@ Status CheckVisibilitySetBudget(uint64_t positions, uint64_t voxels, uint64_t bu
   const uint64_t need = positions * ((voxels + 63) / 64) * 8;
   if (need > budget_bytes / 2) {
     return ResourceExhaustedError(std::string(what) + ": " + std::to_string(positions) + " positions x " +
-                                  std::to_string(voxels) + " occupied voxels need " +
-                                  Num(need / 1073741824.0) + " GiB of visibility sets (budget " +
-                                  Num(budget_bytes / 1073741824.0) +
+                                  std::to_string(voxels) + " occupied voxels need " + Num(need / 1073741824.0) +
+                                  " GiB of visibility sets (budget " + Num(budget_bytes / 1073741824.0) +
                                   " GiB); raise grid_spacing_m or resolution_m");
   }
   return Status::Ok();

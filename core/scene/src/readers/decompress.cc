@@ -27,16 +27,14 @@ bool StartsWith(std::string_view s, std::string_view prefix) {
 }
 
 bool IsGzipMagic(std::string_view s) {
-  return s.size() >= 2 && static_cast<unsigned char>(s[0]) == 0x1f &&
-         static_cast<unsigned char>(s[1]) == 0x8b;
+  return s.size() >= 2 && static_cast<unsigned char>(s[0]) == 0x1f && static_cast<unsigned char>(s[1]) == 0x8b;
 }
 
 bool IsBzip2Magic(std::string_view s) {
   // "BZh" + block size '1'..'9' + block magic (pi) or end-of-stream magic (sqrt pi).
   if (s.size() < 10 || !StartsWith(s, "BZh") || s[3] < '1' || s[3] > '9') return false;
   const std::string_view m = s.substr(4, 6);
-  return m == std::string_view("\x31\x41\x59\x26\x53\x59", 6) ||
-         m == std::string_view("\x17\x72\x45\x38\x50\x90", 6);
+  return m == std::string_view("\x31\x41\x59\x26\x53\x59", 6) || m == std::string_view("\x17\x72\x45\x38\x50\x90", 6);
 }
 
 bool AllZero(std::string_view s) {
@@ -45,8 +43,8 @@ bool AllZero(std::string_view s) {
 
 Status TooLarge(std::string_view source, std::string_view kind, uint64_t max_bytes) {
   return ResourceExhaustedError(std::string(source) + ": " + std::string(kind) +
-                                " input decompresses to more than the limit of " +
-                                std::to_string(max_bytes) + " bytes" + std::string(kRaiseInputLimit));
+                                " input decompresses to more than the limit of " + std::to_string(max_bytes) +
+                                " bytes" + std::string(kRaiseInputLimit));
 }
 
 // Inflates `in`, handing each chunk of output to sink(data, size); see the file comment.
@@ -79,9 +77,8 @@ Status Gunzip(std::string_view in, std::string_view source, uint64_t max_bytes, 
       if (rest.empty() || AllZero(rest)) break;
       if (!IsGzipMagic(rest)) {
         status =
-            InvalidInput(source, "gzip stream ends at compressed byte " + std::to_string(in_pos) +
-                                     " but " + std::to_string(rest.size()) +
-                                     " bytes of non-gzip data follow; corrupt file?");
+            InvalidInput(source, "gzip stream ends at compressed byte " + std::to_string(in_pos) + " but " +
+                                     std::to_string(rest.size()) + " bytes of non-gzip data follow; corrupt file?");
         break;
       }
       inflateReset(&zs);  // Another gzip member (e.g. from `cat a.gz b.gz`).
@@ -89,15 +86,13 @@ Status Gunzip(std::string_view in, std::string_view source, uint64_t max_bytes, 
     }
     if (rc == Z_OK) continue;
     if (rc == Z_BUF_ERROR) {  // No progress possible: all input consumed mid-stream.
-      status = InvalidInput(source, "gzip stream truncated: input ends after " +
-                                        std::to_string(in.size()) + " compressed bytes (" +
-                                        std::to_string(total) +
+      status = InvalidInput(source, "gzip stream truncated: input ends after " + std::to_string(in.size()) +
+                                        " compressed bytes (" + std::to_string(total) +
                                         " decompressed) before the end-of-stream marker");
       break;
     }
-    status =
-        InvalidInput(source, "corrupt gzip stream near compressed byte " + std::to_string(in_pos) +
-                                 ": " + (zs.msg ? zs.msg : "inflate error " + std::to_string(rc)));
+    status = InvalidInput(source, "corrupt gzip stream near compressed byte " + std::to_string(in_pos) + ": " +
+                                      (zs.msg ? zs.msg : "inflate error " + std::to_string(rc)));
     break;
   }
   inflateEnd(&zs);
@@ -145,9 +140,8 @@ Status Bunzip2(std::string_view in, std::string_view source, uint64_t max_bytes,
       if (rest.empty() || AllZero(rest)) break;
       if (!IsBzip2Magic(rest)) {
         status =
-            InvalidInput(source, "bzip2 stream ends at compressed byte " + std::to_string(in_pos) +
-                                     " but " + std::to_string(rest.size()) +
-                                     " bytes of non-bzip2 data follow; corrupt file?");
+            InvalidInput(source, "bzip2 stream ends at compressed byte " + std::to_string(in_pos) + " but " +
+                                     std::to_string(rest.size()) + " bytes of non-bzip2 data follow; corrupt file?");
         break;
       }
       BZ2_bzDecompressEnd(&bz);  // Another stream (e.g. from pbzip2 or `cat a.bz2 b.bz2`).
@@ -159,16 +153,15 @@ Status Bunzip2(std::string_view in, std::string_view source, uint64_t max_bytes,
     }
     if (rc == BZ_OK) {
       if (in_pos >= in.size() && produced == 0) {
-        status = InvalidInput(source, "bzip2 stream truncated: input ends after " +
-                                          std::to_string(in.size()) + " compressed bytes (" +
-                                          std::to_string(total) +
+        status = InvalidInput(source, "bzip2 stream truncated: input ends after " + std::to_string(in.size()) +
+                                          " compressed bytes (" + std::to_string(total) +
                                           " decompressed) before the end-of-stream marker");
         break;
       }
       continue;
     }
-    status = InvalidInput(source, "corrupt bzip2 stream near compressed byte " +
-                                      std::to_string(in_pos) + ": " + Bzip2ErrorName(rc));
+    status = InvalidInput(
+        source, "corrupt bzip2 stream near compressed byte " + std::to_string(in_pos) + ": " + Bzip2ErrorName(rc));
     break;
   }
   BZ2_bzDecompressEnd(&bz);
@@ -194,8 +187,8 @@ std::string_view DetectUnsupportedCompression(std::string_view bytes) {
   return "";
 }
 
-Result<std::string> Decompress(std::string_view bytes, Compression compression,
-                               std::string_view source, uint64_t max_bytes) {
+Result<std::string> Decompress(std::string_view bytes, Compression compression, std::string_view source,
+                               uint64_t max_bytes) {
   if (compression == Compression::kNone) return std::string(bytes);
   auto inflate_into = [&](auto&& sink) {
     return compression == Compression::kGzip ? Gunzip(bytes, source, max_bytes, sink)
@@ -215,10 +208,9 @@ Result<std::string> LzfDecompress(std::string_view compressed, size_t expected_s
   const unsigned char* const in_end = ip + compressed.size();
   size_t op = 0;
   auto error = [&](std::string_view what) -> Status {
-    return InvalidArgumentError(
-        "corrupt LZF data at compressed byte " +
-        std::to_string(ip - reinterpret_cast<const unsigned char*>(compressed.data())) + ": " +
-        std::string(what));
+    return InvalidArgumentError("corrupt LZF data at compressed byte " +
+                                std::to_string(ip - reinterpret_cast<const unsigned char*>(compressed.data())) + ": " +
+                                std::string(what));
   };
   while (ip < in_end) {
     unsigned ctrl = *ip++;
@@ -244,8 +236,8 @@ Result<std::string> LzfDecompress(std::string_view compressed, size_t expected_s
     }
   }
   if (op != expected_size) {
-    return InvalidArgumentError("LZF data decompresses to " + std::to_string(op) +
-                                " bytes, expected " + std::to_string(expected_size));
+    return InvalidArgumentError("LZF data decompresses to " + std::to_string(op) + " bytes, expected " +
+                                std::to_string(expected_size));
   }
   return out;
 }

@@ -30,19 +30,17 @@ T At(std::string_view b, size_t offset) {
 
 bool LooksLikeLas(std::string_view bytes) { return bytes.substr(0, 4) == "LASF"; }
 
-Result<PointCloud> ReadLas(std::string_view bytes, std::string_view source,
-                           const ReadOptions& options) {
+Result<PointCloud> ReadLas(std::string_view bytes, std::string_view source, const ReadOptions& options) {
   if (bytes.size() < kMinHeaderSize) {
     return InvalidInput(source, "LAS file has " + std::to_string(bytes.size()) +
-                                    " bytes; the public header block alone needs " +
-                                    std::to_string(kMinHeaderSize) + "; file truncated?");
+                                    " bytes; the public header block alone needs " + std::to_string(kMinHeaderSize) +
+                                    "; file truncated?");
   }
   const int major = At<uint8_t>(bytes, 24);
   const int minor = At<uint8_t>(bytes, 25);
   const std::string version = std::to_string(major) + "." + std::to_string(minor);
   if (major != 1 || minor > 4) {
-    return InvalidInput(source,
-                        "unsupported LAS version " + version + " at byte 24 (expected 1.0 to 1.4)");
+    return InvalidInput(source, "unsupported LAS version " + version + " at byte 24 (expected 1.0 to 1.4)");
   }
   const uint16_t header_size = At<uint16_t>(bytes, 94);
   const uint32_t point_offset = At<uint32_t>(bytes, 96);
@@ -52,14 +50,12 @@ Result<PointCloud> ReadLas(std::string_view bytes, std::string_view source,
   const uint32_t legacy_count = At<uint32_t>(bytes, 107);
   const size_t required_header = minor >= 4 ? 375 : minor == 3 ? 235 : kMinHeaderSize;
   if (header_size < required_header) {
-    return InvalidInput(source, "LAS " + version + " header size at byte 94 is " +
-                                    std::to_string(header_size) + ", expected at least " +
-                                    std::to_string(required_header));
+    return InvalidInput(source, "LAS " + version + " header size at byte 94 is " + std::to_string(header_size) +
+                                    ", expected at least " + std::to_string(required_header));
   }
   if (header_size > bytes.size()) {
-    return InvalidInput(source, "LAS header size at byte 94 is " + std::to_string(header_size) +
-                                    " but the file has " + std::to_string(bytes.size()) +
-                                    " bytes; file truncated?");
+    return InvalidInput(source, "LAS header size at byte 94 is " + std::to_string(header_size) + " but the file has " +
+                                    std::to_string(bytes.size()) + " bytes; file truncated?");
   }
   // LASzip sets bit 7 (and in some versions bit 6) of the point format id.
   if (format_id & 0xC0) return InvalidInput(source, kLazMessage);
@@ -67,12 +63,10 @@ Result<PointCloud> ReadLas(std::string_view bytes, std::string_view source,
   size_t pos = header_size;
   for (uint32_t i = 0; i < vlr_count; ++i) {
     // pos can pass the end: the previous record's length is not checked against the file.
-    if (pos > bytes.size() || bytes.size() - pos < kVlrHeaderSize ||
-        pos + kVlrHeaderSize > point_offset) {
+    if (pos > bytes.size() || bytes.size() - pos < kVlrHeaderSize || pos + kVlrHeaderSize > point_offset) {
       return InvalidInput(source, "LAS header declares " + std::to_string(vlr_count) +
-                                      " variable length records but record " + std::to_string(i) +
-                                      " at byte " + std::to_string(pos) +
-                                      " runs past the start of the point data (byte " +
+                                      " variable length records but record " + std::to_string(i) + " at byte " +
+                                      std::to_string(pos) + " runs past the start of the point data (byte " +
                                       std::to_string(point_offset) + ")");
     }
     const std::string_view user = bytes.substr(pos + 2, 16);
@@ -84,19 +78,17 @@ Result<PointCloud> ReadLas(std::string_view bytes, std::string_view source,
     pos += kVlrHeaderSize + length;
   }
   if (point_offset < pos || point_offset > bytes.size()) {
-    return InvalidInput(source, "LAS offset to point data at byte 96 is " +
-                                    std::to_string(point_offset) + ", expected " +
-                                    std::to_string(pos) + " to " + std::to_string(bytes.size()) +
+    return InvalidInput(source, "LAS offset to point data at byte 96 is " + std::to_string(point_offset) +
+                                    ", expected " + std::to_string(pos) + " to " + std::to_string(bytes.size()) +
                                     " (after the header and VLRs, inside the file)");
   }
   if (format_id > 10) {
-    return InvalidInput(source, "unknown LAS point data record format " +
-                                    std::to_string(format_id) + " at byte 104 (expected 0 to 10)");
+    return InvalidInput(source, "unknown LAS point data record format " + std::to_string(format_id) +
+                                    " at byte 104 (expected 0 to 10)");
   }
   if (record_length < kMinRecordLength[format_id]) {
-    return InvalidInput(source, "LAS point record length at byte 105 is " +
-                                    std::to_string(record_length) + " but point format " +
-                                    std::to_string(format_id) + " needs at least " +
+    return InvalidInput(source, "LAS point record length at byte 105 is " + std::to_string(record_length) +
+                                    " but point format " + std::to_string(format_id) + " needs at least " +
                                     std::to_string(kMinRecordLength[format_id]));
   }
   uint64_t count = legacy_count;
@@ -105,8 +97,7 @@ Result<PointCloud> ReadLas(std::string_view bytes, std::string_view source,
     if (count64 != 0) {
       if (legacy_count != 0 && legacy_count != count64) {
         return InvalidInput(source, "LAS 1.4 header declares " + std::to_string(count64) +
-                                        " points at byte 247 but a legacy count of " +
-                                        std::to_string(legacy_count) +
+                                        " points at byte 247 but a legacy count of " + std::to_string(legacy_count) +
                                         " at byte 107; header inconsistent");
       }
       count = count64;
@@ -116,8 +107,7 @@ Result<PointCloud> ReadLas(std::string_view bytes, std::string_view source,
   VC_RETURN_IF_ERROR(CheckPointLimit(count, "LAS header", source, options));
   const uint64_t left = bytes.size() - point_offset;
   if (count > left / record_length) {
-    return InvalidInput(source, "LAS header declares " + std::to_string(count) +
-                                    " points but the body ends after " +
+    return InvalidInput(source, "LAS header declares " + std::to_string(count) + " points but the body ends after " +
                                     std::to_string(left / record_length) + "; file truncated?");
   }
   double scale[3], offset[3];
@@ -126,8 +116,7 @@ Result<PointCloud> ReadLas(std::string_view bytes, std::string_view source,
     offset[a] = At<double>(bytes, 155 + 8 * a);
     if (!std::isfinite(scale[a]) || scale[a] == 0 || !std::isfinite(offset[a])) {
       return InvalidInput(source, std::string("LAS ") + "xyz"[a] + " scale/offset at bytes " +
-                                      std::to_string(131 + 8 * a) + "/" +
-                                      std::to_string(155 + 8 * a) + " are " +
+                                      std::to_string(131 + 8 * a) + "/" + std::to_string(155 + 8 * a) + " are " +
                                       std::to_string(scale[a]) + "/" + std::to_string(offset[a]) +
                                       "; expected a finite non-zero scale and a finite offset");
     }
@@ -136,8 +125,7 @@ Result<PointCloud> ReadLas(std::string_view bytes, std::string_view source,
   cloud.points.reserve(count);
   for (uint64_t i = 0; i < count; ++i) {
     const size_t p = point_offset + i * record_length;
-    cloud.Add(At<int32_t>(bytes, p) * scale[0] + offset[0],
-              At<int32_t>(bytes, p + 4) * scale[1] + offset[1],
+    cloud.Add(At<int32_t>(bytes, p) * scale[0] + offset[0], At<int32_t>(bytes, p + 4) * scale[1] + offset[1],
               At<int32_t>(bytes, p + 8) * scale[2] + offset[2]);
   }
   cloud.detail = "LAS " + version + " PDRF " + std::to_string(format_id);

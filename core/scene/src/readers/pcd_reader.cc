@@ -82,15 +82,14 @@ Result<Header> ParseHeader(std::string_view bytes, std::string_view source) {
     const std::string_view key = t[0];
     auto one_number = [&](uint64_t* v) -> Status {
       if (t.size() != 2 || !ParseUint64(t[1], v)) {
-        return InvalidInput(source, where + ": expected \"" + std::string(key) +
-                                        " <non-negative integer>\", found " + Quote(line));
+        return InvalidInput(
+            source, where + ": expected \"" + std::string(key) + " <non-negative integer>\", found " + Quote(line));
       }
       return Status::Ok();
     };
     if (key == "VERSION") {
       if (t.size() != 2 || (t[1] != "0.7" && t[1] != ".7" && t[1] != "0.6" && t[1] != ".6")) {
-        return InvalidInput(
-            source, where + ": unsupported PCD version " + Quote(line) + " (expected VERSION 0.7)");
+        return InvalidInput(source, where + ": unsupported PCD version " + Quote(line) + " (expected VERSION 0.7)");
       }
     } else if (key == "FIELDS" || key == "COLUMNS") {
       if (t.size() < 2) return InvalidInput(source, where + ": FIELDS lists no fields");
@@ -145,8 +144,8 @@ Result<Header> ParseHeader(std::string_view bytes, std::string_view source) {
     }
   }
   if (!have_data) {
-    return InvalidInput(source, "PCD header has no \"DATA\" line (read " +
-                                    std::to_string(lines.line_number()) + " lines)");
+    return InvalidInput(source,
+                        "PCD header has no \"DATA\" line (read " + std::to_string(lines.line_number()) + " lines)");
   }
   h.body_offset = lines.position();
   h.body_first_line = lines.line_number() + 1;
@@ -156,41 +155,34 @@ Result<Header> ParseHeader(std::string_view bytes, std::string_view source) {
                        uint64_t line_no) -> Status {
     if (present && v.size() != n) {
       return InvalidInput(source, "line " + std::to_string(line_no) + ": " + key + " lists " +
-                                      std::to_string(v.size()) + " entries but FIELDS lists " +
-                                      std::to_string(n));
+                                      std::to_string(v.size()) + " entries but FIELDS lists " + std::to_string(n));
     }
     return Status::Ok();
   };
   if (!have[0] || !have[1]) {
-    return InvalidInput(
-        source, std::string("PCD header has no \"") + (have[0] ? "TYPE" : "SIZE") + "\" line");
+    return InvalidInput(source, std::string("PCD header has no \"") + (have[0] ? "TYPE" : "SIZE") + "\" line");
   }
   VC_RETURN_IF_ERROR(check_len(sizes, true, "SIZE", size_line));
   VC_RETURN_IF_ERROR(check_len(types, true, "TYPE", type_line));
   VC_RETURN_IF_ERROR(check_len(counts, have[2], "COUNT", count_line));
   for (size_t i = 0; i < n; ++i) {
     Field& f = h.fields[i];
-    if (types[i].size() != 1 ||
-        std::string_view("FIU").find(types[i][0]) == std::string_view::npos) {
-      return InvalidInput(source, "line " + std::to_string(type_line) + ": unknown PCD TYPE " +
-                                      Quote(types[i]) + " for field \"" + f.name +
-                                      "\" (expected F, I or U)");
+    if (types[i].size() != 1 || std::string_view("FIU").find(types[i][0]) == std::string_view::npos) {
+      return InvalidInput(source, "line " + std::to_string(type_line) + ": unknown PCD TYPE " + Quote(types[i]) +
+                                      " for field \"" + f.name + "\" (expected F, I or U)");
     }
     f.type = types[i][0];
     const bool size_ok =
         ParseUint64(sizes[i], &f.size) &&
-        (f.type == 'F' ? (f.size == 4 || f.size == 8)
-                       : (f.size == 1 || f.size == 2 || f.size == 4 || f.size == 8));
+        (f.type == 'F' ? (f.size == 4 || f.size == 8) : (f.size == 1 || f.size == 2 || f.size == 4 || f.size == 8));
     if (!size_ok) {
-      return InvalidInput(source, "line " + std::to_string(size_line) + ": invalid SIZE " +
-                                      Quote(sizes[i]) + " for field \"" + f.name + "\" of TYPE " +
-                                      f.type + " (expected " +
+      return InvalidInput(source, "line " + std::to_string(size_line) + ": invalid SIZE " + Quote(sizes[i]) +
+                                      " for field \"" + f.name + "\" of TYPE " + f.type + " (expected " +
                                       (f.type == 'F' ? "4 or 8" : "1, 2, 4 or 8") + ")");
     }
     if (have[2] && (!ParseUint64(counts[i], &f.count) || f.count == 0 || f.count > 1'000'000)) {
-      return InvalidInput(source, "line " + std::to_string(count_line) + ": invalid COUNT " +
-                                      Quote(counts[i]) + " for field \"" + f.name +
-                                      "\" (expected a positive integer)");
+      return InvalidInput(source, "line " + std::to_string(count_line) + ": invalid COUNT " + Quote(counts[i]) +
+                                      " for field \"" + f.name + "\" (expected a positive integer)");
     }
     f.offset = h.step;
     h.step += f.size * f.count;
@@ -201,48 +193,42 @@ Result<Header> ParseHeader(std::string_view bytes, std::string_view source) {
       if (h.fields[i].name == kAxis[a]) h.xyz[a] = static_cast<int>(i);
     }
     if (h.xyz[a] < 0) {
-      return InvalidInput(source, std::string("PCD header has no field \"") + kAxis[a] +
-                                      "\" (expected fields x, y and z)");
+      return InvalidInput(source,
+                          std::string("PCD header has no field \"") + kAxis[a] + "\" (expected fields x, y and z)");
     }
   }
   if (!have_width) return InvalidInput(source, "PCD header has no \"WIDTH\" line");
   if (!have_height) height = 1;
   if (height != 0 && width > UINT64_MAX / height) {
-    return InvalidInput(source, "PCD WIDTH " + std::to_string(width) + " times HEIGHT " +
-                                    std::to_string(height) + " overflows");
+    return InvalidInput(
+        source, "PCD WIDTH " + std::to_string(width) + " times HEIGHT " + std::to_string(height) + " overflows");
   }
   if (!have[3]) {
     h.points = width * height;
   } else if (h.points != width * height) {
     return InvalidInput(source, "PCD header declares POINTS " + std::to_string(h.points) +
-                                    " but WIDTH * HEIGHT = " + std::to_string(width) + " * " +
-                                    std::to_string(height) + " = " +
-                                    std::to_string(width * height));
+                                    " but WIDTH * HEIGHT = " + std::to_string(width) + " * " + std::to_string(height) +
+                                    " = " + std::to_string(width * height));
   }
-  if (h.points == 0)
-    return InvalidInput(source, "PCD header declares 0 points; the cloud is empty");
+  if (h.points == 0) return InvalidInput(source, "PCD header declares 0 points; the cloud is empty");
   return h;
 }
 
 Status Truncated(std::string_view source, uint64_t declared, uint64_t present) {
-  return InvalidInput(source, "PCD header declares " + std::to_string(declared) +
-                                  " points but the body ends after " + std::to_string(present) +
-                                  "; file truncated?");
+  return InvalidInput(source, "PCD header declares " + std::to_string(declared) + " points but the body ends after " +
+                                  std::to_string(present) + "; file truncated?");
 }
 
 Status CheckTrailing(std::string_view source, std::string_view rest, size_t pos) {
-  const bool blank = std::all_of(rest.begin(), rest.end(), [](char c) {
-    return c == '\n' || c == '\r' || c == ' ' || c == '\0';
-  });
+  const bool blank =
+      std::all_of(rest.begin(), rest.end(), [](char c) { return c == '\n' || c == '\r' || c == ' ' || c == '\0'; });
   if (blank) return Status::Ok();
   return InvalidInput(source, "PCD body has " + std::to_string(rest.size()) +
-                                  " bytes left after the declared points (at byte " +
-                                  std::to_string(pos) +
+                                  " bytes left after the declared points (at byte " + std::to_string(pos) +
                                   "); header and body do not match (wrong POINTS or SIZE?)");
 }
 
-Status ReadAscii(std::string_view bytes, std::string_view source, const Header& h,
-                 PointCloud* cloud) {
+Status ReadAscii(std::string_view bytes, std::string_view source, const Header& h, PointCloud* cloud) {
   const std::string_view body = bytes.substr(h.body_offset);
   LineCursor lines(body);
   uint64_t values = 0;
@@ -262,8 +248,7 @@ Status ReadAscii(std::string_view bytes, std::string_view source, const Header& 
     const std::string where = "line " + std::to_string(line_base + lines.line_number());
     if (t.size() != values) {
       return InvalidInput(source, where + ": expected " + std::to_string(values) +
-                                      " values per point (FIELDS times COUNT), found " +
-                                      std::to_string(t.size()));
+                                      " values per point (FIELDS times COUNT), found " + std::to_string(t.size()));
     }
     double xyz[3];
     for (int a = 0; a < 3; ++a) {
@@ -271,22 +256,20 @@ Status ReadAscii(std::string_view bytes, std::string_view source, const Header& 
       uint64_t k = 0;
       for (int i2 = 0; i2 < h.xyz[a]; ++i2) k += h.fields[i2].count;
       if (!ParseDouble(t[k], &xyz[a])) {
-        return InvalidInput(source, where + ": expected a number for field \"" + f.name +
-                                        "\", found " + Quote(t[k]));
+        return InvalidInput(source, where + ": expected a number for field \"" + f.name + "\", found " + Quote(t[k]));
       }
     }
     cloud->Add(xyz[0], xyz[1], xyz[2]);
   }
   if (next_point(&line)) {
-    return InvalidInput(source, "line " + std::to_string(line_base + lines.line_number()) +
-                                    ": unexpected data " + Quote(line) + " after the " +
-                                    std::to_string(h.points) + " points declared in the header");
+    return InvalidInput(source, "line " + std::to_string(line_base + lines.line_number()) + ": unexpected data " +
+                                    Quote(line) + " after the " + std::to_string(h.points) +
+                                    " points declared in the header");
   }
   return Status::Ok();
 }
 
-Status ReadBinary(std::string_view bytes, std::string_view source, const Header& h,
-                  PointCloud* cloud) {
+Status ReadBinary(std::string_view bytes, std::string_view source, const Header& h, PointCloud* cloud) {
   const uint64_t left = bytes.size() - h.body_offset;
   if (h.points > left / h.step) return Truncated(source, h.points, left / h.step);
   cloud->points.reserve(h.points);
@@ -302,44 +285,41 @@ Status ReadBinary(std::string_view bytes, std::string_view source, const Header&
   return CheckTrailing(source, bytes.substr(end), end);
 }
 
-Status ReadCompressed(std::string_view bytes, std::string_view source, const Header& h,
-                      const ReadOptions& options, PointCloud* cloud) {
+Status ReadCompressed(std::string_view bytes, std::string_view source, const Header& h, const ReadOptions& options,
+                      PointCloud* cloud) {
   const size_t pos = h.body_offset;
   if (bytes.size() - pos < 8) {
-    return InvalidInput(source, "PCD binary_compressed body at byte " + std::to_string(pos) +
-                                    " has " + std::to_string(bytes.size() - pos) +
+    return InvalidInput(source, "PCD binary_compressed body at byte " + std::to_string(pos) + " has " +
+                                    std::to_string(bytes.size() - pos) +
                                     " bytes; expected an 8-byte size header; file truncated?");
   }
   const uint64_t compressed = LoadScalar<uint32_t>(bytes.data() + pos, false);
   const uint64_t uncompressed = LoadScalar<uint32_t>(bytes.data() + pos + 4, false);
   if (h.points > UINT64_MAX / h.step || uncompressed != h.points * h.step) {
-    return InvalidInput(
-        source, "PCD header declares " + std::to_string(h.points) + " points of " +
-                    std::to_string(h.step) + " bytes but the compressed block at byte " +
-                    std::to_string(pos) + " decompresses to " + std::to_string(uncompressed) +
-                    " bytes; header and body do not match");
+    return InvalidInput(source, "PCD header declares " + std::to_string(h.points) + " points of " +
+                                    std::to_string(h.step) + " bytes but the compressed block at byte " +
+                                    std::to_string(pos) + " decompresses to " + std::to_string(uncompressed) +
+                                    " bytes; header and body do not match");
   }
   const uint64_t left = bytes.size() - pos - 8;
   if (compressed > left) {
     return InvalidInput(source, "PCD compressed block declares " + std::to_string(compressed) +
-                                    " bytes but the body ends after " + std::to_string(left) +
-                                    "; file truncated?");
+                                    " bytes but the body ends after " + std::to_string(left) + "; file truncated?");
   }
   if (uncompressed > compressed * kMaxLzfRatio + 64) {
     return InvalidInput(source, "PCD compressed block of " + std::to_string(compressed) +
-                                    " bytes cannot decompress to the declared " +
-                                    std::to_string(uncompressed) + " bytes; corrupt header?");
+                                    " bytes cannot decompress to the declared " + std::to_string(uncompressed) +
+                                    " bytes; corrupt header?");
   }
   if (uncompressed > options.max_decompressed_bytes) {
     return ResourceExhaustedError(std::string(source) + ": PCD compressed block decompresses to " +
                                   std::to_string(uncompressed) + " bytes, more than the limit of " +
-                                  std::to_string(options.max_decompressed_bytes) +
-                                  std::string(kRaiseInputLimit));
+                                  std::to_string(options.max_decompressed_bytes) + std::string(kRaiseInputLimit));
   }
   Result<std::string> raw = LzfDecompress(bytes.substr(pos + 8, compressed), uncompressed);
   if (!raw.ok()) {
-    return InvalidInput(source, "PCD binary_compressed block at byte " + std::to_string(pos + 8) +
-                                    ": " + raw.status().message());
+    return InvalidInput(
+        source, "PCD binary_compressed block at byte " + std::to_string(pos + 8) + ": " + raw.status().message());
   }
   const std::string& data = *raw;
   cloud->points.reserve(h.points);
@@ -371,8 +351,7 @@ bool LooksLikePcd(std::string_view bytes) {
   return false;
 }
 
-Result<PointCloud> ReadPcd(std::string_view bytes, std::string_view source,
-                           const ReadOptions& options) {
+Result<PointCloud> ReadPcd(std::string_view bytes, std::string_view source, const ReadOptions& options) {
   VC_ASSIGN_OR_RETURN(const Header h, ParseHeader(bytes, source));
   VC_RETURN_IF_ERROR(CheckPointLimit(h.points, "PCD header", source, options));
   PointCloud cloud;

@@ -20,12 +20,10 @@ bool ParseType(std::string_view name, Type* type) {
     Type type;
   };
   static constexpr Entry kTypes[] = {
-      {"char", Type::kInt8},       {"int8", Type::kInt8},       {"uchar", Type::kUint8},
-      {"uint8", Type::kUint8},     {"short", Type::kInt16},     {"int16", Type::kInt16},
-      {"ushort", Type::kUint16},   {"uint16", Type::kUint16},   {"int", Type::kInt32},
-      {"int32", Type::kInt32},     {"uint", Type::kUint32},     {"uint32", Type::kUint32},
-      {"float", Type::kFloat32},   {"float32", Type::kFloat32}, {"double", Type::kFloat64},
-      {"float64", Type::kFloat64},
+      {"char", Type::kInt8},     {"int8", Type::kInt8},       {"uchar", Type::kUint8},    {"uint8", Type::kUint8},
+      {"short", Type::kInt16},   {"int16", Type::kInt16},     {"ushort", Type::kUint16},  {"uint16", Type::kUint16},
+      {"int", Type::kInt32},     {"int32", Type::kInt32},     {"uint", Type::kUint32},    {"uint32", Type::kUint32},
+      {"float", Type::kFloat32}, {"float32", Type::kFloat32}, {"double", Type::kFloat64}, {"float64", Type::kFloat64},
   };
   for (const Entry& e : kTypes) {
     if (e.name == name) {
@@ -92,8 +90,7 @@ struct Element {
   std::vector<Property> properties;
 
   bool has_lists() const {
-    return std::any_of(properties.begin(), properties.end(),
-                       [](const Property& p) { return p.is_list; });
+    return std::any_of(properties.begin(), properties.end(), [](const Property& p) { return p.is_list; });
   }
   // Bytes of one item if it has no lists; with lists, the least (every list empty).
   uint64_t min_stride() const {
@@ -122,8 +119,7 @@ std::string Items(const Element& e) {
 
 Status Truncated(std::string_view source, const Element& e, uint64_t present) {
   return InvalidInput(source, "PLY header declares " + std::to_string(e.count) + " " + Items(e) +
-                                  " but the body ends after " + std::to_string(present) +
-                                  "; file truncated?");
+                                  " but the body ends after " + std::to_string(present) + "; file truncated?");
 }
 
 Result<Header> ParseHeader(std::string_view bytes, std::string_view source) {
@@ -162,8 +158,7 @@ Result<Header> ParseHeader(std::string_view bytes, std::string_view source) {
                                         "binary_big_endian)");
       }
       if (t[2] != "1.0" && t[2] != "1") {
-        return InvalidInput(source,
-                            where + ": unsupported PLY version " + Quote(t[2]) + " (expected 1.0)");
+        return InvalidInput(source, where + ": unsupported PLY version " + Quote(t[2]) + " (expected 1.0)");
       }
       h.format_line = std::string(t[1]) + " " + std::string(t[2]);
       have_format = true;
@@ -172,8 +167,7 @@ Result<Header> ParseHeader(std::string_view bytes, std::string_view source) {
     if (key == "element") {
       Element e;
       if (t.size() != 3 || !ParseUint64(t[2], &e.count)) {
-        return InvalidInput(source,
-                            where + ": expected \"element <name> <count>\", found " + Quote(line));
+        return InvalidInput(source, where + ": expected \"element <name> <count>\", found " + Quote(line));
       }
       e.name = std::string(t[1]);
       h.elements.push_back(std::move(e));
@@ -181,8 +175,7 @@ Result<Header> ParseHeader(std::string_view bytes, std::string_view source) {
     }
     if (key == "property") {
       if (h.elements.empty()) {
-        return InvalidInput(source,
-                            where + ": property " + Quote(line) + " before any \"element\" line");
+        return InvalidInput(source, where + ": property " + Quote(line) + " before any \"element\" line");
       }
       Property p;
       std::string_view type_name;
@@ -200,15 +193,13 @@ Result<Header> ParseHeader(std::string_view bytes, std::string_view source) {
                                           "float, double or int8..uint32, float32, float64)");
         }
         if (!IsInteger(p.count_type)) {
-          return InvalidInput(
-              source, where + ": list count type must be an integer type, found " + Quote(t[2]));
+          return InvalidInput(source, where + ": list count type must be an integer type, found " + Quote(t[2]));
         }
         type_name = t[3];
         p.name = std::string(t[4]);
       } else {
         if (t.size() != 3) {
-          return InvalidInput(
-              source, where + ": expected \"property <type> <name>\", found " + Quote(line));
+          return InvalidInput(source, where + ": expected \"property <type> <name>\", found " + Quote(line));
         }
         type_name = t[1];
         p.name = std::string(t[2]);
@@ -226,8 +217,8 @@ Result<Header> ParseHeader(std::string_view bytes, std::string_view source) {
                                     "end_header)");
   }
   if (!have_end) {
-    return InvalidInput(source, "PLY header has no \"end_header\" line (read " +
-                                    std::to_string(lines.line_number()) + " lines)");
+    return InvalidInput(
+        source, "PLY header has no \"end_header\" line (read " + std::to_string(lines.line_number()) + " lines)");
   }
   if (!have_format) return InvalidInput(source, "PLY header has no \"format\" line");
   h.body_offset = lines.position();
@@ -252,21 +243,18 @@ Result<Header> ParseHeader(std::string_view bytes, std::string_view source) {
       if (v.properties[i].name == kAxis[a]) h.xyz[a] = static_cast<int>(i);
     }
     if (h.xyz[a] < 0) {
-      return InvalidInput(source, std::string("PLY vertex element has no \"") + kAxis[a] +
-                                      "\" property (expected scalar x, y and z)");
+      return InvalidInput(
+          source, std::string("PLY vertex element has no \"") + kAxis[a] + "\" property (expected scalar x, y and z)");
     }
     if (v.properties[h.xyz[a]].is_list) {
-      return InvalidInput(source, std::string("PLY vertex property \"") + kAxis[a] +
-                                      "\" is a list; expected a scalar");
+      return InvalidInput(source, std::string("PLY vertex property \"") + kAxis[a] + "\" is a list; expected a scalar");
     }
   }
-  if (v.count == 0)
-    return InvalidInput(source, "PLY header declares 0 vertices; the cloud is empty");
+  if (v.count == 0) return InvalidInput(source, "PLY header declares 0 vertices; the cloud is empty");
   return h;
 }
 
-Status ReadBinaryBody(std::string_view bytes, std::string_view source, const Header& h,
-                      PointCloud* cloud) {
+Status ReadBinaryBody(std::string_view bytes, std::string_view source, const Header& h, PointCloud* cloud) {
   const bool big = h.encoding == Encoding::kBinaryBig;
   size_t pos = h.body_offset;
   for (size_t ei = 0; ei < h.elements.size(); ++ei) {
@@ -285,12 +273,10 @@ Status ReadBinaryBody(std::string_view bytes, std::string_view source, const Hea
           offset[a] = 0;
           for (int i = 0; i < h.xyz[a]; ++i) offset[a] += SizeOf(e.properties[i].type);
         }
-        const Type tx = e.properties[h.xyz[0]].type, ty = e.properties[h.xyz[1]].type,
-                   tz = e.properties[h.xyz[2]].type;
+        const Type tx = e.properties[h.xyz[0]].type, ty = e.properties[h.xyz[1]].type, tz = e.properties[h.xyz[2]].type;
         for (uint64_t i = 0; i < e.count; ++i) {
           const char* p = bytes.data() + pos + i * min_stride;
-          cloud->Add(Load(p + offset[0], tx, big), Load(p + offset[1], ty, big),
-                     Load(p + offset[2], tz, big));
+          cloud->Add(Load(p + offset[0], tx, big), Load(p + offset[1], ty, big), Load(p + offset[2], tz, big));
         }
       }
       pos += e.count * min_stride;
@@ -312,27 +298,23 @@ Status ReadBinaryBody(std::string_view bytes, std::string_view source, const Hea
         }
         if (!p.is_list) {
           for (int a = 0; a < 3; ++a) {
-            if (is_vertex && static_cast<int>(pi) == h.xyz[a])
-              xyz[a] = Load(bytes.data() + pos, p.type, big);
+            if (is_vertex && static_cast<int>(pi) == h.xyz[a]) xyz[a] = Load(bytes.data() + pos, p.type, big);
           }
           pos += head;
           continue;
         }
         const double n = Load(bytes.data() + pos, p.count_type, big);
         if (n < 0) {
-          return InvalidInput(source, "PLY " + Items(e) + " item " + std::to_string(i) +
-                                          ": negative list length " +
-                                          std::to_string(static_cast<int64_t>(n)) + " at byte " +
-                                          std::to_string(pos));
+          return InvalidInput(source, "PLY " + Items(e) + " item " + std::to_string(i) + ": negative list length " +
+                                          std::to_string(static_cast<int64_t>(n)) + " at byte " + std::to_string(pos));
         }
         pos += head;
         const uint64_t need = static_cast<uint64_t>(n) * SizeOf(p.type);
         if (bytes.size() - pos < need) {
           return InvalidInput(source, "PLY " + Items(e) + " item " + std::to_string(i) + " of " +
-                                          std::to_string(e.count) + ": list \"" + p.name +
-                                          "\" of " + std::to_string(static_cast<uint64_t>(n)) +
-                                          " items at byte " + std::to_string(pos) +
-                                          " runs past the end of the body; file truncated?");
+                                          std::to_string(e.count) + ": list \"" + p.name + "\" of " +
+                                          std::to_string(static_cast<uint64_t>(n)) + " items at byte " +
+                                          std::to_string(pos) + " runs past the end of the body; file truncated?");
         }
         pos += need;
       }
@@ -341,21 +323,18 @@ Status ReadBinaryBody(std::string_view bytes, std::string_view source, const Hea
   }
   if (pos < bytes.size()) {
     const std::string_view rest = bytes.substr(pos);
-    const bool blank = std::all_of(rest.begin(), rest.end(), [](char c) {
-      return c == '\n' || c == '\r' || c == ' ' || c == '\0';
-    });
+    const bool blank =
+        std::all_of(rest.begin(), rest.end(), [](char c) { return c == '\n' || c == '\r' || c == ' ' || c == '\0'; });
     if (!blank) {
       return InvalidInput(source, "PLY body has " + std::to_string(rest.size()) +
-                                      " bytes left after the last declared element (at byte " +
-                                      std::to_string(pos) +
+                                      " bytes left after the last declared element (at byte " + std::to_string(pos) +
                                       "); header and body do not match (wrong counts or types?)");
     }
   }
   return Status::Ok();
 }
 
-Status ReadAsciiBody(std::string_view bytes, std::string_view source, const Header& h,
-                     PointCloud* cloud) {
+Status ReadAsciiBody(std::string_view bytes, std::string_view source, const Header& h, PointCloud* cloud) {
   const std::string_view body = bytes.substr(h.body_offset);
   LineCursor lines(body);
   const uint64_t line_base = h.body_first_line - 1;
@@ -384,61 +363,54 @@ Status ReadAsciiBody(std::string_view bytes, std::string_view source, const Head
       for (size_t pi = 0; pi < e.properties.size(); ++pi) {
         const Property& p = e.properties[pi];
         if (k >= t.size()) {
-          return InvalidInput(source, where + ": PLY " + Items(e) + " item " + std::to_string(i) +
-                                          " has " + std::to_string(t.size()) +
-                                          " values; expected a value for property \"" + p.name +
-                                          "\"");
+          return InvalidInput(source, where + ": PLY " + Items(e) + " item " + std::to_string(i) + " has " +
+                                          std::to_string(t.size()) + " values; expected a value for property \"" +
+                                          p.name + "\"");
         }
         if (p.is_list) {
           uint64_t n = 0;
           if (!ParseUint64(t[k], &n)) {
-            return InvalidInput(source, where + ": expected a list length for \"" + p.name +
-                                            "\", found " + Quote(t[k]));
+            return InvalidInput(source,
+                                where + ": expected a list length for \"" + p.name + "\", found " + Quote(t[k]));
           }
           ++k;
           if (n > t.size() - k) {
-            return InvalidInput(source, where + ": list \"" + p.name + "\" declares " +
-                                            std::to_string(n) + " items but the line has " +
-                                            std::to_string(t.size() - k) + " values left");
+            return InvalidInput(source, where + ": list \"" + p.name + "\" declares " + std::to_string(n) +
+                                            " items but the line has " + std::to_string(t.size() - k) + " values left");
           }
           k += n;
           continue;
         }
         for (int a = 0; a < 3; ++a) {
           if (is_vertex && static_cast<int>(pi) == h.xyz[a] && !ParseDouble(t[k], &xyz[a])) {
-            return InvalidInput(source, where + ": expected a number for vertex property \"" +
-                                            p.name + "\", found " + Quote(t[k]));
+            return InvalidInput(
+                source, where + ": expected a number for vertex property \"" + p.name + "\", found " + Quote(t[k]));
           }
         }
         ++k;
       }
       if (k != t.size()) {
-        return InvalidInput(source, where + ": PLY " + Items(e) + " item " + std::to_string(i) +
-                                        " has " + std::to_string(t.size()) + " values, expected " +
-                                        std::to_string(k) + " (header and body do not match)");
+        return InvalidInput(source, where + ": PLY " + Items(e) + " item " + std::to_string(i) + " has " +
+                                        std::to_string(t.size()) + " values, expected " + std::to_string(k) +
+                                        " (header and body do not match)");
       }
       if (is_vertex) cloud->Add(xyz[0], xyz[1], xyz[2]);
     }
   }
   if (next_item(&line)) {
-    return InvalidInput(source, "line " + std::to_string(line_base + lines.line_number()) +
-                                    ": unexpected data " + Quote(line) +
-                                    " after the last element declared in the PLY header");
+    return InvalidInput(source, "line " + std::to_string(line_base + lines.line_number()) + ": unexpected data " +
+                                    Quote(line) + " after the last element declared in the PLY header");
   }
   return Status::Ok();
 }
 
 }  // namespace
 
-bool LooksLikePly(std::string_view bytes) {
-  return bytes.substr(0, 4) == "ply\n" || bytes.substr(0, 5) == "ply\r\n";
-}
+bool LooksLikePly(std::string_view bytes) { return bytes.substr(0, 4) == "ply\n" || bytes.substr(0, 5) == "ply\r\n"; }
 
-Result<PointCloud> ReadPly(std::string_view bytes, std::string_view source,
-                           const ReadOptions& options) {
+Result<PointCloud> ReadPly(std::string_view bytes, std::string_view source, const ReadOptions& options) {
   VC_ASSIGN_OR_RETURN(const Header h, ParseHeader(bytes, source));
-  VC_RETURN_IF_ERROR(
-      CheckPointLimit(h.elements[h.vertex_index].count, "PLY header", source, options));
+  VC_RETURN_IF_ERROR(CheckPointLimit(h.elements[h.vertex_index].count, "PLY header", source, options));
   PointCloud cloud;
   if (h.encoding == Encoding::kAscii) {
     VC_RETURN_IF_ERROR(ReadAsciiBody(bytes, source, h, &cloud));

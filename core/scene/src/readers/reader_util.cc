@@ -18,8 +18,7 @@ bool ParseDouble(std::string_view token, double* value) {
   // becomes 0, rather than rejecting the whole file.
   if (ec == std::errc::result_out_of_range && ptr == end) {
     const size_t e = token.find_first_of("eE");
-    const bool underflow =
-        e != std::string_view::npos && e + 1 < token.size() && token[e + 1] == '-';
+    const bool underflow = e != std::string_view::npos && e + 1 < token.size() && token[e + 1] == '-';
     const double magnitude = underflow ? 0.0 : std::numeric_limits<double>::infinity();
     *value = token.front() == '-' ? -magnitude : magnitude;
     return true;

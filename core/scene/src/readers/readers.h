@@ -15,8 +15,8 @@
 #include <string_view>
 #include <vector>
 
-#include "vc/scene/scene_input.h"
 #include "vc/base/status.h"
+#include "vc/scene/scene_input.h"
 
 namespace vc::readers {
 
@@ -48,8 +48,8 @@ Compression DetectCompression(std::string_view bytes);
 std::string_view DetectUnsupportedCompression(std::string_view bytes);
 // Inflates a gzip/zlib (possibly multi-member) or bzip2 (possibly multi-stream) input.
 // INVALID_ARGUMENT for truncated or corrupt streams, RESOURCE_EXHAUSTED past `max_bytes`.
-Result<std::string> Decompress(std::string_view bytes, Compression compression,
-                               std::string_view source, uint64_t max_bytes);
+Result<std::string> Decompress(std::string_view bytes, Compression compression, std::string_view source,
+                               uint64_t max_bytes);
 // Decompresses one LZF block (liblzf format, as PCD binary_compressed uses) of exactly
 // `expected_size` bytes. INVALID_ARGUMENT (message without source) when corrupt or the size
 // differs.
@@ -60,26 +60,22 @@ Result<std::string> LzfDecompress(std::string_view compressed, size_t expected_s
 // True if `bytes` starts with the PLY magic line.
 bool LooksLikePly(std::string_view bytes);
 // Reads PLY ascii / binary_little_endian / binary_big_endian (ply_reader.cc).
-Result<PointCloud> ReadPly(std::string_view bytes, std::string_view source,
-                           const ReadOptions& options);
+Result<PointCloud> ReadPly(std::string_view bytes, std::string_view source, const ReadOptions& options);
 
 // True if the first non-comment header line is a PCD keyword (VERSION, FIELDS).
 bool LooksLikePcd(std::string_view bytes);
 // Reads PCD v0.7 ascii / binary / binary_compressed (pcd_reader.cc).
-Result<PointCloud> ReadPcd(std::string_view bytes, std::string_view source,
-                           const ReadOptions& options);
+Result<PointCloud> ReadPcd(std::string_view bytes, std::string_view source, const ReadOptions& options);
 
 // True if `bytes` starts with "LASF".
 bool LooksLikeLas(std::string_view bytes);
 // Reads ASPRS LAS 1.0-1.4, point formats 0-10, uncompressed (las_reader.cc).
-Result<PointCloud> ReadLas(std::string_view bytes, std::string_view source,
-                           const ReadOptions& options);
+Result<PointCloud> ReadLas(std::string_view bytes, std::string_view source, const ReadOptions& options);
 
 // True if the start of `bytes` is plain text (printable ASCII, UTF-8 and whitespace, no NUL).
 bool LooksLikeText(std::string_view bytes);
 // Reads ASCII x y z per line, space/comma/tab separated, optional header line (xyz_reader.cc).
-Result<PointCloud> ReadXyz(std::string_view bytes, std::string_view source,
-                           const ReadOptions& options);
+Result<PointCloud> ReadXyz(std::string_view bytes, std::string_view source, const ReadOptions& options);
 
 // --- Shared helpers ---
 

@@ -31,8 +31,8 @@ Fields SplitFields(std::string_view line, char* separator) {
     size_t start = 0;
     while (true) {
       const size_t comma = line.find(',', start);
-      const std::string_view field = Trim(line.substr(
-          start, comma == std::string_view::npos ? std::string_view::npos : comma - start));
+      const std::string_view field =
+          Trim(line.substr(start, comma == std::string_view::npos ? std::string_view::npos : comma - start));
       if (f.count < 3) f.xyz[f.count] = field;
       ++f.count;
       if (comma == std::string_view::npos) break;
@@ -77,14 +77,12 @@ bool LooksLikeText(std::string_view bytes) {
   return std::all_of(sample.begin(), sample.end(),
                      [](char ch) {
                        const auto c = static_cast<unsigned char>(ch);
-                       return c >= 0x20 || c == '\t' || c == '\n' || c == '\r' || c == '\f' ||
-                              c == '\v';
+                       return c >= 0x20 || c == '\t' || c == '\n' || c == '\r' || c == '\f' || c == '\v';
                      }) &&
          sample.find('\x7f') == std::string_view::npos;
 }
 
-Result<PointCloud> ReadXyz(std::string_view bytes, std::string_view source,
-                           const ReadOptions& options) {
+Result<PointCloud> ReadXyz(std::string_view bytes, std::string_view source, const ReadOptions& options) {
   if (bytes.substr(0, 3) == "\xEF\xBB\xBF") bytes.remove_prefix(3);  // UTF-8 byte-order mark.
   PointCloud cloud;
   LineCursor lines(bytes);
@@ -117,8 +115,8 @@ Result<PointCloud> ReadXyz(std::string_view bytes, std::string_view source,
     }
     const std::string where = "line " + std::to_string(lines.line_number());
     if (f.count < 3) {
-      return InvalidInput(source, where + ": expected at least 3 columns (x y z), found " +
-                                      std::to_string(f.count) + " in " + Quote(trimmed));
+      return InvalidInput(source, where + ": expected at least 3 columns (x y z), found " + std::to_string(f.count) +
+                                      " in " + Quote(trimmed));
     }
     if (bad >= 0) {
       return InvalidInput(source, where + ": expected a number for " + kAxis[bad] + " (column " +
@@ -128,18 +126,16 @@ Result<PointCloud> ReadXyz(std::string_view bytes, std::string_view source,
     ++total;
     if (total > options.max_points) {
       return ResourceExhaustedError(std::string(source) + ": more than the limit of " +
-                                    std::to_string(options.max_points) + " points" +
-                                    std::string(kRaiseResultLimit));
+                                    std::to_string(options.max_points) + " points" + std::string(kRaiseResultLimit));
     }
     cloud.Add(v[0], v[1], v[2]);
   }
   if (total == 0) {
-    return InvalidInput(source,
-                        "no points: expected one \"x y z\" line per point, found " +
-                            std::string(has_header ? "only a header line" : "no data lines"));
+    return InvalidInput(source, "no points: expected one \"x y z\" line per point, found " +
+                                    std::string(has_header ? "only a header line" : "no data lines"));
   }
-  cloud.detail = SeparatorName(separator) + ", " + std::to_string(columns) + " columns" +
-                 (has_header ? ", header line" : "");
+  cloud.detail =
+      SeparatorName(separator) + ", " + std::to_string(columns) + " columns" + (has_header ? ", header line" : "");
   return cloud;
 }
 

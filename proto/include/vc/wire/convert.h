@@ -12,14 +12,14 @@
 #include <functional>
 #include <vector>
 
+#include "vc/base/progress.h"
+#include "vc/base/status.h"
 #include "vc/plan/evaluate_job.h"
 #include "vc/plan/planner.h"
-#include "vc/base/progress.h"
 #include "vc/scene/scene_input.h"
-#include "vc/base/status.h"
-#include "vc/visibility/visibility.h"
 #include "vc/scene/voxel_scene.h"
 #include "vc/v1/planner.pb.h"
+#include "vc/visibility/visibility.h"
 
 namespace vc::wire {
 

@@ -6,24 +6,21 @@
 #include <functional>
 #include <string_view>
 
+#include "vc/base/progress.h"
+#include "vc/base/status.h"
 #include "vc/plan/evaluate_job.h"
 #include "vc/plan/planner.h"
-#include "vc/base/progress.h"
 #include "vc/scene/scene_input.h"
-#include "vc/base/status.h"
 #include "vc/visibility/visibility.h"
 #include "vc/wire/convert.h"
 
 namespace vc::server {
 
 struct Backend {
-  std::function<Result<SceneInput>(std::string_view bytes, std::string_view source, const ReadOptions&)>
-      read_scene;
-  std::function<Result<PlanResult>(const SceneInput&, const PlanOptions&, const JobContext&,
-                                   const PlanCallbacks&)>
+  std::function<Result<SceneInput>(std::string_view bytes, std::string_view source, const ReadOptions&)> read_scene;
+  std::function<Result<PlanResult>(const SceneInput&, const PlanOptions&, const JobContext&, const PlanCallbacks&)>
       plan;
-  std::function<Result<Evaluation>(const SceneInput&, const EvaluateJobOptions&, const JobContext&)>
-      evaluate;
+  std::function<Result<Evaluation>(const SceneInput&, const EvaluateJobOptions&, const JobContext&)> evaluate;
 
   // The production backend.
   static Backend Default();

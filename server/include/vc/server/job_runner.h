@@ -27,15 +27,15 @@ namespace vc::server {
 // One job as the RPC adapter hands it to a worker.
 struct Job {
   using Clock = std::chrono::steady_clock;
-  std::string id;              // "j-" + 12 hex digits
-  std::string method;          // "Plan", "Evaluate"
-  std::string peer;            // the client's address, for the log
-  v1::UploadSpec upload;       // source name, stated format, size
-  std::string data;            // the verified upload
+  std::string id;         // "j-" + 12 hex digits
+  std::string method;     // "Plan", "Evaluate"
+  std::string peer;       // the client's address, for the log
+  v1::UploadSpec upload;  // source name, stated format, size
+  std::string data;       // the verified upload
   // The job's memory budget (already capped by --max-memory-budget-bytes); bounds the reading.
   uint64_t memory_budget_bytes = kDefaultMemoryBudgetBytes;
-  Clock::time_point started;   // the call began
-  Clock::time_point submitted; // the upload was verified and queued
+  Clock::time_point started;    // the call began
+  Clock::time_point submitted;  // the upload was verified and queued
 };
 
 // The RPC function's additions to the log line (on the worker thread).
@@ -61,7 +61,8 @@ class JobRunner {
   // `backend` must outlive the runner. Each job is read with ReadLimits(max_upload_bytes, the
   // job's memory_budget_bytes) (vc/scene/scene_input.h): a decompression bomb or a lying header is
   // refused before it is allocated.
-  JobRunner(const Backend* backend, uint64_t max_upload_bytes) : backend_(backend), max_upload_bytes_(max_upload_bytes) {}
+  JobRunner(const Backend* backend, uint64_t max_upload_bytes)
+      : backend_(backend), max_upload_bytes_(max_upload_bytes) {}
 
   // On a worker thread: reads job.data, runs `fn`, logs the line; the job's status. CANCELLED or
   // DEADLINE_EXCEEDED when `cancel` fired while queued; the reader's and fn's errors as they are;

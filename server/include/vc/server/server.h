@@ -22,8 +22,7 @@ class Server {
  public:
   // Validates `options`, reads the TLS files and starts listening. INVALID_ARGUMENT for bad options,
   // NOT_FOUND for an unreadable TLS file, UNAVAILABLE-like INTERNAL when the address cannot be bound.
-  static Result<std::unique_ptr<Server>> Start(const ServerOptions& options,
-                                               Backend backend = Backend::Default());
+  static Result<std::unique_ptr<Server>> Start(const ServerOptions& options, Backend backend = Backend::Default());
   // Shutdown(0) if not shut down yet.
   ~Server();
   Server(const Server&) = delete;

@@ -50,8 +50,7 @@ class WorkerPool {
   std::optional<Ticket> TryAdmit();
   // Queues `task`; calls on_queued(position) before any worker can start it: 0 when a worker is
   // free to start it now, n when it is n-th in line.
-  void Submit(Ticket ticket, const std::function<void(uint32_t queue_position)>& on_queued,
-              std::function<void()> task);
+  void Submit(Ticket ticket, const std::function<void(uint32_t queue_position)>& on_queued, std::function<void()> task);
 
   int workers() const { return int(threads_.size()); }
   int queue_capacity() const { return queue_capacity_; }

@@ -108,8 +108,7 @@ TEST(LasReaderTest, Las14InconsistentCounts) {
   PutAt<uint32_t>(&las, 107, 1);
   Result<SceneInput> r = ReadScene(las, "p14.las");
   ASSERT_FALSE(r.ok());
-  EXPECT_THAT(r.status().message(),
-              HasSubstr("declares 2 points at byte 247 but a legacy count of 1"));
+  EXPECT_THAT(r.status().message(), HasSubstr("declares 2 points at byte 247 but a legacy count of 1"));
 }
 
 TEST(LasReaderTest, LazCompressedBitIsRefusedWithInstructions) {
@@ -149,8 +148,7 @@ TEST(LasReaderTest, TruncatedPointData) {
   las.resize(las.size() - 30);  // Cuts into the ninth record and removes the tenth.
   Result<SceneInput> r = ReadScene(las, "cut.las");
   ASSERT_FALSE(r.ok());
-  EXPECT_EQ(r.status().message(),
-            "cut.las: LAS header declares 10 points but the body ends after 8; file truncated?");
+  EXPECT_EQ(r.status().message(), "cut.las: LAS header declares 10 points but the body ends after 8; file truncated?");
 }
 
 TEST(LasReaderTest, HugeDeclaredCountFailsWithoutAllocating) {
@@ -160,8 +158,7 @@ TEST(LasReaderTest, HugeDeclaredCountFailsWithoutAllocating) {
   options.max_points = uint64_t{1} << 40;
   Result<SceneInput> r = ReadScene(las, "huge.las", options);
   ASSERT_FALSE(r.ok());
-  EXPECT_THAT(r.status().message(),
-              HasSubstr("declares 4000000000 points but the body ends after 2"));
+  EXPECT_THAT(r.status().message(), HasSubstr("declares 4000000000 points but the body ends after 2"));
   Result<SceneInput> limited = ReadScene(las, "huge.las");
   ASSERT_FALSE(limited.ok());
   EXPECT_EQ(limited.status().code(), StatusCode::kResourceExhausted);

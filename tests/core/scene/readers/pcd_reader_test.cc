@@ -68,17 +68,15 @@ std::string LzfCompress(const std::string& in) {
 
 std::string Header(const std::string& fields, const std::string& size, const std::string& type,
                    const std::string& count, int points, const std::string& data) {
-  return "# .PCD v0.7 - Point Cloud Data file format\nVERSION 0.7\nFIELDS " + fields + "\nSIZE " +
-         size + "\nTYPE " + type + "\nCOUNT " + count + "\nWIDTH " + std::to_string(points) +
-         "\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS " + std::to_string(points) + "\nDATA " +
-         data + "\n";
+  return "# .PCD v0.7 - Point Cloud Data file format\nVERSION 0.7\nFIELDS " + fields + "\nSIZE " + size + "\nTYPE " +
+         type + "\nCOUNT " + count + "\nWIDTH " + std::to_string(points) +
+         "\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS " + std::to_string(points) + "\nDATA " + data + "\n";
 }
 
 TEST(PcdReaderTest, AsciiWithOddFieldOrderAndCounts) {
-  const std::string pcd =
-      Header("normal z hist y x", "4 4 4 8 4", "F F U F F", "3 1 2 1 1", 2, "ascii") +
-      "0 0 1 3 7 8 2 1\n"
-      "0.5 0.5 0.5 -6 1 2 5e-1 4\n";
+  const std::string pcd = Header("normal z hist y x", "4 4 4 8 4", "F F U F F", "3 1 2 1 1", 2, "ascii") +
+                          "0 0 1 3 7 8 2 1\n"
+                          "0.5 0.5 0.5 -6 1 2 5e-1 4\n";
   Result<SceneInput> r = ReadScene(pcd, "a.pcd");
   ASSERT_TRUE(r.ok()) << r.status().ToString();
   EXPECT_EQ(r->format, InputFormat::kPcd);
@@ -89,8 +87,7 @@ TEST(PcdReaderTest, AsciiWithOddFieldOrderAndCounts) {
 }
 
 TEST(PcdReaderTest, AsciiNanPointsAreDropped) {
-  const std::string pcd =
-      Header("x y z", "4 4 4", "F F F", "1 1 1", 3, "ascii") + "nan nan nan\n1 2 3\n4 inf 6\n";
+  const std::string pcd = Header("x y z", "4 4 4", "F F F", "1 1 1", 3, "ascii") + "nan nan nan\n1 2 3\n4 inf 6\n";
   Result<SceneInput> r = ReadScene(pcd, "nan.pcd");
   ASSERT_TRUE(r.ok()) << r.status().ToString();
   ASSERT_EQ(r->points.size(), 1u);
@@ -139,8 +136,7 @@ TEST(PcdReaderTest, BinaryCompressedStoresFieldsOneAfterAnother) {
   std::vector<Eigen::Vector3d> pts;
   for (int i = 0; i < 500; ++i) pts.emplace_back(i * 0.5, i % 7, -0.25 * (i % 11));
   const std::string pcd =
-      Header(kMixedFields, "4 8 2 4 4", "U F I F I", "1 1 3 1 1", 500, "binary_compressed") +
-      CompressedMixed(pts);
+      Header(kMixedFields, "4 8 2 4 4", "U F I F I", "1 1 3 1 1", 500, "binary_compressed") + CompressedMixed(pts);
   Result<SceneInput> r = ReadScene(pcd, "c.pcd");
   ASSERT_TRUE(r.ok()) << r.status().ToString();
   EXPECT_EQ(r->detail, "binary_compressed");
@@ -170,8 +166,7 @@ TEST(PcdReaderTest, TruncatedAsciiBody) {
 TEST(PcdReaderTest, TruncatedCompressedBlock) {
   std::vector<Eigen::Vector3d> pts(10, Eigen::Vector3d(1, 2, 3));
   std::string pcd =
-      Header(kMixedFields, "4 8 2 4 4", "U F I F I", "1 1 3 1 1", 10, "binary_compressed") +
-      CompressedMixed(pts);
+      Header(kMixedFields, "4 8 2 4 4", "U F I F I", "1 1 3 1 1", 10, "binary_compressed") + CompressedMixed(pts);
   pcd.pop_back();
   Result<SceneInput> r = ReadScene(pcd, "cut.pcd");
   ASSERT_FALSE(r.ok());
@@ -181,12 +176,10 @@ TEST(PcdReaderTest, TruncatedCompressedBlock) {
 TEST(PcdReaderTest, CompressedSizeDisagreesWithHeader) {
   std::vector<Eigen::Vector3d> pts(10, Eigen::Vector3d(1, 2, 3));
   const std::string pcd =
-      Header(kMixedFields, "4 8 2 4 4", "U F I F I", "1 1 3 1 1", 11, "binary_compressed") +
-      CompressedMixed(pts);
+      Header(kMixedFields, "4 8 2 4 4", "U F I F I", "1 1 3 1 1", 11, "binary_compressed") + CompressedMixed(pts);
   Result<SceneInput> r = ReadScene(pcd, "m.pcd");
   ASSERT_FALSE(r.ok());
-  EXPECT_THAT(r.status().message(),
-              HasSubstr("declares 11 points of 26 bytes but the compressed block at byte"));
+  EXPECT_THAT(r.status().message(), HasSubstr("declares 11 points of 26 bytes but the compressed block at byte"));
 }
 
 TEST(PcdReaderTest, CorruptLzfBackReference) {
@@ -212,8 +205,7 @@ TEST(PcdReaderTest, ImplausibleUncompressedSizeIsRejectedBeforeAllocating) {
   Result<SceneInput> r = ReadScene(pcd, "bomb.pcd", options);
   ASSERT_FALSE(r.ok());
   EXPECT_EQ(r.status().code(), StatusCode::kInvalidArgument);
-  EXPECT_THAT(r.status().message(),
-              HasSubstr("cannot decompress to the declared 3600000000 bytes"));
+  EXPECT_THAT(r.status().message(), HasSubstr("cannot decompress to the declared 3600000000 bytes"));
 }
 
 TEST(PcdReaderTest, HeaderErrors) {
@@ -224,29 +216,23 @@ TEST(PcdReaderTest, HeaderErrors) {
   const Case cases[] = {
       {Header("x y z", "4 4 4", "F F Q", "1 1 1", 1, "ascii") + "1 2 3\n",
        "line 5: unknown PCD TYPE \"Q\" for field \"z\""},
-      {Header("x y z", "4 4 3", "F F F", "1 1 1", 1, "ascii") + "1 2 3\n",
-       "invalid SIZE \"3\" for field \"z\""},
-      {Header("x y z", "4 4", "F F F", "1 1 1", 1, "ascii") + "1 2 3\n",
-       "SIZE lists 2 entries but FIELDS lists 3"},
-      {Header("x y intensity", "4 4 4", "F F F", "1 1 1", 1, "ascii") + "1 2 3\n",
-       "no field \"z\""},
+      {Header("x y z", "4 4 3", "F F F", "1 1 1", 1, "ascii") + "1 2 3\n", "invalid SIZE \"3\" for field \"z\""},
+      {Header("x y z", "4 4", "F F F", "1 1 1", 1, "ascii") + "1 2 3\n", "SIZE lists 2 entries but FIELDS lists 3"},
+      {Header("x y intensity", "4 4 4", "F F F", "1 1 1", 1, "ascii") + "1 2 3\n", "no field \"z\""},
       {Header("x y z", "4 4 4", "F F F", "1 1 1", 1, "binary_lzma") + "1 2 3\n",
        "unknown PCD DATA type \"binary_lzma\""},
       {Header("x y z", "4 4 4", "F F F", "1 1 1", 0, "ascii"), "declares 0 points"},
-      {"VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nWIDTH 2\nPOINTS 2\n",
-       "no \"DATA\" line"},
+      {"VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nWIDTH 2\nPOINTS 2\n", "no \"DATA\" line"},
       {"VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nWIDTH 2\nHEIGHT 2\nPOINTS 3\nDATA "
        "ascii\n",
        "declares POINTS 3 but WIDTH * HEIGHT = 2 * 2 = 4"},
       {"VERSION 0.9\nFIELDS x y z\n", "unsupported PCD version"},
       {"VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nWIDTH -1\nDATA ascii\n",
        "expected \"WIDTH <non-negative integer>\""},
-      {"VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOLOR red\n",
-       "unknown PCD header keyword \"COLOR\""},
+      {"VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOLOR red\n", "unknown PCD header keyword \"COLOR\""},
       {Header("x y z", "4 4 4", "F F F", "1 1 1", 1, "ascii") + "1 2\n",
        "line 12: expected 3 values per point (FIELDS times COUNT), found 2"},
-      {Header("x y z", "4 4 4", "F F F", "1 1 1", 1, "ascii") + "1 2 3\n4 5 6\n",
-       "line 13: unexpected data"},
+      {Header("x y z", "4 4 4", "F F F", "1 1 1", 1, "ascii") + "1 2 3\n4 5 6\n", "line 13: unexpected data"},
       {Header("x y z", "4 4 4", "F F F", "1 1 1", 1, "ascii") + "1 b 3\n",
        "expected a number for field \"y\", found \"b\""},
   };
@@ -275,8 +261,7 @@ TEST(PcdReaderTest, EveryTruncationOfACompressedFileFailsCleanly) {
   std::vector<Eigen::Vector3d> pts;
   for (int i = 0; i < 20; ++i) pts.emplace_back(i, 2 * i, 3 * i);
   const std::string pcd =
-      Header(kMixedFields, "4 8 2 4 4", "U F I F I", "1 1 3 1 1", 20, "binary_compressed") +
-      CompressedMixed(pts);
+      Header(kMixedFields, "4 8 2 4 4", "U F I F I", "1 1 3 1 1", 20, "binary_compressed") + CompressedMixed(pts);
   ASSERT_TRUE(ReadScene(pcd, "full.pcd").ok());
   const size_t body = pcd.find("DATA binary_compressed\n") + 23;
   for (size_t n = body; n < pcd.size(); ++n) {

@@ -75,15 +75,14 @@ TEST(PlyReaderTest, AsciiCrLfLineEndings) {
 // Header for a binary vertex element; `props` are "type name" pairs, then optional extra lines.
 std::string BinaryHeader(const std::string& format, int vertices, const std::string& props,
                          const std::string& extra = "") {
-  return "ply\nformat " + format + " 1.0\nelement vertex " + std::to_string(vertices) + "\n" +
-         props + extra + "end_header\n";
+  return "ply\nformat " + format + " 1.0\nelement vertex " + std::to_string(vertices) + "\n" + props + extra +
+         "end_header\n";
 }
 
 void TestBinaryFloat(bool big) {
-  std::string ply = BinaryHeader(
-      big ? "binary_big_endian" : "binary_little_endian", 2,
-      "property float x\nproperty float y\nproperty float z\nproperty uchar red\n",
-      "element face 2\nproperty list uchar int vertex_indices\nproperty ushort flags\n");
+  std::string ply = BinaryHeader(big ? "binary_big_endian" : "binary_little_endian", 2,
+                                 "property float x\nproperty float y\nproperty float z\nproperty uchar red\n",
+                                 "element face 2\nproperty list uchar int vertex_indices\nproperty ushort flags\n");
   const float v[2][3] = {{1.5f, -2.25f, 3.0f}, {100.0f, 200.5f, -300.0f}};
   for (const auto& p : v) {
     for (float c : p) Put(&ply, c, big);
@@ -107,8 +106,7 @@ TEST(PlyReaderTest, BinaryLittleEndianWithFaces) { TestBinaryFloat(false); }
 TEST(PlyReaderTest, BinaryBigEndianWithFaces) { TestBinaryFloat(true); }
 
 TEST(PlyReaderTest, BinaryDoubleCoordinates) {
-  std::string ply = BinaryHeader("binary_big_endian", 1,
-                                 "property double z\nproperty float64 y\nproperty double x\n");
+  std::string ply = BinaryHeader("binary_big_endian", 1, "property double z\nproperty float64 y\nproperty double x\n");
   Put<double>(&ply, 3.5, true);
   Put<double>(&ply, -2.0, true);
   Put<double>(&ply, 1e6, true);
@@ -119,15 +117,13 @@ TEST(PlyReaderTest, BinaryDoubleCoordinates) {
 }
 
 TEST(PlyReaderTest, BinaryIntegerCoordinatesOfEveryType) {
-  const char* types[][3] = {{"char", "uchar", "short"},
-                            {"ushort", "int", "uint"},
-                            {"int8", "uint8", "int16"},
-                            {"uint16", "int32", "uint32"}};
+  const char* types[][3] = {
+      {"char", "uchar", "short"}, {"ushort", "int", "uint"}, {"int8", "uint8", "int16"}, {"uint16", "int32", "uint32"}};
   for (const auto& t : types) {
     SCOPED_TRACE(std::string(t[0]) + " " + t[1] + " " + t[2]);
-    std::string ply = BinaryHeader(
-        "binary_little_endian", 1,
-        std::string("property ") + t[0] + " x\nproperty " + t[1] + " y\nproperty " + t[2] + " z\n");
+    std::string ply =
+        BinaryHeader("binary_little_endian", 1,
+                     std::string("property ") + t[0] + " x\nproperty " + t[1] + " y\nproperty " + t[2] + " z\n");
     auto put = [&](const char* type, int value) {
       const std::string n = type;
       if (n == "char" || n == "int8") Put<int8_t>(&ply, static_cast<int8_t>(value));
@@ -172,8 +168,7 @@ TEST(PlyReaderTest, SkipsElementsWithListsBeforeTheVertices) {
 }
 
 TEST(PlyReaderTest, NonFinitePointsAreDroppedAndCounted) {
-  std::string ply = BinaryHeader("binary_little_endian", 4,
-                                 "property float x\nproperty float y\nproperty double z\n");
+  std::string ply = BinaryHeader("binary_little_endian", 4, "property float x\nproperty float y\nproperty double z\n");
   const double values[4][3] = {{1, 2, 3}, {kNaN, 0, 0}, {0, kInf, 0}, {0, 0, 1e300}};
   for (const auto& p : values) {
     Put<float>(&ply, static_cast<float>(p[0]));
@@ -198,8 +193,7 @@ TEST(PlyReaderTest, AsciiNanIsDroppedAndCounted) {
 }
 
 TEST(PlyReaderTest, AllPointsNonFiniteIsAnEmptyCloud) {
-  std::string ply = BinaryHeader("binary_little_endian", 1,
-                                 "property float x\nproperty float y\nproperty float z\n");
+  std::string ply = BinaryHeader("binary_little_endian", 1, "property float x\nproperty float y\nproperty float z\n");
   for (int i = 0; i < 3; ++i) Put<float>(&ply, kNaN);
   Result<SceneInput> r = ReadScene(ply, "allnan.ply");
   ASSERT_FALSE(r.ok());
@@ -208,8 +202,8 @@ TEST(PlyReaderTest, AllPointsNonFiniteIsAnEmptyCloud) {
 }
 
 TEST(PlyReaderTest, TruncatedBinaryBodyNamesDeclaredAndPresentCounts) {
-  std::string ply = BinaryHeader("binary_little_endian", 1000,
-                                 "property float x\nproperty float y\nproperty float z\n");
+  std::string ply =
+      BinaryHeader("binary_little_endian", 1000, "property float x\nproperty float y\nproperty float z\n");
   for (int i = 0; i < 312 * 3; ++i) Put<float>(&ply, 1.0f);
   ply += "xy";  // A partial vertex.
   Result<SceneInput> r = ReadScene(ply, "cut.ply");
@@ -226,13 +220,11 @@ TEST(PlyReaderTest, TruncatedAsciiBody) {
       "property float z\nend_header\n1 2 3\n4 5 6\n";
   Result<SceneInput> r = ReadScene(ply, "cut.ply");
   ASSERT_FALSE(r.ok());
-  EXPECT_THAT(r.status().message(),
-              HasSubstr("PLY header declares 5 vertices but the body ends after 2"));
+  EXPECT_THAT(r.status().message(), HasSubstr("PLY header declares 5 vertices but the body ends after 2"));
 }
 
 TEST(PlyReaderTest, TruncatedFaceList) {
-  std::string ply = BinaryHeader("binary_little_endian", 1,
-                                 "property float x\nproperty float y\nproperty float z\n",
+  std::string ply = BinaryHeader("binary_little_endian", 1, "property float x\nproperty float y\nproperty float z\n",
                                  "element face 1\nproperty list uchar int vertex_indices\n");
   for (int i = 0; i < 3; ++i) Put<float>(&ply, 1.0f);
   Put<uint8_t>(&ply, 3);
@@ -245,8 +237,7 @@ TEST(PlyReaderTest, TruncatedFaceList) {
 }
 
 TEST(PlyReaderTest, HugeDeclaredCountFailsWithoutAllocating) {
-  std::string ply = BinaryHeader("binary_little_endian", 0,
-                                 "property float x\nproperty float y\nproperty float z\n");
+  std::string ply = BinaryHeader("binary_little_endian", 0, "property float x\nproperty float y\nproperty float z\n");
   ply.replace(ply.find("vertex 0"), 8, "vertex 1000000000000");
   for (int i = 0; i < 3; ++i) Put<float>(&ply, 1.0f);
   // Above the default max_points: a limit error.
@@ -259,21 +250,18 @@ TEST(PlyReaderTest, HugeDeclaredCountFailsWithoutAllocating) {
   Result<SceneInput> r = ReadScene(ply, "huge.ply", options);
   ASSERT_FALSE(r.ok());
   EXPECT_EQ(r.status().code(), StatusCode::kInvalidArgument);
-  EXPECT_THAT(r.status().message(),
-              HasSubstr("declares 1000000000000 vertices but the body ends after 1;"));
+  EXPECT_THAT(r.status().message(), HasSubstr("declares 1000000000000 vertices but the body ends after 1;"));
   // Same for ascii.
   std::string ascii = ply.substr(0, ply.find("end_header\n") + 11);
   ascii.replace(ascii.find("binary_little_endian"), 20, "ascii");
   ascii += "1 2 3\n";
   Result<SceneInput> a = ReadScene(ascii, "huge.ply", options);
   ASSERT_FALSE(a.ok());
-  EXPECT_THAT(a.status().message(),
-              HasSubstr("declares 1000000000000 vertices but the body ends after 1;"));
+  EXPECT_THAT(a.status().message(), HasSubstr("declares 1000000000000 vertices but the body ends after 1;"));
 }
 
 TEST(PlyReaderTest, ExtraBinaryBytesAreAHeaderBodyMismatch) {
-  std::string ply = BinaryHeader("binary_little_endian", 1,
-                                 "property float x\nproperty float y\nproperty float z\n");
+  std::string ply = BinaryHeader("binary_little_endian", 1, "property float x\nproperty float y\nproperty float z\n");
   for (int i = 0; i < 6; ++i) Put<float>(&ply, 1.0f);
   Result<SceneInput> r = ReadScene(ply, "long.ply");
   ASSERT_FALSE(r.ok());
@@ -305,8 +293,7 @@ TEST(PlyReaderTest, AsciiBadNumberNamesLineAndToken) {
       "property float z\nend_header\n1 two 3\n";
   Result<SceneInput> r = ReadScene(ply, "bad.ply");
   ASSERT_FALSE(r.ok());
-  EXPECT_EQ(r.status().message(),
-            "bad.ply: line 8: expected a number for vertex property \"y\", found \"two\"");
+  EXPECT_EQ(r.status().message(), "bad.ply: line 8: expected a number for vertex property \"y\", found \"two\"");
 }
 
 TEST(PlyReaderTest, UnknownPropertyType) {
@@ -336,8 +323,7 @@ TEST(PlyReaderTest, HeaderErrors) {
        "2\n",
        "no \"z\" property"},
       {"ply\nformat ascii 1.0\nelement vertex 0\n" + props + "end_header\n", "declares 0 vertices"},
-      {"ply\nformat ascii 1.0\nelement vertex many\n" + props + "end_header\n",
-       "expected \"element <name> <count>\""},
+      {"ply\nformat ascii 1.0\nelement vertex many\n" + props + "end_header\n", "expected \"element <name> <count>\""},
       {"ply\nformat ascii 1.0\nproperty float x\nend_header\n", "before any \"element\" line"},
       {"ply\nformat ascii 1.0\nelement vertex 1\nproperty list float int x\nend_header\n",
        "list count type must be an integer type"},
@@ -354,9 +340,8 @@ TEST(PlyReaderTest, HeaderErrors) {
 }
 
 TEST(PlyReaderTest, EveryTruncationOfABinaryFileFailsCleanly) {
-  std::string ply =
-      BinaryHeader("binary_big_endian", 3, "property double x\nproperty float y\nproperty int z\n",
-                   "element face 2\nproperty list uchar uint vertex_indices\n");
+  std::string ply = BinaryHeader("binary_big_endian", 3, "property double x\nproperty float y\nproperty int z\n",
+                                 "element face 2\nproperty list uchar uint vertex_indices\n");
   for (int i = 0; i < 3; ++i) {
     Put<double>(&ply, i, true);
     Put<float>(&ply, 1, true);

@@ -59,15 +59,13 @@ TEST(XyzReaderTest, NonNumericValueNamesLineAndColumn) {
   Result<SceneInput> r = ReadScene("x y z\n1 2 3\n4 five 6\n", "bad.xyz");
   ASSERT_FALSE(r.ok());
   EXPECT_EQ(r.status().code(), StatusCode::kInvalidArgument);
-  EXPECT_EQ(r.status().message(),
-            "bad.xyz: line 3: expected a number for y (column 2), found \"five\"");
+  EXPECT_EQ(r.status().message(), "bad.xyz: line 3: expected a number for y (column 2), found \"five\"");
 }
 
 TEST(XyzReaderTest, TooFewColumns) {
   Result<SceneInput> r = ReadScene("1 2 3\n4 5\n", "few.xyz");
   ASSERT_FALSE(r.ok());
-  EXPECT_EQ(r.status().message(),
-            "few.xyz: line 2: expected at least 3 columns (x y z), found 2 in \"4 5\"");
+  EXPECT_EQ(r.status().message(), "few.xyz: line 2: expected at least 3 columns (x y z), found 2 in \"4 5\"");
 }
 
 TEST(XyzReaderTest, EmptyCsvFieldIsAnError) {

@@ -47,9 +47,8 @@ enum class Stage : uint8_t {
   kReduction,   // remove redundant stations (the reduction matrix)
   kEvaluation,  // V of every face from the final stations, and G
 };
-inline constexpr Stage kAllStages[] = {Stage::kRead,       Stage::kVoxelize,  Stage::kCandidates,
-                                       Stage::kVisibility, Stage::kSelection, Stage::kRefine,
-                                       Stage::kReduction,  Stage::kEvaluation};
+inline constexpr Stage kAllStages[] = {Stage::kRead,      Stage::kVoxelize, Stage::kCandidates, Stage::kVisibility,
+                                       Stage::kSelection, Stage::kRefine,   Stage::kReduction,  Stage::kEvaluation};
 // "read", "voxelize", "candidates", "visibility", "selection", "refine", "reduction", "evaluation";
 // "unspecified" for kUnspecified.
 std::string_view StageName(Stage stage);
@@ -68,9 +67,7 @@ struct JobContext {
   const CancelToken* cancel = nullptr;
   ProgressFn progress;
 
-  Status CheckCancelled(const char* what) const {
-    return cancel ? cancel->Check(what) : Status::Ok();
-  }
+  Status CheckCancelled(const char* what) const { return cancel ? cancel->Check(what) : Status::Ok(); }
   void Report(Stage stage, double fraction, std::string message = {}) const {
     if (progress) progress(ProgressEvent{stage, fraction, std::move(message)});
   }

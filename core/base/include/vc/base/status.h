@@ -56,9 +56,7 @@ class [[nodiscard]] Status {
   // Returns a copy whose message is prefixed with `context` and ": ".
   Status WithContext(std::string_view context) const;
 
-  friend bool operator==(const Status& a, const Status& b) {
-    return a.code_ == b.code_ && a.message_ == b.message_;
-  }
+  friend bool operator==(const Status& a, const Status& b) { return a.code_ == b.code_ && a.message_ == b.message_; }
 
  private:
   StatusCode code_ = StatusCode::kOk;
@@ -82,7 +80,7 @@ inline Status UnauthenticatedError(std::string m) { return {StatusCode::kUnauthe
 template <typename T>
 class [[nodiscard]] Result {
  public:
-  Result(T value) : v_(std::move(value)) {}  // NOLINT(google-explicit-constructor)
+  Result(T value) : v_(std::move(value)) {}        // NOLINT(google-explicit-constructor)
   Result(Status status) : v_(std::move(status)) {  // NOLINT(google-explicit-constructor)
     assert(!std::get<Status>(v_).ok() && "Result constructed from an OK status");
   }
@@ -127,15 +125,14 @@ auto CatchOutOfMemory(std::string_view what, F&& fn) -> decltype(fn()) {
 #define VC_INTERNAL_CONCAT(a, b) VC_INTERNAL_CONCAT2(a, b)
 
 // Returns the status from the enclosing function if `expr` (a Status) is not OK.
-#define VC_RETURN_IF_ERROR(expr)                  \
-  do {                                            \
-    ::vc::Status vc_status_ = (expr);             \
-    if (!vc_status_.ok()) return vc_status_;      \
+#define VC_RETURN_IF_ERROR(expr)             \
+  do {                                       \
+    ::vc::Status vc_status_ = (expr);        \
+    if (!vc_status_.ok()) return vc_status_; \
   } while (false)
 
 // `lhs = *expr` if `expr` (a Result<T>) holds a value, else returns its status.
-#define VC_ASSIGN_OR_RETURN(lhs, expr) \
-  VC_INTERNAL_ASSIGN_OR_RETURN(VC_INTERNAL_CONCAT(vc_result_, __LINE__), lhs, expr)
+#define VC_ASSIGN_OR_RETURN(lhs, expr) VC_INTERNAL_ASSIGN_OR_RETURN(VC_INTERNAL_CONCAT(vc_result_, __LINE__), lhs, expr)
 #define VC_INTERNAL_ASSIGN_OR_RETURN(tmp, lhs, expr) \
   auto tmp = (expr);                                 \
   if (!tmp.ok()) return tmp.status();                \

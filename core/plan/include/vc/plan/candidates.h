@@ -6,12 +6,11 @@
 // least a quarter of the strongest level's columns and lies at least tripod height + clearance
 // from a stronger one, so desks and shelves under a floor's ceiling do not count). A level whose
 // surfaces are mostly roofs — nothing occupied above them, another occupied run below them in the
-// same column (the outside of a ceiling) — is dropped; an open room's floor (nothing below) stays. Candidates: for each level and each cell of a grid over the occupied
-// footprint, the standing surface within +-0.15 m of that level closest to it under the cell
-// centre (in the 3 x 3 voxel columns around it) is the cell's floor (uneven floors and ramps); the candidate stands at its top +
-// tripod height, and is kept if the voxels within the clearance radius are all free. So every
-// storey of a multi-level scene gets its own candidates, each with floor below it. Internal to
-// vc_core.
+// same column (the outside of a ceiling) — is dropped; an open room's floor (nothing below) stays. Candidates: for each
+// level and each cell of a grid over the occupied footprint, the standing surface within +-0.15 m of that level closest
+// to it under the cell centre (in the 3 x 3 voxel columns around it) is the cell's floor (uneven floors and ramps); the
+// candidate stands at its top + tripod height, and is kept if the voxels within the clearance radius are all free. So
+// every storey of a multi-level scene gets its own candidates, each with floor below it. Internal to vc_core.
 #pragma once
 
 #include <cstdint>

@@ -16,15 +16,15 @@
 #include "vc/visibility/visibility.h"
 
 // X(type, name, default, unit, flag, check, help).
-#define VC_EVALUATE_PARAMETERS(X)                                                                    \
-  X(double, resolution_m, 0.0, "m", "resolution", kNonNegative,                                      \
-    "working resolution (0 = the octree's own, or 0.1 m for clouds)")                                \
-  X(uint64_t, memory_budget_bytes, ::vc::kDefaultMemoryBudgetBytes, "bytes", "memory-budget-bytes",  \
-    kPositive, "memory budget of the job (capped by the server's --max-memory-budget-bytes)")        \
-  X(::vc::FaceSet, faces, ::vc::FaceSet::kAll, "", "faces", kAny, "faces counted in F: all or exposed") \
-  X(uint64_t, sample_faces, 0, "faces", "sample", kAny,                                              \
-    "evaluate a uniform random sample of this many faces, with a 95 % interval (0 = every face)")   \
-  X(uint64_t, seed, 1, "", "seed", kAny, "sampling seed")                                            \
+#define VC_EVALUATE_PARAMETERS(X)                                                                              \
+  X(double, resolution_m, 0.0, "m", "resolution", kNonNegative,                                                \
+    "working resolution (0 = the octree's own, or 0.1 m for clouds)")                                          \
+  X(uint64_t, memory_budget_bytes, ::vc::kDefaultMemoryBudgetBytes, "bytes", "memory-budget-bytes", kPositive, \
+    "memory budget of the job (capped by the server's --max-memory-budget-bytes)")                             \
+  X(::vc::FaceSet, faces, ::vc::FaceSet::kAll, "", "faces", kAny, "faces counted in F: all or exposed")        \
+  X(uint64_t, sample_faces, 0, "faces", "sample", kAny,                                                        \
+    "evaluate a uniform random sample of this many faces, with a 95 % interval (0 = every face)")              \
+  X(uint64_t, seed, 1, "", "seed", kAny, "sampling seed")                                                      \
   X(int32_t, threads, 0, "threads", "threads", kNonNegative, "threads for the job (0 = all, or the server's share)")
 
 namespace vc {

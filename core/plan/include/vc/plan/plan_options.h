@@ -20,29 +20,27 @@
 // - refine: proximity refinement (ALGORITHM.md s.7.4), each station to the best of a sub-grid.
 // - reduce / reduce_to: reduction (s.7.5) removes zero-loss stations; with reduce_to > 0 it keeps
 //   removing the cheapest single or pair until at most reduce_to stations remain.
-#define VC_PLAN_PARAMETERS(X)                                                                              \
-  X(double, resolution_m, 0.0, "m", "resolution", kNonNegative,                                            \
-    "working resolution (0 = the octree's own, or 0.1 m for clouds)")                                      \
-  X(uint64_t, memory_budget_bytes, ::vc::kDefaultMemoryBudgetBytes, "bytes", "memory-budget-bytes",        \
-    kPositive, "memory budget of the job (capped by the server's --max-memory-budget-bytes)")              \
-  X(::vc::SelectionTest, selection_test, ::vc::SelectionTest::kSurfaceVisibility, "", "test", kAny,        \
-    "selection test: surface or compatibility")                                                            \
-  X(double, grid_spacing_m, 1.0, "m", "grid-spacing", kPositive, "candidate grid spacing")                \
-  X(double, tripod_height_m, 1.5, "m", "tripod-height", kPositive, "scanner height above the floor")       \
-  X(double, clearance_m, 0.2, "m", "clearance", kNonNegative, "free space required around a candidate")   \
-  X(int32_t, max_stations, 0, "stations", "max-stations", kNonNegative,                                    \
-    "at most this many stations (0 = no limit)")                                                           \
-  X(uint64_t, min_marginal_gain_voxels, 1, "voxels", "min-gain", kAny,                                     \
-    "stop when the best station adds fewer voxels")                                                        \
-  X(double, target_coverage, 0.99, "fraction", "target-coverage", kFraction,                               \
-    "stop at this covered fraction of the coverable voxels")                                               \
-  X(bool, consolidate, true, "", "consolidate", kAny, "drop covered picks and merge pairs after greedy")   \
-  X(bool, refine, false, "", "refine", kAny, "refine each station on a local sub-grid")                    \
-  X(double, refine_radius_m, 0.5, "m", "refine-radius", kPositive, "refinement radius")                   \
-  X(double, refine_step_m, 0.25, "m", "refine-step", kPositive, "refinement step")                         \
-  X(bool, reduce, true, "", "reduce", kAny, "remove redundant stations")                                   \
-  X(int32_t, reduce_to, 0, "stations", "reduce-to", kNonNegative,                                          \
-    "reduce to at most this many stations (0 = zero-loss removals only)")                                  \
+#define VC_PLAN_PARAMETERS(X)                                                                                          \
+  X(double, resolution_m, 0.0, "m", "resolution", kNonNegative,                                                        \
+    "working resolution (0 = the octree's own, or 0.1 m for clouds)")                                                  \
+  X(uint64_t, memory_budget_bytes, ::vc::kDefaultMemoryBudgetBytes, "bytes", "memory-budget-bytes", kPositive,         \
+    "memory budget of the job (capped by the server's --max-memory-budget-bytes)")                                     \
+  X(::vc::SelectionTest, selection_test, ::vc::SelectionTest::kSurfaceVisibility, "", "test", kAny,                    \
+    "selection test: surface or compatibility")                                                                        \
+  X(double, grid_spacing_m, 1.0, "m", "grid-spacing", kPositive, "candidate grid spacing")                             \
+  X(double, tripod_height_m, 1.5, "m", "tripod-height", kPositive, "scanner height above the floor")                   \
+  X(double, clearance_m, 0.2, "m", "clearance", kNonNegative, "free space required around a candidate")                \
+  X(int32_t, max_stations, 0, "stations", "max-stations", kNonNegative, "at most this many stations (0 = no limit)")   \
+  X(uint64_t, min_marginal_gain_voxels, 1, "voxels", "min-gain", kAny, "stop when the best station adds fewer voxels") \
+  X(double, target_coverage, 0.99, "fraction", "target-coverage", kFraction,                                           \
+    "stop at this covered fraction of the coverable voxels")                                                           \
+  X(bool, consolidate, true, "", "consolidate", kAny, "drop covered picks and merge pairs after greedy")               \
+  X(bool, refine, false, "", "refine", kAny, "refine each station on a local sub-grid")                                \
+  X(double, refine_radius_m, 0.5, "m", "refine-radius", kPositive, "refinement radius")                                \
+  X(double, refine_step_m, 0.25, "m", "refine-step", kPositive, "refinement step")                                     \
+  X(bool, reduce, true, "", "reduce", kAny, "remove redundant stations")                                               \
+  X(int32_t, reduce_to, 0, "stations", "reduce-to", kNonNegative,                                                      \
+    "reduce to at most this many stations (0 = zero-loss removals only)")                                              \
   X(int32_t, threads, 0, "threads", "threads", kNonNegative, "threads for the job (0 = all, or the server's share)")
 
 namespace vc {

@@ -16,19 +16,18 @@
 #include "vc/plan/plan_options.h"
 #include "vc/plan/selector.h"
 #include "vc/plan/stage_runner.h"
-#include "vc/visibility/visibility.h"
 #include "vc/scene/voxel_scene.h"
+#include "vc/visibility/visibility.h"
 
 namespace vc {
 
-
 struct PlannedStation {
   WorldPoint position;
-  uint64_t visible_voxels = 0;      // voxels passing the selection test from here
-  uint64_t marginal_gain = 0;       // new voxels when picked (greedy order)
-  double cumulative_coverage = 0;   // covered / coverable after this pick
-  double global_visibility = 0;     // G of this station alone
-  int candidate_index = -1;         // index into PlanResult::candidates, or -1 if refined off-grid
+  uint64_t visible_voxels = 0;     // voxels passing the selection test from here
+  uint64_t marginal_gain = 0;      // new voxels when picked (greedy order)
+  double cumulative_coverage = 0;  // covered / coverable after this pick
+  double global_visibility = 0;    // G of this station alone
+  int candidate_index = -1;        // index into PlanResult::candidates, or -1 if refined off-grid
 };
 
 struct HeatMap {
@@ -54,7 +53,7 @@ struct PlanResult {
   PlanOptions options;
   double resolution_m = 0;
   SelectionTest selection_test = SelectionTest::kSurfaceVisibility;  // the test that ran
-  std::vector<PlannedStation> stations;  // final stations, in greedy order
+  std::vector<PlannedStation> stations;                              // final stations, in greedy order
   HeatMap heat_map;
   Reduction reduction;
   uint64_t candidate_count = 0;
@@ -66,7 +65,7 @@ struct PlanResult {
   uint64_t occupied_voxels = 0;
   uint64_t coverable_voxels = 0;
   uint64_t covered_voxels = 0;
-  Evaluation evaluation;  // of the final stations at the working resolution (with face values)
+  Evaluation evaluation;             // of the final stations at the working resolution (with face values)
   std::vector<StageTiming> timings;  // the stages that ran, in order
   double total_seconds = 0;          // the whole plan, from validation to the evaluation
   std::vector<std::string> warnings;

@@ -32,16 +32,16 @@ struct FaceTop3 {
 void InsertTop3(FaceTop3& t, float value, int32_t station);
 
 struct ReductionMatrix {
-  int size = 0;                // stations, indexed 0..size-1 (inactive ones have zero rows)
-  std::vector<double> loss;    // size x size, row-major: [i][i] = loss{i}, [i][j] = loss{i,j}
+  int size = 0;                  // stations, indexed 0..size-1 (inactive ones have zero rows)
+  std::vector<double> loss;      // size x size, row-major: [i][i] = loss{i}, [i][j] = loss{i,j}
   double global_visibility = 0;  // G(P) of the active stations
   double at(int i, int j) const { return loss[static_cast<size_t>(i) * size + j]; }
 };
 
 // The matrix from a top-3 table over |F| = faces_total faces (top3.size() <= faces_total; faces
 // not in the table are seen by nobody). Deterministic for any thread count.
-ReductionMatrix ComputeReductionMatrix(const std::vector<FaceTop3>& top3, int num_stations,
-                                       uint64_t faces_total, int threads = 0);
+ReductionMatrix ComputeReductionMatrix(const std::vector<FaceTop3>& top3, int num_stations, uint64_t faces_total,
+                                       int threads = 0);
 
 // What to remove next among `active` (station indices, ascending): the default rule removes only
 // zero-loss stations (a zero-loss pair beats a zero-loss single; among equals, the latest in
@@ -54,8 +54,8 @@ std::vector<int> ChooseRemoval(const ReductionMatrix& m, const std::vector<int>&
 using StationFaceValuesFn = std::function<Result<std::vector<float>>(int station, const JobContext& ctx)>;
 
 struct ReductionRunOptions {
-  int reduce_to = 0;     // 0 = zero-loss rule only
-  bool remove = true;    // false: only compute the matrix
+  int reduce_to = 0;   // 0 = zero-loss rule only
+  bool remove = true;  // false: only compute the matrix
   // Keep every station's face values in memory (for exact top-3 refills after a removal) when
   // they fit in this many bytes; otherwise the values are recomputed after each removal.
   uint64_t cache_budget_bytes = uint64_t{1} << 30;
@@ -63,8 +63,8 @@ struct ReductionRunOptions {
 };
 
 struct ReductionRun {
-  ReductionMatrix initial;       // the matrix of all stations (Fig. 12)
-  std::vector<int> removed;      // station indices, in removal order
+  ReductionMatrix initial;   // the matrix of all stations (Fig. 12)
+  std::vector<int> removed;  // station indices, in removal order
   // Each removal step: the stations removed together and the G it lost.
   struct Step {
     std::vector<int> stations;

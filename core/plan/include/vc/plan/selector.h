@@ -19,10 +19,10 @@ namespace vc {
 
 // Why station selection stopped.
 enum class StopReason : uint8_t {
-  kExhausted,       // every coverable voxel is covered (or nothing was coverable)
-  kTargetReached,   // target_coverage reached
-  kMaxStations,     // max_stations picks made
-  kMinGain,         // best marginal gain below min_marginal_gain
+  kExhausted,      // every coverable voxel is covered (or nothing was coverable)
+  kTargetReached,  // target_coverage reached
+  kMaxStations,    // max_stations picks made
+  kMinGain,        // best marginal gain below min_marginal_gain
 };
 // "exhausted", "target_reached", "max_stations", "min_gain".
 std::string_view StopReasonName(StopReason reason);
@@ -33,12 +33,12 @@ namespace vc::planner {
 
 // What a selector chose over one vector of visibility sets.
 struct Selection {
-  std::vector<int> picks;               // candidate indices (into the sets), in pick order
+  std::vector<int> picks;                    // candidate indices (into the sets), in pick order
   StopReason stop = StopReason::kExhausted;  // why the first pass stopped
-  uint64_t coverable = 0;               // |union of all sets|, in voxels
-  uint64_t covered = 0;                 // voxels the first pass covered when it stopped
-  int first_pass_picks = 0;             // picks before any improvement pass (greedy picks)
-  int saved_by_improvement = 0;         // picks the improvement pass saved (consolidation)
+  uint64_t coverable = 0;                    // |union of all sets|, in voxels
+  uint64_t covered = 0;                      // voxels the first pass covered when it stopped
+  int first_pass_picks = 0;                  // picks before any improvement pass (greedy picks)
+  int saved_by_improvement = 0;              // picks the improvement pass saved (consolidation)
 };
 
 // Chooses stations among candidates from their visibility sets.
@@ -47,15 +47,14 @@ class Selector {
   virtual ~Selector() = default;
   // Picks among `sets` (all of one size). INVALID_ARGUMENT for sets of different sizes;
   // CANCELLED / DEADLINE_EXCEEDED from ctx. Progress is reported as Stage::kSelection.
-  [[nodiscard]] virtual Result<Selection> Select(const std::vector<VoxelSet>& sets,
-                                                 const JobContext& ctx) const = 0;
+  [[nodiscard]] virtual Result<Selection> Select(const std::vector<VoxelSet>& sets, const JobContext& ctx) const = 0;
 };
 
 struct GreedySelectorOptions {
-  int max_stations = 0;                // at most this many greedy picks; 0 = no limit
+  int max_stations = 0;                   // at most this many greedy picks; 0 = no limit
   uint64_t min_marginal_gain_voxels = 1;  // stop when the best gain is below this (voxels)
-  double target_coverage = 1.0;        // stop at this fraction of coverable voxels, in (0, 1]
-  bool consolidate = true;             // run ConsolidatePicks on the greedy picks
+  double target_coverage = 1.0;           // stop at this fraction of coverable voxels, in (0, 1]
+  bool consolidate = true;                // run ConsolidatePicks on the greedy picks
 };
 
 // Lazy greedy (SelectGreedy with lazy = true), then, if enabled, ConsolidatePicks.
@@ -63,8 +62,7 @@ class GreedySelector final : public Selector {
  public:
   explicit GreedySelector(const GreedySelectorOptions& options) : options_(options) {}
   // The greedy picks, consolidated; stop, coverable and covered are the greedy pass's.
-  [[nodiscard]] Result<Selection> Select(const std::vector<VoxelSet>& sets,
-                                         const JobContext& ctx) const override;
+  [[nodiscard]] Result<Selection> Select(const std::vector<VoxelSet>& sets, const JobContext& ctx) const override;
 
  private:
   GreedySelectorOptions options_;

@@ -59,7 +59,7 @@ struct CandidatesOutput {
   uint64_t grid_cells = 0;             // grid cells x levels examined
   uint64_t cells_without_floor = 0;
   uint64_t cells_failing_clearance = 0;
-  std::vector<std::string> warnings;   // for PlanResult::warnings, in order
+  std::vector<std::string> warnings;  // for PlanResult::warnings, in order
 };
 // INVALID_ARGUMENT for a user candidate out of range or inside an occupied voxel;
 // FAILED_PRECONDITION when no floor is found or no candidate survives.
@@ -88,11 +88,11 @@ struct VisibilityOutput {
 // --- Stage::kSelection: the Selector's picks as stations ---
 struct SelectionInput {
   const Selector& selector;
-  std::vector<VoxelSet> sets;                  // per candidate; consumed (freed when done)
+  std::vector<VoxelSet> sets;  // per candidate; consumed (freed when done)
   const std::vector<WorldPoint>& candidates;
-  const std::vector<double>& floor_z_m;        // per candidate
+  const std::vector<double>& floor_z_m;         // per candidate
   const std::vector<uint64_t>& visible_voxels;  // per candidate: |set| (the heat map's counts)
-  const PlanCallbacks& callbacks;              // on_station is called per pick, in pick order
+  const PlanCallbacks& callbacks;               // on_station is called per pick, in pick order
 };
 struct SelectionOutput {
   Stations stations;    // the picks, in pick order
@@ -125,8 +125,8 @@ struct ReductionInput {
   const Stations& stations;
 };
 struct ReductionOutput {
-  Reduction reduction;     // the matrix, the removed stations and G before and after
-  std::vector<int> keep;   // indices into the stations kept, ascending
+  Reduction reduction;    // the matrix, the removed stations and G before and after
+  std::vector<int> keep;  // indices into the stations kept, ascending
   // The evaluation of all stations (with face values), when it was computed and nothing was
   // removed, so the evaluation stage reuses it.
   std::optional<Evaluation> evaluation;

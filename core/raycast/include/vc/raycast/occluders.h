@@ -142,7 +142,8 @@ class OccluderCache {
               const VoxelIndex& keep_hi) {
     if (count_ == 0 || !enabled_) return false;
     const Segment seg(a, b);
-    return FindIf([&](const SolidBox& box) { return !box.Overlaps(keep_lo, keep_hi) && PassesThroughInterior(seg, box); });
+    return FindIf(
+        [&](const SolidBox& box) { return !box.Overlaps(keep_lo, keep_hi) && PassesThroughInterior(seg, box); });
   }
   bool Blocks(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const VoxelIndex& keep) {
     return Blocks(a, b, keep, keep);

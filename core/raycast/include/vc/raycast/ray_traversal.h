@@ -55,8 +55,7 @@ class RayTraversal {
 // The first occupied voxel on the segment a -> b (index space), in traversal order, or nullopt if
 // the segment reaches the voxel containing b without meeting one. The voxel `transparent` (if
 // given) is treated as free.
-std::optional<VoxelIndex> FirstOccupied(const OccupancyGrid& grid, const Eigen::Vector3d& a,
-                                        const Eigen::Vector3d& b,
+std::optional<VoxelIndex> FirstOccupied(const OccupancyGrid& grid, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
                                         const VoxelIndex* transparent = nullptr);
 
 // FirstOccupied on many segments at once: out[i] = FirstOccupied(grid, a[i], b[i]) for

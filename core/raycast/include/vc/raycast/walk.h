@@ -133,11 +133,10 @@ inline void FreeBrickBox(const OccupancyGrid& grid, uint64_t brick, const uint32
 // Jumps across the free box of bricks around an empty brick (FreeBrickBox), as the SIMD
 // kernel's jump does.
 inline bool JumpAcrossFreeBrickBox(const OccupancyGrid& grid, uint64_t brick, const uint32_t rel[3], const int lo3[3],
-                            Walk& w) {
+                                   Walk& w) {
   int box_lo[3], box_hi[3];
   FreeBrickBox(grid, brick, rel, lo3, box_lo, box_hi);
   return JumpAcrossBox(box_lo, box_hi, w);
 }
-
 
 }  // namespace vc::internal

@@ -8,8 +8,8 @@
 #include <vector>
 
 #include "vc/base/geometry.h"
-#include "vc/plan/planner.h"
 #include "vc/base/status.h"
+#include "vc/plan/planner.h"
 #include "vc/visibility/visibility.h"
 
 namespace vc {

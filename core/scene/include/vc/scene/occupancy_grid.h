@@ -10,10 +10,10 @@
 // by side, into a larger free box (ExtraBricks), which the rays jump across: a ray along a floor
 // or a wall jumps far along it, not just as far as the surface is near.
 // (A per-voxel distance field was tried and removed: its byte per voxel of the box falls out of
-// cache, and traversal was 1.2-2x slower in wall time than with these brick distances.) It answers "is voxel (x,y,z) occupied" exactly as the octree at resolution r does
-// (ALGORITHM.md section 1); anything outside the box is free. Memory is computed and checked
-// against a budget before anything is allocated: a scene that does not fit is refused with
-// RESOURCE_EXHAUSTED and a message stating the extent and a resolution that would fit.
+// cache, and traversal was 1.2-2x slower in wall time than with these brick distances.) It answers "is voxel (x,y,z)
+// occupied" exactly as the octree at resolution r does (ALGORITHM.md section 1); anything outside the box is free.
+// Memory is computed and checked against a budget before anything is allocated: a scene that does not fit is refused
+// with RESOURCE_EXHAUSTED and a message stating the extent and a resolution that would fit.
 //
 // Index space ("IS"): voxel (x,y,z) (a VoxelIndex, = OctoMap key - 32768) covers
 // [x, x+1) x [y, y+1) x [z, z+1) in continuous coordinates u = p / r, where p is the world point in
@@ -113,7 +113,8 @@ class OccupancyGrid {
         hi.z - min_.z >= dims_.z() || lo.x > hi.x || lo.y > hi.y || lo.z > hi.z) {
       return false;
     }
-    return !ScanBox</*kEmptyBricks=*/true>(lo, hi, [](uint64_t bits, uint64_t mask, int, int, int) { return bits != mask; });
+    return !ScanBox</*kEmptyBricks=*/true>(lo, hi,
+                                           [](uint64_t bits, uint64_t mask, int, int, int) { return bits != mask; });
   }
   // Whether some occupied voxel v of the box [lo, hi] has pred(v) true. Stops at the first one.
   template <typename Pred>
@@ -175,8 +176,8 @@ bool OccupancyGrid::ScanBox(const VoxelIndex& lo, const VoxelIndex& hi, Fn&& fn)
     for (int by = r0[1] >> kBrickShift; by <= r1[1] >> kBrickShift; ++by) {
       const int y0 = std::max(r0[1] - by * kBrick, 0), y1 = std::min(r1[1] - by * kBrick, kBrick - 1);
       // Bits y0..y1 of a word's 8-bit rows.
-      const uint64_t rows = (y1 == kBrick - 1 ? ~uint64_t{0} : (uint64_t{1} << (8 * (y1 + 1))) - 1) &
-                            ~((uint64_t{1} << (8 * y0)) - 1);
+      const uint64_t rows =
+          (y1 == kBrick - 1 ? ~uint64_t{0} : (uint64_t{1} << (8 * (y1 + 1))) - 1) & ~((uint64_t{1} << (8 * y0)) - 1);
       for (int bx = r0[0] >> kBrickShift; bx <= r1[0] >> kBrickShift; ++bx) {
         const int32_t slot = bricks_[BrickLinear(uint32_t(bx), uint32_t(by), uint32_t(bz))];
         if (slot <= 0 && !kEmptyBricks) continue;
@@ -188,7 +189,8 @@ bool OccupancyGrid::ScanBox(const VoxelIndex& lo, const VoxelIndex& hi, Fn&& fn)
         }
         const uint64_t* words = BrickBits(slot);
         for (int z = z0; z <= z1; ++z) {
-          if (fn(words[z] & mask, mask, min_.x + bx * kBrick, min_.y + by * kBrick, min_.z + bz * kBrick + z)) return true;
+          if (fn(words[z] & mask, mask, min_.x + bx * kBrick, min_.y + by * kBrick, min_.z + bz * kBrick + z))
+            return true;
         }
       }
     }

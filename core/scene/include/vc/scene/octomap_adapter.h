@@ -6,13 +6,12 @@
 // writing.
 #pragma once
 
+#include <Eigen/Core>
 #include <cstdint>
 #include <functional>
 #include <memory>
 #include <string_view>
 #include <vector>
-
-#include <Eigen/Core>
 
 #include "vc/base/geometry.h"
 #include "vc/base/status.h"
@@ -71,7 +70,7 @@ struct CastRayOutcome {
   VoxelKey hit;  // valid when kind == kHitOccupied
 };
 // octomap::OcTree::castRay from `origin` along `direction` up to `max_range_m`, unknown cells free.
-CastRayOutcome OctomapCastRay(const octomap::OcTree& tree, const WorldPoint& origin,
-                              const Eigen::Vector3d& direction, double max_range_m);
+CastRayOutcome OctomapCastRay(const octomap::OcTree& tree, const WorldPoint& origin, const Eigen::Vector3d& direction,
+                              double max_range_m);
 
 }  // namespace vc

@@ -8,13 +8,12 @@
 // trigger a huge allocation. Thread-safe: functions here share no state.
 #pragma once
 
+#include <Eigen/Core>
 #include <cstdint>
 #include <memory>
 #include <string>
 #include <string_view>
 #include <vector>
-
-#include <Eigen/Core>
 
 #include "vc/base/status.h"
 
@@ -89,8 +88,7 @@ struct SceneInput {
 // error messages (a file name or "upload"). Errors: INVALID_ARGUMENT for malformed or unsupported
 // content (truncated, wrong counts, unknown types, LAZ, empty cloud), RESOURCE_EXHAUSTED when a
 // limit in `options` is exceeded, or when memory runs out while reading (never an exception).
-Result<SceneInput> ReadScene(std::string_view bytes, std::string_view source_name,
-                             const ReadOptions& options = {});
+Result<SceneInput> ReadScene(std::string_view bytes, std::string_view source_name, const ReadOptions& options = {});
 
 // Reads a whole file and calls ReadScene. NOT_FOUND if it cannot be opened.
 Result<SceneInput> ReadSceneFile(const std::string& path, const ReadOptions& options = {});

@@ -6,8 +6,8 @@
 
 #include "vc/base/geometry.h"
 #include "vc/base/progress.h"
-#include "vc/scene/scene_input.h"
 #include "vc/base/status.h"
+#include "vc/scene/scene_input.h"
 
 namespace vc {
 
@@ -22,14 +22,14 @@ struct SceneSummary {
   double octree_resolution_m = 0;  // input octree's own resolution (0 for clouds)
   WorldPoint bbox_min{0, 0, 0};    // of the points, or of the occupied leaves' cubes, in metres
   WorldPoint bbox_max{0, 0, 0};
-  double resolution_m = 0;         // working resolution used for the voxel count
-  uint64_t occupied_voxels = 0;    // at resolution_m
+  double resolution_m = 0;       // working resolution used for the voxel count
+  uint64_t occupied_voxels = 0;  // at resolution_m
 };
 
 // Summarises `input`, counting occupied voxels at `resolution_m` (0 = the default working
 // resolution). Errors as Voxelize.
-Result<SceneSummary> Summarize(const SceneInput& input, double resolution_m,
-                               uint64_t memory_budget_bytes, const JobContext& ctx = {});
+Result<SceneSummary> Summarize(const SceneInput& input, double resolution_m, uint64_t memory_budget_bytes,
+                               const JobContext& ctx = {});
 
 // One JSON object with the keys format, compression, detail, points, dropped_nonfinite, scans,
 // octree_leaves, octree_resolution_m, bbox_min, bbox_max, resolution_m, occupied_voxels.

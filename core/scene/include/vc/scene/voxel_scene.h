@@ -13,18 +13,17 @@
 // from the same points. A VoxelAccumulator is not thread-safe; use one per thread.
 #pragma once
 
+#include <Eigen/Core>
 #include <algorithm>
 #include <cstdint>
 #include <memory>
 #include <vector>
 
-#include <Eigen/Core>
-
 #include "vc/base/geometry.h"
-#include "vc/scene/occupancy_grid.h"
 #include "vc/base/progress.h"
-#include "vc/scene/scene_input.h"
 #include "vc/base/status.h"
+#include "vc/scene/occupancy_grid.h"
+#include "vc/scene/scene_input.h"
 
 namespace vc {
 
@@ -58,12 +57,11 @@ struct VoxelScene {
 // Occupied keys of `input` at `resolution_m` by the rules above, sorted and unique.
 // INVALID_ARGUMENT for a bad resolution or an empty scene; RESOURCE_EXHAUSTED (with the extent and
 // a resolution that would fit) when the result would exceed `memory_budget_bytes`.
-Result<std::vector<VoxelKey>> OccupiedKeys(const SceneInput& input, double resolution_m,
-                                           uint64_t memory_budget_bytes, const JobContext& ctx = {});
+Result<std::vector<VoxelKey>> OccupiedKeys(const SceneInput& input, double resolution_m, uint64_t memory_budget_bytes,
+                                           const JobContext& ctx = {});
 
 // Builds the scene at the working resolution. Errors as OccupiedKeys and OccupancyGrid::Build.
-Result<VoxelScene> Voxelize(const SceneInput& input, const VoxelizeOptions& options,
-                            const JobContext& ctx = {});
+Result<VoxelScene> Voxelize(const SceneInput& input, const VoxelizeOptions& options, const JobContext& ctx = {});
 
 // Resolution actually used for `input` under `options` (resolves the 0 default).
 double WorkingResolution(const SceneInput& input, const VoxelizeOptions& options);

@@ -19,13 +19,12 @@
 // Thread-safety: all functions are pure and may be called concurrently.
 #pragma once
 
+#include <Eigen/Core>
 #include <cstdint>
 #include <functional>
 #include <string>
 #include <string_view>
 #include <vector>
-
-#include <Eigen/Core>
 
 #include "vc/base/geometry.h"
 #include "vc/base/status.h"

@@ -136,7 +136,7 @@ class SurfaceTargets {
 // *failed_at (if given) receives an s >= from below which the cone holds no occupied voxel
 // that counts, nor does the cone of any rectangle inside this one.
 bool FreeCone(const OccupancyGrid& grid, const Eigen::Vector3d& uo, int axis, bool viewer_above, int plane,
-              const Eigen::Vector3d& q0, const Eigen::Vector3d& q1, const FreeBox& around = FreeBox(),
-              double from = 0, double* failed_at = nullptr);
+              const Eigen::Vector3d& q0, const Eigen::Vector3d& q1, const FreeBox& around = FreeBox(), double from = 0,
+              double* failed_at = nullptr);
 
 }  // namespace vc::internal

@@ -35,8 +35,8 @@ std::string_view SelectionTestName(SelectionTest t);  // "surface", "compatibili
 
 // The scanner model's parameters (vc/base/parameter.h): X(type, name, default, unit, flag, check, help).
 // The range of ALGORITHM.md s.5; V = 0 outside [min_range_m, max_range_m].
-#define VC_SCANNER_PARAMETERS(X)                                                            \
-  X(double, min_range_m, 0.5, "m", "min-range", kNonNegative, "scanner minimum range")      \
+#define VC_SCANNER_PARAMETERS(X)                                                       \
+  X(double, min_range_m, 0.5, "m", "min-range", kNonNegative, "scanner minimum range") \
   X(double, max_range_m, 75.0, "m", "max-range", kPositive, "scanner maximum range")
 
 // The scanner (ALGORITHM.md s.5).
@@ -121,10 +121,8 @@ struct VisibilitySetsOptions {
 
 // For each viewpoint, the occupied voxels that pass the selection test. Viewpoints inside an
 // occupied voxel get an empty set. CANCELLED / DEADLINE_EXCEEDED from ctx.
-Result<std::vector<VoxelSet>> ComputeVisibilitySets(const VoxelScene& scene,
-                                                    const std::vector<WorldPoint>& viewpoints,
-                                                    const VisibilitySetsOptions& options,
-                                                    const JobContext& ctx = {});
+Result<std::vector<VoxelSet>> ComputeVisibilitySets(const VoxelScene& scene, const std::vector<WorldPoint>& viewpoints,
+                                                    const VisibilitySetsOptions& options, const JobContext& ctx = {});
 
 // Per-viewpoint and overall figures of s.6.
 struct VisibilityFigures {
