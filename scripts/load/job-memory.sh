@@ -5,22 +5,25 @@
 # finish with peak <= budget + CONSTANT, or be refused with RESOURCE_EXHAUSTED (exit 8) with the
 # same bound; any other outcome fails. Prints, per run, the peak, the budget and peak - budget, and
 # the largest peak - budget seen (the constant to document).
-# Usage: scripts/load/job-memory.sh [--build DIR (build/release)] [--quick] [--constant-mib C (256)]
+# Usage: scripts/load/job-memory.sh [--build DIR (build/release)] [--quick] [--constant-mib C (128)]
+#                                   [--budgets-mib "1 16 512 4096"]
 #   scenes: geb079.bt; the real hall scan (scan.dat.bz2) and vc-synth hall --spacing 0.05 (1.7 M
 #   points), both skipped by --quick. Budgets: 1 MiB, 16 MiB, 512 MiB, 4 GiB.
 source "$(dirname "$0")/lib.sh"
-build="" quick="" constant_mib=256
+build="" quick="" constant_mib=128 budgets_mib="1 16 512 4096"
 while [[ $# -gt 0 ]]; do
   case $1 in
     --build) build=$2; shift 2 ;;
     --quick) quick=1; shift ;;
     --constant-mib) constant_mib=$2; shift 2 ;;
-    *) echo "usage: $0 [--build DIR] [--quick] [--constant-mib C]" >&2; exit 2 ;;
+    --budgets-mib) budgets_mib=$2; shift 2 ;;
+    *) echo "usage: $0 [--build DIR] [--quick] [--constant-mib C] [--budgets-mib LIST]" >&2; exit 2 ;;
   esac
 done
 load_init "$build"
 mib=$((1 << 20))
-budgets=($((1 * mib)) $((16 * mib)) $((512 * mib)) $((4096 * mib)))
+budgets=()
+for b in $budgets_mib; do budgets+=($((b * mib))); done
 scenes=("$DATA/geb079/geb079.bt")
 if [[ -z "$quick" ]]; then
   scenes+=("$DATA/hall-scan/scan.dat.bz2")
