@@ -17,13 +17,15 @@ while [[ $# -gt 0 ]]; do
 done
 b=(); [[ -n "$build" ]] && b=(--build "$build")
 summary=() failed=0
+log=$(mktemp /tmp/vc-load-run.XXXXXX)
+trap 'rm -f "$log"' EXIT
 run() {  # run SCRIPT [ARGS...]
   echo "=== scripts/load/$*"
-  local t0 out rc line
+  local t0 rc line
   t0=$(date +%s)
-  out=$(bash "$here/$1" "${@:2}" "${b[@]}" 2>&1 | tee /dev/stderr)
+  bash "$here/$1" "${@:2}" "${b[@]}" 2>&1 | tee "$log"
   rc=$?
-  line=$(grep -E '^(PASS|FAIL) [a-z-]+(:|$)' <<<"$out" | tail -1)
+  line=$(grep -E '^(PASS|FAIL) [a-z-]+(:|$)' "$log" | tail -1)
   [[ -n "$line" ]] || line="FAIL $1: no verdict (exit $rc)"
   [[ $line == PASS* ]] || failed=1
   summary+=("$line ($(( $(date +%s) - t0 )) s)")
