@@ -18,6 +18,8 @@
 #include <atomic>
 #include <chrono>
 #include <cstdint>
+#include <mutex>
+#include <set>
 #include <string>
 
 #include "vc/base/progress.h"
@@ -44,6 +46,28 @@ struct ServiceState {
   const JobRunner runner;
   WorkerPool pool;
   std::atomic<uint64_t> next_job{1};
+
+  // The cancel tokens of the calls alive now, so that a shutdown can cancel them all (CancelAll).
+  void Register(CancelToken* token) {
+    std::lock_guard lock(calls_mu);
+    if (cancelling_all) token->Cancel();
+    calls.insert(token);
+  }
+  void Unregister(CancelToken* token) {
+    std::lock_guard lock(calls_mu);
+    calls.erase(token);
+  }
+  // Cancels every call alive now and every call that starts from now on.
+  void CancelAll() {
+    std::lock_guard lock(calls_mu);
+    cancelling_all = true;
+    for (CancelToken* t : calls) t->Cancel();
+  }
+
+ private:
+  std::mutex calls_mu;
+  std::set<CancelToken*> calls;
+  bool cancelling_all = false;
 };
 
 // Constant-time comparison of the bearer token.
@@ -72,6 +96,7 @@ class JobReactor : public grpc::ServerBidiReactor<Request, Response> {
       token_.SetDeadline(Clock::now() +
                          std::chrono::duration_cast<Clock::duration>(deadline - std::chrono::system_clock::now()));
     }
+    state_->Register(&token_);
     std::string why;
     if (!TokenMatches(*ctx_, state_->options.token, &why)) {
       Reject(UnauthenticatedError(why));
@@ -102,7 +127,10 @@ class JobReactor : public grpc::ServerBidiReactor<Request, Response> {
     outbox_.Break();
   }
 
-  void OnDone() override { delete this; }
+  void OnDone() override {
+    state_->Unregister(&token_);
+    delete this;
+  }
 
  protected:
   // Takes the spec message: stores the parameters (checked) and returns the upload spec.
@@ -132,6 +160,10 @@ class JobReactor : public grpc::ServerBidiReactor<Request, Response> {
   void OnUploadEnd() {
     if (ctx_->IsCancelled()) {
       Reject(CancelledError("the client cancelled the call during the upload"));
+      return;
+    }
+    if (const Status s = token_.Check("the job (the server is shutting down)"); !s.ok()) {
+      Reject(s);
       return;
     }
     Status s = upload_.Finish();

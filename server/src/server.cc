@@ -5,7 +5,10 @@
 #include <grpcpp/health_check_service_interface.h>
 #include <spdlog/spdlog.h>
 
+#include <condition_variable>
 #include <fstream>
+#include <mutex>
+#include <thread>
 #include <sstream>
 
 #include "vc/server/service.h"
@@ -70,7 +73,27 @@ void Server::Shutdown(std::chrono::milliseconds grace) {
   if (shut_down_ || !server_) return;
   shut_down_ = true;
   server_->GetHealthCheckService()->SetServingStatus(false);
-  server_->Shutdown(std::chrono::system_clock::now() + grace);
+  // gRPC stops taking calls and waits for the running ones. When the grace ends with calls still
+  // running, our jobs are cancelled, so each ends with its own CANCELLED status; gRPC's deadline
+  // (where it would cancel the calls itself, with UNAVAILABLE) comes kCancelWindow later.
+  std::mutex mu;
+  std::condition_variable cv;
+  bool drained = false;
+  std::thread canceller([&] {
+    std::unique_lock lock(mu);
+    if (!cv.wait_for(lock, grace, [&] { return drained; })) {
+      spdlog::info("vc-server: the {:.1f} s grace is over; cancelling the jobs still running or queued",
+                   std::chrono::duration<double>(grace).count());
+      service_->CancelAll();
+    }
+  });
+  server_->Shutdown(std::chrono::system_clock::now() + grace + kCancelWindow);
+  {
+    std::lock_guard lock(mu);
+    drained = true;
+  }
+  cv.notify_all();
+  canceller.join();
   server_->Wait();
   service_.reset();  // joins the workers; every job has ended with its call
 }

@@ -158,6 +158,8 @@ grpc::ServerBidiReactor<v1::EvaluateRequest, v1::EvaluateResponse>* StationPlann
   return reactor;
 }
 
+void StationPlannerService::CancelAll() { state_->CancelAll(); }
+
 const WorkerPool& StationPlannerService::pool() const { return state_->pool; }
 
 }  // namespace vc::server

@@ -439,6 +439,8 @@ TEST_F(Blocking, ShutdownCancelsRunningJobsAfterTheGracePeriod) {
   const grpc::Status s = stream->Finish();
   EXPECT_FALSE(s.ok());
   EXPECT_NE(s.error_code(), grpc::StatusCode::DEADLINE_EXCEEDED) << "the call was not ended by the shutdown";
+  // Ended by our cancellation at the end of the grace, not by gRPC's own shutdown (UNAVAILABLE).
+  EXPECT_EQ(s.error_code(), grpc::StatusCode::CANCELLED) << s.error_message();
 }
 
 // --- Authentication ---

@@ -30,8 +30,13 @@ class Server {
 
   // The bound port (the real one when `listen` asked for port 0).
   int port() const { return port_; }
-  // Stops accepting calls and reports NOT_SERVING; running calls get `grace` to finish, then are
-  // cancelled (their jobs stop within about a second). Returns when every call has ended.
+  // After the grace, how long cancelled jobs get to reach a cancellation point and send their
+  // CANCELLED status before gRPC cancels the calls itself (the core polls at least every second).
+  static constexpr std::chrono::milliseconds kCancelWindow{5000};
+
+  // Stops accepting calls and reports NOT_SERVING; running and queued calls get `grace` to finish,
+  // then their jobs are cancelled and end with CANCELLED (within about a second). Returns when every
+  // call has ended.
   void Shutdown(std::chrono::milliseconds grace);
   const WorkerPool& pool() const;
 

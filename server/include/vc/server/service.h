@@ -29,6 +29,11 @@ class StationPlannerService final : public v1::StationPlanner::CallbackService {
   grpc::ServerBidiReactor<v1::EvaluateRequest, v1::EvaluateResponse>* Evaluate(
       grpc::CallbackServerContext* ctx) override;
 
+  // Cancels every call alive now (running, queued or uploading) and every call that starts from
+  // now on: each ends with CANCELLED as soon as its job reaches a cancellation point (the core polls
+  // at least every second). For the end of a shutdown's grace. Thread-safe.
+  void CancelAll();
+
   // The pool running the jobs (for observation in tests and logs).
   const WorkerPool& pool() const;
 
