@@ -17,6 +17,7 @@
 
 #include <atomic>
 #include <chrono>
+#include <condition_variable>
 #include <cstdint>
 #include <mutex>
 #include <set>
@@ -47,27 +48,45 @@ struct ServiceState {
   WorkerPool pool;
   std::atomic<uint64_t> next_job{1};
 
-  // The cancel tokens of the calls alive now, so that a shutdown can cancel them all (CancelAll).
-  void Register(CancelToken* token) {
+  // The calls alive now, by their cancel tokens, for a shutdown: Drain refuses new calls,
+  // WaitForCalls waits for the others to end, CancelAll cancels them.
+  // Registers a new call; false when the service is draining (the call must be refused).
+  bool Register(CancelToken* token) {
     std::lock_guard lock(calls_mu);
-    if (cancelling_all) token->Cancel();
+    if (draining) return false;
     calls.insert(token);
+    return true;
   }
   void Unregister(CancelToken* token) {
-    std::lock_guard lock(calls_mu);
-    calls.erase(token);
+    {
+      std::lock_guard lock(calls_mu);
+      calls.erase(token);
+    }
+    calls_ended.notify_all();
   }
-  // Cancels every call alive now and every call that starts from now on.
+  void Drain() {
+    std::lock_guard lock(calls_mu);
+    draining = true;
+  }
+  // True when no call is alive (any more) at `deadline`.
+  bool WaitForCalls(std::chrono::steady_clock::time_point deadline) {
+    std::unique_lock lock(calls_mu);
+    return calls_ended.wait_until(lock, deadline, [&] { return calls.empty(); });
+  }
+  bool HasCalls() {
+    std::lock_guard lock(calls_mu);
+    return !calls.empty();
+  }
   void CancelAll() {
     std::lock_guard lock(calls_mu);
-    cancelling_all = true;
     for (CancelToken* t : calls) t->Cancel();
   }
 
  private:
   std::mutex calls_mu;
+  std::condition_variable calls_ended;
   std::set<CancelToken*> calls;
-  bool cancelling_all = false;
+  bool draining = false;
 };
 
 // Constant-time comparison of the bearer token.
@@ -96,7 +115,11 @@ class JobReactor : public grpc::ServerBidiReactor<Request, Response> {
       token_.SetDeadline(Clock::now() +
                          std::chrono::duration_cast<Clock::duration>(deadline - std::chrono::system_clock::now()));
     }
-    state_->Register(&token_);
+    registered_ = state_->Register(&token_);
+    if (!registered_) {
+      Reject(UnavailableError("this vc-server is shutting down; retry (another replica will take the job)"));
+      return;
+    }
     std::string why;
     if (!TokenMatches(*ctx_, state_->options.token, &why)) {
       Reject(UnauthenticatedError(why));
@@ -128,7 +151,7 @@ class JobReactor : public grpc::ServerBidiReactor<Request, Response> {
   }
 
   void OnDone() override {
-    state_->Unregister(&token_);
+    if (registered_) state_->Unregister(&token_);
     delete this;
   }
 
@@ -215,6 +238,7 @@ class JobReactor : public grpc::ServerBidiReactor<Request, Response> {
   const char* const method_;
   const Clock::time_point start_;
   CancelToken token_;
+  bool registered_ = false;  // in the service's calls (Start); unregistered in OnDone
   Request request_;         // the message being read (gRPC threads, one reaction at a time)
   UploadAssembler upload_;  // gRPC threads until the job is submitted
   Job job_;                 // handed to the worker

@@ -5,9 +5,7 @@
 #include <grpcpp/health_check_service_interface.h>
 #include <spdlog/spdlog.h>
 
-#include <condition_variable>
 #include <fstream>
-#include <mutex>
 #include <thread>
 #include <sstream>
 
@@ -73,27 +71,24 @@ void Server::Shutdown(std::chrono::milliseconds grace) {
   if (shut_down_ || !server_) return;
   shut_down_ = true;
   server_->GetHealthCheckService()->SetServingStatus(false);
-  // gRPC stops taking calls and waits for the running ones. When the grace ends with calls still
-  // running, our jobs are cancelled, so each ends with its own CANCELLED status; gRPC's deadline
-  // (where it would cancel the calls itself, with UNAVAILABLE) comes kCancelWindow later.
-  std::mutex mu;
-  std::condition_variable cv;
-  bool drained = false;
-  std::thread canceller([&] {
-    std::unique_lock lock(mu);
-    if (!cv.wait_for(lock, grace, [&] { return drained; })) {
-      spdlog::info("vc-server: the {:.1f} s grace is over; cancelling the jobs still running or queued",
-                   std::chrono::duration<double>(grace).count());
-      service_->CancelAll();
-    }
-  });
-  server_->Shutdown(std::chrono::system_clock::now() + grace + kCancelWindow);
-  {
-    std::lock_guard lock(mu);
-    drained = true;
+  // Our own drain first, gRPC's shutdown only once every call has ended: gRPC closes a connection
+  // as soon as its last stream ends while it shuts down, which reset connections whose clients had
+  // not yet read their results (scripts/load/sigterm.sh). So: refuse new calls (UNAVAILABLE, retried
+  // elsewhere), give the running and queued ones the grace, cancel what is left (each ends with its
+  // own CANCELLED), and give those kCancelWindow to end.
+  using Clock = std::chrono::steady_clock;
+  service_->Drain();
+  const bool had_calls = !service_->WaitForCalls(Clock::now());
+  if (!service_->WaitForCalls(Clock::now() + grace)) {
+    spdlog::info("vc-server: the {:.1f} s grace is over; cancelling the jobs still running or queued",
+                 std::chrono::duration<double>(grace).count());
+    service_->CancelAll();
+    service_->WaitForCalls(Clock::now() + kCancelWindow);
   }
-  cv.notify_all();
-  canceller.join();
+  // The last results were handed to the transport; let them reach their clients before the
+  // connections close.
+  if (had_calls) std::this_thread::sleep_for(kFlushLinger);
+  server_->Shutdown(std::chrono::system_clock::now() + kFlushLinger);
   server_->Wait();
   service_.reset();  // joins the workers; every job has ended with its call
 }

@@ -158,6 +158,12 @@ grpc::ServerBidiReactor<v1::EvaluateRequest, v1::EvaluateResponse>* StationPlann
   return reactor;
 }
 
+void StationPlannerService::Drain() { state_->Drain(); }
+
+bool StationPlannerService::WaitForCalls(std::chrono::steady_clock::time_point deadline) {
+  return state_->WaitForCalls(deadline);
+}
+
 void StationPlannerService::CancelAll() { state_->CancelAll(); }
 
 const WorkerPool& StationPlannerService::pool() const { return state_->pool; }

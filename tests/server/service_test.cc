@@ -8,6 +8,7 @@
 #include <cmath>
 #include <thread>
 
+#include "grpc/health/v1/health.grpc.pb.h"
 #include "server/test_server.h"
 #include "vc/client/client.h"
 #include "vc/wire/convert.h"
@@ -441,6 +442,35 @@ TEST_F(Blocking, ShutdownCancelsRunningJobsAfterTheGracePeriod) {
   EXPECT_NE(s.error_code(), grpc::StatusCode::DEADLINE_EXCEEDED) << "the call was not ended by the shutdown";
   // Ended by our cancellation at the end of the grace, not by gRPC's own shutdown (UNAVAILABLE).
   EXPECT_EQ(s.error_code(), grpc::StatusCode::CANCELLED) << s.error_message();
+}
+
+TEST_F(Blocking, DuringTheDrainNewCallsAreRefusedWithUnavailableAndHealthIsNotServing) {
+  grpc::ClientContext ctx;
+  ctx.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(20));  // bounds a failure
+  auto stream = StartBlockedJob(&ctx);
+  std::thread shutdown([&] { server_->Shutdown(std::chrono::milliseconds(1500)); });
+  // The listener stays open during the grace: a new call is refused by the service itself.
+  grpc::Status refused;
+  for (int i = 0; i < 50; ++i) {
+    refused = RawPlan(testing::Address(*server_), PlanRequests(bytes_)).status;
+    if (refused.error_code() == grpc::StatusCode::UNAVAILABLE) break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  EXPECT_EQ(refused.error_code(), grpc::StatusCode::UNAVAILABLE);
+  EXPECT_THAT(refused.error_message(), HasSubstr("shutting down"));
+  auto health = grpc::health::v1::Health::NewStub(
+      grpc::CreateChannel(testing::Address(*server_), grpc::InsecureChannelCredentials()));
+  grpc::ClientContext hctx;
+  grpc::health::v1::HealthCheckRequest hreq;
+  grpc::health::v1::HealthCheckResponse hresp;
+  const grpc::Status hs = health->Check(&hctx, hreq, &hresp);
+  EXPECT_TRUE(hs.ok()) << hs.error_message();
+  EXPECT_EQ(hresp.status(), grpc::health::v1::HealthCheckResponse::NOT_SERVING);
+  v1::PlanResponse r;
+  while (stream->Read(&r)) {
+  }
+  EXPECT_EQ(stream->Finish().error_code(), grpc::StatusCode::CANCELLED);
+  shutdown.join();
 }
 
 // --- Authentication ---

@@ -33,10 +33,12 @@ class Server {
   // After the grace, how long cancelled jobs get to reach a cancellation point and send their
   // CANCELLED status before gRPC cancels the calls itself (the core polls at least every second).
   static constexpr std::chrono::milliseconds kCancelWindow{5000};
+  // After the last call ended, how long the connections stay open for its last bytes.
+  static constexpr std::chrono::milliseconds kFlushLinger{500};
 
-  // Stops accepting calls and reports NOT_SERVING; running and queued calls get `grace` to finish,
-  // then their jobs are cancelled and end with CANCELLED (within about a second). Returns when every
-  // call has ended.
+  // Reports NOT_SERVING and refuses new calls with UNAVAILABLE; running and queued calls get `grace`
+  // to finish, then their jobs are cancelled and end with CANCELLED (within about a second). Then
+  // gRPC shuts down. Returns when every call has ended.
   void Shutdown(std::chrono::milliseconds grace);
   const WorkerPool& pool() const;
 

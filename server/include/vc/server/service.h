@@ -7,6 +7,7 @@
 // grpc::Server down first).
 #pragma once
 
+#include <chrono>
 #include <memory>
 
 #include "vc/server/backend.h"
@@ -29,9 +30,13 @@ class StationPlannerService final : public v1::StationPlanner::CallbackService {
   grpc::ServerBidiReactor<v1::EvaluateRequest, v1::EvaluateResponse>* Evaluate(
       grpc::CallbackServerContext* ctx) override;
 
-  // Cancels every call alive now (running, queued or uploading) and every call that starts from
-  // now on: each ends with CANCELLED as soon as its job reaches a cancellation point (the core polls
-  // at least every second). For the end of a shutdown's grace. Thread-safe.
+  // For a shutdown (Server::Shutdown), all thread-safe. Drain: from now on new calls are refused
+  // with UNAVAILABLE ("shutting down; retry"), which clients retry on another replica.
+  // WaitForCalls: true once every call alive has ended, false at `deadline`. CancelAll: cancels
+  // every call alive (running, queued or uploading); each ends with CANCELLED as soon as its job
+  // reaches a cancellation point (the core polls at least every second).
+  void Drain();
+  bool WaitForCalls(std::chrono::steady_clock::time_point deadline);
   void CancelAll();
 
   // The pool running the jobs (for observation in tests and logs).
