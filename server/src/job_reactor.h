@@ -239,9 +239,9 @@ class JobReactor : public grpc::ServerBidiReactor<Request, Response> {
   const Clock::time_point start_;
   CancelToken token_;
   bool registered_ = false;  // in the service's calls (Start); unregistered in OnDone
-  Request request_;         // the message being read (gRPC threads, one reaction at a time)
-  UploadAssembler upload_;  // gRPC threads until the job is submitted
-  Job job_;                 // handed to the worker
+  Request request_;          // the message being read (gRPC threads, one reaction at a time)
+  UploadAssembler upload_;   // gRPC threads until the job is submitted
+  Job job_;                  // handed to the worker
   Outbox<Response> outbox_;
 };
 

@@ -6,8 +6,8 @@
 #include <spdlog/spdlog.h>
 
 #include <fstream>
-#include <thread>
 #include <sstream>
+#include <thread>
 
 #include "vc/server/service.h"
 
