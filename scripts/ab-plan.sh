@@ -1,0 +1,62 @@
+#!/usr/bin/env bash
+# Paired A/B of the end-to-end plan through the real server and client (docs/BENCHMARKS.md, "the
+# paired method"): for each scene, build A's vc-server pinned to CPU 0 and build B's to CPU 1 plan
+# the same file at the same time with --threads 1, then the CPUs are swapped; prints each plan's
+# total_seconds (plan.json timings_s.total), the stations and G of each side (they must agree),
+# and the geometric mean of the ratios A/B over the pairs.
+# Usage: scripts/ab-plan.sh BUILD_A BUILD_B [ROUNDS (2)] [FILE...]   (default files: the synthetic
+#        hall at 0.05 m and geb079)
+set -euo pipefail
+cd "$(dirname "$0")/.."
+a=$1 b=$2 rounds=${3:-2}
+shift $(( $# >= 3 ? 3 : 2 ))
+work=$(mktemp -d)
+pids=()
+cleanup() { for p in "${pids[@]}"; do kill "$p" 2>/dev/null || true; done; rm -rf "$work"; }
+trap cleanup EXIT
+files=("$@")
+if ((${#files[@]} == 0)); then
+  "$b/client/vc-synth" hall --spacing 0.05 --out "$work/hall.ply" >/dev/null
+  files=("$work/hall.ply" ../shared/data/geb079/geb079.bt)
+fi
+
+start_server() {  # start_server BUILD CPU -> prints the port
+  local log="$work/server-$RANDOM.log"
+  taskset -c "$2" "$1/server/vc-server" --listen 127.0.0.1:0 --workers 1 --threads-per-job 1 >"$log" 2>&1 &
+  pids+=($!)
+  for _ in $(seq 1 100); do
+    local port; port=$(sed -n 's/.*listening on .* (port \([0-9]*\)).*/\1/p' "$log" | head -1)
+    if [[ -n "$port" ]]; then echo "$port"; return; fi
+    sleep 0.1
+  done
+  cat "$log" >&2; exit 1
+}
+
+summary() {  # summary plan.json -> "total stations G"
+  python3 -c 'import json,sys; p=json.load(open(sys.argv[1])); print(p["timings_s"]["total"], len(p["viewpoints"]), p["coverage"]["global_visibility"])' "$1"
+}
+
+for f in "${files[@]}"; do
+  ratios=()
+  for r in $(seq 1 "$rounds"); do
+    for swap in 0 1; do
+      ca=$swap cb=$((1 - swap))
+      pa=$(start_server "$a" "$ca") pb=$(start_server "$b" "$cb")
+      "$a/client/vc-client" submit "$f" --server "127.0.0.1:$pa" --threads 1 --out "$work/a" >/dev/null 2>&1 &
+      ja=$!
+      "$b/client/vc-client" submit "$f" --server "127.0.0.1:$pb" --threads 1 --out "$work/b" >/dev/null 2>&1 &
+      jb=$!
+      wait "$ja" "$jb"
+      read -r ta sa ga < <(summary "$work/a/plan.json")
+      read -r tb sb gb < <(summary "$work/b/plan.json")
+      ratio=$(python3 -c "print(f'{$ta/$tb:.3f}')")
+      ratios+=("$ratio")
+      printf '%-12s round %d  A on CPU %d: %6.2f s (%s stations, G %.6f)   B on CPU %d: %6.2f s (%s stations, G %.6f)   A/B %s\n' \
+        "$(basename "$f")" "$r" "$ca" "$ta" "$sa" "$ga" "$cb" "$tb" "$sb" "$gb" "$ratio"
+      for p in "${pids[@]}"; do kill "$p" 2>/dev/null || true; done
+      wait 2>/dev/null || true
+      pids=()
+    done
+  done
+  python3 -c "import math,sys; r=[float(x) for x in sys.argv[2:]]; print(f'{sys.argv[1]:12s} geometric mean A/B over {len(r)} runs: {math.exp(sum(map(math.log,r))/len(r)):.3f}')" "$(basename "$f")" "${ratios[@]}"
+done
