@@ -20,16 +20,17 @@ if ((${#files[@]} == 0)); then
   files=("$work/hall.ply" ../shared/data/geb079/geb079.bt)
 fi
 
-start_server() {  # start_server BUILD CPU -> prints the port
-  local log="$work/server-$RANDOM.log"
+start_server() {  # start_server BUILD CPU VAR: starts it (in this shell, so pids holds it), VAR=port
+  local log="$work/server-$RANDOM.log" port=""
   taskset -c "$2" "$1/server/vc-server" --listen 127.0.0.1:0 --workers 1 --threads-per-job 1 >"$log" 2>&1 &
   pids+=($!)
   for _ in $(seq 1 100); do
-    local port; port=$(sed -n 's/.*listening on .* (port \([0-9]*\)).*/\1/p' "$log" | head -1)
-    if [[ -n "$port" ]]; then echo "$port"; return; fi
+    port=$(sed -n 's/.*listening on .* (port \([0-9]*\)).*/\1/p' "$log" | head -1)
+    [[ -n "$port" ]] && break
     sleep 0.1
   done
-  cat "$log" >&2; exit 1
+  [[ -n "$port" ]] || { cat "$log" >&2; exit 1; }
+  printf -v "$3" '%s' "$port"
 }
 
 summary() {  # summary plan.json -> "total stations G"
@@ -41,7 +42,8 @@ for f in "${files[@]}"; do
   for r in $(seq 1 "$rounds"); do
     for swap in 0 1; do
       ca=$swap cb=$((1 - swap))
-      pa=$(start_server "$a" "$ca") pb=$(start_server "$b" "$cb")
+      start_server "$a" "$ca" pa
+      start_server "$b" "$cb" pb
       "$a/client/vc-client" submit "$f" --server "127.0.0.1:$pa" --threads 1 --out "$work/a" >/dev/null 2>&1 &
       ja=$!
       "$b/client/vc-client" submit "$f" --server "127.0.0.1:$pb" --threads 1 --out "$work/b" >/dev/null 2>&1 &
