@@ -203,7 +203,16 @@ std::vector<uint8_t> FacesInSetMask(const OccupancyGrid& g, const std::vector<Vo
 
 // Sampled mode into `ev` (resolution, |F| and per_viewpoint's size already set).
 Result<Evaluation> EvaluateSampled(const EvaluationJob& job, Evaluation ev) {
-  const auto& [g, r, n, nv, viewpoints, options, ctx, index, faces_total, uo, shortcuts] = job;
+  // Named references, not a structured binding: clang before 16 cannot capture bindings in lambdas.
+  const OccupancyGrid& g = job.g;
+  const double r = job.r;
+  const size_t n = job.n, nv = job.nv;
+  const std::vector<WorldPoint>& viewpoints = job.viewpoints;
+  const EvaluateOptions& options = job.options;
+  const JobContext& ctx = job.ctx;
+  const std::vector<VoxelIndex>& index = job.index;
+  const std::vector<Vector3d>& uo = job.uo;
+  const std::vector<char>& shortcuts = job.shortcuts;
   // Unbiased uniform sample of F with replacement: pick a voxel id and a face uniformly, and
   // re-draw faces outside F (rejection keeps the distribution uniform over F).
   ev.sampled = true;
@@ -269,7 +278,17 @@ Result<Evaluation> EvaluateSampled(const EvaluationJob& job, Evaluation ev) {
 // Exact mode into `ev` (resolution, |F| and per_viewpoint's size already set); the scene's
 // voxels are sorted and unique.
 Result<Evaluation> EvaluateExact(const EvaluationJob& job, Evaluation ev) {
-  const auto& [g, r, n, nv, viewpoints, options, ctx, index, faces_total, uo, shortcuts] = job;
+  // Named references, not a structured binding: clang before 16 cannot capture bindings in lambdas.
+  const OccupancyGrid& g = job.g;
+  const double r = job.r;
+  const size_t n = job.n, nv = job.nv;
+  const std::vector<WorldPoint>& viewpoints = job.viewpoints;
+  const EvaluateOptions& options = job.options;
+  const JobContext& ctx = job.ctx;
+  const std::vector<VoxelIndex>& index = job.index;
+  const uint64_t faces_total = job.faces_total;
+  const std::vector<Vector3d>& uo = job.uo;
+  const std::vector<char>& shortcuts = job.shortcuts;
   ev.faces_evaluated = faces_total;
   // Distinct lattice corners of all occupied voxels, and each voxel's 8 corner ids.
   const LatticeCorners lattice = ListCorners(index);
