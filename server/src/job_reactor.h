@@ -73,10 +73,6 @@ struct ServiceState {
     std::unique_lock lock(calls_mu);
     return calls_ended.wait_until(lock, deadline, [&] { return calls.empty(); });
   }
-  bool HasCalls() {
-    std::lock_guard lock(calls_mu);
-    return !calls.empty();
-  }
   void CancelAll() {
     std::lock_guard lock(calls_mu);
     for (CancelToken* t : calls) t->Cancel();
