@@ -206,11 +206,12 @@ class JobReactor : public grpc::ServerBidiReactor<Request, Response> {
           r.mutable_accepted()->set_queue_position(position);
           outbox_.Post(std::move(r));
         },
-        [this] { Work(); });
+        [this](WorkerPool::Ticket place) { Work(std::move(place)); });
   }
 
-  // On a worker thread.
-  void Work() {
+  // On a worker thread. The place goes back to the pool before the final status goes out, so a
+  // client that submits again on hearing it is not refused as busy.
+  void Work(WorkerPool::Ticket place) {
     const Status s = state_->runner.Run(
         std::move(job_), token_,
         [this](const ProgressEvent& e) {
@@ -219,11 +220,13 @@ class JobReactor : public grpc::ServerBidiReactor<Request, Response> {
           outbox_.PostProgress(std::move(r));
         },
         [this](const SceneInput& input, const JobContext& ctx, JobLog& log) { return Run(input, ctx, log); });
+    place.Release();
     outbox_.Complete(s);  // last touch of this reactor by the worker
   }
 
   // Ends a call that never reached a worker, with its log line (gRPC threads).
   void Reject(const Status& status) {
+    upload_.TakeTicket();  // the place (if one was reserved) is free before the client hears the status
     spdlog::info("rpc {} peer={} upload={} rejected status={}: {}", method_, ctx_->peer(),
                  HumanBytes(upload_.declared_bytes()), int(wire::ToGrpcCode(status.code())), status.message());
     outbox_.Complete(status);

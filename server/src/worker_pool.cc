@@ -5,7 +5,7 @@
 namespace vc::server {
 
 void WorkerPool::Ticket::Reset() {
-  if (pool_ != nullptr) pool_->Release();
+  if (pool_ != nullptr) pool_->Release(running_);
   pool_ = nullptr;
 }
 
@@ -28,11 +28,11 @@ std::optional<WorkerPool::Ticket> WorkerPool::TryAdmit() {
   std::lock_guard lock(mu_);
   if (stopping_ || admitted_ >= int(threads_.size()) + queue_capacity_) return std::nullopt;
   ++admitted_;
-  return Ticket(this);
+  return Ticket(this, /*running=*/false);
 }
 
-void WorkerPool::Submit(Ticket ticket, const std::function<void(uint32_t)>& on_queued, std::function<void()> task) {
-  ticket.pool_ = nullptr;  // the place is released when the task has run
+void WorkerPool::Submit(Ticket ticket, const std::function<void(uint32_t)>& on_queued, Task task) {
+  ticket.pool_ = nullptr;  // the place passes to the task, as a running ticket, when a worker starts it
   std::lock_guard lock(mu_);
   // Idle workers take the first `idle` queued tasks; the new task is at index queue_.size().
   const int idle = int(threads_.size()) - running_;
@@ -52,9 +52,10 @@ int WorkerPool::running() const {
   return running_;
 }
 
-void WorkerPool::Release() {
+void WorkerPool::Release(bool running) {
   std::lock_guard lock(mu_);
   --admitted_;
+  if (running) --running_;
 }
 
 void WorkerPool::WorkerLoop() {
@@ -66,10 +67,8 @@ void WorkerPool::WorkerLoop() {
     queue_.pop_front();
     ++running_;
     lock.unlock();
-    task();
+    task(Ticket(this, /*running=*/true));  // the task's ticket gives the place back, at the latest on return
     lock.lock();
-    --running_;
-    --admitted_;
   }
 }
 

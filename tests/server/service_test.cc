@@ -232,6 +232,19 @@ TEST_F(PlanErrors, ChecksumMismatch) {
   EXPECT_TRUE(call.responses.empty()) << "no job may start before the upload is verified";
 }
 
+// One worker and no queue: every call's place must be free by the time its client hears the final
+// status, whether the call was refused during the upload or ran to the end, so back-to-back calls
+// are never refused as busy.
+TEST_F(PlanErrors, BackToBackCallsFindThePlaceFreeAfterAnErrorOrAResult) {
+  for (int i = 0; i < 20; ++i) {
+    auto bad = PlanRequests("0123456789");
+    bad[0].mutable_spec()->mutable_upload()->set_crc32c(bad[0].spec().upload().crc32c() ^ 1u);
+    ASSERT_EQ(Send(bad).status.error_code(), grpc::StatusCode::DATA_LOSS) << i;
+    const auto good = Send(PlanRequests("0123456789"));
+    ASSERT_TRUE(good.status.ok()) << i << ": " << good.status.error_message();
+  }
+}
+
 TEST_F(PlanErrors, EmptyUpload) {
   EXPECT_EQ(Send(PlanRequests("")).status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
 }

@@ -31,7 +31,8 @@ TEST(WorkerPool, QueuePositionsAndRelease) {
     auto t = pool.TryAdmit();
     ASSERT_TRUE(t.has_value());
     pool.Submit(
-        std::move(*t), [&](uint32_t p) { positions.push_back(p); }, std::move(task));
+        std::move(*t), [&](uint32_t p) { positions.push_back(p); },
+        [task = std::move(task)](WorkerPool::Ticket) { task(); });
   };
   submit([&] {
     first_running.set_value();
@@ -47,6 +48,54 @@ TEST(WorkerPool, QueuePositionsAndRelease) {
   release.set_value();
   while (pool.admitted() != 0) std::this_thread::yield();
   EXPECT_EQ(done.load(), 3);
+}
+
+// A job answers its client from inside its task; it gives its place back first, so a client that
+// submits again the moment it hears the answer is admitted (the CI run of 2026-12-03 found a
+// service test refused as busy in that window).
+TEST(WorkerPool, ATaskThatReleasesItsPlaceLetsTheNextJobInWhileItFinishes) {
+  WorkerPool pool(1, 0);
+  std::promise<void> place_released;
+  std::promise<void> finish;
+  std::shared_future<void> may_finish = finish.get_future().share();
+  auto t = pool.TryAdmit();
+  ASSERT_TRUE(t.has_value());
+  EXPECT_FALSE(pool.TryAdmit().has_value());
+  pool.Submit(
+      std::move(*t), [](uint32_t) {},
+      [&](WorkerPool::Ticket place) {
+        place.Release();
+        place.Release();  // idempotent
+        place_released.set_value();
+        may_finish.wait();
+      });
+  place_released.get_future().wait();
+  EXPECT_EQ(pool.admitted(), 0);
+  EXPECT_EQ(pool.running(), 0);
+  EXPECT_TRUE(pool.TryAdmit().has_value());
+  finish.set_value();
+}
+
+TEST(WorkerPool, ATaskThatKeepsItsPlaceGivesItBackOnReturn) {
+  WorkerPool pool(1, 0);
+  std::promise<void> started;
+  std::promise<void> finish;
+  std::shared_future<void> may_finish = finish.get_future().share();
+  auto t = pool.TryAdmit();
+  ASSERT_TRUE(t.has_value());
+  pool.Submit(
+      std::move(*t), [](uint32_t) {},
+      [&](WorkerPool::Ticket) {
+        started.set_value();
+        may_finish.wait();
+      });
+  started.get_future().wait();
+  EXPECT_FALSE(pool.TryAdmit().has_value());
+  EXPECT_EQ(pool.running(), 1);
+  finish.set_value();
+  while (pool.admitted() != 0) std::this_thread::yield();
+  EXPECT_EQ(pool.running(), 0);
+  EXPECT_TRUE(pool.TryAdmit().has_value());
 }
 
 }  // namespace

@@ -4,6 +4,10 @@
 // arrives, so a busy server refuses it before the client uploads anything, and submits the work
 // once the upload is verified. At most `workers + queue_capacity` jobs are admitted at a time
 // (running, queued or still uploading). Thread-safe.
+//
+// A running task holds its place as a Ticket and should drop it (Ticket::Release) before it
+// tells its client the job is over: a client that retries the moment it hears the final status
+// must find the place free, not be refused by a job that has already answered.
 #pragma once
 
 #include <condition_variable>
@@ -22,22 +26,26 @@ class WorkerPool {
   // A reserved place; releases it on destruction unless handed to Submit.
   class Ticket {
    public:
-    Ticket(Ticket&& other) noexcept : pool_(other.pool_) { other.pool_ = nullptr; }
+    Ticket(Ticket&& other) noexcept : pool_(other.pool_), running_(other.running_) { other.pool_ = nullptr; }
     Ticket& operator=(Ticket&& other) noexcept {
       if (this != &other) {
         Reset();
         pool_ = other.pool_;
+        running_ = other.running_;
         other.pool_ = nullptr;
       }
       return *this;
     }
     ~Ticket() { Reset(); }
+    // Gives the place back now (idempotent); the destructor does it otherwise.
+    void Release() { Reset(); }
 
    private:
     void Reset();
     friend class WorkerPool;
-    explicit Ticket(WorkerPool* pool) : pool_(pool) {}
+    Ticket(WorkerPool* pool, bool running) : pool_(pool), running_(running) {}
     WorkerPool* pool_;
+    bool running_ = false;  // the place of a task a worker is running
   };
 
   WorkerPool(int workers, int queue_capacity);
@@ -49,8 +57,10 @@ class WorkerPool {
   // A place for one job, or nullopt when workers + queue are all taken.
   std::optional<Ticket> TryAdmit();
   // Queues `task`; calls on_queued(position) before any worker can start it: 0 when a worker is
-  // free to start it now, n when it is n-th in line.
-  void Submit(Ticket ticket, const std::function<void(uint32_t queue_position)>& on_queued, std::function<void()> task);
+  // free to start it now, n when it is n-th in line. The worker hands the task its place; the
+  // place is free once the task releases the ticket or returns.
+  using Task = std::function<void(Ticket place)>;
+  void Submit(Ticket ticket, const std::function<void(uint32_t queue_position)>& on_queued, Task task);
 
   int workers() const { return int(threads_.size()); }
   int queue_capacity() const { return queue_capacity_; }
@@ -60,13 +70,13 @@ class WorkerPool {
   int running() const;
 
  private:
-  void Release();
+  void Release(bool running);
   void WorkerLoop();
 
   const int queue_capacity_;
   mutable std::mutex mu_;
   std::condition_variable cv_;
-  std::deque<std::function<void()>> queue_;
+  std::deque<Task> queue_;
   int admitted_ = 0;
   int running_ = 0;
   bool stopping_ = false;
