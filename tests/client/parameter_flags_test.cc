@@ -22,7 +22,16 @@ namespace {
 using nlohmann::json;
 
 // A valid value of the row's type other than `v`.
-double Other(double v, ParamCheck c) { return c == ParamCheck::kFraction ? v / 2 : v + 0.375; }
+double Other(double v, ParamCheck c) {
+  switch (c) {
+    case ParamCheck::kFraction:
+    case ParamCheck::kElevationDeg:
+    case ParamCheck::kIncidenceDeg:
+      return v / 2;
+    default:
+      return v + 0.375;
+  }
+}
 uint64_t Other(uint64_t v, ParamCheck) { return v + 3; }
 int32_t Other(int32_t v, ParamCheck) { return v + 3; }
 bool Other(bool v, ParamCheck) { return !v; }
@@ -42,6 +51,10 @@ std::optional<double> Bad(double, ParamCheck c) {
       return 0.0;
     case ParamCheck::kFraction:
       return 1.5;
+    case ParamCheck::kElevationDeg:
+      return -91.0;
+    case ParamCheck::kIncidenceDeg:
+      return 0.0;
   }
   return std::nullopt;
 }

@@ -36,6 +36,12 @@ Status CheckParameter(const ParamInfo& info, double v, std::string_view prefix) 
     case ParamCheck::kFraction:
       if (!std::isfinite(v) || v <= 0 || v > 1) return Refuse(info, prefix, "in (0, 1]", Num(v));
       break;
+    case ParamCheck::kElevationDeg:
+      if (!std::isfinite(v) || v < -90 || v > 90) return Refuse(info, prefix, "in [-90, 90]", Num(v));
+      break;
+    case ParamCheck::kIncidenceDeg:
+      if (!std::isfinite(v) || v <= 0 || v > 90) return Refuse(info, prefix, "in (0, 90]", Num(v));
+      break;
   }
   return Status::Ok();
 }
@@ -52,6 +58,12 @@ Status CheckParameter(const ParamInfo& info, int64_t v, std::string_view prefix)
       break;
     case ParamCheck::kFraction:
       if (v <= 0 || v > 1) return Refuse(info, prefix, "in (0, 1]", std::to_string(v));
+      break;
+    case ParamCheck::kElevationDeg:
+      if (v < -90 || v > 90) return Refuse(info, prefix, "in [-90, 90]", std::to_string(v));
+      break;
+    case ParamCheck::kIncidenceDeg:
+      if (v <= 0 || v > 90) return Refuse(info, prefix, "in (0, 90]", std::to_string(v));
       break;
   }
   return Status::Ok();

@@ -40,9 +40,14 @@ Json ParameterJson(SelectionTest t) { return std::string(SelectionTestName(t)); 
 
 #define VC_ROW_TO_JSON(type, name, ...) j[#name] = ParameterJson(o.name);
 
+// The limits that are off are null (docs/PLANNING.md "The scanner model").
 Json ScannerJson(const ScannerModel& o) {
   Json j = Json::object();
   VC_SCANNER_PARAMETERS(VC_ROW_TO_JSON)
+  if (!o.HasVerticalFieldOfView()) j["vfov_min_deg"] = j["vfov_max_deg"] = nullptr;
+  if (!o.HasIncidenceLimit()) j["max_incidence_deg"] = nullptr;
+  if (!o.HasSpacingLimit()) j["max_spacing_m"] = nullptr;
+  if (!(o.angular_step_deg > 0)) j["angular_step_deg"] = nullptr;
   return j;
 }
 

@@ -107,6 +107,16 @@ Status ScannerModel::Validate() const {
     return InvalidArgumentError("scanner.max_range_m (" + std::to_string(max_range_m) +
                                 " m) must be greater than scanner.min_range_m (" + std::to_string(min_range_m) + " m)");
   }
+  if (vfov_max_deg <= vfov_min_deg) {
+    return InvalidArgumentError("scanner.vfov_max_deg (" + std::to_string(vfov_max_deg) +
+                                " deg) must be greater than scanner.vfov_min_deg (" + std::to_string(vfov_min_deg) +
+                                " deg)");
+  }
+  if (max_spacing_m > 0 && !(angular_step_deg > 0)) {
+    return InvalidArgumentError(
+        "scanner.max_spacing_m is set but scanner.angular_step_deg is 0; give the instrument's angular step "
+        "(--angular-step) or a preset (--scanner)");
+  }
   return Status::Ok();
 }
 

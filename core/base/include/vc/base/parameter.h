@@ -32,6 +32,8 @@ enum class ParamCheck : uint8_t {
   kNonNegative,  // >= 0
   kPositive,     // > 0
   kFraction,     // in (0, 1]
+  kElevationDeg, // in [-90, 90] (degrees)
+  kIncidenceDeg, // in (0, 90] (degrees)
 };
 
 // A parameter's metadata, from its table row.

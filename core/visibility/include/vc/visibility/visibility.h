@@ -34,17 +34,35 @@ enum class SelectionTest {
 std::string_view SelectionTestName(SelectionTest t);  // "surface", "compatibility"
 
 // The scanner model's parameters (vc/base/parameter.h): X(type, name, default, unit, flag, check, help).
-// The range of ALGORITHM.md s.5; V = 0 outside [min_range_m, max_range_m].
-#define VC_SCANNER_PARAMETERS(X)                                                       \
-  X(double, min_range_m, 0.5, "m", "min-range", kNonNegative, "scanner minimum range") \
-  X(double, max_range_m, 75.0, "m", "max-range", kPositive, "scanner maximum range")
+// Each is a hard limit on what a station sees (docs/PLANNING.md "The scanner model"): selection
+// counts a voxel only through a face that passes every limit, and V (ALGORITHM.md s.5) is 0 for a
+// face that fails one. The defaults keep the paper's plans: the range [0.5, 75] m and no other
+// limit (a value at its "off" end: vfov -90..90, incidence 90, spacing 0).
+#define VC_SCANNER_PARAMETERS(X)                                                                                 \
+  X(double, min_range_m, 0.5, "m", "min-range", kNonNegative, "scanner minimum range")                           \
+  X(double, max_range_m, 75.0, "m", "max-range", kPositive, "scanner maximum range")                             \
+  X(double, vfov_min_deg, -90.0, "deg", "vfov-min", kElevationDeg,                                               \
+    "lowest elevation the scanner sees (-90 = straight down, no limit)")                                         \
+  X(double, vfov_max_deg, 90.0, "deg", "vfov-max", kElevationDeg,                                                \
+    "highest elevation the scanner sees (90 = straight up, no limit)")                                           \
+  X(double, max_incidence_deg, 90.0, "deg", "max-incidence", kIncidenceDeg,                                      \
+    "largest angle between a face's normal and the direction to the scanner (90 = no limit)")                    \
+  X(double, angular_step_deg, 0.0, "deg", "angular-step", kNonNegative,                                          \
+    "the scanner's angular step between points (needed by --max-spacing)")                                       \
+  X(double, max_spacing_m, 0.0, "m", "max-spacing", kNonNegative,                                                \
+    "largest point spacing a face may get to count: distance x step / cos(incidence) (0 = no requirement)")
 
-// The scanner (ALGORITHM.md s.5).
+// The scanner (ALGORITHM.md s.5, and the limits above).
 struct ScannerModel {
   VC_SCANNER_PARAMETERS(VC_DECLARE_PARAMETER)
-  // INVALID_ARGUMENT naming the field ("scanner.max_range_m ..."): a row's check, or
-  // min_range_m >= max_range_m.
+  // INVALID_ARGUMENT naming the field ("scanner.max_range_m ..."): a row's check,
+  // min_range_m >= max_range_m, vfov_min_deg >= vfov_max_deg, or max_spacing_m without
+  // angular_step_deg.
   Status Validate() const;
+  // Whether a limit other than the range is on.
+  bool HasVerticalFieldOfView() const { return vfov_min_deg > -90.0 || vfov_max_deg < 90.0; }
+  bool HasIncidenceLimit() const { return max_incidence_deg < 90.0; }
+  bool HasSpacingLimit() const { return max_spacing_m > 0.0; }
 };
 
 // Faces of a voxel, by outward normal.
