@@ -132,6 +132,7 @@ struct EvaluationJob {
   uint64_t faces_total;
   std::vector<Vector3d> uo;
   std::vector<char> shortcuts;
+  std::vector<ScannerLimits> limits;  // the scanner's, per viewpoint
 };
 
 // The job of evaluating `viewpoints` on `scene`: voxel indices and |F| always, the viewpoints in
@@ -140,7 +141,7 @@ EvaluationJob Prepare(const VoxelScene& scene, const std::vector<WorldPoint>& vi
                       const EvaluateOptions& options, const JobContext& ctx) {
   const OccupancyGrid& g = scene.grid;
   const size_t n = scene.occupied.size();
-  EvaluationJob job{g, scene.resolution_m, n, viewpoints.size(), viewpoints, options, ctx, {}, 0, {}, {}};
+  EvaluationJob job{g, scene.resolution_m, n, viewpoints.size(), viewpoints, options, ctx, {}, 0, {}, {}, {}};
   job.index.resize(n);
   for (size_t i = 0; i < n; ++i) job.index[i] = KeyToIndex(scene.occupied[i]);
   for (size_t i = 0; i < n; ++i)
@@ -148,9 +149,11 @@ EvaluationJob Prepare(const VoxelScene& scene, const std::vector<WorldPoint>& vi
   if (job.faces_total == 0) return job;
   job.uo.resize(viewpoints.size());
   job.shortcuts.resize(viewpoints.size());
+  job.limits.resize(viewpoints.size());
   for (size_t k = 0; k < viewpoints.size(); ++k) {
     job.uo[k] = g.WorldToIndexSpace(viewpoints[k]);
     job.shortcuts[k] = internal::ShortcutsHold(g, job.uo[k]);
+    job.limits[k] = ScannerLimits(options.scanner, job.r, job.uo[k]);
   }
   return job;
 }
@@ -213,6 +216,7 @@ Result<Evaluation> EvaluateSampled(const EvaluationJob& job, Evaluation ev) {
   const std::vector<VoxelIndex>& index = job.index;
   const std::vector<Vector3d>& uo = job.uo;
   const std::vector<char>& shortcuts = job.shortcuts;
+  const std::vector<ScannerLimits>& limits = job.limits;
   // Unbiased uniform sample of F with replacement: pick a voxel id and a face uniformly, and
   // re-draw faces outside F (rejection keeps the distribution uniform over F).
   ev.sampled = true;
@@ -249,7 +253,7 @@ Result<Evaluation> EvaluateSampled(const EvaluationJob& job, Evaluation ev) {
             OccluderCache cache(shortcuts[k]);
             for (int q : kFaceCorners[int(f)]) visible += CornerVisibleCached(g, uo[k], Corner(v, q), cache);
             const Perception p = FromCount(visible);
-            const double val = FaceValue(p, viewpoints[k], v, f, r, options.scanner);
+            const double val = FaceValue(p, viewpoints[k], v, f, r, options.scanner, limits[k]);
             per[c][k].Add(p, val);
             KeepBest(val, p, best, best_p);
           }
@@ -289,6 +293,7 @@ Result<Evaluation> EvaluateExact(const EvaluationJob& job, Evaluation ev) {
   const uint64_t faces_total = job.faces_total;
   const std::vector<Vector3d>& uo = job.uo;
   const std::vector<char>& shortcuts = job.shortcuts;
+  const std::vector<ScannerLimits>& limits = job.limits;
   ev.faces_evaluated = faces_total;
   // Distinct lattice corners of all occupied voxels, and each voxel's 8 corner ids.
   const LatticeCorners lattice = ListCorners(index);
@@ -392,7 +397,7 @@ Result<Evaluation> EvaluateExact(const EvaluationJob& job, Evaluation ev) {
         for (int f = 0; f < kFacesPerVoxel; ++f) {
           if (!((faces_in_set[i] >> f) & 1)) continue;
           const Perception p = FromCount(std::popcount(corner_bits & kFaceCornerMask[f]));
-          const double val = FaceValue(p, viewpoints[k], index[i], Face(f), r, options.scanner);
+          const double val = FaceValue(p, viewpoints[k], index[i], Face(f), r, options.scanner, limits[k]);
           t.Add(p, val);
           const size_t slot = i * kFacesPerVoxel + f;
           if (keep) (*keep)[slot] = float(val);

@@ -396,7 +396,7 @@ void SurfaceTargets::WalkGroups(const Vector3d& uo, const Brick& brick, GroupWal
     for (int a = 0; a < 3; ++a) {
       const int layer = t[j].local[a];
       const int sp = kind.facing[a][layer];
-      if (sp < 0 || !((t[j].exposed >> (2 * a + sp)) & 1)) continue;
+      if (sp < 0 || !((t[j].exposed >> (2 * a + sp)) & 1) || kind.Excluded(j, 2 * a + sp)) continue;
       const int p = t[j].local[(a + 1) % 3] * 8 + t[j].local[(a + 2) % 3];
       members[a][sp][layer] |= uint64_t{1} << p;
       slot[a][layer][p] = uint16_t(j);
@@ -522,6 +522,8 @@ struct SurfaceTargets::CentreKind {
     return {base[0] + t[j].local[0], base[1] + t[j].local[1], base[2] + t[j].local[2]};
   }
   bool Skip(int j) const { return (visible[j >> 6] >> (j & 63)) & 1; }
+  // Face f of target j fails the scanner's limits (marked in `tried` before the walk).
+  bool Excluded(int j, int f) const { return (tried[j] >> f) & 1; }
   void Rect(int a, const int b[3], int plane, int voxel_a, int umin, int umax, int wmin, int wmax, Vector3d& q0,
             Vector3d& q1, VoxelIndex& klo, VoxelIndex& khi) const {
     const int b1 = (a + 1) % 3, b2 = (a + 2) % 3;
@@ -640,8 +642,8 @@ class LeftoverRays {
 
 }  // namespace
 
-void SurfaceTargets::AppendVisible(const Vector3d& uo, size_t brick_begin, size_t brick_end, GroupWalk& walk,
-                                   const BitWriter& visible) const {
+void SurfaceTargets::AppendVisible(const Vector3d& uo, const ScannerLimits& limits, size_t brick_begin,
+                                   size_t brick_end, GroupWalk& walk, const BitWriter& visible) const {
   LeftoverRays rays(grid_, uo, walk.cache, visible);
   for (size_t b = brick_begin; b < brick_end; ++b) {
     const Brick& brick = bricks_[b];
@@ -652,10 +654,27 @@ void SurfaceTargets::AppendVisible(const Vector3d& uo, size_t brick_begin, size_
     const VoxelIndex lo{base[0] + brick.lo[0], base[1] + brick.lo[1], base[2] + brick.lo[2]};
     const VoxelIndex hi{base[0] + brick.hi[0], base[1] + brick.hi[1], base[2] + brick.hi[2]};
     if (walk.cache.FindIf([&](const SolidBox& box) { return Shadows(box, uo, lo, hi); })) continue;
+    // The scanner's limits: a brick wholly out of range has no visible voxel; in a brick that the
+    // range does not decide whole, each facing face is judged by itself, and one that fails is
+    // marked decided-blocked before the walk, so no group holds it and no ray goes to it.
+    const ScannerLimits::Verdict verdict =
+        limits.BoxVerdict(Vector3d(lo.x, lo.y, lo.z), Vector3d(hi.x + 1, hi.y + 1, hi.z + 1));
+    if (verdict == ScannerLimits::Verdict::kNone) continue;
     CentreKind kind{grid_, uo, &targets_[brick.begin], base, {}, {}, {}};
     FacingTable(uo, base, kind.facing);
     kind.visible.fill(0);
     std::fill_n(kind.tried.begin(), n, 0);
+    if (verdict == ScannerLimits::Verdict::kSome) {
+      for (int j = 0; j < n; ++j) {
+        const VoxelIndex v = kind.VoxelOf(j);
+        for (int a = 0; a < 3; ++a) {
+          const int sp = kind.facing[a][kind.t[j].local[a]];
+          if (sp < 0 || !((kind.t[j].exposed >> (2 * a + sp)) & 1)) continue;
+          const int plane = At(v, a) + sp;
+          if (!limits.Passes(FaceCentre(v, a, plane), a, sp ? 1 : -1)) kind.tried[j] |= uint8_t(1u << (2 * a + sp));
+        }
+      }
+    }
     WalkGroups(uo, brick, walk, kind);
 
     // What no group decided: a ray per face, in batches. facing_bits[a][l]: the face of a
@@ -700,6 +719,7 @@ struct SurfaceTargets::CornerKind {
   const FreeBox& around;
 
   bool Skip(int) const { return false; }
+  bool Excluded(int, int) const { return false; }
   void Rect(int a, const int b[3], int plane, int, int umin, int umax, int wmin, int wmax, Vector3d& q0, Vector3d& q1,
             VoxelIndex& klo, VoxelIndex& khi) const {
     const int b1 = (a + 1) % 3, b2 = (a + 2) % 3;

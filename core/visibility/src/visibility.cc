@@ -19,6 +19,7 @@
 #include "vc/base/popcount.h"
 #include "vc/raycast/occluders.h"
 #include "vc/raycast/ray_traversal.h"
+#include "vc/visibility/scanner_limits.h"
 #include "vc/visibility/surface_groups.h"
 #include "visibility_internal.h"
 
@@ -41,8 +42,14 @@ using internal::StageProgress;
 using planner::ParallelChunks;
 using planner::ResolveThreads;
 
-bool CompatibleCached(const OccupancyGrid& g, const Vector3d& uo, const VoxelIndex& v, OccluderCache& cache) {
+bool CompatibleCached(const OccupancyGrid& g, const Vector3d& uo, const VoxelIndex& v, const ScannerLimits& limits,
+                      OccluderCache& cache) {
   const Vector3d target(v.x + 0.5, v.y + 0.5, v.z + 0.5);
+  if (limits.active()) {
+    int axis, sign;
+    limits.EntryFace(v, &axis, &sign);
+    if (!limits.Passes(target, axis, sign)) return false;
+  }
   if (cache.Blocks(uo, target, v)) return false;
   const auto hit = FirstOccupied(g, uo, target);
   if (hit && *hit != v) cache.Add(*hit);
@@ -73,12 +80,14 @@ int FacingFaces(const Vector3d& uo, const VoxelIndex& v, Face faces[3]) {
   return n;
 }
 
-bool SurfaceVisibleCached(const OccupancyGrid& g, const Vector3d& uo, const VoxelIndex& v, OccluderCache& cache) {
+bool SurfaceVisibleCached(const OccupancyGrid& g, const Vector3d& uo, const VoxelIndex& v, const ScannerLimits& limits,
+                          OccluderCache& cache) {
   Face faces[3];
   const int n = FacingFaces(uo, v, faces);
   for (int i = 0; i < n; ++i) {
     if (g.Occupied(Neighbour(v, faces[i]))) continue;  // not exposed
     const Vector3d target = FaceCenterIS(v, faces[i]);
+    if (!limits.Passes(target, internal::FaceAxis(faces[i]), internal::FaceSign(faces[i]))) continue;
     if (cache.Blocks(uo, target, v)) continue;
     const auto hit = FirstOccupied(g, uo, target, &v);
     if (!hit) return true;
@@ -120,20 +129,37 @@ Status ScannerModel::Validate() const {
   return Status::Ok();
 }
 
-bool IsCompatible(const OccupancyGrid& grid, const WorldPoint& o, const VoxelIndex& v) {
+namespace {
+
+// One selection test for a single (viewpoint, voxel), with the limits of `scanner` or none.
+template <typename Test>
+bool SingleQuery(const OccupancyGrid& grid, const WorldPoint& o, const VoxelIndex& v, const ScannerModel* scanner,
+                 Test test) {
   if (!ViewpointInRange(o, grid.resolution_m())) return false;
   const Vector3d uo = grid.WorldToIndexSpace(o);
   if (InsideOccupied(grid, uo)) return false;
+  const ScannerLimits limits = scanner ? ScannerLimits(*scanner, grid.resolution_m(), uo) : ScannerLimits();
   OccluderCache cache(internal::ShortcutsHold(grid, uo));
-  return CompatibleCached(grid, uo, v, cache);
+  return test(grid, uo, v, limits, cache);
+}
+
+}  // namespace
+
+bool IsCompatible(const OccupancyGrid& grid, const WorldPoint& o, const VoxelIndex& v) {
+  return SingleQuery(grid, o, v, nullptr, CompatibleCached);
+}
+
+bool IsCompatible(const OccupancyGrid& grid, const WorldPoint& o, const VoxelIndex& v, const ScannerModel& scanner) {
+  return SingleQuery(grid, o, v, &scanner, CompatibleCached);
 }
 
 bool IsSurfaceVisible(const OccupancyGrid& grid, const WorldPoint& o, const VoxelIndex& v) {
-  if (!ViewpointInRange(o, grid.resolution_m())) return false;
-  const Vector3d uo = grid.WorldToIndexSpace(o);
-  if (InsideOccupied(grid, uo)) return false;
-  OccluderCache cache(internal::ShortcutsHold(grid, uo));
-  return SurfaceVisibleCached(grid, uo, v, cache);
+  return SingleQuery(grid, o, v, nullptr, SurfaceVisibleCached);
+}
+
+bool IsSurfaceVisible(const OccupancyGrid& grid, const WorldPoint& o, const VoxelIndex& v,
+                      const ScannerModel& scanner) {
+  return SingleQuery(grid, o, v, &scanner, SurfaceVisibleCached);
 }
 
 Perception PerceiveFace(const OccupancyGrid& grid, const WorldPoint& o, const VoxelIndex& v, Face f) {
@@ -155,7 +181,8 @@ double VisibilityValue(Perception p, double d, double theta, const ScannerModel&
 
 double FaceVisibility(const OccupancyGrid& grid, const WorldPoint& o, const VoxelIndex& v, Face f,
                       const ScannerModel& scanner) {
-  return FaceValue(PerceiveFace(grid, o, v, f), o, v, f, grid.resolution_m(), scanner);
+  const ScannerLimits limits(scanner, grid.resolution_m(), grid.WorldToIndexSpace(o));
+  return FaceValue(PerceiveFace(grid, o, v, f), o, v, f, grid.resolution_m(), scanner, limits);
 }
 
 VC_POPCOUNT_CLONES size_t VoxelSet::count() const {
@@ -191,9 +218,11 @@ Result<std::vector<VoxelSet>> ComputeVisibilitySets(const VoxelScene& scene, con
   const std::vector<uint32_t> candidates = NotEnclosed(g, index);
   std::vector<VoxelSet> sets(viewpoints.size());
   std::vector<Vector3d> uo(viewpoints.size());
+  std::vector<ScannerLimits> limits(viewpoints.size());
   std::vector<char> valid(viewpoints.size()), shortcuts(viewpoints.size());
   for (size_t k = 0; k < viewpoints.size(); ++k) {
     uo[k] = g.WorldToIndexSpace(viewpoints[k]);
+    if (options.scanner) limits[k] = ScannerLimits(*options.scanner, g.resolution_m(), uo[k]);
     valid[k] = ViewpointInRange(viewpoints[k], g.resolution_m()) && !InsideOccupied(g, uo[k]);
     shortcuts[k] = valid[k] && internal::ShortcutsHold(g, uo[k]);
   }
@@ -229,7 +258,7 @@ Result<std::vector<VoxelSet>> ComputeVisibilitySets(const VoxelScene& scene, con
         internal::GroupWalk walk;
         walk.around = internal::GrowFreeBox(g, uo[k]);
         const size_t b0 = c * bricks_per_task, b1 = std::min<size_t>(b0 + bricks_per_task, targets.brick_count());
-        targets.AppendVisible(uo[k], b0, b1, walk, {sets[k].words().data(), brick_chunks > 1});
+        targets.AppendVisible(uo[k], limits[k], b0, b1, walk, {sets[k].words().data(), brick_chunks > 1});
       }
       progress.Add(1);
     });
@@ -261,7 +290,8 @@ Result<std::vector<VoxelSet>> ComputeVisibilitySets(const VoxelScene& scene, con
       OccluderCache cache(shortcuts[k]);
       for (size_t j = chunk_start[c]; j < chunk_start[c + 1]; ++j) {
         const uint32_t id = candidates[j];
-        if (compat ? CompatibleCached(g, uo[k], index[id], cache) : SurfaceVisibleCached(g, uo[k], index[id], cache)) {
+        if (compat ? CompatibleCached(g, uo[k], index[id], limits[k], cache)
+                   : SurfaceVisibleCached(g, uo[k], index[id], limits[k], cache)) {
           set.set(id);
         }
       }

@@ -19,7 +19,8 @@ Status CheckVisibilitySetBudget(uint64_t positions, uint64_t voxels, uint64_t bu
 
 Result<VisibilityOutput> RunVisibilityStage(const VisibilityInput& in, const PlanOptions& options,
                                             const JobContext& ctx) {
-  const VisibilitySetsOptions set_options{options.selection_test, options.threads};
+  VisibilitySetsOptions set_options{options.selection_test, options.threads};
+  set_options.scanner = options.scanner;
   VisibilityOutput out;
   VC_ASSIGN_OR_RETURN(out.sets, ComputeVisibilitySets(in.scene, in.candidates, set_options, ctx));
   out.heat_map.positions = in.candidates;

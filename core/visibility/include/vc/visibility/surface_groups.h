@@ -14,6 +14,7 @@
 
 #include "vc/raycast/occluders.h"
 #include "vc/scene/occupancy_grid.h"
+#include "vc/visibility/scanner_limits.h"
 
 namespace vc::internal {
 
@@ -75,10 +76,10 @@ class SurfaceTargets {
 
   // Sets in `visible` the bit of every target in bricks [brick_begin, brick_end) that is
   // surface-visible from uo (index space; uo must not lie in an occupied voxel, and
-  // ShortcutsHold(grid, uo) must be true). `walk` carries state between calls for the same
-  // viewpoint.
-  void AppendVisible(const Eigen::Vector3d& uo, size_t brick_begin, size_t brick_end, GroupWalk& walk,
-                     const BitWriter& visible) const;
+  // ShortcutsHold(grid, uo) must be true) through a face that passes `limits` (the scanner's,
+  // for uo). `walk` carries state between calls for the same viewpoint.
+  void AppendVisible(const Eigen::Vector3d& uo, const ScannerLimits& limits, size_t brick_begin, size_t brick_end,
+                     GroupWalk& walk, const BitWriter& visible) const;
 
   // Appends corner-visibility decisions (ALGORITHM.md s.4, the 8-voxel corner rule) that groups
   // of faces facing uo in bricks [brick_begin, brick_end) prove; corners not mentioned are

@@ -17,6 +17,7 @@
 
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "vc/base/geometry.h"
@@ -73,10 +74,15 @@ enum class Perception : uint8_t { kNone = 0, kPartial, kFull };
 
 // --- Single queries (grid index space for voxels, world frame for viewpoints) ---
 
-// s.3. False if o is inside an occupied voxel.
+// s.3. False if o is inside an occupied voxel. With a scanner: also false unless v's centre passes
+// its limits (incidence and spacing judged on the face the ray enters v through).
 bool IsCompatible(const OccupancyGrid& grid, const WorldPoint& o, const VoxelIndex& v);
-// s.3b. False if o is inside an occupied voxel.
+bool IsCompatible(const OccupancyGrid& grid, const WorldPoint& o, const VoxelIndex& v, const ScannerModel& scanner);
+// s.3b. False if o is inside an occupied voxel. With a scanner: only faces that pass its limits
+// count. Without one: no limit, not even the range (the paper's definition).
 bool IsSurfaceVisible(const OccupancyGrid& grid, const WorldPoint& o, const VoxelIndex& v);
+bool IsSurfaceVisible(const OccupancyGrid& grid, const WorldPoint& o, const VoxelIndex& v,
+                      const ScannerModel& scanner);
 
 // s.4: full, partial or no perception of face `f` of voxel v from o.
 Perception PerceiveFace(const OccupancyGrid& grid, const WorldPoint& o, const VoxelIndex& v, Face f);
@@ -85,7 +91,8 @@ Perception PerceiveFace(const OccupancyGrid& grid, const WorldPoint& o, const Vo
 // (radians, 0..pi) between the ray to the face centre and the face normal.
 double VisibilityValue(Perception p, double distance_m, double theta_rad, const ScannerModel& scanner);
 
-// s.5 for one face: perception, then V with d and theta measured to the face centre.
+// s.5 for one face: perception, then V with d and theta measured to the face centre; 0 when the
+// face centre fails one of the scanner's limits.
 double FaceVisibility(const OccupancyGrid& grid, const WorldPoint& o, const VoxelIndex& v, Face f,
                       const ScannerModel& scanner);
 
@@ -135,6 +142,11 @@ struct VisibilitySetsOptions {
   // Surface test only: decide every voxel by its own rays instead of by groups of faces (same
   // answers, slower; kept as the reference for tests and benchmarks).
   bool per_voxel = false;
+  // The instrument's limits (vc/visibility/scanner_limits.h): a voxel counts only through a face
+  // (compatibility: its centre, judged on the face the ray enters by) that passes all of them.
+  // None: no limit at all, not even the range (the paper's tests, as the planner used them
+  // before the scanner model; the planner always passes its scanner).
+  std::optional<ScannerModel> scanner;
 };
 
 // For each viewpoint, the occupied voxels that pass the selection test. Viewpoints inside an

@@ -1,0 +1,63 @@
+// The scanner model's hard limits for one station (docs/PLANNING.md "The scanner model").
+//
+// Per (station, aim point, face): the aim point is the face centre under surface visibility and
+// the voxel centre under compatibility; the face is the one judged (under compatibility, the face
+// the ray enters through). The limits, all inclusive:
+// - range:     d in [min_range_m, max_range_m], d the distance from the station to the aim point;
+// - vertical field of view: the aim point's elevation atan2(dz, horizontal distance), in degrees,
+//              in [vfov_min_deg, vfov_max_deg];
+// - incidence: the angle between the face's outward normal and the direction from the aim point
+//              to the station is at most max_incidence_deg;
+// - spacing:   d * step_rad / cos(incidence) <= max_spacing_m.
+//
+// Every test is computed here, once, in index space (voxel units): the grouped engine, the per-ray
+// reference and the evaluation all call Passes, so they agree on every tie. Squared lengths are
+// compared, so an aim point exactly on a limit passes up to the rounding of (limit / resolution)^2;
+// that rounding is the same in every path.
+#pragma once
+
+#include <Eigen/Core>
+
+#include "vc/scene/occupancy_grid.h"
+#include "vc/visibility/visibility.h"
+
+namespace vc {
+
+class ScannerLimits {
+ public:
+  ScannerLimits() = default;  // no limit at all
+  // uo: the station in index space (OccupancyGrid::WorldToIndexSpace).
+  ScannerLimits(const ScannerModel& scanner, double resolution_m, const Eigen::Vector3d& uo);
+
+  // Whether any limit can fail (with the defaults on a scene within 75 m: only near the station).
+  bool active() const { return active_; }
+
+  // True if the aim point (index space) passes every limit, judged on the face whose outward
+  // normal is +axis (sign > 0) or -axis (sign < 0).
+  bool Passes(const Eigen::Vector3d& aim, int axis, int sign) const;
+
+  // What the limits say for every aim point in the box [lo, hi] (index space), from the range
+  // alone: kNone when no point of the box is in range, kAll when every point is and no other limit
+  // is on, kSome otherwise (decide point by point).
+  enum class Verdict { kNone, kSome, kAll };
+  Verdict BoxVerdict(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) const;
+
+  // The face a segment from the station to the centre of voxel v enters v through: the axis whose
+  // slab the segment enters last (at an exact tie the lowest axis, which the walk's tie rule - z,
+  // then y, then x - steps last), with the sign of that face's outward normal. The station must
+  // lie outside v.
+  void EntryFace(const VoxelIndex& v, int* axis, int* sign) const;
+
+ private:
+  Eigen::Vector3d uo_ = Eigen::Vector3d::Zero();
+  bool active_ = false;
+  double min2_ = 0, max2_ = 0;  // squared range, voxel units
+  bool vfov_ = false;
+  double vfov_min_deg_ = -90, vfov_max_deg_ = 90;
+  bool incidence_ = false;
+  double cos2_max_ = 0;  // cos^2(max_incidence)
+  bool spacing_ = false;
+  double spacing_k_ = 0;  // resolution * step_rad / max_spacing: d^2 * k <= s passes
+};
+
+}  // namespace vc

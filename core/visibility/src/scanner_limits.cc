@@ -1,0 +1,81 @@
+#include "vc/visibility/scanner_limits.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+namespace vc {
+
+ScannerLimits::ScannerLimits(const ScannerModel& s, double r, const Eigen::Vector3d& uo) : uo_(uo) {
+  min2_ = (s.min_range_m / r) * (s.min_range_m / r);
+  max2_ = (s.max_range_m / r) * (s.max_range_m / r);
+  vfov_ = s.HasVerticalFieldOfView();
+  vfov_min_deg_ = s.vfov_min_deg;
+  vfov_max_deg_ = s.vfov_max_deg;
+  incidence_ = s.HasIncidenceLimit();
+  const double c = std::cos(s.max_incidence_deg * std::numbers::pi / 180.0);
+  cos2_max_ = c * c;
+  spacing_ = s.HasSpacingLimit();
+  spacing_k_ = spacing_ ? r * (s.angular_step_deg * std::numbers::pi / 180.0) / s.max_spacing_m : 0.0;
+  active_ = true;  // the range always is; BoxVerdict says where it matters
+}
+
+bool ScannerLimits::Passes(const Eigen::Vector3d& aim, int axis, int sign) const {
+  if (!active_) return true;
+  const Eigen::Vector3d d = uo_ - aim;  // from the aim point to the station
+  const double d2 = d.squaredNorm();
+  if (!(d2 >= min2_ && d2 <= max2_)) return false;
+  if (vfov_) {
+    // The aim point's elevation seen from the station: dz = aim.z - station.z = -d.z.
+    const double elevation_deg = std::atan2(-d.z(), std::hypot(d.x(), d.y())) * (180.0 / std::numbers::pi);
+    if (!(elevation_deg >= vfov_min_deg_ && elevation_deg <= vfov_max_deg_)) return false;
+  }
+  // s = |d| cos(incidence): the component of d along the face's outward normal.
+  const double s = sign > 0 ? d[axis] : -d[axis];
+  if (incidence_ && !(s >= 0 && s * s >= cos2_max_ * d2)) return false;
+  // spacing = |d| r step / cos(incidence) = d2 r step / s <= max_spacing  <=>  d2 k <= s.
+  if (spacing_ && !(s > 0 && d2 * spacing_k_ <= s)) return false;
+  return true;
+}
+
+ScannerLimits::Verdict ScannerLimits::BoxVerdict(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) const {
+  if (!active_) return Verdict::kAll;
+  double near2 = 0, far2 = 0;
+  for (int a = 0; a < 3; ++a) {
+    const double below = lo[a] - uo_[a], above = uo_[a] - hi[a];
+    const double near = std::max({below, above, 0.0});
+    const double far = std::max(std::abs(lo[a] - uo_[a]), std::abs(hi[a] - uo_[a]));
+    near2 += near * near;
+    far2 += far * far;
+  }
+  // A margin for the rounding of these sums against Passes' own: a box within it is decided point
+  // by point.
+  const double slack = 1e-9 * (far2 + 1);
+  if (near2 > max2_ + slack || far2 < min2_ - slack) return Verdict::kNone;
+  if (near2 >= min2_ + slack && far2 <= max2_ - slack && !vfov_ && !incidence_ && !spacing_) return Verdict::kAll;
+  return Verdict::kSome;
+}
+
+void ScannerLimits::EntryFace(const VoxelIndex& v, int* axis, int* sign) const {
+  const double lo[3] = {double(v.x), double(v.y), double(v.z)};
+  double best = -1;
+  *axis = 0;
+  *sign = 1;
+  for (int a = 0; a < 3; ++a) {
+    const double centre = lo[a] + 0.5;
+    double t;
+    int s;
+    if (uo_[a] < lo[a]) {
+      t = (lo[a] - uo_[a]) / (centre - uo_[a]);
+      s = -1;
+    } else if (uo_[a] > lo[a] + 1) {
+      t = (lo[a] + 1 - uo_[a]) / (centre - uo_[a]);
+      s = 1;
+    } else {
+      continue;  // the station is within v's slab along a: the segment does not enter it there
+    }
+    if (t > best) best = t, *axis = a, *sign = s;
+  }
+}
+
+}  // namespace vc
