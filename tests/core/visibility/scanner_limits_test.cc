@@ -1,0 +1,273 @@
+// The scanner model's limits (vc/visibility/scanner_limits.h) against hand-checkable answers: an
+// open floor seen from above, where the range keeps a ring, the blind cone under the tripod
+// removes a disc, and the incidence and spacing limits keep a disc. The expected sets are computed
+// here in world coordinates with their own formulas, not with ScannerLimits.
+#include "vc/visibility/scanner_limits.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <functional>
+#include <numbers>
+
+#include "testing/scenes.h"
+#include "vc/visibility/visibility.h"
+
+namespace vc {
+namespace {
+
+constexpr double kR = 0.1;  // resolution (m)
+constexpr int kSide = 80;   // the floor is kSide x kSide voxels: 8 m x 8 m, its top at z = 0.1 m
+const WorldPoint kStation(4.03, 3.97, 1.6);
+
+VoxelScene Floor() {
+  std::vector<VoxelIndex> v;
+  for (int x = 0; x < kSide; ++x)
+    for (int y = 0; y < kSide; ++y) v.push_back({x, y, 0});
+  return testing::SceneOfVoxels(v, kR);
+}
+
+double Deg(double rad) { return rad * 180.0 / std::numbers::pi; }
+
+// What the station sees of the floor, by the selection test `test`, with `scanner`, against
+// `want(aim)`: the expected answer from the aim point (the top face's centre, or the voxel's
+// centre under compatibility, both judged on the top face). Returns how many are seen.
+size_t ExpectFloorSeen(const ScannerModel& scanner, SelectionTest test,
+                       const std::function<bool(const WorldPoint& aim)>& want, const std::string& what) {
+  const VoxelScene s = Floor();
+  VisibilitySetsOptions o;
+  o.test = test;
+  o.scanner = scanner;
+  o.threads = 2;
+  VisibilitySetsOptions per_voxel = o;
+  per_voxel.per_voxel = true;
+  auto sets = ComputeVisibilitySets(s, {kStation}, o);
+  auto plain = ComputeVisibilitySets(s, {kStation}, per_voxel);
+  EXPECT_TRUE(sets.ok() && plain.ok()) << what;
+  if (!sets.ok() || !plain.ok()) return 0;
+  size_t seen = 0, wrong = 0;
+  for (size_t id = 0; id < s.occupied.size(); ++id) {
+    const VoxelIndex v = KeyToIndex(s.occupied[id]);
+    const WorldPoint aim((v.x + 0.5) * kR, (v.y + 0.5) * kR,
+                         test == SelectionTest::kSurfaceVisibility ? (v.z + 1) * kR : (v.z + 0.5) * kR);
+    // Under compatibility, rays that graze the floor meet a neighbour first: only the line of
+    // sight decides those, so the expectation is the line-of-sight answer and the limits.
+    const bool los = test == SelectionTest::kSurfaceVisibility ? true : IsCompatible(s.grid, kStation, v);
+    const bool expected = los && want(aim);
+    wrong += (*sets)[0].test(id) != expected;
+    wrong += (*plain)[0].test(id) != expected;
+    const bool single = test == SelectionTest::kSurfaceVisibility ? IsSurfaceVisible(s.grid, kStation, v, scanner)
+                                                                  : IsCompatible(s.grid, kStation, v, scanner);
+    wrong += single != expected;
+    seen += expected;
+  }
+  EXPECT_EQ(wrong, 0u) << what;
+  return seen;
+}
+
+double Distance(const WorldPoint& aim) { return (aim - kStation).norm(); }
+double Horizontal(const WorldPoint& aim) { return std::hypot(aim.x() - kStation.x(), aim.y() - kStation.y()); }
+double Elevation(const WorldPoint& aim) { return Deg(std::atan2(aim.z() - kStation.z(), Horizontal(aim))); }
+// The angle between the top face's normal (+z) and the direction to the station.
+double Incidence(const WorldPoint& aim) { return Deg(std::acos((kStation.z() - aim.z()) / Distance(aim))); }
+
+TEST(ScannerLimitsTest, TheRangeKeepsARingOfTheFloor) {
+  for (SelectionTest test : {SelectionTest::kSurfaceVisibility, SelectionTest::kCompatibility}) {
+    ScannerModel sc;
+    sc.min_range_m = 2.0;
+    sc.max_range_m = 3.2;
+    const size_t seen = ExpectFloorSeen(
+        sc, test, [&](const WorldPoint& a) { return Distance(a) >= 2.0 && Distance(a) <= 3.2; }, "range");
+    // The ring's area over a voxel's: pi (R^2 - r^2) / 0.01 with R, r its radii on the floor.
+    const double h = kStation.z() - 0.1;
+    const double ring = std::numbers::pi * ((3.2 * 3.2 - h * h) - (2.0 * 2.0 - h * h)) / (kR * kR);
+    // Under compatibility the floor's grazing rays meet a neighbour first: fewer, but some.
+    if (test == SelectionTest::kSurfaceVisibility) {
+      EXPECT_NEAR(double(seen), ring, 0.03 * ring);
+    } else {
+      EXPECT_GT(seen, 100u);
+    }
+  }
+}
+
+TEST(ScannerLimitsTest, TheBlindConeUnderTheTripodRemovesADisc) {
+  ScannerModel sc;
+  sc.vfov_min_deg = -60;  // a 30 degree blind cone straight down
+  const size_t seen = ExpectFloorSeen(
+      sc, SelectionTest::kSurfaceVisibility, [&](const WorldPoint& a) { return Elevation(a) >= -60; }, "vfov");
+  // The disc removed has radius h tan(30 deg).
+  const double h = kStation.z() - 0.1, radius = h * std::tan(std::numbers::pi / 6);
+  const double disc = std::numbers::pi * radius * radius / (kR * kR);
+  EXPECT_NEAR(double(kSide * kSide - seen), disc, 0.05 * disc);
+  // A field of view that ends below the horizon sees the floor and nothing above it; one that
+  // starts above the horizon sees no floor at all.
+  sc.vfov_min_deg = 5;
+  EXPECT_EQ(ExpectFloorSeen(
+                sc, SelectionTest::kSurfaceVisibility, [](const WorldPoint&) { return false; }, "up"),
+            0u);
+}
+
+TEST(ScannerLimitsTest, TheIncidenceLimitKeepsADisc) {
+  for (SelectionTest test : {SelectionTest::kSurfaceVisibility, SelectionTest::kCompatibility}) {
+    ScannerModel sc;
+    sc.max_incidence_deg = 45;
+    const size_t seen = ExpectFloorSeen(
+        sc, test, [&](const WorldPoint& a) { return Incidence(a) <= 45; }, "incidence");
+    if (test == SelectionTest::kSurfaceVisibility) {
+      const double h = kStation.z() - 0.1;  // the disc's radius: h tan(45 deg) = h
+      EXPECT_NEAR(double(seen), std::numbers::pi * h * h / (kR * kR), 0.03 * std::numbers::pi * h * h / (kR * kR));
+    } else {
+      EXPECT_GT(seen, 0u);
+    }
+  }
+}
+
+TEST(ScannerLimitsTest, ThePointSpacingRequirementKeepsADisc) {
+  ScannerModel sc;
+  sc.angular_step_deg = 0.036;  // about 6 mm at 10 m
+  sc.max_spacing_m = 0.002;
+  const double step = sc.angular_step_deg * std::numbers::pi / 180;
+  const size_t seen = ExpectFloorSeen(
+      sc, SelectionTest::kSurfaceVisibility,
+      [&](const WorldPoint& a) {
+        const double cos_inc = (kStation.z() - a.z()) / Distance(a);
+        return Distance(a) * step / cos_inc <= 0.002;
+      },
+      "spacing");
+  EXPECT_GT(seen, 100u);
+  EXPECT_LT(seen, size_t(kSide * kSide / 2));
+}
+
+TEST(ScannerLimitsTest, EveryLimitAtOnceIsTheirConjunction) {
+  ScannerModel sc;
+  sc.min_range_m = 1.7;
+  sc.max_range_m = 3.5;
+  sc.vfov_min_deg = -70;
+  sc.vfov_max_deg = 80;
+  sc.max_incidence_deg = 60;
+  sc.angular_step_deg = 0.05;
+  sc.max_spacing_m = 0.004;
+  const double step = sc.angular_step_deg * std::numbers::pi / 180;
+  for (SelectionTest test : {SelectionTest::kSurfaceVisibility, SelectionTest::kCompatibility}) {
+    EXPECT_GT(ExpectFloorSeen(
+                  sc, test,
+                  [&](const WorldPoint& a) {
+                    const double d = Distance(a), cos_inc = (kStation.z() - a.z()) / d;
+                    return d >= 1.7 && d <= 3.5 && Elevation(a) >= -70 && Elevation(a) <= 80 && Incidence(a) <= 60 &&
+                           d * step / cos_inc <= 0.004;
+                  },
+                  "all"),
+              0u)
+        << SelectionTestName(test);
+  }
+}
+
+// Ties are inclusive: with r = 1 m every quantity below is exact, and an aim point exactly at a
+// limit passes.
+TEST(ScannerLimitsTest, AnAimPointExactlyOnALimitPasses) {
+  const VoxelScene s = testing::SceneOfVoxels({{0, 0, 0}}, 1.0);
+  const WorldPoint above(0.5, 0.5, 4.0);  // 3 m above the top face's centre
+  ScannerModel sc;
+  sc.max_range_m = 3.0;
+  EXPECT_TRUE(IsSurfaceVisible(s.grid, above, {0, 0, 0}, sc));
+  sc.max_range_m = 2.999;
+  EXPECT_FALSE(IsSurfaceVisible(s.grid, above, {0, 0, 0}, sc));
+  sc = ScannerModel();
+  sc.min_range_m = 3.0;
+  sc.max_range_m = 10;
+  EXPECT_TRUE(IsSurfaceVisible(s.grid, above, {0, 0, 0}, sc));
+  sc.min_range_m = 3.001;
+  EXPECT_FALSE(IsSurfaceVisible(s.grid, above, {0, 0, 0}, sc));
+  // Straight down is elevation -90, which vfov_min_deg = -90 keeps and -89.9 does not.
+  sc = ScannerModel();
+  sc.vfov_min_deg = -90;
+  sc.vfov_max_deg = 0;
+  EXPECT_TRUE(IsSurfaceVisible(s.grid, above, {0, 0, 0}, sc));
+  sc.vfov_min_deg = -89.9;
+  EXPECT_FALSE(IsSurfaceVisible(s.grid, above, {0, 0, 0}, sc));
+  // From (3.5, 0.5, 4): the top face's centre is 3 m across and 3 m down, incidence 45 degrees.
+  // cos(45 deg)^2 rounds, so 45 itself is within rounding; 45.001 passes and 44.999 does not.
+  const WorldPoint diagonal(3.5, 0.5, 4.0);
+  sc = ScannerModel();
+  sc.max_incidence_deg = 45.001;
+  EXPECT_TRUE(IsSurfaceVisible(s.grid, diagonal, {0, 0, 0}, sc));
+  sc.max_incidence_deg = 44.999;
+  EXPECT_FALSE(IsSurfaceVisible(s.grid, diagonal, {0, 0, 0}, sc));
+  // Without a scanner there is no limit at all, not even the default range.
+  EXPECT_TRUE(IsSurfaceVisible(s.grid, WorldPoint(0.5, 0.5, 1.2), {0, 0, 0}));
+  EXPECT_FALSE(IsSurfaceVisible(s.grid, WorldPoint(0.5, 0.5, 1.2), {0, 0, 0}, ScannerModel()));
+}
+
+TEST(ScannerLimitsTest, EntryFaceIsTheLastSlabEnteredAndTheLowestAxisOnATie) {
+  const ScannerLimits l(ScannerModel(), 1.0, Eigen::Vector3d(0.5, 0.5, 10.5));
+  int axis, sign;
+  l.EntryFace({0, 0, 0}, &axis, &sign);  // straight down: the top face
+  EXPECT_EQ(axis, 2);
+  EXPECT_EQ(sign, 1);
+  const ScannerLimits side(ScannerModel(), 1.0, Eigen::Vector3d(10.5, 0.5, 1.5));
+  side.EntryFace({0, 0, 0}, &axis, &sign);  // from +x, slightly above: enters through +x
+  EXPECT_EQ(axis, 0);
+  EXPECT_EQ(sign, 1);
+  const ScannerLimits diagonal(ScannerModel(), 1.0, Eigen::Vector3d(-4.5, 5.5, 0.5));
+  diagonal.EntryFace({0, 0, 0}, &axis, &sign);  // through the edge of -x and +y: x, the lowest axis
+  EXPECT_EQ(axis, 0);
+  EXPECT_EQ(sign, -1);
+}
+
+// V (ALGORITHM.md s.5) is 0 for a face that fails a limit and unchanged for one that passes.
+TEST(ScannerLimitsTest, EvaluationGivesVZeroOutsideTheLimitsAndTheSameVInside) {
+  const VoxelScene s = Floor();
+  EvaluateOptions plain;
+  plain.threads = 2;
+  plain.keep_per_viewpoint_values = true;
+  EvaluateOptions limited = plain;
+  limited.scanner.max_incidence_deg = 45;
+  limited.scanner.vfov_min_deg = -60;
+  auto a = Evaluate(s, {kStation}, plain);
+  auto b = Evaluate(s, {kStation}, limited);
+  ASSERT_TRUE(a.ok() && b.ok());
+  size_t kept = 0, zeroed = 0;
+  for (size_t id = 0; id < s.occupied.size(); ++id) {
+    const VoxelIndex v = KeyToIndex(s.occupied[id]);
+    const size_t slot = id * kFacesPerVoxel + size_t(Face::kPosZ);
+    const WorldPoint aim((v.x + 0.5) * kR, (v.y + 0.5) * kR, kR);
+    const float va = a->per_viewpoint_face_values[0][slot], vb = b->per_viewpoint_face_values[0][slot];
+    if (Incidence(aim) <= 45 && Elevation(aim) >= -60) {
+      EXPECT_EQ(vb, va) << id;
+      kept += va > 0;
+    } else {
+      EXPECT_EQ(vb, 0.0f) << id;
+      zeroed += va > 0;
+    }
+  }
+  EXPECT_GT(kept, 100u);
+  EXPECT_GT(zeroed, 100u);
+  EXPECT_LT(b->overall.global_visibility, a->overall.global_visibility);
+}
+
+TEST(ScannerModelTest, InvalidLimitsNameTheirField) {
+  auto message = [](ScannerModel s) { return s.Validate().message(); };
+  ScannerModel s;
+  EXPECT_TRUE(s.Validate().ok());
+  s.vfov_min_deg = 10;
+  s.vfov_max_deg = 10;
+  EXPECT_NE(message(s).find("scanner.vfov_max_deg"), std::string::npos);
+  s = ScannerModel();
+  s.vfov_min_deg = std::nan("");
+  EXPECT_NE(message(s).find("scanner.vfov_min_deg"), std::string::npos);
+  s = ScannerModel();
+  s.max_incidence_deg = 0;
+  EXPECT_NE(message(s).find("scanner.max_incidence_deg"), std::string::npos);
+  s.max_incidence_deg = 90.5;
+  EXPECT_NE(message(s).find("scanner.max_incidence_deg"), std::string::npos);
+  s = ScannerModel();
+  s.max_spacing_m = 0.01;
+  EXPECT_NE(message(s).find("scanner.angular_step_deg"), std::string::npos);
+  s.angular_step_deg = 0.036;
+  EXPECT_TRUE(s.Validate().ok());
+  s.max_spacing_m = -1;
+  EXPECT_NE(message(s).find("scanner.max_spacing_m"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace vc
