@@ -6,6 +6,9 @@
 # and the geometric mean of the ratios A/B over the pairs.
 # Usage: scripts/ab-plan.sh BUILD_A BUILD_B [ROUNDS (2)] [FILE...]   (default files: the synthetic
 #        hall at 0.05 m and geb079)
+# AB_ARGS_A / AB_ARGS_B: extra vc-client submit arguments for side A / B, to compare two settings
+# on one build, e.g. AB_ARGS_A="--scanner leica-rtc360" scripts/ab-plan.sh build/release build/release
+# (the stations and G then differ by design).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 a=$1 b=$2 rounds=${3:-2}
@@ -44,9 +47,9 @@ for f in "${files[@]}"; do
       ca=$swap cb=$((1 - swap))
       start_server "$a" "$ca" pa
       start_server "$b" "$cb" pb
-      "$a/client/vc-client" submit "$f" --server "127.0.0.1:$pa" --threads 1 --out "$work/a" >/dev/null 2>&1 &
+      "$a/client/vc-client" submit "$f" --server "127.0.0.1:$pa" --threads 1 ${AB_ARGS_A:-} --out "$work/a" >/dev/null 2>&1 &
       ja=$!
-      "$b/client/vc-client" submit "$f" --server "127.0.0.1:$pb" --threads 1 --out "$work/b" >/dev/null 2>&1 &
+      "$b/client/vc-client" submit "$f" --server "127.0.0.1:$pb" --threads 1 ${AB_ARGS_B:-} --out "$work/b" >/dev/null 2>&1 &
       jb=$!
       wait "$ja" "$jb"
       read -r ta sa ga < <(summary "$work/a/plan.json")
