@@ -36,12 +36,13 @@ start_server() {  # start_server BUILD CPU VAR: starts it (in this shell, so pid
   printf -v "$3" '%s' "$port"
 }
 
-summary() {  # summary plan.json -> "total stations G"
-  python3 -c 'import json,sys; p=json.load(open(sys.argv[1])); print(p["timings_s"]["total"], len(p["viewpoints"]), p["coverage"]["global_visibility"])' "$1"
+summary() {  # summary plan.json -> "total stations G visibility-stage-seconds"
+  python3 -c 'import json,sys; p=json.load(open(sys.argv[1])); t=p["timings_s"]; print(t["total"], len(p["viewpoints"]), p["coverage"]["global_visibility"], t["visibility"])' "$1"
 }
 
 for f in "${files[@]}"; do
   ratios=()
+  vratios=()
   for r in $(seq 1 "$rounds"); do
     for swap in 0 1; do
       ca=$swap cb=$((1 - swap))
@@ -52,16 +53,19 @@ for f in "${files[@]}"; do
       "$b/client/vc-client" submit "$f" --server "127.0.0.1:$pb" --threads 1 ${AB_ARGS_B:-} --out "$work/b" >/dev/null 2>&1 &
       jb=$!
       wait "$ja" "$jb"
-      read -r ta sa ga < <(summary "$work/a/plan.json")
-      read -r tb sb gb < <(summary "$work/b/plan.json")
+      read -r ta sa ga va < <(summary "$work/a/plan.json")
+      read -r tb sb gb vb < <(summary "$work/b/plan.json")
       ratio=$(python3 -c "print(f'{$ta/$tb:.3f}')")
+      vratio=$(python3 -c "print(f'{$va/$vb:.3f}')")
       ratios+=("$ratio")
-      printf '%-12s round %d  A on CPU %d: %6.2f s (%s stations, G %.6f)   B on CPU %d: %6.2f s (%s stations, G %.6f)   A/B %s\n' \
-        "$(basename "$f")" "$r" "$ca" "$ta" "$sa" "$ga" "$cb" "$tb" "$sb" "$gb" "$ratio"
+      vratios+=("$vratio")
+      printf '%-12s round %d  A on CPU %d: %6.2f s (%s stations, G %.6f, sets %.2f s)   B on CPU %d: %6.2f s (%s stations, G %.6f, sets %.2f s)   A/B %s, sets %s\n' \
+        "$(basename "$f")" "$r" "$ca" "$ta" "$sa" "$ga" "$va" "$cb" "$tb" "$sb" "$gb" "$vb" "$ratio" "$vratio"
       for p in "${pids[@]}"; do kill "$p" 2>/dev/null || true; done
       wait 2>/dev/null || true
       pids=()
     done
   done
   python3 -c "import math,sys; r=[float(x) for x in sys.argv[2:]]; print(f'{sys.argv[1]:12s} geometric mean A/B over {len(r)} runs: {math.exp(sum(map(math.log,r))/len(r)):.3f}')" "$(basename "$f")" "${ratios[@]}"
+  python3 -c "import math,sys; r=[float(x) for x in sys.argv[2:]]; print(f'{sys.argv[1]:12s} geometric mean A/B of the visibility stage: {math.exp(sum(map(math.log,r))/len(r)):.3f}')" "$(basename "$f")" "${vratios[@]}"
 done

@@ -290,7 +290,16 @@ INSTANTIATE_TEST_SUITE_P(
         BadParam{"NanTargetCoverage", [](v1::PlanParameters* p) { p->set_target_coverage(std::nan("")); }},
         BadParam{"NegativeThreads", [](v1::PlanParameters* p) { p->set_threads(-2); }},
         BadParam{"UnknownSelectionTest",
-                 [](v1::PlanParameters* p) { p->set_selection_test(static_cast<v1::SelectionTest>(7)); }}),
+                 [](v1::PlanParameters* p) { p->set_selection_test(static_cast<v1::SelectionTest>(7)); }},
+        BadParam{"VfovMinAboveMax",
+                 [](v1::PlanParameters* p) {
+                   p->mutable_scanner()->set_vfov_min_deg(30);
+                   p->mutable_scanner()->set_vfov_max_deg(10);
+                 }},
+        BadParam{"NanVfov", [](v1::PlanParameters* p) { p->mutable_scanner()->set_vfov_max_deg(std::nan("")); }},
+        BadParam{"ZeroIncidence", [](v1::PlanParameters* p) { p->mutable_scanner()->set_max_incidence_deg(0); }},
+        BadParam{"SpacingWithoutAngularStep",
+                 [](v1::PlanParameters* p) { p->mutable_scanner()->set_max_spacing_m(0.01); }}),
     [](const auto& info) { return std::string(info.param.name); });
 
 TEST(EvaluateErrors, InvalidParametersAreRefused) {
