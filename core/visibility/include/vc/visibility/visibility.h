@@ -39,18 +39,18 @@ std::string_view SelectionTestName(SelectionTest t);  // "surface", "compatibili
 // counts a voxel only through a face that passes every limit, and V (ALGORITHM.md s.5) is 0 for a
 // face that fails one. The defaults keep the paper's plans: the range [0.5, 75] m and no other
 // limit (a value at its "off" end: vfov -90..90, incidence 90, spacing 0).
-#define VC_SCANNER_PARAMETERS(X)                                                                                 \
-  X(double, min_range_m, 0.5, "m", "min-range", kNonNegative, "scanner minimum range")                           \
-  X(double, max_range_m, 75.0, "m", "max-range", kPositive, "scanner maximum range")                             \
-  X(double, vfov_min_deg, -90.0, "deg", "vfov-min", kElevationDeg,                                               \
-    "lowest elevation the scanner sees (-90 = straight down, no limit)")                                         \
-  X(double, vfov_max_deg, 90.0, "deg", "vfov-max", kElevationDeg,                                                \
-    "highest elevation the scanner sees (90 = straight up, no limit)")                                           \
-  X(double, max_incidence_deg, 90.0, "deg", "max-incidence", kIncidenceDeg,                                      \
-    "largest angle between a face's normal and the direction to the scanner (90 = no limit)")                    \
-  X(double, angular_step_deg, 0.0, "deg", "angular-step", kNonNegative,                                          \
-    "the scanner's angular step between points (needed by --max-spacing)")                                       \
-  X(double, max_spacing_m, 0.0, "m", "max-spacing", kNonNegative,                                                \
+#define VC_SCANNER_PARAMETERS(X)                                                              \
+  X(double, min_range_m, 0.5, "m", "min-range", kNonNegative, "scanner minimum range")        \
+  X(double, max_range_m, 75.0, "m", "max-range", kPositive, "scanner maximum range")          \
+  X(double, vfov_min_deg, -90.0, "deg", "vfov-min", kElevationDeg,                            \
+    "lowest elevation the scanner sees (-90 = straight down, no limit)")                      \
+  X(double, vfov_max_deg, 90.0, "deg", "vfov-max", kElevationDeg,                             \
+    "highest elevation the scanner sees (90 = straight up, no limit)")                        \
+  X(double, max_incidence_deg, 90.0, "deg", "max-incidence", kIncidenceDeg,                   \
+    "largest angle between a face's normal and the direction to the scanner (90 = no limit)") \
+  X(double, angular_step_deg, 0.0, "deg", "angular-step", kNonNegative,                       \
+    "the scanner's angular step between points (needed by --max-spacing)")                    \
+  X(double, max_spacing_m, 0.0, "m", "max-spacing", kNonNegative,                             \
     "largest point spacing a face may get to count: distance x step / cos(incidence) (0 = no requirement)")
 
 // The scanner (ALGORITHM.md s.5, and the limits above).
