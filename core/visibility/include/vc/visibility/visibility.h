@@ -57,8 +57,9 @@ std::string_view SelectionTestName(SelectionTest t);  // "surface", "compatibili
 struct ScannerModel {
   VC_SCANNER_PARAMETERS(VC_DECLARE_PARAMETER)
   // The instrument preset the values came from (vc/visibility/scanner_presets.h), explicit values
-  // overriding some of them; empty for a custom model. Not a row: rows are scalars.
-  std::string name;
+  // overriding some of them; empty for a custom model. Not a row: rows are scalars. (The `{}` keeps
+  // -Wmissing-field-initializers quiet for positional initialisers such as ScannerModel{2.0, 1.0}.)
+  std::string name{};
   // INVALID_ARGUMENT naming the field ("scanner.max_range_m ..."): a row's check,
   // min_range_m >= max_range_m, vfov_min_deg >= vfov_max_deg, or max_spacing_m without
   // angular_step_deg.
