@@ -109,6 +109,9 @@ int main(int argc, char** argv) {
   auto* health = app.add_subcommand("health", "check the server's gRPC health service");
   health->add_option("--service", health_service, "service name (empty = the whole server)");
 
+  // scanners
+  auto* scanners = app.add_subcommand("scanners", "list the instrument presets for --scanner (no server)");
+
   // inspect
   double inspect_resolution = 0;
   bool json = false;
@@ -120,6 +123,11 @@ int main(int argc, char** argv) {
 
   CLI11_PARSE(app, argc, argv);
   conn.timeout = std::chrono::milliseconds(int64_t(timeout_s * 1000));
+
+  if (*scanners) {
+    std::cout << vc::client::ScannerPresetsTable();
+    return 0;
+  }
 
   if (*inspect) {
     // The limits vc-server applies with its defaults, so inspect accepts what a plan would.

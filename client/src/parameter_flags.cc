@@ -1,7 +1,11 @@
 #include "vc/client/parameter_flags.h"
 
+#include <cstdio>
 #include <map>
 #include <string>
+#include <vector>
+
+#include "vc/visibility/scanner_presets.h"
 
 namespace vc::client {
 namespace {
@@ -48,7 +52,28 @@ void AddFlag(CLI::App* app, const ParamInfo& info, FaceSet* value) {
 
 #define VC_ROW_FLAG(type, name, ...) AddFlag(command, VC_PARAMETER_INFO(type, name, __VA_ARGS__), &o->name);
 
-void AddScannerFlags(CLI::App* command, ScannerModel* o) { VC_SCANNER_PARAMETERS(VC_ROW_FLAG) }
+// --scanner NAME and one flag per row. After the parse, a preset fills the rows whose flag was not
+// given (CLI11's count), so an explicit flag overrides the preset and a flag's default never does.
+void AddScannerFlags(CLI::App* command, ScannerModel* o) {
+  std::vector<std::string> names;
+  for (const ScannerPreset& p : ScannerPresets()) names.emplace_back(p.name);
+  command
+      ->add_option("--scanner", o->name,
+                   "instrument preset (vc-client scanners lists them; docs/SCANNERS.md): its range, vertical field "
+                   "of view and angular step, each overridden by its flag when given")
+      ->check(CLI::IsMember(names))
+      ->type_name("NAME");
+  VC_SCANNER_PARAMETERS(VC_ROW_FLAG)
+  command->callback([command, o] {
+    if (o->name.empty()) return;
+    Result<ScannerModel> preset = ScannerFromPreset(o->name);
+    if (!preset.ok()) throw CLI::ValidationError("--scanner", preset.status().message());
+#define VC_ROW_FROM_PRESET(type, name, default_value, unit, flag, ...) \
+  if (command->get_option("--" flag)->count() == 0) o->name = preset->name;
+    VC_SCANNER_PARAMETERS(VC_ROW_FROM_PRESET)
+#undef VC_ROW_FROM_PRESET
+  });
+}
 
 }  // namespace
 
@@ -63,5 +88,24 @@ void AddEvaluateFlags(CLI::App* command, EvaluateJobOptions* o) {
 }
 
 #undef VC_ROW_FLAG
+
+std::string ScannerPresetsTable() {
+  std::string out;
+  char line[256];
+  std::snprintf(line, sizeof line, "%-24s %-24s %-13s %-12s %-9s %-8s %s\n", "NAME", "INSTRUMENT", "RANGE (m)",
+                "VFOV (deg)", "STEP (deg)", "SCAN (s)", "SETTING");
+  out += line;
+  for (const ScannerPreset& p : ScannerPresets()) {
+    const ScannerModel& m = p.model;
+    char range[32], vfov[32];
+    std::snprintf(range, sizeof range, "%g-%g", m.min_range_m, m.max_range_m);
+    std::snprintf(vfov, sizeof vfov, "%g..%g", m.vfov_min_deg, m.vfov_max_deg);
+    std::snprintf(line, sizeof line, "%-24.*s %-24.*s %-13s %-12s %-9g %-8g %.*s\n", int(p.name.size()), p.name.data(),
+                  int(p.display_name.size()), p.display_name.data(), range, vfov, m.angular_step_deg, p.scan_time_s,
+                  int(p.setting.size()), p.setting.data());
+    out += line;
+  }
+  return out;
+}
 
 }  // namespace vc::client

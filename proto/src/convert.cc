@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <string>
 
+#include "vc/visibility/scanner_presets.h"
+
 namespace vc::wire {
 
 v1::Point ToProto(const WorldPoint& p) {
@@ -110,11 +112,16 @@ Status FromWire(v1::FaceSet wire, FaceSet* out) {
 v1::ScannerModel ToProto(const ScannerModel& o) {
   v1::ScannerModel p;
   VC_SCANNER_PARAMETERS(VC_ROW_TO_PROTO)
+  p.set_name(o.name);
   return p;
 }
 
+// A name first sets the whole model from its preset; the fields that are set override it.
 Status Apply(const v1::ScannerModel& p, ScannerModel* scanner) {
   ScannerModel& o = *scanner;
+  if (!p.name().empty()) {
+    VC_ASSIGN_OR_RETURN(o, ScannerFromPreset(p.name()));
+  }
   VC_SCANNER_PARAMETERS(VC_ROW_FROM_PROTO)
   return Status::Ok();
 }

@@ -14,6 +14,7 @@
 #include <string>
 
 #include "vc/report/plan_report.h"
+#include "vc/visibility/scanner_presets.h"
 #include "vc/wire/convert.h"
 
 namespace vc {
@@ -201,7 +202,9 @@ TEST(ParameterTablesTest, EveryProtoFieldAndPlanJsonParameterHasARow) {
   std::set<std::string> want = plan_rows;
   want.insert({"scanner", "candidates"});
   EXPECT_EQ(FieldNames(v1::PlanParameters::descriptor()), want);
-  EXPECT_EQ(FieldNames(v1::ScannerModel::descriptor()), scanner_rows);
+  want = scanner_rows;
+  want.insert("name");  // the preset, not a row (vc/visibility/scanner_presets.h)
+  EXPECT_EQ(FieldNames(v1::ScannerModel::descriptor()), want);
   want = evaluate_rows;
   want.insert({"scanner", "viewpoints"});
   EXPECT_EQ(FieldNames(v1::EvaluateParameters::descriptor()), want);
@@ -211,6 +214,12 @@ TEST(ParameterTablesTest, EveryProtoFieldAndPlanJsonParameterHasARow) {
   for (const auto& [key, value] : plan["parameters"].items()) keys.insert(key);
   want = plan_rows;
   want.insert({"scanner", "user_candidates"});
+  EXPECT_EQ(keys, want);
+
+  keys.clear();
+  for (const auto& [key, value] : plan["parameters"]["scanner"].items()) keys.insert(key);
+  want = scanner_rows;
+  want.insert("name");
   EXPECT_EQ(keys, want);
 }
 
@@ -222,6 +231,98 @@ TEST(ParameterTablesTest, UnknownEnumNamesAreRefusedByTheFlag) {
   client::AddPlanFlags(&app, &o);
   EXPECT_THROW(app.parse("--test visible", false), CLI::ValidationError);
   EXPECT_EQ(o.selection_test, SelectionTest::kSurfaceVisibility);
+}
+
+// --scanner NAME: the preset fills every scanner row whose flag is not given; a given flag wins,
+// even when it gives the row's default.
+TEST(ScannerPresetFlagTest, ThePresetFillsTheRowsAndExplicitFlagsOverrideIt) {
+  ScannerModel want = *ScannerFromPreset("leica-rtc360");
+  want.max_range_m = 40.0;
+  PlanOptions plan;
+  CLI::App plan_app;
+  client::AddPlanFlags(&plan_app, &plan);
+  plan_app.parse("--scanner leica-rtc360 --max-range 40", false);
+  EvaluateJobOptions eval;
+  CLI::App eval_app;  // as vc-client has it: a subcommand
+  client::AddEvaluateFlags(eval_app.add_subcommand("evaluate"), &eval);
+  eval_app.parse("evaluate --scanner leica-rtc360 --max-range 40", false);
+  for (const ScannerModel* got : {&plan.scanner, &eval.scanner}) {
+    EXPECT_EQ(got->name, "leica-rtc360");
+#define VC_EXPECT_ROW_EQ(type, name, ...) EXPECT_EQ(got->name, want.name) << #name;
+    VC_SCANNER_PARAMETERS(VC_EXPECT_ROW_EQ)
+#undef VC_EXPECT_ROW_EQ
+  }
+}
+
+TEST(ScannerPresetFlagTest, AFlagGivenAtItsDefaultStillOverridesThePreset) {
+  const ScannerModel defaults;
+  const ScannerModel preset = *ScannerFromPreset("zf-imager-5016");
+  ASSERT_NE(preset.min_range_m, defaults.min_range_m);
+  PlanOptions given;
+  CLI::App app;
+  client::AddPlanFlags(&app, &given);
+  app.parse("--scanner zf-imager-5016 --min-range " + std::to_string(defaults.min_range_m), false);
+  EXPECT_EQ(given.scanner.min_range_m, defaults.min_range_m);
+  PlanOptions not_given;
+  CLI::App app2;
+  client::AddPlanFlags(&app2, &not_given);
+  app2.parse("--scanner zf-imager-5016", false);
+  EXPECT_EQ(not_given.scanner.min_range_m, preset.min_range_m);
+  EXPECT_EQ(not_given.scanner.max_range_m, preset.max_range_m);
+}
+
+TEST(ScannerPresetFlagTest, WithoutScannerTheModelIsCustom) {
+  PlanOptions o;
+  CLI::App app;
+  client::AddPlanFlags(&app, &o);
+  app.parse("--max-range 40", false);
+  EXPECT_TRUE(o.scanner.name.empty());
+  EXPECT_EQ(o.scanner.max_range_m, 40.0);
+  EXPECT_EQ(o.scanner.min_range_m, ScannerModel{}.min_range_m);
+}
+
+TEST(ScannerPresetFlagTest, AnUnknownPresetIsRefusedByTheFlag) {
+  EvaluateJobOptions o;
+  CLI::App app;
+  client::AddEvaluateFlags(&app, &o);
+  EXPECT_THROW(app.parse("--scanner leica-p50", false), CLI::ValidationError);
+}
+
+// What the client sends: the name and every field, which the server takes as they are.
+TEST(ScannerPresetFlagTest, TheResolvedModelCrossesTheWireAsItIs) {
+  PlanOptions o;
+  CLI::App app;
+  client::AddPlanFlags(&app, &o);
+  app.parse("--scanner trimble-x7 --vfov-min -30", false);
+  const v1::PlanParameters p = wire::ToProto(o);
+  EXPECT_EQ(p.scanner().name(), "trimble-x7");
+  EXPECT_TRUE(p.scanner().has_max_range_m());
+  const Result<PlanOptions> back = wire::FromProto(p);
+  ASSERT_TRUE(back.ok()) << back.status().ToString();
+  EXPECT_EQ(back->scanner.name, "trimble-x7");
+  EXPECT_EQ(back->scanner.vfov_min_deg, -30.0);
+  EXPECT_EQ(back->scanner.max_range_m, FindScannerPreset("trimble-x7")->model.max_range_m);
+}
+
+TEST(ScannerPresetFlagTest, PlanJsonNamesThePresetOrNull) {
+  PlanResult r;
+  EXPECT_TRUE(json::parse(PlanToJson(r))["parameters"]["scanner"]["name"].is_null());
+  r.options.scanner = *ScannerFromPreset("riegl-vz-400i");
+  const json scanner = json::parse(PlanToJson(r))["parameters"]["scanner"];
+  EXPECT_EQ(scanner["name"], "riegl-vz-400i");
+  EXPECT_EQ(scanner["vfov_max_deg"], 60.0);
+}
+
+TEST(ScannerPresetFlagTest, TheScannersTableListsEveryPreset) {
+  const std::string table = client::ScannerPresetsTable();
+  size_t lines = 0;
+  for (char c : table) lines += c == '\n';
+  EXPECT_EQ(lines, ScannerPresets().size() + 1);  // a header line
+  for (const ScannerPreset& p : ScannerPresets()) {
+    EXPECT_NE(table.find(std::string(p.name) + " "), std::string::npos) << p.name;
+    EXPECT_NE(table.find(p.display_name), std::string::npos) << p.display_name;
+    EXPECT_NE(table.find(p.setting), std::string::npos) << p.setting;
+  }
 }
 
 }  // namespace

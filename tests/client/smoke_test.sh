@@ -70,6 +70,18 @@ rc=$?
 set -e
 [[ $rc -eq 3 ]] || fail "broken upload exited $rc, expected 3 ($(cat "$work/err2"))"
 
+# An instrument preset with one flag overriding it: the server plans with the resolved model and
+# plan.json names the preset (docs/SCANNERS.md). `scanners` lists the presets without a server.
+"$client_bin" scanners | grep -q "^leica-rtc360 " || fail "vc-client scanners does not list leica-rtc360"
+"$client_bin" submit "$work/box.ply" --server "$addr" --scanner leica-rtc360 --max-range 40 --out "$work/out4" \
+  >/dev/null 2>"$work/err4" || { cat "$work/err4" >&2; fail "vc-client submit --scanner failed"; }
+python3 - "$work/out4/plan.json" <<'PY' || fail "plan.json's scanner with a preset"
+import json, sys
+s = json.load(open(sys.argv[1]))["parameters"]["scanner"]
+assert s["name"] == "leica-rtc360", s
+assert s["max_range_m"] == 40 and s["min_range_m"] == 0.5 and s["vfov_min_deg"] == -60, s
+PY
+
 # SIGTERM: the server drains and exits 0.
 kill -TERM "$server_pid"
 wait "$server_pid" && rc=0 || rc=$?

@@ -40,10 +40,12 @@ Json ParameterJson(SelectionTest t) { return std::string(SelectionTestName(t)); 
 
 #define VC_ROW_TO_JSON(type, name, ...) j[#name] = ParameterJson(o.name);
 
-// The limits that are off are null (docs/PLANNING.md "The scanner model").
+// The limits that are off are null (docs/PLANNING.md "The scanner model"), and so is the name of
+// a custom model (docs/SCANNERS.md).
 Json ScannerJson(const ScannerModel& o) {
   Json j = Json::object();
   VC_SCANNER_PARAMETERS(VC_ROW_TO_JSON)
+  j["name"] = o.name.empty() ? Json(nullptr) : Json(o.name);
   if (!o.HasVerticalFieldOfView()) j["vfov_min_deg"] = j["vfov_max_deg"] = nullptr;
   if (!o.HasIncidenceLimit()) j["max_incidence_deg"] = nullptr;
   if (!o.HasSpacingLimit()) j["max_spacing_m"] = nullptr;

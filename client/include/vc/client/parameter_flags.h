@@ -1,21 +1,31 @@
 // vc-client's parameter flags, derived from the parameter tables (vc/base/parameter.h): one
 // `--<flag>` per row, with the row's help, unit and default; bools as `--<flag>` / `--no-<flag>`;
 // enums by name (`--test surface|compatibility`, `--faces all|exposed`). The scanner's rows are
-// added with the plan's and the evaluation's. Lists (candidates, viewpoints) are files, added by
-// main.cc.
+// added with the plan's and the evaluation's, with `--scanner NAME` (an instrument preset,
+// vc/visibility/scanner_presets.h): the preset fills every scanner row whose flag is not given, so
+// explicit flags override it. The client resolves the preset itself and sends the name with every
+// field, which the server then takes as they are (docs/SCANNERS.md). Lists (candidates, viewpoints)
+// are files, added by main.cc.
 #pragma once
 
 #include <CLI/CLI.hpp>
+#include <string>
 
 #include "vc/plan/evaluate_job.h"
 #include "vc/plan/plan_options.h"
 
 namespace vc::client {
 
-// Binds every row of VC_PLAN_PARAMETERS and VC_SCANNER_PARAMETERS to `options` (which must outlive
-// the parse); the defaults shown are options' current values.
+// Binds every row of VC_PLAN_PARAMETERS and VC_SCANNER_PARAMETERS, and --scanner, to `options`
+// (which must outlive the parse); the defaults shown are options' current values. Sets `command`'s
+// callback, which applies the preset after the parse: a command that needs its own callback must
+// call the one set here first. An unknown --scanner is a CLI::ValidationError.
 void AddPlanFlags(CLI::App* command, PlanOptions* options);
 // The same for VC_EVALUATE_PARAMETERS and VC_SCANNER_PARAMETERS.
 void AddEvaluateFlags(CLI::App* command, EvaluateJobOptions* options);
+
+// `vc-client scanners`: one line per preset (name, instrument, range, vertical field of view,
+// angular step, scan time, the setting those are for) under a header line.
+std::string ScannerPresetsTable();
 
 }  // namespace vc::client

@@ -28,12 +28,12 @@ namespace vc {
 
 // What values a parameter accepts (checked by CheckParameter). Numbers must also be finite.
 enum class ParamCheck : uint8_t {
-  kAny,          // any finite value
-  kNonNegative,  // >= 0
-  kPositive,     // > 0
-  kFraction,     // in (0, 1]
-  kElevationDeg, // in [-90, 90] (degrees)
-  kIncidenceDeg, // in (0, 90] (degrees)
+  kAny,           // any finite value
+  kNonNegative,   // >= 0
+  kPositive,      // > 0
+  kFraction,      // in (0, 1]
+  kElevationDeg,  // in [-90, 90] (degrees)
+  kIncidenceDeg,  // in (0, 90] (degrees)
 };
 
 // A parameter's metadata, from its table row.

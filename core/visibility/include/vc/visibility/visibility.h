@@ -18,6 +18,7 @@
 #include <array>
 #include <cstdint>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "vc/base/geometry.h"
@@ -37,8 +38,8 @@ std::string_view SelectionTestName(SelectionTest t);  // "surface", "compatibili
 // The scanner model's parameters (vc/base/parameter.h): X(type, name, default, unit, flag, check, help).
 // Each is a hard limit on what a station sees (docs/PLANNING.md "The scanner model"): selection
 // counts a voxel only through a face that passes every limit, and V (ALGORITHM.md s.5) is 0 for a
-// face that fails one. The defaults keep the paper's plans: the range [0.5, 75] m and no other
-// limit (a value at its "off" end: vfov -90..90, incidence 90, spacing 0).
+// face that fails one. The defaults: the range [0.5, 75] m and no other limit (each at its "off"
+// end: vfov -90..90, incidence 90, spacing 0).
 #define VC_SCANNER_PARAMETERS(X)                                                              \
   X(double, min_range_m, 0.5, "m", "min-range", kNonNegative, "scanner minimum range")        \
   X(double, max_range_m, 75.0, "m", "max-range", kPositive, "scanner maximum range")          \
@@ -56,6 +57,10 @@ std::string_view SelectionTestName(SelectionTest t);  // "surface", "compatibili
 // The scanner (ALGORITHM.md s.5, and the limits above).
 struct ScannerModel {
   VC_SCANNER_PARAMETERS(VC_DECLARE_PARAMETER)
+  // The instrument preset the values came from (vc/visibility/scanner_presets.h), explicit values
+  // overriding some of them; empty for a custom model. Not a row: rows are scalars. (The `{}` keeps
+  // -Wmissing-field-initializers quiet for positional initialisers such as ScannerModel{2.0, 1.0}.)
+  std::string name{};
   // INVALID_ARGUMENT naming the field ("scanner.max_range_m ..."): a row's check,
   // min_range_m >= max_range_m, vfov_min_deg >= vfov_max_deg, or max_spacing_m without
   // angular_step_deg.
