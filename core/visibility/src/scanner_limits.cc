@@ -9,9 +9,12 @@ namespace vc {
 ScannerLimits::ScannerLimits(const ScannerModel& s, double r, const Eigen::Vector3d& uo) : uo_(uo) {
   min2_ = (s.min_range_m / r) * (s.min_range_m / r);
   max2_ = (s.max_range_m / r) * (s.max_range_m / r);
-  vfov_ = s.HasVerticalFieldOfView();
-  vfov_min_deg_ = s.vfov_min_deg;
-  vfov_max_deg_ = s.vfov_max_deg;
+  // elevation >= vfov_min  <=>  dz >= tan(vfov_min) h, and likewise for the maximum (h the
+  // horizontal distance): no atan2 per face.
+  vfov_lo_ = s.vfov_min_deg > -90.0;
+  vfov_hi_ = s.vfov_max_deg < 90.0;
+  tan_lo_ = vfov_lo_ ? std::tan(s.vfov_min_deg * std::numbers::pi / 180.0) : 0.0;
+  tan_hi_ = vfov_hi_ ? std::tan(s.vfov_max_deg * std::numbers::pi / 180.0) : 0.0;
   incidence_ = s.HasIncidenceLimit();
   const double c = std::cos(s.max_incidence_deg * std::numbers::pi / 180.0);
   cos2_max_ = c * c;
@@ -25,10 +28,20 @@ bool ScannerLimits::Passes(const Eigen::Vector3d& aim, int axis, int sign) const
   const Eigen::Vector3d d = uo_ - aim;  // from the aim point to the station
   const double d2 = d.squaredNorm();
   if (!(d2 >= min2_ && d2 <= max2_)) return false;
-  if (vfov_) {
-    // The aim point's elevation seen from the station: dz = aim.z - station.z = -d.z.
-    const double elevation_deg = std::atan2(-d.z(), std::hypot(d.x(), d.y())) * (180.0 / std::numbers::pi);
-    if (!(elevation_deg >= vfov_min_deg_ && elevation_deg <= vfov_max_deg_)) return false;
+  if (vfov_lo_ || vfov_hi_) {
+    // The aim point's elevation seen from the station, compared through its tangent dz / h with
+    // dz = aim.z - station.z = -d.z and h the horizontal distance, squared to spare the root.
+    const double dz = -d.z(), dz2 = dz * dz, h2 = d.x() * d.x() + d.y() * d.y();
+    if (vfov_lo_) {  // dz >= tan_lo h
+      const bool above =
+          tan_lo_ <= 0 ? (dz >= 0 || dz2 <= tan_lo_ * tan_lo_ * h2) : (dz >= 0 && dz2 >= tan_lo_ * tan_lo_ * h2);
+      if (!above) return false;
+    }
+    if (vfov_hi_) {  // dz <= tan_hi h
+      const bool below =
+          tan_hi_ >= 0 ? (dz <= 0 || dz2 <= tan_hi_ * tan_hi_ * h2) : (dz <= 0 && dz2 >= tan_hi_ * tan_hi_ * h2);
+      if (!below) return false;
+    }
   }
   // s = |d| cos(incidence): the component of d along the face's outward normal.
   const double s = sign > 0 ? d[axis] : -d[axis];
@@ -52,7 +65,9 @@ ScannerLimits::Verdict ScannerLimits::BoxVerdict(const Eigen::Vector3d& lo, cons
   // by point.
   const double slack = 1e-9 * (far2 + 1);
   if (near2 > max2_ + slack || far2 < min2_ - slack) return Verdict::kNone;
-  if (near2 >= min2_ + slack && far2 <= max2_ - slack && !vfov_ && !incidence_ && !spacing_) return Verdict::kAll;
+  if (near2 >= min2_ + slack && far2 <= max2_ - slack && !vfov_lo_ && !vfov_hi_ && !incidence_ && !spacing_) {
+    return Verdict::kAll;
+  }
   return Verdict::kSome;
 }
 

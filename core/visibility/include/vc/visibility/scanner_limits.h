@@ -52,8 +52,8 @@ class ScannerLimits {
   Eigen::Vector3d uo_ = Eigen::Vector3d::Zero();
   bool active_ = false;
   double min2_ = 0, max2_ = 0;  // squared range, voxel units
-  bool vfov_ = false;
-  double vfov_min_deg_ = -90, vfov_max_deg_ = 90;
+  bool vfov_lo_ = false, vfov_hi_ = false;  // a lower / upper elevation limit is on
+  double tan_lo_ = 0, tan_hi_ = 0;          // their tangents
   bool incidence_ = false;
   double cos2_max_ = 0;  // cos^2(max_incidence)
   bool spacing_ = false;
