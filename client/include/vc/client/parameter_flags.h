@@ -1,12 +1,15 @@
 // vc-client's parameter flags, derived from the parameter tables (vc/base/parameter.h): one
 // `--<flag>` per row, with the row's help, unit and default; bools as `--<flag>` / `--no-<flag>`;
 // enums by name (`--test surface|compatibility`, `--faces all|exposed`). The scanner's rows are
-// added with the plan's and the evaluation's. Lists (candidates, viewpoints) are files, added by
-// main.cc.
+// added with the plan's and the evaluation's, and `--tripod-heights 1.2,1.6,2.0` with the plan's.
+// The plan's file lists (`--candidates`, `--fixed-stations`, `--keep-out`) are PlanFileFlags, read
+// by LoadPlanFiles; the evaluation's viewpoints by main.cc.
 #pragma once
 
 #include <CLI/CLI.hpp>
+#include <string>
 
+#include "vc/base/status.h"
 #include "vc/plan/evaluate_job.h"
 #include "vc/plan/plan_options.h"
 
@@ -17,5 +20,17 @@ namespace vc::client {
 void AddPlanFlags(CLI::App* command, PlanOptions* options);
 // The same for VC_EVALUATE_PARAMETERS and VC_SCANNER_PARAMETERS.
 void AddEvaluateFlags(CLI::App* command, EvaluateJobOptions* options);
+
+// The plan's list parameters that come from files (paths; empty = not given).
+struct PlanFileFlags {
+  std::string candidates;      // stations.csv format: user candidates
+  std::string fixed_stations;  // stations.csv format: stations already placed
+  std::string keep_out;        // keep-out CSV (docs/PLANNING.md, "Keep-out zones")
+};
+// Binds --candidates, --fixed-stations and --keep-out to `files` (which must outlive the parse).
+void AddPlanFileFlags(CLI::App* command, PlanFileFlags* files);
+// Reads the files named in `files` into options->candidates, fixed_stations and keep_out.
+// NOT_FOUND / INVALID_ARGUMENT (naming file:line) from reading and parsing.
+[[nodiscard]] Status LoadPlanFiles(const PlanFileFlags& files, PlanOptions* options);
 
 }  // namespace vc::client

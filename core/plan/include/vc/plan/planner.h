@@ -27,13 +27,17 @@ struct PlannedStation {
   uint64_t marginal_gain = 0;      // new voxels when picked (greedy order)
   double cumulative_coverage = 0;  // covered / coverable after this pick
   double global_visibility = 0;    // G of this station alone
-  int candidate_index = -1;        // index into PlanResult::candidates, or -1 if refined off-grid
+  int candidate_index = -1;        // index into PlanResult::candidates, or -1 if refined off-grid or fixed
+  bool fixed = false;              // one of PlanOptions::fixed_stations (placed first, never removed)
 };
 
 struct HeatMap {
   // Candidates with their visibility count (Fig. 10); cells without a candidate are absent.
   std::vector<WorldPoint> positions;
   std::vector<uint64_t> visible_voxels;
+  // Per candidate: the top of the floor under it (m), NaN for user candidates; may be empty (then
+  // the heat map groups candidates by their own z).
+  std::vector<double> floor_z_m;
   double grid_spacing_m = 0;
 };
 
