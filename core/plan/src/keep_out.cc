@@ -164,7 +164,7 @@ Result<std::vector<KeepOutZone>> ParseKeepOutCsv(std::string_view text, std::str
     KeepOutZone zone;
     if (kind == "box") {
       if (values.size() != 6) {
-        return InvalidArgumentError(where + ": a box has 7 fields (box,xmin,ymin,zmin,xmax,ymax,zmax), this line " +
+        return InvalidArgumentError(where + ": a box has 7 fields (box,xmin,ymin,zmin,xmax,ymax,zmax); this line has " +
                                     std::to_string(fields.size()));
       }
       zone = KeepOutBox(WorldPoint(values[0], values[1], values[2]), WorldPoint(values[3], values[4], values[5]));

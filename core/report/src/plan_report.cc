@@ -313,7 +313,7 @@ Image DrawHeatmap(const PlanResult& r) {
     if (L.panel_z.size() > 1 || !r.floor_levels_m.empty()) title += "  z = " + Fixed(L.panel_z[p], 2) + " m";
     img.Text(left, 10, title, raster::kBlack, 2);
   }
-  // Stations, numbered in plan order, on the panel of their height.
+  // Stations, numbered in plan order, on the panel of their height; fixed stations ringed in black.
   for (size_t k = 0; k < r.stations.size(); ++k) {
     const WorldPoint& s = r.stations[k].position;
     int panel = 0;
@@ -321,7 +321,8 @@ Image DrawHeatmap(const PlanResult& r) {
     for (size_t p = 0; p < L.panel_z.size(); ++p) {
       if (std::fabs(L.panel_z[p] - s.z()) < best) best = std::fabs(L.panel_z[p] - s.z()), panel = static_cast<int>(p);
     }
-    StationMarker(img, px(panel, s.x()), py(s.y()), static_cast<int>(k) + 1, raster::kRed);
+    StationMarker(img, px(panel, s.x()), py(s.y()), static_cast<int>(k) + 1,
+                  r.stations[k].fixed ? raster::kBlack : raster::kRed);
   }
   const int bar_x = L.width - kLegendWidth + 20;
   ColourBar(img, bar_x, top + 14, std::max(L.plot_h, kMinPlotHeight) - 14, static_cast<double>(max_count), "VOXELS",
