@@ -90,7 +90,9 @@ TEST(CandidatesTest, SeveralHeightsGiveACandidatePerHeightWhereItFitsUnderWhatIs
   for (size_t i = 0; i < c.positions.size(); ++i) {
     EXPECT_NEAR(c.positions[i].z() - c.floor_z_m[i], c.height_m[i], 1e-9);
     ++per_height[c.height_m[i]];
-    if (c.height_m[i] == 2.0) EXPECT_GT(c.positions[i].x(), 0.1) << "2.0 m under the soffit";
+    if (c.height_m[i] == 2.0) {
+      EXPECT_GT(c.positions[i].x(), 0.1) << "2.0 m under the soffit";
+    }
   }
   EXPECT_EQ(per_height[1.2], 20);
   EXPECT_EQ(per_height[1.6], 20);
