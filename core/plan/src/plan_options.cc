@@ -23,6 +23,11 @@ Status PlanOptions::Validate() const {
       return InvalidArgumentError(name + " (" + Num(h) + " m) must be larger than clearance_m (" + Num(clearance_m) +
                                   " m): the scanner would touch the floor");
     }
+    for (size_t j = 0; j < i; ++j) {
+      if (tripod_heights_m[j] == h) {
+        return InvalidArgumentError(name + " (" + Num(h) + " m) repeats tripod_heights_m[" + std::to_string(j) + "]");
+      }
+    }
   }
   if (tripod_heights_m.empty() && clearance_m >= tripod_height_m) {
     return InvalidArgumentError("clearance_m (" + Num(clearance_m) + " m) must be smaller than tripod_height_m (" +

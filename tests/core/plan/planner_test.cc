@@ -425,6 +425,9 @@ TEST(PlannerTest, SeveralTripodHeightsGiveCandidatesAtEachHeightAndOneHeatMapPan
   EXPECT_NE(s.message().find("tripod_heights_m[1]"), std::string::npos) << s.message();
   o.tripod_heights_m = {kNaN};
   EXPECT_NE(o.Validate().message().find("tripod_heights_m[0]"), std::string::npos);
+  o.tripod_heights_m = {1.2, 1.6, 1.2};
+  EXPECT_NE(o.Validate().message().find("tripod_heights_m[2] (1.2 m) repeats tripod_heights_m[0]"), std::string::npos)
+      << o.Validate().message();
 }
 
 TEST(PlannerTest, NoStationOrCandidateLiesInAKeepOutZone) {

@@ -11,7 +11,7 @@
 // to it under the cell centre (in the 3 x 3 voxel columns around it) is the cell's floor (uneven floors and ramps); the
 // candidate stands at its top + tripod height, and is kept if the voxels within the clearance radius are all free. So
 // every storey of a multi-level scene gets its own candidates, each with floor below it. With several tripod heights
-// the levels come from the lowest, and each cell gets one candidate per height (in ascending order of the heights
+// the levels come from the lowest, and each cell gets one candidate per height (in the order of the heights
 // given) that fits under what is above its floor. Internal to vc_core.
 #pragma once
 
