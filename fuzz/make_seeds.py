@@ -73,6 +73,8 @@ def graph():
 GRAPH = graph()
 STATIONS = b"x_m,y_m,z_m\n0,0,1.5\n2.5,1,1.5\n# comment\n3 4 1.6\n"
 
+KEEP_OUT = (b"# keep-out zones: boxes and polygons over a z range\n\nbox, -1, -1, -2, 1, 1, 4  # the tripod\n"
+            b"POLYGON,0,3.5,10,10,12,10,12,12,10,12\npolygon,-1e3,1e3,0,0,1,0,0,1\n")
 SEEDS = {
     "ply_fuzzer": {"ascii.ply": PLY_ASCII, "binary_le.ply": PLY_BIN, "binary_be.ply": PLY_BE},
     "pcd_fuzzer": {"ascii.pcd": PCD_ASCII, "binary.pcd": PCD_BIN, "lzf.pcd": PCD_LZF},
@@ -88,6 +90,8 @@ SEEDS = {
     "lzf_fuzzer": {"literal.lzf": struct.pack("<H", len(_raw)) + _lzf,
                    "backref.lzf": struct.pack("<H", 12) + bytes([3]) + b"abcd" + bytes([0xc0, 3])},
     "stations_csv_fuzzer": {"stations.csv": STATIONS},
+    "keep_out_csv_fuzzer": {"zones.csv": KEEP_OUT, "box.csv": b"box,0,0,0,1,1,1\n",
+                            "polygon.csv": b"polygon,0,3,0,0,2,0,2,1,1,1,1,2,0,2\n"},
 }
 SEEDS["read_scene_fuzzer"] = {
     name: data for target in ("ply_fuzzer", "pcd_fuzzer", "xyz_fuzzer", "las_fuzzer",

@@ -42,8 +42,9 @@ void PrintStations(const vc::PlanResult& r) {
   std::printf("  %3s %10s %10s %10s %12s %9s\n", "#", "x_m", "y_m", "z_m", "gain_voxels", "coverage");
   for (size_t i = 0; i < r.stations.size(); ++i) {
     const auto& s = r.stations[i];
-    std::printf("  %3zu %10.3f %10.3f %10.3f %12llu %8.1f%%\n", i + 1, s.position.x(), s.position.y(), s.position.z(),
-                static_cast<unsigned long long>(s.marginal_gain), 100.0 * s.cumulative_coverage);
+    std::printf("  %3zu %10.3f %10.3f %10.3f %12llu %8.1f%%%s\n", i + 1, s.position.x(), s.position.y(), s.position.z(),
+                static_cast<unsigned long long>(s.marginal_gain), 100.0 * s.cumulative_coverage,
+                s.fixed ? "  fixed" : "");
   }
   for (const auto& w : r.warnings) std::printf("warning: %s\n", w.c_str());
 }
@@ -87,11 +88,12 @@ int main(int argc, char** argv) {
 
   // submit: every planning parameter's flag comes from the parameter table (parameter_flags.h).
   vc::PlanOptions plan;
-  std::string file, out_dir = "./vc-out", candidates_csv;
+  std::string file, out_dir = "./vc-out";
+  vc::client::PlanFileFlags plan_files;
   auto* submit = app.add_subcommand("submit", "plan stations for a scene on the server; write the reports");
   submit->add_option("FILE", file, "scene: PLY, PCD, XYZ, LAS, or OctoMap .bt/.ot/.graph")->required();
   submit->add_option("--out", out_dir, "output directory")->capture_default_str();
-  submit->add_option("--candidates", candidates_csv, "CSV of candidate positions x,y,z (replaces the grid)");
+  vc::client::AddPlanFileFlags(submit, &plan_files);
   vc::client::AddPlanFlags(submit, &plan);
 
   // evaluate
@@ -155,12 +157,8 @@ int main(int argc, char** argv) {
   display.Uploading(upload->source_name, upload->bytes.size(), conn.server);
 
   if (*submit) {
-    if (!candidates_csv.empty()) {
-      auto text = vc::client::ReadUpload(candidates_csv);
-      if (!text.ok()) return Fail("cannot read the candidates", text.status());
-      auto points = vc::ParseStationsCsv(text->bytes, candidates_csv);
-      if (!points.ok()) return Fail("bad candidates file", points.status());
-      plan.candidates = std::move(points).value();
+    if (vc::Status loaded = vc::client::LoadPlanFiles(plan_files, &plan); !loaded.ok()) {
+      return Fail("bad input file", loaded);
     }
     auto r = (*client)->Plan(*upload, plan, Observe(display));
     display.Done();

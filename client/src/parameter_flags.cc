@@ -1,10 +1,14 @@
 #include "vc/client/parameter_flags.h"
 
 #include <cstdio>
+#include <fstream>
 #include <map>
+#include <sstream>
 #include <string>
 #include <vector>
 
+#include "vc/plan/keep_out.h"
+#include "vc/report/plan_report.h"
 #include "vc/visibility/scanner_presets.h"
 
 namespace vc::client {
@@ -79,6 +83,11 @@ void AddScannerFlags(CLI::App* command, ScannerModel* o) {
 
 void AddPlanFlags(CLI::App* command, PlanOptions* o) {
   VC_PLAN_PARAMETERS(VC_ROW_FLAG)
+  command
+      ->add_option("--tripod-heights", o->tripod_heights_m,
+                   "several scanner heights above the floor, comma-separated (m); replaces --tripod-height")
+      ->delimiter(',')
+      ->type_name("H1,H2,...");
   AddScannerFlags(command, &o->scanner);
 }
 
@@ -106,6 +115,43 @@ std::string ScannerPresetsTable() {
     out += line;
   }
   return out;
+}
+
+void AddPlanFileFlags(CLI::App* command, PlanFileFlags* files) {
+  command->add_option("--candidates", files->candidates, "CSV of candidate positions x,y,z (replaces the grid)");
+  command->add_option("--fixed-stations", files->fixed_stations,
+                      "CSV of stations already placed x,y,z (e.g. stations.csv); the plan adds to them");
+  command->add_option("--keep-out", files->keep_out,
+                      "CSV of keep-out zones: box,xmin,ymin,zmin,xmax,ymax,zmax or polygon,zmin,zmax,x1,y1,...");
+}
+
+namespace {
+
+// The whole file at `path`; NOT_FOUND naming `what` when it cannot be read.
+Result<std::string> ReadText(const std::string& path, const std::string& what) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return NotFoundError("cannot read the " + what + " file " + path);
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+}  // namespace
+
+Status LoadPlanFiles(const PlanFileFlags& files, PlanOptions* o) {
+  if (!files.candidates.empty()) {
+    VC_ASSIGN_OR_RETURN(std::string text, ReadText(files.candidates, "candidates"));
+    VC_ASSIGN_OR_RETURN(o->candidates, ParseStationsCsv(text, files.candidates));
+  }
+  if (!files.fixed_stations.empty()) {
+    VC_ASSIGN_OR_RETURN(std::string text, ReadText(files.fixed_stations, "fixed stations"));
+    VC_ASSIGN_OR_RETURN(o->fixed_stations, ParseStationsCsv(text, files.fixed_stations));
+  }
+  if (!files.keep_out.empty()) {
+    VC_ASSIGN_OR_RETURN(std::string text, ReadText(files.keep_out, "keep-out"));
+    VC_ASSIGN_OR_RETURN(o->keep_out, ParseKeepOutCsv(text, files.keep_out));
+  }
+  return Status::Ok();
 }
 
 }  // namespace vc::client

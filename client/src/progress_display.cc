@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <cstring>
 
 namespace vc::client {
 
@@ -47,9 +49,9 @@ void ProgressDisplay::Update(const ProgressEvent& e) {
 
 void ProgressDisplay::Station(const PlannedStation& s, int index) {
   char line[160];
-  std::snprintf(line, sizeof line,
-                "picked station %d (provisional) at (%.2f, %.2f, %.2f): +%llu voxels, coverage %.1f%%", index + 1,
-                s.position.x(), s.position.y(), s.position.z(), static_cast<unsigned long long>(s.marginal_gain),
+  std::snprintf(line, sizeof line, "%s station %d %s at (%.2f, %.2f, %.2f): +%llu voxels, coverage %.1f%%",
+                s.fixed ? "fixed" : "picked", index + 1, s.fixed ? "(already placed)" : "(provisional)", s.position.x(),
+                s.position.y(), s.position.z(), static_cast<unsigned long long>(s.marginal_gain),
                 100.0 * s.cumulative_coverage);
   Note(line);
 }
@@ -57,8 +59,14 @@ void ProgressDisplay::Station(const PlannedStation& s, int index) {
 void ProgressDisplay::FinalStations(const std::vector<PlannedStation>& stations) {
   const double coverage = stations.empty() ? 0.0 : stations.back().cumulative_coverage;
   char line[160];
+  size_t fixed = 0;
+  for (const PlannedStation& s : stations) fixed += s.fixed ? 1 : 0;
   std::snprintf(line, sizeof line, "final stations: %zu after refinement and reduction, coverage %.1f%%",
                 stations.size(), 100.0 * coverage);
+  if (fixed > 0) {
+    std::snprintf(line + std::strlen(line), sizeof line - std::strlen(line), " (%zu fixed, %zu added)", fixed,
+                  stations.size() - fixed);
+  }
   Note(line);
 }
 

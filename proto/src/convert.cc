@@ -166,6 +166,34 @@ Reduction FromProto(const v1::Reduction& r) {
   return out;
 }
 
+v1::KeepOutZone ToProto(const KeepOutZone& z) {
+  v1::KeepOutZone p;
+  if (z.shape == KeepOutShape::kBox) {
+    *p.mutable_box()->mutable_min() = wire::ToProto(z.min);
+    *p.mutable_box()->mutable_max() = wire::ToProto(z.max);
+  } else {
+    v1::KeepOutPolygon* poly = p.mutable_polygon();
+    poly->set_z_min_m(z.min.z());
+    poly->set_z_max_m(z.max.z());
+    poly->mutable_xy_m()->Add(z.polygon_xy_m.begin(), z.polygon_xy_m.end());
+  }
+  return p;
+}
+
+// INVALID_ARGUMENT for a zone without a shape; the values are checked by PlanOptions::Validate.
+Result<KeepOutZone> FromProto(const v1::KeepOutZone& p, size_t index) {
+  switch (p.shape_case()) {
+    case v1::KeepOutZone::kBox:
+      return KeepOutBox(wire::FromProto(p.box().min()), wire::FromProto(p.box().max()));
+    case v1::KeepOutZone::kPolygon:
+      return KeepOutPolygon(p.polygon().z_min_m(), p.polygon().z_max_m(),
+                            std::vector<double>(p.polygon().xy_m().begin(), p.polygon().xy_m().end()));
+    default:
+      break;
+  }
+  return InvalidArgumentError("keep_out[" + std::to_string(index) + "] has neither a box nor a polygon");
+}
+
 Status ChunkError(const std::string& what) {
   return DataLossError("the server's result stream is inconsistent (" + what +
                        "); retry, and report it if it persists");
@@ -178,6 +206,9 @@ v1::PlanParameters ToProto(const PlanOptions& o) {
   VC_PLAN_PARAMETERS(VC_ROW_TO_PROTO)
   *p.mutable_scanner() = ToProto(o.scanner);
   for (const auto& c : o.candidates) *p.add_candidates() = ToProto(c);
+  p.mutable_tripod_heights_m()->Add(o.tripod_heights_m.begin(), o.tripod_heights_m.end());
+  for (const auto& z : o.keep_out) *p.add_keep_out() = ToProto(z);
+  for (const auto& f : o.fixed_stations) *p.add_fixed_stations() = ToProto(f);
   return p;
 }
 
@@ -186,6 +217,12 @@ Result<PlanOptions> FromProto(const v1::PlanParameters& p) {
   VC_PLAN_PARAMETERS(VC_ROW_FROM_PROTO)
   if (p.has_scanner()) VC_RETURN_IF_ERROR(Apply(p.scanner(), &o.scanner));
   for (const auto& c : p.candidates()) o.candidates.push_back(FromProto(c));
+  o.tripod_heights_m.assign(p.tripod_heights_m().begin(), p.tripod_heights_m().end());
+  for (int i = 0; i < p.keep_out_size(); ++i) {
+    VC_ASSIGN_OR_RETURN(KeepOutZone zone, FromProto(p.keep_out(i), static_cast<size_t>(i)));
+    o.keep_out.push_back(std::move(zone));
+  }
+  for (const auto& f : p.fixed_stations()) o.fixed_stations.push_back(FromProto(f));
   return o;
 }
 
@@ -274,6 +311,7 @@ v1::PlannedStation ToProto(const PlannedStation& s) {
   p.set_cumulative_coverage(s.cumulative_coverage);
   p.set_global_visibility(s.global_visibility);
   p.set_candidate_index(s.candidate_index);
+  p.set_fixed(s.fixed);
   return p;
 }
 
@@ -285,6 +323,7 @@ PlannedStation FromProto(const v1::PlannedStation& p) {
   s.cumulative_coverage = p.cumulative_coverage();
   s.global_visibility = p.global_visibility();
   s.candidate_index = p.candidate_index();
+  s.fixed = p.fixed();
   return s;
 }
 
@@ -325,6 +364,7 @@ std::vector<v1::HeatMapChunk> HeatMapChunks(const HeatMap& h) {
     for (size_t i = first; i < end; ++i) {
       *c.add_positions() = ToProto(h.positions[i]);
       c.add_visible_voxels(i < h.visible_voxels.size() ? h.visible_voxels[i] : 0);
+      if (h.floor_z_m.size() == n) c.add_floor_z_m(h.floor_z_m[i]);
     }
     chunks.push_back(std::move(c));
   }
@@ -402,6 +442,7 @@ Status PlanResultAssembler::AddHeatMap(const v1::HeatMapChunk& c) {
   for (int i = 0; i < c.positions_size(); ++i) {
     heat_map_.positions.push_back(FromProto(c.positions(i)));
     heat_map_.visible_voxels.push_back(c.visible_voxels(i));
+    if (c.floor_z_m_size() == c.positions_size()) heat_map_.floor_z_m.push_back(c.floor_z_m(i));
   }
   if (heat_map_.positions.size() > heat_map_total_) return ChunkError("more heat map candidates than declared");
   return Status::Ok();

@@ -13,6 +13,7 @@
 #include <set>
 #include <string>
 
+#include "vc/plan/keep_out.h"
 #include "vc/report/plan_report.h"
 #include "vc/visibility/scanner_presets.h"
 #include "vc/wire/convert.h"
@@ -200,7 +201,7 @@ TEST(ParameterTablesTest, EveryProtoFieldAndPlanJsonParameterHasARow) {
   std::set<std::string> evaluate_rows = {VC_EVALUATE_PARAMETERS(VC_ROW_NAME)};
 
   std::set<std::string> want = plan_rows;
-  want.insert({"scanner", "candidates"});
+  want.insert({"scanner", "candidates", "tripod_heights_m", "keep_out", "fixed_stations"});
   EXPECT_EQ(FieldNames(v1::PlanParameters::descriptor()), want);
   want = scanner_rows;
   want.insert("name");  // the preset, not a row (vc/visibility/scanner_presets.h)
@@ -213,7 +214,7 @@ TEST(ParameterTablesTest, EveryProtoFieldAndPlanJsonParameterHasARow) {
   const json plan = json::parse(PlanToJson(PlanResult{}));
   for (const auto& [key, value] : plan["parameters"].items()) keys.insert(key);
   want = plan_rows;
-  want.insert({"scanner", "user_candidates"});
+  want.insert({"scanner", "user_candidates", "tripod_heights_m", "keep_out", "fixed_stations"});
   EXPECT_EQ(keys, want);
 
   keys.clear();
@@ -224,6 +225,116 @@ TEST(ParameterTablesTest, EveryProtoFieldAndPlanJsonParameterHasARow) {
 }
 
 #undef VC_ROW_NAME
+
+// The list parameters that are not rows: --tripod-heights, and the files of --candidates,
+// --fixed-stations and --keep-out, through the flags, the proto and plan.json.
+std::string WriteTemp(const std::string& name, const std::string& text) {
+  const std::string path = ::testing::TempDir() + "/" + name;
+  std::FILE* f = std::fopen(path.c_str(), "wb");
+  EXPECT_NE(f, nullptr) << path;
+  if (f) {
+    std::fwrite(text.data(), 1, text.size(), f);
+    std::fclose(f);
+  }
+  return path;
+}
+
+TEST(ListParametersTest, FlagsFilesProtoAndPlanJson) {
+  const std::string fixed = WriteTemp("fixed.csv", "x,y,z\n1,2,1.5\n-3.5,0.25,1.6\n");
+  const std::string keep_out = WriteTemp("keep_out.csv", "# zones\nbox,0,0,0,1,1,3\npolygon,-1,4,5,5,7,5,6,7\n");
+  const std::string candidates = WriteTemp("candidates.csv", "2,2,1.5\n");
+  PlanOptions o;
+  client::PlanFileFlags files;
+  CLI::App app;
+  client::AddPlanFlags(&app, &o);
+  client::AddPlanFileFlags(&app, &files);
+  app.parse("--tripod-heights 1.2,1.6,2.0 --fixed-stations " + fixed + " --keep-out " + keep_out + " --candidates " +
+                candidates,
+            false);
+  EXPECT_EQ(o.tripod_heights_m, (std::vector<double>{1.2, 1.6, 2.0}));
+  ASSERT_TRUE(client::LoadPlanFiles(files, &o).ok());
+  ASSERT_EQ(o.fixed_stations.size(), 2u);
+  EXPECT_EQ(o.fixed_stations[1], WorldPoint(-3.5, 0.25, 1.6));
+  ASSERT_EQ(o.keep_out.size(), 2u);
+  EXPECT_EQ(o.keep_out[1].shape, KeepOutShape::kPolygon);
+  EXPECT_EQ(o.candidates.size(), 1u);
+  EXPECT_TRUE(o.Validate().ok()) << o.Validate().ToString();
+
+  Result<PlanOptions> back = wire::FromProto(wire::ToProto(o));
+  ASSERT_TRUE(back.ok()) << back.status().ToString();
+  EXPECT_EQ(back->tripod_heights_m, o.tripod_heights_m);
+  EXPECT_EQ(back->fixed_stations, o.fixed_stations);
+  EXPECT_EQ(back->candidates, o.candidates);
+  ASSERT_EQ(back->keep_out.size(), 2u);
+  for (size_t i = 0; i < 2; ++i) {
+    EXPECT_EQ(back->keep_out[i].shape, o.keep_out[i].shape);
+    EXPECT_EQ(back->keep_out[i].min, o.keep_out[i].min);
+    EXPECT_EQ(back->keep_out[i].max, o.keep_out[i].max);
+    EXPECT_EQ(back->keep_out[i].polygon_xy_m, o.keep_out[i].polygon_xy_m);
+  }
+
+  PlanResult r;
+  r.options = o;
+  const json parameters = json::parse(PlanToJson(r))["parameters"];
+  EXPECT_EQ(parameters["tripod_heights_m"], json({1.2, 1.6, 2.0}));
+  EXPECT_EQ(parameters["fixed_stations"][1], json({-3.5, 0.25, 1.6}));
+  EXPECT_EQ(parameters["keep_out"][0]["box"]["max"], json({1.0, 1.0, 3.0}));
+  EXPECT_EQ(parameters["keep_out"][1]["polygon"]["xy_m"], json({5.0, 5.0, 7.0, 5.0, 6.0, 7.0}));
+}
+
+TEST(ListParametersTest, StationsCarryFixedAndTheHeatMapItsFloorsOverTheWire) {
+  PlannedStation s;
+  s.fixed = true;
+  EXPECT_TRUE(wire::FromProto(wire::ToProto(s)).fixed);
+  s.fixed = false;
+  EXPECT_FALSE(wire::FromProto(wire::ToProto(s)).fixed);
+  HeatMap h;
+  h.positions = {{0, 0, 1.5}, {1, 0, 1.9}};
+  h.visible_voxels = {1, 2};
+  h.floor_z_m = {0, 0.3};
+  const std::vector<v1::HeatMapChunk> chunks = wire::HeatMapChunks(h);
+  ASSERT_EQ(chunks.size(), 1u);
+  ASSERT_EQ(chunks[0].floor_z_m_size(), 2);
+  EXPECT_EQ(chunks[0].floor_z_m(1), 0.3);
+}
+
+TEST(ListParametersTest, BadFilesAndZonesAreRefusedNamingWhere) {
+  PlanOptions o;
+  client::PlanFileFlags files;
+  files.keep_out = WriteTemp("bad_keep_out.csv", "box,0,0,0,1,1,1\nbox,0,0,0,1,1\n");
+  Status s = client::LoadPlanFiles(files, &o);
+  EXPECT_EQ(s.code(), StatusCode::kInvalidArgument);
+  EXPECT_NE(s.message().find("bad_keep_out.csv:2"), std::string::npos) << s.message();
+  files.keep_out = ::testing::TempDir() + "/no_such_file.csv";
+  EXPECT_EQ(client::LoadPlanFiles(files, &o).code(), StatusCode::kNotFound);
+  files = {};
+  files.fixed_stations = WriteTemp("bad_fixed.csv", "1,2,3\n1,2\n");
+  s = client::LoadPlanFiles(files, &o);
+  EXPECT_EQ(s.code(), StatusCode::kInvalidArgument);
+  EXPECT_NE(s.message().find("bad_fixed.csv:2"), std::string::npos) << s.message();
+  // A zone without a shape on the wire, and bad values the server's Validate refuses.
+  v1::PlanParameters p;
+  p.add_keep_out();
+  EXPECT_EQ(wire::FromProto(p).status().code(), StatusCode::kInvalidArgument);
+  p.clear_keep_out();
+  v1::KeepOutPolygon* poly = p.add_keep_out()->mutable_polygon();
+  poly->set_z_min_m(0);
+  poly->set_z_max_m(1);
+  poly->add_xy_m(0);
+  poly->add_xy_m(0);
+  Result<PlanOptions> two = wire::FromProto(p);
+  ASSERT_TRUE(two.ok());
+  s = two->Validate();
+  EXPECT_EQ(s.code(), StatusCode::kInvalidArgument);
+  EXPECT_NE(s.message().find("keep_out[0]"), std::string::npos) << s.message();
+  // A bad height names the entry.
+  CLI::App app;
+  PlanOptions h;
+  client::AddPlanFlags(&app, &h);
+  app.parse("--tripod-heights 1.5,0.1", false);
+  s = h.Validate();
+  EXPECT_NE(s.message().find("tripod_heights_m[1]"), std::string::npos) << s.message();
+}
 
 TEST(ParameterTablesTest, UnknownEnumNamesAreRefusedByTheFlag) {
   PlanOptions o;

@@ -1,6 +1,8 @@
 // CRC32C and the proto <-> core conversions (vc::wire).
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "vc/wire/convert.h"
 #include "vc/wire/crc32c.h"
 
@@ -73,9 +75,11 @@ PlanResult BigResult(size_t voxels, size_t candidates) {
   for (size_t i = 0; i < candidates; ++i) {
     r.heat_map.positions.emplace_back(double(i), 0, 1.5);
     r.heat_map.visible_voxels.push_back(i * 3);
+    r.heat_map.floor_z_m.push_back(i % 2 ? 0.25 : std::nan(""));
   }
   r.heat_map.grid_spacing_m = 1;
   r.stations.push_back({{1, 2, 3}, 10, 10, 0.5, 0.2, 4});
+  r.stations.push_back({{0, 0, 0}, 5, 5, 0.6, 0.1, -1, true});  // a fixed station
   r.reduction.size = 1;
   r.reduction.matrix = {0.25};
   r.occupied_voxels = voxels;
@@ -116,8 +120,13 @@ TEST(PlanResultChunks, ReassembleExactlyAndStayUnderOneMebibyte) {
   EXPECT_EQ(back->evaluation.best_face_values, r.evaluation.best_face_values);
   EXPECT_EQ(back->heat_map.positions, r.heat_map.positions);
   EXPECT_EQ(back->heat_map.visible_voxels, r.heat_map.visible_voxels);
+  ASSERT_EQ(back->heat_map.floor_z_m.size(), r.heat_map.floor_z_m.size());
+  EXPECT_TRUE(std::isnan(back->heat_map.floor_z_m[0]));
+  EXPECT_EQ(back->heat_map.floor_z_m[1], 0.25);
   EXPECT_EQ(back->stations[0].position, r.stations[0].position);
   EXPECT_EQ(back->stations[0].candidate_index, 4);
+  EXPECT_FALSE(back->stations[0].fixed);
+  EXPECT_TRUE(back->stations[1].fixed);
   EXPECT_EQ(back->reduction.matrix, r.reduction.matrix);
   EXPECT_DOUBLE_EQ(back->evaluation.overall.global_visibility, 0.42);
   EXPECT_EQ(back->timings[0].stage, Stage::kSelection);
@@ -136,8 +145,8 @@ TEST(PlanResultChunks, ReassembleExactlyAndStayUnderOneMebibyte) {
 // A tripwire: when a field is added to PlanResult or PlanOptions, its size changes; carry the new
 // field in proto/vc/v1/planner.proto and proto/src/convert.cc (both ways), then update the sizes.
 TEST(PlanResultChunks, EveryCoreFieldIsCarried) {
-  EXPECT_EQ(sizeof(PlanResult), 736u) << "PlanResult changed: update the vc.v1 PlanResult and vc::wire";
-  EXPECT_EQ(sizeof(PlanOptions), 224u) << "PlanOptions changed: update vc.v1 PlanParameters and vc::wire";
+  EXPECT_EQ(sizeof(PlanResult), 832u) << "PlanResult changed: update the vc.v1 PlanResult and vc::wire";
+  EXPECT_EQ(sizeof(PlanOptions), 296u) << "PlanOptions changed: update vc.v1 PlanParameters and vc::wire";
 }
 
 TEST(PlanResultChunks, MissingChunkIsDataLoss) {

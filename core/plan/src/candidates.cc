@@ -10,6 +10,7 @@ namespace {
 
 struct Surface {
   int z;           // index of the top voxel of an occupied run
+  int free_above;  // free voxels above it (INT_MAX up to the top of the grid)
   bool covered;    // another occupied run above it in the column
   bool has_below;  // another occupied run below it in the column
   int run;         // the run's number from the top of the column
@@ -17,9 +18,20 @@ struct Surface {
   bool roof() const { return !covered && has_below; }
 };
 
-// Voxels of free space a standing surface needs above it.
+// Voxels of free space a scanner at `height_m` with `clearance_m` needs above its floor.
+int FreeVoxelsNeeded(double resolution_m, double height_m, double clearance_m) {
+  return std::max(1, static_cast<int>(std::ceil((height_m + clearance_m) / resolution_m - 1e-9)));
+}
+
+// The lowest tripod height of `o` (m).
+double LowestHeight(const CandidateOptions& o) {
+  if (o.tripod_heights_m.empty()) return o.tripod_height_m;
+  return *std::min_element(o.tripod_heights_m.begin(), o.tripod_heights_m.end());
+}
+
+// Voxels of free space a standing surface needs above it: for the lowest height.
 int FreeVoxelsNeeded(double resolution_m, const CandidateOptions& o) {
-  return std::max(1, static_cast<int>(std::ceil((o.tripod_height_m + o.clearance_m) / resolution_m - 1e-9)));
+  return FreeVoxelsNeeded(resolution_m, LowestHeight(o), o.clearance_m);
 }
 
 // Half-width (voxels) of a level's height band: 0.15 m, at least 2 voxels.
@@ -37,7 +49,7 @@ void ColumnSurfaces(const OccupancyGrid& grid, int x, int y, int free_needed, st
   for (int z = m.z + grid.dims().z() - 1; z >= m.z; --z) {
     if (grid.Occupied(x, y, z)) {
       if (!in_run) {
-        if (free_above >= free_needed) out.push_back({z, runs > 0, false, runs});
+        if (free_above >= free_needed) out.push_back({z, free_above, runs > 0, false, runs});
         ++runs;
         in_run = true;
       }
@@ -53,20 +65,27 @@ void ColumnSurfaces(const OccupancyGrid& grid, int x, int y, int free_needed, st
 constexpr int kNoSurface = std::numeric_limits<int>::min();
 
 // The standing surface with z in [ref - band, ref + band] closest to ref (the higher on a tie) in
-// the 3 x 3 columns around (cx, cy), or kNoSurface.
+// the 3 x 3 columns around (cx, cy), or kNoSurface; *free_above (if given) gets the most free
+// voxels above it among the columns where that surface is.
 int SurfaceNear(const OccupancyGrid& grid, int cx, int cy, int ref, int band, int free_needed,
-                std::vector<Surface>& scratch) {
-  int best = kNoSurface;
+                std::vector<Surface>& scratch, int* free_above = nullptr) {
+  int best = kNoSurface, best_free = 0;
   for (int dy = -1; dy <= 1; ++dy) {
     for (int dx = -1; dx <= 1; ++dx) {
       ColumnSurfaces(grid, cx + dx, cy + dy, free_needed, scratch);
       for (const Surface& s : scratch) {
         if (s.z < ref - band || s.z > ref + band) continue;
         const int d = std::abs(s.z - ref), d_best = best == kNoSurface ? band + 1 : std::abs(best - ref);
-        if (d < d_best || (d == d_best && s.z > best)) best = s.z;
+        if (d < d_best || (d == d_best && s.z > best)) {
+          best = s.z;
+          best_free = s.free_above;
+        } else if (s.z == best) {
+          best_free = std::max(best_free, s.free_above);
+        }
       }
     }
   }
+  if (free_above) *free_above = best_free;
   return best;
 }
 
@@ -127,6 +146,8 @@ Result<CandidateGrid> GenerateCandidates(const VoxelScene& scene, const Candidat
   const int band = BandVoxels(r);
   const Eigen::Vector3i dims = grid.dims();
   CandidateGrid out;
+  const std::vector<double> heights =
+      options.tripod_heights_m.empty() ? std::vector<double>{options.tripod_height_m} : options.tripod_heights_m;
 
   // 1. Histogram of standing surfaces over all columns.
   // Histograms are indexed by z - min.z.
@@ -201,23 +222,27 @@ Result<CandidateGrid> GenerateCandidates(const VoxelScene& scene, const Candidat
       VC_RETURN_IF_ERROR(ctx.CheckCancelled("candidate generation"));
       ctx.Report(Stage::kCandidates, 0.5 + 0.5 * (li + static_cast<double>(iy) / ys.size()) / kept.size());
       for (size_t ix = 0; ix < xs.size(); ++ix) {
-        ++out.cells;
+        out.cells += heights.size();
         const Eigen::Vector3d u = grid.WorldToIndexSpace(WorldPoint(xs[ix], ys[iy], lo.z()));
+        int free_above = 0;
         const int z = SurfaceNear(grid, static_cast<int>(std::floor(u.x())), static_cast<int>(std::floor(u.y())), lz,
-                                  band, free_needed, scratch);
+                                  band, free_needed, scratch, &free_above);
         if (z == kNoSurface) {
-          ++out.rejected_no_floor;
+          out.rejected_no_floor += heights.size();
           continue;
         }
         const double top = grid.IndexSpaceToWorld(Eigen::Vector3d(0, 0, z + 1)).z();
-        const WorldPoint p(xs[ix], ys[iy], top + options.tripod_height_m);
-        if (!HasClearance(grid, p, options.clearance_m)) {
-          ++out.rejected_clearance;
-          continue;
+        for (double h : heights) {
+          const WorldPoint p(xs[ix], ys[iy], top + h);
+          if (free_above < FreeVoxelsNeeded(r, h, options.clearance_m) || !HasClearance(grid, p, options.clearance_m)) {
+            ++out.rejected_clearance;
+            continue;
+          }
+          out.positions.push_back(p);
+          out.floor_z_m.push_back(top);
+          out.level.push_back(static_cast<int>(li));
+          out.height_m.push_back(h);
         }
-        out.positions.push_back(p);
-        out.floor_z_m.push_back(top);
-        out.level.push_back(static_cast<int>(li));
       }
     }
   }

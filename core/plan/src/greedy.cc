@@ -44,6 +44,9 @@ struct EntryLess {
 Result<GreedyResult> SelectGreedy(const std::vector<VoxelSet>& sets, const GreedyOptions& options,
                                   const JobContext& ctx) {
   if (options.max_stations < 0) return InvalidArgumentError("max_stations must be >= 0");
+  if (options.fixed < 0 || static_cast<size_t>(options.fixed) > sets.size()) {
+    return InvalidArgumentError("fixed must be in [0, " + std::to_string(sets.size()) + "]");
+  }
   if (!(options.target_coverage > 0.0 && options.target_coverage <= 1.0)) {
     return InvalidArgumentError("target_coverage must be in (0, 1]");
   }
@@ -61,12 +64,20 @@ Result<GreedyResult> SelectGreedy(const std::vector<VoxelSet>& sets, const Greed
   result.coverable = CountBits(uncovered);
   const double coverable = static_cast<double>(result.coverable);
   const uint64_t min_gain = std::max<uint64_t>(options.min_marginal_gain, 1);
+  const size_t fixed = static_cast<size_t>(options.fixed);
+  // The fixed stations first, whatever they add.
+  for (size_t i = 0; i < fixed; ++i) {
+    const uint64_t gain = CountAnd(sets[i], uncovered);
+    SubtractFrom(uncovered, sets[i]);
+    result.covered += gain;
+    result.picks.push_back({static_cast<int>(i), gain, result.covered});
+  }
 
   std::priority_queue<Entry, std::vector<Entry>, EntryLess> heap;
   if (options.lazy) {
-    // Nothing is covered yet, so the initial counts are exact gains for round 0.
-    for (size_t i = 0; i < sets.size(); ++i) {
-      heap.push({CountBits(sets[i]), static_cast<int>(i), 0});
+    // Only the fixed stations cover anything yet, so these are exact gains for round 0.
+    for (size_t i = fixed; i < sets.size(); ++i) {
+      heap.push({fixed ? CountAnd(sets[i], uncovered) : CountBits(sets[i]), static_cast<int>(i), 0});
       ++result.gain_evaluations;
     }
   }
@@ -82,7 +93,7 @@ Result<GreedyResult> SelectGreedy(const std::vector<VoxelSet>& sets, const Greed
       result.stop = StopReason::kTargetReached;
       break;
     }
-    if (options.max_stations > 0 && static_cast<int>(result.picks.size()) >= options.max_stations) {
+    if (options.max_stations > 0 && static_cast<int>(result.picks.size() - fixed) >= options.max_stations) {
       result.stop = StopReason::kMaxStations;
       break;
     }
@@ -103,7 +114,7 @@ Result<GreedyResult> SelectGreedy(const std::vector<VoxelSet>& sets, const Greed
         heap.push(top);
       }
     } else {
-      for (size_t i = 0; i < sets.size(); ++i) {
+      for (size_t i = fixed; i < sets.size(); ++i) {
         const uint64_t g = CountAnd(sets[i], uncovered);
         ++result.gain_evaluations;
         if (g > best_gain) {  // strict: ties keep the lowest index
@@ -126,15 +137,16 @@ Result<GreedyResult> SelectGreedy(const std::vector<VoxelSet>& sets, const Greed
 }
 
 Result<ConsolidateResult> ConsolidatePicks(const std::vector<VoxelSet>& sets, std::vector<int> picks,
-                                           const JobContext& ctx) {
+                                           const JobContext& ctx, int fixed) {
   ConsolidateResult out;
   if (sets.empty() || picks.empty()) {
     out.picks = std::move(picks);
     return out;
   }
   const size_t words = sets[0].words().size();
-  std::vector<int> order(sets.size());
-  for (size_t i = 0; i < order.size(); ++i) order[i] = static_cast<int>(i);
+  std::vector<int> order;
+  for (size_t i = static_cast<size_t>(std::max(fixed, 0)); i < sets.size(); ++i) order.push_back(static_cast<int>(i));
+  auto is_fixed = [&](int candidate) { return candidate < fixed; };
   std::vector<uint64_t> sizes(sets.size());
   for (size_t i = 0; i < sets.size(); ++i) sizes[i] = CountBits(sets[i]);
   std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return sizes[a] > sizes[b]; });
@@ -159,6 +171,7 @@ Result<ConsolidateResult> ConsolidatePicks(const std::vector<VoxelSet>& sets, st
     }
     // A pick nobody needs: all its voxels are covered twice. The latest such pick goes first.
     for (size_t i = picks.size(); i-- > 0 && picks.size() > 1;) {
+      if (is_fixed(picks[i])) continue;
       const auto& w = sets[picks[i]].words();
       bool needed = false;
       for (size_t k = 0; k < words && !needed; ++k) needed = (w[k] & ~c2[k]) != 0;
@@ -173,8 +186,10 @@ Result<ConsolidateResult> ConsolidatePicks(const std::vector<VoxelSet>& sets, st
     // Two picks one candidate can stand in for.
     for (size_t a = 0; a < picks.size() && !changed; ++a) {
       VC_RETURN_IF_ERROR(ctx.CheckCancelled("consolidation"));
+      if (is_fixed(picks[a])) continue;
       const auto& wa = sets[picks[a]].words();
       for (size_t b = a + 1; b < picks.size() && !changed; ++b) {
+        if (is_fixed(picks[b])) continue;
         const auto& wb = sets[picks[b]].words();
         // Voxels only a or b cover: in both and covered exactly twice, or in one and covered once.
         nonzero.clear();

@@ -1,5 +1,6 @@
 #include "vc/plan/plan_options.h"
 
+#include <cmath>
 #include <string>
 
 #include "format.h"
@@ -14,7 +15,21 @@ Status PlanOptions::Validate() const {
   VC_PLAN_PARAMETERS(VC_CHECK_ROW)
 #undef VC_CHECK_ROW
   VC_RETURN_IF_ERROR(scanner.Validate());
-  if (clearance_m >= tripod_height_m) {
+  for (size_t i = 0; i < tripod_heights_m.size(); ++i) {
+    const double h = tripod_heights_m[i];
+    const std::string name = "tripod_heights_m[" + std::to_string(i) + "]";
+    if (!std::isfinite(h)) return InvalidArgumentError(name + " is not finite");
+    if (h <= clearance_m) {
+      return InvalidArgumentError(name + " (" + Num(h) + " m) must be larger than clearance_m (" + Num(clearance_m) +
+                                  " m): the scanner would touch the floor");
+    }
+    for (size_t j = 0; j < i; ++j) {
+      if (tripod_heights_m[j] == h) {
+        return InvalidArgumentError(name + " (" + Num(h) + " m) repeats tripod_heights_m[" + std::to_string(j) + "]");
+      }
+    }
+  }
+  if (tripod_heights_m.empty() && clearance_m >= tripod_height_m) {
     return InvalidArgumentError("clearance_m (" + Num(clearance_m) + " m) must be smaller than tripod_height_m (" +
                                 Num(tripod_height_m) + " m): the scanner would touch the floor");
   }
@@ -25,7 +40,24 @@ Status PlanOptions::Validate() const {
   for (size_t i = 0; i < candidates.size(); ++i) {
     if (!candidates[i].allFinite()) return InvalidArgumentError("candidates[" + std::to_string(i) + "] is not finite");
   }
+  for (size_t i = 0; i < keep_out.size(); ++i) {
+    VC_RETURN_IF_ERROR(ValidateKeepOutZone(keep_out[i], "keep_out[" + std::to_string(i) + "]"));
+  }
+  for (size_t i = 0; i < fixed_stations.size(); ++i) {
+    const WorldPoint& p = fixed_stations[i];
+    const std::string name = "fixed_stations[" + std::to_string(i) + "]";
+    if (!p.allFinite()) return InvalidArgumentError(name + " is not finite");
+    if (const int z = KeepOutZoneContaining(keep_out, p); z >= 0) {
+      return InvalidArgumentError(name + " (" + Num(p.x()) + ", " + Num(p.y()) + ", " + Num(p.z()) +
+                                  ") lies inside keep_out[" + std::to_string(z) + "]");
+    }
+  }
   return Status::Ok();
+}
+
+std::vector<double> PlanOptions::TripodHeights() const {
+  if (!tripod_heights_m.empty()) return tripod_heights_m;
+  return {tripod_height_m};
 }
 
 }  // namespace vc

@@ -39,6 +39,7 @@ FinalStations AssembleFinalStations(const planner::Stations& stations, const std
     out.covered_voxels += ps.marginal_gain;
     ps.cumulative_coverage = coverable_voxels ? double(out.covered_voxels) / coverable_voxels : 0.0;
     ps.candidate_index = stations.candidate[k];
+    ps.fixed = k < static_cast<int>(stations.fixed.size()) && stations.fixed[k];
     out.stations.push_back(ps);
   }
   return out;
@@ -95,18 +96,21 @@ Result<PlanResult> Plan(const SceneInput& input, const PlanOptions& options, con
   result.cells_failing_clearance = candidates.cells_failing_clearance;
   result.warnings = candidates.warnings;
 
-  VC_RETURN_IF_ERROR(planner::CheckVisibilitySetBudget(candidates.positions.size(), result.occupied_voxels,
-                                                       options.memory_budget_bytes, "visibility counts"));
+  VC_RETURN_IF_ERROR(planner::CheckVisibilitySetBudget(candidates.positions.size() + options.fixed_stations.size(),
+                                                       result.occupied_voxels, options.memory_budget_bytes,
+                                                       "visibility counts"));
   VC_ASSIGN_OR_RETURN(planner::VisibilityOutput visibility, runner.Run(Stage::kVisibility, [&](const JobContext& c) {
-    return planner::RunVisibilityStage({scene, candidates.positions, callbacks}, options, c);
+    return planner::RunVisibilityStage(
+        {scene, candidates.positions, candidates.floor_z_m, options.fixed_stations, callbacks}, options, c);
   }));
   result.heat_map = std::move(visibility.heat_map);
 
   const planner::GreedySelector selector(planner::SelectorOptionsFor(options));
   VC_ASSIGN_OR_RETURN(planner::SelectionOutput selected, runner.Run(Stage::kSelection, [&](const JobContext& c) {
-    return planner::RunSelectionStage({selector, std::move(visibility.sets), candidates.positions, candidates.floor_z_m,
-                                       result.heat_map.visible_voxels, callbacks},
-                                      options, c);
+    return planner::RunSelectionStage(
+        {selector, std::move(visibility.sets), std::move(visibility.fixed_sets), candidates.positions,
+         candidates.floor_z_m, result.heat_map.visible_voxels, callbacks},
+        options, c);
   }));
   result.stop_reason = selected.selection.stop;
   result.greedy_stations = selected.selection.first_pass_picks;

@@ -70,19 +70,22 @@ ReductionMatrix ComputeReductionMatrix(const std::vector<FaceTop3>& top3, int nu
   return m;
 }
 
-std::vector<int> ChooseRemoval(const ReductionMatrix& m, const std::vector<int>& active, int reduce_to) {
+std::vector<int> ChooseRemoval(const ReductionMatrix& m, const std::vector<int>& active, int reduce_to,
+                               const std::vector<bool>& fixed) {
   const int count = static_cast<int>(active.size());
   if (count <= 1) return {};
+  auto kept = [&](int a) { return static_cast<size_t>(active[a]) < fixed.size() && fixed[active[a]]; };
   // Zero loss: a pair first (keeping at least one station), else a single; the latest first.
   if (count >= 3) {
     for (int b = count - 1; b >= 1; --b) {
+      if (kept(b)) continue;
       for (int a = b - 1; a >= 0; --a) {
-        if (m.at(active[a], active[b]) == 0.0) return {active[a], active[b]};
+        if (!kept(a) && m.at(active[a], active[b]) == 0.0) return {active[a], active[b]};
       }
     }
   }
   for (int a = count - 1; a >= 0; --a) {
-    if (m.at(active[a], active[a]) == 0.0) return {active[a]};
+    if (!kept(a) && m.at(active[a], active[a]) == 0.0) return {active[a]};
   }
   if (reduce_to <= 0 || count <= reduce_to) return {};
   // Lowest loss per removed station; ties: a pair, then the latest in greedy order.
@@ -98,9 +101,12 @@ std::vector<int> ChooseRemoval(const ReductionMatrix& m, const std::vector<int>&
     }
   };
   for (int a = 0; a < count; ++a) {
+    if (kept(a)) continue;
     consider({active[a]}, m.at(active[a], active[a]));
     if (!pairs) continue;
-    for (int b = a + 1; b < count; ++b) consider({active[a], active[b]}, m.at(active[a], active[b]) / 2);
+    for (int b = a + 1; b < count; ++b) {
+      if (!kept(b)) consider({active[a], active[b]}, m.at(active[a], active[b]) / 2);
+    }
   }
   return best;
 }
@@ -174,7 +180,7 @@ Result<ReductionRun> RunReduction(int num_stations, uint64_t faces_total, const 
   ReductionMatrix current = run.initial;
   while (true) {
     VC_RETURN_IF_ERROR(ctx.CheckCancelled("reduction"));
-    std::vector<int> remove = ChooseRemoval(current, active, options.reduce_to);
+    std::vector<int> remove = ChooseRemoval(current, active, options.reduce_to, options.fixed);
     if (remove.empty()) break;
     const double loss = remove.size() == 1 ? current.at(remove[0], remove[0]) : current.at(remove[0], remove[1]);
     std::vector<bool> removed_now(num_stations, false);

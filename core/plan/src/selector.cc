@@ -24,8 +24,9 @@ std::string_view StopReasonName(StopReason reason) {
 
 namespace vc::planner {
 
-Result<Selection> GreedySelector::Select(const std::vector<VoxelSet>& sets, const JobContext& ctx) const {
+Result<Selection> GreedySelector::Select(const std::vector<VoxelSet>& sets, int fixed, const JobContext& ctx) const {
   GreedyOptions greedy_options;
+  greedy_options.fixed = fixed;
   greedy_options.max_stations = options_.max_stations;
   greedy_options.min_marginal_gain = options_.min_marginal_gain_voxels;
   greedy_options.target_coverage = options_.target_coverage;
@@ -35,9 +36,9 @@ Result<Selection> GreedySelector::Select(const std::vector<VoxelSet>& sets, cons
   out.coverable = greedy.coverable;
   out.covered = greedy.covered;
   for (const GreedyPick& pick : greedy.picks) out.picks.push_back(pick.candidate);
-  out.first_pass_picks = static_cast<int>(out.picks.size());
+  out.first_pass_picks = static_cast<int>(out.picks.size()) - fixed;
   if (options_.consolidate) {
-    VC_ASSIGN_OR_RETURN(ConsolidateResult merged, ConsolidatePicks(sets, std::move(out.picks), ctx));
+    VC_ASSIGN_OR_RETURN(ConsolidateResult merged, ConsolidatePicks(sets, std::move(out.picks), ctx, fixed));
     out.picks = std::move(merged.picks);
     out.saved_by_improvement = merged.dropped + merged.merged;
   }

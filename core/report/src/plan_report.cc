@@ -53,12 +53,29 @@ Json ScannerJson(const ScannerModel& o) {
   return j;
 }
 
-// Every row of VC_PLAN_PARAMETERS, the scanner, and the number of user candidates.
+// A keep-out zone: {"box": {"min": [x, y, z], "max": [x, y, z]}} or
+// {"polygon": {"z_min_m": z, "z_max_m": z, "xy_m": [x1, y1, ...]}}.
+Json KeepOutJson(const KeepOutZone& z) {
+  if (z.shape == KeepOutShape::kBox) {
+    return {{"box", {{"min", {z.min.x(), z.min.y(), z.min.z()}}, {"max", {z.max.x(), z.max.y(), z.max.z()}}}}};
+  }
+  return {{"polygon", {{"z_min_m", z.min.z()}, {"z_max_m", z.max.z()}, {"xy_m", z.polygon_xy_m}}}};
+}
+
+// Every row of VC_PLAN_PARAMETERS, the scanner, the number of user candidates, the tripod heights,
+// the keep-out zones and the fixed stations.
 Json ParametersJson(const PlanOptions& o) {
   Json j = Json::object();
   VC_PLAN_PARAMETERS(VC_ROW_TO_JSON)
   j["scanner"] = ScannerJson(o.scanner);
   j["user_candidates"] = o.candidates.size();
+  j["tripod_heights_m"] = o.tripod_heights_m;
+  Json zones = Json::array();
+  for (const KeepOutZone& z : o.keep_out) zones.push_back(KeepOutJson(z));
+  j["keep_out"] = std::move(zones);
+  Json fixed = Json::array();
+  for (const WorldPoint& p : o.fixed_stations) fixed.push_back({p.x(), p.y(), p.z()});
+  j["fixed_stations"] = std::move(fixed);
   return j;
 }
 
@@ -150,13 +167,28 @@ struct HeatLayout {
   int width = 0, height = 0;
 };
 
-// Panels: positions grouped by z (a gap over 0.5 m starts a new group); at most 4, else one.
+// The z a candidate's panel is chosen by: its floor plus the lowest tripod height when the floor is
+// known (so a cell's candidates at several heights share one panel), else its own z. With one
+// height that is the candidate's z.
+std::vector<double> PanelKeys(const PlanResult& r) {
+  const auto& pos = r.heat_map.positions;
+  const std::vector<double> heights = r.options.TripodHeights();
+  const double lowest = *std::min_element(heights.begin(), heights.end());
+  const bool floors = r.heat_map.floor_z_m.size() == pos.size();
+  std::vector<double> keys;
+  for (size_t i = 0; i < pos.size(); ++i) {
+    keys.push_back(floors && std::isfinite(r.heat_map.floor_z_m[i]) ? r.heat_map.floor_z_m[i] + lowest : pos[i].z());
+  }
+  return keys;
+}
+
+// Panels: positions grouped by PanelKeys (a gap over 0.5 m starts a new group); at most 4, else one.
 HeatLayout ComputeHeatLayout(const PlanResult& r) {
   HeatLayout L;
   const auto& pos = r.heat_map.positions;
   L.cell_m = r.heat_map.grid_spacing_m > 0 ? r.heat_map.grid_spacing_m : 1.0;
-  std::vector<double> zs;
-  for (const WorldPoint& p : pos) zs.push_back(p.z());
+  const std::vector<double> keys = PanelKeys(r);
+  std::vector<double> zs = keys;
   std::sort(zs.begin(), zs.end());
   std::vector<std::pair<double, double>> groups;  // [lo, hi]
   for (double z : zs) {
@@ -166,9 +198,9 @@ HeatLayout ComputeHeatLayout(const PlanResult& r) {
   if (groups.size() > 4) groups = {{zs.front(), zs.back()}};
   for (const auto& g : groups) L.panel_z.push_back(0.5 * (g.first + g.second));
   if (L.panel_z.empty()) L.panel_z.push_back(0.0);
-  for (const WorldPoint& p : pos) {
+  for (double key : keys) {
     int k = 0;
-    while (k + 1 < static_cast<int>(groups.size()) && p.z() > groups[k].second + 1e-9) ++k;
+    while (k + 1 < static_cast<int>(groups.size()) && key > groups[k].second + 1e-9) ++k;
     L.candidate_panel.push_back(k);
   }
   bool any = false;
@@ -234,6 +266,12 @@ Image DrawHeatmap(const PlanResult& r) {
   for (uint64_t c : r.heat_map.visible_voxels) max_count = std::max(max_count, c);
   const double denom = max_count > 0 ? static_cast<double>(max_count) : 1.0;
   const int top = kMarginTop;
+  auto count_of = [&](size_t i) { return i < r.heat_map.visible_voxels.size() ? r.heat_map.visible_voxels[i] : 0; };
+  std::vector<size_t> order(r.heat_map.positions.size());
+  for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+  if (r.options.tripod_heights_m.size() > 1) {
+    std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return count_of(a) < count_of(b); });
+  }
   auto px = [&](int panel, double x) {
     return panel * (kMarginLeft + L.plot_w + kPanelRight) + kMarginLeft +
            static_cast<int>(std::lround((x - L.x0) * L.ppm));
@@ -244,7 +282,8 @@ Image DrawHeatmap(const PlanResult& r) {
     const int pl = static_cast<int>(p);
     const int left = px(pl, L.x0);
     img.FillRect(left, top, left + L.plot_w, top + L.plot_h, Rgb{235, 235, 235});
-    for (size_t i = 0; i < r.heat_map.positions.size(); ++i) {
+    // With several heights in ascending count, so a cell shows the best of its heights.
+    for (size_t i : order) {
       if (L.candidate_panel[i] != pl) continue;
       const WorldPoint& c = r.heat_map.positions[i];
       const double h = L.cell_m / 2;
@@ -270,10 +309,13 @@ Image DrawHeatmap(const PlanResult& r) {
     img.TextVertical(left - kMarginLeft + 4, top + L.plot_h / 2 - raster::TextWidth("y (m)") / 2, "y (m)",
                      raster::kBlack);
     std::string title = "VISIBLE VOXELS PER CANDIDATE";
+    if (r.options.tripod_heights_m.size() > 1) {
+      title = "VISIBLE VOXELS, BEST OF " + std::to_string(r.options.tripod_heights_m.size()) + " HEIGHTS";
+    }
     if (L.panel_z.size() > 1 || !r.floor_levels_m.empty()) title += "  z = " + Fixed(L.panel_z[p], 2) + " m";
     img.Text(left, 10, title, raster::kBlack, 2);
   }
-  // Stations, numbered in plan order, on the panel of their height.
+  // Stations, numbered in plan order, on the panel of their height; fixed stations ringed in black.
   for (size_t k = 0; k < r.stations.size(); ++k) {
     const WorldPoint& s = r.stations[k].position;
     int panel = 0;
@@ -281,7 +323,8 @@ Image DrawHeatmap(const PlanResult& r) {
     for (size_t p = 0; p < L.panel_z.size(); ++p) {
       if (std::fabs(L.panel_z[p] - s.z()) < best) best = std::fabs(L.panel_z[p] - s.z()), panel = static_cast<int>(p);
     }
-    StationMarker(img, px(panel, s.x()), py(s.y()), static_cast<int>(k) + 1, raster::kRed);
+    StationMarker(img, px(panel, s.x()), py(s.y()), static_cast<int>(k) + 1,
+                  r.stations[k].fixed ? raster::kBlack : raster::kRed);
   }
   const int bar_x = L.width - kLegendWidth + 20;
   ColourBar(img, bar_x, top + 14, std::max(L.plot_h, kMinPlotHeight) - 14, static_cast<double>(max_count), "VOXELS",
@@ -424,7 +467,8 @@ std::string PlanToJson(const PlanResult& r) {
            {"marginal_gain", s.marginal_gain},
            {"cumulative_coverage", s.cumulative_coverage},
            {"global_visibility", s.global_visibility},
-           {"candidate_index", s.candidate_index}};
+           {"candidate_index", s.candidate_index},
+           {"fixed", s.fixed}};
     if (k < r.evaluation.per_viewpoint.size()) {
       v["fully_visible_fraction"] = r.evaluation.per_viewpoint[k].fully_visible_fraction;
       v["partially_visible_fraction"] = r.evaluation.per_viewpoint[k].partially_visible_fraction;

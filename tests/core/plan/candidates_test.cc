@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <set>
 
 namespace vc::planner {
@@ -70,6 +71,36 @@ TEST(CandidatesTest, ClosedRoomHasOneLevelAndCandidatesAtTripodHeight) {
     EXPECT_LT(c.positions[i].y(), 2.2);
   }
   EXPECT_EQ(c.rejected_no_floor + c.rejected_clearance + c.positions.size(), c.cells);
+}
+
+TEST(CandidatesTest, SeveralHeightsGiveACandidatePerHeightWhereItFitsUnderWhatIsAbove) {
+  Builder b;
+  b.Room(25, true);             // ceiling at 2.5 m: 2.4 m free above the floor's top at 0.1 m
+  b.Box(0, 0, 20, 20, 39, 20);  // a soffit at 2.0-2.1 m over x -2.0 .. 0.1 m: 1.9 m free below it
+  CandidateOptions o;
+  o.tripod_heights_m = {1.2, 1.6, 2.0};
+  const CandidateGrid c = Generate(b.Build(), o);
+  ASSERT_EQ(c.levels.size(), 1u);
+  // 20 cells x 3 heights, but 2.0 m + 0.2 m clearance does not fit under the soffit (8 cells).
+  EXPECT_EQ(c.cells, 60u);
+  EXPECT_EQ(c.positions.size(), 52u);
+  EXPECT_EQ(c.rejected_clearance, 8u);
+  ASSERT_EQ(c.height_m.size(), c.positions.size());
+  std::map<double, int> per_height;
+  for (size_t i = 0; i < c.positions.size(); ++i) {
+    EXPECT_NEAR(c.positions[i].z() - c.floor_z_m[i], c.height_m[i], 1e-9);
+    ++per_height[c.height_m[i]];
+    if (c.height_m[i] == 2.0) {
+      EXPECT_GT(c.positions[i].x(), 0.1) << "2.0 m under the soffit";
+    }
+  }
+  EXPECT_EQ(per_height[1.2], 20);
+  EXPECT_EQ(per_height[1.6], 20);
+  EXPECT_EQ(per_height[2.0], 12);
+  // A cell's heights are adjacent, in the order given.
+  EXPECT_EQ(c.height_m[0], 1.2);
+  EXPECT_EQ(c.height_m[1], 1.6);
+  EXPECT_EQ(c.positions[0].x(), c.positions[1].x());
 }
 
 TEST(CandidatesTest, FloorBelowZeroWorksToo) {

@@ -14,6 +14,7 @@
 #include <set>
 
 #include "testing/test_paths.h"
+#include "vc/plan/keep_out.h"
 #include "vc/report/plan_report.h"
 #include "vc/synth/synth.h"
 
@@ -392,6 +393,166 @@ TEST(PlannerTest, UserCandidateInsideAnOccupiedVoxelIsRejected) {
   ASSERT_FALSE(r.ok());
   EXPECT_EQ(r.status().code(), StatusCode::kInvalidArgument);
   EXPECT_NE(r.status().message().find("from the origin"), std::string::npos) << r.status().message();
+}
+
+// --- Several tripod heights, keep-out zones, fixed stations (issue #20) ---
+
+TEST(PlannerTest, SeveralTripodHeightsGiveCandidatesAtEachHeightAndOneHeatMapPanel) {
+  Result<SceneInfo> info = DescribeScene("lroom");
+  ASSERT_TRUE(info.ok());
+  PlanOptions one = TestOptions();
+  Result<PlanResult> single = Plan(Synthetic("lroom"), one);
+  ASSERT_TRUE(single.ok()) << single.status().ToString();
+  PlanOptions o = TestOptions();
+  o.tripod_heights_m = {1.2, 1.6, 2.0};
+  Result<PlanResult> r = Plan(Synthetic("lroom"), o);
+  ASSERT_TRUE(r.ok()) << r.status().ToString();
+  std::cout << "[ lroom, heights 1.2/1.6/2.0 ] " << Describe(*r) << "\n";
+  // The room is 3 m high: every cell with floor takes all three heights.
+  EXPECT_EQ(r->candidate_count, 3 * single->candidate_count);
+  ASSERT_EQ(r->heat_map.floor_z_m.size(), r->heat_map.positions.size());
+  std::set<long> heights;
+  for (size_t i = 0; i < r->heat_map.positions.size(); ++i) {
+    heights.insert(std::lround(10 * (r->heat_map.positions[i].z() - r->heat_map.floor_z_m[i])));
+  }
+  EXPECT_EQ(heights, (std::set<long>{12, 16, 20}));
+  EXPECT_GE(static_cast<double>(r->covered_voxels), 0.99 * static_cast<double>(r->coverable_voxels));
+  // The heat map keeps one panel for the one floor.
+  const ImageSize one_panel = HeatmapImageSize(*single);
+  EXPECT_EQ(HeatmapImageSize(*r).width, one_panel.width);
+  // A height at or below the clearance is refused, naming the entry.
+  o.tripod_heights_m = {1.2, 0.1};
+  const Status s = o.Validate();
+  EXPECT_EQ(s.code(), StatusCode::kInvalidArgument);
+  EXPECT_NE(s.message().find("tripod_heights_m[1]"), std::string::npos) << s.message();
+  o.tripod_heights_m = {kNaN};
+  EXPECT_NE(o.Validate().message().find("tripod_heights_m[0]"), std::string::npos);
+  o.tripod_heights_m = {1.2, 1.6, 1.2};
+  EXPECT_NE(o.Validate().message().find("tripod_heights_m[2] (1.2 m) repeats tripod_heights_m[0]"), std::string::npos)
+      << o.Validate().message();
+}
+
+TEST(PlannerTest, NoStationOrCandidateLiesInAKeepOutZone) {
+  Result<SceneInfo> info = DescribeScene("comb:3");
+  ASSERT_TRUE(info.ok());
+  Result<PlanResult> free = Plan(Synthetic("comb:3"), TestOptions());
+  ASSERT_TRUE(free.ok()) << free.status().ToString();
+  ASSERT_GE(free->stations.size(), 2u);
+  // A 1.5 m box around the first station and a triangle around the second, over all heights.
+  PlanOptions o = TestOptions();
+  o.refine = true;  // refined positions must stay out too
+  const WorldPoint a = free->stations[0].position, b = free->stations[1].position;
+  o.keep_out = {KeepOutBox(a - WorldPoint(0.75, 0.75, 10), a + WorldPoint(0.75, 0.75, 10)),
+                KeepOutPolygon(-10, 10, {b.x() - 1, b.y() - 1, b.x() + 1, b.y() - 1, b.x(), b.y() + 1})};
+  Result<PlanResult> r = Plan(Synthetic("comb:3"), o);
+  ASSERT_TRUE(r.ok()) << r.status().ToString();
+  std::cout << "[ comb:3 with 2 keep-out zones ] " << Describe(*r) << "\n";
+  EXPECT_LT(r->candidate_count, free->candidate_count);
+  for (const PlannedStation& s : r->stations) {
+    EXPECT_EQ(KeepOutZoneContaining(o.keep_out, s.position), -1) << s.position.transpose();
+  }
+  for (const WorldPoint& p : r->heat_map.positions) EXPECT_EQ(KeepOutZoneContaining(o.keep_out, p), -1);
+  // Every bay still gets a station.
+  for (const AxisBox& room : info->rooms) {
+    EXPECT_TRUE(std::any_of(r->stations.begin(), r->stations.end(),
+                            [&](const PlannedStation& s) { return Inside(s.position, room); }));
+  }
+  // User candidates in a zone are dropped with a warning; all of them in zones is an error.
+  o.refine = false;
+  o.candidates = {a, b, r->stations[0].position};
+  r = Plan(Synthetic("comb:3"), o);
+  ASSERT_TRUE(r.ok()) << r.status().ToString();
+  EXPECT_EQ(r->candidate_count, 1u);
+  EXPECT_TRUE(std::any_of(r->warnings.begin(), r->warnings.end(),
+                          [](const std::string& w) { return w.find("keep-out") != std::string::npos; }));
+  o.candidates = {a, b};
+  r = Plan(Synthetic("comb:3"), o);
+  ASSERT_FALSE(r.ok());
+  EXPECT_EQ(r.status().code(), StatusCode::kFailedPrecondition);
+}
+
+TEST(PlannerTest, FixedStationsArePlacedFirstKeptAndThePlanAddsToThem) {
+  Result<SceneInfo> info = DescribeScene("comb:3");
+  ASSERT_TRUE(info.ok());
+  ASSERT_EQ(info->rooms.size(), 3u);
+  PlanOptions o = TestOptions();
+  o.target_coverage = 1.0;
+  o.refine = true;
+  // A station already placed in the middle bay, off the candidate grid, twice (a duplicate that
+  // reduction would remove as obsolete were it not fixed).
+  const AxisBox& bay = info->rooms[1];
+  const WorldPoint fixed(0.5 * (bay.min.x() + bay.max.x()) + 0.13, 0.5 * (bay.min.y() + bay.max.y()) + 0.07,
+                         info->floor_heights_m[0] + 1.5);
+  o.fixed_stations = {fixed, fixed};
+  std::vector<PlannedStation> picked, final_stations;
+  PlanCallbacks callbacks;
+  callbacks.on_station = [&](const PlannedStation& s, int) { picked.push_back(s); };
+  callbacks.on_final_stations = [&](const std::vector<PlannedStation>& s) { final_stations = s; };
+  Result<PlanResult> r = Plan(Synthetic("comb:3"), o, {}, callbacks);
+  ASSERT_TRUE(r.ok()) << r.status().ToString();
+  std::cout << "[ comb:3 with a fixed station ] " << Describe(*r) << "\n";
+  ASSERT_GE(r->stations.size(), 4u);
+  for (int k = 0; k < 2; ++k) {
+    EXPECT_TRUE(r->stations[k].fixed);
+    EXPECT_EQ(r->stations[k].position, fixed);  // not refined
+    EXPECT_EQ(r->stations[k].candidate_index, -1);
+  }
+  EXPECT_GT(r->stations[0].marginal_gain, 0u);  // its coverage counts first
+  EXPECT_EQ(r->stations[1].marginal_gain, 0u);
+  for (size_t k = 2; k < r->stations.size(); ++k) {
+    EXPECT_FALSE(r->stations[k].fixed);
+    EXPECT_FALSE(Inside(r->stations[k].position, bay)) << "the middle bay is seen already";
+  }
+  EXPECT_EQ(r->covered_voxels, r->coverable_voxels);
+  EXPECT_EQ(r->reduction.size, static_cast<int>(r->stations.size()));
+  ASSERT_GE(picked.size(), 2u);
+  EXPECT_TRUE(picked[0].fixed && picked[1].fixed);
+  ASSERT_EQ(final_stations.size(), r->stations.size());
+  EXPECT_TRUE(final_stations[0].fixed);
+  EXPECT_FALSE(final_stations.back().fixed);
+  const std::string json = PlanToJson(*r);
+  EXPECT_NE(json.find("\"fixed\": true"), std::string::npos);
+  EXPECT_NE(json.find("\"fixed\": false"), std::string::npos);
+}
+
+TEST(PlannerTest, FixedStationsThatReachTheTargetGetNoneAdded) {
+  Result<SceneInfo> info = DescribeScene("box");
+  ASSERT_TRUE(info.ok());
+  Result<PlanResult> free = Plan(Synthetic("box"), TestOptions());
+  ASSERT_TRUE(free.ok()) << free.status().ToString();
+  ASSERT_EQ(free->stations.size(), 1u);
+  PlanOptions o = TestOptions();
+  o.fixed_stations = {free->stations[0].position};  // where the plan would put its one station
+  Result<PlanResult> r = Plan(Synthetic("box"), o);
+  ASSERT_TRUE(r.ok()) << r.status().ToString();
+  ASSERT_EQ(r->stations.size(), 1u);
+  EXPECT_TRUE(r->stations[0].fixed);
+  EXPECT_EQ(r->greedy_stations, 0);
+  EXPECT_EQ(r->covered_voxels, free->covered_voxels);
+  EXPECT_DOUBLE_EQ(r->evaluation.overall.global_visibility, free->evaluation.overall.global_visibility);
+}
+
+TEST(PlannerTest, FixedStationInAKeepOutZoneOrAWallIsRefused) {
+  Result<SceneInfo> info = DescribeScene("box");
+  ASSERT_TRUE(info.ok());
+  const WorldPoint centre = 0.5 * (info->rooms[0].min + info->rooms[0].max);
+  const WorldPoint station(centre.x(), centre.y(), info->floor_heights_m[0] + 1.5);
+  PlanOptions o = TestOptions();
+  o.keep_out = {KeepOutBox(station - WorldPoint(1, 1, 1), station + WorldPoint(1, 1, 1))};
+  o.fixed_stations = {station};
+  Result<PlanResult> r = Plan(Synthetic("box"), o);
+  ASSERT_FALSE(r.ok());
+  EXPECT_EQ(r.status().code(), StatusCode::kInvalidArgument);
+  EXPECT_NE(r.status().message().find("fixed_stations[0]"), std::string::npos) << r.status().message();
+  EXPECT_NE(r.status().message().find("keep_out[0]"), std::string::npos) << r.status().message();
+  o.keep_out.clear();
+  o.fixed_stations = {station, WorldPoint(centre.x(), centre.y(), info->floor_heights_m[0] + 0.01)};
+  r = Plan(Synthetic("box"), o);
+  ASSERT_FALSE(r.ok());
+  EXPECT_EQ(r.status().code(), StatusCode::kInvalidArgument);
+  EXPECT_NE(r.status().message().find("fixed_stations[1]"), std::string::npos) << r.status().message();
+  o.fixed_stations = {WorldPoint(kNaN, 0, 0)};
+  EXPECT_EQ(Plan(Synthetic("box"), o).status().code(), StatusCode::kInvalidArgument);
 }
 
 TEST(PlannerTest, MaxStationsStopsEarlyWithAWarning) {

@@ -117,6 +117,30 @@ TEST(ReductionTest, RemovesADeliberatelyDuplicatedStation) {
   EXPECT_NEAR(run->global_visibility_after, BruteG(v, {true, true, true, false}), 1e-12);
 }
 
+TEST(ReductionTest, AFixedStationIsNeverRemovedEvenWhenObsolete) {
+  Values v(3, std::vector<float>(6, 0.f));
+  for (int f = 0; f < 3; ++f) v[0][f] = v[1][f] = 1.f;  // 0 and 1 see the same faces
+  for (int f = 3; f < 6; ++f) v[2][f] = 1.f;
+  ReductionRunOptions o;
+  Result<ReductionRun> run = RunReduction(3, 6, FromTable(v), o);
+  ASSERT_TRUE(run.ok());
+  EXPECT_EQ(run->removed, std::vector<int>({1}));  // the later copy
+  o.fixed = {false, true, false};                  // ... unless it is fixed: then the other copy goes
+  run = RunReduction(3, 6, FromTable(v), o);
+  ASSERT_TRUE(run.ok());
+  EXPECT_EQ(run->removed, std::vector<int>({0}));
+  o.fixed = {true, true, false};  // both fixed: nothing goes
+  run = RunReduction(3, 6, FromTable(v), o);
+  ASSERT_TRUE(run.ok());
+  EXPECT_TRUE(run->removed.empty());
+  // reduce_to removes only the stations that are not fixed.
+  o.fixed = {true, false, true};
+  o.reduce_to = 1;
+  run = RunReduction(3, 6, FromTable(v), o);
+  ASSERT_TRUE(run.ok());
+  EXPECT_EQ(run->removed, std::vector<int>({1}));
+}
+
 TEST(ReductionTest, DefaultRuleNeverRemovesAStationThatLosesVisibility) {
   std::mt19937 rng(2024);
   int removed_total = 0;

@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <random>
 #include <vector>
 
@@ -69,7 +70,7 @@ std::vector<VoxelSet> SceneSets(const std::string& spec) {
   if (!candidates.ok()) return {};
   const PlanCallbacks callbacks;
   Result<VisibilityOutput> visibility =
-      RunVisibilityStage({voxels->scene, candidates->positions, callbacks}, options, {});
+      RunVisibilityStage({voxels->scene, candidates->positions, candidates->floor_z_m, {}, callbacks}, options, {});
   EXPECT_TRUE(visibility.ok()) << visibility.status().ToString();
   return visibility.ok() ? std::move(visibility->sets) : std::vector<VoxelSet>{};
 }
@@ -155,9 +156,11 @@ TEST(GreedySelectorTest, RejectsSetsOfDifferentSizesAndStopsWhenCancelled) {
 // Another selector (the way an ILP or a local search would plug in): always the last candidate.
 class LastCandidateSelector final : public Selector {
  public:
-  Result<Selection> Select(const std::vector<VoxelSet>& sets, const JobContext&) const override {
+  using Selector::Select;
+  Result<Selection> Select(const std::vector<VoxelSet>& sets, int fixed, const JobContext&) const override {
     Selection s;
-    s.picks = {static_cast<int>(sets.size()) - 1};
+    for (int f = 0; f < fixed; ++f) s.picks.push_back(f);
+    s.picks.push_back(static_cast<int>(sets.size()) - 1);
     s.first_pass_picks = 1;
     s.coverable = 4;
     return s;
@@ -180,7 +183,7 @@ TEST(SelectionStageTest, TurnsAnySelectorsPicksIntoStationsAndReportsEach) {
   };
   const LastCandidateSelector selector;
   Result<SelectionOutput> out =
-      RunSelectionStage({selector, sets, candidates, floor_z, visible, callbacks}, PlanOptions{}, {});
+      RunSelectionStage({selector, sets, {}, candidates, floor_z, visible, callbacks}, PlanOptions{}, {});
   ASSERT_TRUE(out.ok()) << out.status().ToString();
   ASSERT_EQ(out->stations.size(), 1u);
   EXPECT_EQ(out->stations.candidate, (std::vector<int>{2}));
@@ -192,6 +195,93 @@ TEST(SelectionStageTest, TurnsAnySelectorsPicksIntoStationsAndReportsEach) {
   EXPECT_EQ(reported[0].marginal_gain, 4u);
   EXPECT_EQ(reported[0].cumulative_coverage, 1.0);
   EXPECT_EQ(reported[0].candidate_index, 2);
+  EXPECT_FALSE(reported[0].fixed);
+}
+
+// Sets over 12 voxels: the fixed station sees 0-3, candidates see 4-7, 8-11, 0-5 and 2-3.
+std::vector<VoxelSet> FixedAndCandidates() {
+  std::vector<VoxelSet> sets(5, VoxelSet(12));
+  auto fill = [&](int s, int lo, int hi) {
+    for (int v = lo; v <= hi; ++v) sets[s].set(v);
+  };
+  fill(0, 0, 3);  // fixed
+  fill(1, 4, 7);
+  fill(2, 8, 11);
+  fill(3, 0, 5);
+  fill(4, 2, 3);
+  return sets;
+}
+
+TEST(GreedySelectorTest, FixedStationsArePickedFirstAndKeptThroughConsolidation) {
+  GreedySelectorOptions o;
+  o.target_coverage = 1.0;
+  Result<Selection> got = GreedySelector(o).Select(FixedAndCandidates(), 1, {});
+  ASSERT_TRUE(got.ok()) << got.status().ToString();
+  // Without the fixed station greedy would take 3 (0-5) first; with it, 1 and 2 cover the rest.
+  EXPECT_EQ(got->picks, (std::vector<int>{0, 1, 2}));
+  EXPECT_EQ(got->first_pass_picks, 2);
+  EXPECT_EQ(got->covered, 12u);
+  Result<Selection> free = GreedySelector(o).Select(FixedAndCandidates(), {});
+  ASSERT_TRUE(free.ok());
+  EXPECT_EQ(free->picks.front(), 3);
+}
+
+TEST(GreedySelectorTest, AFixedStationOthersCoverIsNotDropped) {
+  std::vector<VoxelSet> sets = FixedAndCandidates();
+  sets[0] = VoxelSet(12);
+  sets[0].set(2);  // the fixed station sees only voxel 2, which candidate 3 sees too
+  GreedySelectorOptions o;
+  o.target_coverage = 1.0;
+  Result<Selection> got = GreedySelector(o).Select(sets, 1, {});
+  ASSERT_TRUE(got.ok()) << got.status().ToString();
+  ASSERT_FALSE(got->picks.empty());
+  EXPECT_EQ(got->picks.front(), 0);
+  EXPECT_EQ(got->saved_by_improvement, 0);
+}
+
+TEST(GreedySelectorTest, FixedStationsReachingTheTargetAddNone) {
+  std::vector<VoxelSet> sets = FixedAndCandidates();
+  GreedySelectorOptions o;
+  o.target_coverage = 0.3;  // 4 of 12 voxels
+  Result<Selection> got = GreedySelector(o).Select(sets, 1, {});
+  ASSERT_TRUE(got.ok()) << got.status().ToString();
+  EXPECT_EQ(got->picks, (std::vector<int>{0}));
+  EXPECT_EQ(got->first_pass_picks, 0);
+  EXPECT_EQ(got->stop, StopReason::kTargetReached);
+}
+
+TEST(GreedySelectorTest, RefusesMoreFixedStationsThanSets) {
+  EXPECT_EQ(GreedySelector({}).Select(FixedAndCandidates(), 6, {}).status().code(), StatusCode::kInvalidArgument);
+}
+
+TEST(SelectionStageTest, FixedStationsComeFirstMarkedFixed) {
+  std::vector<VoxelSet> sets = FixedAndCandidates();
+  std::vector<VoxelSet> fixed_sets = {sets[0]};
+  sets.erase(sets.begin());
+  const std::vector<WorldPoint> candidates = {{1, 0, 1}, {2, 0, 1}, {3, 0, 1}, {4, 0, 1}};
+  const std::vector<double> floor_z = {0, 0, 0, 0};
+  const std::vector<uint64_t> visible = {4, 4, 6, 2};
+  std::vector<PlannedStation> reported;
+  PlanCallbacks callbacks;
+  callbacks.on_station = [&](const PlannedStation& s, int) { reported.push_back(s); };
+  PlanOptions options;
+  options.fixed_stations = {{9, 9, 1}};
+  GreedySelectorOptions go;
+  go.target_coverage = 1.0;
+  const GreedySelector selector(go);
+  Result<SelectionOutput> out =
+      RunSelectionStage({selector, sets, fixed_sets, candidates, floor_z, visible, callbacks}, options, {});
+  ASSERT_TRUE(out.ok()) << out.status().ToString();
+  ASSERT_EQ(out->stations.size(), 3u);
+  EXPECT_EQ(out->stations.fixed, (std::vector<bool>{true, false, false}));
+  EXPECT_EQ(out->stations.candidate, (std::vector<int>{-1, 0, 1}));
+  EXPECT_EQ(out->stations.positions[0], options.fixed_stations[0]);
+  EXPECT_TRUE(std::isnan(out->stations.floor_z_m[0]));
+  EXPECT_EQ(out->coverable.count(), 12u);
+  ASSERT_EQ(reported.size(), 3u);
+  EXPECT_TRUE(reported[0].fixed);
+  EXPECT_EQ(reported[0].marginal_gain, 4u);
+  EXPECT_FALSE(reported[1].fixed);
 }
 
 }  // namespace

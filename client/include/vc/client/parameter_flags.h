@@ -4,13 +4,15 @@
 // added with the plan's and the evaluation's, with `--scanner NAME` (an instrument preset,
 // vc/visibility/scanner_presets.h): the preset fills every scanner row whose flag is not given, so
 // explicit flags override it. The client resolves the preset itself and sends the name with every
-// field, which the server then takes as they are (docs/SCANNERS.md). Lists (candidates, viewpoints)
-// are files, added by main.cc.
+// field, which the server then takes as they are (docs/SCANNERS.md). `--tripod-heights 1.2,1.6,2.0`
+// comes with the plan's rows. The plan's file lists (`--candidates`, `--fixed-stations`,
+// `--keep-out`) are PlanFileFlags, read by LoadPlanFiles; the evaluation's viewpoints by main.cc.
 #pragma once
 
 #include <CLI/CLI.hpp>
 #include <string>
 
+#include "vc/base/status.h"
 #include "vc/plan/evaluate_job.h"
 #include "vc/plan/plan_options.h"
 
@@ -27,5 +29,17 @@ void AddEvaluateFlags(CLI::App* command, EvaluateJobOptions* options);
 // `vc-client scanners`: one line per preset (name, instrument, range, vertical field of view,
 // angular step, scan time, the setting those are for) under a header line.
 std::string ScannerPresetsTable();
+
+// The plan's list parameters that come from files (paths; empty = not given).
+struct PlanFileFlags {
+  std::string candidates;      // stations.csv format: user candidates
+  std::string fixed_stations;  // stations.csv format: stations already placed
+  std::string keep_out;        // keep-out CSV (docs/PLANNING.md, "Keep-out zones")
+};
+// Binds --candidates, --fixed-stations and --keep-out to `files` (which must outlive the parse).
+void AddPlanFileFlags(CLI::App* command, PlanFileFlags* files);
+// Reads the files named in `files` into options->candidates, fixed_stations and keep_out.
+// NOT_FOUND / INVALID_ARGUMENT (naming file:line) from reading and parsing.
+[[nodiscard]] Status LoadPlanFiles(const PlanFileFlags& files, PlanOptions* options);
 
 }  // namespace vc::client

@@ -4,36 +4,73 @@
 
 #include "format.h"
 #include "vc/plan/candidates.h"
+#include "vc/plan/keep_out.h"
 #include "vc/plan/stages.h"
 
 namespace vc::planner {
 namespace {
 
-// The user's candidates, checked: in range, and not inside an occupied voxel.
-Result<CandidatesOutput> UserCandidates(const VoxelScene& scene, const std::vector<WorldPoint>& user) {
+// INVALID_ARGUMENT naming `what`[i] when a user position is out of range or inside an occupied voxel.
+Status CheckUserPositions(const VoxelScene& scene, const std::vector<WorldPoint>& user, const char* what) {
   for (size_t i = 0; i < user.size(); ++i) {
     const WorldPoint& p = user[i];
+    const std::string name =
+        std::string(what) + "[" + std::to_string(i) + "] (" + Num(p.x()) + ", " + Num(p.y()) + ", " + Num(p.z()) + ")";
     if (!ViewpointInRange(p, scene.resolution_m)) {
-      return InvalidArgumentError("candidates[" + std::to_string(i) + "] (" + Num(p.x()) + ", " + Num(p.y()) + ", " +
-                                  Num(p.z()) + ") is more than " + Num(kMaxViewpointIndex * scene.resolution_m) +
+      return InvalidArgumentError(name + " is more than " + Num(kMaxViewpointIndex * scene.resolution_m) +
                                   " m from the origin along an axis; use coordinates in the scene's frame");
     }
     if (scene.grid.Occupied(scene.grid.WorldToIndex(p))) {
-      return InvalidArgumentError("candidates[" + std::to_string(i) + "] (" + Num(p.x()) + ", " + Num(p.y()) + ", " +
-                                  Num(p.z()) + ") lies inside an occupied voxel");
+      return InvalidArgumentError(name + " lies inside an occupied voxel");
     }
   }
+  return Status::Ok();
+}
+
+// The user's candidates, checked: in range, and not inside an occupied voxel; those in a keep-out
+// zone are dropped (with a warning). FAILED_PRECONDITION when none is left.
+Result<CandidatesOutput> UserCandidates(const VoxelScene& scene, const PlanOptions& options) {
+  VC_RETURN_IF_ERROR(CheckUserPositions(scene, options.candidates, "candidates"));
   CandidatesOutput out;
-  out.positions = user;
+  for (const WorldPoint& p : options.candidates) {
+    if (KeepOutZoneContaining(options.keep_out, p) >= 0) {
+      ++out.in_keep_out;
+      continue;
+    }
+    out.positions.push_back(p);
+  }
+  if (out.positions.empty()) {
+    return FailedPreconditionError("all " + std::to_string(options.candidates.size()) +
+                                   " candidates lie in keep-out zones; pass candidates outside them");
+  }
+  if (out.in_keep_out > 0) {
+    out.warnings.push_back(std::to_string(out.in_keep_out) + " of " + std::to_string(options.candidates.size()) +
+                           " candidates lie in keep-out zones and were dropped");
+  }
   out.floor_z_m.assign(out.positions.size(), std::nan(""));
   return out;
 }
 
 // The generated grid; FAILED_PRECONDITION when no floor is found or no candidate survives.
 Result<CandidatesOutput> GridCandidates(const VoxelScene& scene, const PlanOptions& options, const JobContext& ctx) {
-  const CandidateOptions cand_options{options.grid_spacing_m, options.tripod_height_m, options.clearance_m};
+  const CandidateOptions cand_options{options.grid_spacing_m, options.tripod_height_m, options.clearance_m,
+                                      options.tripod_heights_m};
   VC_ASSIGN_OR_RETURN(CandidateGrid grid, GenerateCandidates(scene, cand_options, ctx));
   CandidatesOutput out;
+  if (!options.keep_out.empty()) {
+    size_t kept = 0;
+    for (size_t i = 0; i < grid.positions.size(); ++i) {
+      if (KeepOutZoneContaining(options.keep_out, grid.positions[i]) >= 0) {
+        ++out.in_keep_out;
+        continue;
+      }
+      grid.positions[kept] = grid.positions[i];
+      grid.floor_z_m[kept] = grid.floor_z_m[i];
+      ++kept;
+    }
+    grid.positions.resize(kept);
+    grid.floor_z_m.resize(kept);
+  }
   for (const FloorLevel& l : grid.levels) out.floor_levels_m.push_back(l.z_m);
   out.grid_cells = grid.cells;
   out.cells_without_floor = grid.rejected_no_floor;
@@ -46,12 +83,14 @@ Result<CandidatesOutput> GridCandidates(const VoxelScene& scene, const PlanOptio
     }
     std::string levels;
     for (double z : out.floor_levels_m) levels += (levels.empty() ? "" : ", ") + Num(z);
-    return FailedPreconditionError("no candidate survived: of " + std::to_string(grid.cells) + " grid cells, " +
-                                   std::to_string(grid.rejected_no_floor) +
-                                   " had no floor below (floor levels at z = " + levels + " m) and " +
-                                   std::to_string(grid.rejected_clearance) +
-                                   " had occupied voxels within clearance_m = " + Num(options.clearance_m) +
-                                   " m; lower clearance_m or grid_spacing_m, or pass candidates");
+    return FailedPreconditionError(
+        "no candidate survived: of " + std::to_string(grid.cells) + " grid cells, " +
+        std::to_string(grid.rejected_no_floor) + " had no floor below (floor levels at z = " + levels + " m) and " +
+        std::to_string(grid.rejected_clearance) +
+        " had occupied voxels within clearance_m = " + Num(options.clearance_m) + " m" +
+        (out.in_keep_out ? ", and " + std::to_string(out.in_keep_out) + " candidates lay in keep-out zones"
+                         : std::string()) +
+        "; lower clearance_m or grid_spacing_m, or pass candidates");
   }
   if (grid.positions.size() < 5) {
     out.warnings.push_back("only " + std::to_string(grid.positions.size()) +
@@ -69,7 +108,8 @@ Result<CandidatesOutput> GridCandidates(const VoxelScene& scene, const PlanOptio
 
 Result<CandidatesOutput> RunCandidatesStage(const CandidatesInput& in, const PlanOptions& options,
                                             const JobContext& ctx) {
-  if (!options.candidates.empty()) return UserCandidates(in.scene, options.candidates);
+  VC_RETURN_IF_ERROR(CheckUserPositions(in.scene, options.fixed_stations, "fixed_stations"));
+  if (!options.candidates.empty()) return UserCandidates(in.scene, options);
   return GridCandidates(in.scene, options, ctx);
 }
 

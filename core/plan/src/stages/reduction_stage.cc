@@ -48,6 +48,7 @@ Result<ReductionOutput> RunReductionStage(const ReductionInput& in, const PlanOp
   red_options.reduce_to = options.reduce_to;
   red_options.threads = options.threads;
   red_options.cache_budget_bytes = cache_budget;
+  red_options.fixed = in.stations.fixed;
   VC_ASSIGN_OR_RETURN(ReductionRun run, RunReduction(static_cast<int>(stations.size()), faces_total, values,
                                                      red_options, ProgressRange(ctx, batch ? 0.9 : 0.0, 1.0)));
   if (all_evaluation) all_evaluation->per_viewpoint_face_values.clear();

@@ -4,6 +4,7 @@
 
 #include "vc/plan/candidates.h"
 #include "vc/plan/greedy.h"
+#include "vc/plan/keep_out.h"
 #include "vc/plan/stage_runner.h"
 #include "vc/plan/stages.h"
 
@@ -16,13 +17,28 @@ struct TrialPositions {
   std::vector<int> station;           // per position: the station it may replace
 };
 
-// Every sub-grid point within options.refine_radius_m of a station (not the station itself),
-// moved onto the floor near the station's and kept if it has the clearance.
+// The tripod height of station k: the one of options.TripodHeights() closest to its height above
+// its floor.
+double StationHeight(const Stations& stations, size_t k, const std::vector<double>& heights) {
+  const double above = stations.positions[k].z() - stations.floor_z_m[k];
+  double best = heights[0];
+  for (double h : heights) {
+    if (std::fabs(h - above) < std::fabs(best - above)) best = h;
+  }
+  return best;
+}
+
+// Every sub-grid point within options.refine_radius_m of a station (not the station itself, and
+// not a fixed station), moved onto the floor near the station's at the station's tripod height,
+// and kept if it has the clearance and lies in no keep-out zone.
 TrialPositions TrialsAround(const OccupancyGrid& grid, const Stations& stations, const PlanOptions& options) {
-  const CandidateOptions cand_options{options.grid_spacing_m, options.tripod_height_m, options.clearance_m};
+  const std::vector<double> heights = options.TripodHeights();
   const int steps = static_cast<int>(std::floor(options.refine_radius_m / options.refine_step_m + 1e-9));
   TrialPositions trials;
   for (size_t k = 0; k < stations.size(); ++k) {
+    if (stations.fixed[k]) continue;
+    const double height = std::isnan(stations.floor_z_m[k]) ? 0.0 : StationHeight(stations, k, heights);
+    const CandidateOptions cand_options{options.grid_spacing_m, height, options.clearance_m, {}};
     for (int iy = -steps; iy <= steps; ++iy) {
       for (int ix = -steps; ix <= steps; ++ix) {
         if (ix == 0 && iy == 0) continue;
@@ -30,9 +46,10 @@ TrialPositions TrialsAround(const OccupancyGrid& grid, const Stations& stations,
         if (!std::isnan(stations.floor_z_m[k])) {
           std::optional<double> top = FloorTopNear(grid, p.x(), p.y(), stations.floor_z_m[k], cand_options);
           if (!top) continue;
-          p.z() = *top + options.tripod_height_m;
+          p.z() = *top + height;
         }
         if (!HasClearance(grid, p, options.clearance_m)) continue;
+        if (KeepOutZoneContaining(options.keep_out, p) >= 0) continue;
         trials.positions.push_back(p);
         trials.station.push_back(static_cast<int>(k));
       }
@@ -77,9 +94,10 @@ Result<RefineOutput> RunRefineStage(RefineInput in, const PlanOptions& options, 
       }
     }
     if (best_trial >= 0) {
+      const bool on_floor = !std::isnan(stations.floor_z_m[k]);
+      const double height = on_floor ? StationHeight(stations, k, options.TripodHeights()) : 0.0;
       stations.positions[k] = trials.positions[best_trial];
-      if (!std::isnan(stations.floor_z_m[k]))
-        stations.floor_z_m[k] = stations.positions[k].z() - options.tripod_height_m;
+      if (on_floor) stations.floor_z_m[k] = stations.positions[k].z() - height;
       stations.candidate[k] = -1;
       stations.sets[k] = std::move(trial_sets[best_trial]);
     }

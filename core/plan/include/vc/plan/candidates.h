@@ -10,7 +10,9 @@
 // level and each cell of a grid over the occupied footprint, the standing surface within +-0.15 m of that level closest
 // to it under the cell centre (in the 3 x 3 voxel columns around it) is the cell's floor (uneven floors and ramps); the
 // candidate stands at its top + tripod height, and is kept if the voxels within the clearance radius are all free. So
-// every storey of a multi-level scene gets its own candidates, each with floor below it. Internal to vc_core.
+// every storey of a multi-level scene gets its own candidates, each with floor below it. With several tripod heights
+// the levels come from the lowest, and each cell gets one candidate per height (in the order of the heights
+// given) that fits under what is above its floor. Internal to vc_core.
 #pragma once
 
 #include <cstdint>
@@ -28,6 +30,10 @@ struct CandidateOptions {
   double grid_spacing_m = 1.0;   // grid cell size (m)
   double tripod_height_m = 1.5;  // optical centre above the floor's top (m)
   double clearance_m = 0.2;      // free radius around the optical centre (m)
+  // Several optical-centre heights (m): when non-empty, replaces tripod_height_m. Floor levels and
+  // standing surfaces use the lowest; a cell gets a candidate at each height whose column above
+  // its floor is free for height + clearance_m and that has the clearance.
+  std::vector<double> tripod_heights_m;
 };
 
 struct FloorLevel {
@@ -39,10 +45,14 @@ struct CandidateGrid {
   std::vector<WorldPoint> positions;  // kept candidates, level by level, then y, then x
   std::vector<double> floor_z_m;      // per candidate: top of the floor under it (m)
   std::vector<int> level;             // per candidate: index into levels
+  std::vector<double> height_m;       // per candidate: its tripod height above floor_z_m (m)
   std::vector<FloorLevel> levels;     // ascending z
-  uint64_t cells = 0;                 // grid cells x levels examined
-  uint64_t rejected_no_floor = 0;     // cells without a standing surface of the level below
-  uint64_t rejected_clearance = 0;    // cells with floor, but occupied voxels within the clearance
+  // Grid cells x levels x heights examined; of those, the ones without a standing surface of the
+  // level below, and the ones with floor but occupied voxels within the clearance (or, at a
+  // height above the lowest, within height + clearance above the floor).
+  uint64_t cells = 0;
+  uint64_t rejected_no_floor = 0;
+  uint64_t rejected_clearance = 0;
 };
 
 // Generates the candidate grid for `scene`. CANCELLED / DEADLINE_EXCEEDED from ctx.

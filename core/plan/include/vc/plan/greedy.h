@@ -29,6 +29,9 @@ struct GreedyOptions {
   double target_coverage = 1.0;
   // CELF lazy evaluation (true) or the plain recount of every candidate per round (false).
   bool lazy = true;
+  // The first `fixed` sets are stations already placed: picked first, in order (whatever their
+  // gain), and not counted by max_stations; the stopping rules then apply to what they cover.
+  int fixed = 0;
 };
 
 struct GreedyPick {
@@ -55,7 +58,8 @@ Result<GreedyResult> SelectGreedy(const std::vector<VoxelSet>& sets, const Greed
 // until neither applies. The covered set never shrinks and the count only falls. Greedy is not
 // optimal (e.g. comb:5 on a 1 m grid: 7 greedy picks where 5 candidates suffice); this repairs the
 // typical case where two early picks each cover half of what one candidate sees. Candidates are
-// tried in order of decreasing |set|, then index; picks are examined in greedy order.
+// tried in order of decreasing |set|, then index; picks are examined in greedy order. Picks of the
+// first `fixed` sets (fixed stations) are never dropped or replaced, nor used as replacements.
 struct ConsolidateResult {
   std::vector<int> picks;  // candidate indices; a replacement takes the place of the earlier pick
   int dropped = 0;         // picks removed as covered by the others
@@ -63,7 +67,7 @@ struct ConsolidateResult {
 };
 // CANCELLED / DEADLINE_EXCEEDED from ctx.
 Result<ConsolidateResult> ConsolidatePicks(const std::vector<VoxelSet>& sets, std::vector<int> picks,
-                                           const JobContext& ctx = {});
+                                           const JobContext& ctx = {}, int fixed = 0);
 
 // |a AND b| over the raw bitset words (equal sizes).
 uint64_t CountAnd(const VoxelSet& a, const VoxelSet& b);

@@ -9,6 +9,7 @@
 #include "vc/base/geometry.h"
 #include "vc/base/parameter.h"
 #include "vc/base/status.h"
+#include "vc/plan/keep_out.h"
 #include "vc/scene/voxel_scene.h"
 #include "vc/visibility/visibility.h"
 
@@ -51,10 +52,21 @@ struct PlanOptions {
   ScannerModel scanner;
   // User-supplied candidates (world frame, m). When non-empty, replaces the generated grid.
   std::vector<WorldPoint> candidates;
+  // Several instrument heights above the floor (m): when non-empty, replaces tripod_height_m and
+  // the grid gets a candidate at each height per cell.
+  std::vector<double> tripod_heights_m;
+  // Places no station may stand in (world frame).
+  std::vector<KeepOutZone> keep_out;
+  // Stations already placed (world frame, m): picked first, never removed; the plan adds to them.
+  std::vector<WorldPoint> fixed_stations;
+
+  // The instrument heights candidates stand at: tripod_heights_m, or {tripod_height_m}.
+  [[nodiscard]] std::vector<double> TripodHeights() const;
 
   // INVALID_ARGUMENT naming the first bad parameter: a row's check (non-finite, negative, zero,
-  // out of range), the scanner's, a non-finite candidate, clearance_m >= tripod_height_m, or
-  // refine_step_m > refine_radius_m with refine on.
+  // out of range), the scanner's, a non-finite candidate, clearance_m >= tripod_height_m (or a
+  // tripod_heights_m entry), refine_step_m > refine_radius_m with refine on, a bad keep-out zone, a
+  // non-finite fixed station or one inside a keep-out zone.
   Status Validate() const;
 };
 

@@ -27,13 +27,17 @@ struct PlannedStation {
   uint64_t marginal_gain = 0;      // new voxels when picked (greedy order)
   double cumulative_coverage = 0;  // covered / coverable after this pick
   double global_visibility = 0;    // G of this station alone
-  int candidate_index = -1;        // index into PlanResult::candidates, or -1 if refined off-grid
+  int candidate_index = -1;        // index into PlanResult::candidates, or -1 if refined off-grid or fixed
+  bool fixed = false;              // one of PlanOptions::fixed_stations (placed first, never removed)
 };
 
 struct HeatMap {
   // Candidates with their visibility count (Fig. 10); cells without a candidate are absent.
   std::vector<WorldPoint> positions;
   std::vector<uint64_t> visible_voxels;
+  // Per candidate: the top of the floor under it (m), NaN for user candidates; may be empty (then
+  // the heat map groups candidates by their own z).
+  std::vector<double> floor_z_m;
   double grid_spacing_m = 0;
 };
 
@@ -74,7 +78,7 @@ struct PlanResult {
   std::vector<double> floor_levels_m;
   // Why selection stopped (StopReasonName: "exhausted", "target_reached", "max_stations", "min_gain").
   StopReason stop_reason = StopReason::kExhausted;
-  // Greedy picks, and how many of them consolidation saved.
+  // Greedy picks (fixed stations not counted), and how many of them consolidation saved.
   int greedy_stations = 0;
   int consolidated = 0;
   // Occupied voxel centres (world, m) in id order, for visibility.ply.
@@ -87,8 +91,9 @@ struct PlanCallbacks {
   // Once, when the visibility stage has counted every candidate (the heat map is final then:
   // refinement's trial positions are not candidates).
   std::function<void(const HeatMap&)> on_heat_map;
-  // Provisional: each station as selection picks it (greedy order, after consolidation), before
-  // refinement and reduction may move or remove it; global_visibility is still 0.
+  // Provisional: each station as selection picks it (greedy order, after consolidation; the fixed
+  // stations first, with fixed = true), before refinement and reduction may move or remove it
+  // (never a fixed one); global_visibility is still 0.
   std::function<void(const PlannedStation&, int index)> on_station;
   // Once, after refinement and reduction: the final stations, in the order of PlanResult::stations
   // (marginal gain and coverage final; global_visibility still 0 until the evaluation).

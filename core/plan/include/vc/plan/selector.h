@@ -37,7 +37,7 @@ struct Selection {
   StopReason stop = StopReason::kExhausted;  // why the first pass stopped
   uint64_t coverable = 0;                    // |union of all sets|, in voxels
   uint64_t covered = 0;                      // voxels the first pass covered when it stopped
-  int first_pass_picks = 0;                  // picks before any improvement pass (greedy picks)
+  int first_pass_picks = 0;                  // picks before any improvement pass (greedy picks, fixed excluded)
   int saved_by_improvement = 0;              // picks the improvement pass saved (consolidation)
 };
 
@@ -45,9 +45,16 @@ struct Selection {
 class Selector {
  public:
   virtual ~Selector() = default;
-  // Picks among `sets` (all of one size). INVALID_ARGUMENT for sets of different sizes;
-  // CANCELLED / DEADLINE_EXCEEDED from ctx. Progress is reported as Stage::kSelection.
-  [[nodiscard]] virtual Result<Selection> Select(const std::vector<VoxelSet>& sets, const JobContext& ctx) const = 0;
+  // Picks among `sets` (all of one size), the first `fixed` of which are stations already placed:
+  // they are the first picks, in order, and stay picked. INVALID_ARGUMENT for sets of different
+  // sizes or fixed outside [0, |sets|]; CANCELLED / DEADLINE_EXCEEDED from ctx. Progress is
+  // reported as Stage::kSelection.
+  [[nodiscard]] virtual Result<Selection> Select(const std::vector<VoxelSet>& sets, int fixed,
+                                                 const JobContext& ctx) const = 0;
+  // Select without fixed stations.
+  [[nodiscard]] Result<Selection> Select(const std::vector<VoxelSet>& sets, const JobContext& ctx) const {
+    return Select(sets, 0, ctx);
+  }
 };
 
 struct GreedySelectorOptions {
@@ -61,8 +68,11 @@ struct GreedySelectorOptions {
 class GreedySelector final : public Selector {
  public:
   explicit GreedySelector(const GreedySelectorOptions& options) : options_(options) {}
-  // The greedy picks, consolidated; stop, coverable and covered are the greedy pass's.
-  [[nodiscard]] Result<Selection> Select(const std::vector<VoxelSet>& sets, const JobContext& ctx) const override;
+  using Selector::Select;
+  // The fixed stations, then the greedy picks, consolidated (fixed stations kept); stop, coverable
+  // and covered are the greedy pass's (covered includes what the fixed stations cover).
+  [[nodiscard]] Result<Selection> Select(const std::vector<VoxelSet>& sets, int fixed,
+                                         const JobContext& ctx) const override;
 
  private:
   GreedySelectorOptions options_;

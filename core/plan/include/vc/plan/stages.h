@@ -29,8 +29,9 @@ namespace vc::planner {
 struct Stations {
   std::vector<WorldPoint> positions;  // optical centres, world frame (m)
   std::vector<double> floor_z_m;      // top of the floor below (m); NaN for user candidates
-  std::vector<int> candidate;         // index into the candidates; -1 once refined off-grid
+  std::vector<int> candidate;         // index into the candidates; -1 once refined off-grid, or fixed
   std::vector<VoxelSet> sets;         // each station's visibility set (selection test)
+  std::vector<bool> fixed;            // a fixed station (options.fixed_stations): never moved or removed
   // Number of stations.
   [[nodiscard]] size_t size() const { return positions.size(); }
   // True when there is no station.
@@ -59,10 +60,12 @@ struct CandidatesOutput {
   uint64_t grid_cells = 0;             // grid cells x levels examined
   uint64_t cells_without_floor = 0;
   uint64_t cells_failing_clearance = 0;
+  uint64_t in_keep_out = 0;           // candidates dropped because they lie in a keep-out zone
   std::vector<std::string> warnings;  // for PlanResult::warnings, in order
 };
-// INVALID_ARGUMENT for a user candidate out of range or inside an occupied voxel;
-// FAILED_PRECONDITION when no floor is found or no candidate survives.
+// Generated candidates at every height of options.TripodHeights(), or the user's; either without
+// those in a keep-out zone. INVALID_ARGUMENT for a user candidate or fixed station out of range or
+// inside an occupied voxel; FAILED_PRECONDITION when no floor is found or no candidate survives.
 [[nodiscard]] Result<CandidatesOutput> RunCandidatesStage(const CandidatesInput& in, const PlanOptions& options,
                                                           const JobContext& ctx);
 
@@ -75,11 +78,14 @@ struct CandidatesOutput {
 struct VisibilityInput {
   const VoxelScene& scene;
   const std::vector<WorldPoint>& candidates;
-  const PlanCallbacks& callbacks;  // on_heat_map is called once, when the heat map is final
+  const std::vector<double>& floor_z_m;           // per candidate (for the heat map)
+  const std::vector<WorldPoint>& fixed_stations;  // their sets are computed too, not in the heat map
+  const PlanCallbacks& callbacks;                 // on_heat_map is called once, when the heat map is final
 };
 struct VisibilityOutput {
-  std::vector<VoxelSet> sets;  // per candidate
-  HeatMap heat_map;            // per candidate: |set|
+  std::vector<VoxelSet> sets;        // per candidate
+  std::vector<VoxelSet> fixed_sets;  // per fixed station
+  HeatMap heat_map;                  // per candidate: |set|
 };
 // CANCELLED / DEADLINE_EXCEEDED from ctx.
 [[nodiscard]] Result<VisibilityOutput> RunVisibilityStage(const VisibilityInput& in, const PlanOptions& options,
@@ -88,15 +94,16 @@ struct VisibilityOutput {
 // --- Stage::kSelection: the Selector's picks as stations ---
 struct SelectionInput {
   const Selector& selector;
-  std::vector<VoxelSet> sets;  // per candidate; consumed (freed when done)
+  std::vector<VoxelSet> sets;        // per candidate; consumed (freed when done)
+  std::vector<VoxelSet> fixed_sets;  // per fixed station (options.fixed_stations); consumed
   const std::vector<WorldPoint>& candidates;
   const std::vector<double>& floor_z_m;         // per candidate
   const std::vector<uint64_t>& visible_voxels;  // per candidate: |set| (the heat map's counts)
   const PlanCallbacks& callbacks;               // on_station is called per pick, in pick order
 };
 struct SelectionOutput {
-  Stations stations;    // the picks, in pick order
-  VoxelSet coverable;   // union of every candidate's set
+  Stations stations;    // the fixed stations, then the picks, in pick order
+  VoxelSet coverable;   // union of every candidate's and fixed station's set
   Selection selection;  // what the selector reported
 };
 // Errors of the selector (CANCELLED / DEADLINE_EXCEEDED from ctx).
