@@ -75,6 +75,53 @@ STATIONS = b"x_m,y_m,z_m\n0,0,1.5\n2.5,1,1.5\n# comment\n3 4 1.6\n"
 
 KEEP_OUT = (b"# keep-out zones: boxes and polygons over a z range\n\nbox, -1, -1, -2, 1, 1, 4  # the tripod\n"
             b"POLYGON,0,3.5,10,10,12,10,12,12,10,12\npolygon,-1e3,1e3,0,0,1,0,0,1\n")
+
+def upload_actions(max_upload, queue, *actions):
+    """An upload_assembler_fuzzer input: the config bytes, then actions (fuzz/upload_assembler_fuzzer.cc)."""
+    return bytes([max_upload, queue]) + b"".join(actions)
+
+
+def op(slot, kind, *args):
+    return bytes([(slot << 4) | kind]) + b"".join(bytes([a]) if isinstance(a, int) else a for a in args)
+
+
+def spec(slot, payload=None, size=None, size_mode=0, fmt=0, crc=0, name=b"x.ply", params_refused=False):
+    """A spec message: the CRC of `payload` (sent later by payload chunks), or `crc`, for `size` bytes."""
+    flags = (1 if params_refused else 0) | (2 if payload is not None else 0) | (size_mode << 2)
+    out = bytes([flags])
+    if size_mode == 0:
+        out += bytes([len(payload) if size is None else size])
+    elif size_mode == 3:
+        out += struct.pack("<Q", size)
+    out += bytes([fmt]) if fmt < 8 else bytes([8]) + struct.pack("<i", fmt)
+    out += payload if payload is not None else struct.pack("<I", crc)
+    return op(slot, 2, out + bytes([len(name)]) + name)
+
+
+NEW, DROP, CHUNK, FINISH, TAKE_DATA, TAKE_HOLD, TAKE_DROP, RELEASE, DROP_HELD = 0, 1, 3, 4, 5, 6, 7, 8, 9
+SCENE = b"ply\nformat ascii"
+UPLOADS = {
+    # New, spec, the payload in two chunks, Finish, TakeData, the ticket held then released.
+    "whole.bin": upload_actions(64, 0, op(0, NEW), spec(0, SCENE, fmt=1), op(0, CHUNK, 0x85),
+                                op(0, CHUNK, 0x80), op(0, FINISH), op(0, TAKE_DATA), op(0, TAKE_HOLD),
+                                op(0, RELEASE)),
+    # One worker, no queue: the second call is busy until the first is dropped; a second spec.
+    "busy.bin": upload_actions(64, 0, op(0, NEW), op(1, NEW), spec(0, SCENE), spec(1, SCENE),
+                               op(0, DROP), spec(1, SCENE), op(1, NEW), spec(1, SCENE),
+                               op(1, CHUNK, 0x80), op(1, FINISH), op(1, TAKE_DROP)),
+    # A 1-job queue: two calls admitted, the third busy; refusals of size, format, emptiness.
+    "queue.bin": upload_actions(16, 1, op(0, NEW), op(1, NEW), op(2, NEW), spec(0, b"abc"),
+                                spec(1, b"defg"), spec(2, b"hi"), op(2, NEW), spec(2, b"", size_mode=2),
+                                op(2, NEW), spec(2, b"xy", fmt=99), op(2, NEW), spec(2, b"", size=0),
+                                op(2, NEW), spec(2, None, size=1 << 40, size_mode=3, crc=7)),
+    # Corrupted and short uploads, bytes past the declared size, chunks after refused parameters.
+    "bad.bin": upload_actions(32, 0, op(0, NEW), spec(0, SCENE), op(0, CHUNK, 3, b"ply"), op(0, FINISH),
+                              op(0, CHUNK, 14, b"\nformat ASCII"), op(0, FINISH), op(0, CHUNK, 1, b"!"),
+                              op(0, TAKE_HOLD), op(1, NEW), spec(1, b"abc", params_refused=True),
+                              op(1, CHUNK, 0), op(1, FINISH), op(1, CHUNK, 2, b"ab"), op(2, CHUNK, 1, b"a"),
+                              op(2, NEW), op(2, FINISH), op(0, DROP_HELD)),
+}
+
 SEEDS = {
     "ply_fuzzer": {"ascii.ply": PLY_ASCII, "binary_le.ply": PLY_BIN, "binary_be.ply": PLY_BE},
     "pcd_fuzzer": {"ascii.pcd": PCD_ASCII, "binary.pcd": PCD_BIN, "lzf.pcd": PCD_LZF},
@@ -92,6 +139,7 @@ SEEDS = {
     "stations_csv_fuzzer": {"stations.csv": STATIONS},
     "keep_out_csv_fuzzer": {"zones.csv": KEEP_OUT, "box.csv": b"box,0,0,0,1,1,1\n",
                             "polygon.csv": b"polygon,0,3,0,0,2,0,2,1,1,1,1,2,0,2\n"},
+    "upload_assembler_fuzzer": UPLOADS,
 }
 SEEDS["read_scene_fuzzer"] = {
     name: data for target in ("ply_fuzzer", "pcd_fuzzer", "xyz_fuzzer", "las_fuzzer",

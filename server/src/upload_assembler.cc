@@ -20,6 +20,7 @@ Status UploadAssembler::StartSpec() {
 }
 
 Status UploadAssembler::AcceptSpec(const v1::UploadSpec& upload) {
+  if (accepted_) return InvalidArgumentError("a second spec arrived; send exactly one spec, first");
   upload_ = upload;
   if (upload.format() != v1::INPUT_FORMAT_UNSPECIFIED) {
     VC_RETURN_IF_ERROR(wire::FromProto(upload.format()).status());
@@ -40,6 +41,7 @@ Status UploadAssembler::AcceptSpec(const v1::UploadSpec& upload) {
                                   "-job queue is full; retry in a few seconds");
   }
   data_.reserve(upload_.total_size_bytes());
+  accepted_ = true;
   return Status::Ok();
 }
 
@@ -47,6 +49,7 @@ Status UploadAssembler::AddChunk(std::string_view data) {
   if (!has_spec_) {
     return InvalidArgumentError("a data chunk arrived before the spec; the first message must be the spec");
   }
+  if (!accepted_) return InvalidArgumentError("a data chunk arrived for a refused spec; start a new upload");
   if (data.size() > upload_.total_size_bytes() - data_.size()) {
     return InvalidArgumentError("the upload carries more than the " + std::to_string(upload_.total_size_bytes()) +
                                 " bytes its spec declares; fix total_size_bytes");
@@ -60,6 +63,7 @@ Status UploadAssembler::Finish() const {
   if (!has_spec_) {
     return InvalidArgumentError("the stream ended before any spec; send a spec message first, then the data");
   }
+  if (!accepted_) return InvalidArgumentError("the upload's spec was refused; start a new upload");
   if (data_.size() != upload_.total_size_bytes()) {
     return InvalidArgumentError("the upload ended after " + std::to_string(data_.size()) + " of the " +
                                 std::to_string(upload_.total_size_bytes()) +

@@ -136,6 +136,61 @@ TEST_F(UploadAssemblerTest, StreamWithoutSpecIsInvalidArgument) {
   EXPECT_THAT(s.message(), HasSubstr("before any spec"));
 }
 
+// Found by upload_assembler_fuzzer: after a refused spec (here the pool was full), chunks were
+// still taken and Finish was OK, for an upload that holds no place (the reactor would submit
+// *TakeTicket() of an empty optional).
+TEST(UploadAssembler, NoChunkOrFinishAfterARefusedSpec) {
+  WorkerPool pool(1, 0);
+  auto held = pool.TryAdmit();
+  ASSERT_TRUE(held);
+  UploadAssembler a(kLimit, &pool);
+  ASSERT_TRUE(a.StartSpec().ok());
+  ASSERT_EQ(a.AcceptSpec(SpecFor("abc")).code(), StatusCode::kResourceExhausted);
+  const Status chunk = a.AddChunk("abc");
+  EXPECT_EQ(chunk.code(), StatusCode::kInvalidArgument);
+  EXPECT_THAT(chunk.message(), HasSubstr("refused spec"));
+  const Status finish = a.Finish();
+  EXPECT_EQ(finish.code(), StatusCode::kInvalidArgument);
+  EXPECT_THAT(finish.message(), HasSubstr("refused"));
+  EXPECT_TRUE(a.data().empty());
+  EXPECT_FALSE(a.TakeTicket().has_value());
+  EXPECT_EQ(pool.admitted(), 1) << "only the held place";
+}
+
+// The same when the RPC refused its own parameters after StartSpec and never called AcceptSpec:
+// the empty upload of the default spec (0 bytes, CRC32C 0) was OK.
+TEST_F(UploadAssemblerTest, NoFinishWhenTheSpecWasNeverAccepted) {
+  ASSERT_TRUE(assembler_.StartSpec().ok());
+  EXPECT_EQ(assembler_.AddChunk("").code(), StatusCode::kInvalidArgument);
+  EXPECT_EQ(assembler_.Finish().code(), StatusCode::kInvalidArgument);
+  EXPECT_EQ(pool_.admitted(), 0);
+}
+
+TEST_F(UploadAssemblerTest, ASecondAcceptedSpecIsInvalidArgumentAndKeepsTheFirst) {
+  ASSERT_TRUE(Begin("abc").ok());
+  const Status s = assembler_.AcceptSpec(SpecFor("abcdef"));
+  EXPECT_EQ(s.code(), StatusCode::kInvalidArgument);
+  EXPECT_EQ(assembler_.declared_bytes(), 3u);
+  EXPECT_EQ(pool_.admitted(), 1);
+}
+
+// Found by upload_assembler_fuzzer: TakeTicket moved the ticket out but left the optional engaged,
+// so a second TakeTicket returned a ticket that holds no place (and TakeData a moved-from string).
+TEST_F(UploadAssemblerTest, TakingTheTicketAndDataLeavesNeither) {
+  const std::string bytes = "abc";
+  ASSERT_TRUE(Begin(bytes).ok());
+  ASSERT_TRUE(assembler_.AddChunk(bytes).ok());
+  ASSERT_TRUE(assembler_.Finish().ok());
+  EXPECT_EQ(assembler_.TakeData(), bytes);
+  EXPECT_TRUE(assembler_.data().empty());
+  auto ticket = assembler_.TakeTicket();
+  EXPECT_TRUE(ticket.has_value());
+  EXPECT_FALSE(assembler_.TakeTicket().has_value());
+  EXPECT_EQ(pool_.admitted(), 1);
+  ticket.reset();
+  EXPECT_EQ(pool_.admitted(), 0);
+}
+
 TEST(HumanBytes, PicksTheUnit) {
   EXPECT_EQ(HumanBytes(512), "512 B");
   EXPECT_EQ(HumanBytes(1536), "1.5 KiB");

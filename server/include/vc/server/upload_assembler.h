@@ -13,6 +13,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <utility>
 
 #include "vc/base/status.h"
 #include "vc/server/worker_pool.h"
@@ -34,11 +35,15 @@ class UploadAssembler {
   Status StartSpec();
   // Checks the upload spec (format, non-empty, within --max-upload-bytes) and admits the job.
   // INVALID_ARGUMENT, or RESOURCE_EXHAUSTED for a too-large upload or a busy server (busy() true).
+  // INVALID_ARGUMENT once a spec was accepted. Until one is (it was refused, or the RPC refused its
+  // parameters and never called this), AddChunk and Finish are INVALID_ARGUMENT: no data is taken
+  // and no upload completes without a place in the pool.
   Status AcceptSpec(const v1::UploadSpec& upload);
-  // Appends a chunk. INVALID_ARGUMENT before the spec or past the declared size.
+  // Appends a chunk. INVALID_ARGUMENT before the spec, for a refused spec or past the declared size.
   Status AddChunk(std::string_view data);
-  // After the client half-closed: INVALID_ARGUMENT without a spec or with bytes missing, DATA_LOSS
-  // when the CRC32C differs from the spec's.
+  // After the client half-closed: INVALID_ARGUMENT without an accepted spec or with bytes missing,
+  // DATA_LOSS when the CRC32C differs from the spec's. OK only while the assembler holds the job's
+  // place (unless TakeTicket already took it).
   Status Finish() const;
 
   // A spec message arrived (StartSpec was called).
@@ -50,15 +55,17 @@ class UploadAssembler {
   // Bytes the spec declares (0 before AcceptSpec).
   uint64_t declared_bytes() const { return upload_.total_size_bytes(); }
   const std::string& data() const { return data_; }
-  // The verified bytes and the job's place in the pool, moved out (after Finish succeeded).
-  std::string TakeData() { return std::move(data_); }
-  std::optional<WorkerPool::Ticket> TakeTicket() { return std::move(ticket_); }
+  // The verified bytes and the job's place in the pool, moved out (after Finish succeeded); the
+  // assembler is left holding neither, so a second TakeTicket returns nullopt, not an empty ticket.
+  std::string TakeData() { return std::exchange(data_, std::string()); }
+  std::optional<WorkerPool::Ticket> TakeTicket() { return std::exchange(ticket_, std::nullopt); }
 
  private:
   const uint64_t max_upload_bytes_;
   WorkerPool* const pool_;
   bool has_spec_ = false;
   bool busy_ = false;
+  bool accepted_ = false;  // AcceptSpec succeeded: the place is reserved and chunks are taken
   v1::UploadSpec upload_;
   std::string data_;
   wire::Crc32c crc_;
