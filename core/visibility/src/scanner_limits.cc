@@ -53,22 +53,29 @@ bool ScannerLimits::Passes(const Eigen::Vector3d& aim, int axis, int sign) const
 
 ScannerLimits::Verdict ScannerLimits::BoxVerdict(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) const {
   if (!active_) return Verdict::kAll;
-  double near2 = 0, far2 = 0;
+  double near[3], far[3];
   for (int a = 0; a < 3; ++a) {
-    const double below = lo[a] - uo_[a], above = uo_[a] - hi[a];
-    const double near = std::max({below, above, 0.0});
-    const double far = std::max(std::abs(lo[a] - uo_[a]), std::abs(hi[a] - uo_[a]));
-    near2 += near * near;
-    far2 += far * far;
+    near[a] = std::max({lo[a] - uo_[a], uo_[a] - hi[a], 0.0});
+    far[a] = std::max(std::abs(lo[a] - uo_[a]), std::abs(hi[a] - uo_[a]));
   }
-  // A margin for the rounding of these sums against Passes' own: a box within it is decided point
-  // by point.
+  const double near2 = near[0] * near[0] + near[1] * near[1] + near[2] * near[2];
+  const double far2 = far[0] * far[0] + far[1] * far[1] + far[2] * far[2];
+  // A margin for the rounding of these sums against Passes' own: a box within it of a limit is
+  // decided point by point.
   const double slack = 1e-9 * (far2 + 1);
   if (near2 > max2_ + slack || far2 < min2_ - slack) return Verdict::kNone;
-  if (near2 >= min2_ + slack && far2 <= max2_ - slack && !vfov_lo_ && !vfov_hi_ && !incidence_ && !spacing_) {
-    return Verdict::kAll;
+  if (!(near2 >= min2_ + slack && far2 <= max2_ - slack) || incidence_ || spacing_) return Verdict::kSome;
+  if (vfov_lo_ || vfov_hi_) {
+    // Every point must have dz >= tan_lo h (and dz <= tan_hi h), dz = z - station.z over
+    // [lo.z, hi.z] - station.z and h the horizontal distance over [h_near, h_far]; each condition
+    // is linear in dz and in h, so its worst case is at an end of each range.
+    const double h_near = std::sqrt(near[0] * near[0] + near[1] * near[1]);
+    const double h_far = std::sqrt(far[0] * far[0] + far[1] * far[1]);
+    const double margin = 1e-9 * (std::sqrt(far2) + 1);
+    if (vfov_lo_ && !(lo[2] - uo_[2] - tan_lo_ * (tan_lo_ <= 0 ? h_near : h_far) >= margin)) return Verdict::kSome;
+    if (vfov_hi_ && !(tan_hi_ * (tan_hi_ >= 0 ? h_near : h_far) - (hi[2] - uo_[2]) >= margin)) return Verdict::kSome;
   }
-  return Verdict::kSome;
+  return Verdict::kAll;
 }
 
 void ScannerLimits::EntryFace(const VoxelIndex& v, int* axis, int* sign) const {

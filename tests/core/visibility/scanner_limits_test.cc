@@ -9,6 +9,7 @@
 #include <cmath>
 #include <functional>
 #include <numbers>
+#include <random>
 
 #include "testing/scenes.h"
 #include "vc/visibility/visibility.h"
@@ -212,6 +213,38 @@ TEST(ScannerLimitsTest, EntryFaceIsTheLastSlabEnteredAndTheLowestAxisOnATie) {
   diagonal.EntryFace({0, 0, 0}, &axis, &sign);  // through the edge of -x and +y: x, the lowest axis
   EXPECT_EQ(axis, 0);
   EXPECT_EQ(sign, -1);
+}
+
+// BoxVerdict may only decide a box whole when every point of it would get that answer from
+// Passes: random boxes around random stations, with the range and the vertical field of view on,
+// and points sampled in each box (corners included).
+TEST(ScannerLimitsTest, ABoxDecidedWholeHoldsOnlyPointsWithThatAnswer) {
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<double> u(0, 1);
+  size_t all = 0, none = 0;
+  for (int trial = 0; trial < 4000; ++trial) {
+    ScannerModel sc;
+    sc.min_range_m = 2 * u(rng);
+    sc.max_range_m = sc.min_range_m + 0.5 + 20 * u(rng);
+    sc.vfov_min_deg = trial % 3 == 0 ? -90 : -89 + 100 * u(rng);
+    sc.vfov_max_deg = trial % 3 == 1 ? 90 : std::max(sc.vfov_min_deg + 1, -60 + 150 * u(rng));
+    if (sc.vfov_max_deg > 90) sc.vfov_max_deg = 90;
+    const double r = 0.1;
+    const Eigen::Vector3d uo(40 * u(rng), 40 * u(rng), 40 * u(rng));
+    const ScannerLimits l(sc, r, uo);
+    const Eigen::Vector3d lo(40 * u(rng) + 20 * u(rng) - 10, 40 * u(rng), 40 * u(rng) - 10);
+    const Eigen::Vector3d hi = lo + Eigen::Vector3d(8, 8, 8) * u(rng);
+    const auto verdict = l.BoxVerdict(lo, hi);
+    if (verdict == ScannerLimits::Verdict::kSome) continue;
+    (verdict == ScannerLimits::Verdict::kAll ? all : none) += 1;
+    for (int k = 0; k < 64; ++k) {
+      Eigen::Vector3d p;
+      for (int a = 0; a < 3; ++a) p[a] = k < 8 ? ((k >> a) & 1 ? hi[a] : lo[a]) : lo[a] + (hi[a] - lo[a]) * u(rng);
+      ASSERT_EQ(l.Passes(p, 0, 1), verdict == ScannerLimits::Verdict::kAll) << trial << " point " << k;
+    }
+  }
+  EXPECT_GT(all, 100u);
+  EXPECT_GT(none, 100u);
 }
 
 // V (ALGORITHM.md s.5) is 0 for a face that fails a limit and unchanged for one that passes.

@@ -36,9 +36,11 @@ class ScannerLimits {
   // normal is +axis (sign > 0) or -axis (sign < 0).
   bool Passes(const Eigen::Vector3d& aim, int axis, int sign) const;
 
-  // What the limits say for every aim point in the box [lo, hi] (index space), from the range
-  // alone: kNone when no point of the box is in range, kAll when every point is and no other limit
-  // is on, kSome otherwise (decide point by point).
+  // What the limits say for every aim point in the box [lo, hi] (index space): kNone when no point
+  // of the box is in range; kAll when every point is in range and in the vertical field of view,
+  // and no incidence or spacing limit is on (those depend on the face); kSome otherwise (decide
+  // point by point). Conservative: a margin far above rounding separates a decided box from the
+  // limits.
   enum class Verdict { kNone, kSome, kAll };
   Verdict BoxVerdict(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) const;
 
