@@ -114,10 +114,25 @@ TEST(GroupedSurfaceVisibilityTest, SameSetsAsPerVoxelOnSyntheticScenes) {
   }
 }
 
+// Every limit of the scanner model on, at values that cut through the scenes (range, blind cone,
+// incidence, spacing), so that bricks are decided whole by the range, face by face, and not at all.
+ScannerModel EveryLimit() {
+  ScannerModel sc;
+  sc.min_range_m = 0.8;
+  sc.max_range_m = 4.5;
+  sc.vfov_min_deg = -55;
+  sc.vfov_max_deg = 60;
+  sc.max_incidence_deg = 70;
+  sc.angular_step_deg = 0.05;
+  sc.max_spacing_m = 0.006;
+  return sc;
+}
+
 TEST(GroupedSurfaceVisibilityTest, SameSetsAsPerVoxelOnClutteredPlanes) {
   // Large planes (where groups are decided whole) with holes, posts and loose voxels in front of
   // them (where groups split and certificates fail), seen from random points, some outside the
-  // scene's box and some a fraction of a voxel from a plane.
+  // scene's box and some a fraction of a voxel from a plane; without limits and with every limit
+  // of the scanner model on.
   std::mt19937_64 rng(5);
   for (int trial = 0; trial < 4; ++trial) {
     std::vector<VoxelIndex> v;
@@ -138,7 +153,10 @@ TEST(GroupedSurfaceVisibilityTest, SameSetsAsPerVoxelOnClutteredPlanes) {
       if (i == 0) o.z() = 1.0 + 1e-9;  // just above the floor's top plane (z = 1 voxel)
       vps.push_back(o);
     }
-    EXPECT_GT(ExpectSameSets(s, vps, "trial " + std::to_string(trial)), 0u);
+    const size_t unlimited = ExpectSameSets(s, vps, "trial " + std::to_string(trial));
+    const size_t limited = ExpectSameSets(s, vps, "limits, trial " + std::to_string(trial), EveryLimit());
+    EXPECT_GT(limited, 0u);
+    EXPECT_LT(limited, unlimited);  // the limits bite
   }
 }
 
@@ -150,60 +168,16 @@ TEST(GroupedSurfaceVisibilityTest, SameSetsAsPerVoxelOnGeb079) {
   Result<VoxelScene> s = Voxelize(*in, vo);
   ASSERT_TRUE(s.ok());
   EXPECT_GT(ExpectSameSets(*s, Candidates(*s, 13), "geb079"), 0u);
-}
-
-// Every limit of the scanner model on, at values that cut through the scenes (range, blind cone,
-// incidence, spacing), so that bricks are decided whole by the range, face by face, and not at all.
-ScannerModel EveryLimit() {
-  ScannerModel sc;
-  sc.min_range_m = 0.8;
-  sc.max_range_m = 4.5;
-  sc.vfov_min_deg = -55;
-  sc.vfov_max_deg = 60;
-  sc.max_incidence_deg = 70;
-  sc.angular_step_deg = 0.05;
-  sc.max_spacing_m = 0.006;
-  return sc;
+  ScannerModel sc = EveryLimit();
+  sc.max_range_m = 20;
+  EXPECT_GT(ExpectSameSets(*s, Candidates(*s, 29), "geb079 with every limit", sc), 0u);
 }
 
 TEST(GroupedSurfaceVisibilityTest, SameSetsAsPerVoxelWithEveryScannerLimitOn) {
-  std::mt19937_64 rng(17);
-  for (int trial = 0; trial < 3; ++trial) {
-    std::vector<VoxelIndex> v;
-    std::uniform_int_distribution<int> c(0, 47);
-    for (int x = 0; x < 48; ++x)
-      for (int y = 0; y < 48; ++y) {
-        v.push_back({x, y, 0});
-        v.push_back({x, 47, y});
-        if (x % 12 == 5 && y % 12 == 5)
-          for (int z = 1; z < 20; ++z) v.push_back({x, y, z});
-      }
-    for (int i = 0; i < 200; ++i) v.push_back({c(rng), c(rng), c(rng) / 2});
-    const VoxelScene s = MakeScene(v);
-    std::vector<WorldPoint> vps;
-    std::uniform_real_distribution<double> p(-8, 56);
-    for (int i = 0; i < 6; ++i) vps.emplace_back(p(rng) * 0.1, p(rng) * 0.1, std::abs(p(rng)) * 0.05);
-    const size_t limited = ExpectSameSets(s, vps, "clutter " + std::to_string(trial), EveryLimit());
-    const size_t unlimited = ExpectSameSets(s, vps, "clutter " + std::to_string(trial));
-    EXPECT_GT(limited, 0u);
-    EXPECT_LT(limited, unlimited);  // the limits bite
-  }
   for (const char* spec : {"rooms:3", "twofloor", "lroom"}) {
     const VoxelScene s = SyntheticScene(spec);
     EXPECT_GT(ExpectSameSets(s, Candidates(s, 37), spec, EveryLimit()), 0u) << spec;
   }
-}
-
-TEST(GroupedSurfaceVisibilityTest, SameSetsAsPerVoxelOnGeb079WithEveryScannerLimitOn) {
-  Result<SceneInput> in = ReadSceneFile(testing::SharedDataPath("geb079/geb079.bt"));
-  ASSERT_TRUE(in.ok()) << in.status().ToString();
-  VoxelizeOptions vo;
-  vo.resolution_m = 0.1;
-  Result<VoxelScene> s = Voxelize(*in, vo);
-  ASSERT_TRUE(s.ok());
-  ScannerModel sc = EveryLimit();
-  sc.max_range_m = 20;
-  EXPECT_GT(ExpectSameSets(*s, Candidates(*s, 29), "geb079", sc), 0u);
 }
 
 TEST(GroupedCornersTest, SameFaceValuesAsPerCornerOnSyntheticScenes) {
