@@ -124,8 +124,8 @@ inline Perception FromCount(int visible) {
 // V of a face given its perception, from world viewpoint o (s.5).
 // V of face f of v from o (world), 0 where the face centre fails one of the scanner's limits
 // (`limits`: those of s for o).
-inline double FaceValue(Perception p, const WorldPoint& o, const VoxelIndex& v, Face f, double r,
-                        const ScannerModel& s, const ScannerLimits& limits) {
+inline double FaceValue(Perception p, const WorldPoint& o, const VoxelIndex& v, Face f, double r, const ScannerModel& s,
+                        const ScannerLimits& limits) {
   if (p == Perception::kNone) return 0.0;
   if (!limits.Passes(FaceCenterIS(v, f), FaceAxis(f), FaceSign(f))) return 0.0;
   const WorldPoint center = FaceCenterIS(v, f) * r;

@@ -53,7 +53,7 @@ class ScannerLimits {
  private:
   Eigen::Vector3d uo_ = Eigen::Vector3d::Zero();
   bool active_ = false;
-  double min2_ = 0, max2_ = 0;  // squared range, voxel units
+  double min2_ = 0, max2_ = 0;              // squared range, voxel units
   bool vfov_lo_ = false, vfov_hi_ = false;  // a lower / upper elevation limit is on
   double tan_lo_ = 0, tan_hi_ = 0;          // their tangents
   bool incidence_ = false;
