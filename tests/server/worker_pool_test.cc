@@ -54,10 +54,10 @@ TEST(WorkerPool, QueuePositionsAndRelease) {
 // submits again the moment it hears the answer is admitted (the CI run of 2026-12-03 found a
 // service test refused as busy in that window).
 TEST(WorkerPool, ATaskThatReleasesItsPlaceLetsTheNextJobInWhileItFinishes) {
-  WorkerPool pool(1, 0);
   std::promise<void> place_released;
   std::promise<void> finish;
   std::shared_future<void> may_finish = finish.get_future().share();
+  WorkerPool pool(1, 0);  // declared last: destroyed (its worker joined) before what the task uses
   auto t = pool.TryAdmit();
   ASSERT_TRUE(t.has_value());
   EXPECT_FALSE(pool.TryAdmit().has_value());
@@ -77,10 +77,10 @@ TEST(WorkerPool, ATaskThatReleasesItsPlaceLetsTheNextJobInWhileItFinishes) {
 }
 
 TEST(WorkerPool, ATaskThatKeepsItsPlaceGivesItBackOnReturn) {
-  WorkerPool pool(1, 0);
   std::promise<void> started;
   std::promise<void> finish;
   std::shared_future<void> may_finish = finish.get_future().share();
+  WorkerPool pool(1, 0);  // declared last: destroyed (its worker joined) before what the task uses
   auto t = pool.TryAdmit();
   ASSERT_TRUE(t.has_value());
   pool.Submit(
