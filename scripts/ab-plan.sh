@@ -40,6 +40,10 @@ summary() {  # summary plan.json -> "total stations G visibility-stage-seconds"
   python3 -c 'import json,sys; p=json.load(open(sys.argv[1])); t=p["timings_s"]; print(t["total"], len(p["viewpoints"]), p["coverage"]["global_visibility"], t["visibility"])' "$1"
 }
 
+gmean() {  # gmean LABEL RATIO...: prints "LABEL: geometric mean"
+  python3 -c "import math,sys; r=[float(x) for x in sys.argv[2:]]; print(f'{sys.argv[1]}: {math.exp(sum(map(math.log,r))/len(r)):.3f}')" "$@"
+}
+
 for f in "${files[@]}"; do
   ratios=()
   vratios=()
@@ -66,6 +70,6 @@ for f in "${files[@]}"; do
       pids=()
     done
   done
-  python3 -c "import math,sys; r=[float(x) for x in sys.argv[2:]]; print(f'{sys.argv[1]:12s} geometric mean A/B over {len(r)} runs: {math.exp(sum(map(math.log,r))/len(r)):.3f}')" "$(basename "$f")" "${ratios[@]}"
-  python3 -c "import math,sys; r=[float(x) for x in sys.argv[2:]]; print(f'{sys.argv[1]:12s} geometric mean A/B of the visibility stage: {math.exp(sum(map(math.log,r))/len(r)):.3f}')" "$(basename "$f")" "${vratios[@]}"
+  gmean "$(printf "%-12s" "$(basename "$f")") geometric mean A/B over ${#ratios[@]} runs" "${ratios[@]}"
+  gmean "$(printf "%-12s" "$(basename "$f")") geometric mean A/B of the visibility stage" "${vratios[@]}"
 done
