@@ -46,8 +46,9 @@ bool CompatibleCached(const OccupancyGrid& g, const Vector3d& uo, const VoxelInd
                       OccluderCache& cache) {
   const Vector3d target(v.x + 0.5, v.y + 0.5, v.z + 0.5);
   if (limits.active()) {
-    int axis, sign;
-    limits.EntryFace(v, &axis, &sign);
+    // The entry face matters only to the incidence and spacing limits; Passes ignores it otherwise.
+    int axis = 0, sign = 1;
+    if (limits.JudgesFace()) limits.EntryFace(v, &axis, &sign);
     if (!limits.Passes(target, axis, sign)) return false;
   }
   if (cache.Blocks(uo, target, v)) return false;

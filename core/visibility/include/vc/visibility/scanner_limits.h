@@ -31,6 +31,8 @@ class ScannerLimits {
 
   // Whether any limit can fail (with the defaults on a scene within 75 m: only near the station).
   bool active() const { return active_; }
+  // Whether Passes depends on the face it is judged on (an incidence or spacing limit is on).
+  bool JudgesFace() const { return incidence_ || spacing_; }
 
   // True if the aim point (index space) passes every limit, judged on the face whose outward
   // normal is +axis (sign > 0) or -axis (sign < 0).
