@@ -30,6 +30,8 @@ double Other(double v, ParamCheck c) {
     case ParamCheck::kElevationDeg:
     case ParamCheck::kIncidenceDeg:
       return v / 2;
+    case ParamCheck::kUnitInterval:
+      return v == 0 ? 0.375 : v / 2;
     default:
       return v + 0.375;
   }
@@ -52,6 +54,7 @@ std::optional<double> Bad(double, ParamCheck c) {
     case ParamCheck::kPositive:
       return 0.0;
     case ParamCheck::kFraction:
+    case ParamCheck::kUnitInterval:
       return 1.5;
     case ParamCheck::kElevationDeg:
       return -91.0;

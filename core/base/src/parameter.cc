@@ -36,6 +36,9 @@ Status CheckParameter(const ParamInfo& info, double v, std::string_view prefix) 
     case ParamCheck::kFraction:
       if (!std::isfinite(v) || v <= 0 || v > 1) return Refuse(info, prefix, "in (0, 1]", Num(v));
       break;
+    case ParamCheck::kUnitInterval:
+      if (!std::isfinite(v) || v < 0 || v > 1) return Refuse(info, prefix, "in [0, 1]", Num(v));
+      break;
     case ParamCheck::kElevationDeg:
       if (!std::isfinite(v) || v < -90 || v > 90) return Refuse(info, prefix, "in [-90, 90]", Num(v));
       break;
@@ -59,6 +62,9 @@ Status CheckParameter(const ParamInfo& info, int64_t v, std::string_view prefix)
     case ParamCheck::kFraction:
       if (v <= 0 || v > 1) return Refuse(info, prefix, "in (0, 1]", std::to_string(v));
       break;
+    case ParamCheck::kUnitInterval:
+      if (v < 0 || v > 1) return Refuse(info, prefix, "in [0, 1]", std::to_string(v));
+      break;
     case ParamCheck::kElevationDeg:
       if (v < -90 || v > 90) return Refuse(info, prefix, "in [-90, 90]", std::to_string(v));
       break;
@@ -74,6 +80,7 @@ Status CheckParameter(const ParamInfo& info, uint64_t v, std::string_view prefix
     return Refuse(info, prefix, info.check == ParamCheck::kPositive ? "> 0" : "in (0, 1]", "0");
   }
   if (info.check == ParamCheck::kFraction && v > 1) return Refuse(info, prefix, "in (0, 1]", std::to_string(v));
+  if (info.check == ParamCheck::kUnitInterval && v > 1) return Refuse(info, prefix, "in [0, 1]", std::to_string(v));
   return Status::Ok();
 }
 

@@ -1,8 +1,13 @@
 #include "vc/plan/greedy.h"
 
 #include <algorithm>
+#include <numeric>
+#include <optional>
 #include <queue>
 #include <string>
+#include <unordered_map>
+
+#include "vc/plan/scan_graph.h"
 
 namespace vc::planner {
 
@@ -39,6 +44,113 @@ struct EntryLess {
   }
 };
 
+// Overlaps between candidates (scan_graph.h), computed on demand; the ones among few nodes (the
+// picks) are cached, so that consolidation's repeated component counts cost one intersection per
+// pair.
+class Overlaps {
+ public:
+  explicit Overlaps(const std::vector<VoxelSet>& sets) : sets_(sets), sizes_(sets.size()) {
+    for (size_t i = 0; i < sets.size(); ++i) sizes_[i] = CountBits(sets[i]);
+  }
+  // Whether candidates a and b have an edge at min_overlap.
+  bool Edge(int a, int b, double min_overlap) const {
+    return IsEdge(Overlap(CountAnd(sets_[a], sets_[b]), sizes_[a], sizes_[b]), min_overlap);
+  }
+  // Edge, cached.
+  bool CachedEdge(int a, int b, double min_overlap) {
+    if (a > b) std::swap(a, b);
+    const uint64_t key = uint64_t(a) * sets_.size() + uint64_t(b);
+    auto it = cache_.find(key);
+    if (it == cache_.end()) it = cache_.emplace(key, Edge(a, b, min_overlap)).first;
+    return it->second;
+  }
+  // Number of components of the scan graph of `nodes` (candidate indices).
+  int Components(const std::vector<int>& nodes, double min_overlap) {
+    std::vector<int> parent(nodes.size());
+    std::iota(parent.begin(), parent.end(), 0);
+    auto find = [&](int x) {
+      while (parent[x] != x) x = parent[x] = parent[parent[x]];
+      return x;
+    };
+    int count = static_cast<int>(nodes.size());
+    for (size_t a = 0; a < nodes.size(); ++a) {
+      for (size_t b = a + 1; b < nodes.size(); ++b) {
+        const int ra = find(static_cast<int>(a)), rb = find(static_cast<int>(b));
+        if (ra == rb || !CachedEdge(nodes[a], nodes[b], min_overlap)) continue;
+        parent[rb] = ra;
+        --count;
+      }
+    }
+    return count;
+  }
+  // The components of `nodes`, as lists of candidate indices in the order of `nodes`.
+  std::vector<std::vector<int>> Groups(const std::vector<int>& nodes, double min_overlap) {
+    std::vector<int> group(nodes.size(), -1);
+    std::vector<std::vector<int>> groups;
+    for (size_t a = 0; a < nodes.size(); ++a) {
+      if (group[a] >= 0) continue;
+      group[a] = static_cast<int>(groups.size());
+      groups.push_back({nodes[a]});
+      for (size_t k = 0; k < groups.back().size(); ++k) {  // breadth-first over the group
+        for (size_t b = 0; b < nodes.size(); ++b) {
+          if (group[b] < 0 && CachedEdge(groups.back()[k], nodes[b], min_overlap)) {
+            group[b] = group[a];
+            groups.back().push_back(nodes[b]);
+          }
+        }
+      }
+    }
+    return groups;
+  }
+
+ private:
+  const std::vector<VoxelSet>& sets_;
+  std::vector<uint64_t> sizes_;
+  std::unordered_map<uint64_t, bool> cache_;
+};
+
+// The shortest chain (fewest candidates, breadth-first over edges at min_overlap) from any of
+// `sources` to a candidate for which score() is >= 0: the candidates after the source, ending
+// with the highest-scoring target at the first depth that has one (lowest index on ties). Empty
+// when no chain exists.
+template <typename Score>
+Result<std::vector<int>> ShortestChain(const Overlaps& overlaps, size_t candidates, const std::vector<int>& sources,
+                                       double min_overlap, const JobContext& ctx, Score score) {
+  constexpr int kUnseen = -2, kSource = -1;
+  std::vector<int> prev(candidates, kUnseen);
+  for (int s : sources) prev[s] = kSource;
+  std::vector<int> frontier = sources;
+  while (!frontier.empty()) {
+    VC_RETURN_IF_ERROR(ctx.CheckCancelled("linking the scan graph"));
+    std::vector<int> next;
+    int best = -1;
+    int64_t best_score = -1;
+    for (int u : frontier) {
+      for (size_t c = 0; c < candidates; ++c) {
+        if (prev[c] != kUnseen || !overlaps.Edge(u, static_cast<int>(c), min_overlap)) continue;
+        prev[c] = u;
+        next.push_back(static_cast<int>(c));
+      }
+    }
+    for (int c : next) {
+      const int64_t sc = score(c);
+      if (sc > best_score || (sc == best_score && sc >= 0 && c < best)) {
+        best_score = sc;
+        best = c;
+      }
+    }
+    if (best_score >= 0) {
+      std::vector<int> chain;
+      for (int c = best; c != kSource; c = prev[c]) chain.push_back(c);
+      chain.pop_back();  // the source
+      std::reverse(chain.begin(), chain.end());
+      return chain;
+    }
+    frontier = std::move(next);
+  }
+  return std::vector<int>{};
+}
+
 }  // namespace
 
 Result<GreedyResult> SelectGreedy(const std::vector<VoxelSet>& sets, const GreedyOptions& options,
@@ -49,6 +161,9 @@ Result<GreedyResult> SelectGreedy(const std::vector<VoxelSet>& sets, const Greed
   }
   if (!(options.target_coverage > 0.0 && options.target_coverage <= 1.0)) {
     return InvalidArgumentError("target_coverage must be in (0, 1]");
+  }
+  if (!(options.min_overlap >= 0.0 && options.min_overlap <= 1.0)) {
+    return InvalidArgumentError("min_overlap must be in [0, 1]");
   }
   GreedyResult result;
   if (sets.empty()) return result;
@@ -65,15 +180,42 @@ Result<GreedyResult> SelectGreedy(const std::vector<VoxelSet>& sets, const Greed
   const double coverable = static_cast<double>(result.coverable);
   const uint64_t min_gain = std::max<uint64_t>(options.min_marginal_gain, 1);
   const size_t fixed = static_cast<size_t>(options.fixed);
-  // The fixed stations first, whatever they add.
-  for (size_t i = 0; i < fixed; ++i) {
-    const uint64_t gain = CountAnd(sets[i], uncovered);
-    SubtractFrom(uncovered, sets[i]);
-    result.covered += gain;
-    result.picks.push_back({static_cast<int>(i), gain, result.covered});
-  }
+  const double min_overlap = options.min_overlap;
+  const bool registration = min_overlap > 0;
+  std::optional<Overlaps> overlaps;
+  if (registration) overlaps.emplace(sets);
 
+  // Registration: which candidates have an edge to a pick; before the first pick, all compete.
+  std::vector<char> picked(sets.size(), 0), linked(sets.size(), 0);
+  std::vector<int> picked_list;
+  auto constrained = [&] { return registration && !picked_list.empty(); };
+  auto eligible = [&](int c) { return !constrained() || linked[c]; };
   std::priority_queue<Entry, std::vector<Entry>, EntryLess> heap;
+  std::vector<Entry> parked;  // lazy: popped while not linked; back in the heap once linked
+  auto pick = [&](int c, uint64_t gain, bool connector) {
+    SubtractFrom(uncovered, sets[c]);
+    result.covered += gain;
+    result.picks.push_back({c, gain, result.covered, connector});
+    result.connectors += connector;
+    picked[c] = 1;
+    picked_list.push_back(c);
+    if (!registration) return;
+    for (size_t i = fixed; i < sets.size(); ++i) {
+      if (!linked[i] && !picked[i] && overlaps->Edge(c, static_cast<int>(i), min_overlap)) linked[i] = 1;
+    }
+    for (size_t k = 0; k < parked.size();) {
+      if (linked[parked[k].index]) {
+        heap.push(parked[k]);
+        parked[k] = parked.back();
+        parked.pop_back();
+      } else {
+        ++k;
+      }
+    }
+  };
+  // The fixed stations first, whatever they add.
+  for (size_t i = 0; i < fixed; ++i) pick(static_cast<int>(i), CountAnd(sets[i], uncovered), false);
+
   if (options.lazy) {
     // Only the fixed stations cover anything yet, so these are exact gains for round 0.
     for (size_t i = fixed; i < sets.size(); ++i) {
@@ -81,6 +223,9 @@ Result<GreedyResult> SelectGreedy(const std::vector<VoxelSet>& sets, const Greed
       ++result.gain_evaluations;
     }
   }
+  auto at_max = [&](size_t more) {
+    return options.max_stations > 0 && picked_list.size() - fixed + more > static_cast<size_t>(options.max_stations);
+  };
 
   int round = 0;
   while (true) {
@@ -93,7 +238,7 @@ Result<GreedyResult> SelectGreedy(const std::vector<VoxelSet>& sets, const Greed
       result.stop = StopReason::kTargetReached;
       break;
     }
-    if (options.max_stations > 0 && static_cast<int>(result.picks.size() - fixed) >= options.max_stations) {
+    if (at_max(1)) {
       result.stop = StopReason::kMaxStations;
       break;
     }
@@ -103,6 +248,11 @@ Result<GreedyResult> SelectGreedy(const std::vector<VoxelSet>& sets, const Greed
       while (!heap.empty()) {
         Entry top = heap.top();
         heap.pop();
+        if (picked[top.index]) continue;  // picked as a link of a chain
+        if (!eligible(top.index)) {
+          parked.push_back(top);
+          continue;
+        }
         if (top.round == round) {  // exact, and no other bound beats it: the plain argmax
           best = top.index;
           best_gain = top.gain;
@@ -115,6 +265,7 @@ Result<GreedyResult> SelectGreedy(const std::vector<VoxelSet>& sets, const Greed
       }
     } else {
       for (size_t i = fixed; i < sets.size(); ++i) {
+        if (picked[i] || !eligible(static_cast<int>(i))) continue;
         const uint64_t g = CountAnd(sets[i], uncovered);
         ++result.gain_evaluations;
         if (g > best_gain) {  // strict: ties keep the lowest index
@@ -123,21 +274,69 @@ Result<GreedyResult> SelectGreedy(const std::vector<VoxelSet>& sets, const Greed
         }
       }
     }
+    if ((best < 0 || best_gain < min_gain) && constrained()) {
+      // Nothing linked gains enough: a chain to the nearest candidates that do, or a new group.
+      std::vector<uint64_t> gains(sets.size(), 0);
+      int unlinked_best = -1;
+      for (size_t i = fixed; i < sets.size(); ++i) {
+        if (picked[i] || linked[i]) continue;
+        gains[i] = CountAnd(sets[i], uncovered);
+        ++result.gain_evaluations;
+        if (gains[i] >= min_gain && (unlinked_best < 0 || gains[i] > gains[unlinked_best])) {
+          unlinked_best = static_cast<int>(i);
+        }
+      }
+      if (unlinked_best >= 0) {
+        VC_ASSIGN_OR_RETURN(std::vector<int> chain,
+                            ShortestChain(*overlaps, sets.size(), picked_list, min_overlap, ctx, [&](int c) -> int64_t {
+                              return !picked[c] && !linked[c] && gains[c] >= min_gain ? int64_t(gains[c]) : -1;
+                            }));
+        if (chain.empty()) {
+          ++result.new_groups;
+          chain = {unlinked_best};
+        }
+        if (at_max(chain.size())) {
+          result.stop = StopReason::kMaxStations;
+          break;
+        }
+        for (size_t k = 0; k < chain.size(); ++k) {
+          pick(chain[k], CountAnd(sets[chain[k]], uncovered), k + 1 < chain.size());
+        }
+        ++round;
+        ctx.Report(Stage::kSelection, coverable > 0 ? std::min(1.0, result.covered / coverable) : 1.0);
+        continue;
+      }
+    }
     if (best < 0 || best_gain < min_gain) {
       result.stop = StopReason::kMinGain;
       break;
     }
-    SubtractFrom(uncovered, sets[best]);
-    result.covered += best_gain;
-    result.picks.push_back({best, best_gain, result.covered});
+    pick(best, best_gain, false);
     ++round;
     ctx.Report(Stage::kSelection, coverable > 0 ? std::min(1.0, result.covered / coverable) : 1.0);
+  }
+  // Groups the fixed stations left apart: joined by the shortest chains that exist.
+  if (registration && result.stop != StopReason::kMaxStations) {
+    while (true) {
+      const std::vector<std::vector<int>> groups = overlaps->Groups(picked_list, min_overlap);
+      if (groups.size() <= 1) break;
+      std::vector<char> other(sets.size(), 0);
+      for (size_t g = 1; g < groups.size(); ++g) {
+        for (int c : groups[g]) other[c] = 1;
+      }
+      VC_ASSIGN_OR_RETURN(std::vector<int> chain,
+                          ShortestChain(*overlaps, sets.size(), groups[0], min_overlap, ctx,
+                                        [&](int c) -> int64_t { return other[c] ? 0 : -1; }));
+      if (chain.size() < 2) break;  // none, or (impossible) a direct edge between two groups
+      chain.pop_back();             // the station of another group it reaches
+      for (int c : chain) pick(c, CountAnd(sets[c], uncovered), true);
+    }
   }
   return result;
 }
 
 Result<ConsolidateResult> ConsolidatePicks(const std::vector<VoxelSet>& sets, std::vector<int> picks,
-                                           const JobContext& ctx, int fixed) {
+                                           const JobContext& ctx, int fixed, double min_overlap) {
   ConsolidateResult out;
   if (sets.empty() || picks.empty()) {
     out.picks = std::move(picks);
@@ -150,6 +349,18 @@ Result<ConsolidateResult> ConsolidatePicks(const std::vector<VoxelSet>& sets, st
   std::vector<uint64_t> sizes(sets.size());
   for (size_t i = 0; i < sets.size(); ++i) sizes[i] = CountBits(sets[i]);
   std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return sizes[a] > sizes[b]; });
+
+  // Registration: a change must not split the picks' scan graph into more groups.
+  std::optional<Overlaps> overlaps;
+  if (min_overlap > 0) overlaps.emplace(sets);
+  int groups = overlaps ? overlaps->Components(picks, min_overlap) : 1;
+  auto keeps_linked = [&](const std::vector<int>& after) {
+    if (!overlaps) return true;
+    const int n = overlaps->Components(after, min_overlap);
+    if (n > groups) return false;
+    groups = n;
+    return true;
+  };
 
   std::vector<uint64_t> c1(words), c2(words), c3(words), rest(words);
   std::vector<size_t> nonzero;
@@ -176,7 +387,10 @@ Result<ConsolidateResult> ConsolidatePicks(const std::vector<VoxelSet>& sets, st
       bool needed = false;
       for (size_t k = 0; k < words && !needed; ++k) needed = (w[k] & ~c2[k]) != 0;
       if (!needed) {
-        picks.erase(picks.begin() + static_cast<std::ptrdiff_t>(i));
+        std::vector<int> after = picks;
+        after.erase(after.begin() + static_cast<std::ptrdiff_t>(i));
+        if (!keeps_linked(after)) continue;
+        picks = std::move(after);
         ++out.dropped;
         changed = true;
         break;
@@ -207,8 +421,11 @@ Result<ConsolidateResult> ConsolidatePicks(const std::vector<VoxelSet>& sets, st
             }
           }
           if (!covers) continue;
-          picks[a] = c;
-          picks.erase(picks.begin() + static_cast<std::ptrdiff_t>(b));
+          std::vector<int> after = picks;
+          after[a] = c;
+          after.erase(after.begin() + static_cast<std::ptrdiff_t>(b));
+          if (!keeps_linked(after)) continue;
+          picks = std::move(after);
           ++out.merged;
           changed = true;
           break;

@@ -52,6 +52,7 @@ Status PlanOptions::Validate() const {
                                   ") lies inside keep_out[" + std::to_string(z) + "]");
     }
   }
+  if (route_start && !route_start->allFinite()) return InvalidArgumentError("route_start is not finite");
   return Status::Ok();
 }
 

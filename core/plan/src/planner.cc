@@ -12,6 +12,7 @@
 #include "vc/plan/selector.h"
 #include "vc/plan/stage_runner.h"
 #include "vc/plan/stages.h"
+#include "vc/visibility/scanner_presets.h"
 
 namespace vc {
 
@@ -69,7 +70,37 @@ std::optional<std::string> StopWarning(const planner::Selection& selection, cons
   return std::nullopt;
 }
 
+// A warning when registration is asked for and the final stations' scan graph is not connected.
+std::optional<std::string> ScanGraphWarning(const ScanGraph& graph) {
+  if (graph.min_overlap <= 0 || graph.connected) return std::nullopt;
+  std::string groups;
+  for (const std::vector<int>& g : graph.components) {
+    groups += groups.empty() ? "[" : ", [";
+    for (size_t k = 0; k < g.size(); ++k) groups += (k ? " " : "") + std::to_string(g[k]);
+    groups += "]";
+  }
+  return "the stations form " + std::to_string(graph.components.size()) + " groups (" + groups +
+         ", plan indices) that no chain of candidates links at min_overlap = " + Num(graph.min_overlap) +
+         ": their scans will not register to each other without targets — add candidates between the groups "
+         "(a finer grid_spacing_m, user candidates), or lower min_overlap";
+}
+
 }  // namespace
+
+FieldTime ComputeFieldTime(size_t stations, double walk_m, const PlanOptions& options) {
+  FieldTime t;
+  t.scan_seconds_per_station = options.scan_seconds;
+  if (t.scan_seconds_per_station <= 0) {
+    if (const ScannerPreset* preset = FindScannerPreset(options.scanner.name)) {
+      t.scan_seconds_per_station = preset->scan_time_s;
+    }
+  }
+  t.setup_s = static_cast<double>(stations) * options.setup_seconds;
+  t.scan_s = static_cast<double>(stations) * t.scan_seconds_per_station;
+  t.walk_s = walk_m / options.walk_speed_mps;
+  t.total_s = t.setup_s + t.scan_s + t.walk_s;
+  return t;
+}
 
 Result<PlanResult> Plan(const SceneInput& input, const PlanOptions& options, const JobContext& ctx,
                         const PlanCallbacks& callbacks) {
@@ -115,6 +146,7 @@ Result<PlanResult> Plan(const SceneInput& input, const PlanOptions& options, con
   result.stop_reason = selected.selection.stop;
   result.greedy_stations = selected.selection.first_pass_picks;
   result.consolidated = selected.selection.saved_by_improvement;
+  result.connecting_stations = selected.selection.connectors;
   planner::Stations stations = std::move(selected.stations);
   VoxelSet coverable = std::move(selected.coverable);
 
@@ -139,6 +171,12 @@ Result<PlanResult> Plan(const SceneInput& input, const PlanOptions& options, con
   FinalStations final_stations = AssembleFinalStations(stations, reduced.keep, result.coverable_voxels);
   result.stations = std::move(final_stations.stations);
   result.covered_voxels = final_stations.covered_voxels;
+  {
+    std::vector<VoxelSet> final_sets;
+    for (int k : reduced.keep) final_sets.push_back(std::move(stations.sets[k]));
+    result.scan_graph = planner::BuildScanGraph(planner::OverlapMatrix(final_sets), options.min_overlap);
+  }
+  if (auto w = ScanGraphWarning(result.scan_graph)) result.warnings.push_back(*w);
   if (callbacks.on_final_stations) callbacks.on_final_stations(result.stations);
   if (auto w = StopWarning(selected.selection, options)) result.warnings.push_back(*w);
 

@@ -71,41 +71,50 @@ ReductionMatrix ComputeReductionMatrix(const std::vector<FaceTop3>& top3, int nu
 }
 
 std::vector<int> ChooseRemoval(const ReductionMatrix& m, const std::vector<int>& active, int reduce_to,
-                               const std::vector<bool>& fixed) {
+                               const std::vector<bool>& fixed, const RemovalCheck& keeps) {
   const int count = static_cast<int>(active.size());
   if (count <= 1) return {};
   auto kept = [&](int a) { return static_cast<size_t>(active[a]) < fixed.size() && fixed[active[a]]; };
+  // Whether removing positions a (and b, if >= 0) of `active` leaves stations `keeps` accepts.
+  auto allowed = [&](int a, int b) {
+    if (!keeps) return true;
+    std::vector<int> remaining;
+    for (int k = 0; k < count; ++k) {
+      if (k != a && k != b) remaining.push_back(active[k]);
+    }
+    return keeps(remaining);
+  };
   // Zero loss: a pair first (keeping at least one station), else a single; the latest first.
   if (count >= 3) {
     for (int b = count - 1; b >= 1; --b) {
       if (kept(b)) continue;
       for (int a = b - 1; a >= 0; --a) {
-        if (!kept(a) && m.at(active[a], active[b]) == 0.0) return {active[a], active[b]};
+        if (!kept(a) && m.at(active[a], active[b]) == 0.0 && allowed(a, b)) return {active[a], active[b]};
       }
     }
   }
   for (int a = count - 1; a >= 0; --a) {
-    if (!kept(a) && m.at(active[a], active[a]) == 0.0) return {active[a]};
+    if (!kept(a) && m.at(active[a], active[a]) == 0.0 && allowed(a, -1)) return {active[a]};
   }
   if (reduce_to <= 0 || count <= reduce_to) return {};
   // Lowest loss per removed station; ties: a pair, then the latest in greedy order.
   const bool pairs = count - reduce_to >= 2;
   std::vector<int> best;
   double best_per = 0;
-  auto consider = [&](std::vector<int> t, double per) {
+  auto consider = [&](std::vector<int> t, double per, int a, int b) {
     const bool better = best.empty() || per < best_per ||
                         (per == best_per && (t.size() > best.size() || (t.size() == best.size() && t > best)));
-    if (better) {
+    if (better && allowed(a, b)) {
       best = std::move(t);
       best_per = per;
     }
   };
   for (int a = 0; a < count; ++a) {
     if (kept(a)) continue;
-    consider({active[a]}, m.at(active[a], active[a]));
+    consider({active[a]}, m.at(active[a], active[a]), a, -1);
     if (!pairs) continue;
     for (int b = a + 1; b < count; ++b) {
-      if (!kept(b)) consider({active[a], active[b]}, m.at(active[a], active[b]) / 2);
+      if (!kept(b)) consider({active[a], active[b]}, m.at(active[a], active[b]) / 2, a, b);
     }
   }
   return best;
@@ -180,7 +189,7 @@ Result<ReductionRun> RunReduction(int num_stations, uint64_t faces_total, const 
   ReductionMatrix current = run.initial;
   while (true) {
     VC_RETURN_IF_ERROR(ctx.CheckCancelled("reduction"));
-    std::vector<int> remove = ChooseRemoval(current, active, options.reduce_to, options.fixed);
+    std::vector<int> remove = ChooseRemoval(current, active, options.reduce_to, options.fixed, options.keeps);
     if (remove.empty()) break;
     const double loss = remove.size() == 1 ? current.at(remove[0], remove[0]) : current.at(remove[0], remove[1]);
     std::vector<bool> removed_now(num_stations, false);

@@ -4,6 +4,7 @@
 #include <utility>
 
 #include "vc/plan/reduction.h"
+#include "vc/plan/scan_graph.h"
 #include "vc/plan/stage_runner.h"
 #include "vc/plan/stages.h"
 
@@ -49,6 +50,18 @@ Result<ReductionOutput> RunReductionStage(const ReductionInput& in, const PlanOp
   red_options.threads = options.threads;
   red_options.cache_budget_bytes = cache_budget;
   red_options.fixed = in.stations.fixed;
+  // Registration: no removal may split the stations' scan graph into more groups.
+  OverlapMatrix overlaps;
+  int groups = 0;
+  if (options.min_overlap > 0) {
+    overlaps = OverlapMatrix(in.stations.sets);
+    std::vector<int> all(stations.size());
+    for (size_t k = 0; k < stations.size(); ++k) all[k] = static_cast<int>(k);
+    groups = CountComponents(overlaps, all, options.min_overlap);
+    red_options.keeps = [&](const std::vector<int>& remaining) {
+      return CountComponents(overlaps, remaining, options.min_overlap) <= groups;
+    };
+  }
   VC_ASSIGN_OR_RETURN(ReductionRun run, RunReduction(static_cast<int>(stations.size()), faces_total, values,
                                                      red_options, ProgressRange(ctx, batch ? 0.9 : 0.0, 1.0)));
   if (all_evaluation) all_evaluation->per_viewpoint_face_values.clear();

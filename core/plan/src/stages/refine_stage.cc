@@ -1,10 +1,12 @@
 #include <cmath>
 #include <optional>
+#include <type_traits>
 #include <utility>
 
 #include "vc/plan/candidates.h"
 #include "vc/plan/greedy.h"
 #include "vc/plan/keep_out.h"
+#include "vc/plan/scan_graph.h"
 #include "vc/plan/stage_runner.h"
 #include "vc/plan/stages.h"
 
@@ -71,8 +73,15 @@ Result<RefineOutput> RunRefineStage(RefineInput in, const PlanOptions& options, 
   VC_ASSIGN_OR_RETURN(std::vector<VoxelSet> trial_sets,
                       ComputeVisibilitySets(in.scene, trials.positions, set_options, ProgressRange(ctx, 0.0, 0.9)));
   for (const VoxelSet& s : trial_sets) UnionInto(in.coverable, s);
+  // Registration: a move must not split the stations' scan graph into more groups.
+  const bool registration = options.min_overlap > 0;
+  std::vector<int> all(stations.size());
+  for (size_t k = 0; k < stations.size(); ++k) all[k] = static_cast<int>(k);
+  OverlapMatrix overlaps = registration ? OverlapMatrix(stations.sets) : OverlapMatrix();
+  const int groups = registration ? CountComponents(overlaps, all, options.min_overlap) : 1;
   // Each station in turn moves to its best trial position if that covers more together with the
-  // other stations (then sees more alone); the others stay where they are meanwhile.
+  // other stations (then sees more alone), and keeps the scan graph's groups; the others stay
+  // where they are meanwhile.
   size_t t = 0;
   for (size_t k = 0; k < stations.size(); ++k) {
     VC_RETURN_IF_ERROR(ctx.CheckCancelled("refinement"));
@@ -84,14 +93,23 @@ Result<RefineOutput> RunRefineStage(RefineInput in, const PlanOptions& options, 
     auto score = [&](const VoxelSet& s) {
       return std::make_pair(others_count + CountBits(s) - CountAnd(others, s), CountBits(s));
     };
-    auto best = score(stations.sets[k]);
-    int best_trial = -1;
+    const auto current = score(stations.sets[k]);
+    std::vector<std::pair<std::remove_const_t<decltype(current)>, int>> better;  // trials that beat the station, best first
     for (; t < trials.positions.size() && trials.station[t] == static_cast<int>(k); ++t) {
       const auto sc = score(trial_sets[t]);
-      if (sc > best) {
-        best = sc;
-        best_trial = static_cast<int>(t);
+      if (sc > current) better.push_back({sc, static_cast<int>(t)});
+    }
+    std::stable_sort(better.begin(), better.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
+    int best_trial = -1;
+    for (const auto& [sc, trial] : better) {
+      if (registration) {
+        OverlapMatrix moved = overlaps;
+        moved.Replace(static_cast<int>(k), trial_sets[trial], stations.sets);
+        if (CountComponents(moved, all, options.min_overlap) > groups) continue;
+        overlaps = std::move(moved);
       }
+      best_trial = trial;
+      break;
     }
     if (best_trial >= 0) {
       const bool on_floor = !std::isnan(stations.floor_z_m[k]);

@@ -13,6 +13,7 @@ GreedySelectorOptions SelectorOptionsFor(const PlanOptions& options) {
   out.min_marginal_gain_voxels = options.min_marginal_gain_voxels;
   out.target_coverage = options.target_coverage;
   out.consolidate = options.consolidate;
+  out.min_overlap = options.min_overlap;
   return out;
 }
 

@@ -32,6 +32,7 @@ enum class ParamCheck : uint8_t {
   kNonNegative,   // >= 0
   kPositive,      // > 0
   kFraction,      // in (0, 1]
+  kUnitInterval,  // in [0, 1] (0 = off, for a fraction that can be switched off)
   kElevationDeg,  // in [-90, 90] (degrees)
   kIncidenceDeg,  // in (0, 90] (degrees)
 };

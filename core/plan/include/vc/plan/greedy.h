@@ -32,12 +32,23 @@ struct GreedyOptions {
   // The first `fixed` sets are stations already placed: picked first, in order (whatever their
   // gain), and not counted by max_stations; the stopping rules then apply to what they cover.
   int fixed = 0;
+  // Registration (scan_graph.h): when > 0, the picks must form a connected scan graph at this
+  // overlap. After the first pick (or the fixed stations) only candidates with an edge to a
+  // picked station compete. When none of them gains min_marginal_gain but another candidate
+  // would, the shortest chain of candidates (fewest, by breadth-first search over edges) from the
+  // picks to the nearest such candidates is added, its links as connecting stations, then the one
+  // with the largest gain at that depth (lowest index on ties). When no chain reaches any gaining
+  // candidate, the best of them starts a new group (GreedyResult::new_groups; the plan reports
+  // the groups). At the end, groups the fixed stations left apart are joined the same way when a
+  // chain exists (unless max_stations stopped the picks). 0 = off: the plain greedy.
+  double min_overlap = 0;
 };
 
 struct GreedyPick {
   int candidate = -1;          // index into the sets
   uint64_t marginal_gain = 0;  // voxels newly covered by this pick
   uint64_t covered_after = 0;  // covered voxels after this pick
+  bool connector = false;      // picked to link the scan graph (min_overlap), not for its gain
 };
 
 struct GreedyResult {
@@ -46,6 +57,8 @@ struct GreedyResult {
   uint64_t covered = 0;    // |union of the picked sets|
   StopReason stop = StopReason::kExhausted;
   uint64_t gain_evaluations = 0;  // intersections counted (lazy needs far fewer)
+  int connectors = 0;             // picks made to link the scan graph (GreedyPick::connector)
+  int new_groups = 0;             // times no chain reached a gaining candidate (min_overlap > 0)
 };
 
 // Greedy maximum coverage over `sets` (all of the same size). INVALID_ARGUMENT for sets of
@@ -67,7 +80,7 @@ struct ConsolidateResult {
 };
 // CANCELLED / DEADLINE_EXCEEDED from ctx.
 Result<ConsolidateResult> ConsolidatePicks(const std::vector<VoxelSet>& sets, std::vector<int> picks,
-                                           const JobContext& ctx = {}, int fixed = 0);
+                                           const JobContext& ctx = {}, int fixed = 0, double min_overlap = 0);
 
 // |a AND b| over the raw bitset words (equal sizes).
 uint64_t CountAnd(const VoxelSet& a, const VoxelSet& b);

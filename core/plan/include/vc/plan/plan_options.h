@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "vc/base/geometry.h"
@@ -21,6 +22,10 @@
 // - refine: proximity refinement (ALGORITHM.md s.7.4), each station to the best of a sub-grid.
 // - reduce / reduce_to: reduction (s.7.5) removes zero-loss stations; with reduce_to > 0 it keeps
 //   removing the cheapest single or pair until at most reduce_to stations remain.
+// - min_overlap: registration (vc/plan/scan_graph.h): selection, consolidation, refinement and
+//   reduction keep the stations' scan graph connected at this overlap.
+// - setup_seconds, scan_seconds, walk_speed_mps: the field time (route.h): per station set-up and
+//   scan, plus the walking route's length at this speed.
 #define VC_PLAN_PARAMETERS(X)                                                                                          \
   X(double, resolution_m, 0.0, "m", "resolution", kNonNegative,                                                        \
     "working resolution (0 = the octree's own, or 0.1 m for clouds)")                                                  \
@@ -42,7 +47,13 @@
   X(bool, reduce, true, "", "reduce", kAny, "remove redundant stations")                                               \
   X(int32_t, reduce_to, 0, "stations", "reduce-to", kNonNegative,                                                      \
     "reduce to at most this many stations (0 = zero-loss removals only)")                                              \
-  X(int32_t, threads, 0, "threads", "threads", kNonNegative, "threads for the job (0 = all, or the server's share)")
+  X(int32_t, threads, 0, "threads", "threads", kNonNegative, "threads for the job (0 = all, or the server's share)")  \
+  X(double, min_overlap, 0.0, "fraction", "min-overlap", kUnitInterval,                                                \
+    "keep the scan graph connected at this overlap (0 = off; 0.3 for target-less registration)")                       \
+  X(double, setup_seconds, 120.0, "s", "setup-seconds", kNonNegative, "field time to set up the scanner per station")  \
+  X(double, scan_seconds, 0.0, "s", "scan-seconds", kNonNegative,                                                      \
+    "field time of one scan (0 = the scanner preset's scan time)")                                                     \
+  X(double, walk_speed_mps, 1.0, "m/s", "walk-speed", kPositive, "walking speed between stations, carrying the kit")
 
 namespace vc {
 
@@ -59,6 +70,8 @@ struct PlanOptions {
   std::vector<KeepOutZone> keep_out;
   // Stations already placed (world frame, m): picked first, never removed; the plan adds to them.
   std::vector<WorldPoint> fixed_stations;
+  // Where the walking route starts (world frame, m; z picks the floor level nearest it), if set.
+  std::optional<WorldPoint> route_start;
 
   // The instrument heights candidates stand at: tripod_heights_m, or {tripod_height_m}.
   [[nodiscard]] std::vector<double> TripodHeights() const;

@@ -14,6 +14,7 @@
 #include "vc/base/progress.h"
 #include "vc/base/status.h"
 #include "vc/plan/plan_options.h"
+#include "vc/plan/scan_graph.h"
 #include "vc/plan/selector.h"
 #include "vc/plan/stage_runner.h"
 #include "vc/scene/voxel_scene.h"
@@ -53,6 +54,18 @@ struct Reduction {
   std::vector<WorldPoint> positions;
 };
 
+// The time a crew needs in the field for a plan (docs/PLANNING.md, "The walking route and the
+// field time"), in seconds: every station set up and scanned, and the route walked.
+struct FieldTime {
+  double setup_s = 0;           // stations x PlanOptions::setup_seconds
+  double scan_s = 0;            // stations x scan_seconds_per_station
+  double walk_s = 0;            // the route's walkable length / PlanOptions::walk_speed_mps
+  double total_s = 0;           // their sum
+  double scan_seconds_per_station = 0;  // PlanOptions::scan_seconds, or the scanner preset's scan time, or 0
+};
+// The field time of `stations` stations and a walk of `walk_m` metres under `options`.
+FieldTime ComputeFieldTime(size_t stations, double walk_m, const PlanOptions& options);
+
 struct PlanResult {
   PlanOptions options;
   double resolution_m = 0;
@@ -83,6 +96,11 @@ struct PlanResult {
   int consolidated = 0;
   // Occupied voxel centres (world, m) in id order, for visibility.ply.
   std::vector<WorldPoint> voxel_centers;
+  // Registration: the final stations' scan graph (indices into stations) at options.min_overlap,
+  // and how many stations selection picked only to link it.
+  ScanGraph scan_graph;
+  int connecting_stations = 0;
+  FieldTime field_time;
 };
 
 // What a plan reports while it runs, for streaming; every member optional, called on the thread

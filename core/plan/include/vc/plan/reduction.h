@@ -48,9 +48,11 @@ ReductionMatrix ComputeReductionMatrix(const std::vector<FaceTop3>& top3, int nu
 // greedy order); with reduce_to > 0 it then keeps removing the subset with the lowest loss per
 // removed station (a pair only while at least two must go) until at most reduce_to remain. Never
 // removes the last station, nor a station s with fixed[s] (fixed stations; may be shorter than
-// the stations, or empty). Empty when nothing is to be removed.
+// the stations, or empty), nor a subset after whose removal `keeps(remaining)` is false (when
+// set; registration: the scan graph must keep its groups). Empty when nothing is to be removed.
+using RemovalCheck = std::function<bool(const std::vector<int>& remaining)>;
 std::vector<int> ChooseRemoval(const ReductionMatrix& m, const std::vector<int>& active, int reduce_to,
-                               const std::vector<bool>& fixed = {});
+                               const std::vector<bool>& fixed = {}, const RemovalCheck& keeps = {});
 
 // V of every face (F order) seen from one station.
 using StationFaceValuesFn = std::function<Result<std::vector<float>>(int station, const JobContext& ctx)>;
@@ -59,6 +61,7 @@ struct ReductionRunOptions {
   int reduce_to = 0;        // 0 = zero-loss rule only
   bool remove = true;       // false: only compute the matrix
   std::vector<bool> fixed;  // per station: never removed (fixed stations); empty = none
+  RemovalCheck keeps;       // when set, a removal must leave stations it accepts (ChooseRemoval)
   // Keep every station's face values in memory (for exact top-3 refills after a removal) when
   // they fit in this many bytes; otherwise the values are recomputed after each removal.
   uint64_t cache_budget_bytes = uint64_t{1} << 30;

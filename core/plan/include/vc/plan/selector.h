@@ -39,6 +39,8 @@ struct Selection {
   uint64_t covered = 0;                      // voxels the first pass covered when it stopped
   int first_pass_picks = 0;                  // picks before any improvement pass (greedy picks, fixed excluded)
   int saved_by_improvement = 0;              // picks the improvement pass saved (consolidation)
+  int connectors = 0;                        // first-pass picks made to link the scan graph (min_overlap)
+  int new_groups = 0;                        // times the first pass found no chain to a gaining candidate
 };
 
 // Chooses stations among candidates from their visibility sets.
@@ -62,6 +64,7 @@ struct GreedySelectorOptions {
   uint64_t min_marginal_gain_voxels = 1;  // stop when the best gain is below this (voxels)
   double target_coverage = 1.0;           // stop at this fraction of coverable voxels, in (0, 1]
   bool consolidate = true;                // run ConsolidatePicks on the greedy picks
+  double min_overlap = 0;                 // > 0: keep the picks' scan graph connected (greedy.h)
 };
 
 // Lazy greedy (SelectGreedy with lazy = true), then, if enabled, ConsolidatePicks.
