@@ -11,6 +11,7 @@
 
 #include "vc/client/client.h"
 #include "vc/client/parameter_flags.h"
+#include "vc/client/plan_summary.h"
 #include "vc/client/progress_display.h"
 #include "vc/report/plan_report.h"
 #include "vc/scene/scene_input.h"
@@ -34,20 +35,7 @@ int FailCall(const std::string& what, const vc::Status& s, const std::string& se
   return code;
 }
 
-void PrintStations(const vc::PlanResult& r) {
-  std::printf("%zu station(s), coverage %.1f%% of %llu coverable voxels, global visibility G = %.3f\n",
-              r.stations.size(),
-              r.coverable_voxels ? 100.0 * double(r.covered_voxels) / double(r.coverable_voxels) : 0.0,
-              static_cast<unsigned long long>(r.coverable_voxels), r.evaluation.overall.global_visibility);
-  std::printf("  %3s %10s %10s %10s %12s %9s\n", "#", "x_m", "y_m", "z_m", "gain_voxels", "coverage");
-  for (size_t i = 0; i < r.stations.size(); ++i) {
-    const auto& s = r.stations[i];
-    std::printf("  %3zu %10.3f %10.3f %10.3f %12llu %8.1f%%%s\n", i + 1, s.position.x(), s.position.y(), s.position.z(),
-                static_cast<unsigned long long>(s.marginal_gain), 100.0 * s.cumulative_coverage,
-                s.fixed ? "  fixed" : "");
-  }
-  for (const auto& w : r.warnings) std::printf("warning: %s\n", w.c_str());
-}
+void PrintStations(const vc::PlanResult& r) { std::fputs(vc::client::PlanSummary(r).c_str(), stdout); }
 
 vc::client::JobObserver Observe(vc::client::ProgressDisplay& display) {
   vc::client::JobObserver o;

@@ -1,7 +1,10 @@
 #include "vc/client/parameter_flags.h"
 
+#include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <sstream>
 #include <string>
@@ -123,6 +126,8 @@ void AddPlanFileFlags(CLI::App* command, PlanFileFlags* files) {
                       "CSV of stations already placed x,y,z (e.g. stations.csv); the plan adds to them");
   command->add_option("--keep-out", files->keep_out,
                       "CSV of keep-out zones: box,xmin,ymin,zmin,xmax,ymax,zmax or polygon,zmin,zmax,x1,y1,...");
+  command->add_option("--start", files->start,
+                      "where the walking route starts: x,y (m; the lowest floor) or x,y,z (the floor nearest z)");
 }
 
 namespace {
@@ -134,6 +139,26 @@ Result<std::string> ReadText(const std::string& path, const std::string& what) {
   std::ostringstream text;
   text << in.rdbuf();
   return text.str();
+}
+
+// "x,y" or "x,y,z" (m) as a point, z NaN when absent; INVALID_ARGUMENT naming --start otherwise.
+Result<WorldPoint> ParseStart(const std::string& text) {
+  std::vector<std::string> fields;
+  for (size_t pos = 0;;) {
+    const size_t end = text.find(',', pos);
+    fields.push_back(text.substr(pos, end == std::string::npos ? std::string::npos : end - pos));
+    if (end == std::string::npos) break;
+    pos = end + 1;
+  }
+  double v[3] = {0, 0, std::numeric_limits<double>::quiet_NaN()};
+  bool ok = fields.size() == 2 || fields.size() == 3;
+  for (size_t k = 0; ok && k < fields.size(); ++k) {
+    char* stop = nullptr;
+    v[k] = std::strtod(fields[k].c_str(), &stop);
+    ok = !fields[k].empty() && stop == fields[k].c_str() + fields[k].size() && std::isfinite(v[k]);
+  }
+  if (!ok) return InvalidArgumentError("--start must be \"x,y\" or \"x,y,z\" in metres, got \"" + text + "\"");
+  return WorldPoint(v[0], v[1], v[2]);
 }
 
 }  // namespace
@@ -150,6 +175,9 @@ Status LoadPlanFiles(const PlanFileFlags& files, PlanOptions* o) {
   if (!files.keep_out.empty()) {
     VC_ASSIGN_OR_RETURN(std::string text, ReadText(files.keep_out, "keep-out"));
     VC_ASSIGN_OR_RETURN(o->keep_out, ParseKeepOutCsv(text, files.keep_out));
+  }
+  if (!files.start.empty()) {
+    VC_ASSIGN_OR_RETURN(o->route_start, ParseStart(files.start));
   }
   return Status::Ok();
 }

@@ -209,6 +209,7 @@ v1::PlanParameters ToProto(const PlanOptions& o) {
   p.mutable_tripod_heights_m()->Add(o.tripod_heights_m.begin(), o.tripod_heights_m.end());
   for (const auto& z : o.keep_out) *p.add_keep_out() = ToProto(z);
   for (const auto& f : o.fixed_stations) *p.add_fixed_stations() = ToProto(f);
+  if (o.route_start) *p.mutable_route_start() = ToProto(*o.route_start);
   return p;
 }
 
@@ -223,6 +224,7 @@ Result<PlanOptions> FromProto(const v1::PlanParameters& p) {
     o.keep_out.push_back(std::move(zone));
   }
   for (const auto& f : p.fixed_stations()) o.fixed_stations.push_back(FromProto(f));
+  if (p.has_route_start()) o.route_start = FromProto(p.route_start());
   return o;
 }
 
@@ -246,7 +248,7 @@ Result<EvaluateJobOptions> FromProto(const v1::EvaluateParameters& p) {
 v1::Stage ToProto(Stage s) { return static_cast<v1::Stage>(s); }
 
 Stage FromProto(v1::Stage s) {
-  return s > v1::STAGE_UNSPECIFIED && s <= v1::STAGE_EVALUATION ? static_cast<Stage>(s) : Stage::kUnspecified;
+  return s > v1::STAGE_UNSPECIFIED && s <= v1::STAGE_ROUTE ? static_cast<Stage>(s) : Stage::kUnspecified;
 }
 
 v1::StopReason ToProto(StopReason r) {
@@ -429,6 +431,33 @@ v1::PlanResult ToProto(const PlanResult& r) {
   p.set_grid_cells(r.grid_cells);
   p.set_cells_without_floor(r.cells_without_floor);
   p.set_cells_failing_clearance(r.cells_failing_clearance);
+  v1::ScanGraph* graph = p.mutable_scan_graph();
+  graph->set_min_overlap(r.scan_graph.min_overlap);
+  graph->set_connected(r.scan_graph.connected);
+  for (const auto& c : r.scan_graph.components) graph->add_components()->mutable_stations()->Add(c.begin(), c.end());
+  for (const auto& e : r.scan_graph.edges) {
+    v1::ScanGraphEdge* pe = graph->add_edges();
+    pe->set_i(e.i);
+    pe->set_j(e.j);
+    pe->set_overlap(e.overlap);
+  }
+  p.set_connecting_stations(r.connecting_stations);
+  v1::WalkingRoute* route = p.mutable_route();
+  route->mutable_order()->Add(r.route.order.begin(), r.route.order.end());
+  route->mutable_legs_m()->Add(r.route.legs_m.begin(), r.route.legs_m.end());
+  route->set_length_m(r.route.length_m);
+  for (const auto& line : r.route.polylines) {
+    v1::Polyline* pl = route->add_polylines();
+    for (const auto& q : line) *pl->add_points() = ToProto(q);
+  }
+  route->set_parts(r.route.parts);
+  if (r.route.start) *route->mutable_start() = ToProto(*r.route.start);
+  v1::FieldTime* t = p.mutable_field_time();
+  t->set_setup_s(r.field_time.setup_s);
+  t->set_scan_s(r.field_time.scan_s);
+  t->set_walk_s(r.field_time.walk_s);
+  t->set_total_s(r.field_time.total_s);
+  t->set_scan_seconds_per_station(r.field_time.scan_seconds_per_station);
   return p;
 }
 
@@ -507,6 +536,39 @@ Result<PlanResult> PlanResultAssembler::Finish(const v1::PlanResult& p) && {
   r.grid_cells = p.grid_cells();
   r.cells_without_floor = p.cells_without_floor();
   r.cells_failing_clearance = p.cells_failing_clearance();
+  const int stations = p.stations_size();
+  auto station_index = [&](int32_t i, const char* what) -> Status {
+    if (i < 0 || i >= stations) return ChunkError(std::string(what) + " names station " + std::to_string(i));
+    return Status::Ok();
+  };
+  r.scan_graph.min_overlap = p.scan_graph().min_overlap();
+  r.scan_graph.connected = p.scan_graph().connected();
+  for (const auto& c : p.scan_graph().components()) {
+    for (int32_t i : c.stations()) VC_RETURN_IF_ERROR(station_index(i, "a scan graph component"));
+    r.scan_graph.components.emplace_back(c.stations().begin(), c.stations().end());
+  }
+  for (const auto& e : p.scan_graph().edges()) {
+    VC_RETURN_IF_ERROR(station_index(e.i(), "a scan graph edge"));
+    VC_RETURN_IF_ERROR(station_index(e.j(), "a scan graph edge"));
+    r.scan_graph.edges.push_back({e.i(), e.j(), e.overlap()});
+  }
+  r.connecting_stations = p.connecting_stations();
+  const v1::WalkingRoute& route = p.route();
+  for (int32_t i : route.order()) VC_RETURN_IF_ERROR(station_index(i, "the route"));
+  if (route.legs_m_size() != route.order_size() || route.polylines_size() != route.order_size()) {
+    return ChunkError("the route's legs, paths and order differ in length");
+  }
+  r.route.order.assign(route.order().begin(), route.order().end());
+  r.route.legs_m.assign(route.legs_m().begin(), route.legs_m().end());
+  r.route.length_m = route.length_m();
+  for (const auto& line : route.polylines()) {
+    std::vector<WorldPoint>& out = r.route.polylines.emplace_back();
+    for (const auto& q : line.points()) out.push_back(FromProto(q));
+  }
+  r.route.parts = route.parts();
+  if (route.has_start()) r.route.start = FromProto(route.start());
+  r.field_time = {p.field_time().setup_s(), p.field_time().scan_s(), p.field_time().walk_s(),
+                  p.field_time().total_s(), p.field_time().scan_seconds_per_station()};
   r.voxel_centers = std::move(centers_);
   return r;
 }

@@ -22,6 +22,8 @@ std::string_view StageName(Stage stage) {
       return "reduction";
     case Stage::kEvaluation:
       return "evaluation";
+    case Stage::kRoute:
+      return "route";
   }
   return "unspecified";
 }

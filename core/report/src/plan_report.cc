@@ -115,6 +115,27 @@ std::string StationsCsv(const std::vector<WorldPoint>& points) {
   return out;
 }
 
+// Per station: its place in the route (1 = visited first), or 0 when the route leaves it out.
+std::vector<int> RoutePositions(const PlanResult& r) {
+  std::vector<int> position(r.stations.size(), 0);
+  for (size_t k = 0; k < r.route.order.size(); ++k) {
+    const int s = r.route.order[k];
+    if (s >= 0 && static_cast<size_t>(s) < position.size()) position[s] = static_cast<int>(k) + 1;
+  }
+  return position;
+}
+
+// A plan's stations.csv: x,y,z and the station's place in the walking route.
+std::string PlanStationsCsv(const PlanResult& r) {
+  const std::vector<int> position = RoutePositions(r);
+  std::string out = "x,y,z,route_order\n";
+  for (size_t k = 0; k < r.stations.size(); ++k) {
+    const WorldPoint& p = r.stations[k].position;
+    out += Fixed(p.x(), 6) + "," + Fixed(p.y(), 6) + "," + Fixed(p.z(), 6) + "," + std::to_string(position[k]) + "\n";
+  }
+  return out;
+}
+
 // ---------- visibility.ply ----------
 
 std::string VisibilityPly(const PlanResult& r) {
@@ -154,7 +175,7 @@ std::string VisibilityPly(const PlanResult& r) {
 // ---------- heatmap.png ----------
 
 // Layout constants (pixels), documented in docs/PLANNING.md.
-constexpr int kMarginLeft = 64, kMarginTop = 40, kMarginBottom = 48, kPanelRight = 24, kLegendWidth = 110;
+constexpr int kMarginLeft = 64, kMarginTop = 40, kMarginBottom = 60, kPanelRight = 24, kLegendWidth = 110;
 constexpr int kMinPlotHeight = 180, kTargetPlot = 720;
 
 struct HeatLayout {
@@ -259,6 +280,12 @@ void ColourBar(Image& img, int x, int y, int h, double max_value, const std::str
   img.Text(x - 2, y - 14, title, raster::kBlack);
 }
 
+// The overlap from which heatmap.png draws a scan graph edge: min_overlap, or 0.3 (the usual
+// target-less registration figure) when registration is off.
+double ScanGraphDrawThreshold(const PlanResult& r) {
+  return r.scan_graph.min_overlap > 0 ? r.scan_graph.min_overlap : 0.3;
+}
+
 Image DrawHeatmap(const PlanResult& r) {
   const HeatLayout L = ComputeHeatLayout(r);
   Image img(L.width, L.height);
@@ -315,17 +342,47 @@ Image DrawHeatmap(const PlanResult& r) {
     if (L.panel_z.size() > 1 || !r.floor_levels_m.empty()) title += "  z = " + Fixed(L.panel_z[p], 2) + " m";
     img.Text(left, 10, title, raster::kBlack, 2);
   }
-  // Stations, numbered in plan order, on the panel of their height; fixed stations ringed in black.
-  for (size_t k = 0; k < r.stations.size(); ++k) {
-    const WorldPoint& s = r.stations[k].position;
+  // The panel a point at height z (m) is drawn on: the one of the nearest representative z.
+  auto panel_of = [&](double z) {
     int panel = 0;
     double best = 1e300;
     for (size_t p = 0; p < L.panel_z.size(); ++p) {
-      if (std::fabs(L.panel_z[p] - s.z()) < best) best = std::fabs(L.panel_z[p] - s.z()), panel = static_cast<int>(p);
+      if (std::fabs(L.panel_z[p] - z) < best) best = std::fabs(L.panel_z[p] - z), panel = static_cast<int>(p);
     }
-    StationMarker(img, px(panel, s.x()), py(s.y()), static_cast<int>(k) + 1,
+    return panel;
+  };
+  const std::vector<double> heights = r.options.TripodHeights();
+  const double lowest_height = *std::min_element(heights.begin(), heights.end());
+  // The scan graph's edges at its threshold (0.3 when registration is off), white, between stations
+  // on one panel.
+  const double edge_min = ScanGraphDrawThreshold(r);
+  for (const ScanGraph::Edge& e : r.scan_graph.edges) {
+    if (e.overlap < edge_min || static_cast<size_t>(std::max(e.i, e.j)) >= r.stations.size()) continue;
+    const WorldPoint& a = r.stations[e.i].position;
+    const WorldPoint& b = r.stations[e.j].position;
+    const int pa = panel_of(a.z()), pb = panel_of(b.z());
+    if (pa != pb) continue;
+    img.Line(px(pa, a.x()), py(a.y()), px(pb, b.x()), py(b.y()), raster::kWhite, 1);
+  }
+  // The walking route, orange, each polyline point on the panel of its floor.
+  for (const std::vector<WorldPoint>& line : r.route.polylines) {
+    for (size_t k = 1; k < line.size(); ++k) {
+      const int pa = panel_of(line[k - 1].z() + lowest_height), pb = panel_of(line[k].z() + lowest_height);
+      if (pa != pb) continue;  // the step between two panels (stairs) is not drawn
+      img.Line(px(pa, line[k - 1].x()), py(line[k - 1].y()), px(pb, line[k].x()), py(line[k].y()), raster::kOrange,
+               3);
+    }
+  }
+  // Stations, numbered in plan order, on the panel of their height; fixed stations ringed in black.
+  for (size_t k = 0; k < r.stations.size(); ++k) {
+    const WorldPoint& s = r.stations[k].position;
+    StationMarker(img, px(panel_of(s.z()), s.x()), py(s.y()), static_cast<int>(k) + 1,
                   r.stations[k].fixed ? raster::kBlack : raster::kRed);
   }
+  // What the lines mean, under the first panel's axis label.
+  std::string legend = "ORANGE: WALKING ROUTE";
+  if (!r.scan_graph.edges.empty()) legend += "   WHITE: OVERLAP >= " + Short(edge_min);
+  img.Text(kMarginLeft, top + std::max(L.plot_h, kMinPlotHeight) + 42, legend, raster::kBlack);
   const int bar_x = L.width - kLegendWidth + 20;
   ColourBar(img, bar_x, top + 14, std::max(L.plot_h, kMinPlotHeight) - 14, static_cast<double>(max_count), "VOXELS",
             true);
@@ -456,6 +513,7 @@ std::vector<std::string_view> SplitFields(std::string_view line) {
 }  // namespace
 
 std::string PlanToJson(const PlanResult& r) {
+  const std::vector<int> route_position = RoutePositions(r);
   Json viewpoints = Json::array();
   for (size_t k = 0; k < r.stations.size(); ++k) {
     const PlannedStation& s = r.stations[k];
@@ -468,7 +526,8 @@ std::string PlanToJson(const PlanResult& r) {
            {"cumulative_coverage", s.cumulative_coverage},
            {"global_visibility", s.global_visibility},
            {"candidate_index", s.candidate_index},
-           {"fixed", s.fixed}};
+           {"fixed", s.fixed},
+           {"route_order", route_position[k]}};
     if (k < r.evaluation.per_viewpoint.size()) {
       v["fully_visible_fraction"] = r.evaluation.per_viewpoint[k].fully_visible_fraction;
       v["partially_visible_fraction"] = r.evaluation.per_viewpoint[k].partially_visible_fraction;
@@ -518,6 +577,27 @@ std::string PlanToJson(const PlanResult& r) {
                   {"cells_without_floor", r.cells_without_floor},
                   {"cells_failing_clearance", r.cells_failing_clearance},
                   {"visible_voxels", std::move(heat)}};
+  Json edges = Json::array();
+  for (const ScanGraph::Edge& e : r.scan_graph.edges) edges.push_back({e.i, e.j, e.overlap});
+  Json scan_graph{{"min_overlap", r.scan_graph.min_overlap},
+                  {"connected", r.scan_graph.connected},
+                  {"components", r.scan_graph.components},
+                  {"connecting_stations", r.connecting_stations},
+                  {"edges", std::move(edges)}};
+  Json polylines = Json::array();
+  for (const std::vector<WorldPoint>& line : r.route.polylines) {
+    Json points = Json::array();
+    for (const WorldPoint& p : line) points.push_back(Point(p));
+    polylines.push_back(std::move(points));
+  }
+  Json route{{"order", r.route.order},         {"legs_m", r.route.legs_m},
+             {"length_m", r.route.length_m},   {"parts", r.route.parts},
+             {"polyline", std::move(polylines)}, {"start", r.route.start ? Point(*r.route.start) : Json(nullptr)}};
+  Json field_time{{"setup", r.field_time.setup_s},
+                  {"scan", r.field_time.scan_s},
+                  {"walk", r.field_time.walk_s},
+                  {"total", r.field_time.total_s},
+                  {"scan_per_station", r.field_time.scan_seconds_per_station}};
   Json timings = Json::object();
   for (const StageTiming& t : r.timings) timings[std::string(StageName(t.stage))] = t.seconds;
   timings["total"] = r.total_seconds;
@@ -531,6 +611,9 @@ std::string PlanToJson(const PlanResult& r) {
          {"coverage", std::move(coverage)},
          {"reduction", std::move(reduction)},
          {"candidates", std::move(candidates)},
+         {"scan_graph", std::move(scan_graph)},
+         {"route", std::move(route)},
+         {"field_time_s", std::move(field_time)},
          {"timings_s", std::move(timings)},
          {"parameters", ParametersJson(r.options)},
          {"warnings", r.warnings}};
@@ -553,9 +636,7 @@ Status WritePlanOutputs(const PlanResult& result, const std::string& out_dir) {
   VC_RETURN_IF_ERROR(MakeDir(out_dir));
   const std::filesystem::path dir(out_dir);
   VC_RETURN_IF_ERROR(WriteFile(dir / "plan.json", PlanToJson(result)));
-  std::vector<WorldPoint> stations;
-  for (const PlannedStation& s : result.stations) stations.push_back(s.position);
-  VC_RETURN_IF_ERROR(WriteFile(dir / "stations.csv", StationsCsv(stations)));
+  VC_RETURN_IF_ERROR(WriteFile(dir / "stations.csv", PlanStationsCsv(result)));
   if (result.voxel_centers.size() != result.evaluation.best_face_values.size()) {
     return FailedPreconditionError("visibility.ply needs one best_face_values entry per voxel centre (" +
                                    std::to_string(result.voxel_centers.size()) + " centres, " +
@@ -599,9 +680,11 @@ Result<std::vector<WorldPoint>> ParseStationsCsv(std::string_view text, std::str
       continue;
     }
     const std::vector<std::string_view> fields = SplitFields(line);
-    double v[3];
-    const bool numeric = fields.size() == 3 && ParseDouble(fields[0], &v[0]) && ParseDouble(fields[1], &v[1]) &&
-                         ParseDouble(fields[2], &v[2]);
+    double v[4];
+    // x,y,z, and a plan's route_order column, which is read and ignored.
+    const bool numeric = (fields.size() == 3 || fields.size() == 4) && ParseDouble(fields[0], &v[0]) &&
+                         ParseDouble(fields[1], &v[1]) && ParseDouble(fields[2], &v[2]) &&
+                         (fields.size() == 3 || ParseDouble(fields[3], &v[3]));
     const std::string where = std::string(source) + ":" + std::to_string(line_no) + ": ";
     if (!numeric) {
       // One header line is allowed, before any station: fields without digits (e.g. "x,y,z").
@@ -612,7 +695,8 @@ Result<std::vector<WorldPoint>> ParseStationsCsv(std::string_view text, std::str
         seen_data_line = true;
         continue;
       }
-      return InvalidArgumentError(where + "expected 3 numbers \"x,y,z\" (metres), found \"" + std::string(line) + "\"");
+      return InvalidArgumentError(where + "expected 3 numbers \"x,y,z\" (metres), or a plan's \"x,y,z,route_order\", found \"" +
+                                  std::string(line) + "\"");
     }
     if (!std::isfinite(v[0]) || !std::isfinite(v[1]) || !std::isfinite(v[2])) {
       return InvalidArgumentError(where + "coordinates must be finite, found \"" + std::string(line) + "\"");

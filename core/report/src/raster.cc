@@ -6,6 +6,7 @@
 #include <cctype>
 #include <cmath>
 #include <csetjmp>
+#include <cstdlib>
 
 namespace vc::raster {
 
@@ -131,6 +132,24 @@ void Image::HLine(int x0, int x1, int y, Rgb c) {
 
 void Image::VLine(int x, int y0, int y1, Rgb c) {
   for (int y = y0; y <= y1; ++y) Set(x, y, c);
+}
+
+void Image::Line(int x0, int y0, int x1, int y1, Rgb c, int width) {
+  // Bresenham; a wide line stamps a disc of radius width / 2 at every step.
+  const int dx = std::abs(x1 - x0), dy = -std::abs(y1 - y0);
+  const int sx = x0 < x1 ? 1 : -1, sy = y0 < y1 ? 1 : -1;
+  int err = dx + dy;
+  while (true) {
+    if (width <= 1) {
+      Set(x0, y0, c);
+    } else {
+      FillCircle(x0, y0, width / 2, c);
+    }
+    if (x0 == x1 && y0 == y1) break;
+    const int e2 = 2 * err;
+    if (e2 >= dy) err += dy, x0 += sx;
+    if (e2 <= dx) err += dx, y0 += sy;
+  }
 }
 
 void Image::FillCircle(int cx, int cy, int radius, Rgb c) {

@@ -20,6 +20,7 @@ inline constexpr Rgb kBlack{0, 0, 0};
 inline constexpr Rgb kGrey{200, 200, 200};
 inline constexpr Rgb kDarkGrey{90, 90, 90};
 inline constexpr Rgb kRed{215, 40, 40};
+inline constexpr Rgb kOrange{255, 140, 0};
 
 // Font cell: glyphs are 5 x 7 pixels, advanced 6 pixels, at integer `scale`.
 inline constexpr int kGlyphW = 5, kGlyphH = 7, kAdvance = 6;
@@ -40,6 +41,8 @@ class Image {
   void FillCircle(int cx, int cy, int radius, Rgb c);
   void HLine(int x0, int x1, int y, Rgb c);
   void VLine(int x, int y0, int y1, Rgb c);
+  // A straight segment from (x0, y0) to (x1, y1), `width` pixels wide (discs along it), clipped.
+  void Line(int x0, int y0, int x1, int y1, Rgb c, int width = 1);
   // Text with its top-left corner at (x, y). Digits, A-Z, lower-case m x y z, and . - , : ( ) %
   // = / + [ ] ' space; other lower-case letters are drawn as capitals, anything else as a box.
   void Text(int x, int y, std::string_view text, Rgb c, int scale = 1);

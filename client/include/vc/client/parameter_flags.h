@@ -35,11 +35,14 @@ struct PlanFileFlags {
   std::string candidates;      // stations.csv format: user candidates
   std::string fixed_stations;  // stations.csv format: stations already placed
   std::string keep_out;        // keep-out CSV (docs/PLANNING.md, "Keep-out zones")
+  std::string start;           // "x,y" or "x,y,z" (m): where the walking route starts
 };
-// Binds --candidates, --fixed-stations and --keep-out to `files` (which must outlive the parse).
+// Binds --candidates, --fixed-stations, --keep-out and --start to `files` (which must outlive the
+// parse).
 void AddPlanFileFlags(CLI::App* command, PlanFileFlags* files);
-// Reads the files named in `files` into options->candidates, fixed_stations and keep_out.
-// NOT_FOUND / INVALID_ARGUMENT (naming file:line) from reading and parsing.
+// Reads the files named in `files` into options->candidates, fixed_stations and keep_out, and the
+// start into options->route_start (z NaN when only x,y is given). NOT_FOUND / INVALID_ARGUMENT
+// (naming file:line, or --start) from reading and parsing.
 [[nodiscard]] Status LoadPlanFiles(const PlanFileFlags& files, PlanOptions* options);
 
 }  // namespace vc::client

@@ -46,11 +46,13 @@ enum class Stage : uint8_t {
   kRefine,      // move each station to the best position of a sub-grid around it
   kReduction,   // remove redundant stations (the reduction matrix)
   kEvaluation,  // V of every face from the final stations, and G
+  kRoute,       // the walking route through the final stations
 };
-inline constexpr Stage kAllStages[] = {Stage::kRead,      Stage::kVoxelize, Stage::kCandidates, Stage::kVisibility,
-                                       Stage::kSelection, Stage::kRefine,   Stage::kReduction,  Stage::kEvaluation};
-// "read", "voxelize", "candidates", "visibility", "selection", "refine", "reduction", "evaluation";
-// "unspecified" for kUnspecified.
+inline constexpr Stage kAllStages[] = {Stage::kRead,      Stage::kVoxelize,  Stage::kCandidates, Stage::kVisibility,
+                                       Stage::kSelection, Stage::kRefine,    Stage::kReduction,  Stage::kEvaluation,
+                                       Stage::kRoute};
+// "read", "voxelize", "candidates", "visibility", "selection", "refine", "reduction", "evaluation",
+// "route"; "unspecified" for kUnspecified.
 std::string_view StageName(Stage stage);
 
 // One progress report: `fraction` of `stage` done, in [0,1], and an optional human-readable note.

@@ -70,7 +70,8 @@ struct PlanOptions {
   std::vector<KeepOutZone> keep_out;
   // Stations already placed (world frame, m): picked first, never removed; the plan adds to them.
   std::vector<WorldPoint> fixed_stations;
-  // Where the walking route starts (world frame, m; z picks the floor level nearest it), if set.
+  // Where the walking route starts (world frame, m; z picks the floor level nearest it, NaN = the
+  // lowest), if set.
   std::optional<WorldPoint> route_start;
 
   // The instrument heights candidates stand at: tripod_heights_m, or {tripod_height_m}.
@@ -79,7 +80,8 @@ struct PlanOptions {
   // INVALID_ARGUMENT naming the first bad parameter: a row's check (non-finite, negative, zero,
   // out of range), the scanner's, a non-finite candidate, clearance_m >= tripod_height_m (or a
   // tripod_heights_m entry), refine_step_m > refine_radius_m with refine on, a bad keep-out zone, a
-  // non-finite fixed station or one inside a keep-out zone.
+  // non-finite fixed station or one inside a keep-out zone, a route_start with a non-finite x or y
+  // or an infinite z.
   Status Validate() const;
 };
 

@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <functional>
 #include <limits>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -52,6 +53,22 @@ struct Reduction {
   double global_visibility_after = 0;
   // P: the stations the matrix is about (greedy order, after refinement), world frame (m).
   std::vector<WorldPoint> positions;
+};
+
+// The walking route through a plan's final stations (docs/PLANNING.md, "The walking route and the
+// field time"; vc/plan/route.h has the rules).
+struct WalkingRoute {
+  std::vector<int> order;  // indices into PlanResult::stations, each once, in visiting order
+  // Per entry of order: the walk arriving there (m); the first from `start`, 0 without one; NaN
+  // where no walkable path links the station to the one before it (a new part of the route).
+  std::vector<double> legs_m;
+  double length_m = 0;  // sum of the finite legs
+  // Per entry of order: the leg's path over the standing surfaces, (x, y, z of the floor) in m,
+  // from the previous station's floor (or the start) to this one's; empty for a NaN leg and for
+  // the first entry without a start.
+  std::vector<std::vector<WorldPoint>> polylines;
+  int parts = 0;                    // groups of stations no walkable path links (1 = one walk)
+  std::optional<WorldPoint> start;  // PlanOptions::route_start, if given
 };
 
 // The time a crew needs in the field for a plan (docs/PLANNING.md, "The walking route and the
@@ -100,6 +117,7 @@ struct PlanResult {
   // and how many stations selection picked only to link it.
   ScanGraph scan_graph;
   int connecting_stations = 0;
+  WalkingRoute route;
   FieldTime field_time;
 };
 

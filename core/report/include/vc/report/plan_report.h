@@ -37,7 +37,8 @@ ImageSize HeatmapImageSize(const PlanResult& result);
 // Size of reduction.png for a |P| x |P| matrix.
 ImageSize ReductionImageSize(int stations);
 
-// Parses a stations CSV ("x,y,z" per line, optional header line, '#' comments). INVALID_ARGUMENT
+// Parses a stations CSV ("x,y,z" per line, or a plan's stations.csv "x,y,z,route_order" whose
+// fourth column is ignored; optional header line, '#' comments). INVALID_ARGUMENT
 // naming `source` and the line on a malformed or non-finite row, or when there is no station.
 Result<std::vector<WorldPoint>> ParseStationsCsv(std::string_view text, std::string_view source);
 

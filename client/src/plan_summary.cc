@@ -1,0 +1,103 @@
+#include "vc/client/plan_summary.h"
+
+#include <cmath>
+#include <cstdio>
+
+namespace vc::client {
+namespace {
+
+// printf into a std::string.
+template <typename... Args>
+std::string Format(const char* format, Args... args) {
+  char buf[512];
+  std::snprintf(buf, sizeof buf, format, args...);
+  return buf;
+}
+
+// "[1 2 5]" from 0-based station indices.
+std::string Group(const std::vector<int>& stations) {
+  std::string out = "[";
+  for (size_t k = 0; k < stations.size(); ++k) out += (k ? " " : "") + std::to_string(stations[k] + 1);
+  return out + "]";
+}
+
+std::string ScanGraphLine(const PlanResult& r) {
+  const ScanGraph& g = r.scan_graph;
+  if (r.stations.size() < 2) return "";
+  const double threshold = g.min_overlap > 0 ? g.min_overlap : 0.3;
+  size_t strong = 0;
+  for (const ScanGraph::Edge& e : g.edges) strong += e.overlap >= threshold;
+  std::string line = Format("scan graph: %zu pairs overlap by %.0f%% or more", strong, 100 * threshold);
+  if (g.min_overlap > 0) {
+    if (g.connected) {
+      line += ", connected";
+    } else {
+      line += Format(", %zu groups no chain links:", g.components.size());
+      for (const std::vector<int>& c : g.components) line += " " + Group(c);
+    }
+    if (r.connecting_stations > 0) line += Format(" (%d connecting station(s))", r.connecting_stations);
+  } else {
+    line += " (registration not required: --min-overlap 0)";
+  }
+  return line + "\n";
+}
+
+std::string RouteLines(const PlanResult& r) {
+  const WalkingRoute& route = r.route;
+  if (route.order.empty()) return "";
+  std::string line = "route:";
+  if (route.start) line += Format(" start (%.2f, %.2f) ->", route.start->x(), route.start->y());
+  for (size_t k = 0; k < route.order.size(); ++k) {
+    if (k > 0) line += k < route.legs_m.size() && std::isnan(route.legs_m[k]) ? " //" : " ->";
+    line += " " + std::to_string(route.order[k] + 1);
+  }
+  line += Format("\n  walking %.1f m", route.length_m);
+  if (route.parts > 1) line += Format(" in %d parts no walkable path links (// above)", route.parts);
+  return line + "\n";
+}
+
+std::string FieldTimeLine(const PlanResult& r) {
+  const FieldTime& t = r.field_time;
+  std::string line = "field time: " + FormatDuration(t.total_s) + " (set-up " + FormatDuration(t.setup_s) +
+                     ", scans " + FormatDuration(t.scan_s) + ", walking " + FormatDuration(t.walk_s) + ")";
+  if (t.scan_seconds_per_station <= 0) line += "; no scan time known: pass --scan-seconds or --scanner";
+  return line + "\n";
+}
+
+}  // namespace
+
+std::string FormatDuration(double seconds) {
+  if (!std::isfinite(seconds) || seconds < 0) return "?";
+  const long s = std::lround(seconds);
+  if (s < 60) return std::to_string(s) + " s";
+  const long minutes = std::lround(seconds / 60.0);
+  if (minutes < 60) return std::to_string(minutes) + " min";
+  return Format("%ld h %02ld min", minutes / 60, minutes % 60);
+}
+
+std::string PlanSummary(const PlanResult& r) {
+  std::vector<int> route_position(r.stations.size(), 0);
+  for (size_t k = 0; k < r.route.order.size(); ++k) {
+    if (r.route.order[k] >= 0 && static_cast<size_t>(r.route.order[k]) < r.stations.size()) {
+      route_position[r.route.order[k]] = static_cast<int>(k) + 1;
+    }
+  }
+  std::string out = Format("%zu station(s), coverage %.1f%% of %llu coverable voxels, global visibility G = %.3f\n",
+                           r.stations.size(),
+                           r.coverable_voxels ? 100.0 * double(r.covered_voxels) / double(r.coverable_voxels) : 0.0,
+                           static_cast<unsigned long long>(r.coverable_voxels), r.evaluation.overall.global_visibility);
+  out += Format("  %3s %10s %10s %10s %12s %9s %6s\n", "#", "x_m", "y_m", "z_m", "gain_voxels", "coverage", "walk");
+  for (size_t i = 0; i < r.stations.size(); ++i) {
+    const PlannedStation& s = r.stations[i];
+    out += Format("  %3zu %10.3f %10.3f %10.3f %12llu %8.1f%% %6s%s\n", i + 1, s.position.x(), s.position.y(),
+                  s.position.z(), static_cast<unsigned long long>(s.marginal_gain), 100.0 * s.cumulative_coverage,
+                  route_position[i] ? std::to_string(route_position[i]).c_str() : "-", s.fixed ? "  fixed" : "");
+  }
+  out += ScanGraphLine(r);
+  out += RouteLines(r);
+  out += FieldTimeLine(r);
+  for (const std::string& w : r.warnings) out += "warning: " + w + "\n";
+  return out;
+}
+
+}  // namespace vc::client

@@ -1,0 +1,146 @@
+// Registration in whole plans (docs/PLANNING.md, "Registration"): with min_overlap the final
+// stations' scan graph is connected, or the plan says which groups no candidate links; the
+// reported overlaps are the brute-force intersections of the stations' own visibility sets;
+// refinement and reduction never split the graph.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <iostream>
+#include <string>
+
+#include "vc/plan/planner.h"
+#include "vc/plan/scan_graph.h"
+#include "vc/synth/synth.h"
+
+namespace vc {
+namespace {
+
+SceneInput Synthetic(const std::string& spec) {
+  SynthOptions o;
+  o.spacing_m = 0.05;
+  Result<std::vector<Eigen::Vector3f>> points = GenerateScene(spec, o);
+  EXPECT_TRUE(points.ok()) << points.status().ToString();
+  SceneInput in;
+  if (points.ok()) in.points = std::move(*points);
+  return in;
+}
+
+PlanOptions Options(double min_overlap) {
+  PlanOptions o;
+  o.resolution_m = 0.1;
+  o.min_overlap = min_overlap;
+  return o;
+}
+
+// Components of the plan's stations under `threshold`, from the reported edges.
+int GroupsAt(const PlanResult& r, double threshold) {
+  std::vector<int> parent(r.stations.size());
+  for (size_t k = 0; k < parent.size(); ++k) parent[k] = static_cast<int>(k);
+  auto find = [&](int x) {
+    while (parent[x] != x) x = parent[x];
+    return x;
+  };
+  int groups = static_cast<int>(r.stations.size());
+  for (const ScanGraph::Edge& e : r.scan_graph.edges) {
+    if (e.overlap < threshold) continue;
+    const int a = find(e.i), b = find(e.j);
+    if (a != b) parent[b] = a, --groups;
+  }
+  return groups;
+}
+
+std::string Describe(const PlanResult& r) {
+  std::string s = std::to_string(r.stations.size()) + " stations, G = " +
+                  std::to_string(r.evaluation.overall.global_visibility) + ", " +
+                  std::to_string(r.scan_graph.components.size()) + " groups, " +
+                  std::to_string(r.connecting_stations) + " connecting";
+  for (const auto& w : r.warnings) s += "\n  warning: " + w;
+  return s;
+}
+
+TEST(Registration, RoomsOffACorridorSplitWithoutItAndAreLinkedWithIt) {
+  const SceneInput in = Synthetic("rooms:3");
+  Result<PlanResult> off = Plan(in, Options(0));
+  ASSERT_TRUE(off.ok()) << off.status().ToString();
+  std::cout << "[ rooms:3 off ] " << Describe(*off) << "\n";
+  EXPECT_GT(GroupsAt(*off, 0.3), 1);  // each room's station shares little with the corridor's
+  EXPECT_TRUE(off->scan_graph.connected);  // min_overlap 0: any shared voxel links
+
+  Result<PlanResult> on = Plan(in, Options(0.3));
+  ASSERT_TRUE(on.ok()) << on.status().ToString();
+  std::cout << "[ rooms:3 0.3 ] " << Describe(*on) << "\n";
+  EXPECT_TRUE(on->scan_graph.connected);
+  EXPECT_EQ(on->scan_graph.components.size(), 1u);
+  EXPECT_EQ(GroupsAt(*on, 0.3), 1);
+  EXPECT_GT(on->stations.size(), off->stations.size());
+  EXPECT_GE(double(on->covered_voxels), 0.99 * double(on->coverable_voxels));
+  for (const std::string& w : on->warnings) EXPECT_EQ(w.find("groups"), std::string::npos) << w;
+}
+
+TEST(Registration, ReportedOverlapsAreTheIntersectionsOfTheStationsSets) {
+  const SceneInput in = Synthetic("rooms:3");
+  const PlanOptions options = Options(0.3);
+  Result<PlanResult> r = Plan(in, options);
+  ASSERT_TRUE(r.ok()) << r.status().ToString();
+  Result<VoxelScene> scene = Voxelize(in, {options.resolution_m, options.memory_budget_bytes});
+  ASSERT_TRUE(scene.ok());
+  std::vector<WorldPoint> positions;
+  for (const PlannedStation& s : r->stations) positions.push_back(s.position);
+  VisibilitySetsOptions set_options{options.selection_test, 0};
+  set_options.scanner = options.scanner;
+  Result<std::vector<VoxelSet>> sets = ComputeVisibilitySets(*scene, positions, set_options);
+  ASSERT_TRUE(sets.ok());
+  size_t pairs = 0;
+  for (size_t i = 0; i < positions.size(); ++i) {
+    for (size_t j = i + 1; j < positions.size(); ++j) {
+      uint64_t common = 0, ni = 0, nj = 0;
+      for (size_t v = 0; v < (*sets)[i].size(); ++v) {
+        ni += (*sets)[i].test(v);
+        nj += (*sets)[j].test(v);
+        common += (*sets)[i].test(v) && (*sets)[j].test(v);
+      }
+      if (common == 0) continue;
+      ++pairs;
+      const auto it = std::find_if(r->scan_graph.edges.begin(), r->scan_graph.edges.end(), [&](const auto& e) {
+        return e.i == static_cast<int>(i) && e.j == static_cast<int>(j);
+      });
+      ASSERT_NE(it, r->scan_graph.edges.end()) << i << "-" << j;
+      EXPECT_DOUBLE_EQ(it->overlap, double(common) / double(std::min(ni, nj))) << i << "-" << j;
+    }
+  }
+  EXPECT_EQ(pairs, r->scan_graph.edges.size());
+}
+
+TEST(Registration, StoreysNoCandidateLinksAreReportedAsGroups) {
+  Result<PlanResult> r = Plan(Synthetic("twofloor"), Options(0.3));
+  ASSERT_TRUE(r.ok()) << r.status().ToString();
+  std::cout << "[ twofloor 0.3 ] " << Describe(*r) << "\n";
+  ASSERT_FALSE(r->scan_graph.connected);
+  EXPECT_EQ(r->scan_graph.components.size(), 2u);
+  const bool warned = std::any_of(r->warnings.begin(), r->warnings.end(), [](const std::string& w) {
+    return w.find("2 groups") != std::string::npos && w.find("min_overlap = 0.3") != std::string::npos;
+  });
+  EXPECT_TRUE(warned);
+}
+
+TEST(Registration, RefinementAndReductionKeepTheGraphConnected) {
+  PlanOptions o = Options(0.3);
+  o.refine = true;
+  o.reduce_to = 3;  // removals down to 3 stations, each allowed only if the graph stays connected
+  Result<PlanResult> r = Plan(Synthetic("rooms:3"), o);
+  ASSERT_TRUE(r.ok()) << r.status().ToString();
+  std::cout << "[ rooms:3 0.3 refine reduce_to 3 ] " << Describe(*r) << "\n";
+  EXPECT_TRUE(r->scan_graph.connected);
+  EXPECT_EQ(GroupsAt(*r, 0.3), 1);
+}
+
+TEST(Registration, BadMinOverlapIsRefused) {
+  PlanOptions o = Options(1.5);
+  Result<PlanResult> r = Plan(Synthetic("box"), o);
+  ASSERT_FALSE(r.ok());
+  EXPECT_EQ(r.status().code(), StatusCode::kInvalidArgument);
+  EXPECT_NE(r.status().message().find("min_overlap"), std::string::npos) << r.status().ToString();
+}
+
+}  // namespace
+}  // namespace vc
