@@ -214,11 +214,11 @@ Model MakeStairs() {
   constexpr int treads = 19;
   constexpr double top = x0 + treads * going;  // 7.0: the last riser, up to the upper floor
   Model m;
-  m.Room(Cuboid(0, 1, 0, 8, 6, 3.0));                        // main room of the lower storey
-  m.Room(Cuboid(0, 0, 0, x0, 1, 3.0));                       // foot of the flight
-  m.Opening(Cuboid(x0, 0, 0, 8, 1, 3.0));                    // stairwell over the flight
-  m.Room(Cuboid(0, 0, 3.3, 8, 5, 6.3));                      // upper storey
-  m.Opening(Cuboid(x0, 0, 3.0, top, 1, 3.3));                // slab opening 5.7 x 1 m
+  m.Room(Cuboid(0, 1, 0, 8, 6, 3.0));          // main room of the lower storey
+  m.Room(Cuboid(0, 0, 0, x0, 1, 3.0));         // foot of the flight
+  m.Opening(Cuboid(x0, 0, 0, 8, 1, 3.0));      // stairwell over the flight
+  m.Room(Cuboid(0, 0, 3.3, 8, 5, 6.3));        // upper storey
+  m.Opening(Cuboid(x0, 0, 3.0, top, 1, 3.3));  // slab opening 5.7 x 1 m
   for (int k = 1; k <= treads; ++k) {
     m.Solid(Cuboid(x0 + (k - 1) * going, 0, 0, x0 + k * going, 1, k * rise));  // step k, solid to the floor
   }

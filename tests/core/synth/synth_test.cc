@@ -146,10 +146,9 @@ TEST(DescribeSceneTest, BadSpecsAreInvalidArgumentListingValidNames) {
 }
 
 TEST(DescribeSceneTest, KnownScenesReportTheirOptimumRoomsAndFloors) {
-  const std::vector<std::pair<std::string, int>> expected = {{"box", 1},     {"lroom", 1},    {"comb:1", 1},
-                                                             {"comb:7", 7},  {"comb:50", 50}, {"rooms:1", 2},
-                                                             {"rooms:4", 5}, {"twofloor", 2}, {"tworooms", 2},
-                                                             {"stairs", 0},  {"hall", 0}};
+  const std::vector<std::pair<std::string, int>> expected = {
+      {"box", 1},     {"lroom", 1},    {"comb:1", 1},   {"comb:7", 7}, {"comb:50", 50}, {"rooms:1", 2},
+      {"rooms:4", 5}, {"twofloor", 2}, {"tworooms", 2}, {"stairs", 0}, {"hall", 0}};
   for (const auto& [spec, optimum] : expected) {
     Result<SceneInfo> info = DescribeScene(spec);
     ASSERT_TRUE(info.ok()) << spec << ": " << info.status().ToString();
@@ -299,7 +298,7 @@ TEST(GenerateSceneTest, StairsHaveARealFlightRiseAtMost18cmGoingAtLeast28cm) {
       tread_lo[kt] = std::min(tread_lo[kt], q.x());
       tread_hi[kt] = std::max(tread_hi[kt], q.x());
     }
-    if (std::abs(kx - std::round(kx)) < 1e-4) {  // on a riser plane
+    if (std::abs(kx - std::round(kx)) < 1e-4) {            // on a riser plane
       const int k = static_cast<int>(std::round(kx)) + 1;  // riser k, from (k - 1) * rise up to k * rise
       // Above the first riser: the end of the foot bay's cornice (y <= 0.2, z in [2.8, 3]) and the
       // end of the slab opening (z in [3, 3.3]).
