@@ -187,6 +187,51 @@ Model MakeTwoFloor() {
   return m;
 }
 
+Model MakeTwoRooms() {
+  // Rooms A and B, 5 x 4 x 3 m, share a 0.25 m wall; the door through it is 0.9 x 2.1 m and 0.3 m
+  // from the south wall, so each room sees the other only through a narrow off-centre gap.
+  Model m;
+  m.Room(Cuboid(0, 0, 0, 5, 4, kRoomHeightM));
+  m.Room(Cuboid(5.25, 0, 0, 10.25, 4, kRoomHeightM));
+  m.Opening(Cuboid(5, 0.3, 0, 5.25, 1.2, 2.1));  // door 0.9 x 2.1 m
+  m.info.description =
+      "two closed rooms 5 x 4 x 3 m side by side, joined by one off-centre door 0.9 x 2.1 m; one "
+      "station per room, the one in A in line with the door";
+  m.info.optimum_stations = 2;
+  m.info.rooms = {{{0, 0, 0}, {5, 4, kRoomHeightM}}, {{5.25, 0, 0}, {10.25, 4, kRoomHeightM}}};
+  m.info.floor_heights_m = {0};
+  return m;
+}
+
+Model MakeStairs() {
+  // Like twofloor, with a straight flight of 19 treads (20 risers of 0.165 m, going 0.3 m, 1 m
+  // wide) along the south wall from the lower floor (z = 0) to the upper floor (z = 3.3), under a
+  // slab opening over the whole flight. The lower storey is the main room (y in [1, 6]), a foot
+  // bay in front of the flight (x in [0, 1.3], y in [0, 1]) and the stairwell over the flight
+  // (x in [1.3, 8], y in [0, 1]; no cornice, so none runs over the steps). The upper storey is 1 m
+  // shallower (y in [0, 5]) so that the lower floor stays the largest horizontal layer.
+  constexpr double x0 = 1.3, going = 0.3, rise = 0.165;
+  constexpr int treads = 19;
+  constexpr double top = x0 + treads * going;  // 7.0: the last riser, up to the upper floor
+  Model m;
+  m.Room(Cuboid(0, 1, 0, 8, 6, 3.0));          // main room of the lower storey
+  m.Room(Cuboid(0, 0, 0, x0, 1, 3.0));         // foot of the flight
+  m.Opening(Cuboid(x0, 0, 0, 8, 1, 3.0));      // stairwell over the flight
+  m.Room(Cuboid(0, 0, 3.3, 8, 5, 6.3));        // upper storey
+  m.Opening(Cuboid(x0, 0, 3.0, top, 1, 3.3));  // slab opening 5.7 x 1 m
+  for (int k = 1; k <= treads; ++k) {
+    m.Solid(Cuboid(x0 + (k - 1) * going, 0, 0, x0 + k * going, 1, k * rise));  // step k, solid to the floor
+  }
+  m.Solid(Cuboid(top, 0, 0, 8, 1, 3.0));  // under the top landing, up to the slab
+  m.info.description =
+      "two storeys (8 x 6 and 8 x 5 m, 3 m high, 0.3 m slab) joined by a straight flight of 20 "
+      "risers 0.165 m, going 0.3 m, 1 m wide";
+  m.info.optimum_stations = 0;
+  m.info.rooms = {{{0, 0, 0}, {8, 6, 3.0}}, {{0, 0, 3.3}, {8, 5, 6.3}}};
+  m.info.floor_heights_m = {0, 3.3};
+  return m;
+}
+
 Model MakeHall() {
   Model m;
   // Nave (south), aisle (north, ground level) and gallery above the aisle, split by an arcade
@@ -261,10 +306,12 @@ const SceneKind kScenes[] = {
     {"comb", true, "comb:K, a corridor with K dead-end bays", [](int k) { return MakeComb(k); }},
     {"rooms", true, "rooms:N, N closed rooms off a corridor", [](int n) { return MakeRooms(n); }},
     {"twofloor", false, "two storeys joined by a stair opening", [](int) { return MakeTwoFloor(); }},
+    {"tworooms", false, "two rooms joined by one off-centre door", [](int) { return MakeTwoRooms(); }},
+    {"stairs", false, "two storeys joined by a straight flight of steps", [](int) { return MakeStairs(); }},
     {"hall", false, "the benchmark hall", [](int) { return MakeHall(); }},
 };
 
-constexpr char kValidSpecs[] = "box, lroom, comb:K, rooms:N, twofloor, hall (K, N in 1..50)";
+constexpr char kValidSpecs[] = "box, lroom, comb:K, rooms:N, twofloor, tworooms, stairs, hall (K, N in 1..50)";
 
 Status BadSpec(std::string_view spec, std::string_view why) {
   return InvalidArgumentError("invalid scene '" + std::string(spec) + "' (" + std::string(why) +
@@ -572,7 +619,7 @@ Status SynthOptions::Validate() const {
 
 std::string ListScenes() {
   std::string out;
-  for (const char* spec : {"box", "lroom", "comb:3", "rooms:3", "twofloor", "hall"}) {
+  for (const char* spec : {"box", "lroom", "comb:3", "rooms:3", "twofloor", "tworooms", "stairs", "hall"}) {
     Result<SceneInfo> info = DescribeScene(spec);
     if (!info.ok()) continue;
     out += info->name;

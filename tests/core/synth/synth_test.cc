@@ -18,7 +18,7 @@
 namespace vc {
 namespace {
 
-const char* const kSmallScenes[] = {"box", "lroom", "comb:3", "rooms:3", "twofloor"};
+const char* const kSmallScenes[] = {"box", "lroom", "comb:3", "rooms:3", "twofloor", "tworooms", "stairs"};
 
 // A dense voxel grid over a scene's bounds (plus a margin), filled from its points; keys are
 // floor(p / resolution) as in OctoMap.
@@ -146,9 +146,9 @@ TEST(DescribeSceneTest, BadSpecsAreInvalidArgumentListingValidNames) {
 }
 
 TEST(DescribeSceneTest, KnownScenesReportTheirOptimumRoomsAndFloors) {
-  const std::vector<std::pair<std::string, int>> expected = {{"box", 1},     {"lroom", 1},    {"comb:1", 1},
-                                                             {"comb:7", 7},  {"comb:50", 50}, {"rooms:1", 2},
-                                                             {"rooms:4", 5}, {"twofloor", 2}, {"hall", 0}};
+  const std::vector<std::pair<std::string, int>> expected = {
+      {"box", 1},     {"lroom", 1},    {"comb:1", 1},   {"comb:7", 7}, {"comb:50", 50}, {"rooms:1", 2},
+      {"rooms:4", 5}, {"twofloor", 2}, {"tworooms", 2}, {"stairs", 0}, {"hall", 0}};
   for (const auto& [spec, optimum] : expected) {
     Result<SceneInfo> info = DescribeScene(spec);
     ASSERT_TRUE(info.ok()) << spec << ": " << info.status().ToString();
@@ -176,11 +176,183 @@ TEST(DescribeSceneTest, KnownScenesReportTheirOptimumRoomsAndFloors) {
     }
   }
   EXPECT_EQ(DescribeScene("twofloor")->floor_heights_m.size(), 2u);
+  EXPECT_EQ(DescribeScene("stairs")->rooms.size(), 2u);  // the lower bound of its unknown optimum
+}
+
+// Design coordinates (before kSceneOffsetM) of a world point.
+Eigen::Vector3d Design(const Eigen::Vector3f& p) { return p.cast<double>() - kSceneOffsetM; }
+Eigen::Vector3d Design(const WorldPoint& p) { return p - kSceneOffsetM; }
+
+void ExpectBox(const AxisBox& box, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, const std::string& what) {
+  EXPECT_TRUE(Design(box.min).isApprox(lo, 1e-9)) << what << " min " << Design(box.min).transpose();
+  EXPECT_TRUE(Design(box.max).isApprox(hi, 1e-9)) << what << " max " << Design(box.max).transpose();
+}
+
+TEST(DescribeSceneTest, TwoRoomsAndStairsRoomsFloorsAndBoundsInWorldCoordinates) {
+  Result<SceneInfo> two = DescribeScene("tworooms");
+  ASSERT_TRUE(two.ok());
+  ASSERT_EQ(two->rooms.size(), 2u);
+  ExpectBox(two->rooms[0], {0, 0, 0}, {5, 4, 3}, "room A");
+  ExpectBox(two->rooms[1], {5.25, 0, 0}, {10.25, 4, 3}, "room B");
+  ASSERT_EQ(two->floor_heights_m.size(), 1u);
+  EXPECT_NEAR(two->floor_heights_m[0], kSceneOffsetM.z(), 1e-12);
+  ExpectBox({two->bounds_min, two->bounds_max}, {-0.3, -0.3, -0.3}, {10.55, 4.3, 3.3}, "tworooms bounds");
+
+  Result<SceneInfo> stairs = DescribeScene("stairs");
+  ASSERT_TRUE(stairs.ok());
+  ASSERT_EQ(stairs->rooms.size(), 2u);
+  ExpectBox(stairs->rooms[0], {0, 0, 0}, {8, 6, 3}, "lower storey");
+  ExpectBox(stairs->rooms[1], {0, 0, 3.3}, {8, 5, 6.3}, "upper storey");
+  ASSERT_EQ(stairs->floor_heights_m.size(), 2u);
+  EXPECT_NEAR(stairs->floor_heights_m[0], kSceneOffsetM.z(), 1e-12);
+  EXPECT_NEAR(stairs->floor_heights_m[1], 3.3 + kSceneOffsetM.z(), 1e-12);
+  ExpectBox({stairs->bounds_min, stairs->bounds_max}, {-0.3, -0.3, -0.3}, {8.3, 6.3, 6.6}, "stairs bounds");
+}
+
+// Whether design point q lies (within tol) on one of the planes x = xs, y = ys or z = zs.
+bool OnAPlane(const Eigen::Vector3d& q, const std::vector<std::vector<double>>& planes, double tol = 1e-4) {
+  for (int a = 0; a < 3; ++a) {
+    for (double c : planes[a]) {
+      if (std::abs(q[a] - c) <= tol) return true;
+    }
+  }
+  return false;
+}
+
+TEST(GenerateSceneTest, TwoRoomsPointsLieOnWallsFloorCeilingCornicesAndTheDoor) {
+  SynthOptions o;
+  o.spacing_m = 0.05;
+  Result<std::vector<Eigen::Vector3f>> points = GenerateScene("tworooms", o);
+  ASSERT_TRUE(points.ok());
+  // Walls, door jambs (y = 0.3, 1.2) and head (z = 2.1), cornice faces (0.2 m from the walls).
+  const std::vector<std::vector<double>> planes = {
+      {0, 0.2, 4.8, 5, 5.25, 5.45, 10.05, 10.25}, {0, 0.2, 0.3, 1.2, 3.8, 4}, {0, 2.1, 2.8, 3}};
+  size_t off = 0, jamb_south = 0, jamb_north = 0, head = 0, in_wall = 0;
+  for (const Eigen::Vector3f& p : *points) {
+    const Eigen::Vector3d q = Design(p);
+    off += !OnAPlane(q, planes);
+    const bool through_wall = q.x() > 5.001 && q.x() < 5.249;  // strictly inside the shared wall
+    if (!through_wall) continue;
+    jamb_south += std::abs(q.y() - 0.3) < 1e-4 && q.z() < 2.1;
+    jamb_north += std::abs(q.y() - 1.2) < 1e-4 && q.z() < 2.1;
+    head += std::abs(q.z() - 2.1) < 1e-4 && q.y() > 0.3 && q.y() < 1.2;
+    in_wall += q.y() < 0.299 || q.y() > 1.201 || q.z() > 2.101;  // only the doorway is open
+  }
+  EXPECT_EQ(off, 0u);
+  EXPECT_GT(jamb_south, 40u);  // 0.25 x 2.1 m at 0.05 m: about 5 x 43 points
+  EXPECT_GT(jamb_north, 40u);
+  EXPECT_GT(head, 40u);
+  EXPECT_EQ(in_wall, 0u);
+}
+
+TEST(SceneVoxelsTest, TwoRoomsAreJoinedOnlyThroughTheDoor) {
+  Result<SceneInfo> info = DescribeScene("tworooms");
+  ASSERT_TRUE(info.ok());
+  VoxelGrid grid = Voxelize("tworooms", 0.05, 0.1);
+  EXPECT_FALSE(grid.FloodEscapes(grid.KeyOf(SeedPoint(info->rooms[0]))));
+  EXPECT_TRUE(grid.Reached(grid.KeyOf(SeedPoint(info->rooms[1]))));
+  // The door: 0.9 m wide (y in [0.3, 1.2]) and 2.1 m high in the wall x in [5, 5.25].
+  const WorldPoint door = WorldPoint(5.125, 0.75, 1.0) + kSceneOffsetM;
+  EXPECT_TRUE(grid.Reached(grid.KeyOf(door)));
+  EXPECT_FALSE(grid.Reached(grid.KeyOf(door + WorldPoint(0, 0, 1.5))));  // above the head
+  EXPECT_FALSE(grid.Reached(grid.KeyOf(door + WorldPoint(0, 1.0, 0))));  // wall north of the door
+  EXPECT_FALSE(grid.Reached(grid.KeyOf(door + WorldPoint(0, 2.5, 0))));  // centre of the wall
+}
+
+// Stairs: 19 treads, step k spanning x in [1.3 + 0.3 (k - 1), 1.3 + 0.3 k], y in [0, 1], top at
+// z = 0.165 k; the 20th riser, at x = 7, goes up to the upper floor at z = 3.3.
+constexpr double kStairX0 = 1.3, kGoing = 0.3, kRise = 0.165;
+constexpr int kTreads = 19;
+
+TEST(GenerateSceneTest, StairsPointsLieOnTheStoreysAndTheSteps) {
+  SynthOptions o;
+  o.spacing_m = 0.05;
+  Result<std::vector<Eigen::Vector3f>> points = GenerateScene("stairs", o);
+  ASSERT_TRUE(points.ok());
+  std::vector<std::vector<double>> planes = {{0, 0.2, 7.8, 8}, {0, 0.2, 1, 4.8, 5, 5.8, 6}, {0, 2.8, 3, 3.3, 6.1, 6.3}};
+  for (int k = 0; k <= kTreads; ++k) {
+    planes[0].push_back(kStairX0 + k * kGoing);  // risers
+    planes[2].push_back(k * kRise);              // treads
+  }
+  size_t off = 0;
+  for (const Eigen::Vector3f& p : *points) off += !OnAPlane(Design(p), planes);
+  EXPECT_EQ(off, 0u);
+}
+
+TEST(GenerateSceneTest, StairsHaveARealFlightRiseAtMost18cmGoingAtLeast28cm) {
+  SynthOptions o;
+  o.spacing_m = 0.05;
+  Result<std::vector<Eigen::Vector3f>> points = GenerateScene("stairs", o);
+  ASSERT_TRUE(points.ok());
+  // Horizontal surfaces over the flight's footprint, below the upper floor: exactly the treads.
+  std::vector<double> tread_lo(kTreads + 1, 1e9), tread_hi(kTreads + 1, -1e9);
+  size_t other = 0, risers = 0, top_riser = 0;
+  for (const Eigen::Vector3f& p : *points) {
+    const Eigen::Vector3d q = Design(p);
+    if (q.y() < 0.001 || q.y() > 0.999 || q.x() < kStairX0 - 0.001 || q.x() > 7.001 || q.z() > 3.299) continue;
+    const double kx = (q.x() - kStairX0) / kGoing;
+    const double kz = q.z() / kRise;
+    const int kt = static_cast<int>(std::round(kz));
+    const bool on_tread = std::abs(kz - kt) < 1e-3 && kt >= 1 && kt <= kTreads;
+    if (on_tread) {  // including the nosing lines, which lie on riser planes too
+      tread_lo[kt] = std::min(tread_lo[kt], q.x());
+      tread_hi[kt] = std::max(tread_hi[kt], q.x());
+    }
+    if (std::abs(kx - std::round(kx)) < 1e-4) {            // on a riser plane
+      const int k = static_cast<int>(std::round(kx)) + 1;  // riser k, from (k - 1) * rise up to k * rise
+      // Above the first riser: the end of the foot bay's cornice (y <= 0.2, z in [2.8, 3]) and the
+      // end of the slab opening (z in [3, 3.3]).
+      if (k == 1 && (q.z() >= 3.0 - 1e-4 || (q.z() >= 2.8 - 1e-4 && q.y() <= 0.2 + 1e-4))) continue;
+      const bool ok = q.z() >= (k - 1) * kRise - 1e-4 && q.z() <= k * kRise + 1e-4;
+      risers += ok;
+      top_riser += ok && k == kTreads + 1;
+      other += !ok;
+    } else {
+      other += !on_tread;
+    }
+  }
+  EXPECT_EQ(other, 0u);
+  EXPECT_GT(risers, 20u * 3 * 20);  // 20 risers 1 m wide, >= 3 rows each at 0.05 m
+  EXPECT_GT(top_riser, 3u * 20);    // the last one, up to the upper floor
+  for (int k = 1; k <= kTreads; ++k) {
+    EXPECT_NEAR(tread_lo[k], kStairX0 + (k - 1) * kGoing, 1e-4) << "tread " << k;
+    EXPECT_NEAR(tread_hi[k], kStairX0 + k * kGoing, 1e-4) << "tread " << k;
+    EXPECT_GE(tread_hi[k] - tread_lo[k], 0.28 - 1e-4) << "going of tread " << k;
+  }
+  // Rises: floor -> tread 1 -> ... -> tread 19 -> upper floor, all equal and <= 0.18 m.
+  Result<SceneInfo> info = DescribeScene("stairs");
+  ASSERT_TRUE(info.ok());
+  const double total = info->floor_heights_m[1] - info->floor_heights_m[0];
+  EXPECT_NEAR(total, (kTreads + 1) * kRise, 1e-9);
+  EXPECT_LE(kRise, 0.18);
+}
+
+TEST(SceneVoxelsTest, StairsFlightIsSolidWithHeadroomAndJoinsTheStoreys) {
+  Result<SceneInfo> info = DescribeScene("stairs");
+  ASSERT_TRUE(info.ok());
+  VoxelGrid grid = Voxelize("stairs", 0.05, 0.1);
+  EXPECT_FALSE(grid.FloodEscapes(grid.KeyOf(SeedPoint(info->rooms[0]))));
+  EXPECT_TRUE(grid.Reached(grid.KeyOf(SeedPoint(info->rooms[1]))));
+  for (int k = 1; k <= kTreads; ++k) {
+    const double x = kStairX0 + (k - 0.5) * kGoing, z = k * kRise;
+    const auto at = [&](double dz) { return grid.KeyOf(WorldPoint(x, 0.5, z + dz) + kSceneOffsetM); };
+    EXPECT_TRUE(grid.IsOccupied(at(0))) << "tread " << k;
+    // 2 m of headroom above every tread, reached from the lower storey.
+    for (double dz = 0.15; dz < 2.0; dz += 0.1) EXPECT_TRUE(grid.Reached(at(dz))) << "tread " << k << " +" << dz;
+    // Solid under the tread: enclosed, never reached.
+    if (k >= 3) {
+      EXPECT_FALSE(grid.Reached(at(-0.25))) << "tread " << k;
+    }
+  }
+  // The slab is closed beside and beyond the opening.
+  EXPECT_FALSE(grid.Reached(grid.KeyOf(WorldPoint(4, 2, 3.15) + kSceneOffsetM)));
+  EXPECT_FALSE(grid.Reached(grid.KeyOf(WorldPoint(7.5, 0.5, 3.15) + kSceneOffsetM)));
+  EXPECT_TRUE(grid.Reached(grid.KeyOf(WorldPoint(4, 0.5, 3.15) + kSceneOffsetM)));
 }
 
 TEST(DescribeSceneTest, ListNamesEveryScene) {
   const std::string list = ListScenes();
-  for (const char* name : {"box", "lroom", "comb", "rooms", "twofloor", "hall"}) {
+  for (const char* name : {"box", "lroom", "comb", "rooms", "twofloor", "tworooms", "stairs", "hall"}) {
     EXPECT_NE(list.find(name), std::string::npos) << name;
   }
 }
@@ -205,7 +377,7 @@ TEST(GenerateSceneTest, SameSeedGivesIdenticalPointsOtherSeedDiffers) {
 }
 
 TEST(GenerateSceneTest, CountMatchesTheStream) {
-  for (const char* spec : {"box", "lroom", "comb:2", "rooms:2", "twofloor"}) {
+  for (const char* spec : {"box", "lroom", "comb:2", "rooms:2", "twofloor", "tworooms", "stairs"}) {
     for (double spacing : {0.07, 0.2}) {
       SynthOptions o;
       o.spacing_m = spacing;
@@ -218,7 +390,7 @@ TEST(GenerateSceneTest, CountMatchesTheStream) {
 }
 
 TEST(GenerateSceneTest, EveryPointIsFiniteAndInsideTheBounds) {
-  for (const char* spec : {"box", "lroom", "comb:3", "rooms:3", "twofloor", "hall"}) {
+  for (const char* spec : {"box", "lroom", "comb:3", "rooms:3", "twofloor", "tworooms", "stairs", "hall"}) {
     SynthOptions o;
     o.spacing_m = 0.2;
     Result<SceneInfo> info = DescribeScene(spec);
