@@ -4,40 +4,16 @@
 #include <cmath>
 #include <limits>
 
+#include "standing_surfaces.h"
+
 namespace vc::planner {
 
-namespace {
+namespace internal {
 
-struct Surface {
-  int z;           // index of the top voxel of an occupied run
-  int free_above;  // free voxels above it (INT_MAX up to the top of the grid)
-  bool covered;    // another occupied run above it in the column
-  bool has_below;  // another occupied run below it in the column
-  int run;         // the run's number from the top of the column
-  // The outside of a ceiling: nothing above, a room below.
-  bool roof() const { return !covered && has_below; }
-};
-
-// Voxels of free space a scanner at `height_m` with `clearance_m` needs above its floor.
 int FreeVoxelsNeeded(double resolution_m, double height_m, double clearance_m) {
   return std::max(1, static_cast<int>(std::ceil((height_m + clearance_m) / resolution_m - 1e-9)));
 }
 
-// The lowest tripod height of `o` (m).
-double LowestHeight(const CandidateOptions& o) {
-  if (o.tripod_heights_m.empty()) return o.tripod_height_m;
-  return *std::min_element(o.tripod_heights_m.begin(), o.tripod_heights_m.end());
-}
-
-// Voxels of free space a standing surface needs above it: for the lowest height.
-int FreeVoxelsNeeded(double resolution_m, const CandidateOptions& o) {
-  return FreeVoxelsNeeded(resolution_m, LowestHeight(o), o.clearance_m);
-}
-
-// Half-width (voxels) of a level's height band: 0.15 m, at least 2 voxels.
-int BandVoxels(double resolution_m) { return std::max(2, static_cast<int>(std::ceil(0.15 / resolution_m - 1e-9))); }
-
-// Standing surfaces of column (x, y) (voxel indices), top to bottom. Outside the box is free.
 void ColumnSurfaces(const OccupancyGrid& grid, int x, int y, int free_needed, std::vector<Surface>& out) {
   out.clear();
   const VoxelIndex& m = grid.min_index();
@@ -61,6 +37,28 @@ void ColumnSurfaces(const OccupancyGrid& grid, int x, int y, int free_needed, st
   }
   for (Surface& s : out) s.has_below = s.run + 1 < runs;
 }
+
+}  // namespace internal
+
+namespace {
+
+using internal::ColumnSurfaces;
+using internal::FreeVoxelsNeeded;
+using internal::Surface;
+
+// The lowest tripod height of `o` (m).
+double LowestHeight(const CandidateOptions& o) {
+  if (o.tripod_heights_m.empty()) return o.tripod_height_m;
+  return *std::min_element(o.tripod_heights_m.begin(), o.tripod_heights_m.end());
+}
+
+// Voxels of free space a standing surface needs above it: for the lowest height.
+int FreeVoxelsNeeded(double resolution_m, const CandidateOptions& o) {
+  return FreeVoxelsNeeded(resolution_m, LowestHeight(o), o.clearance_m);
+}
+
+// Half-width (voxels) of a level's height band: 0.15 m, at least 2 voxels.
+int BandVoxels(double resolution_m) { return std::max(2, static_cast<int>(std::ceil(0.15 / resolution_m - 1e-9))); }
 
 constexpr int kNoSurface = std::numeric_limits<int>::min();
 

@@ -1,0 +1,115 @@
+// The walking route between planned stations: in which order a crew carries the scanner from one
+// station to the next, along which path, and how far it walks (beyond the paper).
+//
+// Walk graph. The scene's columns are grouped into square walk cells of k x k voxel columns
+// (k = round(cell_m / resolution), 1 by default), each represented by its centre column. A cell
+// has one walk node per standing surface of that column (several in a multi-storey scene): the top
+// voxel of an occupied run with at least headroom_m of free voxels above it (the same column scan
+// as the candidates' standing surfaces), and whose walking person fits: the voxel columns whose
+// square footprint comes closer than clearance_m to the cell column's centre (as HasClearance
+// measures) are free from max_step_m above the surface up to headroom_m above it (a cylinder, so a
+// threshold, a skirting board or a stair's next step lower than max_step_m does not block, a wall
+// or a desk does). Known limit: a cluttered or noisy scan (geb079's offices) has occupied voxels in
+// that cylinder almost everywhere, and its route falls apart into many parts. Each node links to the
+// node of each of its 8 neighbour cells whose surface differs from its own by at most max_step_m
+// (the closest in height, the higher on a tie); a diagonal link needs both side cells to have such
+// a node, so paths never cut a wall's corner. A link costs the 3D distance between the two surface
+// points. Stairs and ramps in the scan thus link storeys; without them each storey is its own
+// component. k is limited to 2 * clearance_m / resolution (at least 1): with coarser cells a thin
+// wall could pass between two neighbouring cells' cylinders unseen.
+//
+// Holes. Scans leave the floor unseen in places (shadows under furniture, dark or shiny patches).
+// Along x and y from a node (not diagonally: that would bridge the air beside a floor's corner),
+// when the next cells have no surface within max_step_m of it and then a surface within max_step_m
+// of it follows, the cells in between are a gap; if the gap is at most max_gap_m long (cells x cell
+// edge), each cell in it gets a bridged node at the lower of the two surfaces, provided its column is free
+// from that height up to headroom_m (nothing there at all: a wall, a desk or a step is never
+// bridged) and the cylinder test above passes. Bridged nodes do not bridge further.
+//
+// Stations. A station's floor is floor_z_m (or, when NaN, the top of the highest occupied run
+// below the optical centre). It snaps to the walk node nearest horizontally, within 1 m, whose
+// surface is within max(max_step_m, 2 voxels) of that floor (the 3D-nearest on a tie, then the
+// lowest node number); a station without one is reported in `warnings` and forms a part of its
+// own. The start snaps the same way to the highest walk surface within 1 m horizontally that is at
+// most max_step_m above start.z (a floor point or a person's eye), else the nearest in height.
+//
+// Order. Shortest walking distances between all stations (Dijkstra from each station, with the
+// connectors from each station's floor point to its node) define the parts: groups of stations
+// linked by walkable paths. The start's part is walked first, then the others from the lowest
+// floor up (ties: lowest station number). Within a part the order is an open path (no return):
+// nearest neighbour from the start, or without a start from every station in turn, each improved
+// by 2-opt and Or-opt (segments of 1-3 stations, either direction) to a local optimum, the
+// shortest kept (Croes 1958; Or 1976). Ties are broken by index, so the route is deterministic.
+//
+// Memory: one 4-byte offset per cell and about 60 bytes per walk node (surface, neighbours,
+// Dijkstra state); RESOURCE_EXHAUSTED when that exceeds memory_budget_bytes (geb079 at 0.08 m:
+// see docs/PLANNING.md). Stateless; safe to call from several threads.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "vc/base/geometry.h"
+#include "vc/base/progress.h"
+#include "vc/base/status.h"
+#include "vc/scene/voxel_scene.h"
+
+namespace vc::planner {
+
+struct RouteOptions {
+  double headroom_m = 1.7;     // free height above a surface to walk on it (m); the planner passes tripod + clearance
+  double clearance_m = 0.2;    // free horizontal radius around a walking person (m)
+  double max_step_m = 0.25;    // largest height change between neighbouring walk cells (stairs, ramps) (m)
+  double cell_m = 0;           // walk cell edge (m), rounded to whole voxels; 0 = the scene resolution
+  double max_gap_m = 0.5;      // longest unseen floor gap bridged (m); 0 bridges nothing
+  double snap_radius_m = 1.0;  // how far (horizontally, m) a station or the start may be from its walk node
+  std::optional<WorldPoint> start;                   // where the walk starts (world, m), if anywhere
+  uint64_t memory_budget_bytes = uint64_t{1} << 30;  // bound on the walk graph's memory (bytes)
+};
+
+struct Route {
+  // Every station index exactly once, in visiting order.
+  std::vector<int> order;
+  // legs_m[k]: walking length (m) of the leg arriving at order[k]; legs_m[0] from the start (0
+  // without a start); NaN where no walkable path links it to the previous station (a new part).
+  std::vector<double> legs_m;
+  // Per leg, the path over standing surfaces (world, m; z = the surface's top): first point the
+  // previous station's floor point (or the start's walk point), last this station's floor point.
+  // Empty where legs_m is NaN, and for k = 0 without a start. Every segment lies over walk nodes.
+  std::vector<std::vector<WorldPoint>> polylines;
+  double length_m = 0;                // sum of the finite legs (m)
+  int parts = 0;                      // groups of stations no walkable path links (1 = one walk; 0 without stations)
+  std::vector<std::string> warnings;  // parts, stations or a start with no walk node near them
+  uint64_t walk_cells = 0;            // cells of the walk grid
+  uint64_t walk_nodes = 0;            // walk nodes (bridged ones included)
+  uint64_t bridged_nodes = 0;         // of those, the ones bridging floor gaps
+  double cell_m = 0;                  // the walk cell edge used (m)
+};
+
+// The route through `stations` (optical centres, world, m). floor_z_m: per station the top of the
+// floor under it (m), NaN when unknown; empty = all unknown. INVALID_ARGUMENT for non-finite
+// stations or options, a floor_z_m of the wrong size, or a cell coarser than the clearance allows;
+// RESOURCE_EXHAUSTED when the walk graph exceeds the budget; CANCELLED / DEADLINE_EXCEEDED from
+// ctx. No stations: an empty route.
+Result<Route> PlanRoute(const VoxelScene& scene, const std::vector<WorldPoint>& stations,
+                        const std::vector<double>& floor_z_m, const RouteOptions& options, const JobContext& ctx = {});
+
+// An open-path ordering problem: n points, symmetric distances, an optional fixed start.
+struct OpenPathProblem {
+  int n = 0;
+  std::vector<double> distance_m;    // n x n, row-major, symmetric, finite (m)
+  std::vector<double> from_start_m;  // n distances from the start (m), or empty: the path starts anywhere
+};
+
+// Length (m) of visiting `order` (a permutation of 0..n-1), from the start if there is one.
+double OpenPathLength(const OpenPathProblem& problem, const std::vector<int>& order);
+// Nearest neighbour from `first` (or from the start, when there is one and first < 0); ties to the lower index.
+std::vector<int> NearestNeighbourPath(const OpenPathProblem& problem, int first);
+// `order` improved by 2-opt and Or-opt moves until none shortens it.
+std::vector<int> ImprovePath(const OpenPathProblem& problem, std::vector<int> order);
+// The heuristic PlanRoute uses: nearest neighbour (from the start, else from every point), improved, shortest kept.
+std::vector<int> OrderOpenPath(const OpenPathProblem& problem);
+
+}  // namespace vc::planner

@@ -1,0 +1,701 @@
+#include "vc/plan/route.h"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <numeric>
+#include <tuple>
+#include <utility>
+
+#include "standing_surfaces.h"
+
+namespace vc::planner {
+
+namespace {
+
+using internal::ColumnSurfaces;
+using internal::FreeVoxelsNeeded;
+using internal::Surface;
+
+constexpr int kDirs = 8;
+// The 8 neighbour directions: 4 straight, then 4 diagonal. kSide* name a diagonal's straight sides.
+constexpr int kDx[kDirs] = {1, -1, 0, 0, 1, -1, 1, -1};
+constexpr int kDy[kDirs] = {0, 0, 1, -1, 1, 1, -1, -1};
+constexpr int kSideX[kDirs] = {-1, -1, -1, -1, 0, 1, 0, 1};
+constexpr int kSideY[kDirs] = {-1, -1, -1, -1, 2, 2, 3, 3};
+// Bytes a walk node costs: surface, cell, 8 neighbours, Dijkstra stamp/distance/parent, heap and
+// the transient surface lists while building.
+constexpr uint64_t kBytesPerNode = 80;
+constexpr float kInf = std::numeric_limits<float>::infinity();
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+std::string Fmt(const char* format, double a, double b = 0, double c = 0) {
+  char buf[160];
+  std::snprintf(buf, sizeof buf, format, a, b, c);
+  return buf;
+}
+
+// The walk graph of the file comment, nodes sorted by (cell, z).
+struct WalkGraph {
+  const OccupancyGrid* grid = nullptr;
+  double r = 0;
+  int k = 1;  // voxel columns per cell edge
+  int nx = 0, ny = 0;
+  int step = 0;                      // max_step_m in voxels
+  std::vector<uint32_t> cell_begin;  // per cell, its first node; nx * ny + 1 entries
+  std::vector<int32_t> z;            // per node: the surface's top voxel index
+  std::vector<uint32_t> cell;        // per node: its cell (y * nx + x)
+  std::vector<int32_t> nbr;          // per node, kDirs neighbours or -1
+  uint64_t bridged = 0;
+  float cost[2][64] = {};  // link cost (m) by [diagonal][|dz| voxels]
+
+  int CellX(uint32_t c) const { return int(c % uint32_t(nx)); }
+  int CellY(uint32_t c) const { return int(c / uint32_t(nx)); }
+  int ColumnX(int i) const { return grid->min_index().x + std::min(i * k + k / 2, grid->dims().x() - 1); }
+  int ColumnY(int j) const { return grid->min_index().y + std::min(j * k + k / 2, grid->dims().y() - 1); }
+  WorldPoint Point(int n) const {
+    return {(ColumnX(CellX(cell[n])) + 0.5) * r, (ColumnY(CellY(cell[n])) + 0.5) * r, (z[n] + 1) * r};
+  }
+  double TopZ(int n) const { return (z[n] + 1) * r; }
+  int size() const { return int(z.size()); }
+};
+
+// In a CSR of (cell_begin, zs), the node of cell c with |z - zc| <= step closest to zc (the higher
+// on a tie), or -1.
+int NodeNear(const std::vector<uint32_t>& begin, const std::vector<int32_t>& zs, uint32_t c, int zc, int step) {
+  int best = -1;
+  for (uint32_t n = begin[c]; n < begin[c + 1]; ++n) {
+    const int d = std::abs(zs[n] - zc);
+    if (d > step) continue;
+    if (best < 0 || d < std::abs(zs[best] - zc) || (d == std::abs(zs[best] - zc) && zs[n] > zs[best])) best = int(n);
+  }
+  return best;
+}
+
+Status MemoryCheck(uint64_t cells, uint64_t nodes, const RouteOptions& o, double r, int k) {
+  const uint64_t bytes = (cells + 1) * 4 + nodes * kBytesPerNode;
+  if (bytes <= o.memory_budget_bytes) return Status::Ok();
+  return ResourceExhaustedError("the walk graph (" + std::to_string(cells) + " cells of " + Fmt("%.3g", k * r) +
+                                " m, at least " + std::to_string(nodes) + " standing surfaces) needs " +
+                                std::to_string(bytes >> 20) + " MiB, over the memory budget of " +
+                                std::to_string(o.memory_budget_bytes >> 20) +
+                                " MiB; use a coarser walk cell (cell_m) or a larger budget");
+}
+
+Result<WalkGraph> BuildWalkGraph(const OccupancyGrid& grid, const RouteOptions& o, int k, const JobContext& ctx) {
+  WalkGraph g;
+  g.grid = &grid;
+  g.r = grid.resolution_m();
+  g.k = k;
+  const double r = g.r, cell_m = k * r;
+  g.nx = (grid.dims().x() + k - 1) / k;
+  g.ny = (grid.dims().y() + k - 1) / k;
+  g.step = std::min(63, static_cast<int>(std::floor(o.max_step_m / r + 1e-9)));
+  const uint64_t cells = uint64_t(g.nx) * uint64_t(g.ny);
+  VC_RETURN_IF_ERROR(MemoryCheck(cells, 0, o, r, k));
+  const int headroom = FreeVoxelsNeeded(r, o.headroom_m, 0);
+
+  // 1. Standing surfaces with headroom, per cell, ascending z.
+  std::vector<uint32_t> raw_begin(cells + 1, 0);
+  std::vector<int32_t> raw_z;
+  std::vector<Surface> scratch;
+  for (int j = 0; j < g.ny; ++j) {
+    VC_RETURN_IF_ERROR(ctx.CheckCancelled("walking route"));
+    VC_RETURN_IF_ERROR(MemoryCheck(cells, raw_z.size(), o, r, k));
+    for (int i = 0; i < g.nx; ++i) {
+      const uint32_t c = uint32_t(j) * uint32_t(g.nx) + uint32_t(i);
+      raw_begin[c] = uint32_t(raw_z.size());
+      ColumnSurfaces(grid, g.ColumnX(i), g.ColumnY(j), headroom, scratch);
+      for (auto s = scratch.rbegin(); s != scratch.rend(); ++s) raw_z.push_back(s->z);
+    }
+  }
+  raw_begin[cells] = uint32_t(raw_z.size());
+
+  // 2. Gaps up to max_gap_m between two surfaces within max_step_m of each other.
+  struct Candidate {
+    uint32_t cell;
+    int32_t z;
+    uint8_t lines;  // bridged: the orientations (x, y) of the gaps it lies in, a bit each; 0 = real
+    bool operator<(const Candidate& o) const { return std::tie(cell, z, lines) < std::tie(o.cell, o.z, o.lines); }
+  };
+  std::vector<Candidate> nodes;  // sorted below, so a real node precedes a bridged one at the same place
+  nodes.reserve(raw_z.size());
+  const int max_gap_cells = static_cast<int>(std::floor(o.max_gap_m / cell_m + 1e-9));
+  for (int j = 0; j < g.ny; ++j) {
+    if ((j & 15) == 0) VC_RETURN_IF_ERROR(ctx.CheckCancelled("walking route"));
+    for (int i = 0; i < g.nx; ++i) {
+      const uint32_t c = uint32_t(j) * uint32_t(g.nx) + uint32_t(i);
+      for (uint32_t a = raw_begin[c]; a < raw_begin[c + 1]; ++a) {
+        nodes.push_back({c, raw_z[a], 0});
+        if (max_gap_cells == 0) continue;
+        for (int d = 0; d < 4; ++d) {
+          const double len = cell_m;
+          for (int t = 1; t <= max_gap_cells + 1; ++t) {
+            const int ti = i + t * kDx[d], tj = j + t * kDy[d];
+            if (ti < 0 || tj < 0 || ti >= g.nx || tj >= g.ny) break;
+            const int b = NodeNear(raw_begin, raw_z, uint32_t(tj) * uint32_t(g.nx) + uint32_t(ti), raw_z[a], g.step);
+            if (b < 0) continue;
+            if (t >= 2 && (t - 1) * len <= o.max_gap_m + 1e-9) {
+              const int zb = std::min(raw_z[a], raw_z[b]);
+              for (int u = 1; u < t; ++u) {
+                const int ui = i + u * kDx[d], uj = j + u * kDy[d];
+                const uint32_t uc = uint32_t(uj) * uint32_t(g.nx) + uint32_t(ui);
+                const int x = g.ColumnX(ui), y = g.ColumnY(uj);
+                if (NodeNear(raw_begin, raw_z, uc, zb, g.step) >= 0) continue;
+                if (grid.AnyOccupied({x, y, zb}, {x, y, zb + headroom})) continue;
+                nodes.push_back({uc, zb, uint8_t(1u << (d / 2))});
+              }
+            }
+            break;
+          }
+        }
+      }
+    }
+    VC_RETURN_IF_ERROR(MemoryCheck(cells, nodes.size(), o, r, k));
+  }
+  raw_z = {};
+  raw_begin = {};
+  std::sort(nodes.begin(), nodes.end());
+  // Bridged candidates of a cell within max_step_m of each other are one, at the lowest; it is kept
+  // if no real surface is within max_step_m of it.
+  {
+    size_t out = 0;
+    for (size_t a = 0; a < nodes.size();) {
+      if (nodes[a].lines == 0) {
+        nodes[out++] = nodes[a++];
+        continue;
+      }
+      size_t b = a;
+      uint8_t lines = 0;
+      for (; b < nodes.size() && nodes[b].cell == nodes[a].cell && nodes[b].lines != 0 &&
+             nodes[b].z - nodes[a].z <= g.step;
+           ++b) {
+        lines |= nodes[b].lines;
+      }
+      bool near_real = false;
+      for (size_t e = out; e-- > 0 && nodes[e].cell == nodes[a].cell;)
+        near_real |= std::abs(nodes[e].z - nodes[a].z) <= g.step;
+      for (size_t e = b; e < nodes.size() && nodes[e].cell == nodes[a].cell; ++e) {
+        near_real |= nodes[e].lines == 0 && std::abs(nodes[e].z - nodes[a].z) <= g.step;
+      }
+      if (!near_real) nodes[out++] = {nodes[a].cell, nodes[a].z, lines};
+      a = b;
+    }
+    nodes.resize(out);
+  }
+
+  // 3. A person fits: the cylinder of radius clearance_m from max_step_m to headroom_m is free.
+  const double c_vox = o.clearance_m / r;
+  int rows = 0;
+  while (rows + 0.5 < c_vox) ++rows;
+  std::vector<int> half_width(2 * rows + 1);
+  for (int dy = -rows; dy <= rows; ++dy) {
+    // Columns whose square footprint comes closer than the clearance to the centre column's centre.
+    const double ey = std::max(std::abs(dy) - 0.5, 0.0);
+    int w = 0;
+    while (std::pow(w + 0.5, 2) + ey * ey < c_vox * c_vox) ++w;
+    half_width[dy + rows] = w;
+  }
+  for (size_t n = 0; n < nodes.size(); ++n) {
+    if ((n & 0xffff) == 0) VC_RETURN_IF_ERROR(ctx.CheckCancelled("walking route"));
+    const Candidate& cand = nodes[n];
+    const int x = g.ColumnX(g.CellX(cand.cell)), y = g.ColumnY(g.CellY(cand.cell));
+    const int lo = cand.z + 1 + g.step, hi = cand.z + headroom;
+    bool fits = true;
+    for (int dy = -rows; dy <= rows && fits && lo <= hi; ++dy) {
+      const int w = half_width[dy + rows];
+      fits = !grid.AnyOccupied({x - w, y + dy, lo}, {x + w, y + dy, hi});
+    }
+    if (!fits) continue;
+    g.z.push_back(cand.z);
+    g.cell.push_back(cand.cell);
+    g.bridged += cand.lines != 0;
+  }
+  g.cell_begin.assign(cells + 1, 0);
+  for (uint32_t c : g.cell) ++g.cell_begin[c + 1];
+  for (uint64_t c = 0; c < cells; ++c) g.cell_begin[c + 1] += g.cell_begin[c];
+  nodes = {};
+
+  // 4. Links to the 8 neighbours, mutual only, diagonals only with both sides walkable.
+  for (int dz = 0; dz < 64; ++dz) {
+    g.cost[0][dz] = float(std::hypot(cell_m, dz * r));
+    g.cost[1][dz] = float(std::sqrt(2 * cell_m * cell_m + dz * r * dz * r));
+  }
+  g.nbr.assign(size_t(g.size()) * kDirs, -1);
+  for (int n = 0; n < g.size(); ++n) {
+    if ((n & 0xffff) == 0) VC_RETURN_IF_ERROR(ctx.CheckCancelled("walking route"));
+    const int i = g.CellX(g.cell[n]), j = g.CellY(g.cell[n]);
+    int found[kDirs];
+    for (int d = 0; d < kDirs; ++d) {
+      found[d] = -1;
+      const int ti = i + kDx[d], tj = j + kDy[d];
+      if (ti < 0 || tj < 0 || ti >= g.nx || tj >= g.ny) continue;
+      const int m = NodeNear(g.cell_begin, g.z, uint32_t(tj) * uint32_t(g.nx) + uint32_t(ti), g.z[n], g.step);
+      if (m >= 0 && NodeNear(g.cell_begin, g.z, g.cell[n], g.z[m], g.step) == n) found[d] = m;
+    }
+    for (int d = 0; d < kDirs; ++d) {
+      if (d >= 4 && (found[kSideX[d]] < 0 || found[kSideY[d]] < 0)) continue;
+      g.nbr[size_t(n) * kDirs + d] = found[d];
+    }
+  }
+  return g;
+}
+
+// Dijkstra over a WalkGraph; state kept between runs and reset lazily by a run stamp.
+class ShortestPaths {
+ public:
+  explicit ShortestPaths(const WalkGraph& g) : g_(g), stamp_(g.size(), 0), dist_(g.size()), parent_(g.size()) {}
+
+  // Distances from `source`, until every node of `targets` (-1 entries ignored) is settled or
+  // none is left to reach; over all reachable nodes if `targets` is empty.
+  Status Run(int source, const std::vector<int>& targets, const JobContext& ctx) {
+    ++run_;
+    heap_.clear();
+    Set(source, 0, -1);
+    heap_.push_back({0.0f, source});
+    std::vector<int> sorted_targets(targets);
+    std::sort(sorted_targets.begin(), sorted_targets.end());
+    sorted_targets.erase(std::unique(sorted_targets.begin(), sorted_targets.end()), sorted_targets.end());
+    int remaining = int(std::count_if(sorted_targets.begin(), sorted_targets.end(), [](int t) { return t >= 0; }));
+    uint64_t pops = 0;
+    while (!heap_.empty() && (targets.empty() || remaining > 0)) {
+      std::pop_heap(heap_.begin(), heap_.end(), std::greater<>());
+      const auto [d, n] = heap_.back();
+      heap_.pop_back();
+      if (d > dist_[n]) continue;
+      if ((++pops & 0xffff) == 0) VC_RETURN_IF_ERROR(ctx.CheckCancelled("walking route"));
+      if (std::binary_search(sorted_targets.begin(), sorted_targets.end(), n)) --remaining;
+      const int32_t* nb = &g_.nbr[size_t(n) * kDirs];
+      for (int k = 0; k < kDirs; ++k) {
+        const int m = nb[k];
+        if (m < 0) continue;
+        const float nd = d + g_.cost[k >= 4][std::abs(g_.z[m] - g_.z[n])];
+        if (nd < Dist(m)) {
+          Set(m, nd, n);
+          heap_.push_back({nd, m});
+          std::push_heap(heap_.begin(), heap_.end(), std::greater<>());
+        }
+      }
+    }
+    return Status::Ok();
+  }
+  float Dist(int n) const { return stamp_[n] == run_ ? dist_[n] : kInf; }
+  // Nodes from the last run's source to `target` (reached), in walking order.
+  std::vector<int> PathTo(int target) const {
+    std::vector<int> path;
+    for (int n = target; n >= 0; n = parent_[n]) path.push_back(n);
+    std::reverse(path.begin(), path.end());
+    return path;
+  }
+
+ private:
+  void Set(int n, float d, int parent) {
+    stamp_[n] = run_;
+    dist_[n] = d;
+    parent_[n] = parent;
+  }
+  const WalkGraph& g_;
+  uint32_t run_ = 0;
+  std::vector<uint32_t> stamp_;
+  std::vector<float> dist_;
+  std::vector<int32_t> parent_;
+  std::vector<std::pair<float, int>> heap_;
+};
+
+// Cell (clamped) of world x or y.
+int CellOf(const WalkGraph& g, double v_m, int min_index, int cells) {
+  const int col = static_cast<int>(std::floor(v_m * g.grid->inv_resolution())) - min_index;
+  const int c = col >= 0 ? col / g.k : -((-col + g.k - 1) / g.k);
+  return std::clamp(c, 0, cells - 1);
+}
+
+// Calls fn(node) for each node in cells within radius_m of (x, y) (a square window).
+template <typename Fn>
+void ForNodesNear(const WalkGraph& g, double x_m, double y_m, double radius_m, Fn&& fn) {
+  const int w = static_cast<int>(std::ceil(radius_m / (g.k * g.r))) + 1;
+  const int ci = CellOf(g, x_m, g.grid->min_index().x, g.nx), cj = CellOf(g, y_m, g.grid->min_index().y, g.ny);
+  for (int j = std::max(0, cj - w); j <= std::min(g.ny - 1, cj + w); ++j) {
+    for (int i = std::max(0, ci - w); i <= std::min(g.nx - 1, ci + w); ++i) {
+      const uint32_t c = uint32_t(j) * uint32_t(g.nx) + uint32_t(i);
+      for (uint32_t n = g.cell_begin[c]; n < g.cell_begin[c + 1]; ++n) fn(int(n));
+    }
+  }
+}
+
+double Horizontal2(const WorldPoint& a, const WorldPoint& b) { return (a - b).head<2>().squaredNorm(); }
+
+// The node a point with floor top `floor_m` snaps to (file comment), or -1.
+int SnapToFloor(const WalkGraph& g, const WorldPoint& floor_point, double tolerance_m, double radius_m) {
+  int best = -1;
+  double best_h = 0, best_d = 0;
+  ForNodesNear(g, floor_point.x(), floor_point.y(), radius_m, [&](int n) {
+    const WorldPoint p = g.Point(n);
+    if (std::abs(p.z() - floor_point.z()) > tolerance_m + 1e-9) return;
+    const double h = Horizontal2(p, floor_point), d = (p - floor_point).squaredNorm();
+    if (h > radius_m * radius_m) return;
+    if (best < 0 || h < best_h || (h == best_h && (d < best_d || (d == best_d && n < best)))) {
+      best = n;
+      best_h = h;
+      best_d = d;
+    }
+  });
+  return best;
+}
+
+// The floor top (m) under an optical centre: the highest occupied run's top at or below it, or NaN.
+double FloorBelow(const OccupancyGrid& grid, const WorldPoint& p) {
+  const VoxelIndex v = grid.WorldToIndex(p);
+  std::vector<Surface> runs;
+  ColumnSurfaces(grid, v.x, v.y, 1, runs);
+  for (const Surface& s : runs) {
+    if ((s.z + 1) * grid.resolution_m() <= p.z() + 1e-9) return (s.z + 1) * grid.resolution_m();
+  }
+  return kNaN;
+}
+
+// Drops points equal to the previous one and points between two collinear segments of the same direction.
+std::vector<WorldPoint> Simplify(const std::vector<WorldPoint>& in) {
+  std::vector<WorldPoint> out;
+  for (const WorldPoint& p : in) {
+    if (!out.empty() && (p - out.back()).norm() < 1e-9) continue;
+    if (out.size() >= 2) {
+      const WorldPoint a = out.back() - out[out.size() - 2], b = p - out.back();
+      if (a.cross(b).norm() <= 1e-9 * a.norm() * b.norm() && a.dot(b) > 0) out.pop_back();
+    }
+    out.push_back(p);
+  }
+  return out;
+}
+
+double PolylineLength(const std::vector<WorldPoint>& pts) {
+  double len = 0;
+  for (size_t i = 1; i < pts.size(); ++i) len += (pts[i] - pts[i - 1]).norm();
+  return len;
+}
+
+std::string StationList(const std::vector<int>& stations) {
+  std::string s = stations.size() == 1 ? "station " : "stations ";
+  for (size_t i = 0; i < stations.size(); ++i) s += (i ? ", " : "") + std::to_string(stations[i]);
+  return s;
+}
+
+Status Validate(const std::vector<WorldPoint>& stations, const std::vector<double>& floor_z_m, const RouteOptions& o) {
+  for (size_t i = 0; i < stations.size(); ++i) {
+    if (!stations[i].allFinite()) return InvalidArgumentError("station " + std::to_string(i) + " is not finite");
+  }
+  if (!floor_z_m.empty() && floor_z_m.size() != stations.size()) {
+    return InvalidArgumentError("floor_z_m has " + std::to_string(floor_z_m.size()) + " values for " +
+                                std::to_string(stations.size()) + " stations; give one per station or none");
+  }
+  for (size_t i = 0; i < floor_z_m.size(); ++i) {
+    if (std::isinf(floor_z_m[i]))
+      return InvalidArgumentError("floor_z_m of station " + std::to_string(i) + " is infinite");
+  }
+  auto bad = [](double v, bool zero_ok) { return !std::isfinite(v) || v < 0 || (!zero_ok && v == 0); };
+  if (bad(o.headroom_m, false)) return InvalidArgumentError("headroom_m must be positive and finite");
+  if (bad(o.clearance_m, true)) return InvalidArgumentError("clearance_m must be non-negative and finite");
+  if (bad(o.max_step_m, true)) return InvalidArgumentError("max_step_m must be non-negative and finite");
+  if (bad(o.cell_m, true)) return InvalidArgumentError("cell_m must be non-negative and finite (0 = the resolution)");
+  if (bad(o.max_gap_m, true)) return InvalidArgumentError("max_gap_m must be non-negative and finite");
+  if (bad(o.snap_radius_m, false)) return InvalidArgumentError("snap_radius_m must be positive and finite");
+  if (o.start && !o.start->allFinite()) return InvalidArgumentError("the start is not finite");
+  return Status::Ok();
+}
+
+}  // namespace
+
+double OpenPathLength(const OpenPathProblem& p, const std::vector<int>& order) {
+  double len = 0;
+  for (size_t i = 0; i < order.size(); ++i) {
+    if (i == 0) {
+      len += p.from_start_m.empty() ? 0 : p.from_start_m[order[0]];
+    } else {
+      len += p.distance_m[size_t(order[i - 1]) * p.n + order[i]];
+    }
+  }
+  return len;
+}
+
+std::vector<int> NearestNeighbourPath(const OpenPathProblem& p, int first) {
+  std::vector<int> order;
+  if (p.n == 0) return order;
+  std::vector<bool> used(p.n, false);
+  int cur = first;
+  if (cur < 0) {
+    cur = 0;
+    for (int i = 1; i < p.n && !p.from_start_m.empty(); ++i) {
+      if (p.from_start_m[i] < p.from_start_m[cur]) cur = i;
+    }
+  }
+  for (;;) {
+    order.push_back(cur);
+    used[cur] = true;
+    int next = -1;
+    for (int i = 0; i < p.n; ++i) {
+      if (!used[i] && (next < 0 || p.distance_m[size_t(cur) * p.n + i] < p.distance_m[size_t(cur) * p.n + next])) {
+        next = i;
+      }
+    }
+    if (next < 0) break;
+    cur = next;
+  }
+  return order;
+}
+
+std::vector<int> ImprovePath(const OpenPathProblem& p, std::vector<int> order) {
+  const int n = int(order.size());
+  // d(a, b): from a to b; a < 0 is the start (0 without one); b < 0 is the free end (0).
+  auto d = [&](int a, int b) -> double {
+    if (b < 0) return 0;
+    if (a < 0) return p.from_start_m.empty() ? 0 : p.from_start_m[b];
+    return p.distance_m[size_t(a) * p.n + b];
+  };
+  auto at = [&](int i) { return i < 0 || i >= n ? -1 : order[i]; };
+  constexpr double kEps = 1e-9;
+  std::vector<int> rest;
+  for (bool improved = true; improved;) {
+    improved = false;
+    // 2-opt: reverse order[i..j].
+    for (int i = 0; i < n; ++i) {
+      for (int j = i + 1; j < n; ++j) {
+        const int a = at(i - 1), b = at(j + 1);
+        const double delta =
+            d(a, order[j]) + (b < 0 ? 0 : d(order[i], b)) - d(a, order[i]) - (b < 0 ? 0 : d(order[j], b));
+        if (delta < -kEps) {
+          std::reverse(order.begin() + i, order.begin() + j + 1);
+          improved = true;
+        }
+      }
+    }
+    // Or-opt: move order[i..i+len-1], either way round, elsewhere.
+    for (int len = 1; len <= 3; ++len) {
+      for (int i = 0; i + len <= n; ++i) {
+        const int first = order[i], last = order[i + len - 1], a = at(i - 1), b = at(i + len);
+        const double gain = d(a, first) + d(last, b) - (b < 0 ? 0 : d(a, b));
+        rest.assign(order.begin(), order.begin() + i);
+        rest.insert(rest.end(), order.begin() + i + len, order.end());
+        const int m = int(rest.size());
+        double best = -kEps;
+        int best_g = -1;
+        bool best_rev = false;
+        for (int g = 0; g <= m; ++g) {
+          const int x = g == 0 ? -1 : rest[g - 1], y = g == m ? -1 : rest[g];
+          for (int rev = 0; rev < (len > 1 ? 2 : 1); ++rev) {
+            if (g == i && !rev) continue;
+            const int s = rev ? last : first, e = rev ? first : last;
+            const double delta = d(x, s) + d(e, y) - (y < 0 ? 0 : d(x, y)) - gain;
+            if (delta < best) {
+              best = delta;
+              best_g = g;
+              best_rev = rev;
+            }
+          }
+        }
+        if (best_g >= 0) {
+          std::vector<int> seg(order.begin() + i, order.begin() + i + len);
+          if (best_rev) std::reverse(seg.begin(), seg.end());
+          rest.insert(rest.begin() + best_g, seg.begin(), seg.end());
+          order = rest;
+          improved = true;
+        }
+      }
+    }
+  }
+  return order;
+}
+
+std::vector<int> OrderOpenPath(const OpenPathProblem& p) {
+  if (p.n == 0) return {};
+  if (!p.from_start_m.empty()) return ImprovePath(p, NearestNeighbourPath(p, -1));
+  std::vector<int> best;
+  double best_len = 0;
+  for (int first = 0; first < p.n; ++first) {
+    std::vector<int> o = ImprovePath(p, NearestNeighbourPath(p, first));
+    const double len = OpenPathLength(p, o);
+    if (best.empty() || len < best_len - 1e-9) {
+      best = std::move(o);
+      best_len = len;
+    }
+  }
+  return best;
+}
+
+Result<Route> PlanRoute(const VoxelScene& scene, const std::vector<WorldPoint>& stations,
+                        const std::vector<double>& floor_z_m, const RouteOptions& options, const JobContext& ctx) {
+  VC_RETURN_IF_ERROR(Validate(stations, floor_z_m, options));
+  Route route;
+  if (stations.empty()) return route;
+  const OccupancyGrid& grid = scene.grid;
+  const double r = grid.resolution_m();
+  if (!(r > 0) || grid.brick_count() == 0) return InvalidArgumentError("the scene has no voxels to walk on");
+  const int k_max = std::max(1, static_cast<int>(std::floor(2 * options.clearance_m / r + 1e-9)));
+  const int k = options.cell_m == 0 ? 1 : std::max(1, static_cast<int>(std::lround(options.cell_m / r)));
+  if (k > k_max) {
+    return InvalidArgumentError("cell_m " + Fmt("%.3g", options.cell_m) + " m is coarser than twice the clearance (" +
+                                Fmt("%.3g", k_max * r) + " m at most), so a thin wall could pass between two cells");
+  }
+  VC_ASSIGN_OR_RETURN(const WalkGraph g, BuildWalkGraph(grid, options, k, ctx));
+  route.walk_cells = uint64_t(g.nx) * uint64_t(g.ny);
+  route.walk_nodes = uint64_t(g.size());
+  route.bridged_nodes = g.bridged;
+  route.cell_m = k * r;
+
+  // Snap the stations.
+  const int n = int(stations.size());
+  const double tolerance_m = std::max(options.max_step_m, 2 * r);
+  std::vector<WorldPoint> floor_point(n);
+  std::vector<int> node(n, -1);
+  for (int s = 0; s < n; ++s) {
+    double f = floor_z_m.empty() ? kNaN : floor_z_m[s];
+    if (std::isnan(f)) f = FloorBelow(grid, stations[s]);
+    floor_point[s] = WorldPoint(stations[s].x(), stations[s].y(), f);
+    if (std::isnan(f)) {
+      route.warnings.push_back("station " + std::to_string(s) +
+                               " has no floor below it: it is a part of its own, walking to it is not counted");
+      continue;
+    }
+    node[s] = SnapToFloor(g, floor_point[s], tolerance_m, options.snap_radius_m);
+    if (node[s] < 0) {
+      route.warnings.push_back(
+          "station " + std::to_string(s) + Fmt(" has no walkable cell within %.2g m", options.snap_radius_m) +
+          Fmt(" of (%.2f, %.2f)", stations[s].x(), stations[s].y()) +
+          Fmt(" on its floor (z = %.2f m): it is a part of its own, walking to it is not counted", f));
+    }
+  }
+  int start_node = -1;
+  WorldPoint start_point;
+  if (options.start) {
+    const WorldPoint& st = *options.start;
+    double level = kNaN, nearest = kNaN;
+    ForNodesNear(g, st.x(), st.y(), options.snap_radius_m, [&](int m) {
+      const WorldPoint p = g.Point(m);
+      if (Horizontal2(p, st) > options.snap_radius_m * options.snap_radius_m) return;
+      if (p.z() <= st.z() + options.max_step_m + 1e-9 && !(p.z() <= level)) level = p.z();
+      if (std::isnan(nearest) || std::abs(p.z() - st.z()) < std::abs(nearest - st.z())) nearest = p.z();
+    });
+    if (std::isnan(level)) level = nearest;
+    if (!std::isnan(level)) {
+      start_node = SnapToFloor(g, WorldPoint(st.x(), st.y(), level), options.max_step_m, options.snap_radius_m);
+      start_point = WorldPoint(st.x(), st.y(), level);
+    } else {
+      route.warnings.push_back(
+          Fmt("the start (%.2f, %.2f, %.2f) has no walkable cell within ", st.x(), st.y(), st.z()) +
+          Fmt("%.2g m: the walk from it is not counted", options.snap_radius_m));
+    }
+  }
+
+  // Walking distances between stations (and from the start).
+  ShortestPaths sp(g);
+  std::vector<double> dist(size_t(n) * n, kNaN), from_start(n, kNaN);
+  auto connector = [&](int s) { return (g.Point(node[s]) - floor_point[s]).norm(); };
+  for (int s = 0; s < n; ++s) {
+    if (node[s] < 0) continue;
+    dist[size_t(s) * n + s] = 0;
+    bool done = true;
+    for (int t = s + 1; t < n; ++t) done &= node[t] < 0;
+    if (done) continue;
+    std::vector<int> targets;
+    for (int t = s + 1; t < n; ++t) targets.push_back(node[t]);
+    VC_RETURN_IF_ERROR(sp.Run(node[s], targets, ctx));
+    for (int t = s + 1; t < n; ++t) {
+      if (node[t] < 0 || sp.Dist(node[t]) == kInf) continue;
+      const double d = connector(s) + double(sp.Dist(node[t])) + connector(t);
+      dist[size_t(s) * n + t] = dist[size_t(t) * n + s] = d;
+    }
+  }
+  if (start_node >= 0) {
+    VC_RETURN_IF_ERROR(sp.Run(start_node, node, ctx));
+    for (int s = 0; s < n; ++s) {
+      if (node[s] >= 0 && sp.Dist(node[s]) != kInf) {
+        from_start[s] = (g.Point(start_node) - start_point).norm() + double(sp.Dist(node[s])) + connector(s);
+      }
+    }
+  }
+
+  // Parts: stations linked by finite distances (connected components are transitive).
+  std::vector<int> part_of(n, -1);
+  std::vector<std::vector<int>> parts;
+  for (int s = 0; s < n; ++s) {
+    if (part_of[s] >= 0) continue;
+    part_of[s] = int(parts.size());
+    parts.push_back({s});
+    for (int t = s + 1; t < n; ++t) {
+      if (part_of[t] < 0 && !std::isnan(dist[size_t(s) * n + t])) {
+        part_of[t] = part_of[s];
+        parts.back().push_back(t);
+      }
+    }
+  }
+  auto lowest_floor = [&](const std::vector<int>& part) {
+    double z = std::numeric_limits<double>::infinity();
+    for (int s : part) {
+      if (!std::isnan(floor_point[s].z())) z = std::min(z, floor_point[s].z());
+    }
+    return z;
+  };
+  int start_part = -1;
+  for (int s = 0; s < n && start_part < 0; ++s) {
+    if (!std::isnan(from_start[s])) start_part = part_of[s];
+  }
+  std::vector<int> part_order(parts.size());
+  std::iota(part_order.begin(), part_order.end(), 0);
+  std::stable_sort(part_order.begin(), part_order.end(), [&](int a, int b) {
+    if ((a == start_part) != (b == start_part)) return a == start_part;
+    return lowest_floor(parts[a]) < lowest_floor(parts[b]);
+  });
+  if (options.start && start_node >= 0 && start_part < 0) {
+    route.warnings.push_back(
+        "the start is not linked to any station by a walkable path: the walk from it is not counted");
+  }
+  route.parts = int(parts.size());
+  for (size_t pi = 1; pi < part_order.size(); ++pi) {
+    const std::vector<int>& part = parts[part_order[pi]];
+    const double z = lowest_floor(part);
+    route.warnings.push_back(
+        StationList(part) + (std::isinf(z) ? std::string() : Fmt(" (floor z = %.2f m)", z)) +
+        " not linked to the others by any walkable path (no stairs or ramp found): the route has " +
+        std::to_string(parts.size()) + " parts, walking between them is not counted");
+  }
+
+  // Order each part; legs and polylines.
+  for (size_t pi = 0; pi < part_order.size(); ++pi) {
+    const std::vector<int>& part = parts[part_order[pi]];
+    OpenPathProblem problem;
+    problem.n = int(part.size());
+    problem.distance_m.resize(part.size() * part.size());
+    for (size_t a = 0; a < part.size(); ++a) {
+      for (size_t b = 0; b < part.size(); ++b)
+        problem.distance_m[a * part.size() + b] = dist[size_t(part[a]) * n + part[b]];
+    }
+    const bool from_the_start = part_order[pi] == start_part;
+    if (from_the_start) {
+      for (int s : part) problem.from_start_m.push_back(from_start[s]);
+    }
+    VC_RETURN_IF_ERROR(ctx.CheckCancelled("walking route"));
+    const std::vector<int> local = OrderOpenPath(problem);
+    for (size_t li = 0; li < local.size(); ++li) {
+      const int s = part[local[li]];
+      const bool first = li == 0;
+      route.order.push_back(s);
+      if (first && !from_the_start) {
+        route.legs_m.push_back(pi == 0 && !options.start ? 0.0 : kNaN);
+        route.polylines.emplace_back();
+        continue;
+      }
+      const int prev = first ? -1 : route.order[route.order.size() - 2];
+      const int src = first ? start_node : node[prev];
+      VC_RETURN_IF_ERROR(sp.Run(src, {node[s]}, ctx));
+      std::vector<WorldPoint> pts{first ? start_point : floor_point[prev]};
+      for (int m : sp.PathTo(node[s])) pts.push_back(g.Point(m));
+      pts.push_back(floor_point[s]);
+      route.polylines.push_back(Simplify(pts));
+      route.legs_m.push_back(PolylineLength(route.polylines.back()));
+      route.length_m += route.legs_m.back();
+    }
+  }
+  return route;
+}
+
+}  // namespace vc::planner
