@@ -123,34 +123,37 @@ Result<WalkGraph> BuildWalkGraph(const OccupancyGrid& grid, const RouteOptions& 
   std::vector<Candidate> nodes;  // sorted below, so a real node precedes a bridged one at the same place
   nodes.reserve(raw_z.size());
   const int max_gap_cells = static_cast<int>(std::floor(o.max_gap_m / cell_m + 1e-9));
+  std::vector<int32_t> near_z;
   for (int j = 0; j < g.ny; ++j) {
     if ((j & 15) == 0) VC_RETURN_IF_ERROR(ctx.CheckCancelled("walking route"));
     for (int i = 0; i < g.nx; ++i) {
       const uint32_t c = uint32_t(j) * uint32_t(g.nx) + uint32_t(i);
-      for (uint32_t a = raw_begin[c]; a < raw_begin[c + 1]; ++a) {
-        nodes.push_back({c, raw_z[a], 0});
-        if (max_gap_cells == 0) continue;
-        for (int d = 0; d < 4; ++d) {
-          const double len = cell_m;
-          for (int t = 1; t <= max_gap_cells + 1; ++t) {
-            const int ti = i + t * kDx[d], tj = j + t * kDy[d];
-            if (ti < 0 || tj < 0 || ti >= g.nx || tj >= g.ny) break;
-            const int b = NodeNear(raw_begin, raw_z, uint32_t(tj) * uint32_t(g.nx) + uint32_t(ti), raw_z[a], g.step);
-            if (b < 0) continue;
-            if (t >= 2 && (t - 1) * len <= o.max_gap_m + 1e-9) {
-              const int zb = std::min(raw_z[a], raw_z[b]);
-              for (int u = 1; u < t; ++u) {
-                const int ui = i + u * kDx[d], uj = j + u * kDy[d];
-                const uint32_t uc = uint32_t(uj) * uint32_t(g.nx) + uint32_t(ui);
-                const int x = g.ColumnX(ui), y = g.ColumnY(uj);
-                if (NodeNear(raw_begin, raw_z, uc, zb, g.step) >= 0) continue;
-                if (grid.AnyOccupied({x, y, zb}, {x, y, zb + headroom})) continue;
-                nodes.push_back({uc, zb, uint8_t(1u << (d / 2))});
-              }
-            }
-            break;
-          }
+      for (uint32_t a = raw_begin[c]; a < raw_begin[c + 1]; ++a) nodes.push_back({c, raw_z[a], 0});
+      if (max_gap_cells == 0) continue;
+      // The heights of the real surfaces within max_gap_m (a square window of cells).
+      near_z.clear();
+      for (int tj = std::max(0, j - max_gap_cells); tj <= std::min(g.ny - 1, j + max_gap_cells); ++tj) {
+        for (int ti = std::max(0, i - max_gap_cells); ti <= std::min(g.nx - 1, i + max_gap_cells); ++ti) {
+          const uint32_t t = uint32_t(tj) * uint32_t(g.nx) + uint32_t(ti);
+          for (uint32_t a = raw_begin[t]; a < raw_begin[t + 1]; ++a) near_z.push_back(raw_z[a]);
         }
+      }
+      std::sort(near_z.begin(), near_z.end());
+      near_z.erase(std::unique(near_z.begin(), near_z.end()), near_z.end());
+      const int x = g.ColumnX(i), y = g.ColumnY(j);
+      // The lowest real surface of this column (surfaces are ascending), if any.
+      const int lowest = raw_begin[c] < raw_begin[c + 1] ? raw_z[raw_begin[c]] : std::numeric_limits<int>::max();
+      for (size_t q = 0; q < near_z.size(); ++q) {
+        const int zb = near_z[q];
+        // Only over nothing seen: never in the air beside a stair or above a floor that was seen.
+        if (lowest <= zb + g.step) break;
+        if (q > 0 && zb - near_z[q - 1] <= g.step && !nodes.empty() && nodes.back().cell == c &&
+            nodes.back().lines != 0) {
+          continue;
+        }
+        // Unseen floor: nothing at all from the surface's height up to the headroom.
+        if (grid.AnyOccupied({x, y, zb}, {x, y, zb + headroom})) continue;
+        nodes.push_back({c, zb, 1});
       }
     }
     VC_RETURN_IF_ERROR(MemoryCheck(cells, nodes.size(), o, r, k));
@@ -186,7 +189,8 @@ Result<WalkGraph> BuildWalkGraph(const OccupancyGrid& grid, const RouteOptions& 
     nodes.resize(out);
   }
 
-  // 3. A person fits: the cylinder of radius clearance_m from max_step_m to headroom_m is free.
+  // 3. A person fits: at most max_blocked_fraction of the columns of the cylinder of radius
+  // clearance_m hold an occupied voxel between max_step_m and headroom_m above the surface.
   const double c_vox = o.clearance_m / r;
   int rows = 0;
   while (rows + 0.5 < c_vox) ++rows;
@@ -203,12 +207,15 @@ Result<WalkGraph> BuildWalkGraph(const OccupancyGrid& grid, const RouteOptions& 
     const Candidate& cand = nodes[n];
     const int x = g.ColumnX(g.CellX(cand.cell)), y = g.ColumnY(g.CellY(cand.cell));
     const int lo = cand.z + 1 + g.step, hi = cand.z + headroom;
-    bool fits = true;
-    for (int dy = -rows; dy <= rows && fits && lo <= hi; ++dy) {
+    int blocked = 0, columns = 0;
+    for (int dy = -rows; dy <= rows && lo <= hi; ++dy) {
       const int w = half_width[dy + rows];
-      fits = !grid.AnyOccupied({x - w, y + dy, lo}, {x + w, y + dy, hi});
+      for (int dx = -w; dx <= w; ++dx) {
+        ++columns;
+        blocked += grid.AnyOccupied({x + dx, y + dy, lo}, {x + dx, y + dy, hi});
+      }
     }
-    if (!fits) continue;
+    if (blocked > o.max_blocked_fraction * columns) continue;
     g.z.push_back(cand.z);
     g.cell.push_back(cand.cell);
     g.bridged += cand.lines != 0;
