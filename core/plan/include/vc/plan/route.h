@@ -9,8 +9,9 @@
 // square footprint comes closer than clearance_m to the cell column's centre (as HasClearance
 // measures) are free from max_step_m above the surface up to headroom_m above it (a cylinder, so a
 // threshold, a skirting board or a stair's next step lower than max_step_m does not block, a wall
-// or a desk does). Known limit: a cluttered or noisy scan (geb079's offices) has occupied voxels in
-// that cylinder almost everywhere, and its route falls apart into many parts. Each node links to the
+// or a desk does); with max_blocked_fraction > 0, up to that fraction of the cylinder's columns
+// may hold something (scan noise, chair legs, a door leaf): the planner passes 0.35, as geb079's
+// cluttered offices leave almost no fully free cylinder. Each node links to the
 // node of each of its 8 neighbour cells whose surface differs from its own by at most max_step_m
 // (the closest in height, the higher on a tie); a diagonal link needs both side cells to have such
 // a node, so paths never cut a wall's corner. A link costs the 3D distance between the two surface
@@ -18,13 +19,15 @@
 // component. k is limited to 2 * clearance_m / resolution (at least 1): with coarser cells a thin
 // wall could pass between two neighbouring cells' cylinders unseen.
 //
-// Holes. Scans leave the floor unseen in places (shadows under furniture, dark or shiny patches).
-// Along x and y from a node (not diagonally: that would bridge the air beside a floor's corner),
-// when the next cells have no surface within max_step_m of it and then a surface within max_step_m
-// of it follows, the cells in between are a gap; if the gap is at most max_gap_m long (cells x cell
-// edge), each cell in it gets a bridged node at the lower of the two surfaces, provided its column is free
-// from that height up to headroom_m (nothing there at all: a wall, a desk or a step is never
-// bridged) and the cylinder test above passes. Bridged nodes do not bridge further.
+// Holes. Scans leave the floor unseen in places (shadows under furniture; rooms seen only through
+// their doors, like geb079's offices). A cell whose column has no standing surface at or below a
+// height zb + max_step_m, where zb is the height of a real surface within max_gap_m (a square
+// window of cells), gets a bridged node at zb if its column is free from zb up to headroom_m
+// (nothing there at all: a wall, a desk or a step is never bridged) and the cylinder test above
+// passes. "No surface at or below" keeps bridging off the air beside a stair or a platform, whose
+// floor below was seen; the price is that an unseen patch of an upper storey over a seen lower one
+// is not bridged, and that unseen ground just outside a scan's edge is walkable. Bridged
+// candidates of one cell within max_step_m of each other are one node, at the lowest.
 //
 // Stations. A station's floor is floor_z_m (or, when NaN, the top of the highest occupied run
 // below the optical centre). It snaps to the walk node nearest horizontally, within 1 m, whose
@@ -41,7 +44,9 @@
 // by 2-opt and Or-opt (segments of 1-3 stations, either direction) to a local optimum, the
 // shortest kept (Croes 1958; Or 1976). Ties are broken by index, so the route is deterministic.
 //
-// Memory: one 4-byte offset per cell and about 60 bytes per walk node (surface, neighbours,
+// Cost: bridging looks at (2 max_gap_m / cell + 1)^2 cells per cell (geb079 at 0.08 m with
+// max_gap_m 1.5: about 1.4 s for the whole route). Memory: one 4-byte offset per cell and about 60
+// bytes per walk node (surface, neighbours,
 // Dijkstra state); RESOURCE_EXHAUSTED when that exceeds memory_budget_bytes (geb079 at 0.08 m:
 // see docs/PLANNING.md). Stateless; safe to call from several threads.
 #pragma once
