@@ -2,7 +2,8 @@
 # The main job: plan the scanner stations for one real office floor (geb079, OctoMap) end to end.
 # Installs the dependencies, builds vc-server and vc-client only (release preset: no tests, no
 # benchmarks, no vc-synth; README records the first run's time), starts vc-server on a free loopback port,
-# inspects the scene locally, submits it with vc-client (live progress), prints the stations,
+# inspects the scene locally, submits it with vc-client (live progress) with the Leica RTC360 preset
+# and --min-overlap 0.3, prints the stations, the scan graph, the walking route and the field time,
 # leaves plan.json, stations.csv, visibility.ply, heatmap.png and reduction.png in vc-out/, and
 # stops the server.
 # Usage: scripts/demo.sh [extra vc-client submit flags...]
@@ -50,8 +51,13 @@ addr="127.0.0.1:$port"
 echo "=== vc-client inspect $scene"
 "$client" inspect "$scene"
 
-echo "=== vc-client submit $scene --out $out"
-"$client" submit "$scene" --server "$addr" --out "$out" "$@"
+# A real instrument and registrable scans (30 % overlap between linked stations), unless the
+# caller chose otherwise; the summary ends with the scan graph, the walking route and the field time.
+defaults=()
+[[ " $* " == *" --scanner "* ]] || defaults+=(--scanner leica-rtc360)
+[[ " $* " == *" --min-overlap "* ]] || defaults+=(--min-overlap 0.3)
+echo "=== vc-client submit $scene --out $out ${defaults[*]} $*"
+"$client" submit "$scene" --server "$addr" --out "$out" "${defaults[@]}" "$@"
 
 echo "=== server log"
 stop_server

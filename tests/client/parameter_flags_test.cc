@@ -204,7 +204,7 @@ TEST(ParameterTablesTest, EveryProtoFieldAndPlanJsonParameterHasARow) {
   std::set<std::string> evaluate_rows = {VC_EVALUATE_PARAMETERS(VC_ROW_NAME)};
 
   std::set<std::string> want = plan_rows;
-  want.insert({"scanner", "candidates", "tripod_heights_m", "keep_out", "fixed_stations"});
+  want.insert({"scanner", "candidates", "tripod_heights_m", "keep_out", "fixed_stations", "route_start"});
   EXPECT_EQ(FieldNames(v1::PlanParameters::descriptor()), want);
   want = scanner_rows;
   want.insert("name");  // the preset, not a row (vc/visibility/scanner_presets.h)
@@ -217,7 +217,7 @@ TEST(ParameterTablesTest, EveryProtoFieldAndPlanJsonParameterHasARow) {
   const json plan = json::parse(PlanToJson(PlanResult{}));
   for (const auto& [key, value] : plan["parameters"].items()) keys.insert(key);
   want = plan_rows;
-  want.insert({"scanner", "user_candidates", "tripod_heights_m", "keep_out", "fixed_stations"});
+  want.insert({"scanner", "user_candidates", "tripod_heights_m", "keep_out", "fixed_stations", "route_start"});
   EXPECT_EQ(keys, want);
 
   keys.clear();

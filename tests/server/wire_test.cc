@@ -48,12 +48,20 @@ TEST(PlanParameters, RoundTripKeepsEveryField) {
   o.reduce_to = 3;
   o.threads = 5;
   o.consolidate = !PlanOptions{}.consolidate;
+  o.min_overlap = 0.3;
+  o.setup_seconds = 90;
+  o.scan_seconds = 45;
+  o.walk_speed_mps = 0.8;
+  o.route_start = WorldPoint(1, 2, std::nan(""));
   auto back = FromProto(ToProto(o));
   ASSERT_TRUE(back.ok());
   // Compare through the proto (every field), so a field added to one side only shows up here.
   EXPECT_EQ(ToProto(*back).SerializeAsString(), ToProto(o).SerializeAsString());
   EXPECT_EQ(back->selection_test, SelectionTest::kCompatibility);
   EXPECT_EQ(back->candidates.size(), 2u);
+  ASSERT_TRUE(back->route_start.has_value());
+  EXPECT_TRUE(std::isnan(back->route_start->z()));
+  EXPECT_FALSE(FromProto(ToProto(PlanOptions{}))->route_start.has_value());
 }
 
 TEST(PlanParameters, UnsetFieldsTakeTheDefaults) {
@@ -96,6 +104,15 @@ PlanResult BigResult(size_t voxels, size_t candidates) {
   r.grid_cells = 11;
   r.cells_without_floor = 3;
   r.cells_failing_clearance = 2;
+  r.scan_graph = {0.3, false, {{0}, {1}}, {{0, 1, 0.1}}};
+  r.connecting_stations = 1;
+  r.route.order = {1, 0};
+  r.route.legs_m = {0.5, std::nan("")};
+  r.route.polylines = {{{0, 0, 0}, {0.5, 0, 0}}, {}};
+  r.route.length_m = 0.5;
+  r.route.parts = 2;
+  r.route.start = WorldPoint(0.5, 0, 0);
+  r.field_time = {240, 90, 0.5, 330.5, 45};
   return r;
 }
 
@@ -140,13 +157,43 @@ TEST(PlanResultChunks, ReassembleExactlyAndStayUnderOneMebibyte) {
   EXPECT_EQ(back->grid_cells, 11u);
   EXPECT_EQ(back->cells_without_floor, 3u);
   EXPECT_EQ(back->cells_failing_clearance, 2u);
+  EXPECT_EQ(back->scan_graph.min_overlap, 0.3);
+  EXPECT_FALSE(back->scan_graph.connected);
+  EXPECT_EQ(back->scan_graph.components, r.scan_graph.components);
+  ASSERT_EQ(back->scan_graph.edges.size(), 1u);
+  EXPECT_EQ(back->scan_graph.edges[0].overlap, 0.1);
+  EXPECT_EQ(back->connecting_stations, 1);
+  EXPECT_EQ(back->route.order, r.route.order);
+  EXPECT_EQ(back->route.legs_m[0], 0.5);
+  EXPECT_TRUE(std::isnan(back->route.legs_m[1]));
+  EXPECT_EQ(back->route.polylines, r.route.polylines);
+  EXPECT_EQ(back->route.parts, 2);
+  EXPECT_EQ(back->route.start, r.route.start);
+  EXPECT_EQ(back->field_time.total_s, 330.5);
+  EXPECT_EQ(back->field_time.scan_seconds_per_station, 45);
+}
+
+TEST(PlanResultChunks, ARouteOrGraphNamingAMissingStationIsDataLoss) {
+  for (int bad = 0; bad < 3; ++bad) {
+    const PlanResult r = BigResult(1, 1);
+    v1::PlanResult p = ToProto(r);
+    if (bad == 0) p.mutable_route()->set_order(0, 7);
+    if (bad == 1) p.mutable_scan_graph()->mutable_edges(0)->set_j(-1);
+    if (bad == 2) p.mutable_route()->add_legs_m(1.0);  // one leg more than stations in the order
+    PlanResultAssembler a;
+    for (const auto& c : HeatMapChunks(r.heat_map)) ASSERT_TRUE(a.AddHeatMap(c).ok());
+    ForEachVoxelChunk(r, [&](v1::VoxelChunk&& c) { return a.AddVoxels(c).ok(); });
+    auto back = std::move(a).Finish(p);
+    ASSERT_FALSE(back.ok()) << bad;
+    EXPECT_EQ(back.status().code(), StatusCode::kDataLoss) << bad;
+  }
 }
 
 // A tripwire: when a field is added to PlanResult or PlanOptions, its size changes; carry the new
 // field in proto/vc/v1/planner.proto and proto/src/convert.cc (both ways), then update the sizes.
 TEST(PlanResultChunks, EveryCoreFieldIsCarried) {
-  EXPECT_EQ(sizeof(PlanResult), 832u) << "PlanResult changed: update the vc.v1 PlanResult and vc::wire";
-  EXPECT_EQ(sizeof(PlanOptions), 296u) << "PlanOptions changed: update vc.v1 PlanParameters and vc::wire";
+  EXPECT_EQ(sizeof(PlanResult), 1128u) << "PlanResult changed: update the vc.v1 PlanResult and vc::wire";
+  EXPECT_EQ(sizeof(PlanOptions), 360u) << "PlanOptions changed: update vc.v1 PlanParameters and vc::wire";
 }
 
 TEST(PlanResultChunks, MissingChunkIsDataLoss) {

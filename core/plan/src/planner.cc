@@ -3,12 +3,14 @@
 // gains in greedy order, the warnings) is assembled here, in the order the stages produce it.
 #include "vc/plan/planner.h"
 
+#include <algorithm>
 #include <cmath>
 #include <optional>
 #include <string>
 #include <utility>
 
 #include "format.h"
+#include "vc/plan/route.h"
 #include "vc/plan/selector.h"
 #include "vc/plan/stage_runner.h"
 #include "vc/plan/stages.h"
@@ -19,6 +21,10 @@ namespace vc {
 namespace {
 
 using planner::Num;
+
+// The walking route's settings for real scans (docs/PLANNING.md, "The walking route").
+constexpr double kRouteMaxGapM = 1.5;
+constexpr double kRouteMaxBlockedFraction = 0.35;
 using planner::Percent;
 
 // The final stations among `stations` (those in `keep`, in greedy order) with their gains and
@@ -83,6 +89,33 @@ std::optional<std::string> ScanGraphWarning(const ScanGraph& graph) {
          ", plan indices) that no chain of candidates links at min_overlap = " + Num(graph.min_overlap) +
          ": their scans will not register to each other without targets — add candidates between the groups "
          "(a finer grid_spacing_m, user candidates), or lower min_overlap";
+}
+
+// The walking route through the final stations (route.h) with the planner's settings: headroom
+// of the lowest tripod height + clearance (where candidates stand), the plan's clearance, unseen
+// floor walked on within 1.5 m of a seen one, and up to 35 % of the walking cylinder cluttered.
+// nullopt when the walk graph does not fit a quarter of the memory budget (the plan stands without
+// a route); cancellation and other errors as they are.
+Result<std::optional<planner::Route>> RunRouteStage(const VoxelScene& scene, const std::vector<WorldPoint>& stations,
+                                                    const std::vector<double>& floor_z_m,
+                                                    const std::vector<double>& floor_levels_m,
+                                                    const PlanOptions& options, const JobContext& ctx) {
+  const std::vector<double> heights = options.TripodHeights();
+  planner::RouteOptions o;
+  o.headroom_m = *std::min_element(heights.begin(), heights.end()) + options.clearance_m;
+  o.clearance_m = options.clearance_m;
+  o.max_gap_m = kRouteMaxGapM;
+  o.max_blocked_fraction = kRouteMaxBlockedFraction;
+  o.memory_budget_bytes = options.memory_budget_bytes / 4;
+  if (options.route_start) {
+    WorldPoint start = *options.route_start;
+    if (std::isnan(start.z())) start.z() = floor_levels_m.empty() ? scene.BoundsMin().z() : floor_levels_m.front();
+    o.start = start;
+  }
+  Result<planner::Route> route = planner::PlanRoute(scene, stations, floor_z_m, o, ctx);
+  if (route.ok()) return std::optional<planner::Route>(std::move(*route));
+  if (route.status().code() == StatusCode::kResourceExhausted) return std::optional<planner::Route>();
+  return route.status();
 }
 
 }  // namespace
@@ -169,6 +202,8 @@ Result<PlanResult> Plan(const SceneInput& input, const PlanOptions& options, con
   result.reduction = std::move(reduced.reduction);
 
   FinalStations final_stations = AssembleFinalStations(stations, reduced.keep, result.coverable_voxels);
+  std::vector<double> final_floor_z;
+  for (int k : reduced.keep) final_floor_z.push_back(stations.floor_z_m[k]);
   result.stations = std::move(final_stations.stations);
   result.covered_voxels = final_stations.covered_voxels;
   {
@@ -191,6 +226,17 @@ Result<PlanResult> Plan(const SceneInput& input, const PlanOptions& options, con
     result.stations[k].global_visibility = result.evaluation.per_viewpoint[k].global_visibility;
   }
   result.voxel_centers = std::move(evaluated.voxel_centers);
+
+  VC_ASSIGN_OR_RETURN(std::optional<planner::Route> route, runner.Run(Stage::kRoute, [&](const JobContext& c) {
+    return RunRouteStage(scene, final_positions, final_floor_z, result.floor_levels_m, options, c);
+  }));
+  if (route) {
+    result.route = {route->order, route->legs_m, route->length_m, route->polylines, route->parts, options.route_start};
+    for (std::string& w : route->warnings) result.warnings.push_back(std::move(w));
+  } else {
+    result.warnings.push_back("no walking route: the walk graph does not fit a quarter of memory_budget_bytes");
+  }
+  result.field_time = ComputeFieldTime(result.stations.size(), result.route.length_m, options);
   result.timings = runner.timings();
   result.total_seconds = runner.elapsed_seconds();
   return result;

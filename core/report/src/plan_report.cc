@@ -76,6 +76,8 @@ Json ParametersJson(const PlanOptions& o) {
   Json fixed = Json::array();
   for (const WorldPoint& p : o.fixed_stations) fixed.push_back({p.x(), p.y(), p.z()});
   j["fixed_stations"] = std::move(fixed);
+  // z NaN (the lowest floor) is written as null.
+  j["route_start"] = o.route_start ? Point(*o.route_start) : Json(nullptr);
   return j;
 }
 

@@ -291,8 +291,8 @@ TEST(PlannerTest, ProgressCallbacksAndTimings) {
   EXPECT_EQ(heat_maps, 1);
   EXPECT_EQ(station_indices, std::vector<int>({0, 1, 2}));
   // Stages in pipeline order (each may report several times, but not go back).
-  const std::vector<Stage> order = {Stage::kVoxelize,  Stage::kCandidates, Stage::kVisibility,
-                                    Stage::kSelection, Stage::kReduction,  Stage::kEvaluation};
+  const std::vector<Stage> order = {Stage::kVoxelize,  Stage::kCandidates, Stage::kVisibility, Stage::kSelection,
+                                    Stage::kReduction, Stage::kEvaluation, Stage::kRoute};
   std::vector<Stage> seen;
   for (const auto& s : stages) {
     if (std::find(seen.begin(), seen.end(), s) == seen.end()) seen.push_back(s);
@@ -317,7 +317,8 @@ TEST(PlannerTest, CancelledBeforeAndDuringEveryStage) {
     EXPECT_EQ(Plan(in, TestOptions(), ctx).status().code(), StatusCode::kCancelled);
   }
   for (const Stage stage :
-       {Stage::kCandidates, Stage::kVisibility, Stage::kSelection, Stage::kReduction, Stage::kEvaluation}) {
+       {Stage::kCandidates, Stage::kVisibility, Stage::kSelection, Stage::kReduction, Stage::kEvaluation,
+        Stage::kRoute}) {
     CancelToken token;
     JobContext ctx;
     ctx.cancel = &token;

@@ -77,6 +77,44 @@ TEST(Registration, RoomsOffACorridorSplitWithoutItAndAreLinkedWithIt) {
   for (const std::string& w : on->warnings) EXPECT_EQ(w.find("groups"), std::string::npos) << w;
 }
 
+// tworooms (docs/SCENES.md): rooms A = [0, 5] and B = [5.25, 10.25] x [0, 4] m, the door at
+// x [5, 5.25], y [0.3, 1.2] (design coordinates; the scene is shifted by kSceneOffsetM).
+WorldPoint TwoRoomsPoint(double x, double y) { return WorldPoint(x, y, 1.5) + kSceneOffsetM; }
+
+TEST(Registration, TwoRoomsGetAStationInTheDoorToLinkThem) {
+  const SceneInput in = Synthetic("tworooms");
+  PlanOptions off = Options(0);
+  // Far in each room, in line with the door (so each sees the whole door opening: SCENES.md's
+  // proof of the optimum), and the doorway itself.
+  off.candidates = {TwoRoomsPoint(1.0, 0.75), TwoRoomsPoint(9.25, 0.75), TwoRoomsPoint(5.125, 0.75)};
+  Result<PlanResult> plain = Plan(in, off);
+  ASSERT_TRUE(plain.ok()) << plain.status().ToString();
+  std::cout << "[ tworooms off ] " << Describe(*plain) << "\n";
+  ASSERT_EQ(plain->stations.size(), 2u);  // one per room
+  for (const PlannedStation& s : plain->stations) EXPECT_NE(s.candidate_index, 2);
+  EXPECT_EQ(GroupsAt(*plain, 0.3), 2);
+
+  PlanOptions on = off;
+  on.min_overlap = 0.3;
+  Result<PlanResult> linked = Plan(in, on);
+  ASSERT_TRUE(linked.ok()) << linked.status().ToString();
+  std::cout << "[ tworooms 0.3 ] " << Describe(*linked) << "\n";
+  EXPECT_EQ(linked->stations.size(), 3u);
+  EXPECT_TRUE(std::any_of(linked->stations.begin(), linked->stations.end(),
+                          [](const PlannedStation& s) { return s.candidate_index == 2; }));
+  EXPECT_TRUE(linked->scan_graph.connected);
+
+  // Without the doorway nothing can link the rooms: the plan says so, with the groups.
+  on.candidates.pop_back();
+  Result<PlanResult> apart = Plan(in, on);
+  ASSERT_TRUE(apart.ok()) << apart.status().ToString();
+  EXPECT_FALSE(apart->scan_graph.connected);
+  EXPECT_EQ(apart->scan_graph.components, (std::vector<std::vector<int>>{{0}, {1}}));
+  EXPECT_TRUE(std::any_of(apart->warnings.begin(), apart->warnings.end(), [](const std::string& w) {
+    return w.find("2 groups ([0], [1]") != std::string::npos;
+  }));
+}
+
 TEST(Registration, ReportedOverlapsAreTheIntersectionsOfTheStationsSets) {
   const SceneInput in = Synthetic("rooms:3");
   const PlanOptions options = Options(0.3);

@@ -70,6 +70,17 @@ PlanResult SamplePlan() {
   }
   r.timings = {{Stage::kVoxelize, 0.5}, {Stage::kSelection, 0.01}};
   r.total_seconds = 1.0;
+  r.scan_graph.min_overlap = 0.3;
+  r.scan_graph.connected = true;
+  r.scan_graph.components = {{0, 1}};
+  r.scan_graph.edges = {{0, 1, 0.45}};
+  r.connecting_stations = 1;
+  r.route.order = {1, 0};
+  r.route.legs_m = {0.0, 3.6};
+  r.route.polylines = {{}, {WorldPoint(3.5, 2.5, 0.1), WorldPoint(0.5, 2.5, 0.1), WorldPoint(0.5, 0.5, 0.1)}};
+  r.route.length_m = 3.6;
+  r.route.parts = 1;
+  r.field_time = {240, 52, 3.6, 295.6, 26};
   r.warnings = {"20.0 % of occupied voxels (1) are visible from no candidate"};
   return r;
 }
@@ -77,9 +88,28 @@ PlanResult SamplePlan() {
 TEST(PlanReportTest, PlanJsonHasEveryDocumentedKey) {
   const json j = json::parse(PlanToJson(SamplePlan()));
   for (const char* key : {"schema", "resolution_m", "selection_test", "stop_reason", "viewpoints", "coverage",
-                          "reduction", "candidates", "timings_s", "parameters", "warnings"}) {
+                          "reduction", "candidates", "timings_s", "parameters", "warnings", "scan_graph", "route",
+                          "field_time_s"}) {
     EXPECT_TRUE(j.contains(key)) << key;
   }
+  EXPECT_EQ(j["scan_graph"]["min_overlap"].get<double>(), 0.3);
+  EXPECT_TRUE(j["scan_graph"]["connected"].get<bool>());
+  EXPECT_EQ(j["scan_graph"]["components"], json::parse("[[0, 1]]"));
+  EXPECT_EQ(j["scan_graph"]["edges"], json::parse("[[0, 1, 0.45]]"));
+  EXPECT_EQ(j["scan_graph"]["connecting_stations"].get<int>(), 1);
+  EXPECT_EQ(j["route"]["order"], json::parse("[1, 0]"));
+  EXPECT_EQ(j["route"]["legs_m"], json::parse("[0.0, 3.6]"));
+  EXPECT_EQ(j["route"]["length_m"].get<double>(), 3.6);
+  EXPECT_EQ(j["route"]["parts"].get<int>(), 1);
+  ASSERT_EQ(j["route"]["polyline"].size(), 2u);
+  EXPECT_EQ(j["route"]["polyline"][1].size(), 3u);
+  EXPECT_TRUE(j["route"]["start"].is_null());
+  for (const char* key : {"setup", "scan", "walk", "total", "scan_per_station"}) {
+    EXPECT_TRUE(j["field_time_s"].contains(key)) << key;
+  }
+  EXPECT_DOUBLE_EQ(j["field_time_s"]["total"].get<double>(), 295.6);
+  EXPECT_EQ(j["viewpoints"][0]["route_order"].get<int>(), 2);
+  EXPECT_EQ(j["viewpoints"][1]["route_order"].get<int>(), 1);
   ASSERT_EQ(j["viewpoints"].size(), 2u);
   for (const char* key :
        {"index", "x", "y", "z", "compatible_voxels", "marginal_gain", "cumulative_coverage", "global_visibility",
@@ -131,7 +161,7 @@ TEST(PlanReportTest, WritesAllFilesWithPngsOfTheExpectedSize) {
   const ImageSize red = ReductionImageSize(3);
   // Layout (docs/PLANNING.md): footprint 4 x 3 m -> 180 px/m, plot 720 x 540; one panel.
   EXPECT_EQ(heat.width, 64 + 720 + 24 + 110);
-  EXPECT_EQ(heat.height, 40 + 540 + 48);
+  EXPECT_EQ(heat.height, 40 + 540 + 60);
   for (const auto& [name, size] : {std::pair{"heatmap.png", heat}, std::pair{"reduction.png", red}}) {
     const std::string png = ReadAll(dir + "/" + name);
     ASSERT_GT(png.size(), 33u) << name;
@@ -157,7 +187,10 @@ TEST(PlanReportTest, StationsCsvRoundTrips) {
   const std::string dir = testing::MakeTempDir();
   ASSERT_TRUE(WritePlanOutputs(plan, dir).ok());
   const std::string csv = ReadAll(dir + "/stations.csv");
-  EXPECT_EQ(csv.substr(0, 6), "x,y,z\n");
+  EXPECT_EQ(csv.substr(0, 18), "x,y,z,route_order\n");
+  // The route visits station 1 first, then station 0.
+  EXPECT_NE(csv.find(",2\n"), std::string::npos) << csv;
+  EXPECT_NE(csv.find(",1\n"), std::string::npos) << csv;
   Result<std::vector<WorldPoint>> parsed = ParseStationsCsv(csv, "stations.csv");
   ASSERT_TRUE(parsed.ok()) << parsed.status().ToString();
   ASSERT_EQ(parsed->size(), plan.stations.size());
@@ -243,7 +276,7 @@ TEST(ParseStationsCsvTest, RejectsBadRowsNamingTheLine) {
   };
   for (const Case& c :
        {Case{"x,y,z\n1,2,3\n1,2\n", "my.csv:3:"}, Case{"1,2,3\n1,2,abc\n", "my.csv:2:"},
-        Case{"1,2,3\n1,2,3,4\n", "my.csv:2:"}, Case{"1,2,nan\n", "my.csv:1:"}, Case{"1,2,3\n1,inf,3\n", "my.csv:2:"},
+        Case{"1,2,3\n1,2,3,4,5\n", "my.csv:2:"}, Case{"1,2,3,x\n", "my.csv:1:"}, Case{"1,2,nan\n", "my.csv:1:"}, Case{"1,2,3\n1,inf,3\n", "my.csv:2:"},
         Case{"1,2,3\nx,y,z\n", "my.csv:2:"}, Case{"1,,3\n", "my.csv:1:"}}) {
     Result<std::vector<WorldPoint>> r = ParseStationsCsv(c.text, "my.csv");
     ASSERT_FALSE(r.ok()) << c.text;
