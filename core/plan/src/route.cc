@@ -123,38 +123,50 @@ Result<WalkGraph> BuildWalkGraph(const OccupancyGrid& grid, const RouteOptions& 
   std::vector<Candidate> nodes;  // sorted below, so a real node precedes a bridged one at the same place
   nodes.reserve(raw_z.size());
   const int max_gap_cells = static_cast<int>(std::floor(o.max_gap_m / cell_m + 1e-9));
-  std::vector<int32_t> near_z;
+  // Per cell, the lowest real surface (INT_MAX for none), and its minimum over the square window of
+  // max_gap_m around the cell (two passes of a 1D minimum: rows, then columns).
+  constexpr int kNone = std::numeric_limits<int>::max();
+  std::vector<int32_t> lowest(cells, kNone), window_low;
+  for (uint64_t c = 0; c < cells; ++c) {
+    if (raw_begin[c] < raw_begin[c + 1]) lowest[c] = raw_z[raw_begin[c]];
+  }
+  if (max_gap_cells > 0) {
+    std::vector<int32_t> rows(cells, kNone);
+    for (int j = 0; j < g.ny; ++j) {
+      for (int i = 0; i < g.nx; ++i) {
+        int32_t m = kNone;
+        for (int t = std::max(0, i - max_gap_cells); t <= std::min(g.nx - 1, i + max_gap_cells); ++t) {
+          m = std::min(m, lowest[uint64_t(j) * g.nx + t]);
+        }
+        rows[uint64_t(j) * g.nx + i] = m;
+      }
+    }
+    window_low.assign(cells, kNone);
+    for (int j = 0; j < g.ny; ++j) {
+      if ((j & 15) == 0) VC_RETURN_IF_ERROR(ctx.CheckCancelled("walking route"));
+      for (int i = 0; i < g.nx; ++i) {
+        int32_t m = kNone;
+        for (int t = std::max(0, j - max_gap_cells); t <= std::min(g.ny - 1, j + max_gap_cells); ++t) {
+          m = std::min(m, rows[uint64_t(t) * g.nx + i]);
+        }
+        window_low[uint64_t(j) * g.nx + i] = m;
+      }
+    }
+  }
   for (int j = 0; j < g.ny; ++j) {
     if ((j & 15) == 0) VC_RETURN_IF_ERROR(ctx.CheckCancelled("walking route"));
     for (int i = 0; i < g.nx; ++i) {
       const uint32_t c = uint32_t(j) * uint32_t(g.nx) + uint32_t(i);
       for (uint32_t a = raw_begin[c]; a < raw_begin[c + 1]; ++a) nodes.push_back({c, raw_z[a], 0});
-      if (max_gap_cells == 0) continue;
-      // The heights of the real surfaces within max_gap_m (a square window of cells).
-      near_z.clear();
-      for (int tj = std::max(0, j - max_gap_cells); tj <= std::min(g.ny - 1, j + max_gap_cells); ++tj) {
-        for (int ti = std::max(0, i - max_gap_cells); ti <= std::min(g.nx - 1, i + max_gap_cells); ++ti) {
-          const uint32_t t = uint32_t(tj) * uint32_t(g.nx) + uint32_t(ti);
-          for (uint32_t a = raw_begin[t]; a < raw_begin[t + 1]; ++a) near_z.push_back(raw_z[a]);
-        }
-      }
-      std::sort(near_z.begin(), near_z.end());
-      near_z.erase(std::unique(near_z.begin(), near_z.end()), near_z.end());
+      if (max_gap_cells == 0 || window_low[c] == kNone) continue;
+      // Unseen floor at the lowest real surface within max_gap_m: only over nothing seen (never in
+      // the air beside a stair or above a floor that was seen), and with nothing at all from that
+      // height up to the headroom.
+      const int zb = window_low[c];
+      if (lowest[c] != kNone && lowest[c] <= zb + g.step) continue;
       const int x = g.ColumnX(i), y = g.ColumnY(j);
-      // The lowest real surface of this column (surfaces are ascending), if any.
-      const int lowest = raw_begin[c] < raw_begin[c + 1] ? raw_z[raw_begin[c]] : std::numeric_limits<int>::max();
-      for (size_t q = 0; q < near_z.size(); ++q) {
-        const int zb = near_z[q];
-        // Only over nothing seen: never in the air beside a stair or above a floor that was seen.
-        if (lowest <= zb + g.step) break;
-        if (q > 0 && zb - near_z[q - 1] <= g.step && !nodes.empty() && nodes.back().cell == c &&
-            nodes.back().lines != 0) {
-          continue;
-        }
-        // Unseen floor: nothing at all from the surface's height up to the headroom.
-        if (grid.AnyOccupied({x, y, zb}, {x, y, zb + headroom})) continue;
-        nodes.push_back({c, zb, 1});
-      }
+      if (grid.AnyOccupied({x, y, zb}, {x, y, zb + headroom})) continue;
+      nodes.push_back({c, zb, 1});
     }
     VC_RETURN_IF_ERROR(MemoryCheck(cells, nodes.size(), o, r, k));
   }

@@ -20,14 +20,14 @@
 // wall could pass between two neighbouring cells' cylinders unseen.
 //
 // Holes. Scans leave the floor unseen in places (shadows under furniture; rooms seen only through
-// their doors, like geb079's offices). A cell whose column has no standing surface at or below a
-// height zb + max_step_m, where zb is the height of a real surface within max_gap_m (a square
-// window of cells), gets a bridged node at zb if its column is free from zb up to headroom_m
-// (nothing there at all: a wall, a desk or a step is never bridged) and the cylinder test above
-// passes. "No surface at or below" keeps bridging off the air beside a stair or a platform, whose
-// floor below was seen; the price is that an unseen patch of an upper storey over a seen lower one
-// is not bridged, and that unseen ground just outside a scan's edge is walkable. Bridged
-// candidates of one cell within max_step_m of each other are one node, at the lowest.
+// their doors, like geb079's offices). Let zb be the lowest real surface within max_gap_m of a
+// cell (a square window of cells; a sliding minimum over rows, then columns). A cell whose column
+// has no standing surface at or below zb + max_step_m gets a bridged node at zb if its column is
+// free from zb up to headroom_m (nothing there at all: a wall, a desk or a step is never bridged)
+// and the cylinder test above passes. "No surface at or below" keeps bridging off the air beside
+// a stair or a platform, whose floor below was seen; the price is that an unseen patch of an upper
+// storey over a seen lower one is not bridged, nor unseen floor near a lower surface (a sunken
+// area) at its own height, and that unseen ground just outside a scan's edge is walkable.
 //
 // Stations. A station's floor is floor_z_m (or, when NaN, the top of the highest occupied run
 // below the optical centre). It snaps to the walk node nearest horizontally, within 1 m, whose
@@ -44,8 +44,8 @@
 // by 2-opt and Or-opt (segments of 1-3 stations, either direction) to a local optimum, the
 // shortest kept (Croes 1958; Or 1976). Ties are broken by index, so the route is deterministic.
 //
-// Cost: bridging looks at (2 max_gap_m / cell + 1)^2 cells per cell (geb079 at 0.08 m with
-// max_gap_m 1.5: about 1.4 s for the whole route). Memory: one 4-byte offset per cell and about 60
+// Cost: the window minimum is 2 (2 max_gap_m / cell + 1) cells per cell (geb079 at 0.08 m with
+// max_gap_m 1.5: about 0.25 s for the whole route of 15 stations). Memory: one 4-byte offset per cell and about 60
 // bytes per walk node (surface, neighbours,
 // Dijkstra state); RESOURCE_EXHAUSTED when that exceeds memory_budget_bytes (geb079 at 0.08 m:
 // see docs/PLANNING.md). Stateless; safe to call from several threads.
