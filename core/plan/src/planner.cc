@@ -82,11 +82,11 @@ std::optional<std::string> ScanGraphWarning(const ScanGraph& graph) {
   std::string groups;
   for (const std::vector<int>& g : graph.components) {
     groups += groups.empty() ? "[" : ", [";
-    for (size_t k = 0; k < g.size(); ++k) groups += (k ? " " : "") + std::to_string(g[k]);
+    for (size_t k = 0; k < g.size(); ++k) groups += (k ? " " : "") + std::to_string(g[k] + 1);
     groups += "]";
   }
   return "the stations form " + std::to_string(graph.components.size()) + " groups (" + groups +
-         ", plan indices) that no chain of candidates links at min_overlap = " + Num(graph.min_overlap) +
+         ", numbered as on heatmap.png) that no chain of candidates links at min_overlap = " + Num(graph.min_overlap) +
          ": their scans will not register to each other without targets — add candidates between the groups "
          "(a finer grid_spacing_m, user candidates), or lower min_overlap";
 }
@@ -107,6 +107,7 @@ Result<std::optional<planner::Route>> RunRouteStage(const VoxelScene& scene, con
   o.max_gap_m = kRouteMaxGapM;
   o.max_blocked_fraction = kRouteMaxBlockedFraction;
   o.memory_budget_bytes = options.memory_budget_bytes / 4;
+  o.first_station_number = 1;  // as on heatmap.png and in vc-client's table
   if (options.route_start) {
     WorldPoint start = *options.route_start;
     if (std::isnan(start.z())) start.z() = floor_levels_m.empty() ? scene.BoundsMin().z() : floor_levels_m.front();

@@ -394,9 +394,10 @@ double PolylineLength(const std::vector<WorldPoint>& pts) {
   return len;
 }
 
-std::string StationList(const std::vector<int>& stations) {
+// "station 3" / "stations 3, 7", numbered from `first` (RouteOptions::first_station_number).
+std::string StationList(const std::vector<int>& stations, int first) {
   std::string s = stations.size() == 1 ? "station " : "stations ";
-  for (size_t i = 0; i < stations.size(); ++i) s += (i ? ", " : "") + std::to_string(stations[i]);
+  for (size_t i = 0; i < stations.size(); ++i) s += (i ? ", " : "") + std::to_string(stations[i] + first);
   return s;
 }
 
@@ -571,14 +572,15 @@ Result<Route> PlanRoute(const VoxelScene& scene, const std::vector<WorldPoint>& 
     if (std::isnan(f)) f = FloorBelow(grid, stations[s]);
     floor_point[s] = WorldPoint(stations[s].x(), stations[s].y(), f);
     if (std::isnan(f)) {
-      route.warnings.push_back("station " + std::to_string(s) +
+      route.warnings.push_back("station " + std::to_string(s + options.first_station_number) +
                                " has no floor below it: it is a part of its own, walking to it is not counted");
       continue;
     }
     node[s] = SnapToFloor(g, floor_point[s], tolerance_m, options.snap_radius_m);
     if (node[s] < 0) {
       route.warnings.push_back(
-          "station " + std::to_string(s) + Fmt(" has no walkable cell within %.2g m", options.snap_radius_m) +
+          "station " + std::to_string(s + options.first_station_number) +
+          Fmt(" has no walkable cell within %.2g m", options.snap_radius_m) +
           Fmt(" of (%.2f, %.2f)", stations[s].x(), stations[s].y()) +
           Fmt(" on its floor (z = %.2f m): it is a part of its own, walking to it is not counted", f));
     }
@@ -673,7 +675,8 @@ Result<Route> PlanRoute(const VoxelScene& scene, const std::vector<WorldPoint>& 
     const std::vector<int>& part = parts[part_order[pi]];
     const double z = lowest_floor(part);
     route.warnings.push_back(
-        StationList(part) + (std::isinf(z) ? std::string() : Fmt(" (floor z = %.2f m)", z)) +
+        StationList(part, options.first_station_number) +
+        (std::isinf(z) ? std::string() : Fmt(" (floor z = %.2f m)", z)) +
         " not linked to the others by any walkable path (no stairs or ramp found): the route has " +
         std::to_string(parts.size()) + " parts, walking between them is not counted");
   }
