@@ -47,7 +47,7 @@
   X(bool, reduce, true, "", "reduce", kAny, "remove redundant stations")                                               \
   X(int32_t, reduce_to, 0, "stations", "reduce-to", kNonNegative,                                                      \
     "reduce to at most this many stations (0 = zero-loss removals only)")                                              \
-  X(int32_t, threads, 0, "threads", "threads", kNonNegative, "threads for the job (0 = all, or the server's share)")  \
+  X(int32_t, threads, 0, "threads", "threads", kNonNegative, "threads for the job (0 = all, or the server's share)")   \
   X(double, min_overlap, 0.0, "fraction", "min-overlap", kUnitInterval,                                                \
     "keep the scan graph connected at this overlap (0 = off; 0.3 for target-less registration)")                       \
   X(double, setup_seconds, 120.0, "s", "setup-seconds", kNonNegative, "field time to set up the scanner per station")  \
