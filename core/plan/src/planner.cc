@@ -14,6 +14,7 @@
 #include "vc/plan/selector.h"
 #include "vc/plan/stage_runner.h"
 #include "vc/plan/stages.h"
+#include "vc/scene/octomap_adapter.h"
 #include "vc/visibility/scanner_presets.h"
 
 namespace vc {
@@ -96,7 +97,8 @@ std::optional<std::string> ScanGraphWarning(const ScanGraph& graph) {
 // floor walked on within 1.5 m of a seen one, and up to 35 % of the walking cylinder cluttered.
 // nullopt when the walk graph does not fit a quarter of the memory budget (the plan stands without
 // a route); cancellation and other errors as they are.
-Result<std::optional<planner::Route>> RunRouteStage(const VoxelScene& scene, const std::vector<WorldPoint>& stations,
+Result<std::optional<planner::Route>> RunRouteStage(const SceneInput& input, const VoxelScene& scene,
+                                                    const std::vector<WorldPoint>& stations,
                                                     const std::vector<double>& floor_z_m,
                                                     const std::vector<double>& floor_levels_m,
                                                     const PlanOptions& options, const JobContext& ctx) {
@@ -108,6 +110,10 @@ Result<std::optional<planner::Route>> RunRouteStage(const VoxelScene& scene, con
   o.max_blocked_fraction = kRouteMaxBlockedFraction;
   o.memory_budget_bytes = options.memory_budget_bytes / 4;
   o.first_station_number = 1;  // as on heatmap.png and in vc-client's table
+  if (input.octree) {
+    const octomap::OcTree* tree = input.octree.get();
+    o.known_free = [tree](const WorldPoint& p) { return IsKnownFree(*tree, p); };
+  }
   if (options.route_start) {
     WorldPoint start = *options.route_start;
     if (std::isnan(start.z())) start.z() = floor_levels_m.empty() ? scene.BoundsMin().z() : floor_levels_m.front();
@@ -229,7 +235,7 @@ Result<PlanResult> Plan(const SceneInput& input, const PlanOptions& options, con
   result.voxel_centers = std::move(evaluated.voxel_centers);
 
   VC_ASSIGN_OR_RETURN(std::optional<planner::Route> route, runner.Run(Stage::kRoute, [&](const JobContext& c) {
-    return RunRouteStage(scene, final_positions, final_floor_z, result.floor_levels_m, options, c);
+    return RunRouteStage(input, scene, final_positions, final_floor_z, result.floor_levels_m, options, c);
   }));
   if (route) {
     result.route = {route->order, route->legs_m, route->length_m, route->polylines, route->parts, options.route_start};

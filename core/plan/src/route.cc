@@ -48,6 +48,8 @@ struct WalkGraph {
   std::vector<int32_t> z;            // per node: the surface's top voxel index
   std::vector<uint32_t> cell;        // per node: its cell (y * nx + x)
   std::vector<int32_t> nbr;          // per node, kDirs neighbours or -1
+  std::vector<uint8_t> unknown;      // per node: bridged under space the scan did not observe
+  float unknown_factor = 1;          // cost factor of a link touching such a node
   uint64_t bridged = 0;
   float cost[2][64] = {};  // link cost (m) by [diagonal][|dz| voxels]
 
@@ -93,6 +95,7 @@ Result<WalkGraph> BuildWalkGraph(const OccupancyGrid& grid, const RouteOptions& 
   g.nx = (grid.dims().x() + k - 1) / k;
   g.ny = (grid.dims().y() + k - 1) / k;
   g.step = std::min(63, static_cast<int>(std::floor(o.max_step_m / r + 1e-9)));
+  g.unknown_factor = static_cast<float>(o.unknown_cost_factor);
   const uint64_t cells = uint64_t(g.nx) * uint64_t(g.ny);
   VC_RETURN_IF_ERROR(MemoryCheck(cells, 0, o, r, k));
   const int headroom = FreeVoxelsNeeded(r, o.headroom_m, 0);
@@ -228,8 +231,17 @@ Result<WalkGraph> BuildWalkGraph(const OccupancyGrid& grid, const RouteOptions& 
       }
     }
     if (blocked > o.max_blocked_fraction * columns) continue;
+    // With known_free: a node whose body space (0.5, 1.2 or 1.6 m above its surface) the scan
+    // never observed as free, perhaps beside or inside a wall it never saw, is walked at a cost.
+    bool unknown = false;
+    if (o.known_free) {
+      const WorldPoint floor_m((x + 0.5) * r, (y + 0.5) * r, (cand.z + 1) * r);
+      unknown = true;
+      for (double h : {0.5, 1.2, 1.6}) unknown = unknown && !o.known_free(floor_m + WorldPoint(0, 0, h));
+    }
     g.z.push_back(cand.z);
     g.cell.push_back(cand.cell);
+    g.unknown.push_back(unknown);
     g.bridged += cand.lines != 0;
   }
   g.cell_begin.assign(cells + 1, 0);
@@ -290,7 +302,9 @@ class ShortestPaths {
       for (int k = 0; k < kDirs; ++k) {
         const int m = nb[k];
         if (m < 0) continue;
-        const float nd = d + g_.cost[k >= 4][std::abs(g_.z[m] - g_.z[n])];
+        float step = g_.cost[k >= 4][std::abs(g_.z[m] - g_.z[n])];
+        if (g_.unknown[m] || g_.unknown[n]) step *= g_.unknown_factor;
+        const float nd = d + step;
         if (nd < Dist(m)) {
           Set(m, nd, n);
           heap_.push_back({nd, m});

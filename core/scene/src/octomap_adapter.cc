@@ -335,6 +335,11 @@ Result<ScanGraphData> ReadScanGraph(std::string_view bytes, std::string_view sou
 
 double OctreeResolution(const octomap::OcTree& tree) { return tree.getResolution(); }
 
+bool IsKnownFree(const octomap::OcTree& tree, const WorldPoint& p) {
+  const octomap::OcTreeNode* node = tree.search(p.x(), p.y(), p.z());
+  return node != nullptr && !tree.isNodeOccupied(node);
+}
+
 size_t CountOccupiedLeaves(const octomap::OcTree& tree) {
   size_t n = 0;
   for (auto it = tree.begin_leafs(), end = tree.end_leafs(); it != end; ++it) {

@@ -402,6 +402,36 @@ TEST(RouteTest, UnseenFloorIsNeverBridgedAboveASeenOne) {
   EXPECT_EQ(r.parts, 2);  // no walk up through the air beside the platform
 }
 
+TEST(RouteTest, SpaceTheScanNeverObservedIsWalkedOnlyWhereNothingElseLinks) {
+  // One open floor 6 x 2 m; a band across it (x 2.5 to 3.5 m) is space the scan never observed
+  // (a wall it may have missed), except a 0.4 m gap near y = 1.8 m.
+  Builder b;
+  b.Box(0, 0, 0, 59, 19, 0);
+  const VoxelScene s = b.Build();
+  const std::vector<WorldPoint> st{At(10, 3), At(50, 3)};
+  const Route plain = Plan(s, st);
+  EXPECT_NEAR(plain.legs_m[1], 4.0, 1e-6);  // straight across
+  RouteOptions o;
+  o.known_free = [](const WorldPoint& p) { return p.x() < 2.5 || p.x() > 3.5 || p.y() > 1.6; };
+  const Route careful = Plan(s, st, o);
+  EXPECT_EQ(careful.parts, 1);
+  // Through the gap: up to y ~1.6 m and back, longer than 4 m, and a true length.
+  EXPECT_GT(careful.legs_m[1], 4.5);
+  double top = 0;
+  for (const WorldPoint& p : careful.polylines[1]) top = std::max(top, p.y());
+  EXPECT_GT(top, 1.6);
+  double length = 0;
+  for (size_t k = 1; k < careful.polylines[1].size(); ++k) {
+    length += (careful.polylines[1][k] - careful.polylines[1][k - 1]).norm();
+  }
+  EXPECT_NEAR(careful.legs_m[1], length, 1e-9);
+  // With no gap at all, the unknown band is crossed (nothing else links), straight.
+  o.known_free = [](const WorldPoint& p) { return p.x() < 2.5 || p.x() > 3.5; };
+  const Route forced = Plan(s, st, o);
+  EXPECT_EQ(forced.parts, 1);
+  EXPECT_NEAR(forced.legs_m[1], 4.0, 1e-6);
+}
+
 TEST(RouteTest, SameInputSameRoute) {
   const VoxelScene s = TwoRooms();
   const std::vector<WorldPoint> st{At(10, 10), At(70, 10), At(30, 30), At(60, 35), At(20, 20), At(75, 30)};

@@ -52,6 +52,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -74,6 +75,13 @@ struct RouteOptions {
   double snap_radius_m = 1.0;       // how far (horizontally, m) a station or the start may be from its walk node
   std::optional<WorldPoint> start;  // where the walk starts (world, m), if anywhere
   int first_station_number = 0;     // warnings number the stations from this (the planner: 1)
+  // When set: whether a point (world, m) is known to be free, i.e. observed empty by the scanner's
+  // rays (an OctoMap's free leaves). Unseen floor under space not observed free at 0.5, 1.2 or
+  // 1.6 m (perhaps a wall the scan never saw) is then walked at unknown_cost_factor times its
+  // length: paths prefer space the scan saw, and cross unknown space only where nothing else links.
+  // Unset (point clouds carry no such knowledge): occupancy alone.
+  std::function<bool(const WorldPoint&)> known_free;
+  double unknown_cost_factor = 3;  // see known_free; legs_m stay true lengths
   uint64_t memory_budget_bytes = uint64_t{1} << 30;  // bound on the walk graph's memory (bytes)
 };
 

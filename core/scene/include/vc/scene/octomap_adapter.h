@@ -56,6 +56,10 @@ size_t CountOccupiedLeaves(const octomap::OcTree& tree);
 void ForEachOccupiedLeaf(const octomap::OcTree& tree,
                          const std::function<void(const WorldPoint& min_corner, double edge_m)>& fn);
 
+// Whether the tree knows p (world, m) to be free: p lies in a leaf the scanner's rays observed as
+// free (not occupied, and not unknown: no leaf at all).
+bool IsKnownFree(const octomap::OcTree& tree, const WorldPoint& p);
+
 // Metric bounding box of the tree's occupied leaves. Empty tree: min > max.
 void OccupiedBoundingBox(const octomap::OcTree& tree, WorldPoint* min, WorldPoint* max);
 
