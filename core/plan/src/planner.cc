@@ -10,11 +10,9 @@
 #include <utility>
 
 #include "format.h"
-#include "vc/plan/route.h"
 #include "vc/plan/selector.h"
 #include "vc/plan/stage_runner.h"
 #include "vc/plan/stages.h"
-#include "vc/scene/octomap_adapter.h"
 #include "vc/visibility/scanner_presets.h"
 
 namespace vc {
@@ -23,9 +21,6 @@ namespace {
 
 using planner::Num;
 
-// The walking route's settings for real scans (docs/PLANNING.md, "The walking route").
-constexpr double kRouteMaxGapM = 1.5;
-constexpr double kRouteMaxBlockedFraction = 0.35;
 using planner::Percent;
 
 // The final stations among `stations` (those in `keep`, in greedy order) with their gains and
@@ -90,39 +85,6 @@ std::optional<std::string> ScanGraphWarning(const ScanGraph& graph) {
          ", numbered as on heatmap.png) that no chain of candidates links at min_overlap = " + Num(graph.min_overlap) +
          ": their scans will not register to each other without targets — add candidates between the groups "
          "(a finer grid_spacing_m, user candidates), or lower min_overlap";
-}
-
-// The walking route through the final stations (route.h) with the planner's settings: headroom
-// of the lowest tripod height + clearance (where candidates stand), the plan's clearance, unseen
-// floor walked on within 1.5 m of a seen one, and up to 35 % of the walking cylinder cluttered.
-// nullopt when the walk graph does not fit a quarter of the memory budget (the plan stands without
-// a route); cancellation and other errors as they are.
-Result<std::optional<planner::Route>> RunRouteStage(const SceneInput& input, const VoxelScene& scene,
-                                                    const std::vector<WorldPoint>& stations,
-                                                    const std::vector<double>& floor_z_m,
-                                                    const std::vector<double>& floor_levels_m,
-                                                    const PlanOptions& options, const JobContext& ctx) {
-  const std::vector<double> heights = options.TripodHeights();
-  planner::RouteOptions o;
-  o.headroom_m = *std::min_element(heights.begin(), heights.end()) + options.clearance_m;
-  o.clearance_m = options.clearance_m;
-  o.max_gap_m = kRouteMaxGapM;
-  o.max_blocked_fraction = kRouteMaxBlockedFraction;
-  o.memory_budget_bytes = options.memory_budget_bytes / 4;
-  o.first_station_number = 1;  // as on heatmap.png and in vc-client's table
-  if (input.octree) {
-    const octomap::OcTree* tree = input.octree.get();
-    o.known_free = [tree](const WorldPoint& p) { return IsKnownFree(*tree, p); };
-  }
-  if (options.route_start) {
-    WorldPoint start = *options.route_start;
-    if (std::isnan(start.z())) start.z() = floor_levels_m.empty() ? scene.BoundsMin().z() : floor_levels_m.front();
-    o.start = start;
-  }
-  Result<planner::Route> route = planner::PlanRoute(scene, stations, floor_z_m, o, ctx);
-  if (route.ok()) return std::optional<planner::Route>(std::move(*route));
-  if (route.status().code() == StatusCode::kResourceExhausted) return std::optional<planner::Route>();
-  return route.status();
 }
 
 }  // namespace
@@ -234,14 +196,15 @@ Result<PlanResult> Plan(const SceneInput& input, const PlanOptions& options, con
   }
   result.voxel_centers = std::move(evaluated.voxel_centers);
 
-  VC_ASSIGN_OR_RETURN(std::optional<planner::Route> route, runner.Run(Stage::kRoute, [&](const JobContext& c) {
-    return RunRouteStage(input, scene, final_positions, final_floor_z, result.floor_levels_m, options, c);
+  VC_ASSIGN_OR_RETURN(planner::RouteOutput routed, runner.Run(Stage::kRoute, [&](const JobContext& c) {
+    return planner::RunRouteStage({input, scene, final_positions, final_floor_z, result.floor_levels_m}, options, c);
   }));
+  std::optional<planner::Route>& route = routed.route;
   if (route) {
     result.route = {route->order, route->legs_m, route->length_m, route->polylines, route->parts, options.route_start};
     for (std::string& w : route->warnings) result.warnings.push_back(std::move(w));
   } else {
-    result.warnings.push_back("no walking route: the walk graph does not fit a quarter of memory_budget_bytes");
+    result.warnings.push_back("no walking route: " + routed.unrouted_reason);
   }
   result.field_time = ComputeFieldTime(result.stations.size(), result.route.length_m, options);
   result.timings = runner.timings();

@@ -5,7 +5,9 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <iostream>
+#include <limits>
 #include <string>
 
 #include "vc/plan/planner.h"
@@ -169,6 +171,40 @@ TEST(Registration, RefinementAndReductionKeepTheGraphConnected) {
   std::cout << "[ rooms:3 0.3 refine reduce_to 3 ] " << Describe(*r) << "\n";
   EXPECT_TRUE(r->scan_graph.connected);
   EXPECT_EQ(GroupsAt(*r, 0.3), 1);
+}
+
+TEST(Route, StairsAreClimbedAndTheFieldTimeAddsUp) {
+  PlanOptions o = Options(0);
+  o.scanner.name = "leica-rtc360";  // scan time 26 s (scanner_presets.cc)
+  o.setup_seconds = 90;
+  o.walk_speed_mps = 0.5;
+  o.route_start = WorldPoint(7.5, 5.5, std::numeric_limits<double>::quiet_NaN()) + kSceneOffsetM;
+  Result<PlanResult> r = Plan(Synthetic("stairs"), o);
+  ASSERT_TRUE(r.ok()) << r.status().ToString();
+  std::cout << "[ stairs route ] " << Describe(*r) << ", route " << r->route.length_m << " m\n";
+  const size_t n = r->stations.size();
+  ASSERT_EQ(r->route.order.size(), n);
+  EXPECT_EQ(r->route.parts, 1);  // the flight links the storeys
+  for (double leg : r->route.legs_m) EXPECT_TRUE(std::isfinite(leg));
+  EXPECT_GT(r->route.legs_m[0], 0.0);  // from the start
+  // Some leg climbs from the lower floor (z ~0) to the upper one (z ~3.3).
+  bool climbs = false;
+  for (const auto& line : r->route.polylines) {
+    if (line.size() < 2) continue;
+    climbs |= std::abs(line.back().z() - line.front().z()) > 3.0;
+  }
+  EXPECT_TRUE(climbs);
+  EXPECT_DOUBLE_EQ(r->field_time.scan_seconds_per_station, 26.0);
+  EXPECT_DOUBLE_EQ(r->field_time.setup_s, 90.0 * n);
+  EXPECT_DOUBLE_EQ(r->field_time.scan_s, 26.0 * n);
+  EXPECT_DOUBLE_EQ(r->field_time.walk_s, r->route.length_m / 0.5);
+  EXPECT_DOUBLE_EQ(r->field_time.total_s, r->field_time.setup_s + r->field_time.scan_s + r->field_time.walk_s);
+  // scan_seconds overrides the preset.
+  o.scan_seconds = 60;
+  EXPECT_DOUBLE_EQ(ComputeFieldTime(4, 100, o).total_s, 4 * 90 + 4 * 60 + 100 / 0.5);
+  o.scan_seconds = 0;
+  o.scanner.name.clear();  // no preset, no scan time
+  EXPECT_DOUBLE_EQ(ComputeFieldTime(4, 100, o).scan_s, 0.0);
 }
 
 TEST(Registration, BadMinOverlapIsRefused) {

@@ -18,6 +18,7 @@
 #include "vc/base/progress.h"
 #include "vc/base/status.h"
 #include "vc/plan/planner.h"
+#include "vc/plan/route.h"
 #include "vc/plan/selector.h"
 #include "vc/scene/scene_input.h"
 #include "vc/scene/voxel_scene.h"
@@ -158,6 +159,25 @@ struct EvaluationOutput {
 // Errors of Evaluate (CANCELLED / DEADLINE_EXCEEDED from ctx).
 [[nodiscard]] Result<EvaluationOutput> RunEvaluationStage(EvaluationInput in, const PlanOptions& options,
                                                           const JobContext& ctx);
+
+// --- Stage::kRoute: the walking route through the final stations (route.h) ---
+struct RouteInput {
+  const SceneInput& input;  // an octree's free space tells where the scan saw
+  const VoxelScene& scene;
+  const std::vector<WorldPoint>& stations;    // the final stations, world frame (m)
+  const std::vector<double>& floor_z_m;       // per station: its floor (m), NaN when unknown
+  const std::vector<double>& floor_levels_m;  // the candidates' floor levels, ascending
+};
+struct RouteOutput {
+  std::optional<Route> route;   // none when its walk graph exceeds a quarter of the memory budget
+  std::string unrouted_reason;  // why there is none (the walk graph's RESOURCE_EXHAUSTED message)
+};
+// PlanRoute with the planner's settings: headroom = the lowest tripod height + clearance_m (where
+// candidates stand), clearance_m, unseen floor within 1.5 m of a seen one, up to 35 % of the
+// walking cylinder cluttered, an octree's free space, stations numbered from 1 in warnings, and
+// route_start (z NaN: the lowest floor level). CANCELLED / DEADLINE_EXCEEDED from ctx.
+[[nodiscard]] Result<RouteOutput> RunRouteStage(const RouteInput& in, const PlanOptions& options,
+                                                const JobContext& ctx);
 
 // What reduction and the final evaluation evaluate stations with: the plan's scanner and
 // threads, all faces, each face's best V kept.
