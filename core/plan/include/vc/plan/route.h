@@ -81,7 +81,7 @@ struct RouteOptions {
   // length: paths prefer space the scan saw, and cross unknown space only where nothing else links.
   // Unset (point clouds carry no such knowledge): occupancy alone.
   std::function<bool(const WorldPoint&)> known_free;
-  double unknown_cost_factor = 3;  // see known_free; legs_m stay true lengths
+  double unknown_cost_factor = 3;                    // see known_free; legs_m stay true lengths
   uint64_t memory_budget_bytes = uint64_t{1} << 30;  // bound on the walk graph's memory (bytes)
 };
 
