@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdio>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -337,6 +338,40 @@ TEST(ListParametersTest, BadFilesAndZonesAreRefusedNamingWhere) {
   app.parse("--tripod-heights 1.5,0.1", false);
   s = h.Validate();
   EXPECT_NE(s.message().find("tripod_heights_m[1]"), std::string::npos) << s.message();
+}
+
+TEST(ListParametersTest, StartIsXYOrXYZAndAnythingElseIsRefused) {
+  auto load = [](const std::string& start, PlanOptions* o) {
+    client::PlanFileFlags files;
+    CLI::App app;
+    client::AddPlanFileFlags(&app, &files);
+    app.parse("--start " + start, false);
+    return client::LoadPlanFiles(files, o);
+  };
+  PlanOptions o;
+  ASSERT_TRUE(load("1.5,-2", &o).ok());
+  ASSERT_TRUE(o.route_start.has_value());
+  EXPECT_EQ(o.route_start->x(), 1.5);
+  EXPECT_EQ(o.route_start->y(), -2.0);
+  EXPECT_TRUE(std::isnan(o.route_start->z()));  // the lowest floor
+  EXPECT_TRUE(o.Validate().ok());
+  ASSERT_TRUE(load("1,2,3.25", &o).ok());
+  EXPECT_EQ(*o.route_start, WorldPoint(1, 2, 3.25));
+  for (const char* bad : {"1", "1,2,3,4", "1,,2", "a,b", "1,nan", "1,2,inf"}) {
+    PlanOptions b;
+    const Status s = load(bad, &b);
+    EXPECT_EQ(s.code(), StatusCode::kInvalidArgument) << bad;
+    EXPECT_NE(s.message().find("--start"), std::string::npos) << s.message();
+  }
+  // Over the wire and in plan.json (z NaN is null there).
+  ASSERT_TRUE(load("1.5,-2", &o).ok());
+  Result<PlanOptions> back = wire::FromProto(wire::ToProto(o));
+  ASSERT_TRUE(back.ok());
+  ASSERT_TRUE(back->route_start.has_value());
+  EXPECT_TRUE(std::isnan(back->route_start->z()));
+  PlanResult r;
+  r.options = o;
+  EXPECT_EQ(json::parse(PlanToJson(r))["parameters"]["route_start"], json::parse("[1.5, -2.0, null]"));
 }
 
 TEST(ParameterTablesTest, UnknownEnumNamesAreRefusedByTheFlag) {

@@ -1,0 +1,66 @@
+// What vc-client prints after a plan: durations, the station table's route column, the scan graph,
+// the route (parts marked "//") and the field time.
+#include "vc/client/plan_summary.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+namespace vc::client {
+namespace {
+
+TEST(PlanSummaryTest, DurationsReadAsACrewReadsThem) {
+  EXPECT_EQ(FormatDuration(0), "0 s");
+  EXPECT_EQ(FormatDuration(44.6), "45 s");
+  EXPECT_EQ(FormatDuration(90), "2 min");
+  EXPECT_EQ(FormatDuration(59 * 60), "59 min");
+  EXPECT_EQ(FormatDuration(3600 + 5 * 60), "1 h 05 min");
+  EXPECT_EQ(FormatDuration(std::numeric_limits<double>::quiet_NaN()), "?");
+}
+
+PlanResult ThreeStations() {
+  PlanResult r;
+  for (int k = 0; k < 3; ++k) r.stations.push_back({WorldPoint(k, 0, 1.5), 10, 5, 0.5 + 0.2 * k, 0.1, k});
+  r.coverable_voxels = 20;
+  r.covered_voxels = 20;
+  r.scan_graph.min_overlap = 0.3;
+  r.scan_graph.connected = false;
+  r.scan_graph.components = {{0, 2}, {1}};
+  r.scan_graph.edges = {{0, 2, 0.5}, {0, 1, 0.1}};
+  r.route.order = {2, 0, 1};
+  r.route.legs_m = {0, 2.0, std::numeric_limits<double>::quiet_NaN()};
+  r.route.polylines = {{}, {WorldPoint(2, 0, 0), WorldPoint(0, 0, 0)}, {}};
+  r.route.length_m = 2.0;
+  r.route.parts = 2;
+  r.field_time = {360, 78, 2, 440, 26};
+  r.warnings = {"w1"};
+  return r;
+}
+
+TEST(PlanSummaryTest, StationsScanGraphRouteAndFieldTime) {
+  const std::string s = PlanSummary(ThreeStations());
+  EXPECT_NE(s.find("3 station(s), coverage 100.0% of 20 coverable voxels"), std::string::npos) << s;
+  EXPECT_NE(s.find("walk"), std::string::npos);
+  // Station 3 (index 2) is walked first.
+  EXPECT_NE(s.find("90.0%      1\n"), std::string::npos) << s;
+  EXPECT_NE(s.find("scan graph: 1 pairs overlap by 30% or more, 2 groups no chain links: [1 3] [2]"), std::string::npos)
+      << s;
+  EXPECT_NE(s.find("route: 3 -> 1 // 2"), std::string::npos) << s;
+  EXPECT_NE(s.find("walking 2.0 m in 2 parts"), std::string::npos) << s;
+  EXPECT_NE(s.find("field time: 7 min (set-up 6 min, scans 1 min, walking 2 s)"), std::string::npos) << s;
+  EXPECT_EQ(s.find("no scan time known"), std::string::npos);
+  EXPECT_NE(s.find("warning: w1\n"), std::string::npos);
+}
+
+TEST(PlanSummaryTest, WithoutAScanTimeTheFieldTimeLineSaysSo) {
+  PlanResult r = ThreeStations();
+  r.field_time.scan_seconds_per_station = 0;
+  r.route.start = WorldPoint(1, 1, 0);
+  const std::string s = PlanSummary(r);
+  EXPECT_NE(s.find("no scan time known: pass --scan-seconds or --scanner"), std::string::npos) << s;
+  EXPECT_NE(s.find("route: start (1.00, 1.00) -> 3"), std::string::npos) << s;
+}
+
+}  // namespace
+}  // namespace vc::client
