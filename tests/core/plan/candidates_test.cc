@@ -8,24 +8,14 @@
 #include <map>
 #include <set>
 
+#include "testing/scenes.h"
+
 namespace vc::planner {
 namespace {
 
 constexpr double kR = 0.1;
 
-struct Builder {
-  std::set<std::tuple<int, int, int>> cells;
-  // Fills the inclusive index box.
-  void Box(int x0, int y0, int z0, int x1, int y1, int z1) {
-    for (int z = z0; z <= z1; ++z)
-      for (int y = y0; y <= y1; ++y)
-        for (int x = x0; x <= x1; ++x) cells.insert({x, y, z});
-  }
-  void Erase(int x0, int y0, int z0, int x1, int y1, int z1) {
-    for (int z = z0; z <= z1; ++z)
-      for (int y = y0; y <= y1; ++y)
-        for (int x = x0; x <= x1; ++x) cells.erase({x, y, z});
-  }
+struct Builder : testing::VoxelBuilder {
   // A 5 x 4 m room: floor slab at z index 0, walls up to `top`, and a ceiling at `top` if asked.
   void Room(int top, bool ceiling) {
     Box(0, 0, 0, 49, 39, 0);
@@ -35,18 +25,8 @@ struct Builder {
     Box(0, 39, 0, 49, 39, top);
     if (ceiling) Box(0, 0, top, 49, 39, top);
   }
-  VoxelScene Build(int shift_z = 0) const {
-    VoxelScene s;
-    s.resolution_m = kR;
-    std::vector<VoxelIndex> idx;
-    for (const auto& [x, y, z] : cells) idx.push_back({x - 20, y - 17, z + shift_z});
-    for (const VoxelIndex& v : idx) s.occupied.push_back(IndexToKey(v));
-    std::sort(s.occupied.begin(), s.occupied.end());
-    Result<OccupancyGrid> g = OccupancyGrid::Build(kR, idx, uint64_t{1} << 30);
-    EXPECT_TRUE(g.ok()) << g.status().ToString();
-    s.grid = std::move(*g);
-    return s;
-  }
+  // At kR, moved by (-20, -17, shift_z) voxels.
+  VoxelScene Build(int shift_z = 0) const { return VoxelBuilder::Build(kR, {-20, -17, shift_z}); }
 };
 
 CandidateGrid Generate(const VoxelScene& s, CandidateOptions o = {}) {

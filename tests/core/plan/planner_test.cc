@@ -13,6 +13,7 @@
 #include <limits>
 #include <set>
 
+#include "testing/scenes.h"
 #include "testing/test_paths.h"
 #include "vc/plan/keep_out.h"
 #include "vc/report/plan_report.h"
@@ -23,15 +24,7 @@ namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-SceneInput Synthetic(const std::string& spec) {
-  SynthOptions o;
-  o.spacing_m = 0.05;
-  Result<std::vector<Eigen::Vector3f>> points = GenerateScene(spec, o);
-  EXPECT_TRUE(points.ok()) << points.status().ToString();
-  SceneInput in;
-  if (points.ok()) in.points = std::move(*points);
-  return in;
-}
+using testing::Synthetic;
 
 PlanOptions TestOptions() {
   PlanOptions o;

@@ -10,6 +10,7 @@
 #include <limits>
 #include <string>
 
+#include "testing/scenes.h"
 #include "vc/plan/planner.h"
 #include "vc/plan/scan_graph.h"
 #include "vc/synth/synth.h"
@@ -17,15 +18,7 @@
 namespace vc {
 namespace {
 
-SceneInput Synthetic(const std::string& spec) {
-  SynthOptions o;
-  o.spacing_m = 0.05;
-  Result<std::vector<Eigen::Vector3f>> points = GenerateScene(spec, o);
-  EXPECT_TRUE(points.ok()) << points.status().ToString();
-  SceneInput in;
-  if (points.ok()) in.points = std::move(*points);
-  return in;
-}
+using testing::Synthetic;
 
 PlanOptions Options(double min_overlap) {
   PlanOptions o;

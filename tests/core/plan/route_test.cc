@@ -24,23 +24,9 @@ namespace {
 
 constexpr double kR = 0.1;
 
-struct Builder {
-  std::set<std::tuple<int, int, int>> cells;
-  void Box(int x0, int y0, int z0, int x1, int y1, int z1) {
-    for (int z = z0; z <= z1; ++z)
-      for (int y = y0; y <= y1; ++y)
-        for (int x = x0; x <= x1; ++x) cells.insert({x, y, z});
-  }
-  void Erase(int x0, int y0, int z0, int x1, int y1, int z1) {
-    for (int z = z0; z <= z1; ++z)
-      for (int y = y0; y <= y1; ++y)
-        for (int x = x0; x <= x1; ++x) cells.erase({x, y, z});
-  }
-  VoxelScene Build() const {
-    std::vector<VoxelIndex> v;
-    for (const auto& [x, y, z] : cells) v.push_back({x, y, z});
-    return testing::SceneOfVoxels(v, kR);
-  }
+// Voxel boxes at kR.
+struct Builder : testing::VoxelBuilder {
+  VoxelScene Build() const { return VoxelBuilder::Build(kR); }
 };
 
 // Optical centre 1.5 m above the floor top 0.1 m (slab at z index 0) over voxel column (i, j).
@@ -362,6 +348,17 @@ TEST(RouteTest, SmallFloorHolesAreBridged) {
   EXPECT_NEAR(r.legs_m[1], 3.0, 1e-6);  // straight across the hole
 }
 
+// A 6 x 2 m floor slab (z index 0) closed by walls 2.5 m high.
+Builder ClosedFloor() {
+  Builder b;
+  b.Box(0, 0, 0, 59, 19, 0);
+  b.Box(0, 0, 0, 59, 0, 25);
+  b.Box(0, 19, 0, 59, 19, 25);
+  b.Box(0, 0, 0, 0, 19, 25);
+  b.Box(59, 0, 0, 59, 19, 25);
+  return b;
+}
+
 TEST(RouteTest, WideGapsAndWallsAreNotBridged) {
   // Unseen floor is walked on within max_gap_m (0.5 m) of a seen one: a cut up to about 1 m is
   // crossed (0.8 m here), a 1.2 m one is not (its middle is 0.6 m from either edge).
@@ -377,13 +374,8 @@ TEST(RouteTest, WideGapsAndWallsAreNotBridged) {
   EXPECT_EQ(r.parts, 2);
   // A wall across an intact floor, in a closed room (open sides would let the walk go round the
   // wall's ends over the unseen floor beyond the scan).
-  Builder walled;
-  walled.Box(0, 0, 0, 59, 19, 0);
+  Builder walled = ClosedFloor();
   walled.Box(30, 0, 0, 30, 19, 25);
-  walled.Box(0, 0, 0, 59, 0, 25);
-  walled.Box(0, 19, 0, 59, 19, 25);
-  walled.Box(0, 0, 0, 0, 19, 25);
-  walled.Box(59, 0, 0, 59, 19, 25);
   r = Plan(walled.Build(), st);
   EXPECT_EQ(r.parts, 2);
 }
@@ -391,13 +383,8 @@ TEST(RouteTest, WideGapsAndWallsAreNotBridged) {
 TEST(RouteTest, UnseenFloorIsNeverBridgedAboveASeenOne) {
   // A closed room with a platform 0.5 m high in one half: the air over the floor next to the
   // platform is within max_gap_m of the platform's top, but the floor below it was seen.
-  Builder b;
-  b.Box(0, 0, 0, 59, 19, 0);
+  Builder b = ClosedFloor();
   b.Box(30, 0, 1, 59, 19, 5);
-  b.Box(0, 0, 0, 59, 0, 25);
-  b.Box(0, 19, 0, 59, 19, 25);
-  b.Box(0, 0, 0, 0, 19, 25);
-  b.Box(59, 0, 0, 59, 19, 25);
   const Route r = Plan(b.Build(), {At(10, 10), At(50, 10, 0.6)});
   EXPECT_EQ(r.parts, 2);  // no walk up through the air beside the platform
 }
