@@ -10,6 +10,7 @@
 #include <utility>
 
 #include "standing_surfaces.h"
+#include "vc/base/parallel.h"
 
 namespace vc::planner {
 
@@ -621,25 +622,34 @@ Result<Route> PlanRoute(const VoxelScene& scene, const std::vector<WorldPoint>& 
     }
   }
 
-  // Walking distances between stations (and from the start).
+  // Walking distances between stations (and from the start): one Dijkstra per station, on
+  // options.threads workers, each with its own state.
   ShortestPaths sp(g);
   std::vector<double> dist(size_t(n) * n, kNaN), from_start(n, kNaN);
   auto connector = [&](int s) { return (g.Point(node[s]) - floor_point[s]).norm(); };
-  for (int s = 0; s < n; ++s) {
-    if (node[s] < 0) continue;
-    dist[size_t(s) * n + s] = 0;
-    bool done = true;
-    for (int t = s + 1; t < n; ++t) done &= node[t] < 0;
-    if (done) continue;
-    std::vector<int> targets;
-    for (int t = s + 1; t < n; ++t) targets.push_back(node[t]);
-    VC_RETURN_IF_ERROR(sp.Run(node[s], targets, ctx));
-    for (int t = s + 1; t < n; ++t) {
-      if (node[t] < 0 || sp.Dist(node[t]) == kInf) continue;
-      const double d = connector(s) + double(sp.Dist(node[t])) + connector(t);
-      dist[size_t(s) * n + t] = dist[size_t(t) * n + s] = d;
-    }
-  }
+  std::vector<Status> run_status(n, Status::Ok());
+  VC_RETURN_IF_ERROR(ParallelChunks(
+      uint64_t(n), 1, options.threads, ctx,
+      [&](uint64_t, uint64_t begin, uint64_t) {
+        const int s = int(begin);
+        if (node[s] < 0) return;
+        dist[size_t(s) * n + s] = 0;
+        std::vector<int> targets;
+        for (int t = s + 1; t < n; ++t) {
+          if (node[t] >= 0) targets.push_back(node[t]);
+        }
+        if (targets.empty()) return;
+        ShortestPaths own(g);
+        run_status[s] = own.Run(node[s], targets, ctx);
+        if (!run_status[s].ok()) return;
+        for (int t = s + 1; t < n; ++t) {
+          if (node[t] < 0 || own.Dist(node[t]) == kInf) continue;
+          const double d = connector(s) + double(own.Dist(node[t])) + connector(t);
+          dist[size_t(s) * n + t] = dist[size_t(t) * n + s] = d;  // each pair written by s only
+        }
+      },
+      "walking route"));
+  for (const Status& st : run_status) VC_RETURN_IF_ERROR(st);
   if (start_node >= 0) {
     VC_RETURN_IF_ERROR(sp.Run(start_node, node, ctx));
     for (int s = 0; s < n; ++s) {

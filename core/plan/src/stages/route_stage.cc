@@ -25,6 +25,7 @@ Result<RouteOutput> RunRouteStage(const RouteInput& in, const PlanOptions& optio
   o.max_gap_m = kRouteMaxGapM;
   o.max_blocked_fraction = kRouteMaxBlockedFraction;
   o.memory_budget_bytes = options.memory_budget_bytes / 4;
+  o.threads = options.threads;
   o.first_station_number = 1;  // as on heatmap.png and in vc-client's table
   if (in.input.octree) {
     const octomap::OcTree* tree = in.input.octree.get();

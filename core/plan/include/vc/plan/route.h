@@ -74,6 +74,7 @@ struct RouteOptions {
   double max_blocked_fraction = 0;
   double snap_radius_m = 1.0;       // how far (horizontally, m) a station or the start may be from its walk node
   std::optional<WorldPoint> start;  // where the walk starts (world, m), if anywhere
+  int threads = 0;                  // workers for the distances between stations (0 = all cores)
   int first_station_number = 0;     // warnings number the stations from this (the planner: 1)
   // When set: whether a point (world, m) is known to be free, i.e. observed empty by the scanner's
   // rays (an OctoMap's free leaves). Unseen floor under space not observed free at 0.5, 1.2 or
