@@ -29,7 +29,7 @@ namespace {
 constexpr double kEnvelopeM = 0.3;       // wall thickness around the free space, for the bounds
 constexpr double kCorniceM = 0.2;        // cornice (crown moulding) section, m
 constexpr double kJitterFraction = 0.1;  // in-plane jitter, fraction of the local grid step
-constexpr int kMaxCount = 50;            // largest K of comb:K and N of rooms:N
+constexpr int kMaxCount = 50;            // largest K of comb:K and hub:K and N of rooms:N
 
 double Snap(double v) { return std::round(v * 1e6) / 1e6; }  // micrometres: equal edges compare equal
 
@@ -173,6 +173,31 @@ Model MakeRooms(int n) {
   return m;
 }
 
+Model MakeHub(int k) {
+  // A hub hall, 5k x 4.5 m, with k small rooms 4.5 x 3 m on each side (2k rooms), each joined to it
+  // by a door 1 x 2.1 m in the 0.25 m wall, centred on the room; north door i at x = 5i + 2.5 faces
+  // south door i. A station 0.125 m inside a room, on its door's centre line, sees through the door
+  // the whole far half of the hub's 5 m segment in front of it (docs/SCENES.md has the proof).
+  constexpr double seg = 5.0, d = 4.5, wall = 0.25, dr = 3.0, wr = 4.5, door = 1.0;
+  Model m;
+  m.Room(Cuboid(0, 0, 0, k * seg, d, kRoomHeightM));
+  for (int i = 0; i < k; ++i) {
+    const double x = i * seg + (seg - wr) / 2, xc = i * seg + seg / 2;
+    m.Room(Cuboid(x, d + wall, 0, x + wr, d + wall + dr, kRoomHeightM));
+    m.Opening(Cuboid(xc - door / 2, d, 0, xc + door / 2, d + wall, 2.1));
+    m.Room(Cuboid(x, -wall - dr, 0, x + wr, -wall, kRoomHeightM));
+    m.Opening(Cuboid(xc - door / 2, -wall, 0, xc + door / 2, 0, 2.1));
+    m.info.rooms.push_back({{x, d + wall, 0}, {x + wr, d + wall + dr, kRoomHeightM}});
+    m.info.rooms.push_back({{x, -wall - dr, 0}, {x + wr, -wall, kRoomHeightM}});
+  }
+  m.info.description = "hub hall " + std::to_string(5 * k) + " x 4.5 m with " + std::to_string(k) +
+                       " small rooms 4.5 x 3 m on each side, one 1 m door each; optimum " + std::to_string(2 * k) +
+                       ": a station just inside each door on its centre line, none in the hub";
+  m.info.optimum_stations = 2 * k;
+  m.info.floor_heights_m = {0};
+  return m;
+}
+
 Model MakeTwoFloor() {
   Model m;
   m.Room(Cuboid(0, 0, 0, 8, 6, 3.0));
@@ -305,13 +330,15 @@ const SceneKind kScenes[] = {
     {"lroom", false, "an L-shaped room", [](int) { return MakeLRoom(); }},
     {"comb", true, "comb:K, a corridor with K dead-end bays", [](int k) { return MakeComb(k); }},
     {"rooms", true, "rooms:N, N closed rooms off a corridor", [](int n) { return MakeRooms(n); }},
+    {"hub", true, "hub:K, a hub hall with K small rooms on each side", [](int k) { return MakeHub(k); }},
     {"twofloor", false, "two storeys joined by a stair opening", [](int) { return MakeTwoFloor(); }},
     {"tworooms", false, "two rooms joined by one off-centre door", [](int) { return MakeTwoRooms(); }},
     {"stairs", false, "two storeys joined by a straight flight of steps", [](int) { return MakeStairs(); }},
     {"hall", false, "the benchmark hall", [](int) { return MakeHall(); }},
 };
 
-constexpr char kValidSpecs[] = "box, lroom, comb:K, rooms:N, twofloor, tworooms, stairs, hall (K, N in 1..50)";
+constexpr char kValidSpecs[] =
+    "box, lroom, comb:K, rooms:N, hub:K, twofloor, tworooms, stairs, hall (K, N in 1..50)";
 
 Status BadSpec(std::string_view spec, std::string_view why) {
   return InvalidArgumentError("invalid scene '" + std::string(spec) + "' (" + std::string(why) +
@@ -619,7 +646,7 @@ Status SynthOptions::Validate() const {
 
 std::string ListScenes() {
   std::string out;
-  for (const char* spec : {"box", "lroom", "comb:3", "rooms:3", "twofloor", "tworooms", "stairs", "hall"}) {
+  for (const char* spec : {"box", "lroom", "comb:3", "rooms:3", "hub:2", "twofloor", "tworooms", "stairs", "hall"}) {
     Result<SceneInfo> info = DescribeScene(spec);
     if (!info.ok()) continue;
     out += info->name;

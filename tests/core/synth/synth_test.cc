@@ -18,7 +18,7 @@
 namespace vc {
 namespace {
 
-const char* const kSmallScenes[] = {"box", "lroom", "comb:3", "rooms:3", "twofloor", "tworooms", "stairs"};
+const char* const kSmallScenes[] = {"box", "lroom", "comb:3", "rooms:3", "hub:2", "twofloor", "tworooms", "stairs"};
 
 // A dense voxel grid over a scene's bounds (plus a margin), filled from its points; keys are
 // floor(p / resolution) as in OctoMap.
@@ -137,7 +137,7 @@ TEST(SynthOptionsTest, ValidateRejectsSpacingOutsideRangeOrNotFinite) {
 
 TEST(DescribeSceneTest, BadSpecsAreInvalidArgumentListingValidNames) {
   for (const char* bad : {"", "castle", "Box", "comb", "comb:", "comb:0", "comb:51", "comb:x", "comb:2x", "rooms:-1",
-                          "rooms:1.5", "box:2", "hall:1"}) {
+                          "rooms:1.5", "box:2", "hall:1", "hub", "hub:0", "hub:51"}) {
     Result<SceneInfo> info = DescribeScene(bad);
     ASSERT_FALSE(info.ok()) << bad;
     EXPECT_EQ(info.status().code(), StatusCode::kInvalidArgument) << bad;
@@ -148,7 +148,8 @@ TEST(DescribeSceneTest, BadSpecsAreInvalidArgumentListingValidNames) {
 TEST(DescribeSceneTest, KnownScenesReportTheirOptimumRoomsAndFloors) {
   const std::vector<std::pair<std::string, int>> expected = {
       {"box", 1},     {"lroom", 1},    {"comb:1", 1},   {"comb:7", 7}, {"comb:50", 50}, {"rooms:1", 2},
-      {"rooms:4", 5}, {"twofloor", 2}, {"tworooms", 2}, {"stairs", 0}, {"hall", 0}};
+      {"rooms:4", 5}, {"hub:1", 2},    {"hub:3", 6},    {"twofloor", 2}, {"tworooms", 2}, {"stairs", 0},
+      {"hall", 0}};
   for (const auto& [spec, optimum] : expected) {
     Result<SceneInfo> info = DescribeScene(spec);
     ASSERT_TRUE(info.ok()) << spec << ": " << info.status().ToString();
@@ -259,6 +260,32 @@ TEST(SceneVoxelsTest, TwoRoomsAreJoinedOnlyThroughTheDoor) {
   EXPECT_FALSE(grid.Reached(grid.KeyOf(door + WorldPoint(0, 2.5, 0))));  // centre of the wall
 }
 
+TEST(DescribeSceneTest, HubRoomsAreTheSmallRoomsOnBothSidesOfTheHall) {
+  Result<SceneInfo> hub = DescribeScene("hub:2");
+  ASSERT_TRUE(hub.ok());
+  ASSERT_EQ(hub->rooms.size(), 4u);  // per 5 m segment: the north room, then the south room
+  ExpectBox(hub->rooms[0], {0.25, 4.75, 0}, {4.75, 7.75, 3}, "north room 0");
+  ExpectBox(hub->rooms[1], {0.25, -3.25, 0}, {4.75, -0.25, 3}, "south room 0");
+  ExpectBox(hub->rooms[2], {5.25, 4.75, 0}, {9.75, 7.75, 3}, "north room 1");
+  ExpectBox(hub->rooms[3], {5.25, -3.25, 0}, {9.75, -0.25, 3}, "south room 1");
+  ExpectBox({hub->bounds_min, hub->bounds_max}, {-0.3, -3.55, -0.3}, {10.3, 8.05, 3.3}, "hub:2 bounds");
+}
+
+TEST(SceneVoxelsTest, HubRoomsAreJoinedToTheHallOnlyThroughTheirDoors) {
+  Result<SceneInfo> info = DescribeScene("hub:2");
+  ASSERT_TRUE(info.ok());
+  VoxelGrid grid = Voxelize("hub:2", 0.05, 0.1);
+  const WorldPoint hall = WorldPoint(5, 2.25, 1.5) + kSceneOffsetM;
+  EXPECT_FALSE(grid.FloodEscapes(grid.KeyOf(hall)));
+  for (const AxisBox& room : info->rooms) EXPECT_TRUE(grid.Reached(grid.KeyOf(SeedPoint(room))));
+  // Door of north room 1: x in [7, 8], y in [4.5, 4.75], up to 2.1 m.
+  const WorldPoint door = WorldPoint(7.5, 4.625, 1.0) + kSceneOffsetM;
+  EXPECT_TRUE(grid.Reached(grid.KeyOf(door)));
+  EXPECT_FALSE(grid.Reached(grid.KeyOf(door + WorldPoint(0, 0, 1.5))));  // above the head
+  EXPECT_FALSE(grid.Reached(grid.KeyOf(door + WorldPoint(0.7, 0, 0))));  // wall beside the door
+  EXPECT_FALSE(grid.Reached(grid.KeyOf(WorldPoint(5, 6, 1) + kSceneOffsetM)));  // between two rooms
+}
+
 // Stairs: 19 treads, step k spanning x in [1.3 + 0.3 (k - 1), 1.3 + 0.3 k], y in [0, 1], top at
 // z = 0.165 k; the 20th riser, at x = 7, goes up to the upper floor at z = 3.3.
 constexpr double kStairX0 = 1.3, kGoing = 0.3, kRise = 0.165;
@@ -352,7 +379,7 @@ TEST(SceneVoxelsTest, StairsFlightIsSolidWithHeadroomAndJoinsTheStoreys) {
 
 TEST(DescribeSceneTest, ListNamesEveryScene) {
   const std::string list = ListScenes();
-  for (const char* name : {"box", "lroom", "comb", "rooms", "twofloor", "tworooms", "stairs", "hall"}) {
+  for (const char* name : {"box", "lroom", "comb", "rooms", "hub", "twofloor", "tworooms", "stairs", "hall"}) {
     EXPECT_NE(list.find(name), std::string::npos) << name;
   }
 }
@@ -377,7 +404,7 @@ TEST(GenerateSceneTest, SameSeedGivesIdenticalPointsOtherSeedDiffers) {
 }
 
 TEST(GenerateSceneTest, CountMatchesTheStream) {
-  for (const char* spec : {"box", "lroom", "comb:2", "rooms:2", "twofloor", "tworooms", "stairs"}) {
+  for (const char* spec : {"box", "lroom", "comb:2", "rooms:2", "hub:1", "twofloor", "tworooms", "stairs"}) {
     for (double spacing : {0.07, 0.2}) {
       SynthOptions o;
       o.spacing_m = spacing;
@@ -390,7 +417,7 @@ TEST(GenerateSceneTest, CountMatchesTheStream) {
 }
 
 TEST(GenerateSceneTest, EveryPointIsFiniteAndInsideTheBounds) {
-  for (const char* spec : {"box", "lroom", "comb:3", "rooms:3", "twofloor", "tworooms", "stairs", "hall"}) {
+  for (const char* spec : {"box", "lroom", "comb:3", "rooms:3", "hub:2", "twofloor", "tworooms", "stairs", "hall"}) {
     SynthOptions o;
     o.spacing_m = 0.2;
     Result<SceneInfo> info = DescribeScene(spec);

@@ -1,5 +1,6 @@
 // Synthetic scenes whose answer is known: point clouds sampled on the surfaces of simple buildings
-// (one room, an L-shaped room, a comb of dead-end bays, rooms along a corridor, two storeys, two
+// (one room, an L-shaped room, a comb of dead-end bays, rooms along a corridor, a hub hall whose
+// rooms are best seen from their doorways, two storeys, two
 // rooms joined by a door, two storeys joined by a flight of steps, and the chapel-like benchmark
 // hall), for oracle tests of the planner and for benchmarks.
 //
@@ -75,8 +76,8 @@ struct SceneInfo {
 // Names, descriptions and optima of the available scenes, one line each, for `vc-synth --list`.
 std::string ListScenes();
 
-// Describes the scene `spec` ("box", "lroom", "comb:K", "rooms:N", "hall", "twofloor", "tworooms",
-// "stairs"; K and N in 1..50). INVALID_ARGUMENT naming the valid specs for anything else.
+// Describes the scene `spec` ("box", "lroom", "comb:K", "rooms:N", "hub:K", "hall", "twofloor",
+// "tworooms", "stairs"; K and N in 1..50). INVALID_ARGUMENT naming the valid specs for anything else.
 Result<SceneInfo> DescribeScene(std::string_view spec);
 
 // Calls fn once per point (world, m) of the scene, in a fixed order; memory does not grow with the
