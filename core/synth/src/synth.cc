@@ -191,8 +191,8 @@ Model MakeHub(int k) {
     m.info.rooms.push_back({{x, -wall - dr, 0}, {x + wr, -wall, kRoomHeightM}});
   }
   m.info.description = "hub hall " + std::to_string(5 * k) + " x 4.5 m with " + std::to_string(k) +
-                       " small rooms 4.5 x 3 m on each side, one 1 m door each; optimum " + std::to_string(2 * k) +
-                       ": a station just inside each door on its centre line, none in the hub";
+                       " small rooms 4.5 x 3 m on each side, one 1 m door each; every room needs a station, and one "
+                       "just inside its door, on the door's centre line, also sees half the hall";
   m.info.optimum_stations = 2 * k;
   m.info.floor_heights_m = {0};
   return m;
@@ -337,8 +337,7 @@ const SceneKind kScenes[] = {
     {"hall", false, "the benchmark hall", [](int) { return MakeHall(); }},
 };
 
-constexpr char kValidSpecs[] =
-    "box, lroom, comb:K, rooms:N, hub:K, twofloor, tworooms, stairs, hall (K, N in 1..50)";
+constexpr char kValidSpecs[] = "box, lroom, comb:K, rooms:N, hub:K, twofloor, tworooms, stairs, hall (K, N in 1..50)";
 
 Status BadSpec(std::string_view spec, std::string_view why) {
   return InvalidArgumentError("invalid scene '" + std::string(spec) + "' (" + std::string(why) +

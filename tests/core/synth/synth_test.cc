@@ -147,9 +147,8 @@ TEST(DescribeSceneTest, BadSpecsAreInvalidArgumentListingValidNames) {
 
 TEST(DescribeSceneTest, KnownScenesReportTheirOptimumRoomsAndFloors) {
   const std::vector<std::pair<std::string, int>> expected = {
-      {"box", 1},     {"lroom", 1},    {"comb:1", 1},   {"comb:7", 7}, {"comb:50", 50}, {"rooms:1", 2},
-      {"rooms:4", 5}, {"hub:1", 2},    {"hub:3", 6},    {"twofloor", 2}, {"tworooms", 2}, {"stairs", 0},
-      {"hall", 0}};
+      {"box", 1},   {"lroom", 1}, {"comb:1", 1},   {"comb:7", 7},   {"comb:50", 50}, {"rooms:1", 2}, {"rooms:4", 5},
+      {"hub:1", 2}, {"hub:3", 6}, {"twofloor", 2}, {"tworooms", 2}, {"stairs", 0},   {"hall", 0}};
   for (const auto& [spec, optimum] : expected) {
     Result<SceneInfo> info = DescribeScene(spec);
     ASSERT_TRUE(info.ok()) << spec << ": " << info.status().ToString();
@@ -281,8 +280,8 @@ TEST(SceneVoxelsTest, HubRoomsAreJoinedToTheHallOnlyThroughTheirDoors) {
   // Door of north room 1: x in [7, 8], y in [4.5, 4.75], up to 2.1 m.
   const WorldPoint door = WorldPoint(7.5, 4.625, 1.0) + kSceneOffsetM;
   EXPECT_TRUE(grid.Reached(grid.KeyOf(door)));
-  EXPECT_FALSE(grid.Reached(grid.KeyOf(door + WorldPoint(0, 0, 1.5))));  // above the head
-  EXPECT_FALSE(grid.Reached(grid.KeyOf(door + WorldPoint(0.7, 0, 0))));  // wall beside the door
+  EXPECT_FALSE(grid.Reached(grid.KeyOf(door + WorldPoint(0, 0, 1.5))));         // above the head
+  EXPECT_FALSE(grid.Reached(grid.KeyOf(door + WorldPoint(0.7, 0, 0))));         // wall beside the door
   EXPECT_FALSE(grid.Reached(grid.KeyOf(WorldPoint(5, 6, 1) + kSceneOffsetM)));  // between two rooms
 }
 
