@@ -2,7 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
+#include <set>
+#include <utility>
 
 #include "standing_surfaces.h"
 
@@ -95,6 +98,81 @@ std::vector<double> AxisCells(double lo, double hi, double spacing) {
   std::vector<double> v(n);
   for (int i = 0; i < n; ++i) v[i] = start + i * spacing;
   return v;
+}
+
+// A free run of voxels along one axis of a level's obstacle slice: voxel indices [lo, hi] (along
+// the axis) on the line `at` (index along the other axis).
+struct Run {
+  int lo, hi, at;
+};
+
+// Narrow passages of the level whose floor voxels are below index z `floor_top` (the first free
+// voxel above the floor): the obstacle slice marks a column blocked if a voxel between the lowest
+// tripod height minus and plus the clearance above the floor is occupied. A free run of the slice
+// along x (or y) is a passage cross-section if both its ends are blocked, it is at least
+// 2 clearance_m and less than 2 grid_spacing_m wide. For each, positions at the run's midpoint on
+// a grid_spacing_m / 4 grid along the other axis (aligned with the grid cells `xs`, `ys`), within
+// grid_spacing_m / 2 of the cross-section's line: the passage's centre line, and just beyond its
+// ends. Duplicates (same position within the fine step) are dropped.
+std::vector<WorldPoint> PassagePoints(const OccupancyGrid& grid, int floor_top, const CandidateOptions& o,
+                                      const std::vector<double>& xs, const std::vector<double>& ys) {
+  const double r = grid.resolution_m();
+  const VoxelIndex& m = grid.min_index();
+  const Eigen::Vector3i dims = grid.dims();
+  const int eye = floor_top + static_cast<int>(std::floor(LowestHeight(o) / r));
+  const int c = static_cast<int>(std::ceil(o.clearance_m / r - 1e-9));
+  std::vector<uint8_t> blocked(static_cast<size_t>(dims.x()) * dims.y(), 0);
+  for (int y = 0; y < dims.y(); ++y) {
+    for (int x = 0; x < dims.x(); ++x) {
+      for (int z = std::max(eye - c, m.z); z <= std::min(eye + c, m.z + dims.z() - 1); ++z) {
+        if (grid.Occupied(m.x + x, m.y + y, z)) {
+          blocked[static_cast<size_t>(y) * dims.x() + x] = 1;
+          break;
+        }
+      }
+    }
+  }
+  const double fine = o.grid_spacing_m / 4;
+  const int max_width = static_cast<int>(std::ceil(2 * o.grid_spacing_m / r - 1e-9));  // exclusive, voxels
+  const int min_width = std::max(1, static_cast<int>(std::floor(2 * o.clearance_m / r)));
+  std::vector<WorldPoint> out;
+  std::set<std::pair<long, long>> seen;
+  for (int axis = 0; axis < 2; ++axis) {  // axis 0: runs along x (a passage crossed in x), 1: along y
+    const int n_along = axis == 0 ? dims.x() : dims.y(), n_lines = axis == 0 ? dims.y() : dims.x();
+    const std::vector<double>& across = axis == 0 ? ys : xs;  // the fine grid is aligned with these
+    const double origin = across.empty() ? 0.0 : across.front();
+    for (int line = 0; line < n_lines; ++line) {
+      auto is_blocked = [&](int i) {
+        return axis == 0 ? blocked[static_cast<size_t>(line) * dims.x() + i]
+                         : blocked[static_cast<size_t>(i) * dims.x() + line];
+      };
+      int i = 0;
+      while (i < n_along) {
+        if (is_blocked(i)) {
+          ++i;
+          continue;
+        }
+        const int lo = i;
+        while (i < n_along && !is_blocked(i)) ++i;
+        const int hi = i - 1, width = hi - lo + 1;
+        if (lo == 0 || i == n_along || width < min_width || width >= max_width) continue;
+        const double mid = (axis == 0 ? grid.IndexSpaceToWorld(Eigen::Vector3d(m.x + lo + width / 2.0, 0, 0)).x()
+                                      : grid.IndexSpaceToWorld(Eigen::Vector3d(0, m.y + lo + width / 2.0, 0)).y());
+        const double line_c = axis == 0 ? grid.IndexSpaceToWorld(Eigen::Vector3d(0, m.y + line + 0.5, 0)).y()
+                                        : grid.IndexSpaceToWorld(Eigen::Vector3d(m.x + line + 0.5, 0, 0)).x();
+        const long k_lo = std::lround(std::ceil((line_c - o.grid_spacing_m / 2 - origin) / fine - 1e-9));
+        const long k_hi = std::lround(std::floor((line_c + o.grid_spacing_m / 2 - origin) / fine + 1e-9));
+        const long mid_key = std::lround(mid / fine);
+        for (long k = k_lo; k <= k_hi; ++k) {
+          const std::pair<long, long> key = axis == 0 ? std::pair{mid_key, k} : std::pair{k, mid_key};
+          if (!seen.insert(key).second) continue;
+          const double b = origin + k * fine;
+          out.push_back(axis == 0 ? WorldPoint(mid, b, 0) : WorldPoint(b, mid, 0));
+        }
+      }
+    }
+  }
+  return out;
 }
 
 }  // namespace
@@ -210,10 +288,42 @@ Result<CandidateGrid> GenerateCandidates(const VoxelScene& scene, const Candidat
     out.levels.push_back({grid.IndexSpaceToWorld(Eigen::Vector3d(0, 0, m.z + l.z + 1)).z(), l.columns});
   }
 
-  // 3. Cells of the grid over the footprint, per level.
+  // 3. Cells of the grid over the footprint, per level. place() examines one position: the floor
+  // under it, then each height's headroom and clearance; it appends the kept candidates and
+  // returns how many.
   const WorldPoint lo = scene.BoundsMin(), hi = scene.BoundsMax();
   const std::vector<double> xs = AxisCells(lo.x(), hi.x(), options.grid_spacing_m);
   const std::vector<double> ys = AxisCells(lo.y(), hi.y(), options.grid_spacing_m);
+  auto place = [&](double x, double y, size_t li, int lz, uint64_t* no_floor, uint64_t* no_clearance) {
+    const Eigen::Vector3d u = grid.WorldToIndexSpace(WorldPoint(x, y, lo.z()));
+    int free_above = 0;
+    const int z = SurfaceNear(grid, static_cast<int>(std::floor(u.x())), static_cast<int>(std::floor(u.y())), lz, band,
+                              free_needed, scratch, &free_above);
+    if (z == kNoSurface) {
+      *no_floor += heights.size();
+      return 0;
+    }
+    const double top = grid.IndexSpaceToWorld(Eigen::Vector3d(0, 0, z + 1)).z();
+    int placed = 0;
+    for (double h : heights) {
+      const WorldPoint p(x, y, top + h);
+      if (free_above < FreeVoxelsNeeded(r, h, options.clearance_m) || !HasClearance(grid, p, options.clearance_m)) {
+        ++*no_clearance;
+        continue;
+      }
+      out.positions.push_back(p);
+      out.floor_z_m.push_back(top);
+      out.level.push_back(static_cast<int>(li));
+      out.height_m.push_back(h);
+      ++placed;
+    }
+    return placed;
+  };
+  struct GridPoint {
+    size_t level;
+    double x, y;
+  };
+  std::vector<GridPoint> on_grid;  // grid positions that got a candidate
   for (size_t li = 0; li < kept.size(); ++li) {
     const int lz = m.z + kept[li].z;
     for (size_t iy = 0; iy < ys.size(); ++iy) {
@@ -221,26 +331,23 @@ Result<CandidateGrid> GenerateCandidates(const VoxelScene& scene, const Candidat
       ctx.Report(Stage::kCandidates, 0.5 + 0.5 * (li + static_cast<double>(iy) / ys.size()) / kept.size());
       for (size_t ix = 0; ix < xs.size(); ++ix) {
         out.cells += heights.size();
-        const Eigen::Vector3d u = grid.WorldToIndexSpace(WorldPoint(xs[ix], ys[iy], lo.z()));
-        int free_above = 0;
-        const int z = SurfaceNear(grid, static_cast<int>(std::floor(u.x())), static_cast<int>(std::floor(u.y())), lz,
-                                  band, free_needed, scratch, &free_above);
-        if (z == kNoSurface) {
-          out.rejected_no_floor += heights.size();
-          continue;
+        if (place(xs[ix], ys[iy], li, lz, &out.rejected_no_floor, &out.rejected_clearance) > 0) {
+          on_grid.push_back({li, xs[ix], ys[iy]});
         }
-        const double top = grid.IndexSpaceToWorld(Eigen::Vector3d(0, 0, z + 1)).z();
-        for (double h : heights) {
-          const WorldPoint p(xs[ix], ys[iy], top + h);
-          if (free_above < FreeVoxelsNeeded(r, h, options.clearance_m) || !HasClearance(grid, p, options.clearance_m)) {
-            ++out.rejected_clearance;
-            continue;
-          }
-          out.positions.push_back(p);
-          out.floor_z_m.push_back(top);
-          out.level.push_back(static_cast<int>(li));
-          out.height_m.push_back(h);
-        }
+      }
+    }
+  }
+  if (options.doorway_candidates) {
+    const double fine = options.grid_spacing_m / 4;
+    uint64_t no_floor = 0, no_clearance = 0;
+    for (size_t li = 0; li < kept.size(); ++li) {
+      VC_RETURN_IF_ERROR(ctx.CheckCancelled("candidate generation"));
+      const int lz = m.z + kept[li].z;
+      for (const WorldPoint& q : PassagePoints(grid, lz + 1, options, xs, ys)) {
+        const bool near_grid = std::any_of(on_grid.begin(), on_grid.end(), [&](const GridPoint& g) {
+          return g.level == li && std::abs(g.x - q.x()) < fine / 2 && std::abs(g.y - q.y()) < fine / 2;
+        });
+        if (!near_grid) out.passage_candidates += place(q.x(), q.y(), li, lz, &no_floor, &no_clearance);
       }
     }
   }

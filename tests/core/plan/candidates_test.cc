@@ -184,6 +184,64 @@ TEST(CandidatesTest, FloorTopNearFindsTheLevelUnderAPoint) {
   EXPECT_FALSE(FloorTopNear(s.grid, -1.0, -0.7, 1.5, o).has_value());  // no floor near 1.5 m
 }
 
+// Doorway candidates. Kept passage candidates are appended after the grid's, which they leave
+// unchanged.
+CandidateGrid WithPassages(const VoxelScene& s) {
+  const CandidateGrid off = Generate(s);
+  CandidateOptions o;
+  o.doorway_candidates = true;
+  const CandidateGrid on = Generate(s, o);
+  EXPECT_EQ(on.positions.size(), off.positions.size() + on.passage_candidates);
+  for (size_t i = 0; i < off.positions.size() && i < on.positions.size(); ++i) {
+    EXPECT_EQ(on.positions[i], off.positions[i]) << i;
+  }
+  EXPECT_EQ(off.passage_candidates, 0u);
+  return on;
+}
+
+TEST(CandidatesTest, ADoorInAWallGetsCandidatesInTheDoorwayOnItsCentreLine) {
+  Builder b;
+  b.Room(25, true);
+  b.Box(24, 1, 1, 26, 38, 24);     // a wall across the room at x 0.4-0.7 m
+  b.Erase(24, 15, 1, 26, 23, 20);  // its door: y -0.2-0.7 m (0.9 m wide), 2 m high
+  const CandidateGrid c = WithPassages(b.Build());
+  EXPECT_GT(c.passage_candidates, 0u);
+  bool in_doorway = false;
+  for (size_t i = c.positions.size() - c.passage_candidates; i < c.positions.size(); ++i) {
+    const WorldPoint& p = c.positions[i];
+    EXPECT_NEAR(p.y(), 0.25, 1e-9) << "off the door's centre line: " << p.transpose();
+    EXPECT_NEAR(p.x(), 0.55, 0.5 + 0.15 + 1e-9) << "too far from the door: " << p.transpose();
+    EXPECT_NEAR(p.z(), 1.6, 1e-9);
+    in_doorway = in_doorway || (p.x() > 0.4 && p.x() < 0.7);
+  }
+  EXPECT_TRUE(in_doorway);
+}
+
+TEST(CandidatesTest, AnOpenRoomGetsNoPassageCandidates) {
+  Builder b;
+  b.Room(25, true);
+  EXPECT_EQ(WithPassages(b.Build()).passage_candidates, 0u);
+}
+
+TEST(CandidatesTest, APinchInA2mCorridorGetsCandidatesThereOnly) {
+  testing::VoxelBuilder b;
+  b.Box(0, 0, 0, 99, 21, 0);  // floor of a corridor 10 m long
+  b.Box(0, 0, 0, 99, 0, 25);  // its walls: 2 m of free space between them (y 0.1-2.1 m)
+  b.Box(0, 21, 0, 99, 21, 25);
+  b.Box(0, 0, 0, 0, 21, 25);  // closed ends
+  b.Box(99, 0, 0, 99, 21, 25);
+  b.Box(0, 0, 25, 99, 21, 25);  // ceiling
+  b.Box(45, 1, 1, 54, 4, 24);   // the pinch: 0.4 m from each wall over x 4.5-5.5 m, 1.2 m left
+  b.Box(45, 17, 1, 54, 20, 24);
+  const CandidateGrid c = WithPassages(b.Build(kR));
+  EXPECT_GT(c.passage_candidates, 0u);
+  for (size_t i = c.positions.size() - c.passage_candidates; i < c.positions.size(); ++i) {
+    const WorldPoint& p = c.positions[i];
+    EXPECT_NEAR(p.y(), 1.1, 1e-9) << p.transpose();              // the pinch's centre line
+    EXPECT_NEAR(p.x(), 5.0, 0.5 + 0.5 + 1e-9) << p.transpose();  // within half a cell of it
+  }
+}
+
 TEST(CandidatesTest, Cancelled) {
   Builder b;
   b.Room(25, true);

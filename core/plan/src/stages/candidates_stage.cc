@@ -54,7 +54,7 @@ Result<CandidatesOutput> UserCandidates(const VoxelScene& scene, const PlanOptio
 // The generated grid; FAILED_PRECONDITION when no floor is found or no candidate survives.
 Result<CandidatesOutput> GridCandidates(const VoxelScene& scene, const PlanOptions& options, const JobContext& ctx) {
   const CandidateOptions cand_options{options.grid_spacing_m, options.tripod_height_m, options.clearance_m,
-                                      options.tripod_heights_m};
+                                      options.tripod_heights_m, options.doorway_candidates};
   VC_ASSIGN_OR_RETURN(CandidateGrid grid, GenerateCandidates(scene, cand_options, ctx));
   CandidatesOutput out;
   if (!options.keep_out.empty()) {

@@ -34,6 +34,10 @@ struct CandidateOptions {
   // standing surfaces use the lowest; a cell gets a candidate at each height whose column above
   // its floor is free for height + clearance_m and that has the clearance.
   std::vector<double> tripod_heights_m;
+  // Also candidates in narrow passages (doorways, corridor pinch points): where a free run of the
+  // level's obstacle slice at tripod height, along x or y, is narrower than 2 grid_spacing_m, on a
+  // grid_spacing_m / 4 grid along its centre line and up to grid_spacing_m / 2 beyond it.
+  bool doorway_candidates = false;
 };
 
 struct FloorLevel {
@@ -53,6 +57,8 @@ struct CandidateGrid {
   uint64_t cells = 0;
   uint64_t rejected_no_floor = 0;
   uint64_t rejected_clearance = 0;
+  // Passage candidates (doorway_candidates): kept ones, appended after the grid's, level by level.
+  uint64_t passage_candidates = 0;
 };
 
 // Generates the candidate grid for `scene`. CANCELLED / DEADLINE_EXCEEDED from ctx.

@@ -19,6 +19,8 @@
 //   puts a station on every one of the 123 candidates, 0.99 needs 69 and 0.95 needs 37.
 // - consolidate: after greedy selection, drop picks the others cover and replace two picks by one
 //   candidate that sees all they alone covered (coverage never shrinks; docs/PLANNING.md).
+// - doorway_candidates: candidates in narrow passages (vc/plan/candidates.h; docs/PLANNING.md,
+//   "Doorway candidates").
 // - refine: proximity refinement (ALGORITHM.md s.7.4), each station to the best of a sub-grid.
 // - reduce / reduce_to: reduction (s.7.5) removes zero-loss stations; with reduce_to > 0 it keeps
 //   removing the cheapest single or pair until at most reduce_to stations remain.
@@ -36,6 +38,8 @@
   X(double, grid_spacing_m, 1.0, "m", "grid-spacing", kPositive, "candidate grid spacing")                             \
   X(double, tripod_height_m, 1.5, "m", "tripod-height", kPositive, "scanner height above the floor")                   \
   X(double, clearance_m, 0.2, "m", "clearance", kNonNegative, "free space required around a candidate")                \
+  X(bool, doorway_candidates, false, "", "doorway-candidates", kAny,                                                   \
+    "also candidates in doorways and narrow passages, on a finer grid")                                                \
   X(int32_t, max_stations, 0, "stations", "max-stations", kNonNegative, "at most this many stations (0 = no limit)")   \
   X(uint64_t, min_marginal_gain_voxels, 1, "voxels", "min-gain", kAny, "stop when the best station adds fewer voxels") \
   X(double, target_coverage, 0.99, "fraction", "target-coverage", kFraction,                                           \
