@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <limits>
 #include <set>
+#include <tuple>
 #include <utility>
 
 #include "standing_surfaces.h"
@@ -100,22 +101,16 @@ std::vector<double> AxisCells(double lo, double hi, double spacing) {
   return v;
 }
 
-// A free run of voxels along one axis of a level's obstacle slice: voxel indices [lo, hi] (along
-// the axis) on the line `at` (index along the other axis).
-struct Run {
-  int lo, hi, at;
-};
-
 // Narrow passages of the level whose floor voxels are below index z `floor_top` (the first free
 // voxel above the floor): the obstacle slice marks a column blocked if a voxel between the lowest
 // tripod height minus and plus the clearance above the floor is occupied. A free run of the slice
-// along x (or y) is a passage cross-section if both its ends are blocked, it is at least
-// 2 clearance_m and less than 2 grid_spacing_m wide. For each, positions at the run's midpoint on
-// a grid_spacing_m / 4 grid along the other axis (aligned with the grid cells `xs`, `ys`), within
-// grid_spacing_m / 2 of the cross-section's line: the passage's centre line, and just beyond its
-// ends. Duplicates (same position within the fine step) are dropped.
-std::vector<WorldPoint> PassagePoints(const OccupancyGrid& grid, int floor_top, const CandidateOptions& o,
-                                      const std::vector<double>& xs, const std::vector<double>& ys) {
+// along x (or y) is a cross-section of a passage if both its ends are blocked and it is at least
+// 2 clearance_m and less than 2 grid_spacing_m wide; adjacent lines whose runs have the same
+// midpoint (to grid_spacing_m / 4) form one passage, from its first line to its last. Positions, at
+// the passage's midpoint across it, along it every grid_spacing_m / 4 from its centre, and beyond
+// each end at half that step and then every step up to grid_spacing_m / 2 (just inside the rooms
+// a door joins). Positions closer than an eighth of the grid spacing are dropped.
+std::vector<WorldPoint> PassagePoints(const OccupancyGrid& grid, int floor_top, const CandidateOptions& o) {
   const double r = grid.resolution_m();
   const VoxelIndex& m = grid.min_index();
   const Eigen::Vector3i dims = grid.dims();
@@ -137,10 +132,25 @@ std::vector<WorldPoint> PassagePoints(const OccupancyGrid& grid, int floor_top, 
   const int min_width = std::max(1, static_cast<int>(std::floor(2 * o.clearance_m / r)));
   std::vector<WorldPoint> out;
   std::set<std::pair<long, long>> seen;
+  auto emit = [&](int axis, double mid, double b) {
+    const long ka = std::lround(mid / (fine / 2)), kb = std::lround(b / (fine / 2));
+    if (!seen.insert(axis == 0 ? std::pair{ka, kb} : std::pair{kb, ka}).second) return;
+    out.push_back(axis == 0 ? WorldPoint(mid, b, 0) : WorldPoint(b, mid, 0));
+  };
   for (int axis = 0; axis < 2; ++axis) {  // axis 0: runs along x (a passage crossed in x), 1: along y
     const int n_along = axis == 0 ? dims.x() : dims.y(), n_lines = axis == 0 ? dims.y() : dims.x();
-    const std::vector<double>& across = axis == 0 ? ys : xs;  // the fine grid is aligned with these
-    const double origin = across.empty() ? 0.0 : across.front();
+    const int lo_along = axis == 0 ? m.x : m.y, lo_line = axis == 0 ? m.y : m.x;
+    auto world = [&](int a, double index) {  // world coordinate along axis a of an index-space value
+      Eigen::Vector3d u(0, 0, 0);
+      u[a] = index;
+      return grid.IndexSpaceToWorld(u)[a];
+    };
+    struct Section {
+      long key;
+      int line;
+      double mid;
+    };
+    std::vector<Section> sections;
     for (int line = 0; line < n_lines; ++line) {
       auto is_blocked = [&](int i) {
         return axis == 0 ? blocked[static_cast<size_t>(line) * dims.x() + i]
@@ -154,22 +164,35 @@ std::vector<WorldPoint> PassagePoints(const OccupancyGrid& grid, int floor_top, 
         }
         const int lo = i;
         while (i < n_along && !is_blocked(i)) ++i;
-        const int hi = i - 1, width = hi - lo + 1;
+        const int width = i - lo;
         if (lo == 0 || i == n_along || width < min_width || width >= max_width) continue;
-        const double mid = (axis == 0 ? grid.IndexSpaceToWorld(Eigen::Vector3d(m.x + lo + width / 2.0, 0, 0)).x()
-                                      : grid.IndexSpaceToWorld(Eigen::Vector3d(0, m.y + lo + width / 2.0, 0)).y());
-        const double line_c = axis == 0 ? grid.IndexSpaceToWorld(Eigen::Vector3d(0, m.y + line + 0.5, 0)).y()
-                                        : grid.IndexSpaceToWorld(Eigen::Vector3d(m.x + line + 0.5, 0, 0)).x();
-        const long k_lo = std::lround(std::ceil((line_c - o.grid_spacing_m / 2 - origin) / fine - 1e-9));
-        const long k_hi = std::lround(std::floor((line_c + o.grid_spacing_m / 2 - origin) / fine + 1e-9));
-        const long mid_key = std::lround(mid / fine);
-        for (long k = k_lo; k <= k_hi; ++k) {
-          const std::pair<long, long> key = axis == 0 ? std::pair{mid_key, k} : std::pair{k, mid_key};
-          if (!seen.insert(key).second) continue;
-          const double b = origin + k * fine;
-          out.push_back(axis == 0 ? WorldPoint(mid, b, 0) : WorldPoint(b, mid, 0));
-        }
+        const double mid = world(axis, lo_along + lo + width / 2.0);
+        sections.push_back({std::lround(mid / fine), line, mid});
       }
+    }
+    std::sort(sections.begin(), sections.end(),
+              [](const Section& a, const Section& b) { return std::tie(a.key, a.line) < std::tie(b.key, b.line); });
+    for (size_t first = 0; first < sections.size();) {
+      size_t last = first;
+      double mid_sum = sections[first].mid;
+      while (last + 1 < sections.size() && sections[last + 1].key == sections[first].key &&
+             sections[last + 1].line == sections[last].line + 1) {
+        ++last;
+        mid_sum += sections[last].mid;
+      }
+      const double mid = mid_sum / static_cast<double>(last - first + 1);
+      const double b_lo = world(1 - axis, lo_line + sections[first].line);
+      const double b_hi = world(1 - axis, lo_line + sections[last].line + 1);
+      const double centre = (b_lo + b_hi) / 2;
+      for (int k = 0; centre + k * fine <= b_hi; ++k) {
+        emit(axis, mid, centre + k * fine);
+        emit(axis, mid, centre - k * fine);
+      }
+      for (double d = fine / 2; d <= o.grid_spacing_m / 2 + 1e-9; d += fine) {
+        emit(axis, mid, b_hi + d);
+        emit(axis, mid, b_lo - d);
+      }
+      first = last + 1;
     }
   }
   return out;
@@ -343,7 +366,7 @@ Result<CandidateGrid> GenerateCandidates(const VoxelScene& scene, const Candidat
     for (size_t li = 0; li < kept.size(); ++li) {
       VC_RETURN_IF_ERROR(ctx.CheckCancelled("candidate generation"));
       const int lz = m.z + kept[li].z;
-      for (const WorldPoint& q : PassagePoints(grid, lz + 1, options, xs, ys)) {
+      for (const WorldPoint& q : PassagePoints(grid, lz + 1, options)) {
         const bool near_grid = std::any_of(on_grid.begin(), on_grid.end(), [&](const GridPoint& g) {
           return g.level == li && std::abs(g.x - q.x()) < fine / 2 && std::abs(g.y - q.y()) < fine / 2;
         });

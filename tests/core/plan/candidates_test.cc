@@ -7,6 +7,7 @@
 #include <cmath>
 #include <map>
 #include <set>
+#include <vector>
 
 #include "testing/scenes.h"
 
@@ -239,6 +240,26 @@ TEST(CandidatesTest, APinchInA2mCorridorGetsCandidatesThereOnly) {
     const WorldPoint& p = c.positions[i];
     EXPECT_NEAR(p.y(), 1.1, 1e-9) << p.transpose();              // the pinch's centre line
     EXPECT_NEAR(p.x(), 5.0, 0.5 + 0.5 + 1e-9) << p.transpose();  // within half a cell of it
+  }
+}
+
+// hub:1 (docs/SCENES.md): the optimum's stations stand 0.125 m inside each room's door, on its
+// centre line x = 2.5 (design). The grid's nearest are 0.375 m away; passage candidates are there.
+TEST(CandidatesTest, HubDoorsGetCandidatesWhereTheOptimumStands) {
+  Result<VoxelScene> scene = Voxelize(testing::Synthetic("hub:1"), VoxelizeOptions{0.1});
+  ASSERT_TRUE(scene.ok()) << scene.status().ToString();
+  const CandidateGrid c = WithPassages(*scene);
+  const WorldPoint offset(0.0137, 0.0213, 0);  // kSceneOffsetM in x, y
+  const std::vector<WorldPoint> optima = {WorldPoint(2.5, 4.875, 0) + offset, WorldPoint(2.5, -0.375, 0) + offset};
+  for (const WorldPoint& optimum : optima) {
+    double grid_d = 1e9, passage_d = 1e9;
+    for (size_t i = 0; i < c.positions.size(); ++i) {
+      const double d = (c.positions[i] - optimum).head<2>().norm();
+      double& best = i + c.passage_candidates < c.positions.size() ? grid_d : passage_d;
+      best = std::min(best, d);
+    }
+    EXPECT_GT(grid_d, 0.3) << optimum.transpose();
+    EXPECT_LT(passage_d, 0.1) << optimum.transpose();
   }
 }
 

@@ -35,8 +35,9 @@ struct CandidateOptions {
   // its floor is free for height + clearance_m and that has the clearance.
   std::vector<double> tripod_heights_m;
   // Also candidates in narrow passages (doorways, corridor pinch points): where a free run of the
-  // level's obstacle slice at tripod height, along x or y, is narrower than 2 grid_spacing_m, on a
-  // grid_spacing_m / 4 grid along its centre line and up to grid_spacing_m / 2 beyond it.
+  // level's obstacle slice at tripod height, along x or y, is narrower than 2 grid_spacing_m
+  // (and at least 2 clearance_m), on the passage's centre line every grid_spacing_m / 4, and
+  // beyond its ends at grid_spacing_m / 8, then every grid_spacing_m / 4, up to grid_spacing_m / 2.
   bool doorway_candidates = false;
 };
 
