@@ -1,0 +1,68 @@
+// Local candidate refinement around a solution (issue 21, "Candidates where the grid has none"):
+// solve, add candidates on a fine sub-grid around each chosen station, solve again over all of
+// them, and repeat while the solution improves.
+//
+// Why a loop around a Selector: the grid decides where a station may stand before anything is
+// known about the plan, and the best position of a station is often between grid points (a doorway,
+// the corner of an alcove). Refining each chosen station on its own (proximity refinement, §7.4)
+// keeps the picks; re-solving over the enlarged candidate set lets the selector trade stations, so
+// a selector that optimises the set (an exact one) can drop one. The loop only needs Select, so any
+// Selector works; the visibility sets of new positions come from a callback, so the loop does not
+// depend on how the pipeline computes them.
+//
+// Thread-safety: RefineLocally calls the selector and the callback from the calling thread only.
+#pragma once
+
+#include <functional>
+#include <vector>
+
+#include "vc/base/geometry.h"
+#include "vc/base/progress.h"
+#include "vc/base/status.h"
+#include "vc/plan/candidates.h"
+#include "vc/plan/selector.h"
+#include "vc/scene/voxel_scene.h"
+#include "vc/visibility/visibility.h"
+
+namespace vc::planner {
+
+struct LocalRefinementOptions {
+  double radius_m = 0.5;  // sub-grid half-width around each chosen station (m)
+  double step_m = 0.25;   // sub-grid step (m), in (0, radius_m]
+  int max_rounds = 4;     // solves after the first, at most
+};
+
+// Candidates and their sets: positions[i] sees sets[i]; floor_z_m[i] is the top of its floor (m,
+// NaN when unknown: no sub-grid is placed around it).
+struct CandidateSets {
+  std::vector<WorldPoint> positions;
+  std::vector<double> floor_z_m;
+  std::vector<VoxelSet> sets;
+};
+
+// The visibility sets of `positions` (world, m), each of the scene's size; errors pass through.
+using VisibilityFn = std::function<Result<std::vector<VoxelSet>>(const std::vector<WorldPoint>&)>;
+
+struct LocalRefinementResult {
+  CandidateSets candidates;  // the input's, then the positions the rounds added
+  Selection selection;       // the best solve's, over `candidates`
+  int rounds = 0;            // solves after the first
+  int added = 0;             // positions added over all rounds
+  // Stations and covered voxels of each solve, the first solve's first.
+  std::vector<int> stations_per_solve;
+  std::vector<uint64_t> covered_per_solve;
+};
+
+// Solves with `selector` over `in`, then, each round, adds around every picked station (beyond the
+// `fixed` first ones) the positions of a step_m sub-grid within radius_m (square) that stand on the
+// station's floor (FloorTopNear) at its height above that floor, with the clearance (HasClearance),
+// and are not yet candidates; solves again over all; keeps the new solve if it has fewer stations,
+// or as many covering more voxels. Stops after a round without improvement, without new positions,
+// or after max_rounds. INVALID_ARGUMENT for bad options or inputs of different lengths; the
+// selector's and the callback's errors pass through; CANCELLED / DEADLINE_EXCEEDED from ctx.
+Result<LocalRefinementResult> RefineLocally(const Selector& selector, const VoxelScene& scene, CandidateSets in,
+                                            int fixed, const CandidateOptions& candidate_options,
+                                            const VisibilityFn& visibility, const LocalRefinementOptions& options,
+                                            const JobContext& ctx = {});
+
+}  // namespace vc::planner

@@ -1,0 +1,95 @@
+#include "vc/plan/local_refinement.h"
+
+#include <cmath>
+#include <optional>
+#include <string>
+#include <utility>
+
+namespace vc::planner {
+namespace {
+
+// Whether the solve `b` improves on `a`: fewer stations, or as many covering more.
+bool Better(const Selection& b, const Selection& a) {
+  if (b.picks.size() != a.picks.size()) return b.picks.size() < a.picks.size();
+  return b.covered > a.covered;
+}
+
+// Whether `p` is within half a step of one of `positions` in x and y and at the same height.
+bool Known(const std::vector<WorldPoint>& positions, const WorldPoint& p, double step_m) {
+  for (const WorldPoint& q : positions) {
+    if (std::abs(q.x() - p.x()) < step_m / 2 && std::abs(q.y() - p.y()) < step_m / 2 &&
+        std::abs(q.z() - p.z()) < step_m / 2) {
+      return true;
+    }
+  }
+  return false;
+}
+
+}  // namespace
+
+Result<LocalRefinementResult> RefineLocally(const Selector& selector, const VoxelScene& scene, CandidateSets in,
+                                            int fixed, const CandidateOptions& candidate_options,
+                                            const VisibilityFn& visibility, const LocalRefinementOptions& options,
+                                            const JobContext& ctx) {
+  if (!(options.step_m > 0) || !(options.radius_m >= options.step_m) || !std::isfinite(options.radius_m) ||
+      options.max_rounds < 0) {
+    return InvalidArgumentError("local refinement needs 0 < step_m <= radius_m (finite) and max_rounds >= 0");
+  }
+  if (in.positions.size() != in.sets.size() || in.positions.size() != in.floor_z_m.size()) {
+    return InvalidArgumentError("local refinement: " + std::to_string(in.positions.size()) + " positions, " +
+                                std::to_string(in.floor_z_m.size()) + " floors and " + std::to_string(in.sets.size()) +
+                                " sets; they must match");
+  }
+  LocalRefinementResult out;
+  out.candidates = std::move(in);
+  VC_ASSIGN_OR_RETURN(out.selection, selector.Select(out.candidates.sets, fixed, ctx));
+  out.stations_per_solve.push_back(static_cast<int>(out.selection.picks.size()));
+  out.covered_per_solve.push_back(out.selection.covered);
+  const int n = static_cast<int>(std::floor(options.radius_m / options.step_m + 1e-9));
+  for (int round = 0; round < options.max_rounds; ++round) {
+    VC_RETURN_IF_ERROR(ctx.CheckCancelled("local refinement"));
+    std::vector<WorldPoint> added;
+    std::vector<double> added_floor;
+    for (size_t k = static_cast<size_t>(fixed); k < out.selection.picks.size(); ++k) {
+      const int pick = out.selection.picks[k];
+      const WorldPoint& s = out.candidates.positions[pick];
+      const double floor_z = out.candidates.floor_z_m[pick];
+      if (!std::isfinite(floor_z)) continue;
+      const double height = s.z() - floor_z;
+      for (int iy = -n; iy <= n; ++iy) {
+        for (int ix = -n; ix <= n; ++ix) {
+          if (ix == 0 && iy == 0) continue;
+          const double x = s.x() + ix * options.step_m, y = s.y() + iy * options.step_m;
+          const std::optional<double> top = FloorTopNear(scene.grid, x, y, floor_z, candidate_options);
+          if (!top) continue;
+          const WorldPoint p(x, y, *top + height);
+          if (!HasClearance(scene.grid, p, candidate_options.clearance_m)) continue;
+          if (Known(out.candidates.positions, p, options.step_m) || Known(added, p, options.step_m)) continue;
+          added.push_back(p);
+          added_floor.push_back(*top);
+        }
+      }
+    }
+    if (added.empty()) break;
+    VC_ASSIGN_OR_RETURN(std::vector<VoxelSet> sets, visibility(added));
+    if (sets.size() != added.size()) {
+      return InternalError("local refinement: the visibility callback returned " + std::to_string(sets.size()) +
+                           " sets for " + std::to_string(added.size()) + " positions");
+    }
+    for (size_t i = 0; i < added.size(); ++i) {
+      out.candidates.positions.push_back(added[i]);
+      out.candidates.floor_z_m.push_back(added_floor[i]);
+      out.candidates.sets.push_back(std::move(sets[i]));
+    }
+    out.added += static_cast<int>(added.size());
+    ++out.rounds;
+    VC_ASSIGN_OR_RETURN(Selection next, selector.Select(out.candidates.sets, fixed, ctx));
+    out.stations_per_solve.push_back(static_cast<int>(next.picks.size()));
+    out.covered_per_solve.push_back(next.covered);
+    if (!Better(next, out.selection)) break;
+    out.selection = std::move(next);
+  }
+  return out;
+}
+
+}  // namespace vc::planner
