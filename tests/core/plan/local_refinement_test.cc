@@ -5,10 +5,13 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <iostream>
 #include <vector>
 
 #include "testing/scenes.h"
+#include "vc/synth/synth.h"
 
 namespace vc::planner {
 namespace {
@@ -136,6 +139,117 @@ TEST(LocalRefinementTest, VisibilityErrorsPassThrough) {
   };
   Result<LocalRefinementResult> r = RefineLocally(selector, s.scene, s.in, 0, CandidateOptions{}, fn, {});
   EXPECT_EQ(r.status().code(), StatusCode::kResourceExhausted);
+}
+
+// An exact selector for tiny optima: the first single candidate or pair (in index order) whose
+// union reaches `target` of all the sets' union; else greedy to the same target. No fixed stations.
+class SmallExactSelector final : public Selector {
+ public:
+  explicit SmallExactSelector(double target) : target_(target) {}
+  using Selector::Select;
+  Result<Selection> Select(const std::vector<VoxelSet>& sets, int fixed, const JobContext& ctx) const override {
+    if (fixed != 0 || sets.empty()) return InvalidArgumentError("SmallExactSelector: no fixed stations, some sets");
+    VoxelSet all(sets[0].size());
+    for (const VoxelSet& s : sets) all.Union(s);
+    Selection out;
+    out.coverable = all.count();
+    const uint64_t need = static_cast<uint64_t>(std::ceil(target_ * static_cast<double>(out.coverable) - 1e-9));
+    for (size_t a = 0; a < sets.size(); ++a) {
+      if (sets[a].count() >= need) {
+        out.picks = {static_cast<int>(a)};
+        out.covered = sets[a].count();
+        return out;
+      }
+    }
+    for (size_t a = 0; a < sets.size(); ++a) {
+      const uint64_t na = sets[a].count();
+      for (size_t b = a + 1; b < sets.size(); ++b) {
+        const uint64_t both = na + sets[b].count() - sets[a].CountAnd(sets[b]);
+        if (both >= need && (out.picks.empty() || both > out.covered)) {
+          out.picks = {static_cast<int>(a), static_cast<int>(b)};
+          out.covered = both;
+        }
+      }
+    }
+    if (!out.picks.empty()) return out;
+    GreedySelectorOptions g;
+    g.target_coverage = target_;
+    return GreedySelector(g).Select(sets, 0, ctx);
+  }
+
+ private:
+  double target_;
+};
+
+// hub:1 (docs/SCENES.md, optimum 2: a station just inside each door). Prints the figures
+// docs/PLANNING.md ("Doorway candidates") records.
+struct Hub {
+  VoxelScene scene;
+  CandidateGrid grid;
+  std::vector<VoxelSet> sets;
+  explicit Hub(bool doorways) {
+    Result<VoxelScene> s = Voxelize(testing::Synthetic("hub:1"), VoxelizeOptions{0.1});
+    EXPECT_TRUE(s.ok());
+    scene = std::move(*s);
+    CandidateOptions o;
+    o.doorway_candidates = doorways;
+    grid = *GenerateCandidates(scene, o);
+    sets = *ComputeVisibilitySets(scene, grid.positions, Options());
+  }
+  static VisibilitySetsOptions Options() {
+    VisibilitySetsOptions o;
+    o.scanner = ScannerModel{};
+    return o;
+  }
+  VisibilityFn Fn() const {
+    return [this](const std::vector<WorldPoint>& p) { return ComputeVisibilitySets(scene, p, Options()); };
+  }
+  CandidateSets Candidates() const { return {grid.positions, grid.floor_z_m, sets}; }
+  // Whether every room of hub:1 has a picked station inside it.
+  bool StationInEveryRoom(const LocalRefinementResult& r) const {
+    const SceneInfo info = *DescribeScene("hub:1");
+    return std::all_of(info.rooms.begin(), info.rooms.end(), [&](const AxisBox& room) {
+      return std::any_of(r.selection.picks.begin(), r.selection.picks.end(), [&](int k) {
+        const WorldPoint& p = r.candidates.positions[k];
+        return (p.array() >= room.min.array()).all() && (p.array() <= room.max.array()).all();
+      });
+    });
+  }
+};
+
+void Print(const char* what, const LocalRefinementResult& r) {
+  std::cout << "[ hub:1, " << what << " ] stations per solve:";
+  for (size_t i = 0; i < r.stations_per_solve.size(); ++i) {
+    std::cout << " " << r.stations_per_solve[i] << " (" << r.covered_per_solve[i] << " voxels)";
+  }
+  std::cout << ", " << r.candidates.positions.size() - r.added << " candidates + " << r.added << " added\n";
+}
+
+TEST(LocalRefinementHubTest, AnExactSelectorReachesTheOptimumWithDoorwayCandidates) {
+  const Hub hub(true);
+  Result<LocalRefinementResult> r = RefineLocally(SmallExactSelector(0.99), hub.scene, hub.Candidates(), 0,
+                                                  CandidateOptions{}, hub.Fn(), {0.5, 0.25, 0});
+  ASSERT_TRUE(r.ok()) << r.status().ToString();
+  Print("doorway candidates, exact, no rounds", *r);
+  EXPECT_EQ(r->selection.picks.size(), 2u);
+  EXPECT_TRUE(hub.StationInEveryRoom(*r));
+}
+
+TEST(LocalRefinementHubTest, OnTheGridAloneGreedyAndExactNeedThreeEvenWithTheLoop) {
+  const Hub hub(false);
+  for (const bool exact : {false, true}) {
+    GreedySelectorOptions g;
+    g.target_coverage = 0.99;
+    const GreedySelector greedy(g);
+    const SmallExactSelector small(0.99);
+    const Selector& selector = exact ? static_cast<const Selector&>(small) : greedy;
+    Result<LocalRefinementResult> r =
+        RefineLocally(selector, hub.scene, hub.Candidates(), 0, CandidateOptions{}, hub.Fn(), {});
+    ASSERT_TRUE(r.ok()) << r.status().ToString();
+    Print(exact ? "grid, exact, local refinement" : "grid, greedy, local refinement", *r);
+    EXPECT_EQ(r->stations_per_solve.front(), 3);  // no pair of grid candidates reaches 0.99
+    EXPECT_LE(r->selection.picks.size(), 3u);     // never worse than the first solve
+  }
 }
 
 }  // namespace
