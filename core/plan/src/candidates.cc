@@ -109,7 +109,7 @@ std::vector<double> AxisCells(double lo, double hi, double spacing) {
 // midpoint (to grid_spacing_m / 4) form one passage, from its first line to its last. Positions, at
 // the passage's midpoint across it, along it every grid_spacing_m / 4 from its centre, and beyond
 // each end at half that step and then every step up to grid_spacing_m / 2 (just inside the rooms
-// a door joins). Positions closer than an eighth of the grid spacing are dropped.
+// a door joins). A position rounding to the same point of a grid_spacing_m / 8 lattice as an earlier one is dropped.
 std::vector<WorldPoint> PassagePoints(const OccupancyGrid& grid, int floor_top, const CandidateOptions& o) {
   const double r = grid.resolution_m();
   const VoxelIndex& m = grid.min_index();

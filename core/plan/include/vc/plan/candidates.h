@@ -12,7 +12,9 @@
 // candidate stands at its top + tripod height, and is kept if the voxels within the clearance radius are all free. So
 // every storey of a multi-level scene gets its own candidates, each with floor below it. With several tripod heights
 // the levels come from the lowest, and each cell gets one candidate per height (in the order of the heights
-// given) that fits under what is above its floor. Internal to vc_core.
+// given) that fits under what is above its floor. With doorway_candidates, positions in narrow passages
+// (doorways, pinch points; issue 21) follow the grid's and pass the same floor and clearance checks.
+// Internal to vc_core.
 #pragma once
 
 #include <cstdint>
