@@ -342,11 +342,8 @@ Result<CandidateGrid> GenerateCandidates(const VoxelScene& scene, const Candidat
     }
     return placed;
   };
-  struct GridPoint {
-    size_t level;
-    double x, y;
-  };
-  std::vector<GridPoint> on_grid;  // grid positions that got a candidate
+  // Per level, per grid cell (iy * |xs| + ix): whether the cell got a candidate.
+  std::vector<std::vector<uint8_t>> on_grid(kept.size(), std::vector<uint8_t>(xs.size() * ys.size(), 0));
   for (size_t li = 0; li < kept.size(); ++li) {
     const int lz = m.z + kept[li].z;
     for (size_t iy = 0; iy < ys.size(); ++iy) {
@@ -354,9 +351,8 @@ Result<CandidateGrid> GenerateCandidates(const VoxelScene& scene, const Candidat
       ctx.Report(Stage::kCandidates, 0.5 + 0.5 * (li + static_cast<double>(iy) / ys.size()) / kept.size());
       for (size_t ix = 0; ix < xs.size(); ++ix) {
         out.cells += heights.size();
-        if (place(xs[ix], ys[iy], li, lz, &out.rejected_no_floor, &out.rejected_clearance) > 0) {
-          on_grid.push_back({li, xs[ix], ys[iy]});
-        }
+        on_grid[li][iy * xs.size() + ix] =
+            place(xs[ix], ys[iy], li, lz, &out.rejected_no_floor, &out.rejected_clearance) > 0;
       }
     }
   }
@@ -367,9 +363,14 @@ Result<CandidateGrid> GenerateCandidates(const VoxelScene& scene, const Candidat
       VC_RETURN_IF_ERROR(ctx.CheckCancelled("candidate generation"));
       const int lz = m.z + kept[li].z;
       for (const WorldPoint& q : PassagePoints(grid, lz + 1, options)) {
-        const bool near_grid = std::any_of(on_grid.begin(), on_grid.end(), [&](const GridPoint& g) {
-          return g.level == li && std::abs(g.x - q.x()) < fine / 2 && std::abs(g.y - q.y()) < fine / 2;
-        });
+        // The nearest grid cell; skip q if it got a candidate within fine / 2 of q in x and y.
+        auto nearest = [&](const std::vector<double>& cells, double v) {
+          const long i = std::lround((v - cells.front()) / options.grid_spacing_m);
+          return static_cast<size_t>(std::clamp<long>(i, 0, static_cast<long>(cells.size()) - 1));
+        };
+        const size_t ix = nearest(xs, q.x()), iy = nearest(ys, q.y());
+        const bool near_grid = on_grid[li][iy * xs.size() + ix] && std::abs(xs[ix] - q.x()) < fine / 2 &&
+                               std::abs(ys[iy] - q.y()) < fine / 2;
         if (!near_grid) out.passage_candidates += place(q.x(), q.y(), li, lz, &no_floor, &no_clearance);
       }
     }
