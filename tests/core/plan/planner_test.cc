@@ -144,6 +144,40 @@ TEST(PlannerTest, TwoFloorsGetCandidatesAndStationsOnBothStoreys) {
   EXPECT_EQ(r->covered_voxels, r->coverable_voxels);
 }
 
+// hub:K (optimum 2K): doorway candidates reach the plan (candidates just inside each door), but
+// greedy selection still plans 2K + 1 (docs/PLANNING.md, "Doorway candidates"); every room gets a
+// station and coverage is full either way.
+TEST(PlannerTest, HubDoorwayCandidatesReachThePlanAndEveryRoomGetsAStation) {
+  Result<SceneInfo> info = DescribeScene("hub:1");
+  ASSERT_TRUE(info.ok());
+  PlanOptions o = TestOptions();
+  o.target_coverage = 1.0;
+  Result<PlanResult> off = Plan(Synthetic("hub:1"), o);
+  o.doorway_candidates = true;
+  Result<PlanResult> on = Plan(Synthetic("hub:1"), o);
+  ASSERT_TRUE(off.ok() && on.ok());
+  std::cout << "[ hub:1 ] " << Describe(*off) << "\n[ hub:1, doorway candidates ] " << Describe(*on) << " (optimum "
+            << info->optimum_stations << ")\n";
+  EXPECT_GT(on->candidate_count, off->candidate_count);
+  // Two of the new candidates stand within 0.1 m of the optimum's stations, 0.125 m inside each door.
+  const WorldPoint offset = kSceneOffsetM - WorldPoint(0, 0, kSceneOffsetM.z());
+  for (const WorldPoint& optimum :
+       std::vector<WorldPoint>{WorldPoint(2.5, 4.875, 0) + offset, WorldPoint(2.5, -0.375, 0) + offset}) {
+    EXPECT_TRUE(std::any_of(on->heat_map.positions.begin(), on->heat_map.positions.end(), [&](const WorldPoint& p) {
+      return (p - optimum).head<2>().norm() < 0.1;
+    })) << optimum.transpose();
+  }
+  for (const Result<PlanResult>* r : {&off, &on}) {
+    EXPECT_EQ((*r)->covered_voxels, (*r)->coverable_voxels);
+    EXPECT_GE(static_cast<int>((*r)->stations.size()), info->optimum_stations);
+    for (size_t i = 0; i < info->rooms.size(); ++i) {
+      EXPECT_TRUE(std::any_of((*r)->stations.begin(), (*r)->stations.end(),
+                              [&](const PlannedStation& s) { return Inside(s.position, info->rooms[i]); }))
+          << "no station in room " << i;
+    }
+  }
+}
+
 // Loss of removing T, by evaluating P - T from scratch.
 TEST(PlannerTest, ReductionMatrixMatchesBruteForceEvaluation) {
   const SceneInput in = Synthetic("comb:3");
