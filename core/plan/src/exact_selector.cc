@@ -522,6 +522,13 @@ Result<Selection> ExactSelector::Select(const std::vector<VoxelSet>& sets, int f
   uint64_t nnz = 0;
   for (const std::vector<int>& s : m.seen_by) nnz += s.size() + (cover_rows ? 0 : 2);
   const uint64_t estimate = nnz * 200 + uint64_t(n_rows + n_cols + (cover_rows ? 0 : n_classes)) * 1000;
+  if (estimate > options_.memory_budget_bytes && !options_.swap_search) {
+    opt.solver = "greedy";
+    opt.status = OptimalityStatus::kHeuristic;
+    opt.note = "the integer program (about " + std::to_string(estimate >> 20) + " MiB) exceeds the memory budget (" +
+               std::to_string(options_.memory_budget_bytes >> 20) + " MiB); greedy plan";
+    return finish(greedy_picks);
+  }
   if (estimate > options_.memory_budget_bytes) {
     VC_ASSIGN_OR_RETURN(std::vector<int> picks,
                         SwapLocalSearch(cl, greedy_picks, fixed, n, target, max_mode,

@@ -21,6 +21,18 @@ std::string_view StopReasonName(StopReason reason) {
   return "unknown";
 }
 
+std::string_view SelectionSolverName(SelectionSolver solver) {
+  switch (solver) {
+    case SelectionSolver::kGreedy:
+      return "greedy";
+    case SelectionSolver::kExact:
+      return "exact";
+    case SelectionSolver::kAuto:
+      return "auto";
+  }
+  return "unknown";
+}
+
 }  // namespace vc
 
 namespace vc::planner {

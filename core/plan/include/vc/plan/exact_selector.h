@@ -23,7 +23,7 @@
 // limit the best plan found comes back with its bound (status kFeasible). If the model's
 // estimated memory exceeds memory_budget_bytes, no ILP is built: greedy plus a swap local search
 // (drop a pick, 2-for-1 and 1-for-1 exchanges that keep the covered weight) runs instead, status
-// kHeuristic, with a note saying so.
+// kHeuristic, with a note saying so (or, without swap_search, the greedy plan itself).
 //
 // min_overlap (registration) is passed to the greedy warm start only; the ILP does not model
 // connectivity yet, so with min_overlap > 0 the selector returns the greedy plan (status
@@ -48,6 +48,9 @@ struct ExactSelectorOptions {
   // The integer program may use about this many bytes (estimated from its non-zeros, rows and
   // columns); above it, the swap local search runs instead.
   uint64_t memory_budget_bytes = uint64_t{1} << 30;
+  // Over the memory budget: true = the swap local search (solver "greedy+swap"), false = the
+  // greedy plan as it is (solver "greedy"; SelectionSolver::kAuto).
+  bool swap_search = true;
 };
 
 // The ILP above, warm-started from greedy. The picks: the fixed stations in order, then the

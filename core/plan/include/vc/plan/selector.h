@@ -28,6 +28,15 @@ enum class StopReason : uint8_t {
 // "exhausted", "target_reached", "max_stations", "min_gain".
 std::string_view StopReasonName(StopReason reason);
 
+// Which selector a plan uses (PlanOptions::solver; docs/PLANNING.md, "Exact selection").
+enum class SelectionSolver : uint8_t {
+  kGreedy,  // GreedySelector: lazy greedy, then consolidation
+  kExact,   // ExactSelector: the integer program (CBC), greedy + swaps over the memory budget
+  kAuto,    // the integer program when it fits the memory budget and min_overlap is 0, else greedy
+};
+// "greedy", "exact", "auto".
+std::string_view SelectionSolverName(SelectionSolver solver);
+
 }  // namespace vc
 
 namespace vc::planner {
