@@ -231,6 +231,25 @@ TEST(ExactSelectorTest, TimeLimitReturnsAFeasiblePlanWithItsBound) {
   EXPECT_EQ(got->covered, got->coverable);
 }
 
+// CBC checks its time limit only between nodes: the LP relaxation of a large partial-coverage model
+// is cut off at the deadline too, and the counting bound stands in for the LP's.
+TEST(ExactSelectorTest, TimeLimitCutsOffALongRootLp) {
+  std::mt19937 rng(3);
+  const std::vector<VoxelSet> sets = RandomSets(rng, 120, 40000, 0.03);
+  ExactSelectorOptions o;
+  o.greedy.target_coverage = 0.99;
+  o.time_limit_s = 0.2;
+  const auto t0 = std::chrono::steady_clock::now();
+  Result<Selection> got = ExactSelector(o).Select(sets, 0, {});
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  ASSERT_TRUE(got.ok()) << got.status().ToString();
+  EXPECT_LT(seconds, o.time_limit_s + 3.0);
+  EXPECT_EQ(got->optimality.status, OptimalityStatus::kFeasible);
+  EXPECT_GE(got->optimality.lower_bound, 1);
+  EXPECT_LE(got->optimality.lower_bound, got->picks.size());
+  EXPECT_GE(got->covered, Target(0.99, got->coverable));
+}
+
 TEST(ExactSelectorTest, CancellationStopsTheSolver) {
   const std::vector<VoxelSet> sets = HardSets();
   ExactSelectorOptions o;
