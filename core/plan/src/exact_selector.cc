@@ -242,6 +242,16 @@ Result<ReducedModel> Reduce(const Classes& cl, int n_candidates, int fixed, bool
   return m;
 }
 
+// The counting bound on the columns needed: each covers at most the widest column's weight.
+double CountingBound(const ReducedModel& m, uint64_t need) {
+  std::vector<uint64_t> width(m.columns.size(), 0);
+  for (size_t k = 0; k < m.weight.size(); ++k) {
+    for (int j : m.seen_by[k]) width[j] += m.weight[k];
+  }
+  const uint64_t widest = std::max<uint64_t>(1, width.empty() ? 1 : *std::max_element(width.begin(), width.end()));
+  return std::ceil(double(need) / double(widest) - 1e-9);
+}
+
 // Voxels covered by the union of `picks`.
 uint64_t Covered(const std::vector<VoxelSet>& sets, const std::vector<int>& picks) {
   if (sets.empty()) return 0;
@@ -637,6 +647,17 @@ Result<Selection> ExactSelector::Select(const std::vector<VoxelSet>& sets, int f
   // the dual; with it in the resolves too, CBC proves 69 stations optimal in 67 s.
   solver.setHintParam(OsiDoDualInInitial, false, OsiHintDo);
   solver.setHintParam(OsiDoDualInResolve, false, OsiHintDo);
+  // The root LP first, under the deadline (CbcModel copies the solved basis).
+  solver.initialSolve();
+  VC_RETURN_IF_ERROR(watch.cancelled);
+  if (watch.lp_stopped) {
+    opt.status = OptimalityStatus::kFeasible;
+    opt.lower_bound = static_cast<double>(m.forced.size()) + CountingBound(m, need);
+    opt.note = "the time limit cut off the LP relaxation; the bound is the counting bound";
+    return finish(greedy_picks);
+  }
+  // The LP relaxation's optimum bounds the stations (min mode) from below.
+  const double root_bound = solver.isProvenOptimal() ? solver.getObjValue() : -COIN_DBL_MAX;
   CbcModel model(solver);
   model.setLogLevel(0);
   model.messageHandler()->setLogLevel(0);
@@ -729,22 +750,16 @@ Result<Selection> ExactSelector::Select(const std::vector<VoxelSet>& sets, int f
   if (!ilp_better) picks = greedy_picks;
   opt.status = proven ? OptimalityStatus::kOptimal : OptimalityStatus::kFeasible;
   if (max_mode) {
-    const double bound_covered = std::floor(-bound + eps * options_.greedy.max_stations + 1e-6);
+    const double b = std::max(cbc_bound ? bound : -COIN_DBL_MAX, root_bound);
+    const double bound_covered = b <= -1e30 ? double(need) : std::floor(-b + eps * options_.greedy.max_stations + 1e-6);
     opt.covered_bound = std::min<uint64_t>(target, m.forced_covered + static_cast<uint64_t>(std::max(0.0, bound_covered)));
     if (proven) opt.covered_bound = std::min(Covered(sets, picks), target);
   } else {
-    // The counting bound: each column covers at most the largest column weight of what is needed.
-    uint64_t widest = 1;
-    for (int j = 0; j < n_cols; ++j) {
-      uint64_t w = 0;
-      for (int k : col_classes[j]) w += m.weight[k];
-      widest = std::max(widest, w);
-    }
-    const double counting = std::ceil(double(need) / double(widest) - 1e-9);
-    const double ilp = cbc_bound ? std::max(0.0, std::ceil(bound - 1e-6)) : 0.0;
+    const double counting = CountingBound(m, need);
+    const double ilp = std::max(0.0, std::ceil(std::max(cbc_bound ? bound : 0.0, root_bound) - 1e-6));
     opt.lower_bound = static_cast<double>(m.forced.size()) + std::max(counting, ilp);
     if (proven) opt.lower_bound = static_cast<double>(picks.size());
-    if (watch.lp_stopped) opt.note = "the time limit cut off the LP relaxation; the bound may be weak";
+    if (watch.lp_stopped) opt.note = "the time limit cut off an LP in the search; the bound is the root LP's or CBC's last";
   }
   return finish(std::move(picks));
 }
