@@ -26,6 +26,7 @@
 #include <vector>
 
 #include "vc/plan/greedy.h"
+#include "vc/plan/scan_graph.h"
 
 namespace vc::planner {
 namespace {
@@ -120,7 +121,9 @@ struct ReducedModel {
   int forced_sole_view = 0;
 };
 
-Result<ReducedModel> Reduce(const Classes& cl, int n_candidates, int fixed, bool fix_sole_views,
+// keep_all (connectivity): every candidate that sees something, and every fixed one, stays a
+// column (a dominated candidate may be the link the scan graph needs); only the classes merge.
+Result<ReducedModel> Reduce(const Classes& cl, int n_candidates, int fixed, bool fix_sole_views, bool keep_all,
                             const JobContext& ctx) {
   const int n_classes = static_cast<int>(cl.weight.size());
   ReducedModel m;
@@ -137,7 +140,9 @@ Result<ReducedModel> Reduce(const Classes& cl, int n_candidates, int fixed, bool
       }
     }
   };
-  for (int c = 0; c < fixed; ++c) force(c);
+  if (!keep_all) {
+    for (int c = 0; c < fixed; ++c) force(c);
+  }
   std::vector<int> active_sees(n_candidates, 0);
   std::vector<int32_t> mark(n_classes, -1);
   bool changed = true;
@@ -149,11 +154,12 @@ Result<ReducedModel> Reduce(const Classes& cl, int n_candidates, int fixed, bool
       if (!active[c]) continue;
       active_sees[c] = 0;
       for (int k : cl.sees[c]) active_sees[c] += active_class[k];
-      if (active_sees[c] == 0) {
+      if (active_sees[c] == 0 && !(keep_all && c < fixed)) {
         active[c] = 0;
         m.stand_in[c] = -1;
       }
     }
+    if (keep_all) break;
     if (fix_sole_views) {
       for (int k = 0; k < n_classes; ++k) {
         if (!active_class[k]) continue;
@@ -525,23 +531,33 @@ Result<Selection> ExactSelector::Select(const std::vector<VoxelSet>& sets, int f
     return out;
   };
 
-  if (options_.greedy.min_overlap > 0) {
-    opt.status = OptimalityStatus::kHeuristic;
-    opt.note = "min_overlap > 0: the integer program does not model the scan graph's connectivity yet; greedy plan";
-    opt.solver = "greedy";
-    return finish(greedy_picks);
-  }
+  const bool connect = options_.greedy.min_overlap > 0;
 
   VC_ASSIGN_OR_RETURN(Classes cl, BuildClasses(sets, ctx));
   const bool full = !max_mode && target == coverable;
-  VC_ASSIGN_OR_RETURN(ReducedModel m, Reduce(cl, n, fixed, full, ctx));
+  VC_ASSIGN_OR_RETURN(ReducedModel m, Reduce(cl, n, fixed, full && !connect, connect, ctx));
   opt.forced = m.forced_sole_view;
   opt.dominated = m.dominated;
   const uint64_t need = target - std::min(target, m.forced_covered);  // voxels the columns must add
   const int n_cols = static_cast<int>(m.columns.size());
   const int n_classes = static_cast<int>(m.weight.size());
   const bool cover_rows = full;  // set-cover rows, no y variables
-  const int n_rows = cover_rows ? n_classes : n_classes + 1 + (max_mode ? 1 : 0);
+  const int cover_row_count = cover_rows ? n_classes : n_classes + 1 + (max_mode ? 1 : 0);
+  // Connectivity (min_overlap > 0): the directed arcs of the candidates' scan graph.
+  std::vector<std::pair<int, int>> arcs;
+  if (connect) {
+    for (int a = 0; a < n_cols; ++a) {
+      if (a % 32 == 0) VC_RETURN_IF_ERROR(ctx.CheckCancelled("exact selection (scan graph)"));
+      for (int b = a + 1; b < n_cols; ++b) {
+        if (IsEdge(Overlap(sets[m.columns[a]], sets[m.columns[b]]), options_.greedy.min_overlap)) {
+          arcs.emplace_back(a, b);
+          arcs.emplace_back(b, a);
+        }
+      }
+    }
+  }
+  const int n_arcs = static_cast<int>(arcs.size());
+  const int n_rows = cover_row_count + (connect ? 1 + 3 * n_cols + 2 * n_arcs : 0);
   opt.model = {n_cols, n_classes, n_rows};
 
   // Nothing left to decide: the forced candidates reach the target (or there are no columns).
@@ -578,8 +594,21 @@ Result<Selection> ExactSelector::Select(const std::vector<VoxelSet>& sets, int f
     return finish(std::move(picks));
   }
 
-  // Columns: x (one per candidate column), then y (one per class) unless cover_rows.
-  const int n_vars = cover_rows ? n_cols : n_cols + n_classes;
+  // Columns: x (one per candidate column), then y (one per class) unless cover_rows, then with
+  // connectivity the single-commodity flow (Dehbi et al. 2021): a root r_c (binary, one of them),
+  // the source's flow g_c <= N r_c into the root, and a flow f_a <= (N - 1) x on each arc of the
+  // scan graph; every chosen station consumes one unit (g_c + in - out = x_c), so the chosen
+  // stations are exactly those the root's flow reaches: the plan is connected.
+  const int r0 = cover_rows ? n_cols : n_cols + n_classes, g0 = r0 + n_cols, f0 = g0 + n_cols;
+  const int n_vars = connect ? f0 + n_arcs : r0;
+  const double big_n = max_mode ? std::min<double>(n_cols, options_.greedy.max_stations + fixed) : n_cols;
+  const int root_row = cover_row_count, rx_row = root_row + 1, gr_row = rx_row + n_cols, cons_row = gr_row + n_cols,
+            cap_row = cons_row + n_cols;
+  std::vector<std::vector<int>> arcs_at(n_cols);  // per column: the arcs it is an end of
+  for (int a = 0; a < n_arcs; ++a) {
+    arcs_at[arcs[a].first].push_back(a);
+    arcs_at[arcs[a].second].push_back(a);
+  }
   const double eps = 1.0 / (n_cols + 1.0);
   std::vector<double> col_lb(n_vars, 0.0), col_ub(n_vars, 1.0), obj(n_vars, 0.0);
   std::vector<double> row_lb(n_rows), row_ub(n_rows);
@@ -603,6 +632,12 @@ Result<Selection> ExactSelector::Select(const std::vector<VoxelSet>& sets, int f
     starts.push_back(static_cast<CoinBigIndex>(indices.size()));
     for (int k : col_classes[j]) add(k, cover_rows ? 1.0 : -1.0);
     if (max_mode) add(budget_row, 1.0);
+    if (connect) {
+      add(rx_row + j, -1.0);
+      add(cons_row + j, -1.0);
+      for (int a : arcs_at[j]) add(cap_row + 2 * a + (arcs[a].first == j ? 0 : 1), -(big_n - 1));
+      if (m.columns[j] < fixed) col_lb[j] = 1.0;  // fixed stations are in the plan
+    }
     lengths.push_back(static_cast<int>(indices.size()) - starts.back());
     obj[j] = max_mode ? eps : 1.0;
   }
@@ -613,6 +648,41 @@ Result<Selection> ExactSelector::Select(const std::vector<VoxelSet>& sets, int f
       add(weight_row, static_cast<double>(m.weight[k]));
       lengths.push_back(2);
       obj[n_cols + k] = max_mode ? -static_cast<double>(m.weight[k]) : 0.0;
+    }
+  }
+  if (connect) {
+    for (int j = 0; j < n_cols; ++j) {  // r_j
+      starts.push_back(static_cast<CoinBigIndex>(indices.size()));
+      add(root_row, 1.0);
+      add(rx_row + j, 1.0);
+      add(gr_row + j, -big_n);
+      lengths.push_back(3);
+    }
+    for (int j = 0; j < n_cols; ++j) {  // g_j
+      starts.push_back(static_cast<CoinBigIndex>(indices.size()));
+      add(gr_row + j, 1.0);
+      add(cons_row + j, 1.0);
+      lengths.push_back(2);
+      col_ub[g0 + j] = big_n;
+    }
+    for (int a = 0; a < n_arcs; ++a) {  // f_a, from arcs[a].first to arcs[a].second
+      starts.push_back(static_cast<CoinBigIndex>(indices.size()));
+      add(cons_row + arcs[a].second, 1.0);
+      add(cons_row + arcs[a].first, -1.0);
+      add(cap_row + 2 * a, 1.0);
+      add(cap_row + 2 * a + 1, 1.0);
+      lengths.push_back(4);
+      col_ub[f0 + a] = big_n - 1;
+    }
+    row_lb[root_row] = row_ub[root_row] = 1.0;
+    for (int j = 0; j < n_cols; ++j) {
+      row_lb[rx_row + j] = row_lb[gr_row + j] = -COIN_DBL_MAX;
+      row_ub[rx_row + j] = row_ub[gr_row + j] = 0.0;
+      row_lb[cons_row + j] = row_ub[cons_row + j] = 0.0;
+    }
+    for (int a = 0; a < 2 * n_arcs; ++a) {
+      row_lb[cap_row + a] = -COIN_DBL_MAX;
+      row_ub[cap_row + a] = 0.0;
     }
   }
   const CoinPackedMatrix matrix(true, n_rows, n_vars, static_cast<CoinBigIndex>(indices.size()), elements.data(),
@@ -643,6 +713,9 @@ Result<Selection> ExactSelector::Select(const std::vector<VoxelSet>& sets, int f
   solver.getModelPtr()->passInEventHandler(&lp_handler);
   solver.loadProblem(matrix, col_lb.data(), col_ub.data(), obj.data(), row_lb.data(), row_ub.data());
   for (int j = 0; j < n_cols; ++j) solver.setInteger(j);
+  if (connect) {
+    for (int j = 0; j < n_cols; ++j) solver.setInteger(r0 + j);
+  }
   // Primal simplex: on geb079 (49,706 classes) the root LP takes 11 s with it and over 2 min with
   // the dual; with it in the resolves too, CBC proves 69 stations optimal in 67 s.
   solver.setHintParam(OsiDoDualInInitial, false, OsiHintDo);
@@ -711,7 +784,39 @@ Result<Selection> ExactSelector::Select(const std::vector<VoxelSet>& sets, int f
     }
     warm_covered += m.weight[k];
   }
-  const bool warm_ok = max_mode ? warm_stations <= options_.greedy.max_stations : warm_covered >= need;
+  // With connectivity: a spanning tree of the warm start's stations from its first one, each tree
+  // arc carrying the stations below it; no warm start when greedy's plan is not connected.
+  bool warm_connected = true;
+  if (connect && warm_stations > 0) {
+    int root = -1;
+    for (int j = 0; j < n_cols && root < 0; ++j) {
+      if (warm[j] > 0.5) root = j;
+    }
+    std::vector<int> parent_arc(n_cols, -2), order{root};
+    parent_arc[root] = -1;
+    for (size_t q = 0; q < order.size(); ++q) {
+      for (int a : arcs_at[order[q]]) {
+        const int to = arcs[a].second;
+        if (arcs[a].first == order[q] && warm[to] > 0.5 && parent_arc[to] == -2) {
+          parent_arc[to] = a;
+          order.push_back(to);
+        }
+      }
+    }
+    warm_connected = static_cast<int>(order.size()) == warm_stations;
+    if (warm_connected) {
+      std::vector<double> below(n_cols, 1.0);
+      for (size_t q = order.size(); q-- > 1;) {
+        const int a = parent_arc[order[q]];
+        warm[f0 + a] = below[order[q]];
+        below[arcs[a].first] += below[order[q]];
+      }
+      warm[r0 + root] = 1.0;
+      warm[g0 + root] = warm_stations;
+    }
+  }
+  const bool warm_ok = warm_connected &&
+                       (max_mode ? warm_stations <= options_.greedy.max_stations : warm_covered >= need);
   if (warm_ok) {
     const double warm_obj = max_mode ? -double(std::min(warm_covered, need)) + eps * warm_stations : warm_stations;
     model.setBestSolution(warm.data(), n_vars, warm_obj, true);
@@ -722,6 +827,13 @@ Result<Selection> ExactSelector::Select(const std::vector<VoxelSet>& sets, int f
   model.branchAndBound();
   VC_RETURN_IF_ERROR(watch.cancelled);
   VC_RETURN_IF_ERROR(ctx.CheckCancelled("exact selection"));
+  if (connect && !watch.lp_stopped && model.isProvenInfeasible()) {
+    opt.solver = "greedy";
+    opt.status = OptimalityStatus::kHeuristic;
+    opt.note = "no connected plan over these candidates reaches the target at min_overlap " +
+               std::to_string(options_.greedy.min_overlap) + "; greedy plan";
+    return finish(greedy_picks);
+  }
   if (!watch.lp_stopped && (model.status() == 2 || model.isProvenInfeasible())) {
     return InternalError("exact selection: CBC could not solve the station problem (status " +
                          std::to_string(model.status()) + "/" + std::to_string(model.secondaryStatus()) + ")");
@@ -746,7 +858,7 @@ Result<Selection> ExactSelector::Select(const std::vector<VoxelSet>& sets, int f
       (max_mode ? std::make_pair(std::min(ilp_covered, target), -static_cast<int64_t>(picks.size())) >=
                       std::make_pair(std::min(greedy_covered, target), -static_cast<int64_t>(greedy_picks.size()))
                 : (ilp_covered >= target &&
-                   (greedy_covered < target || picks.size() <= greedy_picks.size())));
+                   (greedy_covered < target || picks.size() <= greedy_picks.size() || !warm_connected)));
   if (!ilp_better) picks = greedy_picks;
   opt.status = proven ? OptimalityStatus::kOptimal : OptimalityStatus::kFeasible;
   if (max_mode) {

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "vc/plan/greedy.h"
+#include "vc/plan/scan_graph.h"
 #include "vc/plan/stages.h"
 #include "vc/synth/synth.h"
 
@@ -152,6 +153,70 @@ TEST(ExactSelectorTest, MaximumCoverageEqualsExhaustiveSearchIncludingUnreachabl
   }
   EXPECT_GT(unreachable, 10);
   EXPECT_LT(unreachable, 110);
+}
+
+// Whether `picks` form one component of the scan graph at min_overlap (scan_graph.h).
+bool Connected(const std::vector<VoxelSet>& sets, const std::vector<int>& picks, double min_overlap) {
+  if (picks.empty()) return true;
+  std::vector<int> reached{picks[0]};
+  std::vector<char> seen(sets.size(), 0);
+  seen[picks[0]] = 1;
+  for (size_t q = 0; q < reached.size(); ++q) {
+    for (int p : picks) {
+      if (!seen[p] && IsEdge(Overlap(sets[reached[q]], sets[p]), min_overlap)) {
+        seen[p] = 1;
+        reached.push_back(p);
+      }
+    }
+  }
+  return reached.size() == picks.size();
+}
+
+// With min_overlap the optimum is over connected plans (the single-commodity flow); when no
+// connected plan reaches the target the greedy plan comes back, heuristic, with a note.
+TEST(ExactSelectorTest, ConnectedOptimumEqualsExhaustiveSearch) {
+  std::mt19937 rng(2022);
+  int infeasible = 0, dearer = 0;
+  for (int trial = 0; trial < 100; ++trial) {
+    const int n = 4 + static_cast<int>(rng() % 8);
+    const size_t voxels = 30 + rng() % 90;
+    std::vector<VoxelSet> sets = RandomSets(rng, n, voxels, 0.1 + 0.3 * (rng() % 100) / 100.0);
+    const int fixed = static_cast<int>(rng() % 2);
+    ExactSelectorOptions o;
+    o.greedy.target_coverage = std::vector<double>{1.0, 0.9, 0.7}[rng() % 3];
+    o.greedy.min_overlap = std::vector<double>{0.2, 0.3, 0.4}[rng() % 3];
+    Result<Selection> got = ExactSelector(o).Select(sets, fixed, {});
+    ASSERT_TRUE(got.ok()) << got.status().ToString();
+    const uint64_t t = Target(o.greedy.target_coverage, got->coverable);
+    // Exhaustive: the fewest stations of a connected plan (fixed included) reaching the target.
+    int best = n + 1;
+    for (uint32_t mask = 0; mask < (1u << n); ++mask) {
+      if (fixed && !(mask & 1u)) continue;
+      std::vector<int> picks;
+      for (int i = 0; i < n; ++i) {
+        if (mask >> i & 1) picks.push_back(i);
+      }
+      if (static_cast<int>(picks.size()) >= best || Union(sets, picks) < t) continue;
+      if (Connected(sets, picks, o.greedy.min_overlap)) best = static_cast<int>(picks.size());
+    }
+    const std::string what = "trial " + std::to_string(trial);
+    if (best > n) {
+      ++infeasible;
+      EXPECT_EQ(got->optimality.status, OptimalityStatus::kHeuristic) << what;
+      EXPECT_NE(got->optimality.note.find("no connected plan"), std::string::npos) << what;
+      continue;
+    }
+    EXPECT_EQ(got->optimality.status, OptimalityStatus::kOptimal) << what;
+    EXPECT_EQ(static_cast<int>(got->picks.size()), best) << what;
+    EXPECT_GE(got->covered, t) << what;
+    EXPECT_TRUE(Connected(sets, got->picks, o.greedy.min_overlap)) << what;
+    ExpectFixedFirstAndGainOrder(sets, *got, fixed);
+    const Best unconnected = Exhaustive(sets, fixed, t, 0);
+    dearer += best > unconnected.stations;
+  }
+  EXPECT_GT(infeasible, 0);
+  EXPECT_LT(infeasible, 60);
+  EXPECT_GT(dearer, 0) << "connectivity never cost a station: the test proves little";
 }
 
 TEST(ExactSelectorTest, FixedStationsStayFirstEvenWhenUseless) {

@@ -25,9 +25,12 @@
 // (drop a pick, 2-for-1 and 1-for-1 exchanges that keep the covered weight) runs instead, status
 // kHeuristic, with a note saying so (or, without swap_search, the greedy plan itself).
 //
-// min_overlap (registration) is passed to the greedy warm start only; the ILP does not model
-// connectivity yet, so with min_overlap > 0 the selector returns the greedy plan (status
-// kHeuristic, with a note). min_marginal_gain_voxels is a greedy stopping rule and is ignored.
+// With min_overlap > 0 (registration, scan_graph.h) the plan must be connected: a single-commodity
+// flow over the candidates' scan-graph arcs (Dehbi et al. 2021) from one root station, which every
+// chosen station consumes one unit of; the reduction then only merges classes (a dominated
+// candidate may be a needed link), and fixed stations are columns fixed to 1. When no connected
+// plan reaches the target, the greedy plan comes back (status kHeuristic, with a note).
+// min_marginal_gain_voxels is a greedy stopping rule and is ignored.
 //
 // Thread-safe: immutable after construction; CBC state lives inside Select.
 #pragma once

@@ -32,7 +32,7 @@ std::string_view StopReasonName(StopReason reason);
 enum class SelectionSolver : uint8_t {
   kGreedy,  // GreedySelector: lazy greedy, then consolidation
   kExact,   // ExactSelector: the integer program (CBC), greedy + swaps over the memory budget
-  kAuto,    // the integer program when it fits the memory budget and min_overlap is 0, else greedy
+  kAuto,    // the integer program when it fits the memory budget, else the greedy plan
 };
 // "greedy", "exact", "auto".
 std::string_view SelectionSolverName(SelectionSolver solver);
