@@ -58,8 +58,8 @@ std::string RouteLines(const PlanResult& r) {
 
 std::string FieldTimeLine(const PlanResult& r) {
   const FieldTime& t = r.field_time;
-  std::string line = "field time: " + FormatDuration(t.total_s) + " (set-up " + FormatDuration(t.setup_s) +
-                     ", scans " + FormatDuration(t.scan_s) + ", walking " + FormatDuration(t.walk_s) + ")";
+  std::string line = "field time: " + FormatDuration(t.total_s) + " (set-up " + FormatDuration(t.setup_s) + ", scans " +
+                     FormatDuration(t.scan_s) + ", walking " + FormatDuration(t.walk_s) + ")";
   if (t.scan_seconds_per_station <= 0) line += "; no scan time known: pass --scan-seconds or --scanner";
   return line + "\n";
 }

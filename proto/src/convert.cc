@@ -667,8 +667,8 @@ Result<PlanResult> PlanResultAssembler::Finish(const v1::PlanResult& p) && {
   }
   r.route.parts = route.parts();
   if (route.has_start()) r.route.start = FromProto(route.start());
-  r.field_time = {p.field_time().setup_s(), p.field_time().scan_s(), p.field_time().walk_s(),
-                  p.field_time().total_s(), p.field_time().scan_seconds_per_station()};
+  r.field_time = {p.field_time().setup_s(), p.field_time().scan_s(), p.field_time().walk_s(), p.field_time().total_s(),
+                  p.field_time().scan_seconds_per_station()};
   r.voxel_centers = std::move(centers_);
   return r;
 }

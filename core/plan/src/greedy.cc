@@ -324,9 +324,8 @@ Result<GreedyResult> SelectGreedy(const std::vector<VoxelSet>& sets, const Greed
       for (size_t g = 1; g < groups.size(); ++g) {
         for (int c : groups[g]) other[c] = 1;
       }
-      VC_ASSIGN_OR_RETURN(std::vector<int> chain,
-                          ShortestChain(*overlaps, sets.size(), groups[0], min_overlap, ctx,
-                                        [&](int c) -> int64_t { return other[c] ? 0 : -1; }));
+      VC_ASSIGN_OR_RETURN(std::vector<int> chain, ShortestChain(*overlaps, sets.size(), groups[0], min_overlap, ctx,
+                                                                [&](int c) -> int64_t { return other[c] ? 0 : -1; }));
       if (chain.size() < 2) break;  // none, or (impossible) a direct edge between two groups
       chain.pop_back();             // the station of another group it reaches
       for (int c : chain) pick(c, CountAnd(sets[c], uncovered), true);

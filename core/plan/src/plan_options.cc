@@ -52,8 +52,8 @@ Status PlanOptions::Validate() const {
                                   ") lies inside keep_out[" + std::to_string(z) + "]");
     }
   }
-  if (route_start && (!std::isfinite(route_start->x()) || !std::isfinite(route_start->y()) ||
-                      std::isinf(route_start->z()))) {
+  if (route_start &&
+      (!std::isfinite(route_start->x()) || !std::isfinite(route_start->y()) || std::isinf(route_start->z()))) {
     return InvalidArgumentError("route_start needs finite x and y (and a finite z, or NaN for the lowest floor)");
   }
   return Status::Ok();

@@ -55,7 +55,8 @@ Result<Selection> GreedySelector::Select(const std::vector<VoxelSet>& sets, int 
   for (const GreedyPick& pick : greedy.picks) out.picks.push_back(pick.candidate);
   out.first_pass_picks = static_cast<int>(out.picks.size()) - fixed;
   if (options_.consolidate) {
-    VC_ASSIGN_OR_RETURN(ConsolidateResult merged, ConsolidatePicks(sets, std::move(out.picks), ctx, fixed, options_.min_overlap));
+    VC_ASSIGN_OR_RETURN(ConsolidateResult merged,
+                        ConsolidatePicks(sets, std::move(out.picks), ctx, fixed, options_.min_overlap));
     out.picks = std::move(merged.picks);
     out.saved_by_improvement = merged.dropped + merged.merged;
   }

@@ -44,16 +44,11 @@ Json OptimalityJson(const planner::Optimality& o) {
   auto size = [](const planner::ModelSize& m) {
     return Json{{"candidates", m.candidates}, {"voxel_classes", m.voxel_classes}, {"rows", m.rows}};
   };
-  Json j{{"solver", o.solver},
-         {"status", std::string(planner::OptimalityStatusName(o.status))},
-         {"stations", o.stations},
-         {"lower_bound", o.lower_bound},
-         {"gap", o.gap},
-         {"seconds", o.seconds},
-         {"model", size(o.model)},
-         {"before", size(o.before)},
-         {"forced", o.forced},
-         {"dominated", o.dominated}};
+  Json j{{"solver", o.solver},     {"status", std::string(planner::OptimalityStatusName(o.status))},
+         {"stations", o.stations}, {"lower_bound", o.lower_bound},
+         {"gap", o.gap},           {"seconds", o.seconds},
+         {"model", size(o.model)}, {"before", size(o.before)},
+         {"forced", o.forced},     {"dominated", o.dominated}};
   if (o.covered_bound > 0) j["covered_bound"] = o.covered_bound;
   if (!o.note.empty()) j["note"] = o.note;
   return j;
@@ -392,8 +387,7 @@ Image DrawHeatmap(const PlanResult& r) {
     for (size_t k = 1; k < line.size(); ++k) {
       const int pa = panel_of(line[k - 1].z() + lowest_height), pb = panel_of(line[k].z() + lowest_height);
       if (pa != pb) continue;  // the step between two panels (stairs) is not drawn
-      img.Line(px(pa, line[k - 1].x()), py(line[k - 1].y()), px(pb, line[k].x()), py(line[k].y()), raster::kOrange,
-               3);
+      img.Line(px(pa, line[k - 1].x()), py(line[k - 1].y()), px(pb, line[k].x()), py(line[k].y()), raster::kOrange, 3);
     }
   }
   // Stations, numbered in plan order, on the panel of their height; fixed stations ringed in black.
@@ -613,8 +607,8 @@ std::string PlanToJson(const PlanResult& r) {
     for (const WorldPoint& p : line) points.push_back(Point(p));
     polylines.push_back(std::move(points));
   }
-  Json route{{"order", r.route.order},         {"legs_m", r.route.legs_m},
-             {"length_m", r.route.length_m},   {"parts", r.route.parts},
+  Json route{{"order", r.route.order},           {"legs_m", r.route.legs_m},
+             {"length_m", r.route.length_m},     {"parts", r.route.parts},
              {"polyline", std::move(polylines)}, {"start", r.route.start ? Point(*r.route.start) : Json(nullptr)}};
   Json field_time{{"setup", r.field_time.setup_s},
                   {"scan", r.field_time.scan_s},
@@ -719,7 +713,8 @@ Result<std::vector<WorldPoint>> ParseStationsCsv(std::string_view text, std::str
         seen_data_line = true;
         continue;
       }
-      return InvalidArgumentError(where + "expected 3 numbers \"x,y,z\" (metres), or a plan's \"x,y,z,route_order\", found \"" +
+      return InvalidArgumentError(where +
+                                  "expected 3 numbers \"x,y,z\" (metres), or a plan's \"x,y,z,route_order\", found \"" +
                                   std::string(line) + "\"");
     }
     if (!std::isfinite(v[0]) || !std::isfinite(v[1]) || !std::isfinite(v[2])) {

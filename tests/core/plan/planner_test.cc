@@ -338,9 +338,8 @@ TEST(PlannerTest, CancelledBeforeAndDuringEveryStage) {
     ctx.cancel = &token;
     EXPECT_EQ(Plan(in, TestOptions(), ctx).status().code(), StatusCode::kCancelled);
   }
-  for (const Stage stage :
-       {Stage::kCandidates, Stage::kVisibility, Stage::kSelection, Stage::kReduction, Stage::kEvaluation,
-        Stage::kRoute}) {
+  for (const Stage stage : {Stage::kCandidates, Stage::kVisibility, Stage::kSelection, Stage::kReduction,
+                            Stage::kEvaluation, Stage::kRoute}) {
     CancelToken token;
     JobContext ctx;
     ctx.cancel = &token;

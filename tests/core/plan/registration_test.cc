@@ -50,10 +50,10 @@ int GroupsAt(const PlanResult& r, double threshold) {
 }
 
 std::string Describe(const PlanResult& r) {
-  std::string s = std::to_string(r.stations.size()) + " stations, G = " +
-                  std::to_string(r.evaluation.overall.global_visibility) + ", " +
-                  std::to_string(r.scan_graph.components.size()) + " groups, " +
-                  std::to_string(r.connecting_stations) + " connecting";
+  std::string s = std::to_string(r.stations.size()) +
+                  " stations, G = " + std::to_string(r.evaluation.overall.global_visibility) + ", " +
+                  std::to_string(r.scan_graph.components.size()) + " groups, " + std::to_string(r.connecting_stations) +
+                  " connecting";
   for (const auto& w : r.warnings) s += "\n  warning: " + w;
   return s;
 }
@@ -63,7 +63,7 @@ TEST(Registration, RoomsOffACorridorSplitWithoutItAndAreLinkedWithIt) {
   Result<PlanResult> off = Plan(in, Options(0));
   ASSERT_TRUE(off.ok()) << off.status().ToString();
   std::cout << "[ rooms:3 off ] " << Describe(*off) << "\n";
-  EXPECT_GT(GroupsAt(*off, 0.3), 1);  // each room's station shares little with the corridor's
+  EXPECT_GT(GroupsAt(*off, 0.3), 1);       // each room's station shares little with the corridor's
   EXPECT_TRUE(off->scan_graph.connected);  // min_overlap 0: any shared voxel links
 
   Result<PlanResult> on = Plan(in, Options(0.3));
@@ -110,9 +110,8 @@ TEST(Registration, TwoRoomsGetAStationInTheDoorToLinkThem) {
   ASSERT_TRUE(apart.ok()) << apart.status().ToString();
   EXPECT_FALSE(apart->scan_graph.connected);
   EXPECT_EQ(apart->scan_graph.components, (std::vector<std::vector<int>>{{0}, {1}}));
-  EXPECT_TRUE(std::any_of(apart->warnings.begin(), apart->warnings.end(), [](const std::string& w) {
-    return w.find("2 groups ([0], [1]") != std::string::npos;
-  }));
+  EXPECT_TRUE(std::any_of(apart->warnings.begin(), apart->warnings.end(),
+                          [](const std::string& w) { return w.find("2 groups ([0], [1]") != std::string::npos; }));
 }
 
 TEST(Registration, ReportedOverlapsAreTheIntersectionsOfTheStationsSets) {

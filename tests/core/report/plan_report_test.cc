@@ -87,9 +87,9 @@ PlanResult SamplePlan() {
 
 TEST(PlanReportTest, PlanJsonHasEveryDocumentedKey) {
   const json j = json::parse(PlanToJson(SamplePlan()));
-  for (const char* key : {"schema", "resolution_m", "selection_test", "stop_reason", "viewpoints", "coverage",
-                          "reduction", "candidates", "timings_s", "parameters", "warnings", "scan_graph", "route",
-                          "field_time_s", "optimality"}) {
+  for (const char* key :
+       {"schema", "resolution_m", "selection_test", "stop_reason", "viewpoints", "coverage", "reduction", "candidates",
+        "timings_s", "parameters", "warnings", "scan_graph", "route", "field_time_s", "optimality"}) {
     EXPECT_TRUE(j.contains(key)) << key;
   }
   EXPECT_EQ(j["scan_graph"]["min_overlap"].get<double>(), 0.3);
@@ -282,8 +282,8 @@ TEST(ParseStationsCsvTest, RejectsBadRowsNamingTheLine) {
   };
   for (const Case& c :
        {Case{"x,y,z\n1,2,3\n1,2\n", "my.csv:3:"}, Case{"1,2,3\n1,2,abc\n", "my.csv:2:"},
-        Case{"1,2,3\n1,2,3,4,5\n", "my.csv:2:"}, Case{"1,2,3,x\n", "my.csv:1:"}, Case{"1,2,nan\n", "my.csv:1:"}, Case{"1,2,3\n1,inf,3\n", "my.csv:2:"},
-        Case{"1,2,3\nx,y,z\n", "my.csv:2:"}, Case{"1,,3\n", "my.csv:1:"}}) {
+        Case{"1,2,3\n1,2,3,4,5\n", "my.csv:2:"}, Case{"1,2,3,x\n", "my.csv:1:"}, Case{"1,2,nan\n", "my.csv:1:"},
+        Case{"1,2,3\n1,inf,3\n", "my.csv:2:"}, Case{"1,2,3\nx,y,z\n", "my.csv:2:"}, Case{"1,,3\n", "my.csv:1:"}}) {
     Result<std::vector<WorldPoint>> r = ParseStationsCsv(c.text, "my.csv");
     ASSERT_FALSE(r.ok()) << c.text;
     EXPECT_EQ(r.status().code(), StatusCode::kInvalidArgument);

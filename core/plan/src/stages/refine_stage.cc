@@ -94,7 +94,8 @@ Result<RefineOutput> RunRefineStage(RefineInput in, const PlanOptions& options, 
       return std::make_pair(others_count + CountBits(s) - CountAnd(others, s), CountBits(s));
     };
     const auto current = score(stations.sets[k]);
-    std::vector<std::pair<std::remove_const_t<decltype(current)>, int>> better;  // trials that beat the station, best first
+    std::vector<std::pair<std::remove_const_t<decltype(current)>, int>>
+        better;  // trials that beat the station, best first
     for (; t < trials.positions.size() && trials.station[t] == static_cast<int>(k); ++t) {
       const auto sc = score(trial_sets[t]);
       if (sc > current) better.push_back({sc, static_cast<int>(t)});

@@ -48,9 +48,9 @@ enum class Stage : uint8_t {
   kEvaluation,  // V of every face from the final stations, and G
   kRoute,       // the walking route through the final stations
 };
-inline constexpr Stage kAllStages[] = {Stage::kRead,      Stage::kVoxelize,  Stage::kCandidates, Stage::kVisibility,
-                                       Stage::kSelection, Stage::kRefine,    Stage::kReduction,  Stage::kEvaluation,
-                                       Stage::kRoute};
+inline constexpr Stage kAllStages[] = {Stage::kRead,       Stage::kVoxelize,   Stage::kCandidates,
+                                       Stage::kVisibility, Stage::kSelection,  Stage::kRefine,
+                                       Stage::kReduction,  Stage::kEvaluation, Stage::kRoute};
 // "read", "voxelize", "candidates", "visibility", "selection", "refine", "reduction", "evaluation",
 // "route"; "unspecified" for kUnspecified.
 std::string_view StageName(Stage stage);

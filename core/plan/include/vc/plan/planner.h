@@ -74,10 +74,10 @@ struct WalkingRoute {
 // The time a crew needs in the field for a plan (docs/PLANNING.md, "The walking route and the
 // field time"), in seconds: every station set up and scanned, and the route walked.
 struct FieldTime {
-  double setup_s = 0;           // stations x PlanOptions::setup_seconds
-  double scan_s = 0;            // stations x scan_seconds_per_station
-  double walk_s = 0;            // the route's walkable length / PlanOptions::walk_speed_mps
-  double total_s = 0;           // their sum
+  double setup_s = 0;                   // stations x PlanOptions::setup_seconds
+  double scan_s = 0;                    // stations x scan_seconds_per_station
+  double walk_s = 0;                    // the route's walkable length / PlanOptions::walk_speed_mps
+  double total_s = 0;                   // their sum
   double scan_seconds_per_station = 0;  // PlanOptions::scan_seconds, or the scanner preset's scan time, or 0
 };
 // The field time of `stations` stations and a walk of `walk_m` metres under `options`.

@@ -64,15 +64,15 @@
 namespace vc::planner {
 
 struct RouteOptions {
-  double headroom_m = 1.7;     // free height above a surface to walk on it (m); the planner passes tripod + clearance
-  double clearance_m = 0.2;    // free horizontal radius around a walking person (m)
-  double max_step_m = 0.25;    // largest height change between neighbouring walk cells (stairs, ramps) (m)
-  double cell_m = 0;           // walk cell edge (m), rounded to whole voxels; 0 = the scene resolution
-  double max_gap_m = 0.5;  // unseen floor within this of a seen one (same height) is walked on (m); 0 = none
+  double headroom_m = 1.7;   // free height above a surface to walk on it (m); the planner passes tripod + clearance
+  double clearance_m = 0.2;  // free horizontal radius around a walking person (m)
+  double max_step_m = 0.25;  // largest height change between neighbouring walk cells (stairs, ramps) (m)
+  double cell_m = 0;         // walk cell edge (m), rounded to whole voxels; 0 = the scene resolution
+  double max_gap_m = 0.5;    // unseen floor within this of a seen one (same height) is walked on (m); 0 = none
   // Fraction of the walking cylinder's columns that may hold clutter or scan noise (0 = all free).
   double max_blocked_fraction = 0;
-  double snap_radius_m = 1.0;  // how far (horizontally, m) a station or the start may be from its walk node
-  std::optional<WorldPoint> start;                   // where the walk starts (world, m), if anywhere
+  double snap_radius_m = 1.0;       // how far (horizontally, m) a station or the start may be from its walk node
+  std::optional<WorldPoint> start;  // where the walk starts (world, m), if anywhere
   uint64_t memory_budget_bytes = uint64_t{1} << 30;  // bound on the walk graph's memory (bytes)
 };
 
