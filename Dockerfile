@@ -5,6 +5,7 @@
 ARG BASE=debian:bookworm
 
 FROM ${BASE} AS build
+# Packages: scripts/install-deps.sh's lists (build: ... coinor-libcbc-dev; runtime: ... coinor-libcbc3).
 WORKDIR /src
 COPY scripts/install-deps.sh scripts/install-deps.sh
 RUN bash scripts/install-deps.sh && rm -rf /var/lib/apt/lists/*

@@ -11,6 +11,8 @@ find_package(CLI11 REQUIRED)
 find_package(Threads REQUIRED)
 find_package(PkgConfig REQUIRED)
 pkg_check_modules(HWY REQUIRED IMPORTED_TARGET libhwy)
+# COIN-OR CBC (coinor-libcbc-dev): the exact station selector (vc::plan only).
+pkg_check_modules(CBC REQUIRED IMPORTED_TARGET cbc)
 
 # OctoMap's package config exports plain variables; wrap them in one imported target.
 if(NOT TARGET vc::octomap)

@@ -53,6 +53,12 @@ void AddFlag(CLI::App* app, const ParamInfo& info, SelectionTest* value) {
               {{"surface", SelectionTest::kSurfaceVisibility}, {"compatibility", SelectionTest::kCompatibility}});
 }
 
+void AddFlag(CLI::App* app, const ParamInfo& info, SelectionSolver* value) {
+  AddEnumFlag(
+      app, info, value,
+      {{"greedy", SelectionSolver::kGreedy}, {"exact", SelectionSolver::kExact}, {"auto", SelectionSolver::kAuto}});
+}
+
 void AddFlag(CLI::App* app, const ParamInfo& info, FaceSet* value) {
   AddEnumFlag(app, info, value, {{"all", FaceSet::kAll}, {"exposed", FaceSet::kExposed}});
 }

@@ -66,6 +66,29 @@ std::string FieldTimeLine(const PlanResult& r) {
 
 }  // namespace
 
+std::string OptimalityLine(const PlanResult& r) {
+  const planner::Optimality& o = r.optimality;
+  if (o.solver == "greedy" && o.status == planner::OptimalityStatus::kHeuristic && o.note.empty()) return "";
+  if (r.options.max_stations > 0 && o.status != planner::OptimalityStatus::kHeuristic) {
+    if (o.status == planner::OptimalityStatus::kOptimal) {
+      return Format("optimal: the most coverage %d station(s) reach, proven\n", o.stations);
+    }
+    return Format("%d station(s), coverage at most %.1f%% below the optimum\n", o.stations, 100.0 * o.gap);
+  }
+  switch (o.status) {
+    case planner::OptimalityStatus::kOptimal:
+      return Format("optimal: %d stations, proven\n", o.stations);
+    case planner::OptimalityStatus::kFeasible: {
+      const int bound = static_cast<int>(std::ceil(o.lower_bound - 1e-9));
+      return Format("%d stations, at most %d more than the optimum (bound %d)\n", o.stations, o.stations - bound,
+                    bound);
+    }
+    case planner::OptimalityStatus::kHeuristic:
+      break;
+  }
+  return Format("%d stations (%s), no bound on the optimum\n", o.stations, o.solver.c_str());
+}
+
 std::string FormatDuration(double seconds) {
   if (!std::isfinite(seconds) || seconds < 0) return "?";
   const long s = std::lround(seconds);
@@ -93,6 +116,7 @@ std::string PlanSummary(const PlanResult& r) {
                   s.position.z(), static_cast<unsigned long long>(s.marginal_gain), 100.0 * s.cumulative_coverage,
                   route_position[i] ? std::to_string(route_position[i]).c_str() : "-", s.fixed ? "  fixed" : "");
   }
+  out += OptimalityLine(r);
   out += ScanGraphLine(r);
   out += RouteLines(r);
   out += FieldTimeLine(r);

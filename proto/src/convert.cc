@@ -66,6 +66,18 @@ v1::SelectionTest ToProto(SelectionTest t) {
 
 v1::FaceSet ToProto(FaceSet f) { return f == FaceSet::kExposed ? v1::FACE_SET_EXPOSED : v1::FACE_SET_ALL; }
 
+v1::SelectionSolver ToProto(SelectionSolver s) {
+  switch (s) {
+    case SelectionSolver::kExact:
+      return v1::SELECTION_SOLVER_EXACT;
+    case SelectionSolver::kAuto:
+      return v1::SELECTION_SOLVER_AUTO;
+    case SelectionSolver::kGreedy:
+      break;
+  }
+  return v1::SELECTION_SOLVER_GREEDY;
+}
+
 namespace {
 
 // A parameter row's value to its proto field's type and back (vc/base/parameter.h). Numbers and
@@ -77,6 +89,7 @@ T ToWire(T v) {
 }
 v1::SelectionTest ToWire(SelectionTest t) { return ToProto(t); }
 v1::FaceSet ToWire(FaceSet f) { return ToProto(f); }
+v1::SelectionSolver ToWire(SelectionSolver s) { return ToProto(s); }
 
 template <typename T>
 Status FromWire(T wire, T* out) {
@@ -87,6 +100,24 @@ Status FromWire(v1::SelectionTest wire, SelectionTest* out) {
   if (wire == v1::SELECTION_TEST_UNSPECIFIED) return Status::Ok();
   VC_ASSIGN_OR_RETURN(*out, FromProto(wire));
   return Status::Ok();
+}
+Status FromWire(v1::SelectionSolver wire, SelectionSolver* out) {
+  switch (wire) {
+    case v1::SELECTION_SOLVER_UNSPECIFIED:
+      return Status::Ok();
+    case v1::SELECTION_SOLVER_GREEDY:
+      *out = SelectionSolver::kGreedy;
+      return Status::Ok();
+    case v1::SELECTION_SOLVER_EXACT:
+      *out = SelectionSolver::kExact;
+      return Status::Ok();
+    case v1::SELECTION_SOLVER_AUTO:
+      *out = SelectionSolver::kAuto;
+      return Status::Ok();
+    default:
+      break;
+  }
+  return InvalidArgumentError("unknown solver value " + std::to_string(int(wire)) + "; use GREEDY, EXACT or AUTO");
 }
 Status FromWire(v1::FaceSet wire, FaceSet* out) {
   switch (wire) {
@@ -197,6 +228,73 @@ Result<KeepOutZone> FromProto(const v1::KeepOutZone& p, size_t index) {
 Status ChunkError(const std::string& what) {
   return DataLossError("the server's result stream is inconsistent (" + what +
                        "); retry, and report it if it persists");
+}
+
+v1::ModelSize ToProto(const planner::ModelSize& m) {
+  v1::ModelSize p;
+  p.set_candidates(m.candidates);
+  p.set_voxel_classes(m.voxel_classes);
+  p.set_rows(m.rows);
+  return p;
+}
+planner::ModelSize FromProto(const v1::ModelSize& p) { return {p.candidates(), p.voxel_classes(), p.rows()}; }
+
+v1::Optimality ToProto(const planner::Optimality& o) {
+  v1::Optimality p;
+  p.set_solver(o.solver);
+  switch (o.status) {
+    case planner::OptimalityStatus::kHeuristic:
+      p.set_status(v1::Optimality::STATUS_HEURISTIC);
+      break;
+    case planner::OptimalityStatus::kFeasible:
+      p.set_status(v1::Optimality::STATUS_FEASIBLE);
+      break;
+    case planner::OptimalityStatus::kOptimal:
+      p.set_status(v1::Optimality::STATUS_OPTIMAL);
+      break;
+  }
+  p.set_stations(o.stations);
+  p.set_lower_bound(o.lower_bound);
+  p.set_gap(o.gap);
+  p.set_covered_bound(o.covered_bound);
+  p.set_seconds(o.seconds);
+  *p.mutable_before() = ToProto(o.before);
+  *p.mutable_model() = ToProto(o.model);
+  p.set_forced(o.forced);
+  p.set_dominated(o.dominated);
+  p.set_note(o.note);
+  return p;
+}
+
+Result<planner::Optimality> FromProto(const v1::Optimality& p) {
+  planner::Optimality o;
+  switch (p.status()) {
+    case v1::Optimality::STATUS_UNSPECIFIED:  // a server from before the exact selector: greedy
+    case v1::Optimality::STATUS_HEURISTIC:
+      o.status = planner::OptimalityStatus::kHeuristic;
+      break;
+    case v1::Optimality::STATUS_FEASIBLE:
+      o.status = planner::OptimalityStatus::kFeasible;
+      break;
+    case v1::Optimality::STATUS_OPTIMAL:
+      o.status = planner::OptimalityStatus::kOptimal;
+      break;
+    default:
+      return DataLossError("the server's result carries an unknown optimality status (" +
+                           std::to_string(int(p.status())) + "); update vc-client");
+  }
+  if (!p.solver().empty()) o.solver = p.solver();
+  o.stations = p.stations();
+  o.lower_bound = p.lower_bound();
+  o.gap = p.gap();
+  o.covered_bound = p.covered_bound();
+  o.seconds = p.seconds();
+  o.before = FromProto(p.before());
+  o.model = FromProto(p.model());
+  o.forced = p.forced();
+  o.dominated = p.dominated();
+  o.note = p.note();
+  return o;
 }
 
 }  // namespace
@@ -428,6 +526,7 @@ v1::PlanResult ToProto(const PlanResult& r) {
   p.set_total_seconds(r.total_seconds);
   p.set_greedy_stations(r.greedy_stations);
   p.set_consolidated(r.consolidated);
+  *p.mutable_optimality() = ToProto(r.optimality);
   p.set_grid_cells(r.grid_cells);
   p.set_cells_without_floor(r.cells_without_floor);
   p.set_cells_failing_clearance(r.cells_failing_clearance);
@@ -533,6 +632,7 @@ Result<PlanResult> PlanResultAssembler::Finish(const v1::PlanResult& p) && {
   VC_ASSIGN_OR_RETURN(r.stop_reason, FromProto(p.stop_reason()));
   r.greedy_stations = p.greedy_stations();
   r.consolidated = p.consolidated();
+  VC_ASSIGN_OR_RETURN(r.optimality, FromProto(p.optimality()));
   r.grid_cells = p.grid_cells();
   r.cells_without_floor = p.cells_without_floor();
   r.cells_failing_clearance = p.cells_failing_clearance();

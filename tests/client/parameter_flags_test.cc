@@ -43,6 +43,9 @@ bool Other(bool v, ParamCheck) { return !v; }
 SelectionTest Other(SelectionTest v, ParamCheck) {
   return v == SelectionTest::kCompatibility ? SelectionTest::kSurfaceVisibility : SelectionTest::kCompatibility;
 }
+SelectionSolver Other(SelectionSolver v, ParamCheck) {
+  return v == SelectionSolver::kExact ? SelectionSolver::kAuto : SelectionSolver::kExact;
+}
 FaceSet Other(FaceSet v, ParamCheck) { return v == FaceSet::kAll ? FaceSet::kExposed : FaceSet::kAll; }
 
 // A value the row's check refuses, if there is one.
@@ -89,6 +92,9 @@ std::string Args(std::string_view flag, bool v) { return (v ? "--" : "--no-") + 
 std::string Args(std::string_view flag, SelectionTest v) {
   return "--" + std::string(flag) + " " + std::string(SelectionTestName(v));
 }
+std::string Args(std::string_view flag, SelectionSolver v) {
+  return "--" + std::string(flag) + " " + std::string(SelectionSolverName(v));
+}
 std::string Args(std::string_view flag, FaceSet v) {
   return "--" + std::string(flag) + (v == FaceSet::kExposed ? " exposed" : " all");
 }
@@ -99,6 +105,7 @@ json JsonValue(T v) {
   return json(v);
 }
 json JsonValue(SelectionTest v) { return std::string(SelectionTestName(v)); }
+json JsonValue(SelectionSolver v) { return std::string(SelectionSolverName(v)); }
 
 std::set<std::string> FieldNames(const google::protobuf::Descriptor* d) {
   std::set<std::string> names;
@@ -380,6 +387,8 @@ TEST(ParameterTablesTest, UnknownEnumNamesAreRefusedByTheFlag) {
   client::AddPlanFlags(&app, &o);
   EXPECT_THROW(app.parse("--test visible", false), CLI::ValidationError);
   EXPECT_EQ(o.selection_test, SelectionTest::kSurfaceVisibility);
+  EXPECT_THROW(app.parse("--solver cplex", false), CLI::ValidationError);
+  EXPECT_EQ(o.solver, SelectionSolver::kGreedy);
 }
 
 // --scanner NAME: the preset fills every scanner row whose flag is not given; a given flag wins,

@@ -1,5 +1,6 @@
 // What vc-client prints after a plan: durations, the station table's route column, the scan graph,
-// the route (parts marked "//") and the field time.
+// the route (parts marked "//"), the field time, and the optimality line for each status (none for
+// the default greedy).
 #include "vc/client/plan_summary.h"
 
 #include <gtest/gtest.h>
@@ -60,6 +61,23 @@ TEST(PlanSummaryTest, WithoutAScanTimeTheFieldTimeLineSaysSo) {
   const std::string s = PlanSummary(r);
   EXPECT_NE(s.find("no scan time known: pass --scan-seconds or --scanner"), std::string::npos) << s;
   EXPECT_NE(s.find("route: start (1.00, 1.00) -> 3"), std::string::npos) << s;
+}
+
+TEST(OptimalityLineTest, SaysProvenOptimalOrHowFarFromTheBound) {
+  PlanResult r;
+  EXPECT_EQ(OptimalityLine(r), "") << "the default greedy plan prints no line";
+  r.optimality.solver = "exact";
+  r.optimality.status = planner::OptimalityStatus::kOptimal;
+  r.optimality.stations = 37;
+  r.optimality.lower_bound = 37;
+  EXPECT_EQ(OptimalityLine(r), "optimal: 37 stations, proven\n");
+  r.optimality.status = planner::OptimalityStatus::kFeasible;
+  r.optimality.lower_bound = 32.2;  // a fractional bound rounds up: 33 stations at least
+  EXPECT_EQ(OptimalityLine(r), "37 stations, at most 4 more than the optimum (bound 33)\n");
+  r.optimality.solver = "greedy+swap";
+  r.optimality.status = planner::OptimalityStatus::kHeuristic;
+  EXPECT_EQ(OptimalityLine(r), "37 stations (greedy+swap), no bound on the optimum\n");
+  EXPECT_NE(PlanSummary(r).find("37 stations (greedy+swap)"), std::string::npos);
 }
 
 }  // namespace

@@ -52,12 +52,16 @@ TEST(PlanParameters, RoundTripKeepsEveryField) {
   o.setup_seconds = 90;
   o.scan_seconds = 45;
   o.walk_speed_mps = 0.8;
+  o.solver = SelectionSolver::kExact;
+  o.solve_seconds = 7.5;
   o.route_start = WorldPoint(1, 2, std::nan(""));
   auto back = FromProto(ToProto(o));
   ASSERT_TRUE(back.ok());
   // Compare through the proto (every field), so a field added to one side only shows up here.
   EXPECT_EQ(ToProto(*back).SerializeAsString(), ToProto(o).SerializeAsString());
   EXPECT_EQ(back->selection_test, SelectionTest::kCompatibility);
+  EXPECT_EQ(back->solver, SelectionSolver::kExact);
+  EXPECT_EQ(back->solve_seconds, 7.5);
   EXPECT_EQ(back->candidates.size(), 2u);
   ASSERT_TRUE(back->route_start.has_value());
   EXPECT_TRUE(std::isnan(back->route_start->z()));
@@ -113,6 +117,18 @@ PlanResult BigResult(size_t voxels, size_t candidates) {
   r.route.parts = 2;
   r.route.start = WorldPoint(0.5, 0, 0);
   r.field_time = {240, 90, 0.5, 330.5, 45};
+  r.optimality.solver = "exact";
+  r.optimality.status = planner::OptimalityStatus::kFeasible;
+  r.optimality.stations = 2;
+  r.optimality.lower_bound = 1;
+  r.optimality.gap = 0.5;
+  r.optimality.covered_bound = 9;
+  r.optimality.seconds = 1.25;
+  r.optimality.before = {7, 300, 301};
+  r.optimality.model = {3, 12, 13};
+  r.optimality.forced = 1;
+  r.optimality.dominated = 2;
+  r.optimality.note = "n";
   return r;
 }
 
@@ -171,6 +187,23 @@ TEST(PlanResultChunks, ReassembleExactlyAndStayUnderOneMebibyte) {
   EXPECT_EQ(back->route.start, r.route.start);
   EXPECT_EQ(back->field_time.total_s, 330.5);
   EXPECT_EQ(back->field_time.scan_seconds_per_station, 45);
+  const planner::Optimality& o = back->optimality;
+  EXPECT_EQ(o.solver, "exact");
+  EXPECT_EQ(o.status, planner::OptimalityStatus::kFeasible);
+  EXPECT_EQ(o.stations, 2);
+  EXPECT_EQ(o.lower_bound, 1);
+  EXPECT_EQ(o.gap, 0.5);
+  EXPECT_EQ(o.covered_bound, 9u);
+  EXPECT_EQ(o.seconds, 1.25);
+  EXPECT_EQ(o.before.candidates, 7);
+  EXPECT_EQ(o.before.voxel_classes, 300);
+  EXPECT_EQ(o.before.rows, 301);
+  EXPECT_EQ(o.model.candidates, 3);
+  EXPECT_EQ(o.model.voxel_classes, 12);
+  EXPECT_EQ(o.model.rows, 13);
+  EXPECT_EQ(o.forced, 1);
+  EXPECT_EQ(o.dominated, 2);
+  EXPECT_EQ(o.note, "n");
 }
 
 TEST(PlanResultChunks, ARouteOrGraphNamingAMissingStationIsDataLoss) {
@@ -192,8 +225,8 @@ TEST(PlanResultChunks, ARouteOrGraphNamingAMissingStationIsDataLoss) {
 // A tripwire: when a field is added to PlanResult or PlanOptions, its size changes; carry the new
 // field in proto/vc/v1/planner.proto and proto/src/convert.cc (both ways), then update the sizes.
 TEST(PlanResultChunks, EveryCoreFieldIsCarried) {
-  EXPECT_EQ(sizeof(PlanResult), 1128u) << "PlanResult changed: update the vc.v1 PlanResult and vc::wire";
-  EXPECT_EQ(sizeof(PlanOptions), 360u) << "PlanOptions changed: update vc.v1 PlanParameters and vc::wire";
+  EXPECT_EQ(sizeof(PlanResult), 1280u) << "PlanResult changed: update the vc.v1 PlanResult and vc::wire";
+  EXPECT_EQ(sizeof(PlanOptions), 376u) << "PlanOptions changed: update vc.v1 PlanParameters and vc::wire";
 }
 
 TEST(PlanResultChunks, MissingChunkIsDataLoss) {

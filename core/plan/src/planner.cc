@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <optional>
 #include <string>
 #include <utility>
@@ -138,10 +139,10 @@ Result<PlanResult> Plan(const SceneInput& input, const PlanOptions& options, con
   }));
   result.heat_map = std::move(visibility.heat_map);
 
-  const planner::GreedySelector selector(planner::SelectorOptionsFor(options));
+  const std::unique_ptr<planner::Selector> selector = planner::SelectorFor(options);
   VC_ASSIGN_OR_RETURN(planner::SelectionOutput selected, runner.Run(Stage::kSelection, [&](const JobContext& c) {
     return planner::RunSelectionStage(
-        {selector, std::move(visibility.sets), std::move(visibility.fixed_sets), candidates.positions,
+        {*selector, std::move(visibility.sets), std::move(visibility.fixed_sets), candidates.positions,
          candidates.floor_z_m, result.heat_map.visible_voxels, callbacks},
         options, c);
   }));
@@ -149,6 +150,8 @@ Result<PlanResult> Plan(const SceneInput& input, const PlanOptions& options, con
   result.greedy_stations = selected.selection.first_pass_picks;
   result.consolidated = selected.selection.saved_by_improvement;
   result.connecting_stations = selected.selection.connectors;
+  result.optimality = selected.selection.optimality;
+  if (!result.optimality.note.empty()) result.warnings.push_back(result.optimality.note);
   planner::Stations stations = std::move(selected.stations);
   VoxelSet coverable = std::move(selected.coverable);
 

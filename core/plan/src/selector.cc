@@ -1,5 +1,6 @@
 #include "vc/plan/selector.h"
 
+#include <chrono>
 #include <utility>
 
 #include "vc/plan/greedy.h"
@@ -20,11 +21,24 @@ std::string_view StopReasonName(StopReason reason) {
   return "unknown";
 }
 
+std::string_view SelectionSolverName(SelectionSolver solver) {
+  switch (solver) {
+    case SelectionSolver::kGreedy:
+      return "greedy";
+    case SelectionSolver::kExact:
+      return "exact";
+    case SelectionSolver::kAuto:
+      return "auto";
+  }
+  return "unknown";
+}
+
 }  // namespace vc
 
 namespace vc::planner {
 
 Result<Selection> GreedySelector::Select(const std::vector<VoxelSet>& sets, int fixed, const JobContext& ctx) const {
+  const auto start = std::chrono::steady_clock::now();
   GreedyOptions greedy_options;
   greedy_options.fixed = fixed;
   greedy_options.max_stations = options_.max_stations;
@@ -46,6 +60,10 @@ Result<Selection> GreedySelector::Select(const std::vector<VoxelSet>& sets, int 
     out.picks = std::move(merged.picks);
     out.saved_by_improvement = merged.dropped + merged.merged;
   }
+  out.optimality.stations = static_cast<int>(out.picks.size());
+  out.optimality.gap = out.picks.empty() ? 0.0 : 1.0;
+  out.optimality.before = {static_cast<int>(sets.size()), static_cast<int>(out.coverable), 0};
+  out.optimality.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return out;
 }
 

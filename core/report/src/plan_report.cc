@@ -37,6 +37,22 @@ Json ParameterJson(T v) {
   return Json(v);
 }
 Json ParameterJson(SelectionTest t) { return std::string(SelectionTestName(t)); }
+Json ParameterJson(SelectionSolver s) { return std::string(SelectionSolverName(s)); }
+
+// plan.json's `optimality` (docs/PLANNING.md, "Exact selection").
+Json OptimalityJson(const planner::Optimality& o) {
+  auto size = [](const planner::ModelSize& m) {
+    return Json{{"candidates", m.candidates}, {"voxel_classes", m.voxel_classes}, {"rows", m.rows}};
+  };
+  Json j{{"solver", o.solver},     {"status", std::string(planner::OptimalityStatusName(o.status))},
+         {"stations", o.stations}, {"lower_bound", o.lower_bound},
+         {"gap", o.gap},           {"seconds", o.seconds},
+         {"model", size(o.model)}, {"before", size(o.before)},
+         {"forced", o.forced},     {"dominated", o.dominated}};
+  if (o.covered_bound > 0) j["covered_bound"] = o.covered_bound;
+  if (!o.note.empty()) j["note"] = o.note;
+  return j;
+}
 
 #define VC_ROW_TO_JSON(type, name, ...) j[#name] = ParameterJson(o.name);
 
@@ -615,6 +631,7 @@ std::string PlanToJson(const PlanResult& r) {
          {"scan_graph", std::move(scan_graph)},
          {"route", std::move(route)},
          {"field_time_s", std::move(field_time)},
+         {"optimality", OptimalityJson(r.optimality)},
          {"timings_s", std::move(timings)},
          {"parameters", ParametersJson(r.options)},
          {"warnings", r.warnings}};

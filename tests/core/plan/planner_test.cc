@@ -87,6 +87,28 @@ INSTANTIATE_TEST_SUITE_P(Scenes, KnownOptimumTest,
                            return n;
                          });
 
+// --solver exact: the selection is proven optimal on each known-optimum scene, with the optimum's
+// station count, and the plan reports it (optimality) with the model sizes before and after.
+TEST_P(KnownOptimumTest, ExactSolverProvesTheOptimum) {
+  const Known k = GetParam();
+  PlanOptions o = TestOptions();
+  o.target_coverage = 1.0;
+  o.solver = SelectionSolver::kExact;
+  Result<PlanResult> r = Plan(Synthetic(k.spec), o);
+  ASSERT_TRUE(r.ok()) << r.status().ToString();
+  EXPECT_EQ(static_cast<int>(r->stations.size()), k.stations);
+  EXPECT_EQ(r->covered_voxels, r->coverable_voxels);
+  const planner::Optimality& opt = r->optimality;
+  EXPECT_EQ(opt.solver, "exact");
+  EXPECT_EQ(opt.status, planner::OptimalityStatus::kOptimal);
+  EXPECT_EQ(opt.stations, k.stations);
+  EXPECT_EQ(opt.lower_bound, k.stations);
+  EXPECT_EQ(opt.gap, 0.0);
+  EXPECT_EQ(opt.before.candidates, static_cast<int>(r->candidate_count));
+  EXPECT_LE(opt.model.candidates, opt.before.candidates);
+  EXPECT_LT(opt.model.voxel_classes, opt.before.voxel_classes);
+}
+
 // ALGORITHM.md s.3: a voxel is compatible only within ~45 degrees of its normal, so the paper's
 // test needs more stations than the optimum under surface visibility. The counts go to PLANNING.md.
 TEST(PlannerTest, CompatibilityNeedsMoreStationsThanSurfaceVisibility) {

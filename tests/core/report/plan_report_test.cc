@@ -89,7 +89,7 @@ TEST(PlanReportTest, PlanJsonHasEveryDocumentedKey) {
   const json j = json::parse(PlanToJson(SamplePlan()));
   for (const char* key :
        {"schema", "resolution_m", "selection_test", "stop_reason", "viewpoints", "coverage", "reduction", "candidates",
-        "timings_s", "parameters", "warnings", "scan_graph", "route", "field_time_s"}) {
+        "timings_s", "parameters", "warnings", "scan_graph", "route", "field_time_s", "optimality"}) {
     EXPECT_TRUE(j.contains(key)) << key;
   }
   EXPECT_EQ(j["scan_graph"]["min_overlap"].get<double>(), 0.3);
@@ -108,6 +108,12 @@ TEST(PlanReportTest, PlanJsonHasEveryDocumentedKey) {
     EXPECT_TRUE(j["field_time_s"].contains(key)) << key;
   }
   EXPECT_DOUBLE_EQ(j["field_time_s"]["total"].get<double>(), 295.6);
+  for (const char* key : {"solver", "status", "stations", "lower_bound", "gap", "seconds", "model"}) {
+    EXPECT_TRUE(j["optimality"].contains(key)) << key;
+  }
+  for (const char* key : {"candidates", "voxel_classes", "rows"}) EXPECT_TRUE(j["optimality"]["model"].contains(key));
+  EXPECT_EQ(j["optimality"]["solver"], "greedy");
+  EXPECT_EQ(j["optimality"]["status"], "heuristic");
   EXPECT_EQ(j["viewpoints"][0]["route_order"].get<int>(), 2);
   EXPECT_EQ(j["viewpoints"][1]["route_order"].get<int>(), 1);
   ASSERT_EQ(j["viewpoints"].size(), 2u);

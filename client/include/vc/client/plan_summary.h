@@ -1,4 +1,4 @@
-// What vc-client prints after a plan: the stations, the scan graph, the walking route and the
+// What vc-client prints after a plan: the stations, how far from the optimum, the scan graph, the walking route and the
 // field time. Stations are numbered from 1 in plan order, as on heatmap.png.
 #pragma once
 
@@ -10,6 +10,10 @@ namespace vc::client {
 
 // The summary lines, each ending in '\n'.
 std::string PlanSummary(const PlanResult& result);
+
+// How far the selection is from the optimum, one line ("optimal: 37 stations, proven", "37 stations,
+// at most 4 more than the optimum (bound 33)"); empty for the default greedy selection.
+std::string OptimalityLine(const PlanResult& result);
 
 // A duration as a crew reads it: "45 s", "12 min", "1 h 05 min".
 std::string FormatDuration(double seconds);

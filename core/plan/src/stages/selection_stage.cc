@@ -1,7 +1,9 @@
 #include <cmath>
+#include <memory>
 #include <utility>
 #include <vector>
 
+#include "vc/plan/exact_selector.h"
 #include "vc/plan/greedy.h"
 #include "vc/plan/stages.h"
 
@@ -15,6 +17,16 @@ GreedySelectorOptions SelectorOptionsFor(const PlanOptions& options) {
   out.consolidate = options.consolidate;
   out.min_overlap = options.min_overlap;
   return out;
+}
+
+std::unique_ptr<Selector> SelectorFor(const PlanOptions& options) {
+  if (options.solver == SelectionSolver::kGreedy) return std::make_unique<GreedySelector>(SelectorOptionsFor(options));
+  ExactSelectorOptions exact;
+  exact.greedy = SelectorOptionsFor(options);
+  exact.time_limit_s = options.solve_seconds;
+  exact.memory_budget_bytes = options.memory_budget_bytes / 2;
+  exact.swap_search = options.solver == SelectionSolver::kExact;
+  return std::make_unique<ExactSelector>(exact);
 }
 
 Result<SelectionOutput> RunSelectionStage(SelectionInput in, const PlanOptions& options, const JobContext& ctx) {

@@ -45,6 +45,8 @@ v1::StopReason ToProto(StopReason r);
 // DATA_LOSS for UNSPECIFIED or an unknown value.
 Result<StopReason> FromProto(v1::StopReason r);
 v1::FaceSet ToProto(FaceSet f);
+// SelectionSolver <-> its enum (UNSPECIFIED in PlanParameters keeps the default).
+v1::SelectionSolver ToProto(SelectionSolver s);
 
 // Parameters (generated from the parameter tables, vc/base/parameter.h). ToProto sets every field;
 // FromProto applies the fields present in `p` to a default-constructed struct. INVALID_ARGUMENT

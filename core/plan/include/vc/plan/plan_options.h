@@ -11,6 +11,7 @@
 #include "vc/base/parameter.h"
 #include "vc/base/status.h"
 #include "vc/plan/keep_out.h"
+#include "vc/plan/selector.h"
 #include "vc/scene/voxel_scene.h"
 #include "vc/visibility/visibility.h"
 
@@ -21,6 +22,8 @@
 //   candidate that sees all they alone covered (coverage never shrinks; docs/PLANNING.md).
 // - doorway_candidates: candidates in narrow passages (vc/plan/candidates.h; docs/PLANNING.md,
 //   "Doorway candidates").
+// - solver / solve_seconds: greedy (the default), the exact integer program (CBC) with a time
+//   limit, or auto (docs/PLANNING.md, "Exact selection").
 // - refine: proximity refinement (ALGORITHM.md s.7.4), each station to the best of a sub-grid.
 // - reduce / reduce_to: reduction (s.7.5) removes zero-loss stations; with reduce_to > 0 it keeps
 //   removing the cheapest single or pair until at most reduce_to stations remain.
@@ -45,6 +48,9 @@
   X(double, target_coverage, 0.99, "fraction", "target-coverage", kFraction,                                           \
     "stop at this covered fraction of the coverable voxels")                                                           \
   X(bool, consolidate, true, "", "consolidate", kAny, "drop covered picks and merge pairs after greedy")               \
+  X(::vc::SelectionSolver, solver, ::vc::SelectionSolver::kGreedy, "", "solver", kAny,                                 \
+    "station selection: greedy, exact (integer program, proven gap) or auto")                                          \
+  X(double, solve_seconds, 20.0, "s", "solve-seconds", kPositive, "time limit of the exact solver")                    \
   X(bool, refine, false, "", "refine", kAny, "refine each station on a local sub-grid")                                \
   X(double, refine_radius_m, 0.5, "m", "refine-radius", kPositive, "refinement radius")                                \
   X(double, refine_step_m, 0.25, "m", "refine-step", kPositive, "refinement step")                                     \

@@ -119,6 +119,9 @@ struct PlanResult {
   int connecting_stations = 0;
   WalkingRoute route;
   FieldTime field_time;
+  // How the selection's station count relates to the optimum over the candidates (docs/PLANNING.md,
+  // "Exact selection"): the selection stage's, before refinement and reduction.
+  planner::Optimality optimality;
 };
 
 // What a plan reports while it runs, for streaming; every member optional, called on the thread

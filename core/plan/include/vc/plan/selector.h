@@ -8,6 +8,7 @@
 #pragma once
 
 #include <cstdint>
+#include <string>
 #include <string_view>
 #include <vector>
 
@@ -27,9 +28,53 @@ enum class StopReason : uint8_t {
 // "exhausted", "target_reached", "max_stations", "min_gain".
 std::string_view StopReasonName(StopReason reason);
 
+// Which selector a plan uses (PlanOptions::solver; docs/PLANNING.md, "Exact selection").
+enum class SelectionSolver : uint8_t {
+  kGreedy,  // GreedySelector: lazy greedy, then consolidation
+  kExact,   // ExactSelector: the integer program (CBC), greedy + swaps over the memory budget
+  kAuto,    // the integer program when it fits the memory budget, else the greedy plan
+};
+// "greedy", "exact", "auto".
+std::string_view SelectionSolverName(SelectionSolver solver);
+
 }  // namespace vc
 
 namespace vc::planner {
+
+// How a selection's station count relates to the optimum over the same candidates (plan.json
+// `optimality`; docs/PLANNING.md, "Exact selection").
+enum class OptimalityStatus : uint8_t {
+  kHeuristic,  // no bound was proven (greedy, or the swap local search)
+  kFeasible,   // a solver's incumbent with a proven bound that may be below it (time limit)
+  kOptimal,    // proven optimal over the candidates given
+};
+// "heuristic", "feasible", "optimal".
+std::string_view OptimalityStatusName(OptimalityStatus status);
+
+// The size of the integer program (after the model reduction) or, in `before`, of the input.
+struct ModelSize {
+  int candidates = 0;     // candidate columns (fixed stations included in `before`)
+  int voxel_classes = 0;  // voxel classes (`before`: coverable voxels, one class each)
+  int rows = 0;           // constraint rows (0 in `before`)
+};
+
+struct Optimality {
+  std::string solver = "greedy";  // "greedy", "exact", or "greedy+swap" (exact's fallback)
+  OptimalityStatus status = OptimalityStatus::kHeuristic;
+  int stations = 0;        // stations selected (fixed ones included)
+  double lower_bound = 0;  // proven lower bound on the stations (0 when none is proven)
+  // (stations - lower_bound) / stations; 1 when no bound is proven (0 stations: 0). With
+  // max_stations the objective is coverage: lower_bound = stations and gap is the coverage gap
+  // (covered_bound - covered) / covered_bound.
+  double gap = 1;
+  uint64_t covered_bound = 0;  // proven upper bound on the covered voxels (max_stations mode; else 0)
+  double seconds = 0;          // wall time of the whole Select, in seconds
+  ModelSize before;            // the input: candidates and coverable voxels
+  ModelSize model;             // the integer program solved (after the model reduction)
+  int forced = 0;              // candidates fixed to 1 as the only view of some voxel
+  int dominated = 0;           // candidates dropped as dominated by another
+  std::string note;            // why a fallback was taken, or empty
+};
 
 // What a selector chose over one vector of visibility sets.
 struct Selection {
@@ -41,6 +86,7 @@ struct Selection {
   int saved_by_improvement = 0;              // picks the improvement pass saved (consolidation)
   int connectors = 0;                        // first-pass picks made to link the scan graph (min_overlap)
   int new_groups = 0;                        // times the first pass found no chain to a gaining candidate
+  Optimality optimality;                     // how far from the optimum (greedy: heuristic, no bound)
 };
 
 // Chooses stations among candidates from their visibility sets.

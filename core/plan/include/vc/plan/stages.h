@@ -10,6 +10,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -113,6 +114,9 @@ struct SelectionOutput {
 
 // The Selector a plan with `options` uses: GreedySelector with its stopping rules.
 [[nodiscard]] GreedySelectorOptions SelectorOptionsFor(const PlanOptions& options);
+// The selector options.solver names: GreedySelector, or ExactSelector with options.solve_seconds
+// and half the job's memory budget (the visibility sets hold the rest).
+[[nodiscard]] std::unique_ptr<Selector> SelectorFor(const PlanOptions& options);
 
 // --- Stage::kRefine: each station to the best position of a sub-grid around it (s.7.4) ---
 struct RefineInput {

@@ -1,0 +1,58 @@
+#!/usr/bin/env bash
+# Greedy against the exact selector (docs/PLANNING.md, "Exact selection"): plans geb079 and the
+# synthetic scenes through a real vc-server and vc-client once per solver, with the default
+# parameters (target coverage 0.99), and prints one row per scene and solver: stations, coverage,
+# the optimality status, lower bound and gap, the selection stage's time and the whole plan's.
+# Usage: scripts/compare-solvers.sh [BUILD_DIR (default build/release)] [SOLVERS (default "greedy exact")]
+#   [SCENES (default: geb079 and the synthetic scenes; "hall" and "hall-scan" add the halls)] [-- FLAGS...]
+set -euo pipefail
+cd "$(dirname "$0")/.."
+bin=${1:-build/release}
+solvers=${2:-greedy exact}
+scenes=${3:-geb079 box lroom comb:3 comb:5 rooms:3 twofloor tworooms}
+shift $(( $# < 3 ? $# : 3 ))
+[[ "${1:-}" == "--" ]] && shift
+extra=("$@")
+work=$(mktemp -d)
+server_pid=""
+cleanup() {
+  [[ -n "$server_pid" ]] && kill "$server_pid" 2>/dev/null && wait "$server_pid" 2>/dev/null || true
+  rm -rf "$work"
+}
+trap cleanup EXIT
+
+"$bin/server/vc-server" --listen 127.0.0.1:0 --workers 1 >"$work/server.log" 2>&1 &
+server_pid=$!
+port=""
+for _ in $(seq 1 100); do
+  port=$(sed -n 's/.*listening on .* (port \([0-9]*\)).*/\1/p' "$work/server.log" | head -1)
+  [[ -n "$port" ]] && break
+  sleep 0.1
+done
+[[ -n "$port" ]] || { cat "$work/server.log"; exit 1; }
+
+printf '%-10s %-7s %8s %9s %-10s %6s %6s %9s %8s  %s\n' scene solver stations coverage status bound gap select_s total_s "model (candidates/classes/rows; before)"
+for s in $scenes; do
+  case "$s" in
+    geb079) f=../shared/data/geb079/geb079.bt ;;
+    hall-scan) f=../shared/data/hall-scan/scan.dat.bz2 ;;
+    *) f="$work/${s/:/_}.ply"; [[ -f "$f" ]] || "$bin/client/vc-synth" "$s" --spacing 0.05 --out "$f" >/dev/null ;;
+  esac
+  for solver in $solvers; do
+    out="$work/out-${s/:/_}-$solver"
+    "$bin/client/vc-client" submit "$f" --server "127.0.0.1:$port" --out "$out" --solver "$solver" "${extra[@]}" \
+      >/dev/null 2>"$work/err" || { cat "$work/err"; exit 1; }
+    python3 - "$s" "$solver" "$out/plan.json" <<'PY'
+import json, sys
+p = json.load(open(sys.argv[3]))
+c, o, t = p["coverage"], p["optimality"], p["timings_s"]
+m, b = o["model"], o["before"]
+bound = f'{o["lower_bound"]:.0f}' if o["status"] != "heuristic" else "-"
+gap = f'{100 * o["gap"]:.0f}%' if o["status"] != "heuristic" else "-"
+print(f'{sys.argv[1]:10s} {sys.argv[2]:7s} {len(p["viewpoints"]):8d} {100 * c["covered_voxels"] / c["coverable_voxels"]:8.2f}% '
+      f'{o["status"]:10s} {bound:>6s} {gap:>6s} {t["selection"]:9.2f} {t["total"]:8.2f}  '
+      f'{m["candidates"]}/{m["voxel_classes"]}/{m["rows"]}; {b["candidates"]}/{b["voxel_classes"]}'
+      + (f'  [{o["note"]}]' if o.get("note") else ''))
+PY
+  done
+done
