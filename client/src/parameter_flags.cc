@@ -54,8 +54,9 @@ void AddFlag(CLI::App* app, const ParamInfo& info, SelectionTest* value) {
 }
 
 void AddFlag(CLI::App* app, const ParamInfo& info, SelectionSolver* value) {
-  AddEnumFlag(app, info, value,
-              {{"greedy", SelectionSolver::kGreedy}, {"exact", SelectionSolver::kExact}, {"auto", SelectionSolver::kAuto}});
+  AddEnumFlag(
+      app, info, value,
+      {{"greedy", SelectionSolver::kGreedy}, {"exact", SelectionSolver::kExact}, {"auto", SelectionSolver::kAuto}});
 }
 
 void AddFlag(CLI::App* app, const ParamInfo& info, FaceSet* value) {

@@ -5,16 +5,15 @@
 #include <CbcHeuristicFPump.hpp>
 #include <CbcHeuristicLocal.hpp>
 #include <CbcModel.hpp>
-#include <ClpEventHandler.hpp>
 #include <CglClique.hpp>
 #include <CglGomory.hpp>
 #include <CglKnapsackCover.hpp>
 #include <CglMixedIntegerRounding2.hpp>
 #include <CglProbing.hpp>
 #include <CglZeroHalf.hpp>
+#include <ClpEventHandler.hpp>
 #include <CoinPackedMatrix.hpp>
 #include <OsiClpSolverInterface.hpp>
-
 #include <algorithm>
 #include <bit>
 #include <chrono>
@@ -56,9 +55,9 @@ uint64_t TargetVoxels(double target, uint64_t coverable) {
 // The coverable voxels partitioned into classes seen by exactly the same candidates (partition
 // refinement: each candidate splits the classes it touches), with each class's candidates.
 struct Classes {
-  std::vector<uint64_t> weight;             // voxels per class
-  std::vector<std::vector<int>> seen_by;    // per class: candidates seeing it, ascending
-  std::vector<std::vector<int>> sees;       // per candidate: classes it sees, ascending
+  std::vector<uint64_t> weight;           // voxels per class
+  std::vector<std::vector<int>> seen_by;  // per class: candidates seeing it, ascending
+  std::vector<std::vector<int>> sees;     // per candidate: classes it sees, ascending
 };
 
 Result<Classes> BuildClasses(const std::vector<VoxelSet>& sets, const JobContext& ctx) {
@@ -183,9 +182,8 @@ Result<ReducedModel> Reduce(const Classes& cl, int n_candidates, int fixed, bool
     for (int c = 0; c < n_candidates; ++c) {
       if (active[c]) order.push_back(c);
     }
-    std::sort(order.begin(), order.end(), [&](int a, int b) {
-      return active_sees[a] != active_sees[b] ? active_sees[a] < active_sees[b] : a > b;
-    });
+    std::sort(order.begin(), order.end(),
+              [&](int a, int b) { return active_sees[a] != active_sees[b] ? active_sees[a] < active_sees[b] : a > b; });
     for (size_t i = 0; i < order.size(); ++i) {
       if (i % 256 == 0) VC_RETURN_IF_ERROR(ctx.CheckCancelled("exact selection (model reduction)"));
       const int a = order[i];
@@ -354,11 +352,11 @@ class WatchHandler final : public CbcEventHandler {
       const double elapsed = std::chrono::duration<double>(now - watch_->start).count();
       char note[160];
       if (watch_->max_mode) {
-        std::snprintf(note, sizeof note, "exact: incumbent %.0f voxels, bound %.0f", watch_->offset - model_->getObjValue(),
-                      watch_->offset - model_->getBestPossibleObjValue());
+        std::snprintf(note, sizeof note, "exact: incumbent %.0f voxels, bound %.0f",
+                      watch_->offset - model_->getObjValue(), watch_->offset - model_->getBestPossibleObjValue());
       } else {
-        std::snprintf(note, sizeof note, "exact: incumbent %.0f stations, bound %.2f", watch_->offset + model_->getObjValue(),
-                      watch_->offset + model_->getBestPossibleObjValue());
+        std::snprintf(note, sizeof note, "exact: incumbent %.0f stations, bound %.2f",
+                      watch_->offset + model_->getObjValue(), watch_->offset + model_->getBestPossibleObjValue());
       }
       watch_->ctx->Report(Stage::kSelection, std::min(0.99, elapsed / watch_->time_limit_s), note);
     }
@@ -513,15 +511,16 @@ Result<Selection> ExactSelector::Select(const std::vector<VoxelSet>& sets, int f
   auto finish = [&](std::vector<int> picks) {
     out.picks = SortByMarginalGain(sets, std::move(picks), fixed);
     out.covered = Covered(sets, out.picks);
-    out.stop = out.covered >= coverable   ? StopReason::kExhausted
-               : out.covered >= target    ? StopReason::kTargetReached
-                                          : StopReason::kMaxStations;
+    out.stop = out.covered >= coverable ? StopReason::kExhausted
+               : out.covered >= target  ? StopReason::kTargetReached
+                                        : StopReason::kMaxStations;
     opt.stations = static_cast<int>(out.picks.size());
     if (max_mode) {
       opt.lower_bound = opt.stations;
       const uint64_t capped = std::min(out.covered, target);
-      opt.gap = opt.covered_bound > 0 ? double(opt.covered_bound - std::min(capped, opt.covered_bound)) / opt.covered_bound
-                                      : 0.0;
+      opt.gap = opt.covered_bound > 0
+                    ? double(opt.covered_bound - std::min(capped, opt.covered_bound)) / opt.covered_bound
+                    : 0.0;
       if (opt.status == OptimalityStatus::kHeuristic) opt.gap = 1;
     } else {
       opt.lower_bound = std::min<double>(opt.lower_bound, opt.stations);
@@ -815,8 +814,8 @@ Result<Selection> ExactSelector::Select(const std::vector<VoxelSet>& sets, int f
       warm[g0 + root] = warm_stations;
     }
   }
-  const bool warm_ok = warm_connected &&
-                       (max_mode ? warm_stations <= options_.greedy.max_stations : warm_covered >= need);
+  const bool warm_ok =
+      warm_connected && (max_mode ? warm_stations <= options_.greedy.max_stations : warm_covered >= need);
   if (warm_ok) {
     const double warm_obj = max_mode ? -double(std::min(warm_covered, need)) + eps * warm_stations : warm_stations;
     model.setBestSolution(warm.data(), n_vars, warm_obj, true);
@@ -864,14 +863,16 @@ Result<Selection> ExactSelector::Select(const std::vector<VoxelSet>& sets, int f
   if (max_mode) {
     const double b = std::max(cbc_bound ? bound : -COIN_DBL_MAX, root_bound);
     const double bound_covered = b <= -1e30 ? double(need) : std::floor(-b + eps * options_.greedy.max_stations + 1e-6);
-    opt.covered_bound = std::min<uint64_t>(target, m.forced_covered + static_cast<uint64_t>(std::max(0.0, bound_covered)));
+    opt.covered_bound =
+        std::min<uint64_t>(target, m.forced_covered + static_cast<uint64_t>(std::max(0.0, bound_covered)));
     if (proven) opt.covered_bound = std::min(Covered(sets, picks), target);
   } else {
     const double counting = CountingBound(m, need);
     const double ilp = std::max(0.0, std::ceil(std::max(cbc_bound ? bound : 0.0, root_bound) - 1e-6));
     opt.lower_bound = static_cast<double>(m.forced.size()) + std::max(counting, ilp);
     if (proven) opt.lower_bound = static_cast<double>(picks.size());
-    if (watch.lp_stopped) opt.note = "the time limit cut off an LP in the search; the bound is the root LP's or CBC's last";
+    if (watch.lp_stopped)
+      opt.note = "the time limit cut off an LP in the search; the bound is the root LP's or CBC's last";
   }
   return finish(std::move(picks));
 }

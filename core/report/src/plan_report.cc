@@ -44,16 +44,11 @@ Json OptimalityJson(const planner::Optimality& o) {
   auto size = [](const planner::ModelSize& m) {
     return Json{{"candidates", m.candidates}, {"voxel_classes", m.voxel_classes}, {"rows", m.rows}};
   };
-  Json j{{"solver", o.solver},
-         {"status", std::string(planner::OptimalityStatusName(o.status))},
-         {"stations", o.stations},
-         {"lower_bound", o.lower_bound},
-         {"gap", o.gap},
-         {"seconds", o.seconds},
-         {"model", size(o.model)},
-         {"before", size(o.before)},
-         {"forced", o.forced},
-         {"dominated", o.dominated}};
+  Json j{{"solver", o.solver},     {"status", std::string(planner::OptimalityStatusName(o.status))},
+         {"stations", o.stations}, {"lower_bound", o.lower_bound},
+         {"gap", o.gap},           {"seconds", o.seconds},
+         {"model", size(o.model)}, {"before", size(o.before)},
+         {"forced", o.forced},     {"dominated", o.dominated}};
   if (o.covered_bound > 0) j["covered_bound"] = o.covered_bound;
   if (!o.note.empty()) j["note"] = o.note;
   return j;

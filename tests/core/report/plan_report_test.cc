@@ -87,9 +87,9 @@ PlanResult SamplePlan() {
 
 TEST(PlanReportTest, PlanJsonHasEveryDocumentedKey) {
   const json j = json::parse(PlanToJson(SamplePlan()));
-  for (const char* key : {"schema", "resolution_m", "selection_test", "stop_reason", "viewpoints", "coverage",
-                          "reduction", "candidates", "timings_s", "parameters", "warnings", "scan_graph", "route",
-                          "field_time_s", "optimality"}) {
+  for (const char* key :
+       {"schema", "resolution_m", "selection_test", "stop_reason", "viewpoints", "coverage", "reduction", "candidates",
+        "timings_s", "parameters", "warnings", "scan_graph", "route", "field_time_s", "optimality"}) {
     EXPECT_TRUE(j.contains(key)) << key;
   }
   EXPECT_EQ(j["scan_graph"]["min_overlap"].get<double>(), 0.3);

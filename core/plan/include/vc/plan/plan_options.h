@@ -46,14 +46,14 @@
   X(bool, consolidate, true, "", "consolidate", kAny, "drop covered picks and merge pairs after greedy")               \
   X(::vc::SelectionSolver, solver, ::vc::SelectionSolver::kGreedy, "", "solver", kAny,                                 \
     "station selection: greedy, exact (integer program, proven gap) or auto")                                          \
-  X(double, solve_seconds, 20.0, "s", "solve-seconds", kPositive, "time limit of the exact solver")                     \
+  X(double, solve_seconds, 20.0, "s", "solve-seconds", kPositive, "time limit of the exact solver")                    \
   X(bool, refine, false, "", "refine", kAny, "refine each station on a local sub-grid")                                \
   X(double, refine_radius_m, 0.5, "m", "refine-radius", kPositive, "refinement radius")                                \
   X(double, refine_step_m, 0.25, "m", "refine-step", kPositive, "refinement step")                                     \
   X(bool, reduce, true, "", "reduce", kAny, "remove redundant stations")                                               \
   X(int32_t, reduce_to, 0, "stations", "reduce-to", kNonNegative,                                                      \
     "reduce to at most this many stations (0 = zero-loss removals only)")                                              \
-  X(int32_t, threads, 0, "threads", "threads", kNonNegative, "threads for the job (0 = all, or the server's share)")  \
+  X(int32_t, threads, 0, "threads", "threads", kNonNegative, "threads for the job (0 = all, or the server's share)")   \
   X(double, min_overlap, 0.0, "fraction", "min-overlap", kUnitInterval,                                                \
     "keep the scan graph connected at this overlap (0 = off; 0.3 for target-less registration)")                       \
   X(double, setup_seconds, 120.0, "s", "setup-seconds", kNonNegative, "field time to set up the scanner per station")  \
