@@ -431,11 +431,12 @@ Result<Evaluation> EvaluateExact(const EvaluationJob& job, Evaluation ev) {
   // merged at the end. Otherwise the viewpoints are evaluated one after another, each on all
   // threads. Both give the same figures: the best (V, perception) pair of a face is the same
   // whatever the order of the viewpoints.
-  // Each extra thread's Work costs 9 bytes per face; beyond kEvaluateExtraWorkBytes in all, the
-  // viewpoints are evaluated one after another instead.
+  // Each extra thread's Work costs 9 bytes per face (and 4 per voxel for the sole viewers); beyond
+  // kEvaluateExtraWorkBytes in all, the viewpoints are evaluated one after another instead.
   const int workers = ResolveThreads(options.threads, nv);
   const size_t viewer_slots = options.keep_face_values ? n : 0;
-  const uint64_t extra_bytes = uint64_t(workers - 1) * n * kFacesPerVoxel * (sizeof(double) + sizeof(uint8_t));
+  const uint64_t extra_bytes = uint64_t(workers - 1) * (n * kFacesPerVoxel * (sizeof(double) + sizeof(uint8_t)) +
+                                                        viewer_slots * sizeof(int32_t));
   std::vector<std::unique_ptr<Work>> works;
   if (workers > 1 && nv >= kEvaluateViewpointsPerThread * uint64_t(workers) && extra_bytes <= kEvaluateExtraWorkBytes) {
     // Allocated here, in the calling thread, so that running out of memory is not a worker's.
