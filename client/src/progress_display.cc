@@ -1,6 +1,7 @@
 #include "vc/client/progress_display.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -22,29 +23,82 @@ void ProgressDisplay::Accepted(const std::string& job_id, uint32_t queue_positio
   Note("job " + job_id + (queue_position == 0 ? " started" : " queued at position " + std::to_string(queue_position)));
 }
 
+double SteadySeconds() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+std::string FormatTimeLeft(double seconds) {
+  const auto s = static_cast<long long>(std::llround(std::max(seconds, 0.0)));
+  char text[48];
+  if (s < 60) {
+    std::snprintf(text, sizeof text, "%llds", s);
+  } else if (s < 3600) {
+    std::snprintf(text, sizeof text, "%lldm%02llds", s / 60, s % 60);
+  } else {
+    std::snprintf(text, sizeof text, "%lldh%02lldm", s / 3600, (s % 3600) / 60);
+  }
+  return text;
+}
+
+std::string ProgressDisplay::Describe(const ProgressEvent& e, double now) {
+  std::string text(StageName(e.stage));
+  char part[96];
+  if (e.unit.empty()) {
+    std::snprintf(part, sizeof part, " %3d%%", int(std::clamp(e.fraction, 0.0, 1.0) * 100));
+    text += part;
+  } else if (e.total == 0) {
+    std::snprintf(part, sizeof part, " %llu %s", static_cast<unsigned long long>(e.done), e.unit.c_str());
+    text += part;
+  } else {
+    std::snprintf(part, sizeof part, " %llu/%llu %s", static_cast<unsigned long long>(e.done),
+                  static_cast<unsigned long long>(e.total), e.unit.c_str());
+    text += part;
+    // The rate since this count was first seen; the time left at that rate.
+    const double span = now - first_seconds_;
+    if (span >= kMinRateSeconds && e.done > first_done_) {
+      const double rate = double(e.done - first_done_) / span;
+      std::snprintf(part, sizeof part, rate < 10 ? "  %.1f/s" : "  %.0f/s", rate);
+      text += part;
+      if (e.done < e.total) text += "  " + FormatTimeLeft(double(e.total - e.done) / rate) + " left";
+    }
+  }
+  if (!e.message.empty()) text += "  " + e.message;
+  return text;
+}
+
 void ProgressDisplay::Update(const ProgressEvent& e) {
+  const double now = now_();
   const double f = std::clamp(e.fraction, 0.0, 1.0);
+  // A new stage, or a new count within it, starts a new rate measurement.
+  const bool fresh = !started_ || e.stage != stage_ || e.unit != unit_ || e.total != total_ || e.done < first_done_;
+  if (fresh) {
+    started_ = true;
+    stage_ = e.stage;
+    unit_ = e.unit;
+    total_ = e.total;
+    first_seconds_ = now;
+    first_done_ = e.done;
+  }
+  std::string text = Describe(e, now);
   if (tty_) {
+    if (text.size() > 90) text = text.substr(0, 87) + "...";  // one line of a narrow terminal
     constexpr int kWidth = 30;
     const int filled = int(std::lround(f * kWidth));
     std::string bar(size_t(filled), '#');
     bar.append(size_t(kWidth - filled), '-');
-    std::string msg = e.message.size() > 40 ? e.message.substr(0, 37) + "..." : e.message;
-    std::fprintf(out_, "\r\033[K[%s] %3d%% %-12s %s", bar.c_str(), int(f * 100),
-                 std::string(StageName(e.stage)).c_str(), msg.c_str());
+    std::fprintf(out_, "\r\033[K[%s] %s", bar.c_str(), text.c_str());
     std::fflush(out_);
     bar_shown_ = true;
     return;
   }
-  const int quarter = int(f * 4);
-  if (e.stage != stage_ || quarter > last_quarter_) {
-    std::fprintf(out_, "progress: %-12s %3d%%%s%s\n", std::string(StageName(e.stage)).c_str(), int(f * 100),
-                 e.message.empty() ? "" : "  ", e.message.c_str());
+  const bool moved = e.done != last_line_done_ || f != last_line_fraction_;
+  if (fresh || (moved && now - last_line_seconds_ >= kPlainLineSeconds)) {
+    std::fprintf(out_, "progress: %s\n", text.c_str());
     std::fflush(out_);
+    last_line_seconds_ = now;
+    last_line_done_ = e.done;
+    last_line_fraction_ = f;
   }
-  if (e.stage != stage_) last_quarter_ = -1;
-  stage_ = e.stage;
-  last_quarter_ = std::max(last_quarter_, quarter);
 }
 
 void ProgressDisplay::Station(const PlannedStation& s, int index) {

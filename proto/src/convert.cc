@@ -398,10 +398,15 @@ v1::Progress ToProto(const ProgressEvent& e) {
   p.set_stage(ToProto(e.stage));
   p.set_fraction(e.fraction);
   p.set_message(e.message);
+  p.set_done(e.done);
+  p.set_total(e.total);
+  p.set_unit(e.unit);
   return p;
 }
 
-ProgressEvent FromProto(const v1::Progress& p) { return {FromProto(p.stage()), p.fraction(), p.message()}; }
+ProgressEvent FromProto(const v1::Progress& p) {
+  return {FromProto(p.stage()), p.fraction(), p.message(), p.done(), p.total(), p.unit()};
+}
 
 v1::PlannedStation ToProto(const PlannedStation& s) {
   v1::PlannedStation p;

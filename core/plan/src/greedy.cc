@@ -1,6 +1,7 @@
 #include "vc/plan/greedy.h"
 
 #include <algorithm>
+#include <cstdio>
 #include <numeric>
 #include <optional>
 #include <queue>
@@ -151,6 +152,13 @@ Result<std::vector<int>> ShortestChain(const Overlaps& overlaps, size_t candidat
   return std::vector<int>{};
 }
 
+// "87.3 %".
+std::string FormatPercent(double fraction) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.1f %%", 100.0 * fraction);
+  return text;
+}
+
 }  // namespace
 
 Result<GreedyResult> SelectGreedy(const std::vector<VoxelSet>& sets, const GreedyOptions& options,
@@ -192,6 +200,13 @@ Result<GreedyResult> SelectGreedy(const std::vector<VoxelSet>& sets, const Greed
   auto eligible = [&](int c) { return !constrained() || linked[c]; };
   std::priority_queue<Entry, std::vector<Entry>, EntryLess> heap;
   std::vector<Entry> parked;  // lazy: popped while not linked; back in the heap once linked
+  // Stations picked so far (the total is not known in advance) and the coverage reached.
+  auto report_selection = [&] {
+    if (!ctx.progress) return;
+    const double fraction = coverable > 0 ? std::min(1.0, double(result.covered) / coverable) : 1.0;
+    ctx.progress(ProgressEvent{Stage::kSelection, fraction, "coverage " + FormatPercent(fraction), result.picks.size(),
+                               0, "stations"});
+  };
   auto pick = [&](int c, uint64_t gain, bool connector) {
     SubtractFrom(uncovered, sets[c]);
     result.covered += gain;
@@ -303,7 +318,7 @@ Result<GreedyResult> SelectGreedy(const std::vector<VoxelSet>& sets, const Greed
           pick(chain[k], CountAnd(sets[chain[k]], uncovered), k + 1 < chain.size());
         }
         ++round;
-        ctx.Report(Stage::kSelection, coverable > 0 ? std::min(1.0, result.covered / coverable) : 1.0);
+        report_selection();
         continue;
       }
     }
@@ -313,7 +328,7 @@ Result<GreedyResult> SelectGreedy(const std::vector<VoxelSet>& sets, const Greed
     }
     pick(best, best_gain, false);
     ++round;
-    ctx.Report(Stage::kSelection, coverable > 0 ? std::min(1.0, result.covered / coverable) : 1.0);
+    report_selection();
   }
   // Groups the fixed stations left apart: joined by the shortest chains that exist.
   if (registration && result.stop != StopReason::kMaxStations) {

@@ -10,7 +10,10 @@ JobContext StageContext(const JobContext& ctx, Stage stage, double lo, double hi
   sub.cancel = ctx.cancel;
   if (ctx.progress) {
     sub.progress = [&ctx, stage, lo, hi](const ProgressEvent& e) {
-      ctx.Report(stage, lo + (hi - lo) * std::clamp(e.fraction, 0.0, 1.0), e.message);
+      ProgressEvent scaled = e;  // the counts describe the step itself
+      scaled.stage = stage;
+      scaled.fraction = lo + (hi - lo) * std::clamp(e.fraction, 0.0, 1.0);
+      ctx.progress(scaled);
     };
   }
   return sub;
@@ -21,7 +24,9 @@ JobContext ProgressRange(const JobContext& ctx, double lo, double hi) {
   sub.cancel = ctx.cancel;
   if (ctx.progress) {
     sub.progress = [&ctx, lo, hi](const ProgressEvent& e) {
-      ctx.Report(e.stage, lo + (hi - lo) * std::clamp(e.fraction, 0.0, 1.0), e.message);
+      ProgressEvent scaled = e;
+      scaled.fraction = lo + (hi - lo) * std::clamp(e.fraction, 0.0, 1.0);
+      ctx.progress(scaled);
     };
   }
   return sub;

@@ -247,7 +247,7 @@ Result<Evaluation> EvaluateSampled(const EvaluationJob& job, Evaluation ev) {
   std::vector<Tally> overall(chunks);
   std::vector<double> sum_sq(chunks, 0.0);
   std::vector<std::vector<Tally>> per(chunks, std::vector<Tally>(nv));
-  StageProgress progress(ctx, Stage::kEvaluation, chunks);
+  StageProgress progress(ctx, Stage::kEvaluation, chunks, sample.size(), "faces");
   VC_RETURN_IF_ERROR(
       ParallelChunks(sample.size(), kChunk, options.threads, ctx, [&](uint64_t c, uint64_t b, uint64_t e) {
         for (uint64_t i = b; i < e; ++i) {
@@ -320,7 +320,7 @@ Result<Evaluation> EvaluateExact(const EvaluationJob& job, Evaluation ev) {
   constexpr uint64_t kCornerChunk = 64 * 256;
   constexpr uint64_t kVoxelChunk = 4096;
   const uint64_t voxel_chunks = (n + kVoxelChunk - 1) / kVoxelChunk;
-  StageProgress progress(ctx, Stage::kEvaluation, nv);
+  StageProgress progress(ctx, Stage::kEvaluation, nv, nv, "stations");
   // Corners that groups of faces decide at once (surface_groups.h), per viewpoint.
   const internal::SurfaceTargets targets(g, index, NotEnclosed(g, index));
   constexpr uint64_t kBricksPerTask = 256;

@@ -251,7 +251,7 @@ Result<std::vector<VoxelSet>> ComputeVisibilitySets(const VoxelScene& scene, con
     const uint64_t brick_chunks =
         std::max<uint64_t>(1, (targets.brick_count() + bricks_per_task - 1) / bricks_per_task);
     const uint64_t tasks = viewpoints.size() * brick_chunks;
-    StageProgress progress(ctx, Stage::kVisibility, tasks);
+    StageProgress progress(ctx, Stage::kVisibility, tasks, viewpoints.size(), "candidates");
     Status st = ParallelChunks(tasks, 1, options.threads, ctx, [&](uint64_t task, uint64_t, uint64_t) {
       const size_t k = task / brick_chunks, c = task % brick_chunks;
       if (task_per_viewpoint) sets[k].Resize(n);  // in the capacity reserved above
@@ -282,7 +282,7 @@ Result<std::vector<VoxelSet>> ComputeVisibilitySets(const VoxelScene& scene, con
         candidates.begin();
   }
   const uint64_t tasks = viewpoints.size() * id_chunks;
-  StageProgress progress(ctx, Stage::kVisibility, tasks);
+  StageProgress progress(ctx, Stage::kVisibility, tasks, viewpoints.size(), "candidates");
   const bool compat = options.test == SelectionTest::kCompatibility;
   Status st = ParallelChunks(tasks, 1, options.threads, ctx, [&](uint64_t task, uint64_t, uint64_t) {
     const size_t k = task / id_chunks, c = task % id_chunks;

@@ -138,17 +138,24 @@ inline double FaceValue(Perception p, const WorldPoint& o, const VoxelIndex& v, 
   return VisibilityValue(p, d, p == Perception::kFull ? std::acos(cos_theta) : kHalfPi, s);
 }
 
-// Rate-limited, thread-safe progress for one stage.
+// Rate-limited, thread-safe progress for one stage: a stage done in `total` tasks that stand for `units` of `unit`
+// (e.g. tasks of candidates x brick chunks for 858 "candidates"): reported about every 1 % of the tasks, with the
+// fraction of tasks done and the count of units done (units x tasks done / tasks, rounded down).
 class StageProgress {
  public:
-  StageProgress(const JobContext& ctx, Stage stage, uint64_t total)
-      : ctx_(ctx), stage_(stage), total_(std::max<uint64_t>(total, 1)) {}
+  StageProgress(const JobContext& ctx, Stage stage, uint64_t total, uint64_t units, std::string unit)
+      : ctx_(ctx), stage_(stage), total_(std::max<uint64_t>(total, 1)), units_(units), unit_(std::move(unit)) {}
   void Add(uint64_t n) {
     const uint64_t before = done_.fetch_add(n);
     const uint64_t step = std::max<uint64_t>(total_ / 100, 1);
     if ((before + n) / step != before / step) {
       std::lock_guard<std::mutex> lock(mu_);
-      ctx_.Report(stage_, std::min(1.0, double(before + n) / double(total_)));
+      const uint64_t done = std::min(before + n, total_);
+      // done <= total_ and units_ are far below 2^32 in practice; the product is taken in long
+      // double so that it cannot overflow anyway.
+      const auto units_done = uint64_t((long double)units_ * (long double)done / (long double)total_);
+      if (ctx_.progress)
+        ctx_.progress(ProgressEvent{stage_, double(done) / double(total_), {}, units_done, units_, unit_});
     }
   }
 
@@ -156,6 +163,8 @@ class StageProgress {
   const JobContext& ctx_;
   Stage stage_;
   uint64_t total_;
+  uint64_t units_;
+  std::string unit_;
   std::atomic<uint64_t> done_{0};
   std::mutex mu_;
 };

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <mutex>
 #include <random>
 
 #include "testing/scenes.h"
@@ -297,6 +298,29 @@ std::vector<int32_t> SoleViewers(const Evaluation& ev, size_t voxels) {
       if (seen) sole[id] = sole[id] == kNoViewer ? int32_t(k) : kSeveralViewers;
     }
   return sole;
+}
+
+TEST(EvaluateTest, ProgressCountsTheStationsAndTheSampledFaces) {
+  std::mt19937_64 rng(5);
+  const VoxelScene s = RandomScene(rng, 60, 9, 1.0);
+  const auto vps = RandomViewpoints(rng, 4, 9, 1.0);
+  for (const uint64_t sample : {uint64_t{0}, uint64_t{100}}) {
+    std::mutex mu;
+    ProgressEvent last;
+    JobContext ctx;
+    ctx.progress = [&](const ProgressEvent& e) {
+      std::lock_guard<std::mutex> lock(mu);
+      if (e.done >= last.done) last = e;
+    };
+    EvaluateOptions opt;
+    opt.sample_faces = sample;
+    ASSERT_TRUE(Evaluate(s, vps, opt, ctx).ok());
+    EXPECT_EQ(last.stage, Stage::kEvaluation);
+    EXPECT_EQ(last.unit, sample == 0 ? "stations" : "faces");
+    EXPECT_EQ(last.total, sample == 0 ? vps.size() : sample);
+    EXPECT_EQ(last.done, last.total);
+    EXPECT_EQ(last.fraction, 1.0);
+  }
 }
 
 TEST(EvaluateTest, GlobalVisibilityEqualsBruteForce) {

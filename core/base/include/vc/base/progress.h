@@ -6,6 +6,7 @@
 // the callback must be thread-safe and cheap (the server forwards it to a queue).
 #pragma once
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cstdint>
@@ -60,6 +61,12 @@ struct ProgressEvent {
   Stage stage = Stage::kUnspecified;
   double fraction = 0.0;
   std::string message;
+  // What was counted, when the work is countable: `done` of `total` `unit`s (e.g. 412 of 858
+  // "candidates"); total 0 when the total is not known in advance (selection: stations picked so
+  // far); unit empty when nothing was counted. A client derives the rate and the time left from it.
+  uint64_t done = 0;
+  uint64_t total = 0;
+  std::string unit;
 };
 
 using ProgressFn = std::function<void(const ProgressEvent&)>;
@@ -72,6 +79,12 @@ struct JobContext {
   Status CheckCancelled(const char* what) const { return cancel ? cancel->Check(what) : Status::Ok(); }
   void Report(Stage stage, double fraction, std::string message = {}) const {
     if (progress) progress(ProgressEvent{stage, fraction, std::move(message)});
+  }
+  // `done` of `total` `unit`s, the fraction done / total (0 when total is 0).
+  void ReportCount(Stage stage, uint64_t done, uint64_t total, std::string unit, std::string message = {}) const {
+    if (!progress) return;
+    const double fraction = total > 0 ? double(std::min(done, total)) / double(total) : 0.0;
+    progress(ProgressEvent{stage, fraction, std::move(message), done, total, std::move(unit)});
   }
 };
 
