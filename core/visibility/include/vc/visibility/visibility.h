@@ -205,7 +205,13 @@ struct Evaluation {
   // With keep_per_viewpoint_values: per viewpoint, V of every face at index voxel_id * 6 + face.
   // Faces outside F hold 0.
   std::vector<std::vector<float>> per_viewpoint_face_values;
+  // TEMPORARY (branch report, until main's sole_viewer commit is merged): per voxel id, the index
+  // of the only viewpoint giving any face V > 0, kNoViewer if none, kSeveralViewers if several;
+  // empty if not computed.
+  std::vector<int32_t> sole_viewer;
 };
+inline constexpr int32_t kNoViewer = -1;
+inline constexpr int32_t kSeveralViewers = -2;
 
 // Evaluates a set of viewpoints on `scene` (s.6): G of the whole set and figures per viewpoint.
 // INVALID_ARGUMENT for a non-finite or out-of-range viewpoint, a bad scanner range, or (exact
