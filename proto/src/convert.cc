@@ -474,6 +474,7 @@ std::vector<v1::HeatMapChunk> HeatMapChunks(const HeatMap& h) {
 bool ForEachVoxelChunk(const PlanResult& result, const std::function<bool(v1::VoxelChunk&&)>& fn) {
   const auto& centers = result.voxel_centers;
   const auto& values = result.evaluation.best_face_values;
+  const auto& viewers = result.evaluation.sole_viewer;
   const bool with_values = values.size() == centers.size();
   const size_t n = centers.size();
   for (size_t first = 0; first < n; first += kVoxelsPerChunk) {
@@ -492,6 +493,9 @@ bool ForEachVoxelChunk(const PlanResult& result, const std::function<bool(v1::Vo
       for (size_t i = first; i < end; ++i) {
         for (float v : values[i]) c.add_best_face_values(v);
       }
+    }
+    if (with_values && viewers.size() == n) {
+      c.mutable_sole_viewer()->Add(viewers.begin() + std::ptrdiff_t(first), viewers.begin() + std::ptrdiff_t(end));
     }
     if (!fn(std::move(c))) return false;
   }
@@ -587,6 +591,17 @@ Status PlanResultAssembler::AddVoxels(const v1::VoxelChunk& c) {
   if (with_values != (face_values_.size() == centers_.size()) && !centers_.empty()) {
     return ChunkError("face values present in some voxel chunks only");
   }
+  const bool with_viewers = c.sole_viewer_size() > 0;
+  if (with_viewers && (!with_values || c.sole_viewer_size() != n)) {
+    return ChunkError("voxel chunk with sole viewers for a different number of voxels");
+  }
+  if (with_viewers != (sole_viewers_.size() == centers_.size()) && !centers_.empty()) {
+    return ChunkError("sole viewers present in some voxel chunks only");
+  }
+  for (int32_t v : c.sole_viewer()) {
+    if (v < kSeveralViewers) return ChunkError("voxel chunk with a sole viewer below -2");
+  }
+  sole_viewers_.insert(sole_viewers_.end(), c.sole_viewer().begin(), c.sole_viewer().end());
   voxel_total_ = c.total_voxels();
   for (int i = 0; i < n; ++i) {
     centers_.emplace_back(c.centers_xyz_m(3 * i), c.centers_xyz_m(3 * i + 1), c.centers_xyz_m(3 * i + 2));
@@ -625,6 +640,18 @@ Result<PlanResult> PlanResultAssembler::Finish(const v1::PlanResult& p) && {
   r.covered_voxels = p.covered_voxels();
   r.evaluation = FromProto(p.evaluation());
   r.evaluation.best_face_values = std::move(face_values_);
+  if (!sole_viewers_.empty()) {
+    if (sole_viewers_.size() != r.evaluation.best_face_values.size()) {
+      return ChunkError("received sole viewers for " + std::to_string(sole_viewers_.size()) + " voxels of " +
+                        std::to_string(r.evaluation.best_face_values.size()));
+    }
+    for (int32_t v : sole_viewers_) {
+      if (v >= p.stations_size())
+        return ChunkError("a sole viewer names station " + std::to_string(v) + " of " +
+                          std::to_string(p.stations_size()));
+    }
+  }
+  r.evaluation.sole_viewer = std::move(sole_viewers_);
   for (const auto& t : p.timings()) r.timings.push_back({FromProto(t.stage()), t.seconds()});
   r.total_seconds = p.total_seconds();
   r.warnings.assign(p.warnings().begin(), p.warnings().end());

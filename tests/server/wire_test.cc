@@ -83,6 +83,7 @@ PlanResult BigResult(size_t voxels, size_t candidates) {
     std::array<float, kFacesPerVoxel> v{};
     for (int f = 0; f < kFacesPerVoxel; ++f) v[f] = float(i % 97) / 97.f + float(f);
     r.evaluation.best_face_values.push_back(v);
+    r.evaluation.sole_viewer.push_back(int32_t(i % 4) - 2);  // several, none, station 0, station 1
   }
   for (size_t i = 0; i < candidates; ++i) {
     r.heat_map.positions.emplace_back(double(i), 0, 1.5);
@@ -151,6 +152,7 @@ TEST(PlanResultChunks, ReassembleExactlyAndStayUnderOneMebibyte) {
   ASSERT_TRUE(back.ok()) << back.status().ToString();
   EXPECT_EQ(back->voxel_centers, r.voxel_centers);
   EXPECT_EQ(back->evaluation.best_face_values, r.evaluation.best_face_values);
+  EXPECT_EQ(back->evaluation.sole_viewer, r.evaluation.sole_viewer);
   EXPECT_EQ(back->heat_map.positions, r.heat_map.positions);
   EXPECT_EQ(back->heat_map.visible_voxels, r.heat_map.visible_voxels);
   ASSERT_EQ(back->heat_map.floor_z_m.size(), r.heat_map.floor_z_m.size());
@@ -222,10 +224,33 @@ TEST(PlanResultChunks, ARouteOrGraphNamingAMissingStationIsDataLoss) {
   }
 }
 
+TEST(PlanResultChunks, ASoleViewerNamingAMissingStationOrOnSomeChunksOnlyIsDataLoss) {
+  for (int bad = 0; bad < 3; ++bad) {
+    PlanResult r = BigResult(2 * kVoxelsPerChunk, 1);
+    PlanResultAssembler a;
+    for (const auto& c : HeatMapChunks(r.heat_map)) ASSERT_TRUE(a.AddHeatMap(c).ok());
+    if (bad == 0) r.evaluation.sole_viewer[5] = 2;  // there are 2 stations
+    if (bad == 1) r.evaluation.sole_viewer[5] = -3;
+    bool ok = true;
+    int chunk = 0;
+    ForEachVoxelChunk(r, [&](v1::VoxelChunk&& c) {
+      if (bad == 2 && chunk++ == 1) c.clear_sole_viewer();
+      ok = ok && a.AddVoxels(c).ok();
+      return ok;
+    });
+    if (!ok) continue;  // refused chunk by chunk (-3, or viewers missing from one chunk)
+    EXPECT_NE(bad, 1);
+    EXPECT_NE(bad, 2);
+    auto back = std::move(a).Finish(ToProto(r));
+    ASSERT_FALSE(back.ok()) << bad;
+    EXPECT_EQ(back.status().code(), StatusCode::kDataLoss) << bad;
+  }
+}
+
 // A tripwire: when a field is added to PlanResult or PlanOptions, its size changes; carry the new
 // field in proto/vc/v1/planner.proto and proto/src/convert.cc (both ways), then update the sizes.
 TEST(PlanResultChunks, EveryCoreFieldIsCarried) {
-  EXPECT_EQ(sizeof(PlanResult), 1280u) << "PlanResult changed: update the vc.v1 PlanResult and vc::wire";
+  EXPECT_EQ(sizeof(PlanResult), 1304u) << "PlanResult changed: update the vc.v1 PlanResult and vc::wire";
   EXPECT_EQ(sizeof(PlanOptions), 376u) << "PlanOptions changed: update vc.v1 PlanParameters and vc::wire";
 }
 

@@ -204,8 +204,42 @@ struct HeatLayout {
   int plot_w = 0, plot_h = 0;
   std::vector<double> panel_z;       // representative z of each panel
   std::vector<int> candidate_panel;  // per heat-map position
+  std::vector<double> floor_m;       // the floor (top, m) under each panel: its z less the lowest height
   int width = 0, height = 0;
 };
+
+double LowestTripodHeight(const PlanResult& r) {
+  const std::vector<double> heights = r.options.TripodHeights();
+  return *std::min_element(heights.begin(), heights.end());
+}
+double HighestTripodHeight(const PlanResult& r) {
+  const std::vector<double> heights = r.options.TripodHeights();
+  return *std::max_element(heights.begin(), heights.end());
+}
+
+// The floor plan of a panel: the occupied voxels standing on its floor and reaching no higher than
+// the highest tripod height above it (walls, furniture, columns: what a crew walks around and what
+// a scanner on a tripod sees past), projected. A voxel belongs to a panel when its centre lies at
+// least a quarter of a voxel above the floor's top (the floor's own voxels lie below it) and at
+// most the highest tripod height above it. Bit p of the result: the voxel is on panel p (at most
+// 4 panels, see ComputeHeatLayout).
+unsigned FloorPlanPanels(const HeatLayout& L, const PlanResult& r, double z) {
+  unsigned panels = 0;
+  const double top = HighestTripodHeight(r);
+  for (size_t p = 0; p < L.floor_m.size(); ++p) {
+    const double above = z - L.floor_m[p];
+    if (above >= 0.25 * r.resolution_m && above <= top) panels |= 1u << p;
+  }
+  return panels;
+}
+
+// The floor plan's shade of a column whose highest voxel in the band stands `above` metres over
+// the floor: light grey for low objects, near black for what reaches the tripod (walls).
+Rgb FloorPlanShade(double above, double top) {
+  const double t = std::clamp(above / std::max(top, 1e-6), 0.0, 1.0);
+  const auto g = static_cast<uint8_t>(std::lround(175 - 135 * t));
+  return Rgb{g, g, g};
+}
 
 // The z a candidate's panel is chosen by: its floor plus the lowest tripod height when the floor is
 // known (so a cell's candidates at several heights share one panel), else its own z. With one
@@ -251,6 +285,13 @@ HeatLayout ComputeHeatLayout(const PlanResult& r) {
   };
   for (const WorldPoint& p : pos) grow(p, L.cell_m / 2);
   for (const PlannedStation& s : r.stations) grow(s.position, L.cell_m / 2);
+  // The walls around the candidates belong to the floor plan: the footprint takes in the voxels
+  // drawn on some panel.
+  L.floor_m.clear();
+  for (double z : L.panel_z) L.floor_m.push_back(z - LowestTripodHeight(r));
+  for (const WorldPoint& v : r.voxel_centers) {
+    if (FloorPlanPanels(L, r, v.z()) != 0) grow(v, r.resolution_m / 2);
+  }
   if (!any) L.x0 = 0, L.x1 = 1, L.y0 = 0, L.y1 = 1;
   const double extent = std::max({L.x1 - L.x0, L.y1 - L.y0, 1e-3});
   L.ppm = std::clamp(std::floor(kTargetPlot / extent), 4.0, 200.0);
@@ -305,6 +346,34 @@ double ScanGraphDrawThreshold(const PlanResult& r) {
   return r.scan_graph.min_overlap > 0 ? r.scan_graph.min_overlap : 0.3;
 }
 
+// Panel `panel`'s floor plan over its cells (so that a cell reaching into a wall does not hide
+// it), under the edges, route and stations: each voxel column of the band shaded by the height of
+// its highest voxel, at least one pixel wide.
+void DrawFloorPlan(Image& img, const HeatLayout& L, const PlanResult& r, int panel, int left, int top) {
+  if (r.resolution_m <= 0) return;
+  std::vector<float> above(size_t(L.plot_w) * size_t(L.plot_h), -1.f);  // per plot pixel, the highest
+  const double half = r.resolution_m / 2;
+  for (const WorldPoint& v : r.voxel_centers) {
+    if (!((FloorPlanPanels(L, r, v.z()) >> panel) & 1)) continue;
+    const auto h = static_cast<float>(v.z() - L.floor_m[size_t(panel)]);
+    const int x0 = static_cast<int>(std::floor((v.x() - half - L.x0) * L.ppm));
+    const int y0 = static_cast<int>(std::floor((L.y1 - v.y() - half) * L.ppm));
+    const int x1 = std::max(x0 + 1, static_cast<int>(std::ceil((v.x() + half - L.x0) * L.ppm)));
+    const int y1 = std::max(y0 + 1, static_cast<int>(std::ceil((L.y1 - v.y() + half) * L.ppm)));
+    for (int y = std::max(y0, 0); y < std::min(y1, L.plot_h); ++y)
+      for (int x = std::max(x0, 0); x < std::min(x1, L.plot_w); ++x) {
+        float& a = above[size_t(y) * size_t(L.plot_w) + size_t(x)];
+        a = std::max(a, h);
+      }
+  }
+  const double highest = HighestTripodHeight(r);
+  for (int y = 0; y < L.plot_h; ++y)
+    for (int x = 0; x < L.plot_w; ++x) {
+      const float a = above[size_t(y) * size_t(L.plot_w) + size_t(x)];
+      if (a >= 0) img.Set(left + x, top + y, FloorPlanShade(a, highest));
+    }
+}
+
 Image DrawHeatmap(const PlanResult& r) {
   const HeatLayout L = ComputeHeatLayout(r);
   Image img(L.width, L.height);
@@ -336,6 +405,7 @@ Image DrawHeatmap(const PlanResult& r) {
       const uint64_t count = i < r.heat_map.visible_voxels.size() ? r.heat_map.visible_voxels[i] : 0;
       img.FillRect(px(pl, c.x() - h), py(c.y() + h), px(pl, c.x() + h), py(c.y() - h), raster::Viridis(count / denom));
     }
+    DrawFloorPlan(img, L, r, pl, left, top);
     img.StrokeRect(left, top, left + L.plot_w, top + L.plot_h, raster::kBlack);
     // Axes in metres.
     for (double v = std::ceil(L.x0 / step) * step; v <= L.x1 + 1e-9; v += step) {
@@ -398,7 +468,7 @@ Image DrawHeatmap(const PlanResult& r) {
                   r.stations[k].fixed ? raster::kBlack : raster::kRed);
   }
   // What the lines mean, under the first panel's axis label.
-  std::string legend = "ORANGE: WALKING ROUTE";
+  std::string legend = "GREY: WALLS AND OBJECTS (DARKER = TALLER)   ORANGE: WALKING ROUTE";
   if (!r.scan_graph.edges.empty()) legend += "   WHITE: OVERLAP >= " + Short(edge_min);
   img.Text(kMarginLeft, top + std::max(L.plot_h, kMinPlotHeight) + 42, legend, raster::kBlack);
   const int bar_x = L.width - kLegendWidth + 20;
@@ -639,6 +709,8 @@ std::string PlanToJson(const PlanResult& r) {
   return j.dump(2) + "\n";
 }
 
+Result<std::string> HeatmapPng(const PlanResult& result) { return raster::EncodePng(DrawHeatmap(result)); }
+
 ImageSize HeatmapImageSize(const PlanResult& result) {
   const HeatLayout L = ComputeHeatLayout(result);
   return {L.width, L.height};
@@ -662,7 +734,7 @@ Status WritePlanOutputs(const PlanResult& result, const std::string& out_dir) {
                                    std::to_string(result.evaluation.best_face_values.size()) + " face values)");
   }
   VC_RETURN_IF_ERROR(WriteFile(dir / "visibility.ply", VisibilityPly(result)));
-  VC_ASSIGN_OR_RETURN(std::string heat, raster::EncodePng(DrawHeatmap(result)));
+  VC_ASSIGN_OR_RETURN(std::string heat, HeatmapPng(result));
   VC_RETURN_IF_ERROR(WriteFile(dir / "heatmap.png", heat));
   VC_ASSIGN_OR_RETURN(std::string red, raster::EncodePng(DrawReduction(result)));
   VC_RETURN_IF_ERROR(WriteFile(dir / "reduction.png", red));

@@ -92,6 +92,13 @@ bool FaceInSet(const OccupancyGrid& g, const VoxelIndex& v, Face f, FaceSet set)
   return set == FaceSet::kAll || !g.Occupied(Neighbour(v, f));
 }
 
+// Who alone sees a voxel, from who alone sees it among two disjoint sets of viewpoints.
+int32_t CombineViewers(int32_t a, int32_t b) {
+  if (a == kNoViewer) return b;
+  if (b == kNoViewer || a == b) return a;
+  return kSeveralViewers;
+}
+
 // A face's best (V, perception) so far: the larger V, and on equal V the better perception. The
 // result does not depend on the order in which the viewpoints' values arrive.
 template <typename P>
@@ -322,16 +329,20 @@ Result<Evaluation> EvaluateExact(const EvaluationJob& job, Evaluation ev) {
   // What evaluating viewpoints needs besides the scene: the corner bitsets of the viewpoint at
   // hand, and the best V (and its perception) of each face over the viewpoints evaluated so far.
   struct Work {
-    Work(size_t corner_words, size_t slots, size_t voxel_chunks)
+    Work(size_t corner_words, size_t slots, size_t voxel_chunks, size_t viewer_slots)
         : visible_bits(corner_words),
           decided_bits(corner_words),
           tallies(voxel_chunks),
           best(internal::FilledOnHugePages(slots, 0.0)),
-          best_p(internal::FilledOnHugePages(slots, uint8_t{0})) {}
+          best_p(internal::FilledOnHugePages(slots, uint8_t{0})),
+          viewer(viewer_slots, kNoViewer) {}
     std::vector<uint64_t> visible_bits, decided_bits;
     std::vector<Tally> tallies;  // per chunk of voxels, for the viewpoint at hand
     std::vector<double> best;
     std::vector<uint8_t> best_p;
+    // With keep_face_values: per voxel, the viewpoint that alone gives it V > 0 so far (or
+    // kNoViewer / kSeveralViewers).
+    std::vector<int32_t> viewer;
   };
   const size_t corner_words = (corners.size() + 63) / 64;
   // Viewpoint k into `w`, on `threads` workers (1: all in the calling thread, with no atomics).
@@ -394,6 +405,7 @@ Result<Evaluation> EvaluateExact(const EvaluationJob& job, Evaluation ev) {
         // No visible corner: every face is unperceived, V = 0, which adds nothing to the tally or
         // the best values, and the kept values are zeros already.
         if (corner_bits == 0) continue;
+        bool seen = false;
         for (int f = 0; f < kFacesPerVoxel; ++f) {
           if (!((faces_in_set[i] >> f) & 1)) continue;
           const Perception p = FromCount(std::popcount(corner_bits & kFaceCornerMask[f]));
@@ -402,7 +414,9 @@ Result<Evaluation> EvaluateExact(const EvaluationJob& job, Evaluation ev) {
           const size_t slot = i * kFacesPerVoxel + f;
           if (keep) (*keep)[slot] = float(val);
           KeepBest(val, uint8_t(p), w.best[slot], w.best_p[slot]);
+          seen |= val > 0;
         }
+        if (seen && !w.viewer.empty()) w.viewer[i] = CombineViewers(w.viewer[i], int32_t(k));
       }
     }));
     Tally total;
@@ -417,16 +431,18 @@ Result<Evaluation> EvaluateExact(const EvaluationJob& job, Evaluation ev) {
   // merged at the end. Otherwise the viewpoints are evaluated one after another, each on all
   // threads. Both give the same figures: the best (V, perception) pair of a face is the same
   // whatever the order of the viewpoints.
-  // Each extra thread's Work costs 9 bytes per face; beyond kEvaluateExtraWorkBytes in all, the
-  // viewpoints are evaluated one after another instead.
+  // Each extra thread's Work costs 9 bytes per face (and 4 per voxel for the sole viewers); beyond
+  // kEvaluateExtraWorkBytes in all, the viewpoints are evaluated one after another instead.
   const int workers = ResolveThreads(options.threads, nv);
-  const uint64_t extra_bytes = uint64_t(workers - 1) * n * kFacesPerVoxel * (sizeof(double) + sizeof(uint8_t));
+  const size_t viewer_slots = options.keep_face_values ? n : 0;
+  const uint64_t extra_bytes = uint64_t(workers - 1) * (n * kFacesPerVoxel * (sizeof(double) + sizeof(uint8_t)) +
+                                                        viewer_slots * sizeof(int32_t));
   std::vector<std::unique_ptr<Work>> works;
   if (workers > 1 && nv >= kEvaluateViewpointsPerThread * uint64_t(workers) && extra_bytes <= kEvaluateExtraWorkBytes) {
     // Allocated here, in the calling thread, so that running out of memory is not a worker's.
     std::vector<Work*> idle;
     for (int t = 0; t < workers; ++t) {
-      works.push_back(std::make_unique<Work>(corner_words, n * kFacesPerVoxel, voxel_chunks));
+      works.push_back(std::make_unique<Work>(corner_words, n * kFacesPerVoxel, voxel_chunks, viewer_slots));
       idle.push_back(works.back().get());
     }
     std::mutex mu;
@@ -452,14 +468,16 @@ Result<Evaluation> EvaluateExact(const EvaluationJob& job, Evaluation ev) {
     VC_RETURN_IF_ERROR(failed);
     for (size_t k = alone; k < nv; ++k) VC_RETURN_IF_ERROR(evaluate_viewpoint(k, workers, *works[0]));
   } else {
-    works.push_back(std::make_unique<Work>(corner_words, n * kFacesPerVoxel, voxel_chunks));
+    works.push_back(std::make_unique<Work>(corner_words, n * kFacesPerVoxel, voxel_chunks, viewer_slots));
     for (size_t k = 0; k < nv; ++k) VC_RETURN_IF_ERROR(evaluate_viewpoint(k, options.threads, *works[0]));
   }
   std::vector<double>& best = works[0]->best;
   std::vector<uint8_t>& best_p = works[0]->best_p;
+  std::vector<int32_t>& viewer = works[0]->viewer;
   for (size_t t = 1; t < works.size(); ++t) {
     for (size_t slot = 0; slot < best.size(); ++slot)
       KeepBest(works[t]->best[slot], works[t]->best_p[slot], best[slot], best_p[slot]);
+    for (size_t i = 0; i < viewer.size(); ++i) viewer[i] = CombineViewers(viewer[i], works[t]->viewer[i]);
   }
   // Overall: the best V of each face over all viewpoints.
   Tally total;
@@ -474,6 +492,7 @@ Result<Evaluation> EvaluateExact(const EvaluationJob& job, Evaluation ev) {
     ev.best_face_values.resize(n);
     for (size_t i = 0; i < n; ++i)
       for (int f = 0; f < kFacesPerVoxel; ++f) ev.best_face_values[i][f] = float(best[i * kFacesPerVoxel + f]);
+    ev.sole_viewer = std::move(viewer);
   }
   return ev;
 }

@@ -376,6 +376,15 @@ TEST(PlannerTest, ProgressCallbacksAndTimings) {
   EXPECT_GT(r->total_seconds, 0.0);
   EXPECT_EQ(r->voxel_centers.size(), r->occupied_voxels);
   EXPECT_EQ(r->evaluation.best_face_values.size(), r->occupied_voxels);
+  // Each voxel's sole viewer: none exactly where no face has V > 0, else a station or several.
+  ASSERT_EQ(r->evaluation.sole_viewer.size(), r->occupied_voxels);
+  for (size_t i = 0; i < r->occupied_voxels; ++i) {
+    const auto& v = r->evaluation.best_face_values[i];
+    const bool seen = *std::max_element(v.begin(), v.end()) > 0;
+    const int32_t sole = r->evaluation.sole_viewer[i];
+    ASSERT_EQ(sole != kNoViewer, seen) << "voxel " << i;
+    ASSERT_TRUE(sole == kNoViewer || sole == kSeveralViewers || (sole >= 0 && size_t(sole) < r->stations.size()));
+  }
   EXPECT_EQ(r->heat_map.positions.size(), r->candidate_count);
 }
 

@@ -3,6 +3,7 @@
 #include "vc/report/plan_report.h"
 
 #include <gtest/gtest.h>
+#include <png.h>
 
 #include <cstring>
 #include <filesystem>
@@ -178,6 +179,76 @@ TEST(PlanReportTest, WritesAllFilesWithPngsOfTheExpectedSize) {
   }
   EXPECT_TRUE(std::filesystem::exists(dir + "/plan.json"));
   EXPECT_EQ(json::parse(ReadAll(dir + "/plan.json"))["viewpoints"].size(), 2u);
+}
+
+// A decoded RGB picture.
+struct Picture {
+  int width = 0, height = 0;
+  std::vector<uint8_t> rgb;
+  std::array<int, 3> at(int x, int y) const {
+    const size_t i = (size_t(y) * size_t(width) + size_t(x)) * 3;
+    return {rgb[i], rgb[i + 1], rgb[i + 2]};
+  }
+};
+
+Picture DecodePng(const std::string& png) {
+  png_image image{};
+  image.version = PNG_IMAGE_VERSION;
+  EXPECT_TRUE(png_image_begin_read_from_memory(&image, png.data(), png.size()));
+  image.format = PNG_FORMAT_RGB;
+  Picture p{int(image.width), int(image.height), std::vector<uint8_t>(PNG_IMAGE_SIZE(image))};
+  EXPECT_TRUE(png_image_finish_read(&image, nullptr, p.rgb.data(), 0, nullptr));
+  return p;
+}
+
+// The heat map reads as a floor plan: a wall (a column of voxels from the floor to the tripod
+// height) is drawn dark over the cells, a low box light grey; the floor's own voxels and a ceiling
+// above the tripod are not drawn. Pixels (docs/PLANNING.md layout): 180 px/m, plot at (64, 40),
+// world (x, y) at (64 + 180 x, 40 + 180 (3 - y)).
+TEST(PlanReportTest, HeatmapDrawsTheWallsAndObjectsOfTheLevelUnderTheStations) {
+  const PlanResult bare = SamplePlan();  // floor top 0.1 m, tripod 1.5 m; its voxels lie in the floor
+  PlanResult plan = bare;
+  auto add = [&](double x, double y, double z) {
+    plan.voxel_centers.emplace_back(x, y, z);
+    plan.evaluation.best_face_values.push_back({});
+  };
+  for (double y = 0.05; y < 3; y += 0.1)
+    for (double z = 0.15; z < 1.6; z += 0.1) add(2.05, y, z);             // a wall at x = 2 m, up to 1.55 m
+  add(0.55, 2.45, 0.15);                                                  // a box 0.1 m high
+  add(3.05, 1.05, 2.8);                                                   // the ceiling, over the tripod
+  add(3.05, 1.35, 0.05);                                                  // the floor itself
+  EXPECT_EQ(HeatmapImageSize(plan).width, HeatmapImageSize(bare).width);  // all inside the footprint
+  const Result<std::string> with = HeatmapPng(plan), without = HeatmapPng(bare);
+  ASSERT_TRUE(with.ok() && without.ok());
+  const Picture a = DecodePng(*with), b = DecodePng(*without);
+  ASSERT_EQ(a.width, 64 + 720 + 24 + 110);
+  auto at = [](double x, double y) { return std::pair{int(64 + 180 * x), int(40 + 180 * (3 - y))}; };
+  auto grey = [](std::array<int, 3> c) { return c[0] == c[1] && c[1] == c[2] ? c[0] : -1; };
+  const auto [wx, wy] = at(2.05, 1.0);
+  EXPECT_LE(grey(a.at(wx, wy)), 60) << "the wall is dark";
+  EXPECT_GE(grey(a.at(wx, wy)), 0);
+  EXPECT_EQ(grey(b.at(wx, wy)), -1) << "a viridis cell without the wall";
+  const auto [bx, by] = at(0.55, 2.43);
+  EXPECT_GE(grey(a.at(bx, by)), 150) << "the box is light";
+  EXPECT_LE(grey(a.at(bx, by)), 180);
+  for (const auto& [x, y] : {at(3.05, 1.05), at(3.05, 1.35), at(1.0, 1.0)}) {
+    EXPECT_EQ(a.at(x, y), b.at(x, y)) << "no floor plan at pixel " << x << "," << y;
+  }
+  // Stations stay on top: station 1's marker centre (white disc) at (0.5, 0.5).
+  const auto [sx, sy] = at(0.5, 0.5);
+  EXPECT_EQ(a.at(sx + 4, sy - 5), (std::array<int, 3>{255, 255, 255}));
+}
+
+// Voxels of the level beyond the candidates (the building's outer walls) widen the picture.
+TEST(PlanReportTest, HeatmapFootprintTakesInTheWallsAroundTheCandidates) {
+  PlanResult plan = SamplePlan();
+  const ImageSize before = HeatmapImageSize(plan);
+  plan.voxel_centers.emplace_back(1.0, -0.95, 1.0);  // a wall 1 m south of the candidates
+  plan.evaluation.best_face_values.push_back({});
+  const ImageSize after = HeatmapImageSize(plan);
+  EXPECT_EQ(after.width, before.width);
+  EXPECT_EQ(before.height, 40 + 540 + 60);
+  EXPECT_EQ(after.height, 40 + 720 + 60);  // 4 x 4 m now, still 180 px/m
 }
 
 TEST(PlanReportTest, ReductionImageGrowsWithTheMatrix) {

@@ -287,6 +287,18 @@ TEST(ComputeVisibilitySetsTest, FarViewpointsAreWalkedPlainlyAndMatchTheOracle) 
   }
 }
 
+// Evaluation::sole_viewer as it must be, from every viewpoint's face values.
+std::vector<int32_t> SoleViewers(const Evaluation& ev, size_t voxels) {
+  std::vector<int32_t> sole(voxels, kNoViewer);
+  for (size_t k = 0; k < ev.per_viewpoint_face_values.size(); ++k)
+    for (size_t id = 0; id < voxels; ++id) {
+      bool seen = false;
+      for (int f = 0; f < 6; ++f) seen |= ev.per_viewpoint_face_values[k][id * 6 + f] > 0;
+      if (seen) sole[id] = sole[id] == kNoViewer ? int32_t(k) : kSeveralViewers;
+    }
+  return sole;
+}
+
 TEST(EvaluateTest, GlobalVisibilityEqualsBruteForce) {
   std::mt19937_64 rng(7);
   for (int trial = 0; trial < 4; ++trial) {
@@ -317,6 +329,7 @@ TEST(EvaluateTest, GlobalVisibilityEqualsBruteForce) {
     }
     EXPECT_NEAR(ev->overall.global_visibility, sum_best / double(6 * n), 1e-9);
     EXPECT_GT(ev->overall.global_visibility, 0.0);
+    EXPECT_EQ(ev->sole_viewer, SoleViewers(*ev, n));
     for (size_t k = 0; k < vps.size(); ++k)
       EXPECT_NEAR(ev->per_viewpoint[k].global_visibility, sum_vp[k] / double(6 * n), 1e-9);
   }
@@ -344,6 +357,7 @@ TEST(EvaluateTest, TaskPerViewpointGivesTheSameFiguresAsOneThread) {
     };
     const Evaluation one = run(1);
     EXPECT_GT(one.overall.global_visibility, 0.0) << scene;
+    EXPECT_EQ(one.sole_viewer, SoleViewers(one, s.occupied.size())) << scene;
     const size_t n = s.occupied.size();
     for (size_t id = 0; extent == 14 && id < n; ++id) {
       const VoxelIndex v = KeyToIndex(s.occupied[id]);
@@ -368,6 +382,7 @@ TEST(EvaluateTest, TaskPerViewpointGivesTheSameFiguresAsOneThread) {
         EXPECT_EQ(other.per_viewpoint_face_values[k], one.per_viewpoint_face_values[k]) << what << ", viewpoint " << k;
       }
       EXPECT_EQ(other.best_face_values, one.best_face_values) << what;
+      EXPECT_EQ(other.sole_viewer, one.sole_viewer) << what;
     }
   }
 }

@@ -22,6 +22,7 @@ Result<EvaluationOutput> RunEvaluationStage(EvaluationInput in, const PlanOption
     out.evaluation.resolution_m = in.scene.resolution_m;
     out.evaluation.faces_total = n_voxels * kFacesPerVoxel;
     out.evaluation.best_face_values.assign(n_voxels, {});
+    out.evaluation.sole_viewer.assign(n_voxels, kNoViewer);
   } else if (in.reusable) {
     out.evaluation = std::move(*in.reusable);  // same stations, nothing was removed
   } else {

@@ -92,6 +92,7 @@ class PlanResultAssembler {
   uint64_t heat_map_total_ = 0;
   std::vector<WorldPoint> centers_;
   std::vector<std::array<float, kFacesPerVoxel>> face_values_;
+  std::vector<int32_t> sole_viewers_;
   uint64_t voxel_total_ = 0;
 };
 

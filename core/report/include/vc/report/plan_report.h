@@ -32,6 +32,9 @@ struct ImageSize {
   int width = 0;
   int height = 0;
 };
+// heatmap.png's bytes: the candidates' cells over the floor plan of each level, the scan graph's
+// edges, the walking route and the stations (docs/PLANNING.md, "heatmap.png").
+Result<std::string> HeatmapPng(const PlanResult& result);
 // Size of heatmap.png for `result` (layout in docs/PLANNING.md: one panel per floor level).
 ImageSize HeatmapImageSize(const PlanResult& result);
 // Size of reduction.png for a |P| x |P| matrix.

@@ -180,7 +180,8 @@ struct EvaluateOptions {
   // replacement), reporting a 95 % confidence interval.
   uint64_t sample_faces = 0;
   uint64_t seed = 1;
-  // Keep each face's best V (needed by visibility.ply). Exact mode only.
+  // Keep each face's best V (needed by visibility.ply) and each voxel's sole viewer (needed by
+  // report.html). Exact mode only.
   bool keep_face_values = false;
   // Keep every viewpoint's V of every face (needed by reduction). Exact mode only; costs
   // 24 bytes per occupied voxel and viewpoint.
@@ -190,6 +191,10 @@ struct EvaluateOptions {
   // slower; kept as the reference for tests and benchmarks).
   bool per_corner = false;
 };
+
+// Evaluation::sole_viewer's values for a voxel no viewpoint sees, and one several viewpoints see.
+inline constexpr int32_t kNoViewer = -1;
+inline constexpr int32_t kSeveralViewers = -2;
 
 struct Evaluation {
   double resolution_m = 0;
@@ -205,13 +210,11 @@ struct Evaluation {
   // With keep_per_viewpoint_values: per viewpoint, V of every face at index voxel_id * 6 + face.
   // Faces outside F hold 0.
   std::vector<std::vector<float>> per_viewpoint_face_values;
-  // TEMPORARY (branch report, until main's sole_viewer commit is merged): per voxel id, the index
-  // of the only viewpoint giving any face V > 0, kNoViewer if none, kSeveralViewers if several;
-  // empty if not computed.
+  // With keep_face_values: per voxel id, the index of the only viewpoint that gives any of its
+  // faces V > 0 ("what only this station sees"); kNoViewer if none does, kSeveralViewers if
+  // several do.
   std::vector<int32_t> sole_viewer;
 };
-inline constexpr int32_t kNoViewer = -1;
-inline constexpr int32_t kSeveralViewers = -2;
 
 // Evaluates a set of viewpoints on `scene` (s.6): G of the whole set and figures per viewpoint.
 // INVALID_ARGUMENT for a non-finite or out-of-range viewpoint, a bad scanner range, or (exact
