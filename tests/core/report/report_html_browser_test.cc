@@ -1,12 +1,14 @@
 // report.html in a real browser: plans a small synthetic scene (three rooms and a corridor), writes
 // the plan's files, and opens report.html in headless chromium (software WebGL: SwiftShader
 // through ANGLE). Checks the page's own state after its first frame (no script errors, one marker
-// per station, every voxel drawn, a station selected from the URL), and that a screenshot shows
-// the scene: many distinct colours, voxels and red station markers. Fails, never skips, when
+// per station, every voxel drawn, a station selected from the URL with its sole voxels), and that
+// a screenshot shows the scene: many distinct colours, red station markers and the selected
+// station's sole voxels in magenta. Fails, never skips, when
 // chromium is missing (scripts/install-deps.sh installs it); VC_CHROMIUM overrides its path.
 #include <gtest/gtest.h>
 #include <png.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -146,25 +148,40 @@ TEST_F(ReportHtmlBrowserTest, StationFromTheUrlIsSelected) {
   EXPECT_EQ(BodyAttributes(dom)["data-errors"], "0");
   EXPECT_EQ(BodyAttributes(dom)["data-ready"], "true");
   EXPECT_NE(dom.find("<tr class=\"selected\">"), std::string::npos);
-  EXPECT_NE(dom.find("Station 2"), std::string::npos);
+  // The plan carries sole viewers, so the page offers the highlight.
+  ASSERT_EQ(plan_->evaluation.sole_viewer.size(), plan_->voxel_centers.size());
+  EXPECT_NE(dom.find("Station 2: "), std::string::npos);
+  EXPECT_NE(dom.find("voxels only it sees (magenta"), std::string::npos);
+  EXPECT_EQ(dom.find("highlight of the voxels only it sees is unavailable"), std::string::npos);
 }
 
-TEST_F(ReportHtmlBrowserTest, ScreenshotShowsTheScene) {
+TEST_F(ReportHtmlBrowserTest, ScreenshotShowsTheSceneAndASelectedStationsSoleVoxels) {
+  // The station that alone sees the most voxels, selected from the URL.
+  std::vector<size_t> sole(plan_->stations.size(), 0);
+  for (int32_t s : plan_->evaluation.sole_viewer) {
+    if (s >= 0 && static_cast<size_t>(s) < sole.size()) ++sole[s];
+  }
+  const size_t best = std::max_element(sole.begin(), sole.end()) - sole.begin();
+  ASSERT_GT(sole[best], 100u) << "no station sees enough voxels alone to show them";
   const std::string png = *dir_ + "/screenshot.png";
-  ASSERT_EQ(RunChromium(*dir_, Url(), "--screenshot='" + png + "'", *dir_ + "/screenshot.out"), 0) << Log();
+  ASSERT_EQ(RunChromium(*dir_, Url("#station=" + std::to_string(best + 1)), "--screenshot='" + png + "'",
+                        *dir_ + "/screenshot.out"),
+            0)
+      << Log();
   const Picture p = ReadPng(png);
   ASSERT_EQ(p.width, kWidth) << "no readable screenshot\n" << Log();
   ASSERT_EQ(p.height, kHeight);
   // The 3D view (left of the panel): not blank, i.e. many pixels differ from its background
   // (#24262b), in many colours (viridis voxels), with red station marker rings among them.
   const int view_width = kWidth - kPanelWidth;
-  size_t scene_pixels = 0, red_pixels = 0;
+  size_t scene_pixels = 0, red_pixels = 0, magenta_pixels = 0;
   std::set<uint32_t> colours;
   for (int y = 0; y < p.height; ++y) {
     for (int x = 0; x < view_width; ++x) {
       const uint8_t* c = &p.rgb[3 * (static_cast<size_t>(y) * p.width + x)];
       if (std::abs(c[0] - 0x24) + std::abs(c[1] - 0x26) + std::abs(c[2] - 0x2b) > 12) ++scene_pixels;
       if (c[0] > 180 && c[1] < 80 && c[2] < 80) ++red_pixels;
+      if (c[0] > 200 && c[1] < 90 && c[2] > 170) ++magenta_pixels;
       colours.insert((c[0] >> 3) << 10 | (c[1] >> 3) << 5 | (c[2] >> 3));
     }
   }
@@ -172,6 +189,7 @@ TEST_F(ReportHtmlBrowserTest, ScreenshotShowsTheScene) {
   EXPECT_GT(scene_pixels, view_pixels / 20) << scene_pixels << " of " << view_pixels << " pixels show the scene";
   EXPECT_GT(colours.size(), 100u) << "distinct colours (5 bits per channel)";
   EXPECT_GT(red_pixels, 50u) << "no red station marker rings";
+  EXPECT_GT(magenta_pixels, 1000u) << "station " << best + 1 << "'s " << sole[best] << " sole voxels are not magenta";
 }
 
 }  // namespace
