@@ -260,8 +260,10 @@
   scene.add(routeGroup);
 
   checkbox('walking route (orange)', true, function (on) { routeGroup.visible = on; requestRender(); });
-  checkbox('scan graph links, overlap \u2265 ' + num(D.edge_min_overlap, 2) + ' (blue)', true,
-           function (on) { edgeGroup.visible = on; requestRender(); });
+  // Hundreds of links hide the scene: then they start hidden.
+  edgeGroup.visible = D.edges.length <= 200;
+  checkbox('scan graph links, overlap \u2265 ' + num(D.edge_min_overlap, 2) + ' (blue): ' + D.edges.length,
+           edgeGroup.visible, function (on) { edgeGroup.visible = on; requestRender(); });
 
   // Hide what lies above a height (ceilings), by default 1 m above the highest station.
   var zLow = origin[2] + box.min.z, zHigh = origin[2] + box.max.z;
@@ -321,7 +323,7 @@
   // ---------- camera, controls, rendering ----------
   var target = box.getCenter(new THREE.Vector3());
   target.z = Math.min(target.z, (box.min.z + cut.constant) / 2);
-  camera.position.copy(target).add(new THREE.Vector3(0.25, -0.8, 0.9).normalize().multiplyScalar(extent * 1.05));
+  camera.position.copy(target).add(new THREE.Vector3(0.1, -0.8, 1).normalize().multiplyScalar(extent * 1.1));
   var controls = new THREE.OrbitControls(camera, renderer.domElement);
   controls.target.copy(target);
   controls.update();
