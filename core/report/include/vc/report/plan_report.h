@@ -1,6 +1,7 @@
 // The files a user gets from a plan or an evaluation (written by vc-client from the streamed
 // result, and usable directly from core): plan.json, stations.csv, visibility.ply, heatmap.png,
-// reduction.png, report.html (vc/report/report_html.h), evaluation.json. Schemas are documented in docs/PLANNING.md and docs/PROTOCOL.md.
+// reduction.png, report.html (vc/report/report_html.h), evaluation.json. Schemas are documented
+// in docs/PLANNING.md and docs/PROTOCOL.md.
 #pragma once
 
 #include <string>
