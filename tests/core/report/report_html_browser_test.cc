@@ -11,10 +11,8 @@
 #include <algorithm>
 #include <cstdlib>
 #include <filesystem>
-#include <fstream>
 #include <map>
 #include <set>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -33,13 +31,6 @@ constexpr int kPanelWidth = 400;  // report_page.css: #panel's width (px)
 std::string Chromium() {
   if (const char* env = std::getenv("VC_CHROMIUM"); env != nullptr && *env != '\0') return env;
   return VC_CHROMIUM;
-}
-
-std::string ReadAll(const std::string& path) {
-  std::ifstream f(path, std::ios::binary);
-  std::stringstream ss;
-  ss << f.rdbuf();
-  return ss.str();
 }
 
 // Runs headless chromium on `url` with `action` (--dump-dom or --screenshot=...), stdout to
@@ -111,7 +102,7 @@ class ReportHtmlBrowserTest : public ::testing::Test {
     ASSERT_NE(plan_, nullptr);
   }
   static std::string Url(const std::string& fragment = "") { return "file://" + *dir_ + "/report.html" + fragment; }
-  static std::string Log() { return ReadAll(*dir_ + "/chromium.log"); }
+  static std::string Log() { return testing::ReadFileBytes(*dir_ + "/chromium.log"); }
 
   static PlanResult* plan_;
   static std::string* dir_;
@@ -123,7 +114,7 @@ TEST_F(ReportHtmlBrowserTest, PageRendersEveryStationWithoutErrors) {
   ASSERT_GE(plan_->stations.size(), 2u);
   const std::string dom_path = *dir_ + "/dom.html";
   ASSERT_EQ(RunChromium(*dir_, Url(), "--dump-dom", dom_path), 0) << Log();
-  const std::string dom = ReadAll(dom_path);
+  const std::string dom = testing::ReadFileBytes(dom_path);
   std::map<std::string, std::string> body = BodyAttributes(dom);
   const size_t errors_at = dom.find("<pre id=\"errors\">");
   const std::string errors = errors_at == std::string::npos ? "" : dom.substr(errors_at, 600);
@@ -144,7 +135,7 @@ TEST_F(ReportHtmlBrowserTest, PageRendersEveryStationWithoutErrors) {
 TEST_F(ReportHtmlBrowserTest, StationFromTheUrlIsSelected) {
   const std::string dom_path = *dir_ + "/dom-station.html";
   ASSERT_EQ(RunChromium(*dir_, Url("#station=2"), "--dump-dom", dom_path), 0) << Log();
-  const std::string dom = ReadAll(dom_path);
+  const std::string dom = testing::ReadFileBytes(dom_path);
   EXPECT_EQ(BodyAttributes(dom)["data-errors"], "0");
   EXPECT_EQ(BodyAttributes(dom)["data-ready"], "true");
   EXPECT_NE(dom.find("<tr class=\"selected\">"), std::string::npos);

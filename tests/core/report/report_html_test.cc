@@ -7,10 +7,8 @@
 #include <gtest/gtest.h>
 
 #include <cctype>
-#include <fstream>
 #include <nlohmann/json.hpp>
 #include <set>
-#include <sstream>
 
 #include "testing/test_paths.h"
 #include "vc/report/plan_report.h"
@@ -55,13 +53,6 @@ PlanResult BlockPlan() {
   }
   r.warnings = {"a plain warning"};
   return r;
-}
-
-std::string ReadAll(const std::string& path) {
-  std::ifstream f(path, std::ios::binary);
-  std::stringstream ss;
-  ss << f.rdbuf();
-  return ss.str();
 }
 
 // The page's data object (window.VC_REPORT_DATA = {...};).
@@ -256,7 +247,7 @@ TEST(ReportHtmlTest, WritePlanOutputsWritesReportHtml) {
   const PlanResult plan = BlockPlan();
   const std::string dir = testing::MakeTempDir();
   ASSERT_TRUE(WritePlanOutputs(plan, dir).ok());
-  EXPECT_EQ(ReadAll(dir + "/report.html"), PlanToHtml(plan));
+  EXPECT_EQ(testing::ReadFileBytes(dir + "/report.html"), PlanToHtml(plan));
 }
 
 }  // namespace
