@@ -20,9 +20,10 @@ find_file(VC_THREE_JS three.min.js PATHS /usr/share/javascript/three/build NO_DE
   DOC "three.min.js (libjs-three) for report.html")
 find_file(VC_THREE_ORBIT_CONTROLS_JS OrbitControls.js PATHS /usr/share/javascript/three/examples/js/controls
   NO_DEFAULT_PATH DOC "three.js's OrbitControls.js (libjs-three) for report.html")
-if(NOT VC_THREE_JS OR NOT VC_THREE_ORBIT_CONTROLS_JS)
+if(NOT EXISTS "${VC_THREE_JS}" OR NOT EXISTS "${VC_THREE_ORBIT_CONTROLS_JS}")
   message(FATAL_ERROR "report.html needs three.js from Debian's libjs-three "
-    "(/usr/share/javascript/three/build/three.min.js and examples/js/controls/OrbitControls.js not found). "
+    "(/usr/share/javascript/three/build/three.min.js and examples/js/controls/OrbitControls.js; found "
+    "'${VC_THREE_JS}' and '${VC_THREE_ORBIT_CONTROLS_JS}'). "
     "Install it with scripts/install-deps.sh (or apt-get install libjs-three), or point "
     "-DVC_THREE_JS=... and -DVC_THREE_ORBIT_CONTROLS_JS=... at copies of three.js r111.")
 endif()

@@ -2,7 +2,8 @@
 // r111 and its OrbitControls). Reads window.VC_REPORT_DATA (schema "vc.report/1", written there),
 // fills the side panel and draws the plan with WebGL. Every string from the plan is inserted as
 // text (textContent), never as HTML. After the first frame it sets window.vcReport.ready, the
-// <body> data-* attributes and a title ending in " - ready" (an em dash) for headless tests.
+// <body> data-* attributes and a title ending in " - ready" (an em dash) for headless tests, and
+// window.vcReport.markerScreenPosition(k) lets a test click station k's marker.
 (function () {
   'use strict';
   var D = window.VC_REPORT_DATA;
@@ -371,6 +372,12 @@
   select(wanted && wanted[1] >= 1 && wanted[1] <= stations.length ? Number(wanted[1]) - 1 : -1);
   resize();
   render();
+  // For tests: where station k's marker is on the screen (client pixels), to click it.
+  R.markerScreenPosition = function (k) {
+    var p = markers[k].position.clone().project(camera);
+    var rect = renderer.domElement.getBoundingClientRect();
+    return [rect.left + (p.x + 1) / 2 * rect.width, rect.top + (1 - p.y) / 2 * rect.height];
+  };
   requestAnimationFrame(function () {
     R.ready = true;
     R.stationMarkers = scene.children.filter(function (o) { return o.isSprite; }).length;

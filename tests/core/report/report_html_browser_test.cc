@@ -1,9 +1,9 @@
 // report.html in a real browser: plans a small synthetic scene (three rooms and a corridor), writes
 // the plan's files, and opens report.html in headless chromium (software WebGL: SwiftShader
 // through ANGLE). Checks the page's own state after its first frame (no script errors, one marker
-// per station, every voxel drawn, a station selected from the URL with its sole voxels), and that
-// a screenshot shows the scene: many distinct colours, red station markers and the selected
-// station's sole voxels in magenta. Fails, never skips, when
+// per station, every voxel drawn, a station selected from the URL with its sole voxels, a click on
+// a marker selecting its station), and that a screenshot shows the scene: many distinct colours,
+// red station markers and the selected station's sole voxels in magenta. Fails, never skips, when
 // chromium is missing (scripts/install-deps.sh installs it); VC_CHROMIUM overrides its path.
 #include <gtest/gtest.h>
 #include <png.h>
@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <map>
 #include <set>
 #include <string>
@@ -144,6 +145,33 @@ TEST_F(ReportHtmlBrowserTest, StationFromTheUrlIsSelected) {
   EXPECT_NE(dom.find("Station 2: "), std::string::npos);
   EXPECT_NE(dom.find("voxels only it sees (magenta"), std::string::npos);
   EXPECT_EQ(dom.find("highlight of the voxels only it sees is unavailable"), std::string::npos);
+}
+
+TEST_F(ReportHtmlBrowserTest, ClickingAMarkerSelectsItsStation) {
+  // A copy of the page that, once ready, clicks station 2's marker (a pointerdown and pointerup on
+  // the canvas where the page says the marker is) and writes the selected row's number on <body>.
+  std::string html = testing::ReadFileBytes(*dir_ + "/report.html");
+  const size_t end = html.rfind("</body>");
+  ASSERT_NE(end, std::string::npos);
+  html.insert(end, R"js(<script>
+(function click() {
+  if (!window.vcReport.ready) { setTimeout(click, 20); return; }
+  var xy = window.vcReport.markerScreenPosition(1);
+  var canvas = document.querySelector('#view canvas');
+  var at = {clientX: xy[0], clientY: xy[1], bubbles: true};
+  canvas.dispatchEvent(new PointerEvent('pointerdown', at));
+  canvas.dispatchEvent(new PointerEvent('pointerup', at));
+  var row = document.querySelector('#stations tr.selected');
+  document.body.setAttribute('data-clicked', row ? row.firstChild.textContent : 'none');
+})();
+</script>
+)js");
+  std::ofstream(*dir_ + "/click.html", std::ios::binary) << html;
+  const std::string dom_path = *dir_ + "/dom-click.html";
+  ASSERT_EQ(RunChromium(*dir_, "file://" + *dir_ + "/click.html", "--dump-dom", dom_path), 0) << Log();
+  std::map<std::string, std::string> body = BodyAttributes(testing::ReadFileBytes(dom_path));
+  EXPECT_EQ(body["data-errors"], "0");
+  EXPECT_EQ(body["data-clicked"], "2");
 }
 
 TEST_F(ReportHtmlBrowserTest, ScreenshotShowsTheSceneAndASelectedStationsSoleVoxels) {
