@@ -147,6 +147,21 @@ TEST_F(ReportHtmlBrowserTest, StationFromTheUrlIsSelected) {
   EXPECT_EQ(dom.find("highlight of the voxels only it sees is unavailable"), std::string::npos);
 }
 
+TEST_F(ReportHtmlBrowserTest, DecimatedPageDrawsItsCapAndSaysSo) {
+  ReportHtmlOptions options;
+  options.max_points = 1000;
+  ASSERT_GT(plan_->voxel_centers.size(), options.max_points);
+  std::ofstream(*dir_ + "/decimated.html", std::ios::binary) << PlanToHtml(*plan_, options);
+  const std::string dom_path = *dir_ + "/dom-decimated.html";
+  ASSERT_EQ(RunChromium(*dir_, "file://" + *dir_ + "/decimated.html#station=1", "--dump-dom", dom_path), 0) << Log();
+  const std::string dom = testing::ReadFileBytes(dom_path);
+  std::map<std::string, std::string> body = BodyAttributes(dom);
+  EXPECT_EQ(body["data-errors"], "0");
+  EXPECT_EQ(body["data-ready"], "true");
+  EXPECT_EQ(body["data-points-drawn"], "1000");
+  EXPECT_NE(dom.find("1,000 of "), std::string::npos) << "the panel does not say how many voxels are drawn";
+}
+
 TEST_F(ReportHtmlBrowserTest, ClickingAMarkerSelectsItsStation) {
   // A copy of the page that, once ready, clicks station 2's marker (a pointerdown and pointerup on
   // the canvas where the page says the marker is) and writes the selected row's number on <body>.
