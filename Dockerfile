@@ -5,7 +5,8 @@
 ARG BASE=debian:bookworm
 
 FROM ${BASE} AS build
-# Packages: scripts/install-deps.sh's lists (build: ... coinor-libcbc-dev; runtime: ... coinor-libcbc3).
+# Packages: scripts/install-deps.sh's lists (build: ... coinor-libcbc-dev, libjs-three, chromium; runtime: ...
+# coinor-libcbc3; report.html carries three.js inside the binary, so the runtime needs neither).
 WORKDIR /src
 COPY scripts/install-deps.sh scripts/install-deps.sh
 RUN bash scripts/install-deps.sh && rm -rf /var/lib/apt/lists/*

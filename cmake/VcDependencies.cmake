@@ -14,6 +14,20 @@ pkg_check_modules(HWY REQUIRED IMPORTED_TARGET libhwy)
 # COIN-OR CBC (coinor-libcbc-dev): the exact station selector (vc::plan only).
 pkg_check_modules(CBC REQUIRED IMPORTED_TARGET cbc)
 
+# three.js r111 and its OrbitControls from Debian's libjs-three: report.html inlines them
+# (core/report). Needed at build time only; the binaries carry the text.
+find_file(VC_THREE_JS three.min.js PATHS /usr/share/javascript/three/build NO_DEFAULT_PATH
+  DOC "three.min.js (libjs-three) for report.html")
+find_file(VC_THREE_ORBIT_CONTROLS_JS OrbitControls.js PATHS /usr/share/javascript/three/examples/js/controls
+  NO_DEFAULT_PATH DOC "three.js's OrbitControls.js (libjs-three) for report.html")
+if(NOT EXISTS "${VC_THREE_JS}" OR NOT EXISTS "${VC_THREE_ORBIT_CONTROLS_JS}")
+  message(FATAL_ERROR "report.html needs three.js from Debian's libjs-three "
+    "(/usr/share/javascript/three/build/three.min.js and examples/js/controls/OrbitControls.js; found "
+    "'${VC_THREE_JS}' and '${VC_THREE_ORBIT_CONTROLS_JS}'). "
+    "Install it with scripts/install-deps.sh (or apt-get install libjs-three), or point "
+    "-DVC_THREE_JS=... and -DVC_THREE_ORBIT_CONTROLS_JS=... at copies of three.js r111.")
+endif()
+
 # OctoMap's package config exports plain variables; wrap them in one imported target.
 if(NOT TARGET vc::octomap)
   add_library(vc_octomap INTERFACE)

@@ -13,6 +13,8 @@ BUILD_PKGS=(
   zlib1g-dev libbz2-dev libpng-dev
   openssl python3 bzip2 gzip
   clang clang-format libfuzzer-14-dev
+  libjs-three  # three.js, inlined into report.html at build time
+  chromium     # report_html_browser_test opens report.html in headless chromium
 )
 RUNTIME_PKGS=(
   libgrpc++1.51 libgrpc29 libprotobuf32 liboctomap1.9 libspdlog1.10 libfmt9 libhwy1

@@ -154,7 +154,8 @@ int main(int argc, char** argv) {
     vc::Status written = vc::WritePlanOutputs(*r, out_dir);
     if (!written.ok()) return Fail("cannot write the reports", written);
     PrintStations(*r);
-    std::printf("wrote plan.json, stations.csv, visibility.ply, heatmap.png, reduction.png to %s\n", out_dir.c_str());
+    std::printf("wrote plan.json, stations.csv, visibility.ply, heatmap.png, reduction.png, report.html to %s\n",
+                out_dir.c_str());
     return 0;
   }
 

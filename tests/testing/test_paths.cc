@@ -5,8 +5,10 @@
 
 #include <atomic>
 #include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <mutex>
+#include <sstream>
 #include <vector>
 
 namespace vc::testing {
@@ -60,6 +62,13 @@ std::string MakeTempDir() {
   std::filesystem::create_directories(dir);
   Made().Add(dir);
   return dir.string();
+}
+
+std::string ReadFileBytes(const std::string& path) {
+  std::ifstream f(path, std::ios::binary);
+  std::stringstream ss;
+  ss << f.rdbuf();
+  return ss.str();
 }
 
 }  // namespace vc::testing

@@ -14,5 +14,7 @@ std::string BinaryDir();
 // A fresh, empty temporary directory unique to the calling test. Removed when the test program
 // exits, unless a test failed (then they are kept for inspection, and their paths printed).
 std::string MakeTempDir();
+// The whole content of the file at `path` (bytes); empty if it cannot be read.
+std::string ReadFileBytes(const std::string& path);
 
 }  // namespace vc::testing

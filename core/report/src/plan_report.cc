@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "raster.h"
+#include "vc/report/report_html.h"
 
 namespace vc {
 
@@ -737,6 +738,7 @@ Status WritePlanOutputs(const PlanResult& result, const std::string& out_dir) {
   VC_RETURN_IF_ERROR(WriteFile(dir / "heatmap.png", heat));
   VC_ASSIGN_OR_RETURN(std::string red, raster::EncodePng(DrawReduction(result)));
   VC_RETURN_IF_ERROR(WriteFile(dir / "reduction.png", red));
+  VC_RETURN_IF_ERROR(WriteFile(dir / "report.html", PlanToHtml(result)));
   return Status::Ok();
 }
 

@@ -1,6 +1,7 @@
 // The files a user gets from a plan or an evaluation (written by vc-client from the streamed
 // result, and usable directly from core): plan.json, stations.csv, visibility.ply, heatmap.png,
-// reduction.png, evaluation.json. Schemas are documented in docs/PLANNING.md and docs/PROTOCOL.md.
+// reduction.png, report.html (vc/report/report_html.h), evaluation.json. Schemas are documented
+// in docs/PLANNING.md and docs/PROTOCOL.md.
 #pragma once
 
 #include <string>
@@ -17,7 +18,7 @@ namespace vc {
 // plan.json's content (documented schema).
 std::string PlanToJson(const PlanResult& result);
 
-// Writes plan.json, stations.csv, visibility.ply, heatmap.png and reduction.png into `out_dir`
+// Writes plan.json, stations.csv, visibility.ply, heatmap.png, reduction.png and report.html into `out_dir`
 // (created if missing). visibility.ply needs result.voxel_centers and
 // result.evaluation.best_face_values. INTERNAL / FAILED_PRECONDITION with the path on I/O errors.
 Status WritePlanOutputs(const PlanResult& result, const std::string& out_dir);

@@ -1,0 +1,36 @@
+// report.html: one self-contained web page showing a plan in 3D (docs/PLANNING.md, "Output
+// files"). It opens offline in any browser with WebGL: three.js r111 (Debian's libjs-three, embedded
+// into the binary at build time), the page's script and style, and the plan's data are all inlined.
+//
+// The page draws the occupied voxels coloured by their best V (visibility.ply's colours; at most
+// ReportHtmlOptions::max_points of them, a deterministic pseudo-random subset when there are more),
+// the stations as numbered markers (plan order, 1-based, as heatmap.png and stations.csv), the scan
+// graph's edges, the walking route, and a side panel with plan.json's figures and the station
+// table; clicking a station highlights the voxels only it sees (Evaluation::sole_viewer).
+//
+// Data is inlined as JSON with the bulk arrays in base64 (positions quantised to uint16 steps of
+// the resolution); every string from the plan (warnings, names) is JSON-escaped with '<', '>' and
+// '&' as \u escapes, so it can neither end the <script> element nor inject markup, and the page
+// inserts it as text, never as HTML. Stateless; safe to call from several threads.
+#pragma once
+
+#include <cstddef>
+#include <string>
+
+#include "vc/plan/planner.h"
+
+namespace vc {
+
+struct ReportHtmlOptions {
+  // Most voxels drawn: 300,000 points stay smooth on a laptop's integrated GPU (and keep the file
+  // a few MB); a larger scene shows a deterministic pseudo-random subset of this size.
+  size_t max_points = 300000;
+};
+
+// report.html's content for `result`. Uses result.voxel_centers with
+// result.evaluation.best_face_values (the shorter of the two; none drawn when either is empty) and
+// result.evaluation.sole_viewer when it has one entry per voxel (else the page says the
+// highlight is unavailable).
+std::string PlanToHtml(const PlanResult& result, const ReportHtmlOptions& options = {});
+
+}  // namespace vc

@@ -1,0 +1,230 @@
+// report.html in a real browser: plans a small synthetic scene (three rooms and a corridor), writes
+// the plan's files, and opens report.html in headless chromium (software WebGL: SwiftShader
+// through ANGLE). Checks the page's own state after its first frame (no script errors, one marker
+// per station, every voxel drawn, a station selected from the URL with its sole voxels, a click on
+// a marker selecting its station), and that a screenshot shows the scene: many distinct colours,
+// red station markers and the selected station's sole voxels in magenta. Fails, never skips, when
+// chromium is missing (scripts/install-deps.sh installs it); VC_CHROMIUM overrides its path.
+#include <gtest/gtest.h>
+#include <png.h>
+
+#include <algorithm>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "testing/scenes.h"
+#include "testing/test_paths.h"
+#include "vc/plan/planner.h"
+#include "vc/report/plan_report.h"
+#include "vc/report/report_html.h"
+
+namespace vc {
+namespace {
+
+constexpr int kWidth = 1280, kHeight = 800;
+constexpr int kPanelWidth = 400;  // report_page.css: #panel's width (px)
+
+std::string Chromium() {
+  if (const char* env = std::getenv("VC_CHROMIUM"); env != nullptr && *env != '\0') return env;
+  return VC_CHROMIUM;
+}
+
+// Runs headless chromium on `url` with `action` (--dump-dom or --screenshot=...), stdout to
+// `out`; its exit status.
+int RunChromium(const std::string& dir, const std::string& url, const std::string& action, const std::string& out) {
+  const std::string command = "timeout 90 '" + Chromium() +
+                              "' --headless=new --no-sandbox --use-angle=swiftshader --enable-unsafe-swiftshader"
+                              " --disable-gpu-sandbox --no-first-run --disable-extensions --hide-scrollbars"
+                              " --user-data-dir='" +
+                              dir + "/profile' --window-size=" + std::to_string(kWidth) + "," +
+                              std::to_string(kHeight) + " --virtual-time-budget=15000 " + action + " '" + url + "' >'" +
+                              out + "' 2>'" + dir + "/chromium.log'";
+  return std::system(command.c_str());
+}
+
+// The attributes of the dumped DOM's <body> tag.
+std::map<std::string, std::string> BodyAttributes(const std::string& dom) {
+  std::map<std::string, std::string> attributes;
+  const size_t start = dom.find("<body");
+  if (start == std::string::npos) return attributes;
+  const std::string tag = dom.substr(start, dom.find('>', start) - start);
+  for (size_t at = tag.find(" data-"); at != std::string::npos; at = tag.find(" data-", at + 1)) {
+    const size_t eq = tag.find("=\"", at);
+    const size_t close = tag.find('"', eq + 2);
+    if (eq == std::string::npos || close == std::string::npos) break;
+    attributes[tag.substr(at + 1, eq - at - 1)] = tag.substr(eq + 2, close - eq - 2);
+  }
+  return attributes;
+}
+
+struct Picture {
+  int width = 0, height = 0;
+  std::vector<uint8_t> rgb;
+};
+
+Picture ReadPng(const std::string& path) {
+  Picture p;
+  png_image image{};
+  image.version = PNG_IMAGE_VERSION;
+  if (!png_image_begin_read_from_file(&image, path.c_str())) return p;
+  image.format = PNG_FORMAT_RGB;
+  p.rgb.resize(PNG_IMAGE_SIZE(image));
+  if (!png_image_finish_read(&image, nullptr, p.rgb.data(), 0, nullptr)) return Picture{};
+  p.width = static_cast<int>(image.width);
+  p.height = static_cast<int>(image.height);
+  return p;
+}
+
+class ReportHtmlBrowserTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    PlanOptions o;
+    o.resolution_m = 0.1;
+    o.min_overlap = 0.3;
+    Result<PlanResult> r = Plan(testing::Synthetic("rooms:3"), o);
+    ASSERT_TRUE(r.ok()) << r.status().ToString();
+    plan_ = new PlanResult(std::move(*r));
+    dir_ = new std::string(testing::MakeTempDir());
+    ASSERT_TRUE(WritePlanOutputs(*plan_, *dir_).ok());
+  }
+  static void TearDownTestSuite() {
+    delete plan_;
+    delete dir_;
+  }
+  void SetUp() override {
+    ASSERT_TRUE(std::filesystem::exists(Chromium()))
+        << "chromium not found at '" << Chromium()
+        << "': install it with scripts/install-deps.sh (Debian package chromium) or set VC_CHROMIUM";
+    ASSERT_NE(plan_, nullptr);
+  }
+  static std::string Url(const std::string& fragment = "") { return "file://" + *dir_ + "/report.html" + fragment; }
+  static std::string Log() { return testing::ReadFileBytes(*dir_ + "/chromium.log"); }
+
+  static PlanResult* plan_;
+  static std::string* dir_;
+};
+PlanResult* ReportHtmlBrowserTest::plan_ = nullptr;
+std::string* ReportHtmlBrowserTest::dir_ = nullptr;
+
+TEST_F(ReportHtmlBrowserTest, PageRendersEveryStationWithoutErrors) {
+  ASSERT_GE(plan_->stations.size(), 2u);
+  const std::string dom_path = *dir_ + "/dom.html";
+  ASSERT_EQ(RunChromium(*dir_, Url(), "--dump-dom", dom_path), 0) << Log();
+  const std::string dom = testing::ReadFileBytes(dom_path);
+  std::map<std::string, std::string> body = BodyAttributes(dom);
+  const size_t errors_at = dom.find("<pre id=\"errors\">");
+  const std::string errors = errors_at == std::string::npos ? "" : dom.substr(errors_at, 600);
+  EXPECT_EQ(body["data-errors"], "0") << errors;
+  ASSERT_EQ(body["data-ready"], "true") << "the page never rendered its first frame\n" << errors << Log();
+  EXPECT_EQ(body["data-station-markers"], std::to_string(plan_->stations.size()));
+  EXPECT_EQ(body["data-points-drawn"], std::to_string(plan_->voxel_centers.size()));
+  EXPECT_NE(dom.find("vc plan report \u2014 ready</title>"), std::string::npos);
+  // One table row per station.
+  size_t rows = 0;
+  for (size_t at = dom.find("<tr", dom.find("<tbody>")); at != std::string::npos && at < dom.find("</tbody>");
+       at = dom.find("<tr", at + 1)) {
+    ++rows;
+  }
+  EXPECT_EQ(rows, plan_->stations.size());
+}
+
+TEST_F(ReportHtmlBrowserTest, StationFromTheUrlIsSelected) {
+  const std::string dom_path = *dir_ + "/dom-station.html";
+  ASSERT_EQ(RunChromium(*dir_, Url("#station=2"), "--dump-dom", dom_path), 0) << Log();
+  const std::string dom = testing::ReadFileBytes(dom_path);
+  EXPECT_EQ(BodyAttributes(dom)["data-errors"], "0");
+  EXPECT_EQ(BodyAttributes(dom)["data-ready"], "true");
+  EXPECT_NE(dom.find("<tr class=\"selected\">"), std::string::npos);
+  // The plan carries sole viewers, so the page offers the highlight.
+  ASSERT_EQ(plan_->evaluation.sole_viewer.size(), plan_->voxel_centers.size());
+  EXPECT_NE(dom.find("Station 2: "), std::string::npos);
+  EXPECT_NE(dom.find("voxels only it sees (magenta"), std::string::npos);
+  EXPECT_EQ(dom.find("highlight of the voxels only it sees is unavailable"), std::string::npos);
+}
+
+TEST_F(ReportHtmlBrowserTest, DecimatedPageDrawsItsCapAndSaysSo) {
+  ReportHtmlOptions options;
+  options.max_points = 1000;
+  ASSERT_GT(plan_->voxel_centers.size(), options.max_points);
+  std::ofstream(*dir_ + "/decimated.html", std::ios::binary) << PlanToHtml(*plan_, options);
+  const std::string dom_path = *dir_ + "/dom-decimated.html";
+  ASSERT_EQ(RunChromium(*dir_, "file://" + *dir_ + "/decimated.html#station=1", "--dump-dom", dom_path), 0) << Log();
+  const std::string dom = testing::ReadFileBytes(dom_path);
+  std::map<std::string, std::string> body = BodyAttributes(dom);
+  EXPECT_EQ(body["data-errors"], "0");
+  EXPECT_EQ(body["data-ready"], "true");
+  EXPECT_EQ(body["data-points-drawn"], "1000");
+  EXPECT_NE(dom.find("1,000 of "), std::string::npos) << "the panel does not say how many voxels are drawn";
+}
+
+TEST_F(ReportHtmlBrowserTest, ClickingAMarkerSelectsItsStation) {
+  // A copy of the page that, once ready, clicks station 2's marker (a pointerdown and pointerup on
+  // the canvas where the page says the marker is) and writes the selected row's number on <body>.
+  std::string html = testing::ReadFileBytes(*dir_ + "/report.html");
+  const size_t end = html.rfind("</body>");
+  ASSERT_NE(end, std::string::npos);
+  html.insert(end, R"js(<script>
+(function click() {
+  if (!window.vcReport.ready) { setTimeout(click, 20); return; }
+  var xy = window.vcReport.markerScreenPosition(1);
+  var canvas = document.querySelector('#view canvas');
+  var at = {clientX: xy[0], clientY: xy[1], bubbles: true};
+  canvas.dispatchEvent(new PointerEvent('pointerdown', at));
+  canvas.dispatchEvent(new PointerEvent('pointerup', at));
+  var row = document.querySelector('#stations tr.selected');
+  document.body.setAttribute('data-clicked', row ? row.firstChild.textContent : 'none');
+})();
+</script>
+)js");
+  std::ofstream(*dir_ + "/click.html", std::ios::binary) << html;
+  const std::string dom_path = *dir_ + "/dom-click.html";
+  ASSERT_EQ(RunChromium(*dir_, "file://" + *dir_ + "/click.html", "--dump-dom", dom_path), 0) << Log();
+  std::map<std::string, std::string> body = BodyAttributes(testing::ReadFileBytes(dom_path));
+  EXPECT_EQ(body["data-errors"], "0");
+  EXPECT_EQ(body["data-clicked"], "2");
+}
+
+TEST_F(ReportHtmlBrowserTest, ScreenshotShowsTheSceneAndASelectedStationsSoleVoxels) {
+  // The station that alone sees the most voxels, selected from the URL.
+  std::vector<size_t> sole(plan_->stations.size(), 0);
+  for (int32_t s : plan_->evaluation.sole_viewer) {
+    if (s >= 0 && static_cast<size_t>(s) < sole.size()) ++sole[s];
+  }
+  const size_t best = std::max_element(sole.begin(), sole.end()) - sole.begin();
+  ASSERT_GT(sole[best], 100u) << "no station sees enough voxels alone to show them";
+  const std::string png = *dir_ + "/screenshot.png";
+  ASSERT_EQ(RunChromium(*dir_, Url("#station=" + std::to_string(best + 1)), "--screenshot='" + png + "'",
+                        *dir_ + "/screenshot.out"),
+            0)
+      << Log();
+  const Picture p = ReadPng(png);
+  ASSERT_EQ(p.width, kWidth) << "no readable screenshot\n" << Log();
+  ASSERT_EQ(p.height, kHeight);
+  // The 3D view (left of the panel): not blank, i.e. many pixels differ from its background
+  // (#24262b), in many colours (viridis voxels), with red station marker rings among them.
+  const int view_width = kWidth - kPanelWidth;
+  size_t scene_pixels = 0, red_pixels = 0, magenta_pixels = 0;
+  std::set<uint32_t> colours;
+  for (int y = 0; y < p.height; ++y) {
+    for (int x = 0; x < view_width; ++x) {
+      const uint8_t* c = &p.rgb[3 * (static_cast<size_t>(y) * p.width + x)];
+      if (std::abs(c[0] - 0x24) + std::abs(c[1] - 0x26) + std::abs(c[2] - 0x2b) > 12) ++scene_pixels;
+      if (c[0] > 180 && c[1] < 80 && c[2] < 80) ++red_pixels;
+      if (c[0] > 200 && c[1] < 90 && c[2] > 170) ++magenta_pixels;
+      colours.insert((c[0] >> 3) << 10 | (c[1] >> 3) << 5 | (c[2] >> 3));
+    }
+  }
+  const size_t view_pixels = static_cast<size_t>(view_width) * p.height;
+  EXPECT_GT(scene_pixels, view_pixels / 20) << scene_pixels << " of " << view_pixels << " pixels show the scene";
+  EXPECT_GT(colours.size(), 100u) << "distinct colours (5 bits per channel)";
+  EXPECT_GT(red_pixels, 50u) << "no red station marker rings";
+  EXPECT_GT(magenta_pixels, 1000u) << "station " << best + 1 << "'s " << sole[best] << " sole voxels are not magenta";
+}
+
+}  // namespace
+}  // namespace vc
