@@ -5,7 +5,7 @@
 ARG BASE=debian:bookworm
 
 FROM ${BASE} AS build
-# Packages: scripts/install-deps.sh's lists (build: ... coinor-libcbc-dev, libjs-three, chromium; runtime: ...
+# Packages: scripts/install-deps.sh's lists (build: ... coinor-libcbc-dev, libjs-three; runtime: ...
 # coinor-libcbc3; report.html carries three.js inside the binary, so the runtime needs neither).
 WORKDIR /src
 COPY scripts/install-deps.sh scripts/install-deps.sh

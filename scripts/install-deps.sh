@@ -1,7 +1,10 @@
 #!/usr/bin/env bash
 # Installs every build and test dependency of vc from Debian 12's packages.
 # Used by the README commands, .ci/run and the Dockerfile, so a brand-new Debian 12 machine needs nothing else.
-# Usage: scripts/install-deps.sh [--runtime]   (--runtime: only what the built binaries need to run)
+# Usage: scripts/install-deps.sh [--runtime | --tests]
+#   --runtime: only what the built binaries need to run
+#   --tests:   the build packages and what the tests need besides (headless chromium for
+#              report_html_browser_test); scripts/test.sh uses it, the demo does not
 set -euo pipefail
 
 BUILD_PKGS=(
@@ -14,7 +17,9 @@ BUILD_PKGS=(
   openssl python3 bzip2 gzip
   clang clang-format libfuzzer-14-dev
   libjs-three  # three.js, inlined into report.html at build time
-  chromium     # report_html_browser_test opens report.html in headless chromium
+)
+TEST_PKGS=(
+  chromium  # report_html_browser_test opens report.html in headless chromium
 )
 RUNTIME_PKGS=(
   libgrpc++1.51 libgrpc29 libprotobuf32 liboctomap1.9 libspdlog1.10 libfmt9 libhwy1
@@ -23,7 +28,12 @@ RUNTIME_PKGS=(
 )
 
 pkgs=("${BUILD_PKGS[@]}")
-if [[ "${1:-}" == "--runtime" ]]; then pkgs=("${RUNTIME_PKGS[@]}"); fi
+case "${1:-}" in
+  --runtime) pkgs=("${RUNTIME_PKGS[@]}") ;;
+  --tests) pkgs=("${BUILD_PKGS[@]}" "${TEST_PKGS[@]}") ;;
+  "") ;;
+  *) echo "install-deps: unknown option $1 (use --runtime or --tests)" >&2; exit 2 ;;
+esac
 
 missing=()
 for p in "${pkgs[@]}"; do

@@ -11,7 +11,7 @@
 # Usage: scripts/test.sh [--quick]   (--quick: the release preset only)
 set -euo pipefail
 cd "$(dirname "$0")/.."
-bash scripts/install-deps.sh
+bash scripts/install-deps.sh --tests
 
 presets=(release asan tsan fuzz)
 if [[ "${1:-}" == "--quick" ]]; then presets=(release); fi
