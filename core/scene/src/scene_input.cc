@@ -19,7 +19,7 @@ namespace {
 
 constexpr std::string_view kSupported =
     "supported: PLY, PCD v0.7, ASCII XYZ/CSV, LAS 1.0-1.4, OctoMap .bt/.ot, OctoMap ScanGraph "
-    ".graph, and gzip/bzip2 copies of these";
+    ".graph, vc-voxels (vc-client's compact upload), and gzip/bzip2 copies of these";
 
 bool StartsWith(std::string_view s, std::string_view prefix) { return s.substr(0, prefix.size()) == prefix; }
 
@@ -61,6 +61,7 @@ Result<SceneInput> ReadDecompressed(std::string_view bytes, std::string_view sou
   if (StartsWith(bytes, "# Octomap OcTree file")) {
     return FromOctree(ReadOctreeText(bytes, source, options.max_result_bytes), InputFormat::kOctomapText);
   }
+  if (readers::LooksLikeVoxelStream(bytes)) return readers::ReadVoxelStream(bytes, source, options);
   if (readers::LooksLikePly(bytes)) {
     return FromCloud(readers::ReadPly(bytes, source, options), InputFormat::kPly, source);
   }
@@ -119,6 +120,8 @@ std::string_view InputFormatName(InputFormat format) {
       return "octomap-ot";
     case InputFormat::kOctomapGraph:
       return "octomap-graph";
+    case InputFormat::kVoxelStream:
+      return "vc-voxels";
   }
   return "unknown";
 }

@@ -12,6 +12,13 @@
 namespace vc {
 namespace {
 
+// "0.1 m", "0.025 m": a resolution for people (up to 6 significant digits).
+std::string FormatMetres(double m) {
+  std::ostringstream out;
+  out << m << " m";
+  return out.str();
+}
+
 // Packs a key into 48 bits in VoxelKey's order (z, then y, then x), so sorting packed values
 // sorts keys.
 uint64_t Pack(const VoxelKey& k) { return (uint64_t(k.z) << 32) | (uint64_t(k.y) << 16) | uint64_t(k.x); }
@@ -103,11 +110,22 @@ WorldPoint VoxelScene::BoundsMax() const {
 double WorkingResolution(const SceneInput& input, const VoxelizeOptions& options) {
   if (options.resolution_m != 0) return options.resolution_m;
   if (input.octree) return OctreeResolution(*input.octree);
+  if (input.voxel_resolution_m > 0) return input.voxel_resolution_m;
   return kDefaultResolutionM;
 }
 
 Result<std::vector<VoxelKey>> OccupiedKeys(const SceneInput& input, double r, uint64_t budget, const JobContext& ctx) {
   VC_RETURN_IF_ERROR(CheckResolution(r));
+  // A voxel stream's points are voxel centres: at its own resolution they give back its voxels;
+  // at any other they would not be the scene the client voxelised.
+  if (input.voxel_resolution_m > 0 && std::fabs(r - input.voxel_resolution_m) > 1e-9 * input.voxel_resolution_m) {
+    return InvalidArgumentError("the scene was uploaded as voxels of " + FormatMetres(input.voxel_resolution_m) +
+                                " (a compact upload) and can only be voxelised at that resolution, not " +
+                                FormatMetres(r) +
+                                ": upload the raw cloud (vc-client --raw-upload), or let the "
+                                "client voxelise at " +
+                                FormatMetres(r));
+  }
   std::vector<uint64_t> packed;
   if (input.octree) {
     const octomap::OcTree& tree = *input.octree;

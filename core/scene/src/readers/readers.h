@@ -77,6 +77,12 @@ bool LooksLikeText(std::string_view bytes);
 // Reads ASCII x y z per line, space/comma/tab separated, optional header line (xyz_reader.cc).
 Result<PointCloud> ReadXyz(std::string_view bytes, std::string_view source, const ReadOptions& options);
 
+// vc-voxels (voxel_stream.cc; vc/scene/voxel_stream.h): starts with "VCVOXELS".
+bool LooksLikeVoxelStream(std::string_view bytes);
+// One point per voxel centre, voxel_resolution_m set. INVALID_ARGUMENT naming the byte or voxel,
+// RESOURCE_EXHAUSTED past the limits.
+Result<SceneInput> ReadVoxelStream(std::string_view bytes, std::string_view source, const ReadOptions& options);
+
 // --- Shared helpers ---
 
 // "source: message" as an INVALID_ARGUMENT status.

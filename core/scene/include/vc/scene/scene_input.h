@@ -31,9 +31,10 @@ enum class InputFormat {
   kOctomapBinary,  // OctoMap .bt
   kOctomapText,    // OctoMap .ot (full, any AbstractOcTree stream of type OcTree)
   kOctomapGraph,   // OctoMap ScanGraph .graph (points plus each scan's origin)
+  kVoxelStream,    // vc-voxels: a compact upload's occupied voxels (vc/scene/voxel_stream.h)
 };
 
-// "ply", "pcd", "xyz", "las", "octomap-bt", "octomap-ot", "octomap-graph".
+// "ply", "pcd", "xyz", "las", "octomap-bt", "octomap-ot", "octomap-graph", "vc-voxels".
 std::string_view InputFormatName(InputFormat format);
 
 enum class Compression { kNone, kGzip, kBzip2 };
@@ -80,6 +81,9 @@ struct SceneInput {
   std::shared_ptr<const octomap::OcTree> octree;
   // Points dropped because a coordinate was NaN or infinite.
   uint64_t dropped_nonfinite = 0;
+  // vc-voxels only: the voxel edge (m) the points are the centres of; the scene can only be
+  // voxelised at this resolution (Voxelize). 0 for every other format.
+  double voxel_resolution_m = 0;
 
   bool is_octree() const { return octree != nullptr; }
 };
