@@ -33,6 +33,8 @@ v1::InputFormat ToProto(InputFormat f) {
       return v1::INPUT_FORMAT_OCTOMAP_OT;
     case InputFormat::kOctomapGraph:
       return v1::INPUT_FORMAT_OCTOMAP_GRAPH;
+    case InputFormat::kE57:
+      return v1::INPUT_FORMAT_E57;
   }
   return v1::INPUT_FORMAT_UNSPECIFIED;
 }
@@ -53,6 +55,8 @@ Result<InputFormat> FromProto(v1::InputFormat f) {
       return InputFormat::kOctomapText;
     case v1::INPUT_FORMAT_OCTOMAP_GRAPH:
       return InputFormat::kOctomapGraph;
+    case v1::INPUT_FORMAT_E57:
+      return InputFormat::kE57;
     default:
       break;
   }
