@@ -7,8 +7,8 @@
 #include <thread>
 
 #include "grpc/health/v1/health.grpc.pb.h"
-#include "vc/v1/planner.grpc.pb.h"
 #include "vc/base/crc32c.h"
+#include "vc/v1/planner.grpc.pb.h"
 #include "vc/wire/status_mapping.h"
 
 namespace vc::client {

@@ -34,6 +34,8 @@ constexpr uint64_t kPageData = 1020;  // Bytes of a page before its checksum.
 constexpr uint64_t kHeaderSize = 48;
 constexpr uint64_t kSectionHeaderSize = 32;
 constexpr int kMaxXmlDepth = 64;
+// A tree node costs ~40x the 4 bytes of "<a/>"; real files have a few dozen elements per scan.
+constexpr size_t kMaxXmlElements = size_t{1} << 20;
 
 std::string Str(uint64_t v) { return std::to_string(v); }
 
@@ -145,6 +147,7 @@ struct XmlBuilder {
     try {
       if (b->open.size() >= kMaxXmlDepth) return b->Stop("elements nest deeper than " + Str(kMaxXmlDepth));
       if (b->open.empty() && !b->tree.nodes.empty()) return b->Stop("more than one root element");
+      if (b->tree.nodes.size() >= kMaxXmlElements) return b->Stop("more than " + Str(kMaxXmlElements) + " elements");
       XmlNode node;
       node.name = name;
       for (size_t i = 0; attributes[i] != nullptr; i += 2)
@@ -460,6 +463,17 @@ class XmlReader {
     VC_RETURN_IF_ERROR(ExpectType(*prototype, "Structure"));
     VC_RETURN_IF_ERROR(Prototype(*prototype, "", index, &layout.fields));
     if (layout.fields.empty()) return ScanError(*prototype, index, "the points' <prototype> has no fields");
+    if (const XmlNode* codecs = Child(*points, "codecs")) {
+      for (size_t c : codecs->children) {
+        for (size_t k : tree_.nodes[c].children) {
+          const XmlNode& codec = tree_.nodes[k];
+          if (codec.name != "inputs" && codec.name != "bitPackCodec") {
+            return ScanError(codec, index,
+                             "codec <" + codec.name + "> is not supported (only bitPackCodec, E57 1.0's one)");
+          }
+        }
+      }
+    }
     const auto find = [&](std::string_view name) {
       for (size_t i = 0; i < layout.fields.size(); ++i) {
         if (layout.fields[i].name == name) return static_cast<int>(i);

@@ -15,10 +15,10 @@
 #include <string_view>
 #include <utility>
 
+#include "vc/base/crc32c.h"
 #include "vc/base/status.h"
 #include "vc/server/worker_pool.h"
 #include "vc/v1/planner.pb.h"
-#include "vc/base/crc32c.h"
 
 namespace vc::server {
 

@@ -198,6 +198,41 @@ TEST(E57Reader, DropsAndCountsNonFinitePoints) {
   EXPECT_EQ(in->dropped_nonfinite, 2u);
 }
 
+// The root as libE57Format writes it (seen in a published sample's XML: indentation, an empty
+// Integer element for 0, min/max attributes on Integer elements), plus the optional scan elements
+// real scanners write (bounds, an extension namespace): all parsed past; empty Floats are 0.
+TEST(E57Reader, ReadsTheLayoutOfLibE57FormatFiles) {
+  E57ScanSpec scan = Scan();
+  scan.translation_m = {0, 2, 0};
+  E57Spec spec = OneScan(scan);
+  spec.edit_xml = [](std::string& xml) {
+    const auto replace = [&](const std::string& from, const std::string& to) {
+      ASSERT_NE(xml.find(from), std::string::npos) << from;
+      xml.replace(xml.find(from), from.size(), to);
+    };
+    replace("<e57Root type=\"Structure\" xmlns=",
+            "<e57Root type=\"Structure\"\n         xmlns:nor=\"http://www.libe57.org/E57_NOR_surface_normals.txt\"\n"
+            "         xmlns=");
+    replace("<versionMajor type=\"Integer\">1</versionMajor>",
+            "  <versionMajor type=\"Integer\" minimum=\"0\" maximum=\"255\">1</versionMajor>");
+    replace("<versionMinor type=\"Integer\">0</versionMinor>",
+            "  <versionMinor type=\"Integer\" minimum=\"0\" maximum=\"255\"/>");
+    replace("<coordinateMetadata type=\"String\"></coordinateMetadata>", "  <coordinateMetadata type=\"String\"/>");
+    replace("<x type=\"Float\">0</x><y type=\"Float\">2</y>", "<x type=\"Float\"/>\n    <y type=\"Float\">2</y>");
+    replace("<points type=",
+            "<cartesianBounds type=\"Structure\">\n      <xMinimum type=\"Float\">-4</xMinimum>\n"
+            "      <xMaximum type=\"Float\">10</xMaximum>\n    </cartesianBounds>\n"
+            "    <indexBounds type=\"Structure\">\n      <rowMaximum type=\"Integer\" minimum=\"0\"/>\n"
+            "    </indexBounds>\n    <nor:normalsInfo type=\"String\"><![CDATA[none]]></nor:normalsInfo>\n"
+            "    <points type=");
+  };
+  Result<SceneInput> in = ReadScene(WriteE57(spec), "t.e57");
+  ASSERT_TRUE(in.ok()) << in.status().message();
+  std::vector<Eigen::Vector3d> expected;
+  for (const auto& p : SomePoints()) expected.push_back(p + Eigen::Vector3d(0, 2, 0));
+  ExpectPoints(*in, expected, 1e-9);
+}
+
 // --- Refusals: each names the section and the byte offset ---
 
 TEST(E57Reader, RefusesAWrongChecksumNamingThePage) {
@@ -282,6 +317,12 @@ TEST(E57Reader, RefusesBadXml) {
 
   spec.edit_xml = [](std::string& xml) { xml.replace(xml.find("<w type=\"Float\">1"), 17, "<w type=\"Float\">2"); };
   EXPECT_THAT(ReadStatus(WriteE57(spec)).message(), HasSubstr("expected a unit quaternion"));
+
+  spec.edit_xml = [](std::string& xml) {
+    const std::string codec = "<vectorChild type=\"Structure\"><zipCodec type=\"Structure\"/></vectorChild>";
+    xml.insert(xml.find("</codecs>"), codec);
+  };
+  EXPECT_THAT(ReadStatus(WriteE57(spec)).message(), HasSubstr("codec <zipCodec> is not supported"));
 
   spec.edit_xml = [](std::string& xml) { xml.replace(xml.find("cartesianZ"), 10, "cartesianQ"); };
   EXPECT_THAT(ReadStatus(WriteE57(spec)).message(), HasSubstr("neither cartesianX/Y/Z nor sphericalRange"));

@@ -88,8 +88,9 @@ struct SceneInput {
 
 // Detects the format of `bytes` (after decompression) and parses it. `source_name` only labels
 // error messages (a file name or "upload"). Errors: INVALID_ARGUMENT for malformed or unsupported
-// content (truncated, wrong counts, unknown types, LAZ, a bad E57 page checksum, empty cloud), RESOURCE_EXHAUSTED when a
-// limit in `options` is exceeded, or when memory runs out while reading (never an exception).
+// content (truncated, wrong counts, unknown types, LAZ, a bad E57 page checksum, empty cloud),
+// RESOURCE_EXHAUSTED when a limit in `options` is exceeded, or when memory runs out while reading
+// (never an exception).
 Result<SceneInput> ReadScene(std::string_view bytes, std::string_view source_name, const ReadOptions& options = {});
 
 // Reads a whole file and calls ReadScene. NOT_FOUND if it cannot be opened.
