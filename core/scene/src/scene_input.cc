@@ -72,6 +72,11 @@ Result<SceneInput> ReadDecompressed(std::string_view bytes, std::string_view sou
     if (!e57.ok()) return e57.status();
     std::vector<Eigen::Vector3d> origins;
     for (const E57Scan& scan : e57->scans) origins.push_back(scan.translation_m);
+    if (e57->cloud.points.empty()) {
+      return readers::InvalidInput(source, e57->cloud.detail + ": no valid, finite point (" +
+                                               std::to_string(e57->cloud.dropped_nonfinite) +
+                                               " non-finite); the cloud is empty");
+    }
     VC_ASSIGN_OR_RETURN(SceneInput in, FromCloud(std::move(e57->cloud), InputFormat::kE57, source));
     in.scan_origins = std::move(origins);
     return in;

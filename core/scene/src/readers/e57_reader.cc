@@ -604,9 +604,10 @@ Result<std::vector<std::string>> ReadStreams(PagedFile* file, const ScanLayout& 
       continue;
     }
     if (type != 1) return error(pos, "unknown packet type " + Str(type) + " (expected 0, 1 or 2)");
+    if (length < 6) return error(pos, "data packet of " + Str(length) + " bytes is shorter than its 6-byte header");
     VC_RETURN_IF_ERROR(file->Read(pos + 4, length - 4, where + " data packet", &packet));
-    const uint64_t count = length >= 6 ? At<uint16_t>(packet, 4) : 0;
-    if (length < 6 || count != streams.size()) {
+    const uint64_t count = At<uint16_t>(packet, 4);
+    if (count != streams.size()) {
       return error(pos, "data packet has " + Str(count) + " bytestreams but the prototype has " + Str(streams.size()) +
                             " fields");
     }

@@ -179,6 +179,14 @@ TEST(E57Reader, SkipsRecordsMarkedInvalidAndIgnoresIntensity) {
   EXPECT_EQ(in->detail, "E57 1.0, 1 scan, 2 records marked invalid");
 }
 
+TEST(E57Reader, RefusesAFileWithoutValidPoints) {
+  E57ScanSpec scan = Scan();
+  scan.invalid_state = {2, 2, 1, 2, 2};
+  const Status s = ReadStatus(WriteE57(OneScan(scan)));
+  EXPECT_EQ(s.code(), StatusCode::kInvalidArgument);
+  EXPECT_THAT(s.message(), HasSubstr("E57 1.0, 1 scan, 5 records marked invalid: no valid, finite point"));
+}
+
 TEST(E57Reader, SkipsEmptyAndIndexPackets) {
   E57ScanSpec scan = Scan(E57ValueType::kScaledInteger);
   scan.packets = 3;
@@ -328,6 +336,15 @@ TEST(E57Reader, RefusesBadXml) {
   EXPECT_THAT(ReadStatus(WriteE57(spec)).message(), HasSubstr("neither cartesianX/Y/Z nor sphericalRange"));
 }
 
+TEST(E57Reader, RefusesFieldsWiderThan64Bits) {
+  E57Spec spec = OneScan(Scan(E57ValueType::kScaledInteger));
+  spec.edit_xml = [](std::string& xml) { xml.insert(xml.find("maximum=\"") + 9, "99999999999999999999"); };
+  const Status s = ReadStatus(WriteE57(spec));
+  EXPECT_EQ(s.code(), StatusCode::kInvalidArgument);
+  EXPECT_THAT(s.message(), HasSubstr("scan 0: prototype field <cartesianX> maximum="));
+  EXPECT_THAT(s.message(), HasSubstr("is not a 64-bit integer"));
+}
+
 TEST(E57Reader, RefusesAWrongHeader) {
   const std::string good = WriteE57(OneScan(Scan()));
   std::string page = good;
@@ -371,6 +388,19 @@ TEST(E57Reader, RefusesABadBinarySection) {
   file[48 + 32 + 4] = 9;  // Bytestream count.
   testing::FixE57Checksums(&file);
   EXPECT_THAT(ReadStatus(file).message(), HasSubstr("data packet has 9 bytestreams but the prototype has 3 fields"));
+
+  file = WriteE57(OneScan(Scan()));
+  file[48 + 32 + 2] = 2;  // Packet length - 1, low byte.
+  file[48 + 32 + 3] = 0;
+  testing::FixE57Checksums(&file);
+  EXPECT_THAT(ReadStatus(file).message(), HasSubstr("data packet of 3 bytes is shorter than its 6-byte header"));
+
+  file = WriteE57(OneScan(Scan()));
+  const uint64_t past_end = file.size() + 8;
+  std::memcpy(file.data() + 48 + 16, &past_end, 8);  // dataPhysicalOffset.
+  testing::FixE57Checksums(&file);
+  EXPECT_THAT(ReadStatus(file).message(),
+              HasSubstr("scan 0 binary section data (section header byte 16) at physical byte"));
 }
 
 TEST(E57Reader, ChecksLimitsBeforeReadingPoints) {
