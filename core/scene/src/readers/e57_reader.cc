@@ -583,11 +583,14 @@ Result<std::vector<std::string>> ReadStreams(PagedFile* file, const ScanLayout& 
                             "the end of the file");
   }
   const uint64_t end = start + section_length;
+  std::vector<std::string> streams(layout.fields.size(), std::string(16, '\0'));
+  // A writer that wrote no record may leave the data offset 0: nothing to read.
+  if (data_offset == 0 && layout.scan.point_count == 0) return streams;
+  for (std::string& s : streams) s.clear();
   VC_ASSIGN_OR_RETURN(uint64_t pos, file->ToLogical(data_offset, where + " data (section header byte 16)"));
   if (pos < start + kSectionHeaderSize || pos > end) {
     return error(start, "data offset " + Str(data_offset) + " is outside the section");
   }
-  std::vector<std::string> streams(layout.fields.size());
   std::string packet;
   while (pos < end) {
     packet.clear();

@@ -187,6 +187,23 @@ TEST(E57Reader, RefusesAFileWithoutValidPoints) {
   EXPECT_THAT(s.message(), HasSubstr("E57 1.0, 1 scan, 5 records marked invalid: no valid, finite point"));
 }
 
+TEST(E57Reader, ReadsAnEmptyScanWithoutDataPackets) {
+  E57Spec spec;
+  E57ScanSpec empty = Scan();
+  empty.points.clear();
+  empty.translation_m = {5, 5, 1};
+  spec.scans = {empty, Scan()};
+  std::string file = WriteE57(spec);
+  const uint64_t none = 0;
+  std::memcpy(file.data() + 48 + 16, &none, 8);  // The empty scan's dataPhysicalOffset.
+  testing::FixE57Checksums(&file);
+  Result<SceneInput> in = ReadScene(file, "t.e57");
+  ASSERT_TRUE(in.ok()) << in.status().message();
+  ExpectPoints(*in, SomePoints(), 1e-9);
+  ASSERT_EQ(in->scan_origins.size(), 2u);
+  EXPECT_EQ(in->scan_origins[0], Eigen::Vector3d(5, 5, 1));
+}
+
 TEST(E57Reader, SkipsEmptyAndIndexPackets) {
   E57ScanSpec scan = Scan(E57ValueType::kScaledInteger);
   scan.packets = 3;
