@@ -3,6 +3,10 @@
 
 Usage: fuzz/make_seeds.py [OUT_DIR]   (default: fuzz/corpus beside this script)
 scripts/fuzz.sh adds slices of ../shared/data at run time; nothing big is checked in.
+The E57 seeds (corpus/e57_fuzzer/, and copies in corpus/read_scene_fuzzer/) need CRC-32C pages and
+bit-packed sections, so they come from the tests' E57 writer instead of this script:
+  cmake --build --preset release --target write_e57_seeds
+  build/release/tests/write_e57_seeds fuzz/corpus/e57_fuzzer
 """
 import bz2
 import gzip

@@ -17,7 +17,7 @@ while (($#)); do
   esac
 done
 
-targets=(read_scene_fuzzer ply_fuzzer pcd_fuzzer xyz_fuzzer las_fuzzer octomap_bt_fuzzer
+targets=(read_scene_fuzzer ply_fuzzer pcd_fuzzer xyz_fuzzer las_fuzzer e57_fuzzer octomap_bt_fuzzer
          octomap_ot_fuzzer octomap_graph_fuzzer gzip_fuzzer bzip2_fuzzer lzf_fuzzer stations_csv_fuzzer
          keep_out_csv_fuzzer upload_assembler_fuzzer)
 if [[ -n "$only" ]]; then targets=("$only"); fi

@@ -7,8 +7,8 @@
 #include <thread>
 
 #include "grpc/health/v1/health.grpc.pb.h"
+#include "vc/base/crc32c.h"
 #include "vc/v1/planner.grpc.pb.h"
-#include "vc/wire/crc32c.h"
 #include "vc/wire/status_mapping.h"
 
 namespace vc::client {
@@ -27,7 +27,7 @@ v1::UploadSpec MakeUploadSpec(const Upload& upload) {
   v1::UploadSpec spec;
   spec.set_format(v1::INPUT_FORMAT_UNSPECIFIED);  // the server detects it from the content
   spec.set_total_size_bytes(upload.bytes.size());
-  spec.set_crc32c(wire::ComputeCrc32c(upload.bytes));
+  spec.set_crc32c(ComputeCrc32c(upload.bytes));
   spec.set_source_name(upload.source_name);
   return spec;
 }

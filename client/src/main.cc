@@ -14,6 +14,7 @@
 #include "vc/client/plan_summary.h"
 #include "vc/client/progress_display.h"
 #include "vc/report/plan_report.h"
+#include "vc/scene/e57.h"
 #include "vc/scene/scene_input.h"
 #include "vc/scene/scene_summary.h"
 #include "vc/wire/status_mapping.h"
@@ -125,6 +126,13 @@ int main(int argc, char** argv) {
     if (!input.ok()) return Fail("cannot read " + file, input.status());
     auto summary = vc::Summarize(*input, inspect_resolution, vc::kDefaultMemoryBudgetBytes);
     if (!summary.ok()) return Fail("cannot summarise " + file, summary.status());
+    if (input->format == vc::InputFormat::kE57 && input->compression == vc::Compression::kNone) {
+      auto bytes = vc::client::ReadUpload(file);
+      if (!bytes.ok()) return Fail("cannot read " + file, bytes.status());
+      auto scans = vc::ReadE57Scans(bytes->bytes, file);
+      if (!scans.ok()) return Fail("cannot list the scans of " + file, scans.status());
+      summary->e57_scans = std::move(scans).value();
+    }
     std::cout << (json ? vc::SummaryToJson(*summary) : vc::SummaryToText(*summary, file)) << "\n";
     return 0;
   }

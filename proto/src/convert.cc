@@ -33,6 +33,10 @@ v1::InputFormat ToProto(InputFormat f) {
       return v1::INPUT_FORMAT_OCTOMAP_OT;
     case InputFormat::kOctomapGraph:
       return v1::INPUT_FORMAT_OCTOMAP_GRAPH;
+    case InputFormat::kE57:
+      return v1::INPUT_FORMAT_E57;
+    case InputFormat::kVoxelStream:
+      return v1::INPUT_FORMAT_VC_VOXELS;
   }
   return v1::INPUT_FORMAT_UNSPECIFIED;
 }
@@ -53,6 +57,10 @@ Result<InputFormat> FromProto(v1::InputFormat f) {
       return InputFormat::kOctomapText;
     case v1::INPUT_FORMAT_OCTOMAP_GRAPH:
       return InputFormat::kOctomapGraph;
+    case v1::INPUT_FORMAT_E57:
+      return InputFormat::kE57;
+    case v1::INPUT_FORMAT_VC_VOXELS:
+      return InputFormat::kVoxelStream;
     default:
       break;
   }

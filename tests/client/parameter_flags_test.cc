@@ -14,6 +14,7 @@
 #include <set>
 #include <string>
 
+#include "testing/e57_writer.h"
 #include "vc/plan/keep_out.h"
 #include "vc/report/plan_report.h"
 #include "vc/visibility/scanner_presets.h"
@@ -291,6 +292,33 @@ TEST(ListParametersTest, FlagsFilesProtoAndPlanJson) {
   EXPECT_EQ(parameters["fixed_stations"][1], json({-3.5, 0.25, 1.6}));
   EXPECT_EQ(parameters["keep_out"][0]["box"]["max"], json({1.0, 1.0, 3.0}));
   EXPECT_EQ(parameters["keep_out"][1]["polygon"]["xy_m"], json({5.0, 5.0, 7.0, 5.0, 6.0, 7.0}));
+}
+
+// --fixed-stations FILE.e57: "plan the next stations from what I already scanned", each scan's
+// origin (its pose translation) a fixed station; a damaged file is refused naming it.
+TEST(ListParametersTest, FixedStationsFromAnE57FilesScanOrigins) {
+  testing::E57Spec spec;
+  for (const Eigen::Vector3d& origin : {Eigen::Vector3d(1, 2, 1.5), Eigen::Vector3d(-4, 0.5, 1.7)}) {
+    testing::E57ScanSpec scan;
+    scan.points = {{1, 0, 0}, {0, 1, 0}};
+    scan.translation_m = origin;
+    scan.rotation = Eigen::Quaterniond(Eigen::AngleAxisd(0.7, Eigen::Vector3d::UnitZ()));
+    spec.scans.push_back(scan);
+  }
+  std::string e57 = testing::WriteE57(spec);
+  client::PlanFileFlags files;
+  files.fixed_stations = WriteTemp("scanned.e57", e57);
+  PlanOptions o;
+  ASSERT_TRUE(client::LoadPlanFiles(files, &o).ok());
+  ASSERT_EQ(o.fixed_stations.size(), 2u);
+  EXPECT_EQ(o.fixed_stations[0], WorldPoint(1, 2, 1.5));
+  EXPECT_EQ(o.fixed_stations[1], WorldPoint(-4, 0.5, 1.7));
+
+  e57[1500] ^= 1;
+  files.fixed_stations = WriteTemp("damaged.e57", e57);
+  const Status s = client::LoadPlanFiles(files, &o);
+  EXPECT_EQ(s.code(), StatusCode::kInvalidArgument);
+  EXPECT_NE(s.message().find("damaged.e57: E57 page 1"), std::string::npos) << s.message();
 }
 
 TEST(ListParametersTest, StationsCarryFixedAndTheHeatMapItsFloorsOverTheWire) {

@@ -15,6 +15,19 @@ fail() { echo "smoke: FAIL: $*" >&2; [[ -f "$work/server.log" ]] && tail -20 "$w
 "$synth_bin" box --out "$work/box.ply" >/dev/null || fail "vc-synth box failed"
 [[ -s "$work/box.ply" ]] || fail "vc-synth wrote no box.ply"
 
+# inspect FILE.e57 lists the scans and their poses (the fuzz seed written by the tests' E57 writer).
+e57="$(dirname "$0")/../../fuzz/corpus/e57_fuzzer/two_scans.e57"
+"$client_bin" inspect "$e57" >"$work/inspect.out" 2>&1 || { cat "$work/inspect.out" >&2; fail "inspect FILE.e57"; }
+grep -q "format:            e57 (E57 1.0, 2 scans)" "$work/inspect.out" || fail "inspect: no E57 format line"
+grep -q '1 "second": 8 points, at (4.000, -2.000, 1.500) m, rotation (w, x, y, z) (0.9689, 0.0000, 0.0000, 0.2474)' \
+  "$work/inspect.out" || { cat "$work/inspect.out" >&2; fail "inspect: no line for the second scan"; }
+"$client_bin" inspect "$e57" --json | python3 -c '
+import json, sys
+scans = json.load(sys.stdin)["e57_scans"]
+assert [s["points"] for s in scans] == [8, 8], scans
+assert scans[1]["translation_m"] == [4, -2, 1.5], scans
+' || fail "inspect --json: e57_scans"
+
 # Port 0: the server picks a free port and logs it.
 "$server_bin" --listen 127.0.0.1:0 --workers 1 --shutdown-grace 2 >"$work/server.log" 2>&1 &
 server_pid=$!

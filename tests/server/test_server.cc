@@ -76,7 +76,7 @@ std::string Address(const server::Server& s) { return "127.0.0.1:" + std::to_str
 v1::UploadSpec SpecFor(const std::string& bytes) {
   v1::UploadSpec spec;
   spec.set_total_size_bytes(bytes.size());
-  spec.set_crc32c(wire::ComputeCrc32c(bytes));
+  spec.set_crc32c(ComputeCrc32c(bytes));
   spec.set_source_name("test.ply");
   return spec;
 }

@@ -15,9 +15,9 @@
 #include <string>
 #include <vector>
 
+#include "vc/base/crc32c.h"
 #include "vc/server/server.h"
 #include "vc/v1/planner.grpc.pb.h"
-#include "vc/wire/crc32c.h"
 
 namespace vc::testing {
 

@@ -7,7 +7,7 @@
 
 #include <string>
 
-#include "vc/wire/crc32c.h"
+#include "vc/base/crc32c.h"
 
 namespace vc::server {
 namespace {
@@ -17,7 +17,7 @@ using ::testing::HasSubstr;
 v1::UploadSpec SpecFor(const std::string& bytes) {
   v1::UploadSpec spec;
   spec.set_total_size_bytes(bytes.size());
-  spec.set_crc32c(wire::ComputeCrc32c(bytes));
+  spec.set_crc32c(ComputeCrc32c(bytes));
   spec.set_source_name("x.ply");
   return spec;
 }

@@ -1,7 +1,7 @@
 // Format detection and dispatch for ReadScene (see scene_input.h); the readers are in readers/.
 //
 // Detection order: compression magic (gzip, bzip2; decompressed once, then detected again),
-// OctoMap headers, PLY, LAS, PCD, plain text (XYZ), and last the binary ScanGraph, which has no
+// OctoMap headers, PLY, LAS, E57, PCD, plain text (XYZ), and last the binary ScanGraph, which has no
 // magic of its own.
 #include "vc/scene/scene_input.h"
 
@@ -18,8 +18,8 @@ namespace vc {
 namespace {
 
 constexpr std::string_view kSupported =
-    "supported: PLY, PCD v0.7, ASCII XYZ/CSV, LAS 1.0-1.4, OctoMap .bt/.ot, OctoMap ScanGraph "
-    ".graph, vc-voxels (vc-client's compact upload), and gzip/bzip2 copies of these";
+    "supported: PLY, PCD v0.7, ASCII XYZ/CSV, LAS 1.0-1.4, E57 1.0, OctoMap .bt/.ot, OctoMap "
+    "ScanGraph .graph, vc-voxels (vc-client's compact upload), and gzip/bzip2 copies of these";
 
 bool StartsWith(std::string_view s, std::string_view prefix) { return s.substr(0, prefix.size()) == prefix; }
 
@@ -68,6 +68,20 @@ Result<SceneInput> ReadDecompressed(std::string_view bytes, std::string_view sou
   if (readers::LooksLikeLas(bytes)) {
     return FromCloud(readers::ReadLas(bytes, source, options), InputFormat::kLas, source);
   }
+  if (LooksLikeE57(bytes)) {
+    Result<readers::E57Cloud> e57 = readers::ReadE57(bytes, source, options);
+    if (!e57.ok()) return e57.status();
+    std::vector<Eigen::Vector3d> origins;
+    for (const E57Scan& scan : e57->scans) origins.push_back(scan.translation_m);
+    if (e57->cloud.points.empty()) {
+      return readers::InvalidInput(source, e57->cloud.detail + ": no valid, finite point (" +
+                                               std::to_string(e57->cloud.dropped_nonfinite) +
+                                               " non-finite); the cloud is empty");
+    }
+    VC_ASSIGN_OR_RETURN(SceneInput in, FromCloud(std::move(e57->cloud), InputFormat::kE57, source));
+    in.scan_origins = std::move(origins);
+    return in;
+  }
   if (readers::LooksLikePcd(bytes)) {
     return FromCloud(readers::ReadPcd(bytes, source, options), InputFormat::kPcd, source);
   }
@@ -80,7 +94,7 @@ Result<SceneInput> ReadDecompressed(std::string_view bytes, std::string_view sou
     const std::string prefix = std::string(source) + ": ";
     if (why.compare(0, prefix.size(), prefix) == 0) why.erase(0, prefix.size());
     return readers::InvalidInput(source,
-                                 "unrecognised format: binary content that is not PLY, PCD, LAS or OctoMap "
+                                 "unrecognised format: binary content that is not PLY, PCD, LAS, E57 or OctoMap "
                                  "(" +
                                      std::string(kSupported) + "); read as a ScanGraph: " + why);
   }
@@ -120,6 +134,8 @@ std::string_view InputFormatName(InputFormat format) {
       return "octomap-ot";
     case InputFormat::kOctomapGraph:
       return "octomap-graph";
+    case InputFormat::kE57:
+      return "e57";
     case InputFormat::kVoxelStream:
       return "vc-voxels";
   }

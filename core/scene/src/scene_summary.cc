@@ -57,6 +57,19 @@ std::string SummaryToJson(const SceneSummary& s) {
   j["bbox_max"] = {s.bbox_max.x(), s.bbox_max.y(), s.bbox_max.z()};
   j["resolution_m"] = s.resolution_m;
   j["occupied_voxels"] = s.occupied_voxels;
+  if (!s.e57_scans.empty()) {
+    nlohmann::ordered_json scans = nlohmann::ordered_json::array();
+    for (const E57Scan& e : s.e57_scans) {
+      nlohmann::ordered_json scan;
+      scan["name"] = e.name;
+      scan["guid"] = e.guid;
+      scan["points"] = e.point_count;
+      scan["translation_m"] = {e.translation_m.x(), e.translation_m.y(), e.translation_m.z()};
+      scan["rotation_wxyz"] = {e.rotation.w(), e.rotation.x(), e.rotation.y(), e.rotation.z()};
+      scans.push_back(std::move(scan));
+    }
+    j["e57_scans"] = std::move(scans);
+  }
   return j.dump();
 }
 
@@ -75,6 +88,14 @@ std::string SummaryToText(const SceneSummary& s, const std::string& source) {
     os << "  dropped (NaN/inf): " << s.dropped_nonfinite << "\n";
   }
   if (s.scans > 0) os << "  scans:             " << s.scans << " (with scanner origins)\n";
+  for (size_t i = 0; i < s.e57_scans.size(); ++i) {
+    const E57Scan& e = s.e57_scans[i];
+    const Eigen::Quaterniond& q = e.rotation;
+    os << "    " << i << " \"" << e.name << "\": " << e.point_count << " points, at (" << e.translation_m.x() << ", "
+       << e.translation_m.y() << ", " << e.translation_m.z() << ") m, rotation (w, x, y, z) (" << std::setprecision(4)
+       << q.w() << ", " << q.x() << ", " << q.y() << ", " << q.z() << ")\n"
+       << std::setprecision(3);
+  }
   os << "  bounding box:      [" << s.bbox_min.x() << ", " << s.bbox_min.y() << ", " << s.bbox_min.z() << "] .. ["
      << s.bbox_max.x() << ", " << s.bbox_max.y() << ", " << s.bbox_max.z() << "] m\n";
   const WorldPoint e = s.bbox_max - s.bbox_min;

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "vc/base/status.h"
+#include "vc/scene/e57.h"
 #include "vc/scene/scene_input.h"
 
 namespace vc::readers {
@@ -71,6 +72,15 @@ Result<PointCloud> ReadPcd(std::string_view bytes, std::string_view source, cons
 bool LooksLikeLas(std::string_view bytes);
 // Reads ASPRS LAS 1.0-1.4, point formats 0-10, uncompressed (las_reader.cc).
 Result<PointCloud> ReadLas(std::string_view bytes, std::string_view source, const ReadOptions& options);
+
+// What ReadE57 read: the points of every scan in the world frame, and the scans.
+struct E57Cloud {
+  PointCloud cloud;
+  std::vector<E57Scan> scans;
+};
+// Reads ASTM E57 1.0: every /data3D scan's points, transformed by its pose (e57_reader.cc). Detect
+// with LooksLikeE57 (vc/scene/e57.h).
+Result<E57Cloud> ReadE57(std::string_view bytes, std::string_view source, const ReadOptions& options);
 
 // True if the start of `bytes` is plain text (printable ASCII, UTF-8 and whitespace, no NUL).
 bool LooksLikeText(std::string_view bytes);

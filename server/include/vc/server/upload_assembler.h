@@ -15,10 +15,10 @@
 #include <string_view>
 #include <utility>
 
+#include "vc/base/crc32c.h"
 #include "vc/base/status.h"
 #include "vc/server/worker_pool.h"
 #include "vc/v1/planner.pb.h"
-#include "vc/wire/crc32c.h"
 
 namespace vc::server {
 
@@ -68,7 +68,7 @@ class UploadAssembler {
   bool accepted_ = false;  // AcceptSpec succeeded: the place is reserved and chunks are taken
   v1::UploadSpec upload_;
   std::string data_;
-  wire::Crc32c crc_;
+  Crc32c crc_;
   std::optional<WorkerPool::Ticket> ticket_;
 };
 

@@ -31,10 +31,11 @@ enum class InputFormat {
   kOctomapBinary,  // OctoMap .bt
   kOctomapText,    // OctoMap .ot (full, any AbstractOcTree stream of type OcTree)
   kOctomapGraph,   // OctoMap ScanGraph .graph (points plus each scan's origin)
+  kE57,            // ASTM E57 1.0 (E2807): every scan's points in the world frame, and its origin
   kVoxelStream,    // vc-voxels: a compact upload's occupied voxels (vc/scene/voxel_stream.h)
 };
 
-// "ply", "pcd", "xyz", "las", "octomap-bt", "octomap-ot", "octomap-graph", "vc-voxels".
+// "ply", "pcd", "xyz", "las", "octomap-bt", "octomap-ot", "octomap-graph", "e57", "vc-voxels".
 std::string_view InputFormatName(InputFormat format);
 
 enum class Compression { kNone, kGzip, kBzip2 };
@@ -73,9 +74,10 @@ struct SceneInput {
   Compression compression = Compression::kNone;
   // Format specifics for people, e.g. "binary_little_endian 1.0", "binary_compressed", "LAS 1.2 PDRF 1".
   std::string detail;
-  // Points in metres, world frame (LAS scale and offset applied). Non-finite points are not here.
+  // Points in metres, world frame (LAS scale and offset applied; E57 scans transformed by their
+  // poses). Non-finite points, and E57 records marked invalid, are not here.
   std::vector<Eigen::Vector3f> points;
-  // .graph only: the sensor origin of each scan, in metres, world frame.
+  // .graph and .e57 only: the sensor origin of each scan, in metres, world frame.
   std::vector<Eigen::Vector3d> scan_origins;
   // .bt/.ot only: the tree as read, at its own resolution.
   std::shared_ptr<const octomap::OcTree> octree;
@@ -90,8 +92,9 @@ struct SceneInput {
 
 // Detects the format of `bytes` (after decompression) and parses it. `source_name` only labels
 // error messages (a file name or "upload"). Errors: INVALID_ARGUMENT for malformed or unsupported
-// content (truncated, wrong counts, unknown types, LAZ, empty cloud), RESOURCE_EXHAUSTED when a
-// limit in `options` is exceeded, or when memory runs out while reading (never an exception).
+// content (truncated, wrong counts, unknown types, LAZ, a bad E57 page checksum, empty cloud),
+// RESOURCE_EXHAUSTED when a limit in `options` is exceeded, or when memory runs out while reading
+// (never an exception).
 Result<SceneInput> ReadScene(std::string_view bytes, std::string_view source_name, const ReadOptions& options = {});
 
 // Reads a whole file and calls ReadScene. NOT_FOUND if it cannot be opened.

@@ -3,10 +3,12 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "vc/base/geometry.h"
 #include "vc/base/progress.h"
 #include "vc/base/status.h"
+#include "vc/scene/e57.h"
 #include "vc/scene/scene_input.h"
 
 namespace vc {
@@ -22,8 +24,9 @@ struct SceneSummary {
   double octree_resolution_m = 0;  // input octree's own resolution (0 for clouds)
   WorldPoint bbox_min{0, 0, 0};    // of the points, or of the occupied leaves' cubes, in metres
   WorldPoint bbox_max{0, 0, 0};
-  double resolution_m = 0;       // working resolution used for the voxel count
-  uint64_t occupied_voxels = 0;  // at resolution_m
+  double resolution_m = 0;         // working resolution used for the voxel count
+  uint64_t occupied_voxels = 0;    // at resolution_m
+  std::vector<E57Scan> e57_scans;  // E57 only, set by the caller from ReadE57Scans: each scan and its pose
 };
 
 // Summarises `input`, counting occupied voxels at `resolution_m` (0 = the default working
@@ -32,9 +35,10 @@ Result<SceneSummary> Summarize(const SceneInput& input, double resolution_m, uin
                                const JobContext& ctx = {});
 
 // One JSON object with the keys format, compression, detail, points, dropped_nonfinite, scans,
-// octree_leaves, octree_resolution_m, bbox_min, bbox_max, resolution_m, occupied_voxels.
+// octree_leaves, octree_resolution_m, bbox_min, bbox_max, resolution_m, occupied_voxels, and for E57
+// e57_scans: [{name, guid, points, translation_m: [x, y, z], rotation_wxyz: [w, x, y, z]}, ...].
 std::string SummaryToJson(const SceneSummary& s);
-// Human-readable multi-line text.
+// Human-readable multi-line text; E57 scans one line each (name, points, translation, rotation).
 std::string SummaryToText(const SceneSummary& s, const std::string& source);
 
 }  // namespace vc

@@ -1,9 +1,9 @@
-#include "vc/wire/crc32c.h"
+#include "vc/base/crc32c.h"
 
 #include <array>
 #include <cstring>
 
-namespace vc::wire {
+namespace vc {
 namespace {
 
 constexpr uint32_t kPolyReflected = 0x82F63B78u;
@@ -50,4 +50,4 @@ uint32_t ComputeCrc32c(std::string_view bytes) {
   return crc.value();
 }
 
-}  // namespace vc::wire
+}  // namespace vc
