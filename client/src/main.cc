@@ -10,6 +10,7 @@
 #include <string>
 
 #include "vc/client/client.h"
+#include "vc/client/compact_upload.h"
 #include "vc/client/parameter_flags.h"
 #include "vc/client/plan_summary.h"
 #include "vc/client/progress_display.h"
@@ -82,6 +83,10 @@ int main(int argc, char** argv) {
   auto* submit = app.add_subcommand("submit", "plan stations for a scene on the server; write the reports");
   submit->add_option("FILE", file, "scene: PLY, PCD, XYZ, LAS, or OctoMap .bt/.ot/.graph")->required();
   submit->add_option("--out", out_dir, "output directory")->capture_default_str();
+  bool raw_upload = false;
+  const char* kRawUploadHelp =
+      "upload the file's bytes as they are, not a point cloud's voxels at the working resolution (vc-voxels)";
+  submit->add_flag("--raw-upload", raw_upload, kRawUploadHelp);
   vc::client::AddPlanFileFlags(submit, &plan_files);
   vc::client::AddPlanFlags(submit, &plan);
 
@@ -93,6 +98,7 @@ int main(int argc, char** argv) {
   evaluate->add_option("FILE", file, "scene file")->required();
   evaluate->add_option("--viewpoints", viewpoints_csv, "CSV of viewpoints x,y,z (e.g. stations.csv)")->required();
   evaluate->add_option("--out", out_dir, "output directory")->capture_default_str();
+  evaluate->add_flag("--raw-upload", raw_upload, kRawUploadHelp);
   vc::client::AddEvaluateFlags(evaluate, &eval);
 
   // health
@@ -147,19 +153,25 @@ int main(int argc, char** argv) {
     return 0;
   }
 
-  auto upload = vc::client::ReadUpload(file);
-  if (!upload.ok()) return Fail("cannot read the scene", upload.status());
-  vc::client::ProgressDisplay display(stderr, isatty(fileno(stderr)) != 0);
-  display.Uploading(upload->source_name, upload->bytes.size(), conn.server);
-
+  auto file_bytes = vc::client::ReadUpload(file);
+  if (!file_bytes.ok()) return Fail("cannot read the scene", file_bytes.status());
   if (*submit) {
     if (vc::Status loaded = vc::client::LoadPlanFiles(plan_files, &plan); !loaded.ok()) {
       return Fail("bad input file", loaded);
     }
+  }
+  vc::client::ProgressDisplay display(stderr, isatty(fileno(stderr)) != 0);
+  const vc::client::PreparedUpload prepared = vc::client::PrepareUpload(
+      std::move(file_bytes).value(), *submit ? plan.resolution_m : eval.resolution_m, raw_upload);
+  const vc::client::Upload* upload = &prepared.upload;
+  display.Note(vc::client::DescribeUpload(prepared.summary));
+  display.Uploading(upload->source_name, upload->bytes.size(), conn.server);
+
+  if (*submit) {
     auto r = (*client)->Plan(*upload, plan, Observe(display));
     display.Done();
     if (!r.ok()) return FailCall("plan", r.status(), conn.server);
-    vc::Status written = vc::WritePlanOutputs(*r, out_dir);
+    vc::Status written = vc::WritePlanOutputs(*r, out_dir, &prepared.summary);
     if (!written.ok()) return Fail("cannot write the reports", written);
     PrintStations(*r);
     std::printf("wrote plan.json, stations.csv, visibility.ply, heatmap.png, reduction.png, report.html to %s\n",

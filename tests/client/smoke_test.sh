@@ -76,6 +76,22 @@ assert open(os.path.join(out, "visibility.ply"), "rb").read(4) == b"ply\n", "vis
 print(f"smoke: {len(stations)} station(s)")
 PY
 
+# The compact upload (the default) and --raw-upload give the same plan; plan.json says which ran.
+grep -q "compact upload: .* voxels of 0.1 m" "$work/client.err" || fail "no compact upload line"
+"$client_bin" submit "$work/box.ply" --server "$addr" --out "$work/raw" --raw-upload >/dev/null 2>"$work/raw.err" \
+  || { cat "$work/raw.err" >&2; fail "vc-client submit --raw-upload failed"; }
+grep -q "raw upload of .* (--raw-upload)" "$work/raw.err" || fail "no raw upload line"
+cmp -s "$work/out/stations.csv" "$work/raw/stations.csv" || fail "compact and raw uploads planned different stations"
+python3 - "$work/out/plan.json" "$work/raw/plan.json" <<'PY' || fail "plan.json upload"
+import json, sys
+compact, raw = (json.load(open(p)) for p in sys.argv[1:3])
+assert compact["upload"]["format"] == "vc-voxels", compact["upload"]
+assert raw["upload"]["format"] == "raw" and raw["upload"]["why_raw"] == "--raw-upload", raw["upload"]
+assert compact["upload"]["bytes_sent"] * 20 < raw["upload"]["bytes_sent"], (compact["upload"], raw["upload"])
+assert compact["upload"]["voxels"] == compact["coverage"]["occupied_voxels"], compact["upload"]
+assert compact["coverage"]["global_visibility"] == raw["coverage"]["global_visibility"]
+PY
+
 # A bad input gives a clear error and the INVALID_ARGUMENT exit status (3).
 head -c 100 "$work/box.ply" > "$work/broken.ply"
 set +e

@@ -600,7 +600,7 @@ std::vector<std::string_view> SplitFields(std::string_view line) {
 
 }  // namespace
 
-std::string PlanToJson(const PlanResult& r) {
+std::string PlanToJson(const PlanResult& r, const UploadSummary* upload) {
   const std::vector<int> route_position = RoutePositions(r);
   Json viewpoints = Json::array();
   for (size_t k = 0; k < r.stations.size(); ++k) {
@@ -705,6 +705,13 @@ std::string PlanToJson(const PlanResult& r) {
          {"optimality", OptimalityJson(r.optimality)},
          {"timings_s", std::move(timings)},
          {"parameters", ParametersJson(r.options)},
+         {"upload", upload == nullptr ? Json(nullptr)
+                                      : Json{{"format", upload->format},
+                                             {"bytes_sent", upload->bytes_sent},
+                                             {"file_bytes", upload->file_bytes},
+                                             {"voxels", upload->voxels},
+                                             {"resolution_m", upload->resolution_m},
+                                             {"why_raw", upload->why_raw}}},
          {"warnings", r.warnings}};
   return j.dump(2) + "\n";
 }
@@ -723,10 +730,10 @@ ImageSize ReductionImageSize(int stations) {
   return {std::max(kRedLeft + n * cell + kRedLegend, title_w), kRedTop + std::max(n * cell, kRedMinH) + kRedBottom};
 }
 
-Status WritePlanOutputs(const PlanResult& result, const std::string& out_dir) {
+Status WritePlanOutputs(const PlanResult& result, const std::string& out_dir, const UploadSummary* upload) {
   VC_RETURN_IF_ERROR(MakeDir(out_dir));
   const std::filesystem::path dir(out_dir);
-  VC_RETURN_IF_ERROR(WriteFile(dir / "plan.json", PlanToJson(result)));
+  VC_RETURN_IF_ERROR(WriteFile(dir / "plan.json", PlanToJson(result, upload)));
   VC_RETURN_IF_ERROR(WriteFile(dir / "stations.csv", PlanStationsCsv(result)));
   if (result.voxel_centers.size() != result.evaluation.best_face_values.size()) {
     return FailedPreconditionError("visibility.ply needs one best_face_values entry per voxel centre (" +

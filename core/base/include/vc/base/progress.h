@@ -78,7 +78,7 @@ struct JobContext {
 
   Status CheckCancelled(const char* what) const { return cancel ? cancel->Check(what) : Status::Ok(); }
   void Report(Stage stage, double fraction, std::string message = {}) const {
-    if (progress) progress(ProgressEvent{stage, fraction, std::move(message)});
+    if (progress) progress(ProgressEvent{stage, fraction, std::move(message), 0, 0, {}});
   }
   // `done` of `total` `unit`s, the fraction done / total (0 when total is 0).
   void ReportCount(Stage stage, uint64_t done, uint64_t total, std::string unit, std::string message = {}) const {

@@ -4,6 +4,7 @@
 // in docs/PLANNING.md and docs/PROTOCOL.md.
 #pragma once
 
+#include <cstdint>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -15,13 +16,23 @@
 
 namespace vc {
 
-// plan.json's content (documented schema).
-std::string PlanToJson(const PlanResult& result);
+// How the scene reached the server, for plan.json's `upload` (filled by vc-client, which chose it).
+struct UploadSummary {
+  std::string format;       // "vc-voxels" (a compact upload) or "raw" (the file's bytes as they are)
+  uint64_t bytes_sent = 0;  // bytes of the scene sent (before the transport's gzip)
+  uint64_t file_bytes = 0;  // bytes of the file the user named
+  uint64_t voxels = 0;      // vc-voxels: voxels sent; 0 for raw
+  double resolution_m = 0;  // vc-voxels: their edge (m); 0 for raw
+  std::string why_raw;      // raw: why (e.g. "--raw-upload", "an octree is uploaded as it is")
+};
+
+// plan.json's content (documented schema). `upload` null when not given.
+std::string PlanToJson(const PlanResult& result, const UploadSummary* upload = nullptr);
 
 // Writes plan.json, stations.csv, visibility.ply, heatmap.png, reduction.png and report.html into `out_dir`
 // (created if missing). visibility.ply needs result.voxel_centers and
 // result.evaluation.best_face_values. INTERNAL / FAILED_PRECONDITION with the path on I/O errors.
-Status WritePlanOutputs(const PlanResult& result, const std::string& out_dir);
+Status WritePlanOutputs(const PlanResult& result, const std::string& out_dir, const UploadSummary* upload = nullptr);
 
 // evaluation.json's content: resolution_m, global_visibility, per_viewpoint[...] and more.
 std::string EvaluationToJson(const Evaluation& evaluation, const std::vector<WorldPoint>& viewpoints);
