@@ -13,7 +13,7 @@ BUILD_PKGS=(
   liboctomap-dev libeigen3-dev libspdlog-dev libfmt-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libcli11-dev nlohmann-json3-dev libhwy-dev coinor-libcbc-dev
-  zlib1g-dev libbz2-dev libpng-dev libexpat1-dev
+  zlib1g-dev libbz2-dev libpng-dev libssl-dev libexpat1-dev
   openssl python3 bzip2 gzip
   clang clang-format libfuzzer-14-dev
   libjs-three  # three.js, inlined into report.html at build time

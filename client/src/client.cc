@@ -9,6 +9,7 @@
 #include "grpc/health/v1/health.grpc.pb.h"
 #include "vc/base/crc32c.h"
 #include "vc/v1/planner.grpc.pb.h"
+#include "vc/wire/sha256.h"
 #include "vc/wire/status_mapping.h"
 
 namespace vc::client {
@@ -31,6 +32,8 @@ v1::UploadSpec MakeUploadSpec(const Upload& upload) {
   spec.set_source_name(upload.source_name);
   return spec;
 }
+
+const Upload kNoData;
 
 // Streams the spec and the chunks, half-closes. Stops early when the server has ended the call
 // (a write fails); the status then comes from Finish.
@@ -106,64 +109,83 @@ Status Client::WithRetries(const JobObserver& observer, Fn&& attempt) {
   }
 }
 
+Status Client::WithSceneCache(const Upload& upload, v1::UploadSpec* spec, const std::function<Status(bool)>& call) {
+  last_upload_ = {};
+  if (options_.scene_cache) {
+    spec->set_scene_sha256(wire::Sha256Hex(upload.bytes));
+    last_upload_.scene_sha256 = spec->scene_sha256();
+    spec->set_from_cache(true);
+    const Status s = call(true);
+    if (s.code() != StatusCode::kNotFound) {
+      last_upload_.from_cache = s.ok();
+      return s;
+    }
+    spec->set_from_cache(false);
+  }
+  last_upload_.bytes_sent = upload.bytes.size();
+  return call(false);
+}
+
 Result<PlanResult> Client::Plan(const Upload& upload, const PlanOptions& options, const JobObserver& observer) {
   auto stub = v1::StationPlanner::NewStub(channel_);
   v1::PlanRequest spec;
   *spec.mutable_spec()->mutable_upload() = MakeUploadSpec(upload);
   *spec.mutable_spec()->mutable_parameters() = wire::ToProto(options);
   PlanResult out;
-  const Status status = WithRetries(observer, [&](bool* accepted) -> Status {
-    grpc::ClientContext ctx;
-    Prepare(&ctx);
-    auto stream = stub->Plan(&ctx);
-    SendUpload(*stream, spec, upload, options_.chunk_bytes);
-    wire::PlanResultAssembler assembler;
-    std::optional<v1::PlanResult> summary;
-    Status broken;
-    v1::PlanResponse r;
-    while (stream->Read(&r)) {
-      switch (r.event_case()) {
-        case v1::PlanResponse::kAccepted:
-          *accepted = true;
-          if (observer.on_accepted) observer.on_accepted(r.accepted().job_id(), r.accepted().queue_position());
-          break;
-        case v1::PlanResponse::kProgress:
-          if (observer.on_progress) observer.on_progress(wire::FromProto(r.progress()));
-          break;
-        case v1::PlanResponse::kStation:
-          if (observer.on_station) observer.on_station(wire::FromProto(r.station().station()), r.station().index());
-          break;
-        case v1::PlanResponse::kFinalStations:
-          if (observer.on_final_stations) {
-            std::vector<PlannedStation> stations;
-            for (const auto& s : r.final_stations().stations()) stations.push_back(wire::FromProto(s));
-            observer.on_final_stations(stations);
-          }
-          break;
-        case v1::PlanResponse::kHeatMap:
-          if (broken.ok()) broken = assembler.AddHeatMap(r.heat_map());
-          if (broken.ok() && observer.on_heat_map &&
-              assembler.heat_map().positions.size() == r.heat_map().total_candidates()) {
-            observer.on_heat_map(assembler.heat_map());
-          }
-          break;
-        case v1::PlanResponse::kVoxels:
-          if (broken.ok()) broken = assembler.AddVoxels(r.voxels());
-          break;
-        case v1::PlanResponse::kResult:
-          summary = r.result();
-          break;
-        default:
-          break;
+  const Status status = WithSceneCache(upload, spec.mutable_spec()->mutable_upload(), [&](bool from_cache) {
+    return WithRetries(observer, [&](bool* accepted) -> Status {
+      grpc::ClientContext ctx;
+      Prepare(&ctx);
+      auto stream = stub->Plan(&ctx);
+      SendUpload(*stream, spec, from_cache ? kNoData : upload, options_.chunk_bytes);
+      wire::PlanResultAssembler assembler;
+      std::optional<v1::PlanResult> summary;
+      Status broken;
+      v1::PlanResponse r;
+      while (stream->Read(&r)) {
+        switch (r.event_case()) {
+          case v1::PlanResponse::kAccepted:
+            *accepted = true;
+            if (observer.on_accepted) observer.on_accepted(r.accepted().job_id(), r.accepted().queue_position());
+            break;
+          case v1::PlanResponse::kProgress:
+            if (observer.on_progress) observer.on_progress(wire::FromProto(r.progress()));
+            break;
+          case v1::PlanResponse::kStation:
+            if (observer.on_station) observer.on_station(wire::FromProto(r.station().station()), r.station().index());
+            break;
+          case v1::PlanResponse::kFinalStations:
+            if (observer.on_final_stations) {
+              std::vector<PlannedStation> stations;
+              for (const auto& s : r.final_stations().stations()) stations.push_back(wire::FromProto(s));
+              observer.on_final_stations(stations);
+            }
+            break;
+          case v1::PlanResponse::kHeatMap:
+            if (broken.ok()) broken = assembler.AddHeatMap(r.heat_map());
+            if (broken.ok() && observer.on_heat_map &&
+                assembler.heat_map().positions.size() == r.heat_map().total_candidates()) {
+              observer.on_heat_map(assembler.heat_map());
+            }
+            break;
+          case v1::PlanResponse::kVoxels:
+            if (broken.ok()) broken = assembler.AddVoxels(r.voxels());
+            break;
+          case v1::PlanResponse::kResult:
+            summary = r.result();
+            break;
+          default:
+            break;
+        }
       }
-    }
-    VC_RETURN_IF_ERROR(wire::FromGrpcStatus(stream->Finish()));
-    if (!broken.ok()) return Local(broken);
-    if (!summary) return InternalError("the server ended the plan without a result");
-    auto result = std::move(assembler).Finish(*summary);
-    if (!result.ok()) return Local(result.status());
-    out = std::move(result).value();
-    return Status::Ok();
+      VC_RETURN_IF_ERROR(wire::FromGrpcStatus(stream->Finish()));
+      if (!broken.ok()) return Local(broken);
+      if (!summary) return InternalError("the server ended the plan without a result");
+      auto result = std::move(assembler).Finish(*summary);
+      if (!result.ok()) return Local(result.status());
+      out = std::move(result).value();
+      return Status::Ok();
+    });
   });
   if (!status.ok()) return status;
   return out;
@@ -176,33 +198,35 @@ Result<Evaluation> Client::Evaluate(const Upload& upload, const EvaluateJobOptio
   *spec.mutable_spec()->mutable_upload() = MakeUploadSpec(upload);
   *spec.mutable_spec()->mutable_parameters() = wire::ToProto(options);
   Evaluation out;
-  const Status status = WithRetries(observer, [&](bool* accepted) -> Status {
-    grpc::ClientContext ctx;
-    Prepare(&ctx);
-    auto stream = stub->Evaluate(&ctx);
-    SendUpload(*stream, spec, upload, options_.chunk_bytes);
-    std::optional<v1::EvaluateResult> result;
-    v1::EvaluateResponse r;
-    while (stream->Read(&r)) {
-      switch (r.event_case()) {
-        case v1::EvaluateResponse::kAccepted:
-          *accepted = true;
-          if (observer.on_accepted) observer.on_accepted(r.accepted().job_id(), r.accepted().queue_position());
-          break;
-        case v1::EvaluateResponse::kProgress:
-          if (observer.on_progress) observer.on_progress(wire::FromProto(r.progress()));
-          break;
-        case v1::EvaluateResponse::kResult:
-          result = r.result();
-          break;
-        default:
-          break;
+  const Status status = WithSceneCache(upload, spec.mutable_spec()->mutable_upload(), [&](bool from_cache) {
+    return WithRetries(observer, [&](bool* accepted) -> Status {
+      grpc::ClientContext ctx;
+      Prepare(&ctx);
+      auto stream = stub->Evaluate(&ctx);
+      SendUpload(*stream, spec, from_cache ? kNoData : upload, options_.chunk_bytes);
+      std::optional<v1::EvaluateResult> result;
+      v1::EvaluateResponse r;
+      while (stream->Read(&r)) {
+        switch (r.event_case()) {
+          case v1::EvaluateResponse::kAccepted:
+            *accepted = true;
+            if (observer.on_accepted) observer.on_accepted(r.accepted().job_id(), r.accepted().queue_position());
+            break;
+          case v1::EvaluateResponse::kProgress:
+            if (observer.on_progress) observer.on_progress(wire::FromProto(r.progress()));
+            break;
+          case v1::EvaluateResponse::kResult:
+            result = r.result();
+            break;
+          default:
+            break;
+        }
       }
-    }
-    VC_RETURN_IF_ERROR(wire::FromGrpcStatus(stream->Finish()));
-    if (!result) return InternalError("the server ended the evaluation without a result");
-    out = wire::FromProto(result->evaluation());
-    return Status::Ok();
+      VC_RETURN_IF_ERROR(wire::FromGrpcStatus(stream->Finish()));
+      if (!result) return InternalError("the server ended the evaluation without a result");
+      out = wire::FromProto(result->evaluation());
+      return Status::Ok();
+    });
   });
   if (!status.ok()) return status;
   return out;

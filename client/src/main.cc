@@ -39,6 +39,18 @@ int FailCall(const std::string& what, const vc::Status& s, const std::string& se
 
 void PrintStations(const vc::PlanResult& r) { std::fputs(vc::client::PlanSummary(r).c_str(), stdout); }
 
+// Says whether the server had the scene already, and keeps it for plan.json.
+void NoteCache(const vc::client::UploadOutcome& outcome, vc::UploadSummary* summary,
+               vc::client::ProgressDisplay& display) {
+  summary->scene_hash = outcome.scene_sha256;
+  summary->from_cache = outcome.from_cache;
+  if (outcome.from_cache) {
+    summary->bytes_sent = 0;
+    display.Note("the server had the scene (" + outcome.scene_sha256.substr(0, 12) +
+                 "...) in its cache: nothing uploaded");
+  }
+}
+
 vc::client::JobObserver Observe(vc::client::ProgressDisplay& display) {
   vc::client::JobObserver o;
   o.on_accepted = [&](const std::string& id, uint32_t pos) { display.Accepted(id, pos); };
@@ -73,6 +85,9 @@ int main(int argc, char** argv) {
       ->envname("VC_TLS_SERVER_NAME");
   app.add_option("--token", conn.token, "bearer token for the server")->envname("VC_TOKEN");
   app.add_flag("--gzip,!--no-gzip", conn.gzip, "gzip-compress the upload")->capture_default_str();
+  app.add_flag("--scene-cache,!--no-scene-cache", conn.scene_cache,
+               "name the scene by its SHA-256 first; upload it only when the server does not hold it")
+      ->capture_default_str();
   app.add_option("--retries", conn.max_attempts, "attempts when the server is unavailable")->capture_default_str();
   app.add_option("--timeout", timeout_s, "deadline per call in seconds (0 = none)")->capture_default_str();
 
@@ -161,7 +176,7 @@ int main(int argc, char** argv) {
     }
   }
   vc::client::ProgressDisplay display(stderr, isatty(fileno(stderr)) != 0);
-  const vc::client::PreparedUpload prepared = vc::client::PrepareUpload(
+  vc::client::PreparedUpload prepared = vc::client::PrepareUpload(
       std::move(file_bytes).value(), *submit ? plan.resolution_m : eval.resolution_m, raw_upload);
   const vc::client::Upload* upload = &prepared.upload;
   display.Note(vc::client::DescribeUpload(prepared.summary));
@@ -171,6 +186,7 @@ int main(int argc, char** argv) {
     auto r = (*client)->Plan(*upload, plan, Observe(display));
     display.Done();
     if (!r.ok()) return FailCall("plan", r.status(), conn.server);
+    NoteCache((*client)->last_upload(), &prepared.summary, display);
     vc::Status written = vc::WritePlanOutputs(*r, out_dir, &prepared.summary);
     if (!written.ok()) return Fail("cannot write the reports", written);
     PrintStations(*r);
@@ -188,6 +204,7 @@ int main(int argc, char** argv) {
   auto r = (*client)->Evaluate(*upload, eval, Observe(display));
   display.Done();
   if (!r.ok()) return FailCall("evaluate", r.status(), conn.server);
+  NoteCache((*client)->last_upload(), &prepared.summary, display);
   vc::Status written = vc::WriteEvaluationOutputs(*r, eval.viewpoints, out_dir);
   if (!written.ok()) return Fail("cannot write evaluation.json", written);
   std::printf("global visibility G = %.4f%s over %llu faces; wrote %s/evaluation.json\n", r->overall.global_visibility,

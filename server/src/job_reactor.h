@@ -29,6 +29,7 @@
 #include "vc/server/backend.h"
 #include "vc/server/job_runner.h"
 #include "vc/server/outbox.h"
+#include "vc/server/scene_cache.h"
 #include "vc/server/server_options.h"
 #include "vc/server/upload_assembler.h"
 #include "vc/server/worker_pool.h"
@@ -41,9 +42,14 @@ namespace vc::server::internal {
 // Shared by every call of a service.
 struct ServiceState {
   ServiceState(const ServerOptions& o, Backend b)
-      : options(o), backend(std::move(b)), runner(&backend, o.max_upload_bytes), pool(o.EffectiveWorkers(), o.queue) {}
+      : options(o),
+        backend(std::move(b)),
+        cache(o.scene_cache_bytes),
+        runner(&backend, o.max_upload_bytes, &cache),
+        pool(o.EffectiveWorkers(), o.queue) {}
   const ServerOptions options;
   const Backend backend;
+  SceneCache cache;
   const JobRunner runner;
   WorkerPool pool;
   std::atomic<uint64_t> next_job{1};
@@ -194,7 +200,25 @@ class JobReactor : public grpc::ServerBidiReactor<Request, Response> {
     job_.method = method_;
     job_.peer = ctx_->peer();
     job_.upload = upload_.spec();
-    job_.data = upload_.TakeData();
+    if (job_.upload.from_cache()) {
+      const SceneCache::Bytes cached = state_->cache.Get(job_.upload.scene_sha256());
+      if (!cached) {
+        Reject(NotFoundError("scene " + job_.upload.scene_sha256().substr(0, 12) +
+                             "... is not in this server's scene cache (it was never sent here, or it was evicted "
+                             "or the replica restarted); upload it"));
+        return;
+      }
+      if (cached->size() != job_.upload.total_size_bytes()) {
+        Reject(InvalidArgumentError("the cached scene " + job_.upload.scene_sha256().substr(0, 12) + "... has " +
+                                    std::to_string(cached->size()) + " bytes, the spec says " +
+                                    std::to_string(job_.upload.total_size_bytes())));
+        return;
+      }
+      job_.data = *cached;
+      job_.cache = "hit";
+    } else {
+      job_.data = upload_.TakeData();
+    }
     job_.memory_budget_bytes = MemoryBudgetBytes();
     job_.started = start_;
     job_.submitted = Clock::now();

@@ -4,10 +4,12 @@
 #include <spdlog/spdlog.h>
 
 #include <exception>
+#include <memory>
 #include <new>
 
 #include "vc/server/upload_assembler.h"
 #include "vc/wire/convert.h"
+#include "vc/wire/sha256.h"
 
 namespace vc::server {
 namespace {
@@ -41,8 +43,10 @@ Status JobRunner::Run(Job job, const CancelToken& cancel, ProgressFn progress, c
   const auto level = s.ok() || s.code() == StatusCode::kInvalidArgument ? spdlog::level::info
                      : s.code() == StatusCode::kInternal                ? spdlog::level::err
                                                                         : spdlog::level::warn;
-  spdlog::log(level, "job {} {} peer={} upload={} upload={:.3f}s queued={:.3f}s{} elapsed={:.3f}s{} status={}", job.id,
-              job.method, job.peer, HumanBytes(job.upload.total_size_bytes()), upload_s, wait_s, log.timings(),
+  // upload= counts the bytes sent: none for a scene taken from the cache.
+  spdlog::log(level, "job {} {} peer={} upload={} upload={:.3f}s{} queued={:.3f}s{} elapsed={:.3f}s{} status={}",
+              job.id, job.method, job.peer, HumanBytes(job.cache == "hit" ? 0 : job.upload.total_size_bytes()),
+              upload_s, job.cache.empty() ? std::string() : " cache=" + job.cache, wait_s, log.timings(),
               SecondsSince(job.started), log.details(), s.ok() ? std::string("OK") : s.ToString());
   return s;
 }
@@ -51,6 +55,15 @@ Status JobRunner::Execute(Job& job, const JobContext& ctx, JobLog& log, const Jo
   VC_RETURN_IF_ERROR(ctx.CheckCancelled("the job (while queued)"));
   const ReadOptions read_options = ReadLimits(max_upload_bytes_, job.memory_budget_bytes);
   const auto t0 = Job::Clock::now();
+  if (!job.upload.scene_sha256().empty() && job.cache != "hit") {
+    const std::string sha256 = wire::Sha256Hex(job.data);
+    if (sha256 != job.upload.scene_sha256()) {
+      return InvalidArgumentError("the upload's SHA-256 is " + sha256 + " but its spec says " +
+                                  job.upload.scene_sha256() + "; send the hash of the bytes uploaded");
+    }
+    job.cache = "miss";
+    if (cache_ != nullptr) cache_->Put(sha256, std::make_shared<const std::string>(job.data));
+  }
   ctx.Report(Stage::kRead, 0.0, "parsing " + HumanBytes(job.data.size()));
   const v1::UploadSpec& upload = job.upload;
   const std::string source = upload.source_name().empty() ? "upload" : upload.source_name();

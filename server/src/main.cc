@@ -29,6 +29,10 @@ int main(int argc, char** argv) {
                  "upper bound on a job's memory budget, in bytes")
       ->envname("VC_MAX_MEMORY_BUDGET_BYTES")
       ->capture_default_str();
+  app.add_option("--scene-cache-bytes", o.scene_cache_bytes,
+                 "bytes of uploaded scenes kept by their SHA-256 for clients that plan them again (0 = none)")
+      ->envname("VC_SCENE_CACHE_BYTES")
+      ->capture_default_str();
   app.add_option("--threads-per-job", o.threads_per_job, "threads per job (0 = cores / workers)")
       ->envname("VC_THREADS_PER_JOB")
       ->capture_default_str();

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include "vc/wire/convert.h"
+#include "vc/wire/sha256.h"
 
 namespace vc::server {
 
@@ -25,6 +26,12 @@ Status UploadAssembler::AcceptSpec(const v1::UploadSpec& upload) {
   if (upload.format() != v1::INPUT_FORMAT_UNSPECIFIED) {
     VC_RETURN_IF_ERROR(wire::FromProto(upload.format()).status());
   }
+  if (!upload.scene_sha256().empty() && !wire::IsSha256Hex(upload.scene_sha256())) {
+    return InvalidArgumentError("the spec's scene_sha256 is not 64 lower-case hex digits");
+  }
+  if (upload.from_cache() && upload.scene_sha256().empty()) {
+    return InvalidArgumentError("the spec asks for a cached scene (from_cache) but names none (scene_sha256)");
+  }
   if (upload.total_size_bytes() == 0) {
     return InvalidArgumentError("the spec declares an empty upload (total_size_bytes = 0); send the file's size");
   }
@@ -40,7 +47,7 @@ Status UploadAssembler::AcceptSpec(const v1::UploadSpec& upload) {
                                   " workers are running and the " + std::to_string(pool_->queue_capacity()) +
                                   "-job queue is full; retry in a few seconds");
   }
-  data_.reserve(upload_.total_size_bytes());
+  if (!upload.from_cache()) data_.reserve(upload_.total_size_bytes());
   accepted_ = true;
   return Status::Ok();
 }
@@ -50,6 +57,9 @@ Status UploadAssembler::AddChunk(std::string_view data) {
     return InvalidArgumentError("a data chunk arrived before the spec; the first message must be the spec");
   }
   if (!accepted_) return InvalidArgumentError("a data chunk arrived for a refused spec; start a new upload");
+  if (upload_.from_cache()) {
+    return InvalidArgumentError("a data chunk arrived for a scene to take from the cache (from_cache); send none");
+  }
   if (data.size() > upload_.total_size_bytes() - data_.size()) {
     return InvalidArgumentError("the upload carries more than the " + std::to_string(upload_.total_size_bytes()) +
                                 " bytes its spec declares; fix total_size_bytes");
@@ -64,6 +74,7 @@ Status UploadAssembler::Finish() const {
     return InvalidArgumentError("the stream ended before any spec; send a spec message first, then the data");
   }
   if (!accepted_) return InvalidArgumentError("the upload's spec was refused; start a new upload");
+  if (upload_.from_cache()) return Status::Ok();  // the bytes come from the cache (the reactor)
   if (data_.size() != upload_.total_size_bytes()) {
     return InvalidArgumentError("the upload ended after " + std::to_string(data_.size()) + " of the " +
                                 std::to_string(upload_.total_size_bytes()) +

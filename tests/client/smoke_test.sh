@@ -92,6 +92,15 @@ assert compact["upload"]["voxels"] == compact["coverage"]["occupied_voxels"], co
 assert compact["coverage"]["global_visibility"] == raw["coverage"]["global_visibility"]
 PY
 
+# The same scene again with other parameters: the server has it in its cache, nothing is uploaded.
+"$client_bin" submit "$work/box.ply" --server "$addr" --out "$work/again" --grid-spacing 0.5 >/dev/null \
+  2>"$work/again.err" || { cat "$work/again.err" >&2; fail "the second submit failed"; }
+grep -q "in its cache: nothing uploaded" "$work/again.err" || { cat "$work/again.err" >&2; fail "no cache hit"; }
+python3 -c 'import json,sys; u=json.load(open(sys.argv[1]))["upload"]; assert u["from_cache"] and u["bytes_sent"] == 0 and len(u["scene_hash"]) == 64, u' \
+  "$work/again/plan.json" || fail "plan.json upload after a cache hit"
+grep -q "cache=hit" "$work/server.log" || fail "the server log has no cache=hit"
+grep -q "cache=miss" "$work/server.log" || fail "the server log has no cache=miss"
+
 # A bad input gives a clear error and the INVALID_ARGUMENT exit status (3).
 head -c 100 "$work/box.ply" > "$work/broken.ply"
 set +e

@@ -12,12 +12,14 @@
 #include "server/test_server.h"
 #include "vc/client/client.h"
 #include "vc/wire/convert.h"
+#include "vc/wire/sha256.h"
 
 namespace vc {
 namespace {
 
 using ::testing::HasSubstr;
 using testing::PlanRequests;
+using testing::RawCall;
 using testing::RawPlan;
 using testing::SpecFor;
 
@@ -327,6 +329,107 @@ TEST(EvaluateErrors, InvalidParametersAreRefused) {
 }
 
 // --- Bad content (real readers) ---
+
+// --- The scene cache ---
+
+// A Plan of the box room named by its SHA-256: uploaded (with the hash) or only named (from_cache).
+RawCall<v1::PlanResponse> CachedPlan(const std::string& address, const std::string& bytes, bool from_cache,
+                                     const std::string& sha256) {
+  std::vector<v1::PlanRequest> rs = PlanRequests(bytes, FastParams());
+  rs[0].mutable_spec()->mutable_upload()->set_scene_sha256(sha256);
+  rs[0].mutable_spec()->mutable_upload()->set_from_cache(from_cache);
+  if (from_cache) rs.resize(1);  // the spec only
+  return RawPlan(address, rs);
+}
+
+TEST(SceneCacheRpc, AnUploadWithItsHashIsKeptAndASecondPlanNeedsOnlyTheHash) {
+  auto server = testing::StartServer(SmallServer());
+  ASSERT_TRUE(server);
+  const std::string address = testing::Address(*server);
+  const std::string ply = testing::BoxRoomPly();
+  const std::string sha = wire::Sha256Hex(ply);
+  // Not sent yet: NOT_FOUND, telling the client to upload.
+  auto miss = CachedPlan(address, ply, true, sha);
+  EXPECT_EQ(miss.status.error_code(), grpc::StatusCode::NOT_FOUND) << miss.status.error_message();
+  EXPECT_THAT(miss.status.error_message(), HasSubstr("upload it"));
+  auto first = CachedPlan(address, ply, false, sha);
+  ASSERT_TRUE(first.status.ok()) << first.status.error_message();
+  auto second = CachedPlan(address, ply, true, sha);
+  ASSERT_TRUE(second.status.ok()) << second.status.error_message();
+  ASSERT_FALSE(first.responses.empty());
+  // The same plan both times: the results' stations agree.
+  auto result_of = [](const RawCall<v1::PlanResponse>& c) {
+    for (const auto& r : c.responses)
+      if (r.has_result()) return r.result().stations_size();
+    return -1;
+  };
+  EXPECT_GT(result_of(first), 0);
+  EXPECT_EQ(result_of(first), result_of(second));
+}
+
+TEST(SceneCacheRpc, AWrongHashABadHashOrDataWithFromCacheIsInvalidArgument) {
+  auto server = testing::StartServer(SmallServer());
+  ASSERT_TRUE(server);
+  const std::string address = testing::Address(*server);
+  const std::string ply = testing::BoxRoomPly();
+  auto wrong = CachedPlan(address, ply, false, wire::Sha256Hex("something else"));
+  EXPECT_EQ(wrong.status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(wrong.status.error_message(), HasSubstr("SHA-256"));
+  // The wrong upload was not kept under either hash.
+  EXPECT_EQ(CachedPlan(address, ply, true, wire::Sha256Hex(ply)).status.error_code(), grpc::StatusCode::NOT_FOUND);
+  EXPECT_EQ(CachedPlan(address, ply, false, "ABC").status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  std::vector<v1::PlanRequest> rs = PlanRequests(ply, FastParams());
+  rs[0].mutable_spec()->mutable_upload()->set_from_cache(true);
+  rs[0].mutable_spec()->mutable_upload()->set_scene_sha256(wire::Sha256Hex(ply));
+  const auto with_data = RawPlan(address, rs);
+  EXPECT_EQ(with_data.status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(with_data.status.error_message(), HasSubstr("send none"));
+}
+
+TEST(SceneCacheRpc, WithoutACacheEveryPlanUploadsAndTheClientRecovers) {
+  server::ServerOptions o = SmallServer();
+  o.scene_cache_bytes = 0;
+  auto server = testing::StartServer(o);
+  ASSERT_TRUE(server);
+  client::ConnectionOptions conn;
+  conn.server = testing::Address(*server);
+  auto c = client::Client::Create(conn);
+  ASSERT_TRUE(c.ok());
+  PlanOptions options = *wire::FromProto(FastParams());
+  for (int i = 0; i < 2; ++i) {
+    auto r = (*c)->Plan({testing::BoxRoomPly(), "box.ply"}, options);
+    ASSERT_TRUE(r.ok()) << r.status().ToString();
+    EXPECT_FALSE((*c)->last_upload().from_cache);
+    EXPECT_EQ((*c)->last_upload().bytes_sent, testing::BoxRoomPly().size());
+  }
+}
+
+TEST(SceneCacheRpc, TheClientUploadsOnceThenNamesTheSceneOnly) {
+  auto server = testing::StartServer(SmallServer());
+  ASSERT_TRUE(server);
+  client::ConnectionOptions conn;
+  conn.server = testing::Address(*server);
+  auto c = client::Client::Create(conn);
+  ASSERT_TRUE(c.ok());
+  PlanOptions options = *wire::FromProto(FastParams());
+  const std::string ply = testing::BoxRoomPly();
+  auto first = (*c)->Plan({ply, "box.ply"}, options);
+  ASSERT_TRUE(first.ok()) << first.status().ToString();
+  EXPECT_FALSE((*c)->last_upload().from_cache);
+  EXPECT_EQ((*c)->last_upload().scene_sha256, wire::Sha256Hex(ply));
+  options.grid_spacing_m = 0.5;  // other parameters, the same scene
+  auto second = (*c)->Plan({ply, "box.ply"}, options);
+  ASSERT_TRUE(second.ok()) << second.status().ToString();
+  EXPECT_TRUE((*c)->last_upload().from_cache);
+  EXPECT_EQ((*c)->last_upload().bytes_sent, 0u);
+  EXPECT_GT(second->candidate_count, first->candidate_count);
+  EvaluateJobOptions eval;
+  eval.resolution_m = 0.2;
+  eval.viewpoints = {first->stations[0].position};
+  auto ev = (*c)->Evaluate({ply, "box.ply"}, eval);
+  ASSERT_TRUE(ev.ok()) << ev.status().ToString();
+  EXPECT_TRUE((*c)->last_upload().from_cache);
+}
 
 TEST(PlanContent, UnknownFormatIsInvalidArgument) {
   auto server = testing::StartServer(SmallServer());

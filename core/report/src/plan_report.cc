@@ -705,13 +705,16 @@ std::string PlanToJson(const PlanResult& r, const UploadSummary* upload) {
          {"optimality", OptimalityJson(r.optimality)},
          {"timings_s", std::move(timings)},
          {"parameters", ParametersJson(r.options)},
-         {"upload", upload == nullptr ? Json(nullptr)
-                                      : Json{{"format", upload->format},
-                                             {"bytes_sent", upload->bytes_sent},
-                                             {"file_bytes", upload->file_bytes},
-                                             {"voxels", upload->voxels},
-                                             {"resolution_m", upload->resolution_m},
-                                             {"why_raw", upload->why_raw}}},
+         {"upload", upload == nullptr
+                        ? Json(nullptr)
+                        : Json{{"format", upload->format},
+                               {"bytes_sent", upload->bytes_sent},
+                               {"file_bytes", upload->file_bytes},
+                               {"voxels", upload->voxels},
+                               {"resolution_m", upload->resolution_m},
+                               {"why_raw", upload->why_raw},
+                               {"scene_hash", upload->scene_hash.empty() ? Json(nullptr) : Json(upload->scene_hash)},
+                               {"from_cache", upload->from_cache}}},
          {"warnings", r.warnings}};
   return j.dump(2) + "\n";
 }

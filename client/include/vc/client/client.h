@@ -50,6 +50,16 @@ struct ConnectionOptions {
   std::chrono::milliseconds timeout{0};
   // Bytes per upload chunk (well under the 4 MiB message limit).
   size_t chunk_bytes = size_t{256} << 10;
+  // Name the scene by its SHA-256 first and upload it only when the server does not hold it
+  // (docs/PROTOCOL.md, "The scene cache").
+  bool scene_cache = true;
+};
+
+// How the last Plan or Evaluate call got its scene to the server.
+struct UploadOutcome {
+  std::string scene_sha256;  // empty without the scene cache
+  bool from_cache = false;   // the server had it: no byte was sent
+  uint64_t bytes_sent = 0;
 };
 
 // What the caller sees while a job runs; every member optional. Called on the calling thread.
@@ -87,9 +97,14 @@ class Client {
   // grpc.health.v1.Health/Check of `service` ("" = the whole server). The value is the serving
   // status name ("SERVING"); a server that is not serving gives UNAVAILABLE.
   Result<std::string> Health(const std::string& service = "");
+  const UploadOutcome& last_upload() const { return last_upload_; }
 
  private:
   Client() = default;
+  // Runs `call(from_cache)`: first naming the scene by its hash only (when the scene cache is on),
+  // then, when the server does not hold it (NOT_FOUND), uploading it; notes the outcome.
+  Status WithSceneCache(const Upload& upload, v1::UploadSpec* spec, const std::function<Status(bool)>& call);
+  UploadOutcome last_upload_;
   void Prepare(grpc::ClientContext* ctx) const;
   template <typename Fn>
   Status WithRetries(const JobObserver& observer, Fn&& attempt);

@@ -20,6 +20,7 @@
 #include "vc/scene/scene_input.h"
 #include "vc/scene/voxel_scene.h"
 #include "vc/server/backend.h"
+#include "vc/server/scene_cache.h"
 #include "vc/v1/planner.pb.h"
 
 namespace vc::server {
@@ -32,6 +33,9 @@ struct Job {
   std::string peer;       // the client's address, for the log
   v1::UploadSpec upload;  // source name, stated format, size
   std::string data;       // the verified upload
+  // "hit": data came from the scene cache; "miss": uploaded with its SHA-256 (checked by Run, then
+  // kept in the cache); empty: uploaded without one.
+  std::string cache;
   // The job's memory budget (already capped by --max-memory-budget-bytes); bounds the reading.
   uint64_t memory_budget_bytes = kDefaultMemoryBudgetBytes;
   Clock::time_point started;    // the call began
@@ -61,8 +65,10 @@ class JobRunner {
   // `backend` must outlive the runner. Each job is read with ReadLimits(max_upload_bytes, the
   // job's memory_budget_bytes) (vc/scene/scene_input.h): a decompression bomb or a lying header is
   // refused before it is allocated.
-  JobRunner(const Backend* backend, uint64_t max_upload_bytes)
-      : backend_(backend), max_upload_bytes_(max_upload_bytes) {}
+  // With `cache`, a job uploaded with its SHA-256 is checked against it (INVALID_ARGUMENT when
+  // they differ) and kept there.
+  JobRunner(const Backend* backend, uint64_t max_upload_bytes, SceneCache* cache = nullptr)
+      : backend_(backend), max_upload_bytes_(max_upload_bytes), cache_(cache) {}
 
   // On a worker thread: reads job.data, runs `fn`, logs the line; the job's status. CANCELLED or
   // DEADLINE_EXCEEDED when `cancel` fired while queued; the reader's and fn's errors as they are;
@@ -74,6 +80,7 @@ class JobRunner {
 
   const Backend* const backend_;
   const uint64_t max_upload_bytes_;
+  SceneCache* const cache_;
 };
 
 }  // namespace vc::server

@@ -23,6 +23,8 @@ struct ServerOptions {
   // Upper bound on a job's memory budget (PlanOptions::memory_budget_bytes), in bytes; requests
   // above it are capped to it.
   uint64_t max_memory_budget_bytes = kDefaultMemoryBudgetBytes;
+  // Bytes of uploaded scenes kept for clients that name a scene by its SHA-256 (0 = no cache).
+  uint64_t scene_cache_bytes = uint64_t{1} << 30;
   // Threads each job may use; 0 = cores / workers (at least 1).
   int threads_per_job = 0;
   // PEM files. With cert and key the server speaks TLS; with client_ca it also requires and

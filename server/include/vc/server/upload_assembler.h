@@ -42,7 +42,8 @@ class UploadAssembler {
   // Appends a chunk. INVALID_ARGUMENT before the spec, for a refused spec or past the declared size.
   Status AddChunk(std::string_view data);
   // After the client half-closed: INVALID_ARGUMENT without an accepted spec or with bytes missing,
-  // DATA_LOSS when the CRC32C differs from the spec's. OK only while the assembler holds the job's
+  // DATA_LOSS when the CRC32C differs from the spec's. A from_cache spec takes no chunk and is
+  // complete at once (its bytes come from the scene cache). OK only while the assembler holds the job's
   // place (unless TakeTicket already took it).
   Status Finish() const;
 

@@ -24,6 +24,8 @@ struct UploadSummary {
   uint64_t voxels = 0;      // vc-voxels: voxels sent; 0 for raw
   double resolution_m = 0;  // vc-voxels: their edge (m); 0 for raw
   std::string why_raw;      // raw: why (e.g. "--raw-upload", "an octree is uploaded as it is")
+  std::string scene_hash;   // SHA-256 of what was (or would have been) sent; empty without the cache
+  bool from_cache = false;  // the server held the scene: bytes_sent is 0
 };
 
 // plan.json's content (documented schema). `upload` null when not given.
