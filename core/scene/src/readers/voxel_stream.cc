@@ -11,6 +11,7 @@
 #include <bit>
 #include <cmath>
 #include <cstring>
+#include <sstream>
 
 #include "readers.h"
 #include "vc/scene/voxel_scene.h"
@@ -177,7 +178,9 @@ Result<SceneInput> ReadVoxelStream(std::string_view bytes, std::string_view sour
     return InvalidInput(source,
                         "vc-voxels holds " + std::to_string(varints.size() - at) + " key bytes after its last voxel");
   }
-  in.detail = std::to_string(count) + " voxels of " + std::to_string(resolution) + " m";
+  std::ostringstream detail;
+  detail << count << " voxels of " << resolution << " m";
+  in.detail = detail.str();
   return in;
 }
 
