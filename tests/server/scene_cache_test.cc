@@ -15,7 +15,7 @@ TEST(SceneCache, KeepsScenesUntilTheBytesRunOutThenDropsTheLeastRecentlyUsed) {
   SceneCache cache(100);
   EXPECT_TRUE(cache.Put("a", Of(40, 'a')));
   EXPECT_TRUE(cache.Put("b", Of(40, 'b')));
-  ASSERT_TRUE(cache.Get("a"));  // a is now the most recently used
+  ASSERT_TRUE(cache.Get("a"));               // a is now the most recently used
   EXPECT_TRUE(cache.Put("c", Of(40, 'c')));  // 120 > 100: b goes
   EXPECT_EQ(cache.Get("b"), nullptr);
   ASSERT_TRUE(cache.Get("a"));
