@@ -86,6 +86,7 @@ Result<std::unique_ptr<Client>> Client::Create(const ConnectionOptions& options)
   grpc::ChannelArguments args;
   args.SetMaxReceiveMessageSize(16 << 20);
   if (!options.tls_server_name.empty()) args.SetSslTargetNameOverride(options.tls_server_name);
+  c->credentials_ = creds;
   c->channel_ = grpc::CreateCustomChannel(options.server, creds, args);
   return c;
 }
@@ -116,7 +117,8 @@ Status Client::WithSceneCache(const Upload& upload, v1::UploadSpec* spec, const 
     last_upload_.scene_sha256 = spec->scene_sha256();
     spec->set_from_cache(true);
     const Status s = call(true);
-    if (s.code() != StatusCode::kNotFound) {
+    // NOT_FOUND means a cache miss only before a job was accepted (after, it is a lost job).
+    if (s.code() != StatusCode::kNotFound || !last_job_.job_id.empty()) {
       last_upload_.from_cache = s.ok();
       return s;
     }
@@ -126,11 +128,132 @@ Status Client::WithSceneCache(const Upload& upload, v1::UploadSpec* spec, const 
   return call(false);
 }
 
+namespace {
+
+void NoteAccepted(const v1::Accepted& a, const JobObserver& observer, JobTicket* ticket) {
+  ticket->job_id = a.job_id();
+  ticket->attach_address = a.attach_address();
+  ticket->detach_grace_s = a.detach_grace_s();
+  if (observer.on_accepted) observer.on_accepted(a.job_id(), a.queue_position());
+}
+
+// Reads a Plan event stream (Plan's or AttachPlan's) to its end and its status.
+template <typename Stream>
+Status FollowPlan(Stream& stream, const JobObserver& observer, JobTicket* ticket, bool* accepted, PlanResult* out) {
+  wire::PlanResultAssembler assembler;
+  std::optional<v1::PlanResult> summary;
+  Status broken;
+  v1::PlanResponse r;
+  while (stream.Read(&r)) {
+    switch (r.event_case()) {
+      case v1::PlanResponse::kAccepted:
+        *accepted = true;
+        NoteAccepted(r.accepted(), observer, ticket);
+        break;
+      case v1::PlanResponse::kProgress:
+        if (observer.on_progress) observer.on_progress(wire::FromProto(r.progress()));
+        break;
+      case v1::PlanResponse::kStation:
+        if (observer.on_station) observer.on_station(wire::FromProto(r.station().station()), r.station().index());
+        break;
+      case v1::PlanResponse::kFinalStations:
+        if (observer.on_final_stations) {
+          std::vector<PlannedStation> stations;
+          for (const auto& s : r.final_stations().stations()) stations.push_back(wire::FromProto(s));
+          observer.on_final_stations(stations);
+        }
+        break;
+      case v1::PlanResponse::kHeatMap:
+        if (broken.ok()) broken = assembler.AddHeatMap(r.heat_map());
+        if (broken.ok() && observer.on_heat_map &&
+            assembler.heat_map().positions.size() == r.heat_map().total_candidates()) {
+          observer.on_heat_map(assembler.heat_map());
+        }
+        break;
+      case v1::PlanResponse::kVoxels:
+        if (broken.ok()) broken = assembler.AddVoxels(r.voxels());
+        break;
+      case v1::PlanResponse::kResult:
+        summary = r.result();
+        break;
+      default:
+        break;
+    }
+  }
+  VC_RETURN_IF_ERROR(wire::FromGrpcStatus(stream.Finish()));
+  if (!broken.ok()) return Local(broken);
+  if (!summary) return InternalError("the server ended the plan without a result");
+  auto result = std::move(assembler).Finish(*summary);
+  if (!result.ok()) return Local(result.status());
+  *out = std::move(result).value();
+  return Status::Ok();
+}
+
+// Reads an Evaluate event stream (Evaluate's or AttachEvaluate's) to its end and its status.
+template <typename Stream>
+Status FollowEvaluate(Stream& stream, const JobObserver& observer, JobTicket* ticket, bool* accepted,
+                      EvaluateOutcome* out) {
+  std::optional<v1::EvaluateResult> result;
+  v1::EvaluateResponse r;
+  while (stream.Read(&r)) {
+    switch (r.event_case()) {
+      case v1::EvaluateResponse::kAccepted:
+        *accepted = true;
+        NoteAccepted(r.accepted(), observer, ticket);
+        break;
+      case v1::EvaluateResponse::kProgress:
+        if (observer.on_progress) observer.on_progress(wire::FromProto(r.progress()));
+        break;
+      case v1::EvaluateResponse::kResult:
+        result = r.result();
+        break;
+      default:
+        break;
+    }
+  }
+  VC_RETURN_IF_ERROR(wire::FromGrpcStatus(stream.Finish()));
+  if (!result) return InternalError("the server ended the evaluation without a result");
+  out->evaluation = wire::FromProto(result->evaluation());
+  out->viewpoints.clear();
+  for (const auto& p : result->viewpoints()) out->viewpoints.push_back(wire::FromProto(p));
+  return Status::Ok();
+}
+
+}  // namespace
+
+std::shared_ptr<grpc::Channel> Client::AttachChannel(const JobTicket& ticket) {
+  if (ticket.attach_address.empty() || ticket.attach_address == options_.server) return channel_;
+  grpc::ChannelArguments args;
+  args.SetMaxReceiveMessageSize(16 << 20);
+  if (!options_.tls_server_name.empty()) args.SetSslTargetNameOverride(options_.tls_server_name);
+  return grpc::CreateCustomChannel(ticket.attach_address, credentials_, args);
+}
+
+template <typename Fn>
+Status Client::Reattach(const Status& broken, const JobObserver& observer, Fn&& attach) {
+  if (broken.code() != StatusCode::kUnavailable || last_job_.job_id.empty() || last_job_.detach_grace_s == 0) {
+    return broken;
+  }
+  // Keep trying while the job may still be alive: within its grace, from 1 s up to 30 s apart.
+  const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(last_job_.detach_grace_s);
+  auto backoff = std::max(options_.initial_backoff, std::chrono::milliseconds(0));
+  Status s = broken;
+  while (s.code() == StatusCode::kUnavailable && std::chrono::steady_clock::now() + backoff < give_up) {
+    if (observer.on_reattach) observer.on_reattach(last_job_, s, backoff);
+    std::this_thread::sleep_for(backoff);
+    backoff = std::min(std::max(backoff * 2, std::chrono::milliseconds(1000)), std::chrono::milliseconds(30000));
+    s = attach();
+  }
+  return s;
+}
+
 Result<PlanResult> Client::Plan(const Upload& upload, const PlanOptions& options, const JobObserver& observer) {
   auto stub = v1::StationPlanner::NewStub(channel_);
   v1::PlanRequest spec;
   *spec.mutable_spec()->mutable_upload() = MakeUploadSpec(upload);
   *spec.mutable_spec()->mutable_parameters() = wire::ToProto(options);
+  spec.mutable_spec()->mutable_control()->set_detach_grace_s(options_.detach_grace_s);
+  last_job_ = {};
   PlanResult out;
   const Status status = WithSceneCache(upload, spec.mutable_spec()->mutable_upload(), [&](bool from_cache) {
     return WithRetries(observer, [&](bool* accepted) -> Status {
@@ -138,53 +261,8 @@ Result<PlanResult> Client::Plan(const Upload& upload, const PlanOptions& options
       Prepare(&ctx);
       auto stream = stub->Plan(&ctx);
       SendUpload(*stream, spec, from_cache ? kNoData : upload, options_.chunk_bytes);
-      wire::PlanResultAssembler assembler;
-      std::optional<v1::PlanResult> summary;
-      Status broken;
-      v1::PlanResponse r;
-      while (stream->Read(&r)) {
-        switch (r.event_case()) {
-          case v1::PlanResponse::kAccepted:
-            *accepted = true;
-            if (observer.on_accepted) observer.on_accepted(r.accepted().job_id(), r.accepted().queue_position());
-            break;
-          case v1::PlanResponse::kProgress:
-            if (observer.on_progress) observer.on_progress(wire::FromProto(r.progress()));
-            break;
-          case v1::PlanResponse::kStation:
-            if (observer.on_station) observer.on_station(wire::FromProto(r.station().station()), r.station().index());
-            break;
-          case v1::PlanResponse::kFinalStations:
-            if (observer.on_final_stations) {
-              std::vector<PlannedStation> stations;
-              for (const auto& s : r.final_stations().stations()) stations.push_back(wire::FromProto(s));
-              observer.on_final_stations(stations);
-            }
-            break;
-          case v1::PlanResponse::kHeatMap:
-            if (broken.ok()) broken = assembler.AddHeatMap(r.heat_map());
-            if (broken.ok() && observer.on_heat_map &&
-                assembler.heat_map().positions.size() == r.heat_map().total_candidates()) {
-              observer.on_heat_map(assembler.heat_map());
-            }
-            break;
-          case v1::PlanResponse::kVoxels:
-            if (broken.ok()) broken = assembler.AddVoxels(r.voxels());
-            break;
-          case v1::PlanResponse::kResult:
-            summary = r.result();
-            break;
-          default:
-            break;
-        }
-      }
-      VC_RETURN_IF_ERROR(wire::FromGrpcStatus(stream->Finish()));
-      if (!broken.ok()) return Local(broken);
-      if (!summary) return InternalError("the server ended the plan without a result");
-      auto result = std::move(assembler).Finish(*summary);
-      if (!result.ok()) return Local(result.status());
-      out = std::move(result).value();
-      return Status::Ok();
+      const Status s = FollowPlan(*stream, observer, &last_job_, accepted, &out);
+      return Reattach(s, observer, [&] { return AttachPlanOnce(observer, &out); });
     });
   });
   if (!status.ok()) return status;
@@ -197,39 +275,78 @@ Result<Evaluation> Client::Evaluate(const Upload& upload, const EvaluateJobOptio
   v1::EvaluateRequest spec;
   *spec.mutable_spec()->mutable_upload() = MakeUploadSpec(upload);
   *spec.mutable_spec()->mutable_parameters() = wire::ToProto(options);
-  Evaluation out;
+  spec.mutable_spec()->mutable_control()->set_detach_grace_s(options_.detach_grace_s);
+  last_job_ = {};
+  EvaluateOutcome out;
   const Status status = WithSceneCache(upload, spec.mutable_spec()->mutable_upload(), [&](bool from_cache) {
     return WithRetries(observer, [&](bool* accepted) -> Status {
       grpc::ClientContext ctx;
       Prepare(&ctx);
       auto stream = stub->Evaluate(&ctx);
       SendUpload(*stream, spec, from_cache ? kNoData : upload, options_.chunk_bytes);
-      std::optional<v1::EvaluateResult> result;
-      v1::EvaluateResponse r;
-      while (stream->Read(&r)) {
-        switch (r.event_case()) {
-          case v1::EvaluateResponse::kAccepted:
-            *accepted = true;
-            if (observer.on_accepted) observer.on_accepted(r.accepted().job_id(), r.accepted().queue_position());
-            break;
-          case v1::EvaluateResponse::kProgress:
-            if (observer.on_progress) observer.on_progress(wire::FromProto(r.progress()));
-            break;
-          case v1::EvaluateResponse::kResult:
-            result = r.result();
-            break;
-          default:
-            break;
-        }
-      }
-      VC_RETURN_IF_ERROR(wire::FromGrpcStatus(stream->Finish()));
-      if (!result) return InternalError("the server ended the evaluation without a result");
-      out = wire::FromProto(result->evaluation());
-      return Status::Ok();
+      const Status s = FollowEvaluate(*stream, observer, &last_job_, accepted, &out);
+      return Reattach(s, observer, [&] { return AttachEvaluateOnce(observer, &out); });
     });
   });
   if (!status.ok()) return status;
+  return std::move(out.evaluation);
+}
+
+Status Client::AttachPlanOnce(const JobObserver& observer, PlanResult* out) {
+  auto stub = v1::StationPlanner::NewStub(AttachChannel(last_job_));
+  grpc::ClientContext ctx;
+  Prepare(&ctx);
+  v1::AttachRequest request;
+  request.set_job_id(last_job_.job_id);
+  auto stream = stub->AttachPlan(&ctx, request);
+  bool accepted = false;
+  return FollowPlan(*stream, observer, &last_job_, &accepted, out);
+}
+
+Status Client::AttachEvaluateOnce(const JobObserver& observer, EvaluateOutcome* out) {
+  auto stub = v1::StationPlanner::NewStub(AttachChannel(last_job_));
+  grpc::ClientContext ctx;
+  Prepare(&ctx);
+  v1::AttachRequest request;
+  request.set_job_id(last_job_.job_id);
+  auto stream = stub->AttachEvaluate(&ctx, request);
+  bool accepted = false;
+  return FollowEvaluate(*stream, observer, &last_job_, &accepted, out);
+}
+
+Result<PlanResult> Client::AttachPlan(const std::string& job_id, const JobObserver& observer) {
+  last_job_ = {job_id, "", 0};
+  PlanResult out;
+  Status s = WithRetries(observer, [&](bool*) { return AttachPlanOnce(observer, &out); });
+  s = Reattach(s, observer, [&] { return AttachPlanOnce(observer, &out); });
+  if (!s.ok()) return s;
   return out;
+}
+
+Result<EvaluateOutcome> Client::AttachEvaluate(const std::string& job_id, const JobObserver& observer) {
+  last_job_ = {job_id, "", 0};
+  EvaluateOutcome out;
+  Status s = WithRetries(observer, [&](bool*) { return AttachEvaluateOnce(observer, &out); });
+  s = Reattach(s, observer, [&] { return AttachEvaluateOnce(observer, &out); });
+  if (!s.ok()) return s;
+  return out;
+}
+
+Result<std::string> Client::CancelJob(const std::string& job_id) {
+  auto stub = v1::StationPlanner::NewStub(channel_);
+  std::string outcome;
+  const Status status = WithRetries({}, [&](bool*) -> Status {
+    grpc::ClientContext ctx;
+    Prepare(&ctx);
+    v1::CancelJobRequest request;
+    request.set_job_id(job_id);
+    v1::CancelJobResponse response;
+    VC_RETURN_IF_ERROR(wire::FromGrpcStatus(stub->CancelJob(&ctx, request, &response)));
+    outcome = response.outcome();
+    return Status::Ok();
+  });
+  if (!status.ok()) return status;
+  return outcome;
 }
 
 Result<std::string> Client::Health(const std::string& service) {

@@ -51,9 +51,26 @@ void NoteCache(const vc::client::UploadOutcome& outcome, vc::UploadSummary* summ
   }
 }
 
-vc::client::JobObserver Observe(vc::client::ProgressDisplay& display) {
+// Writes evaluation.json and prints G.
+int WriteEvaluation(const vc::Evaluation& r, const std::vector<vc::WorldPoint>& viewpoints,
+                    const std::string& out_dir) {
+  vc::Status written = vc::WriteEvaluationOutputs(r, viewpoints, out_dir);
+  if (!written.ok()) return Fail("cannot write evaluation.json", written);
+  std::printf("global visibility G = %.4f%s over %llu faces; wrote %s/evaluation.json\n", r.overall.global_visibility,
+              r.sampled ? (" (+/- " + std::to_string(r.global_visibility_ci95) + ", sampled)").c_str() : "",
+              static_cast<unsigned long long>(r.faces_evaluated), out_dir.c_str());
+  return 0;
+}
+
+vc::client::JobObserver Observe(vc::client::ProgressDisplay& display, uint32_t detach_grace_s = 0) {
   vc::client::JobObserver o;
-  o.on_accepted = [&](const std::string& id, uint32_t pos) { display.Accepted(id, pos); };
+  o.on_accepted = [&display, detach_grace_s](const std::string& id, uint32_t pos) {
+    display.Accepted(id, pos);
+    if (detach_grace_s > 0) {
+      display.Note("it runs on for " + std::to_string(detach_grace_s) +
+                   " s if the connection drops: vc-client attach " + id + " (or cancel " + id + ")");
+    }
+  };
   o.on_progress = [&](const vc::ProgressEvent& e) { display.Update(e); };
   o.on_station = [&](const vc::PlannedStation& s, int i) { display.Station(s, i); };
   o.on_final_stations = [&](const std::vector<vc::PlannedStation>& s) { display.FinalStations(s); };
@@ -62,6 +79,10 @@ vc::client::JobObserver Observe(vc::client::ProgressDisplay& display) {
   };
   o.on_retry = [&](const vc::Status& s, std::chrono::milliseconds wait) {
     display.Note("server unavailable (" + s.message() + "); retrying in " + std::to_string(wait.count()) + " ms");
+  };
+  o.on_reattach = [&](const vc::client::JobTicket& t, const vc::Status& s, std::chrono::milliseconds wait) {
+    display.Note("lost the stream of job " + t.job_id + " (" + s.message() + "); re-attaching in " +
+                 std::to_string(wait.count()) + " ms");
   };
   return o;
 }
@@ -102,6 +123,11 @@ int main(int argc, char** argv) {
   const char* kRawUploadHelp =
       "upload the file's bytes as they are, not a point cloud's voxels at the working resolution (vc-voxels)";
   submit->add_flag("--raw-upload", raw_upload, kRawUploadHelp);
+  conn.detach_grace_s = 600;
+  const char* kDetachHelp =
+      "seconds the job runs on if this connection drops (re-attached automatically, or with vc-client attach); "
+      "0 = the job ends with the connection";
+  submit->add_option("--detach-grace", conn.detach_grace_s, kDetachHelp)->capture_default_str();
   vc::client::AddPlanFileFlags(submit, &plan_files);
   vc::client::AddPlanFlags(submit, &plan);
 
@@ -114,7 +140,17 @@ int main(int argc, char** argv) {
   evaluate->add_option("--viewpoints", viewpoints_csv, "CSV of viewpoints x,y,z (e.g. stations.csv)")->required();
   evaluate->add_option("--out", out_dir, "output directory")->capture_default_str();
   evaluate->add_flag("--raw-upload", raw_upload, kRawUploadHelp);
+  evaluate->add_option("--detach-grace", conn.detach_grace_s, kDetachHelp)->capture_default_str();
   vc::client::AddEvaluateFlags(evaluate, &eval);
+
+  // attach, cancel
+  std::string job_id;
+  auto* attach = app.add_subcommand(
+      "attach", "re-attach to a detached job (plan or evaluation) by its id; write its reports like submit/evaluate");
+  attach->add_option("JOB_ID", job_id, "the id submit printed (j-...)")->required();
+  attach->add_option("--out", out_dir, "output directory")->capture_default_str();
+  auto* cancel = app.add_subcommand("cancel", "cancel a detached job, or discard its kept result");
+  cancel->add_option("JOB_ID", job_id, "the id submit printed (j-...)")->required();
 
   // health
   std::string health_service;
@@ -168,6 +204,33 @@ int main(int argc, char** argv) {
     return 0;
   }
 
+  if (*cancel) {
+    auto r = (*client)->CancelJob(job_id);
+    if (!r.ok()) return FailCall("cancel", r.status(), conn.server);
+    std::cout << "job " << job_id << ": " << *r << "\n";
+    return 0;
+  }
+
+  if (*attach) {
+    vc::client::ProgressDisplay display(stderr, isatty(fileno(stderr)) != 0);
+    auto r = (*client)->AttachPlan(job_id, Observe(display));
+    if (r.ok() || r.status().code() != vc::StatusCode::kFailedPrecondition) {
+      display.Done();
+      if (!r.ok()) return FailCall("attach", r.status(), conn.server);
+      if (vc::Status written = vc::WritePlanOutputs(*r, out_dir); !written.ok()) {
+        return Fail("cannot write the reports", written);
+      }
+      PrintStations(*r);
+      std::printf("wrote plan.json, stations.csv, visibility.ply, heatmap.png, reduction.png, report.html to %s\n",
+                  out_dir.c_str());
+      return 0;
+    }
+    auto e = (*client)->AttachEvaluate(job_id, Observe(display));  // an Evaluate job
+    display.Done();
+    if (!e.ok()) return FailCall("attach", e.status(), conn.server);
+    return WriteEvaluation(e->evaluation, e->viewpoints, out_dir);
+  }
+
   auto file_bytes = vc::client::ReadUpload(file);
   if (!file_bytes.ok()) return Fail("cannot read the scene", file_bytes.status());
   if (*submit) {
@@ -183,7 +246,7 @@ int main(int argc, char** argv) {
   display.Uploading(upload->source_name, upload->bytes.size(), conn.server);
 
   if (*submit) {
-    auto r = (*client)->Plan(*upload, plan, Observe(display));
+    auto r = (*client)->Plan(*upload, plan, Observe(display, conn.detach_grace_s));
     display.Done();
     if (!r.ok()) return FailCall("plan", r.status(), conn.server);
     NoteCache((*client)->last_upload(), &prepared.summary, display);
@@ -201,14 +264,9 @@ int main(int argc, char** argv) {
   auto points = vc::ParseStationsCsv(text->bytes, viewpoints_csv);
   if (!points.ok()) return Fail("bad viewpoints file", points.status());
   eval.viewpoints = std::move(points).value();
-  auto r = (*client)->Evaluate(*upload, eval, Observe(display));
+  auto r = (*client)->Evaluate(*upload, eval, Observe(display, conn.detach_grace_s));
   display.Done();
   if (!r.ok()) return FailCall("evaluate", r.status(), conn.server);
   NoteCache((*client)->last_upload(), &prepared.summary, display);
-  vc::Status written = vc::WriteEvaluationOutputs(*r, eval.viewpoints, out_dir);
-  if (!written.ok()) return Fail("cannot write evaluation.json", written);
-  std::printf("global visibility G = %.4f%s over %llu faces; wrote %s/evaluation.json\n", r->overall.global_visibility,
-              r->sampled ? (" (+/- " + std::to_string(r->global_visibility_ci95) + ", sampled)").c_str() : "",
-              static_cast<unsigned long long>(r->faces_evaluated), out_dir.c_str());
-  return 0;
+  return WriteEvaluation(*r, eval.viewpoints, out_dir);
 }

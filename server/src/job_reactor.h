@@ -19,6 +19,7 @@
 #include <chrono>
 #include <condition_variable>
 #include <cstdint>
+#include <memory>
 #include <mutex>
 #include <set>
 #include <string>
@@ -28,6 +29,7 @@
 #include "vc/scene/scene_input.h"
 #include "vc/server/backend.h"
 #include "vc/server/job_runner.h"
+#include "vc/server/kept_jobs.h"
 #include "vc/server/outbox.h"
 #include "vc/server/scene_cache.h"
 #include "vc/server/server_options.h"
@@ -46,12 +48,14 @@ struct ServiceState {
         backend(std::move(b)),
         cache(o.scene_cache_bytes),
         runner(&backend, o.max_upload_bytes, &cache),
-        pool(o.EffectiveWorkers(), o.queue) {}
+        pool(o.EffectiveWorkers(), o.queue),
+        kept(o.result_ttl, o.kept_results_bytes) {}
   const ServerOptions options;
   const Backend backend;
   SceneCache cache;
   const JobRunner runner;
   WorkerPool pool;
+  KeptJobs kept;  // the detachable jobs, by id
   std::atomic<uint64_t> next_job{1};
 
   // The calls alive now, by their cancel tokens, for a shutdown: Drain refuses new calls,
@@ -91,8 +95,10 @@ struct ServiceState {
   bool draining = false;
 };
 
-// Constant-time comparison of the bearer token.
-bool TokenMatches(const grpc::CallbackServerContext& ctx, const std::string& token, std::string* why);
+// Checks the call's bearer token against `tokens` (constant time; any token when `tokens` is
+// empty). On success `owner` is the token matched ("" without tokens); else `why` says what to do.
+bool Authenticate(const grpc::CallbackServerContext& ctx, const std::vector<std::string>& tokens, std::string* owner,
+                  std::string* why);
 // A fresh job id ("j-" + 12 hex digits).
 std::string NewJobId(ServiceState& state);
 
@@ -107,26 +113,31 @@ class JobReactor : public grpc::ServerBidiReactor<Request, Response> {
         method_(method),
         start_(Clock::now()),
         upload_(state->options.max_upload_bytes, &state->pool),
-        outbox_([this](const Response* r) { this->StartWrite(r); },
-                [this](const Status& s) { this->Finish(wire::ToGrpcStatus(s)); }, &token_) {}
+        channel_(std::make_shared<JobChannel<Response>>(method, state->kept.budget())),
+        outbox_(std::make_shared<Outbox<Response>>([this](const Response* r) { this->StartWrite(r); },
+                                                   [this](const Status& s) { this->Finish(wire::ToGrpcStatus(s)); },
+                                                   &token())) {
+    channel_->SetSink(outbox_);
+  }
 
   // Call once right after construction (from the RPC method).
   void Start() {
     const auto deadline = ctx_->deadline();
     if (deadline != std::chrono::system_clock::time_point::max()) {
-      token_.SetDeadline(Clock::now() +
-                         std::chrono::duration_cast<Clock::duration>(deadline - std::chrono::system_clock::now()));
+      token().SetDeadline(Clock::now() +
+                          std::chrono::duration_cast<Clock::duration>(deadline - std::chrono::system_clock::now()));
     }
-    registered_ = state_->Register(&token_);
+    registered_ = state_->Register(&token());
     if (!registered_) {
       Reject(UnavailableError("this vc-server is shutting down; retry (another replica will take the job)"));
       return;
     }
-    std::string why;
-    if (!TokenMatches(*ctx_, state_->options.token, &why)) {
+    std::string owner, why;
+    if (!Authenticate(*ctx_, state_->options.tokens, &owner, &why)) {
       Reject(UnauthenticatedError(why));
       return;
     }
+    channel_->set_owner(std::move(owner));
     this->StartRead(&request_);
   }
 
@@ -143,18 +154,32 @@ class JobReactor : public grpc::ServerBidiReactor<Request, Response> {
     this->StartRead(&request_);
   }
 
-  void OnWriteDone(bool ok) override { outbox_.OnWriteDone(ok); }
+  void OnWriteDone(bool ok) override { outbox_->OnWriteDone(ok); }
 
+  // The client cancelled, vanished, or the deadline passed. A detachable job that is queued or
+  // running runs on without this call (docs/PROTOCOL.md, "Detachable jobs"); any other is cancelled.
   void OnCancel() override {
     const bool past_deadline = ctx_->deadline() != std::chrono::system_clock::time_point::max() &&
                                std::chrono::system_clock::now() >= ctx_->deadline();
-    if (!past_deadline || !token_.cancelled()) token_.Cancel();
-    outbox_.Break();
+    outbox_->Break();
+    if (submitted_.load() && channel_->detachable() && !past_deadline && !token().cancelled()) {
+      detached_ = true;
+      channel_->Detach(outbox_.get());
+      spdlog::info("job {} detached: its stream broke; it runs on for up to {:.0f} s without a client", job_id_,
+                   std::chrono::duration<double>(channel_->grace()).count());
+      outbox_->Complete(CancelledError("the stream broke; the job runs on detached"));
+      return;
+    }
+    if (!past_deadline || !token().cancelled()) token().Cancel();
   }
 
+  // The call is over; the reactor lives on while a detached job's worker still uses it.
   void OnDone() override {
-    if (registered_) state_->Unregister(&token_);
-    delete this;
+    if (!detached_ && submitted_.load() && channel_->state().done) {
+      channel_->MarkDelivered();  // its status reached the client: nothing more to keep
+      state_->kept.Erase(job_id_);
+    }
+    ReleaseHold();
   }
 
  protected:
@@ -165,7 +190,7 @@ class JobReactor : public grpc::ServerBidiReactor<Request, Response> {
   // Runs the RPC's core function on the parsed input, posting responses; on a worker thread.
   virtual Status Run(const SceneInput& input, const JobContext& ctx, JobLog& log) = 0;
 
-  Outbox<Response>& outbox() { return outbox_; }
+  JobChannel<Response>& channel() { return *channel_; }
   const ServerOptions& options() const { return state_->options; }
   const Backend& backend() const { return state_->backend; }
 
@@ -174,6 +199,8 @@ class JobReactor : public grpc::ServerBidiReactor<Request, Response> {
     if (request_.has_spec()) {
       VC_RETURN_IF_ERROR(upload_.StartSpec());
       VC_ASSIGN_OR_RETURN(const v1::UploadSpec spec, TakeSpec(request_));
+      const auto asked = std::chrono::milliseconds(int64_t{request_.spec().control().detach_grace_s()} * 1000);
+      channel_->set_grace(std::min(asked, state_->options.max_detach_grace));
       Status s = upload_.AcceptSpec(spec);
       if (upload_.busy()) ctx_->AddTrailingMetadata("retry-after-ms", "2000");
       return s;
@@ -187,7 +214,7 @@ class JobReactor : public grpc::ServerBidiReactor<Request, Response> {
       Reject(CancelledError("the client cancelled the call during the upload"));
       return;
     }
-    if (const Status s = token_.Check("the job (the server is shutting down)"); !s.ok()) {
+    if (const Status s = token().Check("the job (the server is shutting down)"); !s.ok()) {
       Reject(s);
       return;
     }
@@ -197,6 +224,7 @@ class JobReactor : public grpc::ServerBidiReactor<Request, Response> {
       return;
     }
     job_.id = NewJobId(*state_);
+    job_id_ = job_.id;
     job_.method = method_;
     job_.peer = ctx_->peer();
     job_.upload = upload_.spec();
@@ -222,13 +250,19 @@ class JobReactor : public grpc::ServerBidiReactor<Request, Response> {
     job_.memory_budget_bytes = MemoryBudgetBytes();
     job_.started = start_;
     job_.submitted = Clock::now();
+    if (channel_->detachable()) state_->kept.Add(job_.id, channel_);
+    holds_.fetch_add(1);  // the worker's, released by Work
+    submitted_.store(true);
     state_->pool.Submit(
         std::move(*upload_.TakeTicket()),
         [this, id = job_.id](uint32_t position) {
           Response r;
           r.mutable_accepted()->set_job_id(id);
           r.mutable_accepted()->set_queue_position(position);
-          outbox_.Post(std::move(r));
+          r.mutable_accepted()->set_attach_address(state_->options.advertise_address);
+          r.mutable_accepted()->set_detach_grace_s(
+              uint32_t(std::chrono::duration_cast<std::chrono::seconds>(channel_->grace()).count()));
+          channel_->Post(std::move(r));
         },
         [this](WorkerPool::Ticket place) { Work(std::move(place)); });
   }
@@ -237,15 +271,25 @@ class JobReactor : public grpc::ServerBidiReactor<Request, Response> {
   // client that submits again on hearing it is not refused as busy.
   void Work(WorkerPool::Ticket place) {
     const Status s = state_->runner.Run(
-        std::move(job_), token_,
+        std::move(job_), token(),
         [this](const ProgressEvent& e) {
           Response r;
           *r.mutable_progress() = wire::ToProto(e);
-          outbox_.PostProgress(std::move(r));
+          channel_->PostProgress(std::move(r));
         },
         [this](const SceneInput& input, const JobContext& ctx, JobLog& log) { return Run(input, ctx, log); });
     place.Release();
-    outbox_.Complete(s);  // last touch of this reactor by the worker
+    channel_->Complete(s);
+    ReleaseHold();  // last touch of this reactor by the worker
+  }
+
+  CancelToken& token() { return channel_->token(); }
+
+  // The call (OnDone) and the worker (Work) each hold the reactor; the last one deletes it.
+  void ReleaseHold() {
+    if (holds_.fetch_sub(1) != 1) return;
+    if (registered_) state_->Unregister(&token());
+    delete this;
   }
 
   // Ends a call that never reached a worker, with its log line (gRPC threads).
@@ -253,19 +297,24 @@ class JobReactor : public grpc::ServerBidiReactor<Request, Response> {
     upload_.TakeTicket();  // the place (if one was reserved) is free before the client hears the status
     spdlog::info("rpc {} peer={} upload={} rejected status={}: {}", method_, ctx_->peer(),
                  HumanBytes(upload_.declared_bytes()), int(wire::ToGrpcCode(status.code())), status.message());
-    outbox_.Complete(status);
+    outbox_->Complete(status);
   }
 
   grpc::CallbackServerContext* const ctx_;
   ServiceState* const state_;
   const char* const method_;
   const Clock::time_point start_;
-  CancelToken token_;
-  bool registered_ = false;  // in the service's calls (Start); unregistered in OnDone
-  Request request_;          // the message being read (gRPC threads, one reaction at a time)
-  UploadAssembler upload_;   // gRPC threads until the job is submitted
-  Job job_;                  // handed to the worker
-  Outbox<Response> outbox_;
+  bool registered_ = false;             // in the service's calls (Start); unregistered with the last hold
+  std::atomic<int> holds_{1};           // the call's, plus the worker's once submitted
+  std::atomic<bool> submitted_{false};  // the job went to the pool
+  std::atomic<bool> detached_{false};   // OnCancel let the job run on
+  std::string job_id_;                  // for the log, once submitted
+  Request request_;                     // the message being read (gRPC threads, one reaction at a time)
+  UploadAssembler upload_;              // gRPC threads until the job is submitted
+  Job job_;                             // handed to the worker
+  // The job's events and cancellation (kept in state_->kept when detachable), and this call's queue.
+  const std::shared_ptr<JobChannel<Response>> channel_;
+  const std::shared_ptr<Outbox<Response>> outbox_;
 };
 
 }  // namespace vc::server::internal

@@ -40,7 +40,29 @@ int main(int argc, char** argv) {
   app.add_option("--tls-key", o.tls_key_file, "server private key (PEM)")->envname("VC_TLS_KEY");
   app.add_option("--tls-client-ca", o.tls_client_ca_file, "CA (PEM) for client certificates; enables mutual TLS")
       ->envname("VC_TLS_CLIENT_CA");
-  app.add_option("--token", o.token, "require 'authorization: Bearer TOKEN' on vc.v1 calls")->envname("VC_TOKEN");
+  app.add_option("--token", o.tokens,
+                 "require 'authorization: Bearer TOKEN' on vc.v1 calls; several tokens separated by commas (each "
+                 "owns the detachable jobs submitted with it)")
+      ->delimiter(',')
+      ->envname("VC_TOKEN");
+  double max_grace_s = std::chrono::duration<double>(o.max_detach_grace).count();
+  double ttl_s = std::chrono::duration<double>(o.result_ttl).count();
+  app.add_option("--max-detach-grace-seconds", max_grace_s,
+                 "largest detach grace granted to a job (vc-client --detach-grace); 0 = no job outlives its stream")
+      ->envname("VC_MAX_DETACH_GRACE_SECONDS")
+      ->capture_default_str();
+  app.add_option("--result-ttl-seconds", ttl_s,
+                 "how long a detached job's result is kept for a client to attach after the job ended")
+      ->envname("VC_RESULT_TTL_SECONDS")
+      ->capture_default_str();
+  app.add_option("--kept-results-bytes", o.kept_results_bytes,
+                 "bytes of events and results all detached jobs together may keep")
+      ->envname("VC_KEPT_RESULTS_BYTES")
+      ->capture_default_str();
+  app.add_option("--advertise-address", o.advertise_address,
+                 "host:port clients re-attach to (sent in Accepted); set it to the replica's own address behind "
+                 "a load balancer")
+      ->envname("VC_ADVERTISE_ADDRESS");
   app.add_option("--shutdown-grace", grace_s, "seconds running jobs get after SIGTERM before they are cancelled")
       ->envname("VC_SHUTDOWN_GRACE")
       ->capture_default_str();
@@ -49,6 +71,8 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   CLI11_PARSE(app, argc, argv);
   o.shutdown_grace = std::chrono::milliseconds(int64_t(grace_s * 1000));
+  o.max_detach_grace = std::chrono::milliseconds(int64_t(max_grace_s * 1000));
+  o.result_ttl = std::chrono::milliseconds(int64_t(ttl_s * 1000));
   spdlog::set_level(spdlog::level::from_str(log_level));
 
   // Block the signals in every thread (gRPC's included); this thread waits for them.

@@ -58,10 +58,10 @@ Result<std::unique_ptr<Server>> Server::Start(const ServerOptions& options, Back
                          ": the address is in use or not local; choose another --listen");
   }
   s->server_->GetHealthCheckService()->SetServingStatus(true);
-  spdlog::info("vc-server listening on {} (port {}), {} workers x {} threads, queue {}, tls={}, token={}",
+  spdlog::info("vc-server listening on {} (port {}), {} workers x {} threads, queue {}, tls={}, tokens={}",
                options.listen, s->port_, options.EffectiveWorkers(), options.EffectiveThreadsPerJob(), options.queue,
                options.tls_cert_file.empty() ? "off" : (options.tls_client_ca_file.empty() ? "on" : "mutual"),
-               options.token.empty() ? "off" : "on");
+               options.tokens.empty() ? "off" : std::to_string(options.tokens.size()));
   return s;
 }
 

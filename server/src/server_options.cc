@@ -25,6 +25,11 @@ Status ServerOptions::Validate() const {
   if (!tls_client_ca_file.empty() && tls_cert_file.empty()) {
     return InvalidArgumentError("--tls-client-ca needs --tls-cert and --tls-key");
   }
+  for (const std::string& t : tokens) {
+    if (t.empty()) return InvalidArgumentError("--token: a token is empty (separate several with commas)");
+  }
+  if (max_detach_grace.count() < 0) return InvalidArgumentError("--max-detach-grace-seconds must be >= 0");
+  if (result_ttl.count() < 0) return InvalidArgumentError("--result-ttl-seconds must be >= 0");
   if (shutdown_grace.count() < 0) return InvalidArgumentError("--shutdown-grace must be >= 0");
   return Status::Ok();
 }

@@ -11,8 +11,10 @@
 namespace vc::server {
 namespace internal {
 
-bool TokenMatches(const grpc::CallbackServerContext& ctx, const std::string& token, std::string* why) {
-  if (token.empty()) return true;
+bool Authenticate(const grpc::CallbackServerContext& ctx, const std::vector<std::string>& tokens, std::string* owner,
+                  std::string* why) {
+  owner->clear();
+  if (tokens.empty()) return true;
   const auto& md = ctx.client_metadata();
   const auto it = md.find("authorization");
   if (it == md.end()) {
@@ -20,13 +22,19 @@ bool TokenMatches(const grpc::CallbackServerContext& ctx, const std::string& tok
     return false;
   }
   const std::string_view got(it->second.data(), it->second.size());
-  const std::string expected = "Bearer " + token;
-  unsigned diff = got.size() == expected.size() ? 0u : 1u;
-  for (size_t i = 0; i < expected.size(); ++i) diff |= unsigned(expected[i] ^ (i < got.size() ? got[i] : 0));
-  if (diff != 0) {
+  // Every token is compared in full (constant time in the token's content).
+  const std::string* matched = nullptr;
+  for (const std::string& token : tokens) {
+    const std::string expected = "Bearer " + token;
+    unsigned diff = got.size() == expected.size() ? 0u : 1u;
+    for (size_t i = 0; i < expected.size(); ++i) diff |= unsigned(expected[i] ^ (i < got.size() ? got[i] : 0));
+    if (diff == 0) matched = &token;
+  }
+  if (matched == nullptr) {
     *why = "the bearer token is wrong: check --token (or VC_TOKEN)";
     return false;
   }
+  *owner = *matched;
   return true;
 }
 
@@ -72,12 +80,12 @@ class PlanReactor final : public JobReactor<v1::PlanRequest, v1::PlanResponse> {
       r.mutable_station()->set_index(index);
       r.mutable_station()->set_provisional(true);
       *r.mutable_station()->mutable_station() = wire::ToProto(s);
-      outbox().Post(std::move(r));
+      channel().Post(std::move(r));
     };
     callbacks.on_final_stations = [this](const std::vector<PlannedStation>& stations) {
       v1::PlanResponse r;
       for (const PlannedStation& s : stations) *r.mutable_final_stations()->add_stations() = wire::ToProto(s);
-      outbox().Post(std::move(r));
+      channel().Post(std::move(r));
     };
     VC_ASSIGN_OR_RETURN(const PlanResult result, backend().plan(input, options_, ctx, callbacks));
     for (const auto& t : result.timings) log.NoteTiming(StageName(t.stage), t.seconds);
@@ -88,11 +96,11 @@ class PlanReactor final : public JobReactor<v1::PlanRequest, v1::PlanResponse> {
     wire::ForEachVoxelChunk(result, [this](v1::VoxelChunk&& c) {
       v1::PlanResponse r;
       *r.mutable_voxels() = std::move(c);
-      return outbox().Post(std::move(r), /*bulk=*/true);
+      return channel().Post(std::move(r), /*bulk=*/true);
     });
     v1::PlanResponse r;
     *r.mutable_result() = wire::ToProto(result);
-    outbox().Post(std::move(r), /*bulk=*/true);
+    channel().Post(std::move(r), /*bulk=*/true);
     return ctx.CheckCancelled("the plan (while sending the result)");
   }
 
@@ -101,7 +109,7 @@ class PlanReactor final : public JobReactor<v1::PlanRequest, v1::PlanResponse> {
     for (auto& c : wire::HeatMapChunks(h)) {
       v1::PlanResponse r;
       *r.mutable_heat_map() = std::move(c);
-      if (!outbox().Post(std::move(r), /*bulk=*/true)) return;
+      if (!channel().Post(std::move(r), /*bulk=*/true)) return;
     }
   }
 
@@ -129,12 +137,113 @@ class EvaluateReactor final : public JobReactor<v1::EvaluateRequest, v1::Evaluat
     VC_ASSIGN_OR_RETURN(const Evaluation evaluation, backend().evaluate(input, options_, ctx));
     v1::EvaluateResponse r;
     *r.mutable_result() = wire::ToProto(evaluation, options_.viewpoints);
-    outbox().Post(std::move(r));
+    channel().Post(std::move(r));
     return ctx.CheckCancelled("the evaluation (while sending the result)");
   }
 
   EvaluateJobOptions options_;
 };
+
+// AttachPlan / AttachEvaluate: follows a detachable job from a new call. The job's events so far
+// are replayed into this call's outbox, then it follows the job live (JobChannel::Attach).
+template <class Response>
+class AttachReactor final : public grpc::ServerWriteReactor<Response> {
+ public:
+  AttachReactor(grpc::CallbackServerContext* ctx, ServiceState* state, const char* method)
+      : ctx_(ctx),
+        state_(state),
+        method_(method),
+        outbox_(std::make_shared<Outbox<Response>>([this](const Response* r) { this->StartWrite(r); },
+                                                   [this](const Status& s) { this->Finish(wire::ToGrpcStatus(s)); },
+                                                   &call_token_)) {}
+
+  void Start(const std::string& job_id) {
+    const Status s = Attach(job_id);
+    spdlog::info("rpc {} job={} peer={} status={}{}{}", method_, job_id, ctx_->peer(), int(wire::ToGrpcCode(s.code())),
+                 s.ok() ? "" : ": ", s.message());
+    if (!s.ok()) outbox_->Complete(s);
+  }
+
+  void OnWriteDone(bool ok) override { outbox_->OnWriteDone(ok); }
+
+  // The client went away again: the job runs on (its grace counts from now).
+  void OnCancel() override {
+    call_token_.Cancel();
+    outbox_->Break();
+    if (channel_) {
+      detached_ = true;
+      channel_->Detach(outbox_.get());
+    }
+    outbox_->Complete(CancelledError("the attach stream broke; the job runs on detached"));
+  }
+
+  void OnDone() override {
+    if (channel_ && !detached_.load() && channel_->state().done) {
+      channel_->MarkDelivered();  // its status reached the client: nothing more to keep
+      state_->kept.Erase(job_id_);
+    }
+    delete this;
+  }
+
+ private:
+  Status Attach(const std::string& job_id) {
+    if (!state_->Register(&call_token_)) {
+      return UnavailableError("this vc-server is shutting down; its jobs end with it");
+    }
+    registered_ = true;
+    std::string owner, why;
+    if (!Authenticate(*ctx_, state_->options.tokens, &owner, &why)) return UnauthenticatedError(why);
+    if (job_id.empty()) return InvalidArgumentError("job_id is empty: pass the id the Accepted event gave");
+    VC_ASSIGN_OR_RETURN(std::shared_ptr<KeptJob> job, state_->kept.Find(job_id, owner));
+    auto channel = std::dynamic_pointer_cast<JobChannel<Response>>(job);
+    if (!channel) {
+      return FailedPreconditionError("job " + job_id + " is a" + (job->method() == "Evaluate" ? "n " : " ") +
+                                     job->method() + " job: attach with Attach" + job->method());
+    }
+    channel_ = std::move(channel);
+    job_id_ = job_id;
+    return channel_->Attach(job_id, outbox_);
+  }
+
+ public:
+  ~AttachReactor() override {
+    if (registered_) state_->Unregister(&call_token_);
+  }
+
+ private:
+  grpc::CallbackServerContext* const ctx_;
+  ServiceState* const state_;
+  const char* const method_;
+  CancelToken call_token_;  // this call only; the job's is the channel's
+  bool registered_ = false;
+  std::atomic<bool> detached_{false};
+  std::string job_id_;  // set with channel_
+  std::shared_ptr<JobChannel<Response>> channel_;
+  const std::shared_ptr<Outbox<Response>> outbox_;
+};
+
+template <class Response>
+grpc::ServerWriteReactor<Response>* StartAttach(grpc::CallbackServerContext* ctx, ServiceState* state,
+                                                const char* method, const std::string& job_id) {
+  auto* reactor = new AttachReactor<Response>(ctx, state, method);
+  reactor->Start(job_id);
+  return reactor;
+}
+
+// CancelJob: a queued or running job is cancelled (its worker is free within a second); a finished
+// one's kept result is discarded.
+Result<std::string> CancelKeptJob(const grpc::CallbackServerContext& ctx, ServiceState& state, const std::string& id) {
+  std::string owner, why;
+  if (!Authenticate(ctx, state.options.tokens, &owner, &why)) return UnauthenticatedError(why);
+  if (id.empty()) return InvalidArgumentError("job_id is empty: pass the id the Accepted event gave");
+  VC_ASSIGN_OR_RETURN(std::shared_ptr<KeptJob> job, state.kept.Find(id, owner));
+  if (job->state().done) {
+    state.kept.Erase(id);
+    return std::string("discarded");
+  }
+  job->Cancel("job " + id + " was cancelled by CancelJob (vc-client cancel)");
+  return std::string("cancelled");
+}
 
 }  // namespace
 }  // namespace internal
@@ -155,6 +264,28 @@ grpc::ServerBidiReactor<v1::EvaluateRequest, v1::EvaluateResponse>* StationPlann
     grpc::CallbackServerContext* ctx) {
   auto* reactor = new internal::EvaluateReactor(ctx, state_.get(), "Evaluate");
   reactor->Start();
+  return reactor;
+}
+
+grpc::ServerWriteReactor<v1::PlanResponse>* StationPlannerService::AttachPlan(grpc::CallbackServerContext* ctx,
+                                                                              const v1::AttachRequest* request) {
+  return internal::StartAttach<v1::PlanResponse>(ctx, state_.get(), "AttachPlan", request->job_id());
+}
+
+grpc::ServerWriteReactor<v1::EvaluateResponse>* StationPlannerService::AttachEvaluate(
+    grpc::CallbackServerContext* ctx, const v1::AttachRequest* request) {
+  return internal::StartAttach<v1::EvaluateResponse>(ctx, state_.get(), "AttachEvaluate", request->job_id());
+}
+
+grpc::ServerUnaryReactor* StationPlannerService::CancelJob(grpc::CallbackServerContext* ctx,
+                                                           const v1::CancelJobRequest* request,
+                                                           v1::CancelJobResponse* response) {
+  auto* reactor = ctx->DefaultReactor();
+  const Result<std::string> outcome = internal::CancelKeptJob(*ctx, *state_, request->job_id());
+  spdlog::info("rpc CancelJob job={} peer={} outcome={}", request->job_id(), ctx->peer(),
+               outcome.ok() ? *outcome : outcome.status().message());
+  if (outcome.ok()) response->set_outcome(*outcome);
+  reactor->Finish(wire::ToGrpcStatus(outcome.ok() ? Status::Ok() : outcome.status()));
   return reactor;
 }
 

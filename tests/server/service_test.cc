@@ -604,7 +604,7 @@ TEST(Auth, WrongOrMissingTokenIsUnauthenticated) {
   testing::BlockingBackend backend;
   backend.block = false;
   auto o = SmallServer();
-  o.token = "s3cret";
+  o.tokens = {"s3cret"};
   auto server = testing::StartServer(o, backend.Make());
   ASSERT_TRUE(server);
   const auto rs = PlanRequests("0123456789");
@@ -620,7 +620,7 @@ TEST(Auth, WrongOrMissingTokenIsUnauthenticated) {
 
 TEST(Health, ServingWhileUpAndHealthNeedsNoToken) {
   auto o = SmallServer();
-  o.token = "s3cret";
+  o.tokens = {"s3cret"};
   auto server = testing::StartServer(o);
   ASSERT_TRUE(server);
   client::ConnectionOptions conn;

@@ -23,6 +23,7 @@
 
 namespace grpc {
 class Channel;
+class ChannelCredentials;
 class ClientContext;
 }  // namespace grpc
 
@@ -53,6 +54,23 @@ struct ConnectionOptions {
   // Name the scene by its SHA-256 first and upload it only when the server does not hold it
   // (docs/PROTOCOL.md, "The scene cache").
   bool scene_cache = true;
+  // Detachable jobs (docs/PROTOCOL.md, "Detachable jobs"): seconds the job may run on without this
+  // client (0 = it ends with the stream). With a grace, a stream that breaks after the job was
+  // accepted is re-attached (AttachPlan / AttachEvaluate) up to `max_attempts` times with backoff.
+  uint32_t detach_grace_s = 0;
+};
+
+// Where a job runs, once accepted: what a client needs to re-attach to it.
+struct JobTicket {
+  std::string job_id;
+  std::string attach_address;  // empty = the server the job was submitted to
+  uint32_t detach_grace_s = 0;
+};
+
+// An Evaluate job's outcome with the viewpoints it evaluated (as the server echoes them).
+struct EvaluateOutcome {
+  Evaluation evaluation;
+  std::vector<WorldPoint> viewpoints;
 };
 
 // How the last Plan or Evaluate call got its scene to the server.
@@ -75,6 +93,8 @@ struct JobObserver {
   std::function<void(const std::vector<PlannedStation>&)> on_final_stations;
   // Called before each retry, with the failed attempt's status (UNAVAILABLE) and the wait.
   std::function<void(const Status&, std::chrono::milliseconds)> on_retry;
+  // Called before each re-attach to a detached job, with the status that broke the stream.
+  std::function<void(const JobTicket&, const Status&, std::chrono::milliseconds)> on_reattach;
 };
 
 // A scene to upload: its bytes and a label for error messages (the file name).
@@ -94,10 +114,19 @@ class Client {
   Result<PlanResult> Plan(const Upload& upload, const PlanOptions& options, const JobObserver& observer = {});
   Result<Evaluation> Evaluate(const Upload& upload, const EvaluateJobOptions& options,
                               const JobObserver& observer = {});
+  // Re-attaches to a detachable job by id (docs/PROTOCOL.md, "Detachable jobs"): the events so far
+  // are replayed, then the job is followed to its end. FAILED_PRECONDITION when the job is of the
+  // other kind; NOT_FOUND when the server does not hold it (any more).
+  Result<PlanResult> AttachPlan(const std::string& job_id, const JobObserver& observer = {});
+  Result<EvaluateOutcome> AttachEvaluate(const std::string& job_id, const JobObserver& observer = {});
+  // Cancels a detachable job, or discards its kept result: "cancelled" or "discarded".
+  Result<std::string> CancelJob(const std::string& job_id);
   // grpc.health.v1.Health/Check of `service` ("" = the whole server). The value is the serving
   // status name ("SERVING"); a server that is not serving gives UNAVAILABLE.
   Result<std::string> Health(const std::string& service = "");
   const UploadOutcome& last_upload() const { return last_upload_; }
+  // The last Plan or Evaluate job accepted (job_id empty when none was).
+  const JobTicket& last_job() const { return last_job_; }
 
  private:
   Client() = default;
@@ -105,11 +134,22 @@ class Client {
   // then, when the server does not hold it (NOT_FOUND), uploading it; notes the outcome.
   Status WithSceneCache(const Upload& upload, v1::UploadSpec* spec, const std::function<Status(bool)>& call);
   UploadOutcome last_upload_;
+  JobTicket last_job_;
   void Prepare(grpc::ClientContext* ctx) const;
+  // The channel to re-attach through: this client's, or one to the ticket's attach_address.
+  std::shared_ptr<grpc::Channel> AttachChannel(const JobTicket& ticket);
+  // After a broken stream: re-attaches with `attach` (up to max_attempts, with backoff) while the
+  // failure is UNAVAILABLE; the original status when the job is not detachable.
+  // One AttachPlan / AttachEvaluate call to last_job_, followed to its end.
+  Status AttachPlanOnce(const JobObserver& observer, PlanResult* out);
+  Status AttachEvaluateOnce(const JobObserver& observer, EvaluateOutcome* out);
+  template <typename Fn>
+  Status Reattach(const Status& broken, const JobObserver& observer, Fn&& attach);
   template <typename Fn>
   Status WithRetries(const JobObserver& observer, Fn&& attempt);
 
   ConnectionOptions options_;
+  std::shared_ptr<grpc::ChannelCredentials> credentials_;
   std::shared_ptr<grpc::Channel> channel_;
 };
 

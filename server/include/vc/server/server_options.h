@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "vc/base/status.h"
 #include "vc/scene/scene_input.h"
@@ -32,8 +33,18 @@ struct ServerOptions {
   std::string tls_cert_file;
   std::string tls_key_file;
   std::string tls_client_ca_file;
-  // When non-empty, vc.v1 calls must carry "authorization: Bearer <token>".
-  std::string token;
+  // When non-empty, vc.v1 calls must carry "authorization: Bearer <token>" with one of these
+  // tokens. Each token owns the detachable jobs submitted with it: only it may attach or cancel.
+  std::vector<std::string> tokens;
+  // Detachable jobs (docs/PROTOCOL.md, "Detachable jobs"): the largest detach grace granted (a
+  // request asks for more is capped to it; 0 = no job is detachable), how long a finished job's
+  // result waits for a client, and the bytes of events all detachable jobs together may keep.
+  std::chrono::milliseconds max_detach_grace{std::chrono::hours(1)};
+  std::chrono::milliseconds result_ttl{std::chrono::minutes(30)};
+  uint64_t kept_results_bytes = uint64_t{1} << 30;
+  // The address clients re-attach to, sent in Accepted.attach_address (e.g. the pod's own
+  // address behind a load balancer); empty = the address the client used.
+  std::string advertise_address;
   // On shutdown, running jobs get this long to finish before they are cancelled.
   std::chrono::milliseconds shutdown_grace{std::chrono::seconds(30)};
 

@@ -1,10 +1,10 @@
 // StationPlannerService: the vc.v1.StationPlanner gRPC service (callback API, gRFC L67).
 //
-// Stateless: a job lives exactly as long as its stream. Reactions on gRPC's threads only do protocol
-// work; every job runs on the service's own bounded WorkerPool. Each RPC body is thin: convert the
-// spec (vc::wire::FromProto), call one Backend function, stream the converted result, and map the
-// vc::Status with ToGrpcStatus. Thread-safe; destroying the service joins its workers (shut the
-// grpc::Server down first).
+// Stateless: a job lives as long as its stream, unless the client asked for a detach grace; then it
+// may outlive it, and its events are kept in memory for a re-attach (kept_jobs.h), never on disk. Reactions on gRPC's
+// threads only do protocol work; every job runs on the service's own bounded WorkerPool. Each RPC body is thin: convert
+// the spec (vc::wire::FromProto), call one Backend function, stream the converted result, and map the vc::Status with
+// ToGrpcStatus. Thread-safe; destroying the service joins its workers (shut the grpc::Server down first).
 #pragma once
 
 #include <chrono>
@@ -29,6 +29,13 @@ class StationPlannerService final : public v1::StationPlanner::CallbackService {
   grpc::ServerBidiReactor<v1::PlanRequest, v1::PlanResponse>* Plan(grpc::CallbackServerContext* ctx) override;
   grpc::ServerBidiReactor<v1::EvaluateRequest, v1::EvaluateResponse>* Evaluate(
       grpc::CallbackServerContext* ctx) override;
+  // Detachable jobs (docs/PROTOCOL.md, "Detachable jobs").
+  grpc::ServerWriteReactor<v1::PlanResponse>* AttachPlan(grpc::CallbackServerContext* ctx,
+                                                         const v1::AttachRequest* request) override;
+  grpc::ServerWriteReactor<v1::EvaluateResponse>* AttachEvaluate(grpc::CallbackServerContext* ctx,
+                                                                 const v1::AttachRequest* request) override;
+  grpc::ServerUnaryReactor* CancelJob(grpc::CallbackServerContext* ctx, const v1::CancelJobRequest* request,
+                                      v1::CancelJobResponse* response) override;
 
   // For a shutdown (Server::Shutdown), all thread-safe. Drain: from now on new calls are refused
   // with UNAVAILABLE ("shutting down; retry"), which clients retry on another replica.

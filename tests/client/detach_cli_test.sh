@@ -1,0 +1,90 @@
+#!/usr/bin/env bash
+# Detachable jobs with the real binaries (docs/PROTOCOL.md, "Detachable jobs"): a plan survives a
+# killed vc-client and a new vc-client process attaches to it and gets the same stations as a plan
+# never interrupted; a second attach finds nothing (the result was delivered); `vc-client cancel`
+# ends another detached job, and attaching to it then says why it ended.
+# Usage: detach_cli_test.sh VC_SERVER VC_CLIENT SCENE (a scene whose plan takes a few seconds)
+set -euo pipefail
+server_bin="$1" client_bin="$2" scene="$3"
+work=$(mktemp -d)
+server_pid=""
+cleanup() {
+  if [[ -n "$server_pid" ]]; then kill "$server_pid" 2>/dev/null || true; wait "$server_pid" 2>/dev/null || true; fi
+  rm -rf "$work"
+}
+trap cleanup EXIT
+fail() { echo "detach: FAIL: $*" >&2; [[ -f "$work/server.log" ]] && tail -20 "$work/server.log" >&2; exit 1; }
+
+"$server_bin" --listen 127.0.0.1:0 --workers 1 --shutdown-grace 2 >"$work/server.log" 2>&1 &
+server_pid=$!
+port=""
+for _ in $(seq 1 100); do
+  port=$(sed -n 's/.*listening on .* (port \([0-9]*\)).*/\1/p' "$work/server.log" | head -1)
+  [[ -n "$port" ]] && break
+  kill -0 "$server_pid" 2>/dev/null || fail "vc-server exited"
+  sleep 0.1
+done
+[[ -n "$port" ]] || fail "vc-server did not report its port"
+addr="127.0.0.1:$port"
+
+# Starts a submit in the background and kills it (-9) as soon as its job runs; prints the job id.
+submit_and_kill() {
+  local name="$1"
+  "$client_bin" submit "$scene" --server "$addr" --out "$work/$name" >"$work/$name.out" 2>"$work/$name.err" &
+  local pid=$! job=""
+  for _ in $(seq 1 600); do
+    job=$(sed -n 's/.*job \(j-[0-9a-f]*\) started.*/\1/p' "$work/$name.err" | head -1)
+    [[ -n "$job" ]] && break
+    kill -0 "$pid" 2>/dev/null || { cat "$work/$name.err" >&2; fail "$name: vc-client ended before its job started"; }
+    sleep 0.05
+  done
+  [[ -n "$job" ]] || fail "$name: no 'job ... started' line"
+  kill -9 "$pid"
+  wait "$pid" 2>/dev/null || true
+  grep -q "vc-client attach $job" "$work/$name.err" || fail "$name: submit does not say how to re-attach"
+  echo "$job"
+}
+
+# The reference: a plan never interrupted (and it puts the scene in the server's cache).
+"$client_bin" submit "$scene" --server "$addr" --out "$work/direct" >/dev/null 2>"$work/direct.err" \
+  || { cat "$work/direct.err" >&2; fail "the reference plan failed"; }
+
+job=$(submit_and_kill killed)
+"$client_bin" attach "$job" --server "$addr" --out "$work/attached" >"$work/attach.out" 2>"$work/attach.err" \
+  || { cat "$work/attach.err" >&2; fail "attach $job failed"; }
+grep -q "job $job" "$work/attach.err" || fail "attach does not name the job it follows"
+grep -q "job $job detached" "$work/server.log" || fail "the server did not log the detach"
+cmp -s "$work/direct/stations.csv" "$work/attached/stations.csv" || fail "the attached plan's stations differ"
+python3 - "$work/direct/plan.json" "$work/attached/plan.json" <<'PY' || fail "the attached plan.json differs"
+import json, sys
+a, b = (json.load(open(p)) for p in sys.argv[1:])
+assert a["coverage"] == b["coverage"], (a["coverage"], b["coverage"])
+assert a["viewpoints"] == b["viewpoints"]
+assert a["parameters"] == b["parameters"]
+PY
+for f in plan.json stations.csv visibility.ply heatmap.png report.html; do
+  [[ -s "$work/attached/$f" ]] || fail "attach wrote no $f"
+done
+# Delivered: a second attach finds nothing (NOT_FOUND, exit 5) and says what may have happened.
+set +e
+"$client_bin" attach "$job" --server "$addr" --out "$work/again" >/dev/null 2>"$work/again.err"
+rc=$?
+set -e
+[[ $rc -eq 5 ]] || fail "a second attach exited $rc, not 5 (NOT_FOUND)"
+grep -q "no detachable job $job" "$work/again.err" || fail "a second attach does not explain the NOT_FOUND"
+
+job2=$(submit_and_kill cancelled)
+"$client_bin" cancel "$job2" --server "$addr" | grep -qx "job $job2: cancelled" || fail "cancel $job2"
+set +e
+"$client_bin" attach "$job2" --server "$addr" --out "$work/cancelled-out" >/dev/null 2>"$work/cancelled.attach.err"
+rc=$?
+set -e
+[[ $rc -eq 1 ]] || { cat "$work/cancelled.attach.err" >&2; fail "attaching to a cancelled job exited $rc, not 1 (CANCELLED)"; }
+grep -q "cancelled by CancelJob" "$work/cancelled.attach.err" || fail "attaching to a cancelled job does not say why"
+grep -q "rpc CancelJob job=$job2" "$work/server.log" || fail "the server did not log the CancelJob"
+
+kill -TERM "$server_pid"
+wait "$server_pid" && rc=0 || rc=$?
+server_pid=""
+[[ $rc -eq 0 ]] || fail "vc-server exited $rc after SIGTERM"
+echo "detach: OK (job $job attached from a new process; job $job2 cancelled)"
