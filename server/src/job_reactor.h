@@ -48,14 +48,14 @@ struct ServiceState {
         backend(std::move(b)),
         cache(o.scene_cache_bytes),
         runner(&backend, o.max_upload_bytes, &cache),
-        pool(o.EffectiveWorkers(), o.queue),
-        kept(o.result_ttl, o.kept_results_bytes) {}
+        kept(o.result_ttl, o.kept_results_bytes),
+        pool(o.EffectiveWorkers(), o.queue) {}
   const ServerOptions options;
   const Backend backend;
   SceneCache cache;
   const JobRunner runner;
-  WorkerPool pool;
-  KeptJobs kept;  // the detachable jobs, by id
+  KeptJobs kept;    // the detachable jobs, by id (their channels use its budget: outlives the pool)
+  WorkerPool pool;  // destroyed first: joins the workers
   std::atomic<uint64_t> next_job{1};
 
   // The calls alive now, by their cancel tokens, for a shutdown: Drain refuses new calls,

@@ -101,6 +101,23 @@ python3 -c 'import json,sys; u=json.load(open(sys.argv[1]))["upload"]; assert u[
 grep -q "cache=hit" "$work/server.log" || fail "the server log has no cache=hit"
 grep -q "cache=miss" "$work/server.log" || fail "the server log has no cache=miss"
 
+# evaluate voxelises a cloud at its own --resolution: compact at 0.05 m, the same figures as raw.
+for mode in compact raw; do
+  flag=""; [[ $mode == raw ]] && flag="--raw-upload"
+  "$client_bin" evaluate "$work/box.ply" --viewpoints "$work/out/stations.csv" --resolution 0.05 $flag \
+    --no-scene-cache --server "$addr" --out "$work/eval-$mode" >/dev/null 2>"$work/eval-$mode.err" \
+    || { cat "$work/eval-$mode.err" >&2; fail "vc-client evaluate ($mode) failed"; }
+done
+grep -q "compact upload: .* voxels of 0.05 m" "$work/eval-compact.err" \
+  || { cat "$work/eval-compact.err" >&2; fail "evaluate did not upload compactly at its --resolution"; }
+python3 - "$work/eval-compact/evaluation.json" "$work/eval-raw/evaluation.json" <<'PY' || fail "evaluate: compact and raw differ"
+import json, sys
+compact, raw = (json.load(open(p)) for p in sys.argv[1:3])
+assert compact["resolution_m"] == raw["resolution_m"] == 0.05, (compact["resolution_m"], raw["resolution_m"])
+for k in ("faces_total", "global_visibility", "fully_visible_fraction", "per_viewpoint"):
+    assert compact[k] == raw[k], (k, compact[k], raw[k])
+PY
+
 # A bad input gives a clear error and the INVALID_ARGUMENT exit status (3).
 head -c 100 "$work/box.ply" > "$work/broken.ply"
 set +e
