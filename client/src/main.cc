@@ -5,9 +5,13 @@
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
+#include <csignal>
 #include <cstdio>
 #include <iostream>
+#include <mutex>
+#include <optional>
 #include <string>
+#include <thread>
 
 #include "vc/client/client.h"
 #include "vc/client/compact_upload.h"
@@ -51,6 +55,52 @@ void NoteCache(const vc::client::UploadOutcome& outcome, vc::UploadSummary* summ
   }
 }
 
+// Ctrl-C (SIGINT) or SIGTERM while a job runs: the job is cancelled on the server (CancelJob), so
+// its worker is free at once, rather than left running detached as a dropped link would leave it.
+// The signals are blocked in every thread (gRPC's too) and taken by one watcher thread.
+class InterruptCancelsTheJob {
+ public:
+  explicit InterruptCancelsTheJob(vc::client::ConnectionOptions conn) : conn_(std::move(conn)) {
+    sigemptyset(&signals_);
+    sigaddset(&signals_, SIGINT);
+    sigaddset(&signals_, SIGTERM);
+    pthread_sigmask(SIG_BLOCK, &signals_, nullptr);
+    std::thread([this] { Watch(); }).detach();
+  }
+  void set_job(const std::string& id) {
+    std::lock_guard lock(mu_);
+    job_id_ = id;
+  }
+
+ private:
+  [[noreturn]] void Watch() {
+    int sig = 0;
+    sigwait(&signals_, &sig);
+    std::string id;
+    {
+      std::lock_guard lock(mu_);
+      id = job_id_;
+    }
+    if (!id.empty() && conn_.detach_grace_s > 0) {
+      conn_.max_attempts = 1;
+      conn_.timeout = std::chrono::seconds(3);
+      auto client = vc::client::Client::Create(conn_);
+      const auto r = client.ok() ? (*client)->CancelJob(id) : vc::Result<std::string>(client.status());
+      std::fprintf(
+          stderr, "\nvc-client: interrupted; job %s %s\n", id.c_str(),
+          r.ok() ? (*r + " on the server").c_str()
+                 : ("may still run on the server (" + r.status().message() + "): vc-client cancel " + id).c_str());
+    } else {
+      std::fprintf(stderr, "\nvc-client: interrupted\n");
+    }
+    std::_Exit(128 + sig);
+  }
+  vc::client::ConnectionOptions conn_;
+  sigset_t signals_;
+  std::mutex mu_;
+  std::string job_id_;
+};
+
 // Writes evaluation.json and prints G.
 int WriteEvaluation(const vc::Evaluation& r, const std::vector<vc::WorldPoint>& viewpoints,
                     const std::string& out_dir) {
@@ -62,10 +112,12 @@ int WriteEvaluation(const vc::Evaluation& r, const std::vector<vc::WorldPoint>& 
   return 0;
 }
 
-vc::client::JobObserver Observe(vc::client::ProgressDisplay& display, uint32_t detach_grace_s = 0) {
+vc::client::JobObserver Observe(vc::client::ProgressDisplay& display, uint32_t detach_grace_s = 0,
+                                InterruptCancelsTheJob* interrupt = nullptr) {
   vc::client::JobObserver o;
-  o.on_accepted = [&display, detach_grace_s](const std::string& id, uint32_t pos) {
+  o.on_accepted = [&display, detach_grace_s, interrupt](const std::string& id, uint32_t pos) {
     display.Accepted(id, pos);
+    if (interrupt != nullptr) interrupt->set_job(id);
     if (detach_grace_s > 0) {
       display.Note("it runs on for " + std::to_string(detach_grace_s) +
                    " s if the connection drops: vc-client attach " + id + " (or cancel " + id + ")");
@@ -194,6 +246,10 @@ int main(int argc, char** argv) {
     return 0;
   }
 
+  // Before any gRPC thread exists, so that every thread inherits the blocked signals.
+  std::optional<InterruptCancelsTheJob> interrupt;
+  // (attach leaves SIGINT as it is: interrupting it stops following, and the job runs on.)
+  if (*submit || *evaluate) interrupt.emplace(conn);
   auto client = vc::client::Client::Create(conn);
   if (!client.ok()) return Fail("cannot set up the connection", client.status());
 
@@ -246,7 +302,7 @@ int main(int argc, char** argv) {
   display.Uploading(upload->source_name, upload->bytes.size(), conn.server);
 
   if (*submit) {
-    auto r = (*client)->Plan(*upload, plan, Observe(display, conn.detach_grace_s));
+    auto r = (*client)->Plan(*upload, plan, Observe(display, conn.detach_grace_s, interrupt ? &*interrupt : nullptr));
     display.Done();
     if (!r.ok()) return FailCall("plan", r.status(), conn.server);
     NoteCache((*client)->last_upload(), &prepared.summary, display);
@@ -264,7 +320,7 @@ int main(int argc, char** argv) {
   auto points = vc::ParseStationsCsv(text->bytes, viewpoints_csv);
   if (!points.ok()) return Fail("bad viewpoints file", points.status());
   eval.viewpoints = std::move(points).value();
-  auto r = (*client)->Evaluate(*upload, eval, Observe(display, conn.detach_grace_s));
+  auto r = (*client)->Evaluate(*upload, eval, Observe(display, conn.detach_grace_s, interrupt ? &*interrupt : nullptr));
   display.Done();
   if (!r.ok()) return FailCall("evaluate", r.status(), conn.server);
   NoteCache((*client)->last_upload(), &prepared.summary, display);

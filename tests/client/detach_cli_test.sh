@@ -2,7 +2,8 @@
 # Detachable jobs with the real binaries (docs/PROTOCOL.md, "Detachable jobs"): a plan survives a
 # killed vc-client and a new vc-client process attaches to it and gets the same stations as a plan
 # never interrupted; a second attach finds nothing (the result was delivered); `vc-client cancel`
-# ends another detached job, and attaching to it then says why it ended.
+# ends another detached job, and attaching to it then says why it ended; Ctrl-C on a submit cancels
+# its job.
 # Usage: detach_cli_test.sh VC_SERVER VC_CLIENT SCENE (a scene whose plan takes a few seconds)
 set -euo pipefail
 server_bin="$1" client_bin="$2" scene="$3"
@@ -27,9 +28,10 @@ done
 [[ -n "$port" ]] || fail "vc-server did not report its port"
 addr="127.0.0.1:$port"
 
-# Starts a submit in the background and kills it (-9) as soon as its job runs; prints the job id.
+# Starts a submit in the background and kills it (SIGKILL, or $2) as soon as its job runs; prints
+# the job id.
 submit_and_kill() {
-  local name="$1"
+  local name="$1" signal="${2:-KILL}"
   "$client_bin" submit "$scene" --server "$addr" --out "$work/$name" >"$work/$name.out" 2>"$work/$name.err" &
   local pid=$! job=""
   for _ in $(seq 1 600); do
@@ -39,7 +41,7 @@ submit_and_kill() {
     sleep 0.05
   done
   [[ -n "$job" ]] || fail "$name: no 'job ... started' line"
-  kill -9 "$pid"
+  kill -"$signal" "$pid"
   wait "$pid" 2>/dev/null || true
   grep -q "vc-client attach $job" "$work/$name.err" || fail "$name: submit does not say how to re-attach"
   echo "$job"
@@ -83,8 +85,14 @@ set -e
 grep -q "cancelled by CancelJob" "$work/cancelled.attach.err" || fail "attaching to a cancelled job does not say why"
 grep -q "rpc CancelJob job=$job2" "$work/server.log" || fail "the server did not log the CancelJob"
 
+# Ctrl-C is not a dropped link: vc-client cancels its job on the server before it exits.
+job3=$(submit_and_kill interrupted INT)
+grep -q "vc-client: interrupted; job $job3 cancelled on the server" "$work/interrupted.err" \
+  || { cat "$work/interrupted.err" >&2; fail "Ctrl-C did not cancel the job"; }
+grep -q "rpc CancelJob job=$job3 .*outcome=cancelled" "$work/server.log" || fail "the server did not log the Ctrl-C's CancelJob"
+
 kill -TERM "$server_pid"
 wait "$server_pid" && rc=0 || rc=$?
 server_pid=""
 [[ $rc -eq 0 ]] || fail "vc-server exited $rc after SIGTERM"
-echo "detach: OK (job $job attached from a new process; job $job2 cancelled)"
+echo "detach: OK (job $job attached from a new process; job $job2 cancelled; job $job3 cancelled by Ctrl-C)"
