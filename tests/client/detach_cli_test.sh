@@ -7,26 +7,9 @@
 # Usage: detach_cli_test.sh VC_SERVER VC_CLIENT SCENE (a scene whose plan takes a few seconds)
 set -euo pipefail
 server_bin="$1" client_bin="$2" scene="$3"
-work=$(mktemp -d)
-server_pid=""
-cleanup() {
-  if [[ -n "$server_pid" ]]; then kill "$server_pid" 2>/dev/null || true; wait "$server_pid" 2>/dev/null || true; fi
-  rm -rf "$work"
-}
-trap cleanup EXIT
-fail() { echo "detach: FAIL: $*" >&2; [[ -f "$work/server.log" ]] && tail -20 "$work/server.log" >&2; exit 1; }
-
-"$server_bin" --listen 127.0.0.1:0 --workers 1 --shutdown-grace 2 >"$work/server.log" 2>&1 &
-server_pid=$!
-port=""
-for _ in $(seq 1 100); do
-  port=$(sed -n 's/.*listening on .* (port \([0-9]*\)).*/\1/p' "$work/server.log" | head -1)
-  [[ -n "$port" ]] && break
-  kill -0 "$server_pid" 2>/dev/null || fail "vc-server exited"
-  sleep 0.1
-done
-[[ -n "$port" ]] || fail "vc-server did not report its port"
-addr="127.0.0.1:$port"
+test_name=detach
+source "$(dirname "$0")/server_lib.sh"
+start_server "$server_bin" --workers 1 --shutdown-grace 2
 
 # Starts a submit in the background and kills it (SIGKILL, or $2) as soon as its job runs; prints
 # the job id.
@@ -91,8 +74,5 @@ grep -q "vc-client: interrupted; job $job3 cancelled on the server" "$work/inter
   || { cat "$work/interrupted.err" >&2; fail "Ctrl-C did not cancel the job"; }
 grep -q "rpc CancelJob job=$job3 .*outcome=cancelled" "$work/server.log" || fail "the server did not log the Ctrl-C's CancelJob"
 
-kill -TERM "$server_pid"
-wait "$server_pid" && rc=0 || rc=$?
-server_pid=""
-[[ $rc -eq 0 ]] || fail "vc-server exited $rc after SIGTERM"
+stop_server
 echo "detach: OK (job $job attached from a new process; job $job2 cancelled; job $job3 cancelled by Ctrl-C)"

@@ -3,14 +3,8 @@
 # vc-client, and the output files are checked. Usage: smoke_test.sh VC_SERVER VC_CLIENT VC_SYNTH
 set -euo pipefail
 server_bin="$1" client_bin="$2" synth_bin="$3"
-work=$(mktemp -d)
-server_pid=""
-cleanup() {
-  if [[ -n "$server_pid" ]]; then kill "$server_pid" 2>/dev/null || true; wait "$server_pid" 2>/dev/null || true; fi
-  rm -rf "$work"
-}
-trap cleanup EXIT
-fail() { echo "smoke: FAIL: $*" >&2; [[ -f "$work/server.log" ]] && tail -20 "$work/server.log" >&2; exit 1; }
+test_name=smoke
+source "$(dirname "$0")/server_lib.sh"
 
 "$synth_bin" box --out "$work/box.ply" >/dev/null || fail "vc-synth box failed"
 [[ -s "$work/box.ply" ]] || fail "vc-synth wrote no box.ply"
@@ -28,18 +22,7 @@ assert [s["points"] for s in scans] == [8, 8], scans
 assert scans[1]["translation_m"] == [4, -2, 1.5], scans
 ' || fail "inspect --json: e57_scans"
 
-# Port 0: the server picks a free port and logs it.
-"$server_bin" --listen 127.0.0.1:0 --workers 1 --shutdown-grace 2 >"$work/server.log" 2>&1 &
-server_pid=$!
-port=""
-for _ in $(seq 1 100); do
-  port=$(sed -n 's/.*listening on .* (port \([0-9]*\)).*/\1/p' "$work/server.log" | head -1)
-  [[ -n "$port" ]] && break
-  kill -0 "$server_pid" 2>/dev/null || fail "vc-server exited"
-  sleep 0.1
-done
-[[ -n "$port" ]] || fail "vc-server did not report its port"
-addr="127.0.0.1:$port"
+start_server "$server_bin" --workers 1 --shutdown-grace 2
 
 "$client_bin" health --server "$addr" | grep -qx SERVING || fail "health is not SERVING"
 
@@ -139,10 +122,7 @@ assert s["max_range_m"] == 40 and s["min_range_m"] == 0.5 and s["vfov_min_deg"] 
 PY
 
 # SIGTERM: the server drains and exits 0.
-kill -TERM "$server_pid"
-wait "$server_pid" && rc=0 || rc=$?
-server_pid=""
-[[ $rc -eq 0 ]] || fail "vc-server exited $rc after SIGTERM"
+stop_server
 
 # Nothing listens now: UNAVAILABLE (14), worded for people.
 set +e

@@ -10,6 +10,7 @@
 #include <thread>
 #include <vector>
 
+#include "server/test_messages.h"
 #include "vc/v1/planner.pb.h"
 
 namespace vc::server {
@@ -19,21 +20,9 @@ using Message = v1::PlanResponse;
 using Channel = JobChannel<Message>;
 using namespace std::chrono_literals;
 
-Message Accepted(const std::string& id) {
-  Message m;
-  m.mutable_accepted()->set_job_id(id);
-  return m;
-}
-Message Progress(double fraction) {
-  Message m;
-  m.mutable_progress()->set_fraction(fraction);
-  return m;
-}
-Message Bulk(size_t bytes) {
-  Message m;
-  m.mutable_voxels()->mutable_centers_xyz_m()->Resize(int(bytes / sizeof(float)), 0.f);
-  return m;
-}
+Message Accepted(const std::string& id) { return testing::AcceptedMessage(id); }
+Message Progress(double fraction) { return testing::ProgressMessage(fraction); }
+Message Bulk(size_t bytes) { return testing::BulkMessage(bytes); }
 
 // An outbox whose writes complete at once: what a healthy client received, and its final status.
 struct RecordingSink {

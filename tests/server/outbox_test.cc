@@ -11,6 +11,7 @@
 #include <thread>
 #include <vector>
 
+#include "server/test_messages.h"
 #include "vc/v1/planner.pb.h"
 
 namespace vc::server {
@@ -18,23 +19,9 @@ namespace {
 
 using Message = v1::PlanResponse;
 
-Message Accepted(const std::string& id) {
-  Message m;
-  m.mutable_accepted()->set_job_id(id);
-  return m;
-}
-
-Message Progress(double fraction) {
-  Message m;
-  m.mutable_progress()->set_fraction(fraction);
-  return m;
-}
-
-Message Bulk(size_t bytes) {
-  Message m;
-  m.mutable_voxels()->mutable_centers_xyz_m()->Resize(int(bytes / sizeof(float)), 0.f);
-  return m;
-}
+Message Accepted(const std::string& id) { return testing::AcceptedMessage(id); }
+Message Progress(double fraction) { return testing::ProgressMessage(fraction); }
+Message Bulk(size_t bytes) { return testing::BulkMessage(bytes); }
 
 // Records the writes; the test completes them one at a time with Ack.
 struct FakeStream {
