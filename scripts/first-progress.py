@@ -41,8 +41,10 @@ def main():
     ap.add_argument("server")
     ap.add_argument("scene")
     ap.add_argument("--repeat", type=int, default=3)
-    ap.add_argument("extra", nargs="*")
-    a = ap.parse_args()
+    argv = sys.argv[1:]
+    extra = argv[argv.index("--") + 1:] if "--" in argv else []
+    a = ap.parse_args(argv[:argv.index("--")] if "--" in argv else argv)
+    a.extra = extra
     runs = [one_run(a.client, a.server, a.scene, a.extra) for _ in range(a.repeat)]
     med = [statistics.median(r[i] for r in runs) for i in range(3)]
     flags = " ".join(a.extra) or "(compact)"
