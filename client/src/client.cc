@@ -135,6 +135,7 @@ void NoteAccepted(const v1::Accepted& a, const JobObserver& observer, JobTicket*
   ticket->attach_address = a.attach_address();
   ticket->detach_grace_s = a.detach_grace_s();
   if (observer.on_accepted) observer.on_accepted(a.job_id(), a.queue_position());
+  if (observer.on_job) observer.on_job(*ticket);
 }
 
 // Reads a Plan event stream (Plan's or AttachPlan's) to its end and its status.
@@ -234,15 +235,23 @@ Status Client::Reattach(const Status& broken, const JobObserver& observer, Fn&& 
   if (broken.code() != StatusCode::kUnavailable || last_job_.job_id.empty() || last_job_.detach_grace_s == 0) {
     return broken;
   }
-  // Keep trying while the job may still be alive: within its grace, from 1 s up to 30 s apart.
-  const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(last_job_.detach_grace_s);
+  // Keep trying while the job may still be alive: within its grace of the moment the stream was
+  // last alive (the server grants a fresh grace at every break), from 1 s up to 30 s apart.
+  using Clock = std::chrono::steady_clock;
+  const auto grace = std::chrono::seconds(last_job_.detach_grace_s);
+  auto give_up = Clock::now() + grace;
   auto backoff = std::max(options_.initial_backoff, std::chrono::milliseconds(0));
   Status s = broken;
-  while (s.code() == StatusCode::kUnavailable && std::chrono::steady_clock::now() + backoff < give_up) {
+  while (s.code() == StatusCode::kUnavailable && Clock::now() + backoff < give_up) {
     if (observer.on_reattach) observer.on_reattach(last_job_, s, backoff);
     std::this_thread::sleep_for(backoff);
     backoff = std::min(std::max(backoff * 2, std::chrono::milliseconds(1000)), std::chrono::milliseconds(30000));
-    s = attach();
+    bool followed = false;
+    s = attach(&followed);
+    if (followed) {  // it was attached again, then broke again: a new grace, a fresh backoff
+      give_up = Clock::now() + grace;
+      backoff = std::max(options_.initial_backoff, std::chrono::milliseconds(0));
+    }
   }
   return s;
 }
@@ -262,7 +271,7 @@ Result<PlanResult> Client::Plan(const Upload& upload, const PlanOptions& options
       auto stream = stub->Plan(&ctx);
       SendUpload(*stream, spec, from_cache ? kNoData : upload, options_.chunk_bytes);
       const Status s = FollowPlan(*stream, observer, &last_job_, accepted, &out);
-      return Reattach(s, observer, [&] { return AttachPlanOnce(observer, &out); });
+      return Reattach(s, observer, [&](bool* followed) { return AttachPlanOnce(observer, &out, followed); });
     });
   });
   if (!status.ok()) return status;
@@ -285,40 +294,38 @@ Result<Evaluation> Client::Evaluate(const Upload& upload, const EvaluateJobOptio
       auto stream = stub->Evaluate(&ctx);
       SendUpload(*stream, spec, from_cache ? kNoData : upload, options_.chunk_bytes);
       const Status s = FollowEvaluate(*stream, observer, &last_job_, accepted, &out);
-      return Reattach(s, observer, [&] { return AttachEvaluateOnce(observer, &out); });
+      return Reattach(s, observer, [&](bool* followed) { return AttachEvaluateOnce(observer, &out, followed); });
     });
   });
   if (!status.ok()) return status;
   return std::move(out.evaluation);
 }
 
-Status Client::AttachPlanOnce(const JobObserver& observer, PlanResult* out) {
+Status Client::AttachPlanOnce(const JobObserver& observer, PlanResult* out, bool* followed) {
   auto stub = v1::StationPlanner::NewStub(AttachChannel(last_job_));
   grpc::ClientContext ctx;
   Prepare(&ctx);
   v1::AttachRequest request;
   request.set_job_id(last_job_.job_id);
   auto stream = stub->AttachPlan(&ctx, request);
-  bool accepted = false;
-  return FollowPlan(*stream, observer, &last_job_, &accepted, out);
+  return FollowPlan(*stream, observer, &last_job_, followed, out);
 }
 
-Status Client::AttachEvaluateOnce(const JobObserver& observer, EvaluateOutcome* out) {
+Status Client::AttachEvaluateOnce(const JobObserver& observer, EvaluateOutcome* out, bool* followed) {
   auto stub = v1::StationPlanner::NewStub(AttachChannel(last_job_));
   grpc::ClientContext ctx;
   Prepare(&ctx);
   v1::AttachRequest request;
   request.set_job_id(last_job_.job_id);
   auto stream = stub->AttachEvaluate(&ctx, request);
-  bool accepted = false;
-  return FollowEvaluate(*stream, observer, &last_job_, &accepted, out);
+  return FollowEvaluate(*stream, observer, &last_job_, followed, out);
 }
 
 Result<PlanResult> Client::AttachPlan(const std::string& job_id, const JobObserver& observer) {
   last_job_ = {job_id, "", 0};
   PlanResult out;
-  Status s = WithRetries(observer, [&](bool*) { return AttachPlanOnce(observer, &out); });
-  s = Reattach(s, observer, [&] { return AttachPlanOnce(observer, &out); });
+  const auto once = [&](bool* followed) { return AttachPlanOnce(observer, &out, followed); };
+  const Status s = Reattach(WithRetries(observer, once), observer, once);
   if (!s.ok()) return s;
   return out;
 }
@@ -326,8 +333,8 @@ Result<PlanResult> Client::AttachPlan(const std::string& job_id, const JobObserv
 Result<EvaluateOutcome> Client::AttachEvaluate(const std::string& job_id, const JobObserver& observer) {
   last_job_ = {job_id, "", 0};
   EvaluateOutcome out;
-  Status s = WithRetries(observer, [&](bool*) { return AttachEvaluateOnce(observer, &out); });
-  s = Reattach(s, observer, [&] { return AttachEvaluateOnce(observer, &out); });
+  const auto once = [&](bool* followed) { return AttachEvaluateOnce(observer, &out, followed); };
+  const Status s = Reattach(WithRetries(observer, once), observer, once);
   if (!s.ok()) return s;
   return out;
 }

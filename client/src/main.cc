@@ -67,23 +67,25 @@ class InterruptCancelsTheJob {
     pthread_sigmask(SIG_BLOCK, &signals_, nullptr);
     std::thread([this] { Watch(); }).detach();
   }
-  void set_job(const std::string& id) {
+  void set_job(const vc::client::JobTicket& ticket) {
     std::lock_guard lock(mu_);
-    job_id_ = id;
+    job_ = ticket;
   }
 
  private:
   [[noreturn]] void Watch() {
     int sig = 0;
     sigwait(&signals_, &sig);
-    std::string id;
+    vc::client::JobTicket job;
     {
       std::lock_guard lock(mu_);
-      id = job_id_;
+      job = job_;
     }
-    if (!id.empty() && conn_.detach_grace_s > 0) {
+    const std::string& id = job.job_id;
+    if (!id.empty() && job.detach_grace_s > 0) {  // else the job ends with this process's stream
       conn_.max_attempts = 1;
       conn_.timeout = std::chrono::seconds(3);
+      if (!job.attach_address.empty()) conn_.server = job.attach_address;  // the replica running it
       auto client = vc::client::Client::Create(conn_);
       const auto r = client.ok() ? (*client)->CancelJob(id) : vc::Result<std::string>(client.status());
       std::fprintf(
@@ -98,7 +100,7 @@ class InterruptCancelsTheJob {
   vc::client::ConnectionOptions conn_;
   sigset_t signals_;
   std::mutex mu_;
-  std::string job_id_;
+  vc::client::JobTicket job_;
 };
 
 // Writes evaluation.json and prints G.
@@ -112,16 +114,16 @@ int WriteEvaluation(const vc::Evaluation& r, const std::vector<vc::WorldPoint>& 
   return 0;
 }
 
-vc::client::JobObserver Observe(vc::client::ProgressDisplay& display, uint32_t detach_grace_s = 0,
-                                InterruptCancelsTheJob* interrupt = nullptr) {
+vc::client::JobObserver Observe(vc::client::ProgressDisplay& display, InterruptCancelsTheJob* interrupt = nullptr) {
   vc::client::JobObserver o;
-  o.on_accepted = [&display, detach_grace_s, interrupt](const std::string& id, uint32_t pos) {
-    display.Accepted(id, pos);
-    if (interrupt != nullptr) interrupt->set_job(id);
-    if (detach_grace_s > 0) {
-      display.Note("it runs on for " + std::to_string(detach_grace_s) +
-                   " s if the connection drops: vc-client attach " + id + " (or cancel " + id + ")");
-    }
+  o.on_accepted = [&display](const std::string& id, uint32_t pos) { display.Accepted(id, pos); };
+  o.on_job = [&display, interrupt, noted = false](const vc::client::JobTicket& t) mutable {
+    if (interrupt != nullptr) interrupt->set_job(t);
+    if (t.detach_grace_s == 0 || noted) return;
+    noted = true;  // once, not again on a re-attach's replay
+    const std::string server = t.attach_address.empty() ? "" : " --server " + t.attach_address;
+    display.Note("it runs on for " + std::to_string(t.detach_grace_s) + " s if the connection drops: vc-client" +
+                 server + " attach " + t.job_id + " (or cancel " + t.job_id + ")");
   };
   o.on_progress = [&](const vc::ProgressEvent& e) { display.Update(e); };
   o.on_station = [&](const vc::PlannedStation& s, int i) { display.Station(s, i); };
@@ -247,9 +249,9 @@ int main(int argc, char** argv) {
   }
 
   // Before any gRPC thread exists, so that every thread inherits the blocked signals.
-  std::optional<InterruptCancelsTheJob> interrupt;
+  InterruptCancelsTheJob* interrupt = nullptr;  // never freed: its watcher thread lives as long as the process
   // (attach leaves SIGINT as it is: interrupting it stops following, and the job runs on.)
-  if (*submit || *evaluate) interrupt.emplace(conn);
+  if (*submit || *evaluate) interrupt = new InterruptCancelsTheJob(conn);
   auto client = vc::client::Client::Create(conn);
   if (!client.ok()) return Fail("cannot set up the connection", client.status());
 
@@ -302,7 +304,7 @@ int main(int argc, char** argv) {
   display.Uploading(upload->source_name, upload->bytes.size(), conn.server);
 
   if (*submit) {
-    auto r = (*client)->Plan(*upload, plan, Observe(display, conn.detach_grace_s, interrupt ? &*interrupt : nullptr));
+    auto r = (*client)->Plan(*upload, plan, Observe(display, interrupt));
     display.Done();
     if (!r.ok()) return FailCall("plan", r.status(), conn.server);
     NoteCache((*client)->last_upload(), &prepared.summary, display);
@@ -320,7 +322,7 @@ int main(int argc, char** argv) {
   auto points = vc::ParseStationsCsv(text->bytes, viewpoints_csv);
   if (!points.ok()) return Fail("bad viewpoints file", points.status());
   eval.viewpoints = std::move(points).value();
-  auto r = (*client)->Evaluate(*upload, eval, Observe(display, conn.detach_grace_s, interrupt ? &*interrupt : nullptr));
+  auto r = (*client)->Evaluate(*upload, eval, Observe(display, interrupt));
   display.Done();
   if (!r.ok()) return FailCall("evaluate", r.status(), conn.server);
   NoteCache((*client)->last_upload(), &prepared.summary, display);

@@ -21,6 +21,7 @@
 #include <cstdint>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <set>
 #include <string>
 
@@ -54,8 +55,6 @@ struct ServiceState {
   const Backend backend;
   SceneCache cache;
   const JobRunner runner;
-  KeptJobs kept;    // the detachable jobs, by id (their channels use its budget: outlives the pool)
-  WorkerPool pool;  // destroyed first: joins the workers
   std::atomic<uint64_t> next_job{1};
 
   // The calls alive now, by their cancel tokens, for a shutdown: Drain refuses new calls,
@@ -93,6 +92,12 @@ struct ServiceState {
   std::condition_variable calls_ended;
   std::set<CancelToken*> calls;
   bool draining = false;
+
+ public:
+  // Declared last, so destroyed first: the pool's destructor joins the workers, and a detached
+  // job's worker may still unregister its call and release its kept events.
+  KeptJobs kept;    // the detachable jobs, by id
+  WorkerPool pool;  // the workers
 };
 
 // Checks the call's bearer token against `tokens` (constant time; any token when `tokens` is
@@ -115,7 +120,10 @@ class JobReactor : public grpc::ServerBidiReactor<Request, Response> {
         upload_(state->options.max_upload_bytes, &state->pool),
         channel_(std::make_shared<JobChannel<Response>>(method, state->kept.budget())),
         outbox_(std::make_shared<Outbox<Response>>([this](const Response* r) { this->StartWrite(r); },
-                                                   [this](const Status& s) { this->Finish(wire::ToGrpcStatus(s)); },
+                                                   [this](const Status& s) {
+                                                     finished_with_ = s;
+                                                     this->Finish(wire::ToGrpcStatus(s));
+                                                   },
                                                    &token())) {
     channel_->SetSink(outbox_);
   }
@@ -124,8 +132,9 @@ class JobReactor : public grpc::ServerBidiReactor<Request, Response> {
   void Start() {
     const auto deadline = ctx_->deadline();
     if (deadline != std::chrono::system_clock::time_point::max()) {
-      token().SetDeadline(Clock::now() +
-                          std::chrono::duration_cast<Clock::duration>(deadline - std::chrono::system_clock::now()));
+      const auto at =
+          Clock::now() + std::chrono::duration_cast<Clock::duration>(deadline - std::chrono::system_clock::now());
+      token().SetDeadline(at);
     }
     registered_ = state_->Register(&token());
     if (!registered_) {
@@ -161,6 +170,7 @@ class JobReactor : public grpc::ServerBidiReactor<Request, Response> {
   void OnCancel() override {
     const bool past_deadline = ctx_->deadline() != std::chrono::system_clock::time_point::max() &&
                                std::chrono::system_clock::now() >= ctx_->deadline();
+    cancelled_ = true;
     outbox_->Break();
     if (submitted_.load() && channel_->detachable() && !past_deadline && !token().cancelled()) {
       detached_ = true;
@@ -171,12 +181,16 @@ class JobReactor : public grpc::ServerBidiReactor<Request, Response> {
       return;
     }
     if (!past_deadline || !token().cancelled()) token().Cancel();
+    // The call ends now (the worker, if any, holds the reactor until it stops); its status cannot
+    // reach a client that is gone, and one past its deadline has its own.
+    outbox_->Complete(past_deadline ? DeadlineExceededError("the call's deadline passed")
+                                    : CancelledError("the call was cancelled"));
   }
 
   // The call is over; the reactor lives on while a detached job's worker still uses it.
   void OnDone() override {
-    if (!detached_ && submitted_.load() && channel_->state().done) {
-      channel_->MarkDelivered();  // its status reached the client: nothing more to keep
+    // Delivered: this call ended with the job's own final status on a stream that did not break.
+    if (submitted_.load() && !cancelled_.load() && finished_with_ && channel_->Delivered(*finished_with_)) {
       state_->kept.Erase(job_id_);
     }
     ReleaseHold();
@@ -304,14 +318,16 @@ class JobReactor : public grpc::ServerBidiReactor<Request, Response> {
   ServiceState* const state_;
   const char* const method_;
   const Clock::time_point start_;
-  bool registered_ = false;             // in the service's calls (Start); unregistered with the last hold
-  std::atomic<int> holds_{1};           // the call's, plus the worker's once submitted
-  std::atomic<bool> submitted_{false};  // the job went to the pool
-  std::atomic<bool> detached_{false};   // OnCancel let the job run on
-  std::string job_id_;                  // for the log, once submitted
-  Request request_;                     // the message being read (gRPC threads, one reaction at a time)
-  UploadAssembler upload_;              // gRPC threads until the job is submitted
-  Job job_;                             // handed to the worker
+  bool registered_ = false;              // in the service's calls (Start); unregistered with the last hold
+  std::atomic<int> holds_{1};            // the call's, plus the worker's once submitted
+  std::atomic<bool> submitted_{false};   // the job went to the pool
+  std::atomic<bool> detached_{false};    // OnCancel let the job run on
+  std::atomic<bool> cancelled_{false};   // OnCancel ran: the stream broke or was cancelled
+  std::optional<Status> finished_with_;  // the status the outbox finished the call with
+  std::string job_id_;                   // for the log, once submitted
+  Request request_;                      // the message being read (gRPC threads, one reaction at a time)
+  UploadAssembler upload_;               // gRPC threads until the job is submitted
+  Job job_;                              // handed to the worker
   // The job's events and cancellation (kept in state_->kept when detachable), and this call's queue.
   const std::shared_ptr<JobChannel<Response>> channel_;
   const std::shared_ptr<Outbox<Response>> outbox_;

@@ -75,11 +75,13 @@ void KeptJobs::Sweep(Clock::time_point now) {
       spdlog::info("job {} result expired: no client attached within {} s of its end", id,
                    std::chrono::duration_cast<std::chrono::seconds>(ttl_).count());
       forget.push_back(id);
-    } else if (!s.done && !s.attached && now - s.since >= job->grace() && !job->token().cancelled()) {
+    } else if (!s.done && !s.attached) {
       const auto grace_s = std::chrono::duration<double>(job->grace()).count();
-      spdlog::info("job {}: no client re-attached within its {:.0f} s detach grace; cancelling it", id, grace_s);
-      job->Cancel(
-          fmt::format("job {} was cancelled: no client re-attached within its {:.0f} s detach grace", id, grace_s));
+      if (job->CancelIfAbandoned(
+              now, fmt::format("job {} was cancelled: no client re-attached within its {:.0f} s detach grace", id,
+                               grace_s))) {
+        spdlog::info("job {}: no client re-attached within its {:.0f} s detach grace; cancelled it", id, grace_s);
+      }
     }
   }
   if (forget.empty()) return;

@@ -150,15 +150,11 @@ template <class Response>
 class AttachReactor final : public grpc::ServerWriteReactor<Response> {
  public:
   AttachReactor(grpc::CallbackServerContext* ctx, ServiceState* state, const char* method)
-      : ctx_(ctx),
-        state_(state),
-        method_(method),
-        outbox_(std::make_shared<Outbox<Response>>([this](const Response* r) { this->StartWrite(r); },
-                                                   [this](const Status& s) { this->Finish(wire::ToGrpcStatus(s)); },
-                                                   &call_token_)) {}
+      : ctx_(ctx), state_(state), method_(method) {}
 
   void Start(const std::string& job_id) {
     const Status s = Attach(job_id);
+    if (!outbox_) outbox_ = MakeOutbox(&call_token_);
     spdlog::info("rpc {} job={} peer={} status={}{}{}", method_, job_id, ctx_->peer(), int(wire::ToGrpcCode(s.code())),
                  s.ok() ? "" : ": ", s.message());
     if (!s.ok()) outbox_->Complete(s);
@@ -178,8 +174,8 @@ class AttachReactor final : public grpc::ServerWriteReactor<Response> {
   }
 
   void OnDone() override {
-    if (channel_ && !detached_.load() && channel_->state().done) {
-      channel_->MarkDelivered();  // its status reached the client: nothing more to keep
+    // Delivered: this call ended with the job's own final status on a stream that did not break.
+    if (channel_ && !detached_.load() && finished_with_ && channel_->Delivered(*finished_with_)) {
       state_->kept.Erase(job_id_);
     }
     delete this;
@@ -202,7 +198,20 @@ class AttachReactor final : public grpc::ServerWriteReactor<Response> {
     }
     channel_ = std::move(channel);
     job_id_ = job_id;
+    // While the job runs, the outbox watches its token, so a producer waiting on this (slow)
+    // client wakes when the job is cancelled. A job that ended produces nothing more, and its
+    // token may have expired since (the submitting call's deadline): then this call's own.
+    outbox_ = MakeOutbox(channel_->state().done ? &call_token_ : &channel_->token());
     return channel_->Attach(job_id, outbox_);
+  }
+
+  std::shared_ptr<Outbox<Response>> MakeOutbox(const CancelToken* token) {
+    return std::make_shared<Outbox<Response>>([this](const Response* r) { this->StartWrite(r); },
+                                              [this](const Status& s) {
+                                                finished_with_ = s;
+                                                this->Finish(wire::ToGrpcStatus(s));
+                                              },
+                                              token);
   }
 
  public:
@@ -214,12 +223,13 @@ class AttachReactor final : public grpc::ServerWriteReactor<Response> {
   grpc::CallbackServerContext* const ctx_;
   ServiceState* const state_;
   const char* const method_;
-  CancelToken call_token_;  // this call only; the job's is the channel's
+  CancelToken call_token_;  // this call's, for a shutdown's CancelAll (the job's is the channel's)
   bool registered_ = false;
   std::atomic<bool> detached_{false};
-  std::string job_id_;  // set with channel_
+  std::string job_id_;                   // set with channel_
+  std::optional<Status> finished_with_;  // the status the outbox finished the call with
   std::shared_ptr<JobChannel<Response>> channel_;
-  const std::shared_ptr<Outbox<Response>> outbox_;
+  std::shared_ptr<Outbox<Response>> outbox_;  // made by Start
 };
 
 template <class Response>

@@ -169,7 +169,8 @@ TEST(KeptJobsTest, TheSweeperCancelsAfterTheGraceAndForgetsAfterTheTtlOrOnDelive
   jobs.Add("j-delivered", delivered);
   done->Complete(Status::Ok());
   delivered->Complete(Status::Ok());
-  delivered->MarkDelivered();
+  EXPECT_FALSE(delivered->Delivered(CancelledError("another status")));
+  EXPECT_TRUE(delivered->Delivered(Status::Ok()));
   const auto t0 = KeptJob::Clock::now();
 
   jobs.Sweep(t0 + 1s);

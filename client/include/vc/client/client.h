@@ -93,6 +93,9 @@ struct JobObserver {
   std::function<void(const std::vector<PlannedStation>&)> on_final_stations;
   // Called before each retry, with the failed attempt's status (UNAVAILABLE) and the wait.
   std::function<void(const Status&, std::chrono::milliseconds)> on_retry;
+  // Called when a job is accepted (after on_accepted, and again on each re-attach's replay) with
+  // what it takes to re-attach: the id, the replica's address, the grace the server granted.
+  std::function<void(const JobTicket&)> on_job;
   // Called before each re-attach to a detached job, with the status that broke the stream.
   std::function<void(const JobTicket&, const Status&, std::chrono::milliseconds)> on_reattach;
 };
@@ -138,11 +141,13 @@ class Client {
   void Prepare(grpc::ClientContext* ctx) const;
   // The channel to re-attach through: this client's, or one to the ticket's attach_address.
   std::shared_ptr<grpc::Channel> AttachChannel(const JobTicket& ticket);
-  // After a broken stream: re-attaches with `attach` (up to max_attempts, with backoff) while the
-  // failure is UNAVAILABLE; the original status when the job is not detachable.
-  // One AttachPlan / AttachEvaluate call to last_job_, followed to its end.
-  Status AttachPlanOnce(const JobObserver& observer, PlanResult* out);
-  Status AttachEvaluateOnce(const JobObserver& observer, EvaluateOutcome* out);
+  // After a broken stream: re-attaches with `attach(bool* followed)` while the failure is
+  // UNAVAILABLE and the job may still be alive (its grace since the stream was last alive), with
+  // backoff; the original status when the job is not detachable.
+  // One AttachPlan / AttachEvaluate call to last_job_, followed to its end; `followed` says
+  // whether the job's events came (the stream was alive) before it ended.
+  Status AttachPlanOnce(const JobObserver& observer, PlanResult* out, bool* followed);
+  Status AttachEvaluateOnce(const JobObserver& observer, EvaluateOutcome* out, bool* followed);
   template <typename Fn>
   Status Reattach(const Status& broken, const JobObserver& observer, Fn&& attach);
   template <typename Fn>

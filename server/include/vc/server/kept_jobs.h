@@ -89,10 +89,25 @@ class KeptJob {
     }
     token_.Cancel();
   }
-  // The status that reached an attached client: the job may be forgotten.
-  void MarkDelivered() {
+  // A call ended with `status` on a stream that did not break: if that is the job's final status,
+  // it reached a client and the job may be forgotten (true then).
+  bool Delivered(const Status& status) {
     std::lock_guard lock(mu_);
+    if (!final_ || !(*final_ == status)) return false;
     delivered_ = true;
+    return true;
+  }
+  // The sweeper: cancels the job with `reason` if it is still running without a client `grace`
+  // after it lost its last one (checked and done under the lock, so an attach cannot slip in
+  // between). True if it did.
+  bool CancelIfAbandoned(Clock::time_point now, const std::string& reason) {
+    {
+      std::lock_guard lock(mu_);
+      if (final_ || sink_attached_ || !detachable() || now - since_ < grace() || token_.cancelled()) return false;
+      if (!cancel_reason_) cancel_reason_ = reason;
+    }
+    token_.Cancel();
+    return true;
   }
 
   struct State {
@@ -166,7 +181,10 @@ class JobChannel final : public KeptJob {
     }
     if (sink && !sink->Post(detachable() ? Response(message) : std::move(message), bulk)) {
       if (!detachable()) return false;
-      Detach(sink.get());
+      // A sink refuses when its stream broke, or when the job was cancelled (its outbox watches
+      // the job's token to wake a producer waiting on a slow client): only the first detaches, so
+      // that a cancelled job's status still reaches the client that follows it.
+      if (!token_.cancelled()) Detach(sink.get());
     }
     return !token_.cancelled();
   }
