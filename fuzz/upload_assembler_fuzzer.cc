@@ -171,7 +171,7 @@ void Run(Reader& in) {
         }
         spec.set_total_size_bytes(size);
         const uint8_t f = in.Byte();
-        const int32_t format = f < 8 ? int32_t(f) : int32_t(uint32_t(in.Uint(4)));
+        const int32_t format = f < 16 ? int32_t(f) : int32_t(uint32_t(in.Uint(4)));
         spec.set_format(vc::v1::InputFormat(format));
         std::string payload;
         if (flags & 2) {
@@ -193,7 +193,8 @@ void Run(Reader& in) {
         CHECK(a.has_spec());
         if (flags & 1) break;  // the RPC refused its own parameters (TakeSpec): no AcceptSpec
 
-        const bool format_ok = format >= 0 && format < 8;
+        // Every value the enum names (E57 = 8 and vc-voxels = 9 came after this fuzzer).
+        const bool format_ok = vc::v1::InputFormat_IsValid(format);
         const bool size_ok = size > 0 && size <= max_upload;
         const bool room = admitted_before < capacity;
         const Status s = a.AcceptSpec(spec);
