@@ -173,7 +173,6 @@ class JobReactor : public grpc::ServerBidiReactor<Request, Response> {
     cancelled_ = true;
     outbox_->Break();
     if (submitted_.load() && channel_->detachable() && !past_deadline && !token().cancelled()) {
-      detached_ = true;
       channel_->Detach(outbox_.get());
       spdlog::info("job {} detached: its stream broke; it runs on for up to {:.0f} s without a client", job_id_,
                    std::chrono::duration<double>(channel_->grace()).count());
@@ -321,7 +320,6 @@ class JobReactor : public grpc::ServerBidiReactor<Request, Response> {
   bool registered_ = false;              // in the service's calls (Start); unregistered with the last hold
   std::atomic<int> holds_{1};            // the call's, plus the worker's once submitted
   std::atomic<bool> submitted_{false};   // the job went to the pool
-  std::atomic<bool> detached_{false};    // OnCancel let the job run on
   std::atomic<bool> cancelled_{false};   // OnCancel ran: the stream broke or was cancelled
   std::optional<Status> finished_with_;  // the status the outbox finished the call with
   std::string job_id_;                   // for the log, once submitted

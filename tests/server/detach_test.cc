@@ -328,7 +328,7 @@ TEST_F(Detach, WhenTheGraceRunsOutWithoutAClientTheJobIsCancelled) {
   EXPECT_THAT(r.status().message(), HasSubstr("no client re-attached within its 1 s detach grace"));
 }
 
-TEST_F(Detach, TheGraceIsCappedByTheServerAndZeroEndsTheJobWithItsStream) {
+TEST_F(Detach, TheServerCapsTheGraceAndTheCappedGraceRunsOut) {
   server::ServerOptions o;
   o.max_detach_grace = 2s;
   Start(o);

@@ -115,11 +115,10 @@ class KeptJob {
     bool done = false;
     bool delivered = false;
     Clock::time_point since;  // running: detached at; done: ended at
-    uint64_t kept_bytes = 0;
   };
   State state() const {
     std::lock_guard lock(mu_);
-    return {sink_attached_, final_.has_value(), delivered_, since_, kept_bytes_};
+    return {sink_attached_, final_.has_value(), delivered_, since_};
   }
 
  protected:
