@@ -2,7 +2,8 @@
 # Greedy against the exact selector (docs/PLANNING.md, "Exact selection"): plans geb079 and the
 # synthetic scenes through a real vc-server and vc-client once per solver, with the default
 # parameters (target coverage 0.99), and prints one row per scene and solver: stations, coverage,
-# the optimality status, lower bound and gap, the selection stage's time and the whole plan's.
+# the optimality status, lower bound and gap, the selection stage's time and the whole plan's (and,
+# with --local-candidates among FLAGS, the positions it added and the stations of each selection).
 # Usage: scripts/compare-solvers.sh [BUILD_DIR (default build/release)] [SOLVERS (default "greedy exact")]
 #   [SCENES (default: geb079 and the synthetic scenes; "hall" and "hall-scan" add the halls)] [-- FLAGS...]
 set -euo pipefail
@@ -52,7 +53,9 @@ gap = f'{100 * o["gap"]:.0f}%' if o["status"] != "heuristic" else "-"
 print(f'{sys.argv[1]:10s} {sys.argv[2]:7s} {len(p["viewpoints"]):8d} {100 * c["covered_voxels"] / c["coverable_voxels"]:8.2f}% '
       f'{o["status"]:10s} {bound:>6s} {gap:>6s} {t["selection"]:9.2f} {t["total"]:8.2f}  '
       f'{m["candidates"]}/{m["voxel_classes"]}/{m["rows"]}; {b["candidates"]}/{b["voxel_classes"]}'
-      + (f'  [{o["note"]}]' if o.get("note") else ''))
+      + (f'  [{o["note"]}]' if o.get("note") else '')
+      + (f'  local: +{o["local_candidates"]["added"]} positions, stations per selection '
+         + ' -> '.join(str(n) for n in o["local_candidates"]["stations_per_solve"]) if o.get("local_candidates") else ''))
 PY
   done
 done

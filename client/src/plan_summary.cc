@@ -64,9 +64,8 @@ std::string FieldTimeLine(const PlanResult& r) {
   return line + "\n";
 }
 
-}  // namespace
-
-std::string OptimalityLine(const PlanResult& r) {
+// The optimality line: proven optimal, a bound, or none.
+std::string OptimalityBoundLine(const PlanResult& r) {
   const planner::Optimality& o = r.optimality;
   if (o.solver == "greedy" && o.status == planner::OptimalityStatus::kHeuristic && o.note.empty()) return "";
   if (r.options.max_stations > 0 && o.status != planner::OptimalityStatus::kHeuristic) {
@@ -87,6 +86,20 @@ std::string OptimalityLine(const PlanResult& r) {
       break;
   }
   return Format("%d stations (%s), no bound on the optimum\n", o.stations, o.solver.c_str());
+}
+
+}  // namespace
+
+std::string OptimalityLine(const PlanResult& r) {
+  const planner::Optimality& o = r.optimality;
+  std::string local;
+  if (const planner::LocalCandidatesReport& l = o.local_candidates; !l.stations_per_solve.empty()) {
+    std::string counts;
+    for (int n : l.stations_per_solve) counts += (counts.empty() ? "" : " -> ") + std::to_string(n);
+    local = Format("local candidates: %d position(s) in %d round(s); stations per selection %s\n", l.added, l.rounds,
+                   counts.c_str());
+  }
+  return local + OptimalityBoundLine(r);
 }
 
 std::string FormatDuration(double seconds) {

@@ -271,6 +271,14 @@ v1::Optimality ToProto(const planner::Optimality& o) {
   p.set_forced(o.forced);
   p.set_dominated(o.dominated);
   p.set_note(o.note);
+  const planner::LocalCandidatesReport& l = o.local_candidates;
+  if (!l.stations_per_solve.empty()) {
+    v1::LocalCandidates* pl = p.mutable_local_candidates();
+    pl->set_rounds(l.rounds);
+    pl->set_added(l.added);
+    for (int s : l.stations_per_solve) pl->add_stations_per_solve(s);
+    for (uint64_t c : l.covered_per_solve) pl->add_covered_per_solve(c);
+  }
   return p;
 }
 
@@ -302,6 +310,11 @@ Result<planner::Optimality> FromProto(const v1::Optimality& p) {
   o.forced = p.forced();
   o.dominated = p.dominated();
   o.note = p.note();
+  const v1::LocalCandidates& pl = p.local_candidates();
+  o.local_candidates.rounds = pl.rounds();
+  o.local_candidates.added = pl.added();
+  o.local_candidates.stations_per_solve.assign(pl.stations_per_solve().begin(), pl.stations_per_solve().end());
+  o.local_candidates.covered_per_solve.assign(pl.covered_per_solve().begin(), pl.covered_per_solve().end());
   return o;
 }
 

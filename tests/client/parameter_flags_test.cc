@@ -416,7 +416,7 @@ TEST(ParameterTablesTest, UnknownEnumNamesAreRefusedByTheFlag) {
   EXPECT_THROW(app.parse("--test visible", false), CLI::ValidationError);
   EXPECT_EQ(o.selection_test, SelectionTest::kSurfaceVisibility);
   EXPECT_THROW(app.parse("--solver cplex", false), CLI::ValidationError);
-  EXPECT_EQ(o.solver, SelectionSolver::kGreedy);
+  EXPECT_EQ(o.solver, SelectionSolver::kAuto);
 }
 
 // --scanner NAME: the preset fills every scanner row whose flag is not given; a given flag wins,

@@ -65,7 +65,7 @@ TEST(PlanSummaryTest, WithoutAScanTimeTheFieldTimeLineSaysSo) {
 
 TEST(OptimalityLineTest, SaysProvenOptimalOrHowFarFromTheBound) {
   PlanResult r;
-  EXPECT_EQ(OptimalityLine(r), "") << "the default greedy plan prints no line";
+  EXPECT_EQ(OptimalityLine(r), "") << "a greedy plan without a bound prints no line";
   r.optimality.solver = "exact";
   r.optimality.status = planner::OptimalityStatus::kOptimal;
   r.optimality.stations = 37;
@@ -78,6 +78,18 @@ TEST(OptimalityLineTest, SaysProvenOptimalOrHowFarFromTheBound) {
   r.optimality.status = planner::OptimalityStatus::kHeuristic;
   EXPECT_EQ(OptimalityLine(r), "37 stations (greedy+swap), no bound on the optimum\n");
   EXPECT_NE(PlanSummary(r).find("37 stations (greedy+swap)"), std::string::npos);
+}
+
+TEST(OptimalityLineTest, TheLocalCandidatesLoopGetsALineBeforeTheBound) {
+  PlanResult r;
+  r.optimality.solver = "exact";
+  r.optimality.status = planner::OptimalityStatus::kOptimal;
+  r.optimality.stations = 3;
+  r.optimality.lower_bound = 3;
+  r.optimality.local_candidates = {2, 90, {4, 3, 3}, {26912, 26912, 26912}};
+  EXPECT_EQ(OptimalityLine(r),
+            "local candidates: 90 position(s) in 2 round(s); stations per selection 4 -> 3 -> 3\n"
+            "optimal: 3 stations, proven\n");
 }
 
 }  // namespace

@@ -35,6 +35,10 @@ TEST(PlanParameters, RoundTripKeepsEveryField) {
   o.walk_speed_mps = 0.8;
   o.solver = SelectionSolver::kExact;
   o.solve_seconds = 7.5;
+  o.local_candidates = !PlanOptions{}.local_candidates;
+  o.local_candidates_radius_m = 0.75;
+  o.local_candidates_step_m = 0.3;
+  o.local_candidates_rounds = 2;
   o.route_start = WorldPoint(1, 2, std::nan(""));
   auto back = FromProto(ToProto(o));
   ASSERT_TRUE(back.ok());
@@ -43,6 +47,10 @@ TEST(PlanParameters, RoundTripKeepsEveryField) {
   EXPECT_EQ(back->selection_test, SelectionTest::kCompatibility);
   EXPECT_EQ(back->solver, SelectionSolver::kExact);
   EXPECT_EQ(back->solve_seconds, 7.5);
+  EXPECT_TRUE(back->local_candidates);
+  EXPECT_EQ(back->local_candidates_radius_m, 0.75);
+  EXPECT_EQ(back->local_candidates_step_m, 0.3);
+  EXPECT_EQ(back->local_candidates_rounds, 2);
   EXPECT_EQ(back->candidates.size(), 2u);
   ASSERT_TRUE(back->route_start.has_value());
   EXPECT_TRUE(std::isnan(back->route_start->z()));
@@ -111,6 +119,7 @@ PlanResult BigResult(size_t voxels, size_t candidates) {
   r.optimality.forced = 1;
   r.optimality.dominated = 2;
   r.optimality.note = "n";
+  r.optimality.local_candidates = {2, 90, {4, 3, 3}, {26912, 26912, 26912}};
   return r;
 }
 
@@ -187,6 +196,10 @@ TEST(PlanResultChunks, ReassembleExactlyAndStayUnderOneMebibyte) {
   EXPECT_EQ(o.forced, 1);
   EXPECT_EQ(o.dominated, 2);
   EXPECT_EQ(o.note, "n");
+  EXPECT_EQ(o.local_candidates.rounds, 2);
+  EXPECT_EQ(o.local_candidates.added, 90);
+  EXPECT_EQ(o.local_candidates.stations_per_solve, (std::vector<int>{4, 3, 3}));
+  EXPECT_EQ(o.local_candidates.covered_per_solve, (std::vector<uint64_t>{26912, 26912, 26912}));
 }
 
 TEST(PlanResultChunks, ARouteOrGraphNamingAMissingStationIsDataLoss) {
@@ -231,8 +244,8 @@ TEST(PlanResultChunks, ASoleViewerNamingAMissingStationOrOnSomeChunksOnlyIsDataL
 // A tripwire: when a field is added to PlanResult or PlanOptions, its size changes; carry the new
 // field in proto/vc/v1/planner.proto and proto/src/convert.cc (both ways), then update the sizes.
 TEST(PlanResultChunks, EveryCoreFieldIsCarried) {
-  EXPECT_EQ(sizeof(PlanResult), 1304u) << "PlanResult changed: update the vc.v1 PlanResult and vc::wire";
-  EXPECT_EQ(sizeof(PlanOptions), 376u) << "PlanOptions changed: update vc.v1 PlanParameters and vc::wire";
+  EXPECT_EQ(sizeof(PlanResult), 1384u) << "PlanResult changed: update the vc.v1 PlanResult and vc::wire";
+  EXPECT_EQ(sizeof(PlanOptions), 400u) << "PlanOptions changed: update vc.v1 PlanParameters and vc::wire";
 }
 
 TEST(PlanResultChunks, MissingChunkIsDataLoss) {

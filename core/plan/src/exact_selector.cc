@@ -266,6 +266,13 @@ uint64_t Covered(const std::vector<VoxelSet>& sets, const std::vector<int>& pick
 
 // The fixed stations in order, then the other picks in greedy order among themselves (largest
 // marginal gain first, ties to the lowest index).
+// Whether `a` and `b` hold the same candidates (in any order).
+bool SameSet(std::vector<int> a, std::vector<int> b) {
+  std::sort(a.begin(), a.end());
+  std::sort(b.begin(), b.end());
+  return a == b;
+}
+
 std::vector<int> SortByMarginalGain(const std::vector<VoxelSet>& sets, std::vector<int> picks, int fixed) {
   std::vector<int> out;
   std::sort(picks.begin(), picks.end());
@@ -507,13 +514,36 @@ Result<Selection> ExactSelector::Select(const std::vector<VoxelSet>& sets, int f
   opt.before = {n, static_cast<int>(coverable), static_cast<int>(coverable) + (target < coverable ? 1 : 0)};
   const std::vector<int> greedy_picks = out.picks;
   const uint64_t greedy_covered = Covered(sets, greedy_picks);
+  const uint64_t greedy_pass_covered = out.covered;
+  const StopReason greedy_stop = out.stop;
+
+  // Whether `picks` is strictly better than greedy's plan: (reaches the target with fewer stations,
+  // or greedy's does not reach it, or greedy's is not connected where it must be) or, with
+  // max_stations, (more covered, capped at the target; or as much with fewer stations).
+  bool greedy_connected = true;  // set once the flow model has checked greedy's plan
+  auto strictly_better = [&](const std::vector<int>& picks) {
+    const uint64_t covered = Covered(sets, picks);
+    if (max_mode) {
+      return std::make_pair(std::min(covered, target), -static_cast<int64_t>(picks.size())) >
+             std::make_pair(std::min(greedy_covered, target), -static_cast<int64_t>(greedy_picks.size()));
+    }
+    return covered >= target && (greedy_covered < target || picks.size() < greedy_picks.size() || !greedy_connected);
+  };
 
   auto finish = [&](std::vector<int> picks) {
-    out.picks = SortByMarginalGain(sets, std::move(picks), fixed);
-    out.covered = Covered(sets, out.picks);
-    out.stop = out.covered >= coverable ? StopReason::kExhausted
-               : out.covered >= target  ? StopReason::kTargetReached
-                                        : StopReason::kMaxStations;
+    if (options_.prefer_greedy && !strictly_better(picks)) picks = greedy_picks;
+    if (options_.prefer_greedy && SameSet(picks, greedy_picks)) {
+      // Greedy's plan as GreedySelector returned it: its order, its covered count and stop reason.
+      out.picks = greedy_picks;
+      out.covered = greedy_pass_covered;
+      out.stop = greedy_stop;
+    } else {
+      out.picks = SortByMarginalGain(sets, std::move(picks), fixed);
+      out.covered = Covered(sets, out.picks);
+      out.stop = out.covered >= coverable ? StopReason::kExhausted
+                 : out.covered >= target  ? StopReason::kTargetReached
+                                          : StopReason::kMaxStations;
+    }
     opt.stations = static_cast<int>(out.picks.size());
     if (max_mode) {
       opt.lower_bound = opt.stations;
@@ -814,6 +844,7 @@ Result<Selection> ExactSelector::Select(const std::vector<VoxelSet>& sets, int f
       warm[g0 + root] = warm_stations;
     }
   }
+  greedy_connected = warm_connected;
   const bool warm_ok =
       warm_connected && (max_mode ? warm_stations <= options_.greedy.max_stations : warm_covered >= need);
   if (warm_ok) {

@@ -64,6 +64,7 @@ Result<LocalRefinementResult> RefineLocally(const Selector& selector, const Voxe
           if (!top) continue;
           const WorldPoint p(x, y, *top + height);
           if (!HasClearance(scene.grid, p, candidate_options.clearance_m)) continue;
+          if (KeepOutZoneContaining(options.keep_out, p) >= 0) continue;
           if (Known(out.candidates.positions, p, options.step_m) || Known(added, p, options.step_m)) continue;
           added.push_back(p);
           added_floor.push_back(*top);

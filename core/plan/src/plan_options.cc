@@ -37,6 +37,11 @@ Status PlanOptions::Validate() const {
     return InvalidArgumentError("refine_step_m (" + Num(refine_step_m) + " m) must not exceed refine_radius_m (" +
                                 Num(refine_radius_m) + " m)");
   }
+  if (local_candidates && local_candidates_step_m > local_candidates_radius_m) {
+    return InvalidArgumentError("local_candidates_step_m (" + Num(local_candidates_step_m) +
+                                " m) must not exceed local_candidates_radius_m (" + Num(local_candidates_radius_m) +
+                                " m)");
+  }
   for (size_t i = 0; i < candidates.size(); ++i) {
     if (!candidates[i].allFinite()) return InvalidArgumentError("candidates[" + std::to_string(i) + "] is not finite");
   }

@@ -142,7 +142,7 @@ Result<PlanResult> Plan(const SceneInput& input, const PlanOptions& options, con
   const std::unique_ptr<planner::Selector> selector = planner::SelectorFor(options);
   VC_ASSIGN_OR_RETURN(planner::SelectionOutput selected, runner.Run(Stage::kSelection, [&](const JobContext& c) {
     return planner::RunSelectionStage(
-        {*selector, std::move(visibility.sets), std::move(visibility.fixed_sets), candidates.positions,
+        {scene, *selector, std::move(visibility.sets), std::move(visibility.fixed_sets), candidates.positions,
          candidates.floor_z_m, result.heat_map.visible_voxels, callbacks},
         options, c);
   }));

@@ -52,6 +52,13 @@ Json OptimalityJson(const planner::Optimality& o) {
          {"forced", o.forced},     {"dominated", o.dominated}};
   if (o.covered_bound > 0) j["covered_bound"] = o.covered_bound;
   if (!o.note.empty()) j["note"] = o.note;
+  const planner::LocalCandidatesReport& l = o.local_candidates;
+  if (!l.stations_per_solve.empty()) {
+    j["local_candidates"] = {{"rounds", l.rounds},
+                             {"added", l.added},
+                             {"stations_per_solve", l.stations_per_solve},
+                             {"covered_per_solve", l.covered_per_solve}};
+  }
   return j;
 }
 

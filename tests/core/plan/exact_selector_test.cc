@@ -120,6 +120,51 @@ TEST(ExactSelectorTest, MinimumStationsEqualsExhaustiveSearch) {
   EXPECT_GT(beats_greedy, 0) << "no instance where greedy was short of the optimum: the test proves little";
 }
 
+// prefer_greedy (--solver auto): greedy's plan exactly as GreedySelector returns it (picks, order,
+// covered, stop) unless the integer program has strictly fewer stations (max_stations: strictly
+// more coverage, or as much with fewer stations); the bounds are the solver's either way.
+TEST(ExactSelectorTest, PreferGreedyKeepsGreedysPlanUnlessStrictlyBetter) {
+  std::mt19937 rng(33);
+  int kept_although_exact_differs = 0, replaced = 0;
+  for (int trial = 0; trial < 160; ++trial) {
+    const int n = 4 + static_cast<int>(rng() % 9);
+    const size_t voxels = 20 + rng() % 120;
+    std::vector<VoxelSet> sets = RandomSets(rng, n, voxels, 0.08 + 0.3 * (rng() % 100) / 100.0);
+    const int fixed = static_cast<int>(rng() % 3);
+    ExactSelectorOptions o;
+    o.greedy.target_coverage = std::vector<double>{1.0, 0.95, 0.8}[rng() % 3];
+    o.greedy.consolidate = trial % 2 == 0;
+    const bool max_mode = trial % 4 == 3;
+    if (max_mode) o.greedy.max_stations = 1 + static_cast<int>(rng() % 3);
+    Result<Selection> exact = ExactSelector(o).Select(sets, fixed, {});
+    o.prefer_greedy = true;
+    Result<Selection> got = ExactSelector(o).Select(sets, fixed, {});
+    Result<Selection> greedy = GreedySelector(o.greedy).Select(sets, fixed, {});
+    ASSERT_TRUE(got.ok() && exact.ok() && greedy.ok()) << got.status().ToString();
+    const std::string what = "trial " + std::to_string(trial);
+    const uint64_t t = Target(o.greedy.target_coverage, got->coverable);
+    const auto key = [&](const std::vector<int>& picks) {
+      return std::make_pair(std::min(Union(sets, picks), t), -static_cast<int>(picks.size()));
+    };
+    const bool better = max_mode ? key(exact->picks) > key(greedy->picks) : exact->picks.size() < greedy->picks.size();
+    if (better) {
+      ++replaced;
+      EXPECT_EQ(got->picks.size(), exact->picks.size()) << what;
+      EXPECT_EQ(key(got->picks), key(exact->picks)) << what;
+    } else {
+      kept_although_exact_differs += exact->picks != greedy->picks;
+      EXPECT_EQ(got->picks, greedy->picks) << what;
+      EXPECT_EQ(got->covered, greedy->covered) << what;
+      EXPECT_EQ(got->stop, greedy->stop) << what;
+    }
+    EXPECT_EQ(got->optimality.status, OptimalityStatus::kOptimal) << what;
+    EXPECT_EQ(got->optimality.stations, static_cast<int>(got->picks.size())) << what;
+    if (!max_mode) EXPECT_EQ(got->optimality.lower_bound, exact->optimality.lower_bound) << what;
+  }
+  EXPECT_GT(replaced, 0) << "greedy was never beaten: the test proves little";
+  EXPECT_GT(kept_although_exact_differs, 0) << "exact never reordered greedy's plan: the test proves little";
+}
+
 // With max_stations the covered voxels are maximised (capped at the target); when no plan of that
 // size reaches the target, the plan covers the most any can and stops on kMaxStations.
 TEST(ExactSelectorTest, MaximumCoverageEqualsExhaustiveSearchIncludingUnreachableTargets) {

@@ -103,6 +103,25 @@ TEST(LocalRefinementTest, FindsOneStationBetweenGridPointsWhereTwoWereNeeded) {
   }
 }
 
+// A keep-out zone around the one position that sees everything: no position is added inside it,
+// so the loop cannot find that station and the two grid picks stay.
+TEST(LocalRefinementTest, NoPositionIsAddedInsideAKeepOutZone) {
+  Fixture s;
+  CountingSelector selector;
+  const VisibilityFn fn = [&](const std::vector<WorldPoint>& p) { return s.fake(p); };
+  LocalRefinementOptions o;
+  const WorldPoint& a = s.fake.all;
+  o.keep_out = {KeepOutBox(a - WorldPoint(0.1, 0.1, 5), a + WorldPoint(0.1, 0.1, 5))};
+  Result<LocalRefinementResult> r = RefineLocally(selector, s.scene, s.in, 0, CandidateOptions{}, fn, o);
+  ASSERT_TRUE(r.ok()) << r.status().ToString();
+  EXPECT_GT(r->added, 0);
+  for (size_t i = s.in.positions.size(); i < r->candidates.positions.size(); ++i) {
+    EXPECT_LT(KeepOutZoneContaining(o.keep_out, r->candidates.positions[i]), 0) << "position " << i;
+  }
+  EXPECT_EQ(r->selection.picks.size(), 2u);
+  EXPECT_EQ(r->stations_per_solve, (std::vector<int>{2, 2}));
+}
+
 TEST(LocalRefinementTest, NoRoundsKeepsTheFirstSolve) {
   Fixture s;
   CountingSelector selector;

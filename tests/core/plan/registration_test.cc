@@ -20,10 +20,14 @@ namespace {
 
 using testing::Synthetic;
 
+// Greedy selection: these tests are about how greedy selection, consolidation, refinement and
+// reduction keep the scan graph; the connected integer program is tested in exact_selector_test
+// (with the default auto it would spend its 20 s on every plan here for a bound).
 PlanOptions Options(double min_overlap) {
   PlanOptions o;
   o.resolution_m = 0.1;
   o.min_overlap = min_overlap;
+  o.solver = SelectionSolver::kGreedy;
   return o;
 }
 

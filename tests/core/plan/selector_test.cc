@@ -183,7 +183,7 @@ TEST(SelectionStageTest, TurnsAnySelectorsPicksIntoStationsAndReportsEach) {
   };
   const LastCandidateSelector selector;
   Result<SelectionOutput> out =
-      RunSelectionStage({selector, sets, {}, candidates, floor_z, visible, callbacks}, PlanOptions{}, {});
+      RunSelectionStage({VoxelScene{}, selector, sets, {}, candidates, floor_z, visible, callbacks}, PlanOptions{}, {});
   ASSERT_TRUE(out.ok()) << out.status().ToString();
   ASSERT_EQ(out->stations.size(), 1u);
   EXPECT_EQ(out->stations.candidate, (std::vector<int>{2}));
@@ -269,8 +269,8 @@ TEST(SelectionStageTest, FixedStationsComeFirstMarkedFixed) {
   GreedySelectorOptions go;
   go.target_coverage = 1.0;
   const GreedySelector selector(go);
-  Result<SelectionOutput> out =
-      RunSelectionStage({selector, sets, fixed_sets, candidates, floor_z, visible, callbacks}, options, {});
+  Result<SelectionOutput> out = RunSelectionStage(
+      {VoxelScene{}, selector, sets, fixed_sets, candidates, floor_z, visible, callbacks}, options, {});
   ASSERT_TRUE(out.ok()) << out.status().ToString();
   ASSERT_EQ(out->stations.size(), 3u);
   EXPECT_EQ(out->stations.fixed, (std::vector<bool>{true, false, false}));

@@ -115,6 +115,11 @@ TEST(PlanReportTest, PlanJsonHasEveryDocumentedKey) {
   for (const char* key : {"candidates", "voxel_classes", "rows"}) EXPECT_TRUE(j["optimality"]["model"].contains(key));
   EXPECT_EQ(j["optimality"]["solver"], "greedy");
   EXPECT_EQ(j["optimality"]["status"], "heuristic");
+  EXPECT_FALSE(j["optimality"].contains("local_candidates"));  // the loop did not run
+  PlanResult local = SamplePlan();
+  local.optimality.local_candidates = {1, 24, {2, 2}, {5, 5}};
+  const json l = json::parse(PlanToJson(local))["optimality"]["local_candidates"];
+  EXPECT_EQ(l, json::parse(R"({"rounds": 1, "added": 24, "stations_per_solve": [2, 2], "covered_per_solve": [5, 5]})"));
   EXPECT_EQ(j["viewpoints"][0]["route_order"].get<int>(), 2);
   EXPECT_EQ(j["viewpoints"][1]["route_order"].get<int>(), 1);
   ASSERT_EQ(j["viewpoints"].size(), 2u);

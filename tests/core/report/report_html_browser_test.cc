@@ -86,6 +86,7 @@ class ReportHtmlBrowserTest : public ::testing::Test {
     PlanOptions o;
     o.resolution_m = 0.1;
     o.min_overlap = 0.3;
+    o.solver = SelectionSolver::kGreedy;  // the page, not the bound (auto would spend 20 s here)
     Result<PlanResult> r = Plan(testing::Synthetic("rooms:3"), o);
     ASSERT_TRUE(r.ok()) << r.status().ToString();
     plan_ = new PlanResult(std::move(*r));

@@ -12,7 +12,8 @@ namespace vc::client {
 std::string PlanSummary(const PlanResult& result);
 
 // How far the selection is from the optimum, one line ("optimal: 37 stations, proven", "37 stations,
-// at most 4 more than the optimum (bound 33)"); empty for the default greedy selection.
+// at most 4 more than the optimum (bound 33)"; empty for a greedy selection without a bound),
+// after a line on the local-candidates loop when it ran.
 std::string OptimalityLine(const PlanResult& result);
 
 // A duration as a crew reads it: "45 s", "12 min", "1 h 05 min".

@@ -1,13 +1,112 @@
+#include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <memory>
+#include <string>
 #include <utility>
 #include <vector>
 
+#include "vc/plan/candidates.h"
 #include "vc/plan/exact_selector.h"
 #include "vc/plan/greedy.h"
+#include "vc/plan/keep_out.h"
+#include "vc/plan/local_refinement.h"
 #include "vc/plan/stages.h"
 
 namespace vc::planner {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// The exact selector for the solves of the local-candidates loop: each gets what is left of one
+// time limit, so options.solve_seconds bounds the whole selection stage, as it does without the loop.
+class SharedDeadlineSelector final : public Selector {
+ public:
+  SharedDeadlineSelector(const ExactSelectorOptions& options, Clock::time_point deadline)
+      : options_(options), deadline_(deadline) {}
+  using Selector::Select;
+  [[nodiscard]] Result<Selection> Select(const std::vector<VoxelSet>& sets, int fixed,
+                                         const JobContext& ctx) const override {
+    ExactSelectorOptions o = options_;
+    // A solve past the deadline still returns a plan (greedy's, with the bounds of the root LP
+    // CBC reaches in its first moments); 0.05 s is what it is given then.
+    o.time_limit_s = std::max(0.05, std::chrono::duration<double>(deadline_ - Clock::now()).count());
+    return ExactSelector(o).Select(sets, fixed, ctx);
+  }
+
+ private:
+  ExactSelectorOptions options_;
+  Clock::time_point deadline_;
+};
+
+ExactSelectorOptions ExactOptionsFor(const PlanOptions& options) {
+  ExactSelectorOptions exact;
+  exact.greedy = SelectorOptionsFor(options);
+  exact.time_limit_s = options.solve_seconds;
+  exact.memory_budget_bytes = options.memory_budget_bytes / 2;
+  exact.swap_search = options.solver == SelectionSolver::kExact;
+  exact.prefer_greedy = options.solver == SelectionSolver::kAuto;
+  return exact;
+}
+
+// RefineLocally over the fixed stations and the candidates (`sets`, consumed), with the added
+// positions' sets cut to the coverable set of the first selection.
+Result<LocalRefinementResult> SelectWithLocalCandidates(const SelectionInput& in, std::vector<VoxelSet> sets, int fixed,
+                                                        const PlanOptions& options, const JobContext& ctx) {
+  const Clock::time_point start = Clock::now();
+  CandidateSets all;
+  all.positions = options.fixed_stations;
+  all.floor_z_m.assign(options.fixed_stations.size(), std::nan(""));
+  all.positions.insert(all.positions.end(), in.candidates.begin(), in.candidates.end());
+  all.floor_z_m.insert(all.floor_z_m.end(), in.floor_z_m.begin(), in.floor_z_m.end());
+  const size_t n_voxels = in.scene.occupied.size();
+  VoxelSet coverable(n_voxels);
+  for (const VoxelSet& s : sets) UnionInto(coverable, s);
+  all.sets = std::move(sets);
+  uint64_t positions_held = all.positions.size();
+
+  VisibilitySetsOptions set_options{options.selection_test, options.threads};
+  set_options.scanner = options.scanner;
+  const JobContext quiet{ctx.cancel, {}};  // the selection stage reports the loop's progress itself
+  const VisibilityFn visibility = [&](const std::vector<WorldPoint>& positions) -> Result<std::vector<VoxelSet>> {
+    positions_held += positions.size();
+    VC_RETURN_IF_ERROR(
+        CheckVisibilitySetBudget(positions_held, n_voxels, options.memory_budget_bytes, "local candidates"));
+    ctx.Report(Stage::kSelection, 0.0,
+               "local candidates: visibility of " + std::to_string(positions.size()) + " positions");
+    VC_ASSIGN_OR_RETURN(std::vector<VoxelSet> out, ComputeVisibilitySets(in.scene, positions, set_options, quiet));
+    for (VoxelSet& s : out) {
+      for (size_t w = 0; w < s.words().size(); ++w) s.words()[w] &= coverable.words()[w];
+    }
+    return out;
+  };
+
+  const std::vector<double> heights = options.TripodHeights();
+  CandidateOptions cand_options{options.grid_spacing_m, *std::min_element(heights.begin(), heights.end()),
+                                options.clearance_m, options.tripod_heights_m, false};
+  LocalRefinementOptions local{options.local_candidates_radius_m, options.local_candidates_step_m,
+                               options.local_candidates_rounds, options.keep_out};
+
+  std::unique_ptr<Selector> selector;
+  const Selector* use = &in.selector;
+  if (options.solver != SelectionSolver::kGreedy) {
+    selector = std::make_unique<SharedDeadlineSelector>(
+        ExactOptionsFor(options),
+        start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(options.solve_seconds)));
+    use = selector.get();
+  }
+  VC_ASSIGN_OR_RETURN(LocalRefinementResult out,
+                      RefineLocally(*use, in.scene, std::move(all), fixed, cand_options, visibility, local, ctx));
+  LocalCandidatesReport& report = out.selection.optimality.local_candidates;
+  report.rounds = out.rounds;
+  report.added = out.added;
+  report.stations_per_solve = out.stations_per_solve;
+  report.covered_per_solve = out.covered_per_solve;
+  out.selection.optimality.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  return out;
+}
+
+}  // namespace
 
 GreedySelectorOptions SelectorOptionsFor(const PlanOptions& options) {
   GreedySelectorOptions out;
@@ -21,23 +120,34 @@ GreedySelectorOptions SelectorOptionsFor(const PlanOptions& options) {
 
 std::unique_ptr<Selector> SelectorFor(const PlanOptions& options) {
   if (options.solver == SelectionSolver::kGreedy) return std::make_unique<GreedySelector>(SelectorOptionsFor(options));
-  ExactSelectorOptions exact;
-  exact.greedy = SelectorOptionsFor(options);
-  exact.time_limit_s = options.solve_seconds;
-  exact.memory_budget_bytes = options.memory_budget_bytes / 2;
-  exact.swap_search = options.solver == SelectionSolver::kExact;
-  return std::make_unique<ExactSelector>(exact);
+  return std::make_unique<ExactSelector>(ExactOptionsFor(options));
 }
 
 Result<SelectionOutput> RunSelectionStage(SelectionInput in, const PlanOptions& options, const JobContext& ctx) {
   SelectionOutput out;
   // The fixed stations' sets first: the selector starts with them picked.
   const int fixed = static_cast<int>(in.fixed_sets.size());
+  const int n_candidates = static_cast<int>(in.sets.size());
   std::vector<VoxelSet> sets = std::move(in.fixed_sets);
   sets.reserve(sets.size() + in.sets.size());
   for (VoxelSet& s : in.sets) sets.push_back(std::move(s));
   in.sets.clear();
-  VC_ASSIGN_OR_RETURN(out.selection, in.selector.Select(sets, fixed, ctx));
+  // Positions the local-candidates loop added, after the fixed stations and the candidates.
+  std::vector<WorldPoint> added_positions;
+  std::vector<double> added_floor_z;
+  if (options.local_candidates) {
+    VC_ASSIGN_OR_RETURN(LocalRefinementResult local,
+                        SelectWithLocalCandidates(in, std::move(sets), fixed, options, ctx));
+    out.selection = std::move(local.selection);
+    sets = std::move(local.candidates.sets);
+    const size_t first_added = static_cast<size_t>(fixed + n_candidates);
+    added_positions.assign(local.candidates.positions.begin() + static_cast<std::ptrdiff_t>(first_added),
+                           local.candidates.positions.end());
+    added_floor_z.assign(local.candidates.floor_z_m.begin() + static_cast<std::ptrdiff_t>(first_added),
+                         local.candidates.floor_z_m.end());
+  } else {
+    VC_ASSIGN_OR_RETURN(out.selection, in.selector.Select(sets, fixed, ctx));
+  }
   const size_t n_voxels = sets.empty() ? 0 : sets[0].size();
   out.coverable = VoxelSet(n_voxels);
   for (const VoxelSet& s : sets) UnionInto(out.coverable, s);
@@ -49,11 +159,15 @@ Result<SelectionOutput> RunSelectionStage(SelectionInput in, const PlanOptions& 
   for (size_t k = 0; k < out.selection.picks.size(); ++k) {
     const int pick = out.selection.picks[k];
     const bool is_fixed = pick < fixed;
-    const int c = is_fixed ? -1 : pick - fixed;  // candidate index
-    const WorldPoint& position = is_fixed ? options.fixed_stations[pick] : in.candidates[c];
-    const uint64_t visible = is_fixed ? CountBits(sets[pick]) : in.visible_voxels[c];
+    const bool is_added = pick >= fixed + n_candidates;      // a local candidate
+    const int c = is_fixed || is_added ? -1 : pick - fixed;  // candidate index
+    const int a = pick - fixed - n_candidates;               // index into the added positions
+    const WorldPoint& position = is_fixed   ? options.fixed_stations[pick]
+                                 : is_added ? added_positions[a]
+                                            : in.candidates[c];
+    const uint64_t visible = c < 0 ? CountBits(sets[pick]) : in.visible_voxels[c];
     st.positions.push_back(position);
-    st.floor_z_m.push_back(is_fixed ? std::nan("") : in.floor_z_m[c]);
+    st.floor_z_m.push_back(is_fixed ? std::nan("") : is_added ? added_floor_z[a] : in.floor_z_m[c]);
     st.candidate.push_back(c);
     st.sets.push_back(sets[pick]);
     st.fixed.push_back(is_fixed);

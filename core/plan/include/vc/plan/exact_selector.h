@@ -54,14 +54,20 @@ struct ExactSelectorOptions {
   // Over the memory budget: true = the swap local search (solver "greedy+swap"), false = the
   // greedy plan as it is (solver "greedy"; SelectionSolver::kAuto).
   bool swap_search = true;
+  // Keep greedy's plan (its picks, order, covered count and stop reason) unless the integer program
+  // finds a strictly better one: fewer stations reaching the target (max_stations: more covered,
+  // or as many with fewer stations), or a connected one where greedy's is not. The optimality
+  // figures are the solver's either way. SelectionSolver::kAuto sets it, so a plan whose greedy
+  // selection is already optimal stays exactly what greedy planned.
+  bool prefer_greedy = false;
 };
 
 // The ILP above, warm-started from greedy. The picks: the fixed stations in order, then the
 // chosen candidates re-sorted by marginal gain among the chosen (greedy order over them, ties to
-// the lowest index). stop: kTargetReached (or kExhausted at full coverage) when the target is
-// reached, else kMaxStations. first_pass_picks and saved_by_improvement are the greedy warm
-// start's. INVALID_ARGUMENT for sets of different sizes, fixed out of range or time_limit_s <= 0;
-// CANCELLED / DEADLINE_EXCEEDED from ctx, also while CBC runs; INTERNAL if CBC fails.
+// the lowest index); with prefer_greedy and no strictly better plan, greedy's picks as they were. stop: kTargetReached
+// (or kExhausted at full coverage) when the target is reached, else kMaxStations. first_pass_picks and
+// saved_by_improvement are the greedy warm start's. INVALID_ARGUMENT for sets of different sizes, fixed out of range or
+// time_limit_s <= 0; CANCELLED / DEADLINE_EXCEEDED from ctx, also while CBC runs; INTERNAL if CBC fails.
 class ExactSelector final : public Selector {
  public:
   explicit ExactSelector(const ExactSelectorOptions& options) : options_(options) {}

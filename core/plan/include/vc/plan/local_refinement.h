@@ -20,6 +20,7 @@
 #include "vc/base/progress.h"
 #include "vc/base/status.h"
 #include "vc/plan/candidates.h"
+#include "vc/plan/keep_out.h"
 #include "vc/plan/selector.h"
 #include "vc/scene/voxel_scene.h"
 #include "vc/visibility/visibility.h"
@@ -27,9 +28,10 @@
 namespace vc::planner {
 
 struct LocalRefinementOptions {
-  double radius_m = 0.5;  // sub-grid half-width around each chosen station (m)
-  double step_m = 0.25;   // sub-grid step (m), in (0, radius_m]
-  int max_rounds = 4;     // solves after the first, at most
+  double radius_m = 0.5;              // sub-grid half-width around each chosen station (m)
+  double step_m = 0.25;               // sub-grid step (m), in (0, radius_m]
+  int max_rounds = 4;                 // solves after the first, at most
+  std::vector<KeepOutZone> keep_out;  // no position is added inside these
 };
 
 // Candidates and their sets: positions[i] sees sets[i]; floor_z_m[i] is the top of its floor (m,
@@ -56,10 +58,10 @@ struct LocalRefinementResult {
 // Solves with `selector` over `in`, then, each round, adds around every picked station (beyond the
 // `fixed` first ones) the positions of a step_m sub-grid within radius_m (square) that stand on the
 // station's floor (FloorTopNear) at its height above that floor, with the clearance (HasClearance),
-// and are not yet candidates; solves again over all; keeps the new solve if it has fewer stations,
-// or as many covering more voxels. Stops after a round without improvement, without new positions,
-// or after max_rounds. INVALID_ARGUMENT for bad options or inputs of different lengths; the
-// selector's and the callback's errors pass through; CANCELLED / DEADLINE_EXCEEDED from ctx.
+// outside options.keep_out, and are not yet candidates; solves again over all; keeps the new solve if it has fewer
+// stations, or as many covering more voxels. Stops after a round without improvement, without new positions, or after
+// max_rounds. INVALID_ARGUMENT for bad options or inputs of different lengths; the selector's and the callback's errors
+// pass through; CANCELLED / DEADLINE_EXCEEDED from ctx.
 Result<LocalRefinementResult> RefineLocally(const Selector& selector, const VoxelScene& scene, CandidateSets in,
                                             int fixed, const CandidateOptions& candidate_options,
                                             const VisibilityFn& visibility, const LocalRefinementOptions& options,

@@ -22,8 +22,11 @@
 //   candidate that sees all they alone covered (coverage never shrinks; docs/PLANNING.md).
 // - doorway_candidates: candidates in narrow passages (vc/plan/candidates.h; docs/PLANNING.md,
 //   "Doorway candidates").
-// - solver / solve_seconds: greedy (the default), the exact integer program (CBC) with a time
-//   limit, or auto (docs/PLANNING.md, "Exact selection").
+// - solver / solve_seconds: greedy, the exact integer program (CBC) with a time limit, or auto
+//   (the default: the integer program within the limit, keeping greedy's plan unless it finds a
+//   better one; docs/PLANNING.md, "Exact selection").
+// - local_candidates: solve, add a sub-grid of candidates around each chosen station, solve again
+//   over all, while the plan improves (vc/plan/local_refinement.h; docs/PLANNING.md).
 // - refine: proximity refinement (ALGORITHM.md s.7.4), each station to the best of a sub-grid.
 // - reduce / reduce_to: reduction (s.7.5) removes zero-loss stations; with reduce_to > 0 it keeps
 //   removing the cheapest single or pair until at most reduce_to stations remain.
@@ -48,9 +51,16 @@
   X(double, target_coverage, 0.99, "fraction", "target-coverage", kFraction,                                           \
     "stop at this covered fraction of the coverable voxels")                                                           \
   X(bool, consolidate, true, "", "consolidate", kAny, "drop covered picks and merge pairs after greedy")               \
-  X(::vc::SelectionSolver, solver, ::vc::SelectionSolver::kGreedy, "", "solver", kAny,                                 \
+  X(::vc::SelectionSolver, solver, ::vc::SelectionSolver::kAuto, "", "solver", kAny,                                   \
     "station selection: greedy, exact (integer program, proven gap) or auto")                                          \
   X(double, solve_seconds, 20.0, "s", "solve-seconds", kPositive, "time limit of the exact solver")                    \
+  X(bool, local_candidates, false, "", "local-candidates", kAny,                                                       \
+    "after selection, add candidates around each station and select again while it improves")                          \
+  X(double, local_candidates_radius_m, 0.5, "m", "local-candidates-radius", kPositive,                                 \
+    "half-width of the sub-grid around each station")                                                                  \
+  X(double, local_candidates_step_m, 0.25, "m", "local-candidates-step", kPositive, "sub-grid step")                   \
+  X(int32_t, local_candidates_rounds, 4, "rounds", "local-candidates-rounds", kPositive,                               \
+    "selections after the first, at most")                                                                             \
   X(bool, refine, false, "", "refine", kAny, "refine each station on a local sub-grid")                                \
   X(double, refine_radius_m, 0.5, "m", "refine-radius", kPositive, "refinement radius")                                \
   X(double, refine_step_m, 0.25, "m", "refine-step", kPositive, "refinement step")                                     \
@@ -89,7 +99,8 @@ struct PlanOptions {
 
   // INVALID_ARGUMENT naming the first bad parameter: a row's check (non-finite, negative, zero,
   // out of range), the scanner's, a non-finite candidate, clearance_m >= tripod_height_m (or a
-  // tripod_heights_m entry), refine_step_m > refine_radius_m with refine on, a bad keep-out zone, a
+  // tripod_heights_m entry), refine_step_m > refine_radius_m with refine on (local_candidates_step_m
+  // > local_candidates_radius_m with local_candidates on), a bad keep-out zone, a
   // non-finite fixed station or one inside a keep-out zone, a route_start with a non-finite x or y
   // or an infinite z.
   Status Validate() const;

@@ -58,6 +58,14 @@ struct ModelSize {
   int rows = 0;           // constraint rows (0 in `before`)
 };
 
+// The local-candidates loop (PlanOptions::local_candidates; vc/plan/local_refinement.h), when it ran.
+struct LocalCandidatesReport {
+  int rounds = 0;                           // selections after the first
+  int added = 0;                            // positions added over all rounds
+  std::vector<int> stations_per_solve;      // the first selection's first; empty when the loop did not run
+  std::vector<uint64_t> covered_per_solve;  // voxels, per selection
+};
+
 struct Optimality {
   std::string solver = "greedy";  // "greedy", "exact", or "greedy+swap" (exact's fallback)
   OptimalityStatus status = OptimalityStatus::kHeuristic;
@@ -67,13 +75,14 @@ struct Optimality {
   // max_stations the objective is coverage: lower_bound = stations and gap is the coverage gap
   // (covered_bound - covered) / covered_bound.
   double gap = 1;
-  uint64_t covered_bound = 0;  // proven upper bound on the covered voxels (max_stations mode; else 0)
-  double seconds = 0;          // wall time of the whole Select, in seconds
-  ModelSize before;            // the input: candidates and coverable voxels
-  ModelSize model;             // the integer program solved (after the model reduction)
-  int forced = 0;              // candidates fixed to 1 as the only view of some voxel
-  int dominated = 0;           // candidates dropped as dominated by another
-  std::string note;            // why a fallback was taken, or empty
+  uint64_t covered_bound = 0;              // proven upper bound on the covered voxels (max_stations mode; else 0)
+  double seconds = 0;                      // wall time of the whole Select, in seconds
+  ModelSize before;                        // the input: candidates and coverable voxels
+  ModelSize model;                         // the integer program solved (after the model reduction)
+  int forced = 0;                          // candidates fixed to 1 as the only view of some voxel
+  int dominated = 0;                       // candidates dropped as dominated by another
+  std::string note;                        // why a fallback was taken, or empty
+  LocalCandidatesReport local_candidates;  // the local-candidates loop (seconds then covers all its solves)
 };
 
 // What a selector chose over one vector of visibility sets.

@@ -95,6 +95,7 @@ struct VisibilityOutput {
 
 // --- Stage::kSelection: the Selector's picks as stations ---
 struct SelectionInput {
+  const VoxelScene& scene;  // for the local-candidates loop's positions and their sets
   const Selector& selector;
   std::vector<VoxelSet> sets;        // per candidate; consumed (freed when done)
   std::vector<VoxelSet> fixed_sets;  // per fixed station (options.fixed_stations); consumed
@@ -108,7 +109,13 @@ struct SelectionOutput {
   VoxelSet coverable;   // union of every candidate's and fixed station's set
   Selection selection;  // what the selector reported
 };
-// Errors of the selector (CANCELLED / DEADLINE_EXCEEDED from ctx).
+// With options.local_candidates, RefineLocally (local_refinement.h) around the selector: positions
+// on a local_candidates_step_m sub-grid around each chosen station (on its floor, with the
+// clearance, outside keep-out zones) become candidates, their sets cut to the first coverable set
+// (the coverage problem stays the same: voxels only they see raise no target), and selection runs
+// again over all while it improves; an exact selector's solves share options.solve_seconds. A
+// station at an added position has candidate index -1. RESOURCE_EXHAUSTED when the added
+// positions' sets exceed the budget; errors of the selector (CANCELLED / DEADLINE_EXCEEDED from ctx).
 [[nodiscard]] Result<SelectionOutput> RunSelectionStage(SelectionInput in, const PlanOptions& options,
                                                         const JobContext& ctx);
 
