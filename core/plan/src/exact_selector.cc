@@ -264,8 +264,6 @@ uint64_t Covered(const std::vector<VoxelSet>& sets, const std::vector<int>& pick
   return CountBits(u);
 }
 
-// The fixed stations in order, then the other picks in greedy order among themselves (largest
-// marginal gain first, ties to the lowest index).
 // Whether `a` and `b` hold the same candidates (in any order).
 bool SameSet(std::vector<int> a, std::vector<int> b) {
   std::sort(a.begin(), a.end());
@@ -273,6 +271,8 @@ bool SameSet(std::vector<int> a, std::vector<int> b) {
   return a == b;
 }
 
+// The fixed stations in order, then the other picks in greedy order among themselves (largest
+// marginal gain first, ties to the lowest index).
 std::vector<int> SortByMarginalGain(const std::vector<VoxelSet>& sets, std::vector<int> picks, int fixed) {
   std::vector<int> out;
   std::sort(picks.begin(), picks.end());
@@ -603,11 +603,20 @@ Result<Selection> ExactSelector::Select(const std::vector<VoxelSet>& sets, int f
   uint64_t nnz = 0;
   for (const std::vector<int>& s : m.seen_by) nnz += s.size() + (cover_rows ? 0 : 2);
   const uint64_t estimate = nnz * 200 + uint64_t(n_rows + n_cols + (cover_rows ? 0 : n_classes)) * 1000;
+  // Over the budget no integer program is built; at a station-count target the counting bound
+  // (the forced candidates plus what the widest candidate would need) still says how far off the
+  // plan can be, at no cost.
+  const auto counting_bound_only = [&] {
+    if (max_mode) return;
+    opt.lower_bound = static_cast<double>(m.forced.size()) + CountingBound(m, need);
+    if (opt.lower_bound > 0) opt.status = OptimalityStatus::kFeasible;
+  };
   if (estimate > options_.memory_budget_bytes && !options_.swap_search) {
     opt.solver = "greedy";
     opt.status = OptimalityStatus::kHeuristic;
     opt.note = "the integer program (about " + std::to_string(estimate >> 20) + " MiB) exceeds the memory budget (" +
-               std::to_string(options_.memory_budget_bytes >> 20) + " MiB); greedy plan";
+               std::to_string(options_.memory_budget_bytes >> 20) + " MiB); greedy plan, with the counting bound";
+    counting_bound_only();
     return finish(greedy_picks);
   }
   if (estimate > options_.memory_budget_bytes) {
@@ -619,7 +628,9 @@ Result<Selection> ExactSelector::Select(const std::vector<VoxelSet>& sets, int f
     opt.solver = "greedy+swap";
     opt.status = OptimalityStatus::kHeuristic;
     opt.note = "the integer program (about " + std::to_string(estimate >> 20) + " MiB) exceeds the memory budget (" +
-               std::to_string(options_.memory_budget_bytes >> 20) + " MiB); greedy plus swap local search instead";
+               std::to_string(options_.memory_budget_bytes >> 20) +
+               " MiB); greedy plus swap local search instead, with the counting bound";
+    counting_bound_only();
     return finish(std::move(picks));
   }
 
