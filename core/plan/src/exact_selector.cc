@@ -517,17 +517,19 @@ Result<Selection> ExactSelector::Select(const std::vector<VoxelSet>& sets, int f
   const uint64_t greedy_pass_covered = out.covered;
   const StopReason greedy_stop = out.stop;
 
-  // Whether `picks` is strictly better than greedy's plan: (reaches the target with fewer stations,
-  // or greedy's does not reach it, or greedy's is not connected where it must be) or, with
-  // max_stations, (more covered, capped at the target; or as much with fewer stations).
+  // Whether `picks` is strictly better than greedy's plan: greedy's is not connected where it must
+  // be (the integer program's plans are), or (reaches the target with fewer stations, or greedy's
+  // does not reach it) or, with max_stations, (more covered, capped at the target; or as much with
+  // fewer stations).
   bool greedy_connected = true;  // set once the flow model has checked greedy's plan
   auto strictly_better = [&](const std::vector<int>& picks) {
+    if (!greedy_connected) return true;
     const uint64_t covered = Covered(sets, picks);
     if (max_mode) {
       return std::make_pair(std::min(covered, target), -static_cast<int64_t>(picks.size())) >
              std::make_pair(std::min(greedy_covered, target), -static_cast<int64_t>(greedy_picks.size()));
     }
-    return covered >= target && (greedy_covered < target || picks.size() < greedy_picks.size() || !greedy_connected);
+    return covered >= target && (greedy_covered < target || picks.size() < greedy_picks.size());
   };
 
   auto finish = [&](std::vector<int> picks) {
@@ -538,11 +540,13 @@ Result<Selection> ExactSelector::Select(const std::vector<VoxelSet>& sets, int f
       out.covered = greedy_pass_covered;
       out.stop = greedy_stop;
     } else {
+      const bool greedys = SameSet(picks, greedy_picks);
       out.picks = SortByMarginalGain(sets, std::move(picks), fixed);
       out.covered = Covered(sets, out.picks);
-      out.stop = out.covered >= coverable ? StopReason::kExhausted
-                 : out.covered >= target  ? StopReason::kTargetReached
-                                          : StopReason::kMaxStations;
+      out.stop = greedys                    ? greedy_stop  // e.g. kMinGain, which no recount can tell
+                 : out.covered >= coverable ? StopReason::kExhausted
+                 : out.covered >= target    ? StopReason::kTargetReached
+                                            : StopReason::kMaxStations;
     }
     opt.stations = static_cast<int>(out.picks.size());
     if (max_mode) {
@@ -896,8 +900,9 @@ Result<Selection> ExactSelector::Select(const std::vector<VoxelSet>& sets, int f
   const uint64_t ilp_covered = best != nullptr ? Covered(sets, picks) : 0;
   const bool ilp_better =
       best != nullptr &&
-      (max_mode ? std::make_pair(std::min(ilp_covered, target), -static_cast<int64_t>(picks.size())) >=
-                      std::make_pair(std::min(greedy_covered, target), -static_cast<int64_t>(greedy_picks.size()))
+      (max_mode ? (!warm_connected ||
+                   std::make_pair(std::min(ilp_covered, target), -static_cast<int64_t>(picks.size())) >=
+                       std::make_pair(std::min(greedy_covered, target), -static_cast<int64_t>(greedy_picks.size())))
                 : (ilp_covered >= target &&
                    (greedy_covered < target || picks.size() <= greedy_picks.size() || !warm_connected)));
   if (!ilp_better) picks = greedy_picks;

@@ -8,10 +8,23 @@
 namespace vc::planner {
 namespace {
 
-// Whether the solve `b` improves on `a`: fewer stations, or as many covering more.
-bool Better(const Selection& b, const Selection& a) {
-  if (b.picks.size() != a.picks.size()) return b.picks.size() < a.picks.size();
-  return b.covered > a.covered;
+// Whether a selection reaches target_coverage of its coverable voxels (greedy's own test).
+bool Reaches(const Selection& s, double target_coverage) {
+  return s.coverable == 0 || double(s.covered) >= target_coverage * double(s.coverable);
+}
+
+// Whether the solve `b` improves on `a`: reaching the target beats not reaching it; among plans
+// that reach it, fewer stations, or as many covering more; among plans that do not (max_stations,
+// min_marginal_gain_voxels), more covered, or as much with fewer stations.
+bool Better(const Selection& b, const Selection& a, double target_coverage) {
+  const bool rb = Reaches(b, target_coverage), ra = Reaches(a, target_coverage);
+  if (rb != ra) return rb;
+  if (rb) {
+    if (b.picks.size() != a.picks.size()) return b.picks.size() < a.picks.size();
+    return b.covered > a.covered;
+  }
+  if (b.covered != a.covered) return b.covered > a.covered;
+  return b.picks.size() < a.picks.size();
 }
 
 // Whether `p` is within half a step of one of `positions` in x and y and at the same height.
@@ -56,11 +69,16 @@ Result<LocalRefinementResult> RefineLocally(const Selector& selector, const Voxe
       const double floor_z = out.candidates.floor_z_m[pick];
       if (!std::isfinite(floor_z)) continue;
       const double height = s.z() - floor_z;
+      // The candidate stage's checks at this station's own height (with several tripod heights, a
+      // high station's column must be free up to its height, not the lowest one's).
+      CandidateOptions at_height = candidate_options;
+      at_height.tripod_height_m = height;
+      at_height.tripod_heights_m.clear();
       for (int iy = -n; iy <= n; ++iy) {
         for (int ix = -n; ix <= n; ++ix) {
           if (ix == 0 && iy == 0) continue;
           const double x = s.x() + ix * options.step_m, y = s.y() + iy * options.step_m;
-          const std::optional<double> top = FloorTopNear(scene.grid, x, y, floor_z, candidate_options);
+          const std::optional<double> top = FloorTopNear(scene.grid, x, y, floor_z, at_height);
           if (!top) continue;
           const WorldPoint p(x, y, *top + height);
           if (!HasClearance(scene.grid, p, candidate_options.clearance_m)) continue;
@@ -70,6 +88,11 @@ Result<LocalRefinementResult> RefineLocally(const Selector& selector, const Voxe
           added_floor.push_back(*top);
         }
       }
+    }
+    if (static_cast<uint64_t>(out.added) + added.size() > options.max_added) {
+      out.limited = true;
+      added.resize(options.max_added - static_cast<uint64_t>(out.added));
+      added_floor.resize(added.size());
     }
     if (added.empty()) break;
     VC_ASSIGN_OR_RETURN(std::vector<VoxelSet> sets, visibility(added));
@@ -87,7 +110,7 @@ Result<LocalRefinementResult> RefineLocally(const Selector& selector, const Voxe
     VC_ASSIGN_OR_RETURN(Selection next, selector.Select(out.candidates.sets, fixed, ctx));
     out.stations_per_solve.push_back(static_cast<int>(next.picks.size()));
     out.covered_per_solve.push_back(next.covered);
-    if (!Better(next, out.selection)) break;
+    if (!Better(next, out.selection, options.target_coverage)) break;
     out.selection = std::move(next);
   }
   return out;

@@ -152,6 +152,7 @@ Result<PlanResult> Plan(const SceneInput& input, const PlanOptions& options, con
   result.connecting_stations = selected.selection.connectors;
   result.optimality = selected.selection.optimality;
   if (!result.optimality.note.empty()) result.warnings.push_back(result.optimality.note);
+  for (std::string& w : selected.warnings) result.warnings.push_back(std::move(w));
   planner::Stations stations = std::move(selected.stations);
   VoxelSet coverable = std::move(selected.coverable);
 

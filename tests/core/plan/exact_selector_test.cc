@@ -264,6 +264,35 @@ TEST(ExactSelectorTest, ConnectedOptimumEqualsExhaustiveSearch) {
   EXPECT_GT(dearer, 0) << "connectivity never cost a station: the test proves little";
 }
 
+// prefer_greedy with min_overlap: the plan is connected whenever a connected one exists, in both
+// modes; greedy's plan is kept only when it is connected and no worse.
+TEST(ExactSelectorTest, PreferGreedyNeverKeepsADisconnectedPlan) {
+  std::mt19937 rng(2023);
+  int replaced_disconnected = 0;
+  for (int trial = 0; trial < 80; ++trial) {
+    const int n = 4 + static_cast<int>(rng() % 8);
+    const size_t voxels = 30 + rng() % 90;
+    std::vector<VoxelSet> sets = RandomSets(rng, n, voxels, 0.1 + 0.3 * (rng() % 100) / 100.0);
+    ExactSelectorOptions o;
+    o.greedy.target_coverage = std::vector<double>{1.0, 0.9, 0.7}[rng() % 3];
+    o.greedy.min_overlap = std::vector<double>{0.2, 0.3, 0.4}[rng() % 3];
+    if (trial % 2) o.greedy.max_stations = 1 + static_cast<int>(rng() % 3);
+    Result<Selection> exact = ExactSelector(o).Select(sets, 0, {});
+    o.prefer_greedy = true;
+    Result<Selection> got = ExactSelector(o).Select(sets, 0, {});
+    Result<Selection> greedy = GreedySelector(o.greedy).Select(sets, 0, {});
+    ASSERT_TRUE(exact.ok() && got.ok() && greedy.ok());
+    const std::string what = "trial " + std::to_string(trial);
+    if (exact->optimality.status == OptimalityStatus::kHeuristic) continue;  // no connected plan found
+    EXPECT_TRUE(Connected(sets, got->picks, o.greedy.min_overlap)) << what;
+    if (!Connected(sets, greedy->picks, o.greedy.min_overlap)) {
+      ++replaced_disconnected;
+      EXPECT_NE(got->picks, greedy->picks) << what;
+    }
+  }
+  EXPECT_GT(replaced_disconnected, 0) << "greedy's plan was always connected: the test proves little";
+}
+
 TEST(ExactSelectorTest, FixedStationsStayFirstEvenWhenUseless) {
   std::vector<VoxelSet> sets(4, VoxelSet(10));
   for (size_t v = 0; v < 10; ++v) sets[3].set(v);  // one candidate sees everything

@@ -122,6 +122,70 @@ TEST(LocalRefinementTest, NoPositionIsAddedInsideAKeepOutZone) {
   EXPECT_EQ(r->stations_per_solve, (std::vector<int>{2, 2}));
 }
 
+// Returns the scripted selections in turn (then the last one again), whatever the sets.
+class ScriptedSelector final : public Selector {
+ public:
+  explicit ScriptedSelector(std::vector<Selection> script) : script_(std::move(script)) {}
+  using Selector::Select;
+  Result<Selection> Select(const std::vector<VoxelSet>&, int, const JobContext&) const override {
+    const size_t k = std::min(calls_++, script_.size() - 1);
+    return script_[k];
+  }
+
+ private:
+  std::vector<Selection> script_;
+  mutable size_t calls_ = 0;
+};
+
+Selection Scripted(std::vector<int> picks, uint64_t covered, uint64_t coverable) {
+  Selection s;
+  s.picks = std::move(picks);
+  s.covered = covered;
+  s.coverable = coverable;
+  return s;
+}
+
+// Fewer stations short of the target (a max_stations plan, a solve cut off at the deadline) do not
+// replace a plan that reaches it; more coverage short of the target does replace less.
+TEST(LocalRefinementTest, ASolveReachingTheTargetBeatsFewerStationsShortOfIt) {
+  Fixture s;
+  const VisibilityFn fn = [&](const std::vector<WorldPoint>& p) { return s.fake(p); };
+  LocalRefinementOptions o;
+  o.target_coverage = 0.9;
+  {
+    const ScriptedSelector selector({Scripted({0, 1}, 10, 10), Scripted({0}, 5, 10)});
+    Result<LocalRefinementResult> r = RefineLocally(selector, s.scene, s.in, 0, CandidateOptions{}, fn, o);
+    ASSERT_TRUE(r.ok()) << r.status().ToString();
+    EXPECT_EQ(r->selection.picks, (std::vector<int>{0, 1}));
+    EXPECT_EQ(r->stations_per_solve, (std::vector<int>{2, 1}));
+  }
+  {
+    const ScriptedSelector selector({Scripted({0}, 5, 10), Scripted({0, 1}, 8, 10), Scripted({1}, 8, 10)});
+    Result<LocalRefinementResult> r = RefineLocally(selector, s.scene, s.in, 0, CandidateOptions{}, fn, o);
+    ASSERT_TRUE(r.ok()) << r.status().ToString();
+    EXPECT_EQ(r->selection.picks, (std::vector<int>{1}));           // 5 -> 8 covered, then as much with one station
+    EXPECT_EQ(r->stations_per_solve, (std::vector<int>{1, 2, 1}));  // then no new position around it: stop
+  }
+}
+
+TEST(LocalRefinementTest, MaxAddedBoundsThePositionsAndSaysSo) {
+  Fixture s;
+  CountingSelector selector;
+  const VisibilityFn fn = [&](const std::vector<WorldPoint>& p) { return s.fake(p); };
+  LocalRefinementOptions o;
+  o.max_added = 3;
+  Result<LocalRefinementResult> r = RefineLocally(selector, s.scene, s.in, 0, CandidateOptions{}, fn, o);
+  ASSERT_TRUE(r.ok()) << r.status().ToString();
+  EXPECT_EQ(r->added, 3);
+  EXPECT_TRUE(r->limited);
+  EXPECT_EQ(r->candidates.positions.size(), s.in.positions.size() + 3);
+  o.max_added = 0;
+  r = RefineLocally(selector, s.scene, s.in, 0, CandidateOptions{}, fn, o);
+  ASSERT_TRUE(r.ok());
+  EXPECT_EQ(r->added, 0);
+  EXPECT_EQ(r->rounds, 0);
+}
+
 TEST(LocalRefinementTest, NoRoundsKeepsTheFirstSolve) {
   Fixture s;
   CountingSelector selector;

@@ -49,8 +49,9 @@ ExactSelectorOptions ExactOptionsFor(const PlanOptions& options) {
   return exact;
 }
 
-// RefineLocally over the fixed stations and the candidates (`sets`, consumed), with the added
-// positions' sets cut to the coverable set of the first selection.
+// RefineLocally with the stage's selector over the fixed stations and the candidates (`sets`,
+// consumed), with the added positions' sets cut to the coverable set of the first selection and
+// as many of them as the memory budget holds beside the sets already held.
 Result<LocalRefinementResult> SelectWithLocalCandidates(const SelectionInput& in, std::vector<VoxelSet> sets, int fixed,
                                                         const PlanOptions& options, const JobContext& ctx) {
   const Clock::time_point start = Clock::now();
@@ -63,15 +64,11 @@ Result<LocalRefinementResult> SelectWithLocalCandidates(const SelectionInput& in
   VoxelSet coverable(n_voxels);
   for (const VoxelSet& s : sets) UnionInto(coverable, s);
   all.sets = std::move(sets);
-  uint64_t positions_held = all.positions.size();
 
   VisibilitySetsOptions set_options{options.selection_test, options.threads};
   set_options.scanner = options.scanner;
   const JobContext quiet{ctx.cancel, {}};  // the selection stage reports the loop's progress itself
   const VisibilityFn visibility = [&](const std::vector<WorldPoint>& positions) -> Result<std::vector<VoxelSet>> {
-    positions_held += positions.size();
-    VC_RETURN_IF_ERROR(
-        CheckVisibilitySetBudget(positions_held, n_voxels, options.memory_budget_bytes, "local candidates"));
     ctx.Report(Stage::kSelection, 0.0,
                "local candidates: visibility of " + std::to_string(positions.size()) + " positions");
     VC_ASSIGN_OR_RETURN(std::vector<VoxelSet> out, ComputeVisibilitySets(in.scene, positions, set_options, quiet));
@@ -82,21 +79,19 @@ Result<LocalRefinementResult> SelectWithLocalCandidates(const SelectionInput& in
   };
 
   const std::vector<double> heights = options.TripodHeights();
-  CandidateOptions cand_options{options.grid_spacing_m, *std::min_element(heights.begin(), heights.end()),
-                                options.clearance_m, options.tripod_heights_m, false};
+  const CandidateOptions cand_options{options.grid_spacing_m, *std::min_element(heights.begin(), heights.end()),
+                                      options.clearance_m, options.tripod_heights_m, false};
   LocalRefinementOptions local{options.local_candidates_radius_m, options.local_candidates_step_m,
                                options.local_candidates_rounds, options.keep_out};
+  local.target_coverage = options.target_coverage;
+  // The visibility sets may take half the budget (CheckVisibilitySetBudget); what is left of it
+  // after the sets held bounds the positions added.
+  const uint64_t set_bytes = std::max<uint64_t>(8, (n_voxels + 63) / 64 * 8);
+  const uint64_t fit = options.memory_budget_bytes / 2 / set_bytes;
+  local.max_added = fit > all.positions.size() ? fit - all.positions.size() : 0;
 
-  std::unique_ptr<Selector> selector;
-  const Selector* use = &in.selector;
-  if (options.solver != SelectionSolver::kGreedy) {
-    selector = std::make_unique<SharedDeadlineSelector>(
-        ExactOptionsFor(options),
-        start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(options.solve_seconds)));
-    use = selector.get();
-  }
-  VC_ASSIGN_OR_RETURN(LocalRefinementResult out,
-                      RefineLocally(*use, in.scene, std::move(all), fixed, cand_options, visibility, local, ctx));
+  VC_ASSIGN_OR_RETURN(LocalRefinementResult out, RefineLocally(in.selector, in.scene, std::move(all), fixed,
+                                                               cand_options, visibility, local, ctx));
   LocalCandidatesReport& report = out.selection.optimality.local_candidates;
   report.rounds = out.rounds;
   report.added = out.added;
@@ -120,6 +115,11 @@ GreedySelectorOptions SelectorOptionsFor(const PlanOptions& options) {
 
 std::unique_ptr<Selector> SelectorFor(const PlanOptions& options) {
   if (options.solver == SelectionSolver::kGreedy) return std::make_unique<GreedySelector>(SelectorOptionsFor(options));
+  if (options.local_candidates) {
+    return std::make_unique<SharedDeadlineSelector>(
+        ExactOptionsFor(options), Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                                                     std::chrono::duration<double>(options.solve_seconds)));
+  }
   return std::make_unique<ExactSelector>(ExactOptionsFor(options));
 }
 
@@ -139,6 +139,12 @@ Result<SelectionOutput> RunSelectionStage(SelectionInput in, const PlanOptions& 
     VC_ASSIGN_OR_RETURN(LocalRefinementResult local,
                         SelectWithLocalCandidates(in, std::move(sets), fixed, options, ctx));
     out.selection = std::move(local.selection);
+    if (local.limited) {
+      out.warnings.push_back("local candidates: the memory budget holds the visibility sets of " +
+                             std::to_string(local.added) +
+                             " added positions and no more; raise memory_budget_bytes or lower "
+                             "local_candidates_radius_m for the rest");
+    }
     sets = std::move(local.candidates.sets);
     const size_t first_added = static_cast<size_t>(fixed + n_candidates);
     added_positions.assign(local.candidates.positions.begin() + static_cast<std::ptrdiff_t>(first_added),

@@ -13,6 +13,7 @@
 // Thread-safety: RefineLocally calls the selector and the callback from the calling thread only.
 #pragma once
 
+#include <cstdint>
 #include <functional>
 #include <vector>
 
@@ -32,6 +33,8 @@ struct LocalRefinementOptions {
   double step_m = 0.25;               // sub-grid step (m), in (0, radius_m]
   int max_rounds = 4;                 // solves after the first, at most
   std::vector<KeepOutZone> keep_out;  // no position is added inside these
+  double target_coverage = 1.0;       // a solve reaching this fraction of its coverable voxels beats one that does not
+  uint64_t max_added = UINT64_MAX;    // positions added over all rounds, at most (the caller's memory budget)
 };
 
 // Candidates and their sets: positions[i] sees sets[i]; floor_z_m[i] is the top of its floor (m,
@@ -50,6 +53,7 @@ struct LocalRefinementResult {
   Selection selection;       // the best solve's, over `candidates`
   int rounds = 0;            // solves after the first
   int added = 0;             // positions added over all rounds
+  bool limited = false;      // max_added cut a round short (the rounds after it add nothing)
   // Stations and covered voxels of each solve, the first solve's first.
   std::vector<int> stations_per_solve;
   std::vector<uint64_t> covered_per_solve;
@@ -57,11 +61,13 @@ struct LocalRefinementResult {
 
 // Solves with `selector` over `in`, then, each round, adds around every picked station (beyond the
 // `fixed` first ones) the positions of a step_m sub-grid within radius_m (square) that stand on the
-// station's floor (FloorTopNear) at its height above that floor, with the clearance (HasClearance),
-// outside options.keep_out, and are not yet candidates; solves again over all; keeps the new solve if it has fewer
-// stations, or as many covering more voxels. Stops after a round without improvement, without new positions, or after
-// max_rounds. INVALID_ARGUMENT for bad options or inputs of different lengths; the selector's and the callback's errors
-// pass through; CANCELLED / DEADLINE_EXCEEDED from ctx.
+// station's floor (FloorTopNear, with the station's own height above that floor), with the
+// clearance (HasClearance), outside options.keep_out, and are not yet candidates (at most
+// options.max_added over all rounds); solves again over all; keeps the new solve if it is better:
+// reaching target_coverage beats not reaching it, then fewer stations, or as many covering more
+// (short of the target: more covered, then fewer stations). Stops after a round without
+// improvement, without new positions, or after max_rounds. INVALID_ARGUMENT for bad options or inputs of different
+// lengths; the selector's and the callback's errors pass through; CANCELLED / DEADLINE_EXCEEDED from ctx.
 Result<LocalRefinementResult> RefineLocally(const Selector& selector, const VoxelScene& scene, CandidateSets in,
                                             int fixed, const CandidateOptions& candidate_options,
                                             const VisibilityFn& visibility, const LocalRefinementOptions& options,

@@ -105,24 +105,26 @@ struct SelectionInput {
   const PlanCallbacks& callbacks;               // on_station is called per pick, in pick order
 };
 struct SelectionOutput {
-  Stations stations;    // the fixed stations, then the picks, in pick order
-  VoxelSet coverable;   // union of every candidate's and fixed station's set
-  Selection selection;  // what the selector reported
+  Stations stations;                  // the fixed stations, then the picks, in pick order
+  VoxelSet coverable;                 // union of every candidate's and fixed station's set
+  Selection selection;                // what the selector reported
+  std::vector<std::string> warnings;  // the local-candidates loop's, when the memory budget cut it short
 };
 // With options.local_candidates, RefineLocally (local_refinement.h) around the selector: positions
 // on a local_candidates_step_m sub-grid around each chosen station (on its floor, with the
 // clearance, outside keep-out zones) become candidates, their sets cut to the first coverable set
 // (the coverage problem stays the same: voxels only they see raise no target), and selection runs
-// again over all while it improves; an exact selector's solves share options.solve_seconds. A
-// station at an added position has candidate index -1. RESOURCE_EXHAUSTED when the added
-// positions' sets exceed the budget; errors of the selector (CANCELLED / DEADLINE_EXCEEDED from ctx).
+// again with in.selector over all while it improves. A station at an added position has candidate
+// index -1. Positions beyond what half the memory budget holds are not added (a warning says so).
+// Errors of the selector (CANCELLED / DEADLINE_EXCEEDED from ctx).
 [[nodiscard]] Result<SelectionOutput> RunSelectionStage(SelectionInput in, const PlanOptions& options,
                                                         const JobContext& ctx);
 
 // The Selector a plan with `options` uses: GreedySelector with its stopping rules.
 [[nodiscard]] GreedySelectorOptions SelectorOptionsFor(const PlanOptions& options);
 // The selector options.solver names: GreedySelector, or ExactSelector with options.solve_seconds
-// and half the job's memory budget (the visibility sets hold the rest).
+// and half the job's memory budget (the visibility sets hold the rest). With local_candidates its
+// solves share options.solve_seconds counted from this call: make it right before the stage.
 [[nodiscard]] std::unique_ptr<Selector> SelectorFor(const PlanOptions& options);
 
 // --- Stage::kRefine: each station to the best position of a sub-grid around it (s.7.4) ---
