@@ -22,8 +22,9 @@
 // cancellable through ctx (a CbcEventHandler polls ctx.CheckCancelled between nodes); on the
 // limit the best plan found comes back with its bound (status kFeasible). If the model's
 // estimated memory exceeds memory_budget_bytes, no ILP is built: greedy plus a swap local search
-// (drop a pick, 2-for-1 and 1-for-1 exchanges that keep the covered weight) runs instead, status
-// kHeuristic, with a note saying so (or, without swap_search, the greedy plan itself).
+// (drop a pick, 2-for-1 and 1-for-1 exchanges that keep the covered weight) runs instead, with a
+// note saying so (or, without swap_search, the greedy plan itself); its bound is the counting
+// bound (status kFeasible), or none with max_stations (kHeuristic).
 //
 // With min_overlap > 0 (registration, scan_graph.h) the plan must be connected: a single-commodity
 // flow over the candidates' scan-graph arcs (Dehbi et al. 2021) from one root station, which every
