@@ -1,6 +1,6 @@
 // What vc-client prints after a plan: durations, the station table's route column, the scan graph,
 // the route (parts marked "//"), the field time, and the optimality line for each status (none for
-// the default greedy).
+// a greedy plan without a bound) with the local-candidates line before it.
 #include "vc/client/plan_summary.h"
 
 #include <gtest/gtest.h>

@@ -1,10 +1,10 @@
 // Station selection behind one interface (ALGORITHM.md s.7.3; docs/PLANNING.md, "Pipeline").
 //
 // The selection stage hands a Selector the candidates' visibility sets and gets back the picks
-// (candidate indices, in pick order) and why it stopped. Today's selector is GreedySelector: lazy
-// greedy maximum coverage (greedy.h, CELF), then consolidation of the picks. An exact solver (an
-// ILP over the same sets) or a local search is one more class implementing Select. Selectors are
-// immutable after construction, so Select is thread-safe; the sets are only read.
+// (candidate indices, in pick order) and why it stopped. GreedySelector: lazy greedy maximum
+// coverage (greedy.h, CELF), then consolidation of the picks; ExactSelector (exact_selector.h): the
+// integer program over the same sets, warm-started from greedy. Selectors are immutable after
+// construction, so Select is thread-safe; the sets are only read.
 #pragma once
 
 #include <cstdint>
@@ -32,7 +32,7 @@ std::string_view StopReasonName(StopReason reason);
 enum class SelectionSolver : uint8_t {
   kGreedy,  // GreedySelector: lazy greedy, then consolidation
   kExact,   // ExactSelector: the integer program (CBC), greedy + swaps over the memory budget
-  kAuto,    // the integer program when it fits the memory budget, else the greedy plan
+  kAuto,    // the default: ExactSelector keeping greedy's plan unless it finds a strictly better one
 };
 // "greedy", "exact", "auto".
 std::string_view SelectionSolverName(SelectionSolver solver);
