@@ -12,7 +12,7 @@ BUILD_PKGS=(
   libgrpc++-dev libprotobuf-dev protobuf-compiler protobuf-compiler-grpc
   liboctomap-dev libeigen3-dev libspdlog-dev libfmt-dev
   libgtest-dev libgmock-dev libbenchmark-dev
-  libcli11-dev nlohmann-json3-dev libhwy-dev coinor-libcbc-dev
+  libcli11-dev nlohmann-json3-dev libhwy-dev coinor-libcbc-dev libroaring-dev
   zlib1g-dev libbz2-dev libpng-dev libssl-dev libexpat1-dev
   openssl python3 bzip2 gzip
   clang clang-format libfuzzer-14-dev
@@ -24,7 +24,7 @@ TEST_PKGS=(
 RUNTIME_PKGS=(
   libgrpc++1.51 libgrpc29 libprotobuf32 liboctomap1.9 libspdlog1.10 libfmt9 libhwy1
   coinor-libcbc3 coinor-libcgl1 coinor-libclp1 coinor-libosi1v5 coinor-libcoinutils3v5
-  zlib1g libbz2-1.0 libpng16-16 libexpat1 ca-certificates
+  zlib1g libbz2-1.0 libpng16-16 libexpat1 ca-certificates libroaring0
 )
 
 pkgs=("${BUILD_PKGS[@]}")

@@ -102,6 +102,13 @@ std::string OptimalityLine(const PlanResult& r) {
   return local + OptimalityBoundLine(r);
 }
 
+std::string DistributionLine(const PlanResult& r) {
+  const Distribution& d = r.distribution;
+  if (d.shards == 0) return "";
+  return Format("visibility: %d shard(s) on %d replica(s), %d retried, %.1f MiB exchanged\n", d.shards, d.replicas,
+                d.retried, double(d.bytes_exchanged) / 1048576.0);
+}
+
 std::string FormatDuration(double seconds) {
   if (!std::isfinite(seconds) || seconds < 0) return "?";
   const long s = std::lround(seconds);
@@ -130,6 +137,7 @@ std::string PlanSummary(const PlanResult& r) {
                   route_position[i] ? std::to_string(route_position[i]).c_str() : "-", s.fixed ? "  fixed" : "");
   }
   out += OptimalityLine(r);
+  out += DistributionLine(r);
   out += ScanGraphLine(r);
   out += RouteLines(r);
   out += FieldTimeLine(r);

@@ -557,6 +557,13 @@ v1::PlanResult ToProto(const PlanResult& r) {
   p.set_greedy_stations(r.greedy_stations);
   p.set_consolidated(r.consolidated);
   *p.mutable_optimality() = ToProto(r.optimality);
+  if (r.distribution.shards > 0) {
+    v1::Distribution* d = p.mutable_distribution();
+    d->set_replicas(r.distribution.replicas);
+    d->set_shards(r.distribution.shards);
+    d->set_retried(r.distribution.retried);
+    d->set_bytes_exchanged(r.distribution.bytes_exchanged);
+  }
   p.set_grid_cells(r.grid_cells);
   p.set_cells_without_floor(r.cells_without_floor);
   p.set_cells_failing_clearance(r.cells_failing_clearance);
@@ -686,6 +693,8 @@ Result<PlanResult> PlanResultAssembler::Finish(const v1::PlanResult& p) && {
   r.greedy_stations = p.greedy_stations();
   r.consolidated = p.consolidated();
   VC_ASSIGN_OR_RETURN(r.optimality, FromProto(p.optimality()));
+  r.distribution = {p.distribution().replicas(), p.distribution().shards(), p.distribution().retried(),
+                    p.distribution().bytes_exchanged()};
   r.grid_cells = p.grid_cells();
   r.cells_without_floor = p.cells_without_floor();
   r.cells_failing_clearance = p.cells_failing_clearance();

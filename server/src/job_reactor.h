@@ -32,9 +32,11 @@
 #include "vc/server/job_runner.h"
 #include "vc/server/kept_jobs.h"
 #include "vc/server/outbox.h"
+#include "vc/server/peers.h"
 #include "vc/server/scene_cache.h"
 #include "vc/server/server_options.h"
 #include "vc/server/upload_assembler.h"
+#include "vc/server/voxelized_scenes.h"
 #include "vc/server/worker_pool.h"
 #include "vc/v1/planner.pb.h"
 #include "vc/wire/convert.h"
@@ -44,16 +46,23 @@ namespace vc::server::internal {
 
 // Shared by every call of a service.
 struct ServiceState {
-  ServiceState(const ServerOptions& o, Backend b)
+  ServiceState(const ServerOptions& o, Backend b, std::string id, std::unique_ptr<PeerFanOut> peers)
       : options(o),
         backend(std::move(b)),
+        replica_id(std::move(id)),
+        fan_out(std::move(peers)),
         cache(o.scene_cache_bytes),
         runner(&backend, o.max_upload_bytes, &cache),
         kept(o.result_ttl, o.kept_results_bytes),
         pool(o.EffectiveWorkers(), o.queue) {}
   const ServerOptions options;
   const Backend backend;
+  // This process's id among replicas (PeerHello), and the fan-out of its plans (null without peers).
+  const std::string replica_id;
+  const std::unique_ptr<PeerFanOut> fan_out;
   SceneCache cache;
+  // The scenes voxelized for peers' shards (ComputeShard).
+  VoxelizedScenes voxelized{2};
   const JobRunner runner;
   std::atomic<uint64_t> next_job{1};
 
@@ -204,6 +213,12 @@ class JobReactor : public grpc::ServerBidiReactor<Request, Response> {
   virtual Status Run(const SceneInput& input, const JobContext& ctx, JobLog& log) = 0;
 
   JobChannel<Response>& channel() { return *channel_; }
+  // The uploaded bytes, kept for the job's life only on a replica that fans plans out (null
+  // otherwise): peers are sent the scene from them.
+  const SceneCache::Bytes& scene_bytes() const { return scene_bytes_; }
+  const v1::UploadSpec& upload_spec() const { return upload_spec_; }
+  PeerFanOut* fan_out() const { return state_->fan_out.get(); }
+  const std::string& replica_id() const { return state_->replica_id; }
   const ServerOptions& options() const { return state_->options; }
   const Backend& backend() const { return state_->backend; }
 
@@ -255,11 +270,13 @@ class JobReactor : public grpc::ServerBidiReactor<Request, Response> {
                                     std::to_string(job_.upload.total_size_bytes())));
         return;
       }
-      job_.data = *cached;
+      job_.data = cached;
       job_.cache = "hit";
     } else {
-      job_.data = upload_.TakeData();
+      job_.data = std::make_shared<const std::string>(upload_.TakeData());
     }
+    upload_spec_ = job_.upload;
+    if (state_->fan_out) scene_bytes_ = job_.data;
     job_.memory_budget_bytes = MemoryBudgetBytes();
     job_.started = start_;
     job_.submitted = Clock::now();
@@ -326,6 +343,8 @@ class JobReactor : public grpc::ServerBidiReactor<Request, Response> {
   Request request_;                      // the message being read (gRPC threads, one reaction at a time)
   UploadAssembler upload_;               // gRPC threads until the job is submitted
   Job job_;                              // handed to the worker
+  v1::UploadSpec upload_spec_;           // job_.upload, kept for the worker's Run
+  SceneCache::Bytes scene_bytes_;        // with peers only: the upload, for them
   // The job's events and cancellation (kept in state_->kept when detachable), and this call's queue.
   const std::shared_ptr<JobChannel<Response>> channel_;
   const std::shared_ptr<Outbox<Response>> outbox_;

@@ -55,19 +55,21 @@ Status JobRunner::Execute(Job& job, const JobContext& ctx, JobLog& log, const Jo
   VC_RETURN_IF_ERROR(ctx.CheckCancelled("the job (while queued)"));
   const ReadOptions read_options = ReadLimits(max_upload_bytes_, job.memory_budget_bytes);
   const auto t0 = Job::Clock::now();
+  if (job.data == nullptr) return InternalError("job " + job.id + " has no upload");
+  const std::string& data = *job.data;
   if (!job.upload.scene_sha256().empty() && job.cache != "hit") {
-    const std::string sha256 = wire::Sha256Hex(job.data);
+    const std::string sha256 = wire::Sha256Hex(data);
     if (sha256 != job.upload.scene_sha256()) {
       return InvalidArgumentError("the upload's SHA-256 is " + sha256 + " but its spec says " +
                                   job.upload.scene_sha256() + "; send the hash of the bytes uploaded");
     }
     job.cache = "miss";
-    if (cache_ != nullptr) cache_->Put(sha256, std::make_shared<const std::string>(job.data));
+    if (cache_ != nullptr) cache_->Put(sha256, job.data);
   }
-  ctx.Report(Stage::kRead, 0.0, "parsing " + HumanBytes(job.data.size()));
+  ctx.Report(Stage::kRead, 0.0, "parsing " + HumanBytes(data.size()));
   const v1::UploadSpec& upload = job.upload;
   const std::string source = upload.source_name().empty() ? "upload" : upload.source_name();
-  VC_ASSIGN_OR_RETURN(SceneInput input, backend_->read_scene(job.data, source, read_options));
+  VC_ASSIGN_OR_RETURN(SceneInput input, backend_->read_scene(data, source, read_options));
   log.NoteTiming(StageName(Stage::kRead), SecondsSince(t0));
   if (upload.format() != v1::INPUT_FORMAT_UNSPECIFIED && wire::ToProto(input.format) != upload.format()) {
     return InvalidArgumentError(source + " is " + std::string(InputFormatName(input.format)) +
@@ -75,8 +77,7 @@ Status JobRunner::Execute(Job& job, const JobContext& ctx, JobLog& log, const Jo
                                 "; fix the spec's format or leave it unspecified");
   }
   ctx.Report(Stage::kRead, 1.0, std::string(InputFormatName(input.format)));
-  job.data.clear();
-  job.data.shrink_to_fit();
+  job.data.reset();
   const auto t1 = Job::Clock::now();
   Status s = fn(input, ctx, log);
   log.NoteTiming("run", SecondsSince(t1));

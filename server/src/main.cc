@@ -63,6 +63,31 @@ int main(int argc, char** argv) {
                  "host:port clients re-attach to (sent in Accepted); set it to the replica's own address behind "
                  "a load balancer")
       ->envname("VC_ADVERTISE_ADDRESS");
+  app.add_option("--peers", o.peers,
+                 "host:port of replicas to fan each plan's visibility stage out to, separated by commas "
+                 "(docs/DEPLOY.md, \"Scaling out\")")
+      ->delimiter(',')
+      ->envname("VC_PEERS");
+  app.add_option("--peers-dns", o.peers_dns,
+                 "NAME:PORT whose every address is a peer, resolved again for each plan (a Kubernetes headless "
+                 "Service)")
+      ->envname("VC_PEERS_DNS");
+  app.add_option("--shard-candidates", o.shard_candidates, "candidates per shard sent to a peer")
+      ->envname("VC_SHARD_CANDIDATES")
+      ->capture_default_str();
+  app.add_option("--local-shards", o.local_shards,
+                 "whether this replica computes shards of its own plans too (false: only when its peers cannot)")
+      ->envname("VC_LOCAL_SHARDS")
+      ->capture_default_str();
+  app.add_option("--peer-token", o.peer_token, "bearer token presented to peers (default: the first --token)")
+      ->envname("VC_PEER_TOKEN");
+  app.add_option("--peer-tls-ca", o.peer_tls_ca_file, "CA (PEM) that peers' certificates are checked against")
+      ->envname("VC_PEER_TLS_CA");
+  double shard_deadline_s = std::chrono::duration<double>(o.shard_deadline).count();
+  app.add_option("--shard-deadline-seconds", shard_deadline_s,
+                 "seconds a peer gets for one shard before it is computed elsewhere")
+      ->envname("VC_SHARD_DEADLINE_SECONDS")
+      ->capture_default_str();
   app.add_option("--shutdown-grace", grace_s, "seconds running jobs get after SIGTERM before they are cancelled")
       ->envname("VC_SHUTDOWN_GRACE")
       ->capture_default_str();
@@ -73,6 +98,7 @@ int main(int argc, char** argv) {
   o.shutdown_grace = std::chrono::milliseconds(int64_t(grace_s * 1000));
   o.max_detach_grace = std::chrono::milliseconds(int64_t(max_grace_s * 1000));
   o.result_ttl = std::chrono::milliseconds(int64_t(ttl_s * 1000));
+  o.shard_deadline = std::chrono::milliseconds(int64_t(shard_deadline_s * 1000));
   spdlog::set_level(spdlog::level::from_str(log_level));
 
   // Block the signals in every thread (gRPC's included); this thread waits for them.

@@ -1,11 +1,14 @@
 #include "vc/server/server.h"
 
+#include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <grpcpp/ext/proto_server_reflection_plugin.h>
 #include <grpcpp/grpcpp.h>
 #include <grpcpp/health_check_service_interface.h>
 #include <spdlog/spdlog.h>
 
 #include <fstream>
+#include <random>
 #include <sstream>
 #include <thread>
 
@@ -46,7 +49,15 @@ Result<std::unique_ptr<Server>> Server::Start(const ServerOptions& options, Back
   grpc::reflection::InitProtoReflectionServerBuilderPlugin();
 
   std::unique_ptr<Server> s(new Server());
-  s->service_ = std::make_unique<StationPlannerService>(options, std::move(backend));
+  const std::string replica_id = [] {
+    std::random_device rd;
+    return fmt::format("{:08x}{:08x}", rd(), rd());
+  }();
+  std::unique_ptr<PeerFanOut> fan_out;
+  if (options.HasPeers()) {
+    VC_ASSIGN_OR_RETURN(fan_out, PeerFanOut::Create(options, replica_id));
+  }
+  s->service_ = std::make_unique<StationPlannerService>(options, std::move(backend), replica_id, std::move(fan_out));
   grpc::ServerBuilder builder;
   builder.AddListeningPort(options.listen, credentials, &s->port_);
   builder.RegisterService(s->service_.get());
@@ -58,10 +69,15 @@ Result<std::unique_ptr<Server>> Server::Start(const ServerOptions& options, Back
                          ": the address is in use or not local; choose another --listen");
   }
   s->server_->GetHealthCheckService()->SetServingStatus(true);
-  spdlog::info("vc-server listening on {} (port {}), {} workers x {} threads, queue {}, tls={}, tokens={}",
-               options.listen, s->port_, options.EffectiveWorkers(), options.EffectiveThreadsPerJob(), options.queue,
-               options.tls_cert_file.empty() ? "off" : (options.tls_client_ca_file.empty() ? "on" : "mutual"),
-               options.tokens.empty() ? "off" : std::to_string(options.tokens.size()));
+  spdlog::info(
+      "vc-server listening on {} (port {}), {} workers x {} threads, queue {}, tls={}, tokens={}, replica {}{}",
+      options.listen, s->port_, options.EffectiveWorkers(), options.EffectiveThreadsPerJob(), options.queue,
+      options.tls_cert_file.empty() ? "off" : (options.tls_client_ca_file.empty() ? "on" : "mutual"),
+      options.tokens.empty() ? "off" : std::to_string(options.tokens.size()), replica_id,
+      options.HasPeers() ? fmt::format(", peers {}{}{} in shards of {}", fmt::join(options.peers, ","),
+                                       options.peers.empty() || options.peers_dns.empty() ? "" : ",", options.peers_dns,
+                                       options.shard_candidates)
+                         : std::string());
   return s;
 }
 

@@ -31,6 +31,22 @@ Status ServerOptions::Validate() const {
   if (max_detach_grace.count() < 0) return InvalidArgumentError("--max-detach-grace-seconds must be >= 0");
   if (result_ttl.count() < 0) return InvalidArgumentError("--result-ttl-seconds must be >= 0");
   if (shutdown_grace.count() < 0) return InvalidArgumentError("--shutdown-grace must be >= 0");
+  for (const std::string& p : peers) {
+    if (p.empty() || p.rfind(':') == std::string::npos || p.rfind(':') + 1 == p.size()) {
+      return InvalidArgumentError("--peers: '" + p + "' is not host:port (separate several with commas)");
+    }
+  }
+  if (!peers_dns.empty() &&
+      (peers_dns.rfind(':') == std::string::npos || peers_dns.rfind(':') + 1 == peers_dns.size())) {
+    return InvalidArgumentError("--peers-dns '" + peers_dns +
+                                "' is not NAME:PORT (e.g. vc-server-peers.default.svc.cluster.local:50051)");
+  }
+  if (shard_candidates < 1) return InvalidArgumentError("--shard-candidates must be >= 1");
+  if (shard_deadline.count() <= 0) return InvalidArgumentError("--shard-deadline-seconds must be > 0");
+  if (!peer_tls_ca_file.empty() && tls_cert_file.empty()) {
+    return InvalidArgumentError(
+        "--peer-tls-ca needs --tls-cert and --tls-key (peers speak TLS when this replica does)");
+  }
   return Status::Ok();
 }
 

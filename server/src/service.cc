@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "job_reactor.h"
+#include "vc/wire/sha256.h"
 
 namespace vc::server {
 namespace internal {
@@ -87,6 +88,16 @@ class PlanReactor final : public JobReactor<v1::PlanRequest, v1::PlanResponse> {
       for (const PlannedStation& s : stations) *r.mutable_final_stations()->add_stations() = wire::ToProto(s);
       channel().Post(std::move(r));
     };
+    if (fan_out() != nullptr) {
+      callbacks.visibility_sets = [this](const VoxelScene& scene, const std::vector<WorldPoint>& viewpoints,
+                                         const VisibilitySetsOptions& set_options, const JobContext& c) {
+        PeerFanOut::SceneRef ref;
+        ref.bytes = scene_bytes();
+        ref.sha256 = upload_spec().scene_sha256().empty() ? wire::Sha256Hex(*ref.bytes) : upload_spec().scene_sha256();
+        ref.source_name = upload_spec().source_name();
+        return fan_out()->Compute(ref, wire::ToProto(options_), scene, viewpoints, set_options, c);
+      };
+    }
     VC_ASSIGN_OR_RETURN(const PlanResult result, backend().plan(input, options_, ctx, callbacks));
     for (const auto& t : result.timings) log.NoteTiming(StageName(t.stage), t.seconds);
     log.set_details(fmt::format(" stations={}", result.stations.size()));
@@ -258,8 +269,10 @@ Result<std::string> CancelKeptJob(const grpc::CallbackServerContext& ctx, Servic
 }  // namespace
 }  // namespace internal
 
-StationPlannerService::StationPlannerService(const ServerOptions& options, Backend backend)
-    : state_(std::make_unique<internal::ServiceState>(options, std::move(backend))) {}
+StationPlannerService::StationPlannerService(const ServerOptions& options, Backend backend, std::string replica_id,
+                                             std::unique_ptr<PeerFanOut> fan_out)
+    : state_(std::make_unique<internal::ServiceState>(options, std::move(backend), std::move(replica_id),
+                                                      std::move(fan_out))) {}
 
 StationPlannerService::~StationPlannerService() = default;
 

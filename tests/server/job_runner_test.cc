@@ -39,7 +39,7 @@ struct Fixture {
     job.upload.set_source_name("room.ply");
     job.upload.set_format(format);
     job.upload.set_total_size_bytes(data.size());
-    job.data = std::move(data);
+    job.data = std::make_shared<const std::string>(std::move(data));
     job.started = job.submitted = Job::Clock::now();
     return job;
   }

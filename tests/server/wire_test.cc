@@ -120,6 +120,7 @@ PlanResult BigResult(size_t voxels, size_t candidates) {
   r.optimality.dominated = 2;
   r.optimality.note = "n";
   r.optimality.local_candidates = {2, 90, {4, 3, 3}, {26912, 26912, 26912}};
+  r.distribution = {3, 31, 2, 5000000000};
   return r;
 }
 
@@ -200,6 +201,10 @@ TEST(PlanResultChunks, ReassembleExactlyAndStayUnderOneMebibyte) {
   EXPECT_EQ(o.local_candidates.added, 90);
   EXPECT_EQ(o.local_candidates.stations_per_solve, (std::vector<int>{4, 3, 3}));
   EXPECT_EQ(o.local_candidates.covered_per_solve, (std::vector<uint64_t>{26912, 26912, 26912}));
+  EXPECT_EQ(back->distribution.replicas, 3);
+  EXPECT_EQ(back->distribution.shards, 31);
+  EXPECT_EQ(back->distribution.retried, 2);
+  EXPECT_EQ(back->distribution.bytes_exchanged, 5000000000u);
 }
 
 TEST(PlanResultChunks, ARouteOrGraphNamingAMissingStationIsDataLoss) {
@@ -244,7 +249,7 @@ TEST(PlanResultChunks, ASoleViewerNamingAMissingStationOrOnSomeChunksOnlyIsDataL
 // A tripwire: when a field is added to PlanResult or PlanOptions, its size changes; carry the new
 // field in proto/vc/v1/planner.proto and proto/src/convert.cc (both ways), then update the sizes.
 TEST(PlanResultChunks, EveryCoreFieldIsCarried) {
-  EXPECT_EQ(sizeof(PlanResult), 1384u) << "PlanResult changed: update the vc.v1 PlanResult and vc::wire";
+  EXPECT_EQ(sizeof(PlanResult), 1408u) << "PlanResult changed: update the vc.v1 PlanResult and vc::wire";
   EXPECT_EQ(sizeof(PlanOptions), 400u) << "PlanOptions changed: update vc.v1 PlanParameters and vc::wire";
 }
 

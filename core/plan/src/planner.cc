@@ -138,6 +138,8 @@ Result<PlanResult> Plan(const SceneInput& input, const PlanOptions& options, con
         {scene, candidates.positions, candidates.floor_z_m, options.fixed_stations, callbacks}, options, c);
   }));
   result.heat_map = std::move(visibility.heat_map);
+  result.distribution = visibility.distribution;
+  for (std::string& w : visibility.warnings) result.warnings.push_back(std::move(w));
 
   const std::unique_ptr<planner::Selector> selector = planner::SelectorFor(options);
   VC_ASSIGN_OR_RETURN(planner::SelectionOutput selected, runner.Run(Stage::kSelection, [&](const JobContext& c) {

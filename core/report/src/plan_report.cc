@@ -710,6 +710,11 @@ std::string PlanToJson(const PlanResult& r, const UploadSummary* upload) {
          {"route", std::move(route)},
          {"field_time_s", std::move(field_time)},
          {"optimality", OptimalityJson(r.optimality)},
+         {"distribution", r.distribution.shards == 0 ? Json(nullptr)
+                                                     : Json{{"replicas", r.distribution.replicas},
+                                                            {"shards", r.distribution.shards},
+                                                            {"retried", r.distribution.retried},
+                                                            {"bytes_exchanged", r.distribution.bytes_exchanged}}},
          {"timings_s", std::move(timings)},
          {"parameters", ParametersJson(r.options)},
          {"upload", upload == nullptr

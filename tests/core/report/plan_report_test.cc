@@ -90,7 +90,7 @@ TEST(PlanReportTest, PlanJsonHasEveryDocumentedKey) {
   const json j = json::parse(PlanToJson(SamplePlan()));
   for (const char* key :
        {"schema", "resolution_m", "selection_test", "stop_reason", "viewpoints", "coverage", "reduction", "candidates",
-        "timings_s", "parameters", "warnings", "scan_graph", "route", "field_time_s", "optimality"}) {
+        "timings_s", "parameters", "warnings", "scan_graph", "route", "field_time_s", "optimality", "distribution"}) {
     EXPECT_TRUE(j.contains(key)) << key;
   }
   EXPECT_EQ(j["scan_graph"]["min_overlap"].get<double>(), 0.3);
@@ -120,6 +120,11 @@ TEST(PlanReportTest, PlanJsonHasEveryDocumentedKey) {
   local.optimality.local_candidates = {1, 24, {2, 2}, {5, 5}};
   const json l = json::parse(PlanToJson(local))["optimality"]["local_candidates"];
   EXPECT_EQ(l, json::parse(R"({"rounds": 1, "added": 24, "stations_per_solve": [2, 2], "covered_per_solve": [5, 5]})"));
+  EXPECT_TRUE(j["distribution"].is_null());  // planned by one replica
+  PlanResult fanned = SamplePlan();
+  fanned.distribution = {3, 12, 2, 123456};
+  EXPECT_EQ(json::parse(PlanToJson(fanned))["distribution"],
+            json::parse(R"({"replicas": 3, "shards": 12, "retried": 2, "bytes_exchanged": 123456})"));
   EXPECT_EQ(j["viewpoints"][0]["route_order"].get<int>(), 2);
   EXPECT_EQ(j["viewpoints"][1]["route_order"].get<int>(), 1);
   ASSERT_EQ(j["viewpoints"].size(), 2u);

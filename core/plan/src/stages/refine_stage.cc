@@ -68,8 +68,7 @@ Result<RefineOutput> RunRefineStage(RefineInput in, const PlanOptions& options, 
   TrialPositions trials = TrialsAround(in.scene.grid, stations, options);
   VC_RETURN_IF_ERROR(
       CheckVisibilitySetBudget(trials.positions.size(), n_voxels, options.memory_budget_bytes, "refinement"));
-  VisibilitySetsOptions set_options{options.selection_test, options.threads};
-  set_options.scanner = options.scanner;
+  const VisibilitySetsOptions set_options = VisibilitySetsOptionsFor(options);
   VC_ASSIGN_OR_RETURN(std::vector<VoxelSet> trial_sets,
                       ComputeVisibilitySets(in.scene, trials.positions, set_options, ProgressRange(ctx, 0.0, 0.9)));
   for (const VoxelSet& s : trial_sets) UnionInto(in.coverable, s);

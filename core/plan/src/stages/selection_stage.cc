@@ -65,8 +65,7 @@ Result<LocalRefinementResult> SelectWithLocalCandidates(const SelectionInput& in
   for (const VoxelSet& s : sets) UnionInto(coverable, s);
   all.sets = std::move(sets);
 
-  VisibilitySetsOptions set_options{options.selection_test, options.threads};
-  set_options.scanner = options.scanner;
+  const VisibilitySetsOptions set_options = VisibilitySetsOptionsFor(options);
   const JobContext quiet{ctx.cancel, {}};  // the selection stage reports the loop's progress itself
   const VisibilityFn visibility = [&](const std::vector<WorldPoint>& positions) -> Result<std::vector<VoxelSet>> {
     ctx.Report(Stage::kSelection, 0.0,

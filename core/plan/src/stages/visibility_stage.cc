@@ -19,18 +19,40 @@ Status CheckVisibilitySetBudget(uint64_t positions, uint64_t voxels, uint64_t bu
   return Status::Ok();
 }
 
+VisibilitySetsOptions VisibilitySetsOptionsFor(const PlanOptions& options) {
+  VisibilitySetsOptions set_options;
+  set_options.test = options.selection_test;
+  set_options.threads = options.threads;
+  set_options.scanner = options.scanner;
+  return set_options;
+}
+
 Result<VisibilityOutput> RunVisibilityStage(const VisibilityInput& in, const PlanOptions& options,
                                             const JobContext& ctx) {
-  VisibilitySetsOptions set_options{options.selection_test, options.threads};
-  set_options.scanner = options.scanner;
+  const VisibilitySetsOptions set_options = VisibilitySetsOptionsFor(options);
   VisibilityOutput out;
-  if (in.fixed_stations.empty()) {
-    VC_ASSIGN_OR_RETURN(out.sets, ComputeVisibilitySets(in.scene, in.candidates, set_options, ctx));
+  // One pass over the fixed stations and the candidates; the fixed stations' sets come first.
+  std::vector<WorldPoint> all = in.fixed_stations;
+  all.insert(all.end(), in.candidates.begin(), in.candidates.end());
+  if (in.callbacks.visibility_sets) {
+    VC_ASSIGN_OR_RETURN(DistributedSets d, in.callbacks.visibility_sets(in.scene, all, set_options, ctx));
+    if (d.sets.size() != all.size()) {
+      return InternalError("the distributed visibility stage returned " + std::to_string(d.sets.size()) + " sets for " +
+                           std::to_string(all.size()) + " positions");
+    }
+    for (const VoxelSet& set : d.sets) {
+      if (set.size() != in.scene.occupied.size()) {
+        return InternalError("the distributed visibility stage returned a set of " + std::to_string(set.size()) +
+                             " voxels for a scene of " + std::to_string(in.scene.occupied.size()));
+      }
+    }
+    out.sets = std::move(d.sets);
+    out.distribution = d.distribution;
+    out.warnings = std::move(d.warnings);
   } else {
-    // One pass over the fixed stations and the candidates; the fixed stations' sets come first.
-    std::vector<WorldPoint> all = in.fixed_stations;
-    all.insert(all.end(), in.candidates.begin(), in.candidates.end());
     VC_ASSIGN_OR_RETURN(out.sets, ComputeVisibilitySets(in.scene, all, set_options, ctx));
+  }
+  if (!in.fixed_stations.empty()) {
     const auto split = out.sets.begin() + static_cast<std::ptrdiff_t>(in.fixed_stations.size());
     out.fixed_sets.assign(std::make_move_iterator(out.sets.begin()), std::make_move_iterator(split));
     out.sets.erase(out.sets.begin(), split);

@@ -28,11 +28,11 @@ namespace vc::server {
 // One job as the RPC adapter hands it to a worker.
 struct Job {
   using Clock = std::chrono::steady_clock;
-  std::string id;         // "j-" + 12 hex digits
-  std::string method;     // "Plan", "Evaluate"
-  std::string peer;       // the client's address, for the log
-  v1::UploadSpec upload;  // source name, stated format, size
-  std::string data;       // the verified upload
+  std::string id;          // "j-" + 12 hex digits
+  std::string method;      // "Plan", "Evaluate"
+  std::string peer;        // the client's address, for the log
+  v1::UploadSpec upload;   // source name, stated format, size
+  SceneCache::Bytes data;  // the verified upload (shared with the scene cache; dropped once parsed)
   // "hit": data came from the scene cache; "miss": uploaded with its SHA-256 (checked by Run, then
   // kept in the cache); empty: uploaded without one.
   std::string cache;

@@ -45,6 +45,27 @@ struct ServerOptions {
   // The address clients re-attach to, sent in Accepted.attach_address (e.g. the pod's own
   // address behind a load balancer); empty = the address the client used.
   std::string advertise_address;
+  // Scaling out (docs/DEPLOY.md, "Scaling out"): the replicas a plan's visibility stage is fanned
+  // out to, as host:port addresses and/or a DNS name (NAME:PORT, every address it resolves to,
+  // re-resolved per plan: a Kubernetes headless Service). Empty: every plan runs here alone.
+  std::vector<std::string> peers;
+  std::string peers_dns;
+  // Candidates per shard (the unit a peer computes, and retries).
+  int shard_candidates = 128;
+  // Whether this replica computes shards of its own plans too; false leaves them to the peers
+  // while any is working (it still starts a slow shard again, and finishes alone if all fail).
+  bool local_shards = true;
+  // The bearer token this replica presents to its peers; empty = the first of `tokens` (replicas
+  // of one deployment share them).
+  std::string peer_token;
+  // Peers speak TLS when this replica does (tls_cert_file), verified against this CA (PEM; empty =
+  // the system's roots); with tls_client_ca_file (mutual TLS) this replica's own certificate and
+  // key are presented to them.
+  std::string peer_tls_ca_file;
+  // A shard attempt a peer has not answered within this long is abandoned and computed elsewhere
+  // (a slow one is started again elsewhere much sooner, see DEPLOY.md).
+  std::chrono::milliseconds shard_deadline{std::chrono::minutes(10)};
+
   // On shutdown, running jobs get this long to finish before they are cancelled.
   std::chrono::milliseconds shutdown_grace{std::chrono::seconds(30)};
 
@@ -53,6 +74,8 @@ struct ServerOptions {
   // Workers and per-job threads with the 0 defaults resolved.
   int EffectiveWorkers() const;
   int EffectiveThreadsPerJob() const;
+  // Whether plans fan out (peers or peers_dns given).
+  bool HasPeers() const { return !peers.empty() || !peers_dns.empty(); }
 };
 
 }  // namespace vc::server

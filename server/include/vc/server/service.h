@@ -11,6 +11,7 @@
 #include <memory>
 
 #include "vc/server/backend.h"
+#include "vc/server/peers.h"
 #include "vc/server/server_options.h"
 #include "vc/server/worker_pool.h"
 #include "vc/v1/planner.grpc.pb.h"
@@ -23,7 +24,10 @@ struct ServiceState;
 
 class StationPlannerService final : public v1::StationPlanner::CallbackService {
  public:
-  StationPlannerService(const ServerOptions& options, Backend backend);
+  // `replica_id` names this process to its peers (PeerHello); `fan_out` (may be null) spreads
+  // its plans' visibility stages over them.
+  StationPlannerService(const ServerOptions& options, Backend backend, std::string replica_id = {},
+                        std::unique_ptr<PeerFanOut> fan_out = nullptr);
   ~StationPlannerService() override;
 
   grpc::ServerBidiReactor<v1::PlanRequest, v1::PlanResponse>* Plan(grpc::CallbackServerContext* ctx) override;
@@ -36,6 +40,13 @@ class StationPlannerService final : public v1::StationPlanner::CallbackService {
                                                                  const v1::AttachRequest* request) override;
   grpc::ServerUnaryReactor* CancelJob(grpc::CallbackServerContext* ctx, const v1::CancelJobRequest* request,
                                       v1::CancelJobResponse* response) override;
+  // Between replicas (peer_service.cc; docs/DEPLOY.md, "Scaling out").
+  grpc::ServerUnaryReactor* PeerHello(grpc::CallbackServerContext* ctx, const v1::PeerHelloRequest* request,
+                                      v1::PeerHelloResponse* response) override;
+  grpc::ServerReadReactor<v1::SceneChunk>* ShareScene(grpc::CallbackServerContext* ctx,
+                                                      v1::ShareSceneResponse* response) override;
+  grpc::ServerUnaryReactor* ComputeShard(grpc::CallbackServerContext* ctx, const v1::ShardRequest* request,
+                                         v1::ShardResponse* response) override;
 
   // For a shutdown (Server::Shutdown), all thread-safe. Drain: from now on new calls are refused
   // with UNAVAILABLE ("shutting down; retry"), which clients retry on another replica.

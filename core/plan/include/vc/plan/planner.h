@@ -83,6 +83,27 @@ struct FieldTime {
 // The field time of `stations` stations and a walk of `walk_m` metres under `options`.
 FieldTime ComputeFieldTime(size_t stations, double walk_m, const PlanOptions& options);
 
+// How a plan's visibility stage was spread over vc-server replicas (docs/DEPLOY.md, "Scaling out").
+// All zero for a plan computed in one process.
+struct Distribution {
+  int replicas = 0;              // replicas that computed at least one shard (this one included)
+  int shards = 0;                // shards of candidates the stage was split into
+  int retried = 0;               // shard attempts started again elsewhere (failed, refused or slow)
+  uint64_t bytes_exchanged = 0;  // bytes sent to and received from peers (scenes, requests, sets)
+};
+
+// The visibility sets of `viewpoints`, computed elsewhere than ComputeVisibilitySets (vc-server
+// fans them out over its peers): must return exactly what ComputeVisibilitySets(scene, viewpoints,
+// options, ctx) returns, with how it was spread and any warnings for PlanResult::warnings.
+struct DistributedSets {
+  std::vector<VoxelSet> sets;
+  Distribution distribution;
+  std::vector<std::string> warnings;
+};
+using VisibilitySetsFn =
+    std::function<Result<DistributedSets>(const VoxelScene& scene, const std::vector<WorldPoint>& viewpoints,
+                                          const VisibilitySetsOptions& options, const JobContext& ctx)>;
+
 struct PlanResult {
   PlanOptions options;
   double resolution_m = 0;
@@ -122,10 +143,12 @@ struct PlanResult {
   // How the selection's station count relates to the optimum over the candidates (docs/PLANNING.md,
   // "Exact selection"): the selection stage's, before refinement and reduction.
   planner::Optimality optimality;
+  // The visibility stage across replicas (PlanCallbacks::visibility_sets); zero when local.
+  Distribution distribution;
 };
 
-// What a plan reports while it runs, for streaming; every member optional, called on the thread
-// that runs Plan.
+// What a plan reports while it runs, for streaming, and the one piece of work it may hand to its
+// caller; every member optional, called on the thread that runs Plan.
 struct PlanCallbacks {
   // Once, when the visibility stage has counted every candidate (the heat map is final then:
   // refinement's trial positions are not candidates).
@@ -137,6 +160,9 @@ struct PlanCallbacks {
   // Once, after refinement and reduction: the final stations, in the order of PlanResult::stations
   // (marginal gain and coverage final; global_visibility still 0 until the evaluation).
   std::function<void(const std::vector<PlannedStation>&)> on_final_stations;
+  // The visibility stage's sets (fixed stations first, then the candidates), when set: vc-server
+  // fans them out over its peers. Unset: ComputeVisibilitySets in this process.
+  VisibilitySetsFn visibility_sets;
 };
 
 // Runs the whole pipeline on an already-read input. INVALID_ARGUMENT for bad options,

@@ -85,10 +85,15 @@ struct VisibilityInput {
   const PlanCallbacks& callbacks;                 // on_heat_map is called once, when the heat map is final
 };
 struct VisibilityOutput {
-  std::vector<VoxelSet> sets;        // per candidate
-  std::vector<VoxelSet> fixed_sets;  // per fixed station
-  HeatMap heat_map;                  // per candidate: |set|
+  std::vector<VoxelSet> sets;         // per candidate
+  std::vector<VoxelSet> fixed_sets;   // per fixed station
+  HeatMap heat_map;                   // per candidate: |set|
+  Distribution distribution;          // from callbacks.visibility_sets; zero when computed here
+  std::vector<std::string> warnings;  // from callbacks.visibility_sets
 };
+// The options the visibility stage computes its sets with (a peer computing a shard of them must
+// use the same).
+[[nodiscard]] VisibilitySetsOptions VisibilitySetsOptionsFor(const PlanOptions& options);
 // CANCELLED / DEADLINE_EXCEEDED from ctx.
 [[nodiscard]] Result<VisibilityOutput> RunVisibilityStage(const VisibilityInput& in, const PlanOptions& options,
                                                           const JobContext& ctx);

@@ -1,0 +1,152 @@
+// vc-set-bench: dense bitsets against Roaring bitmaps for a plan's visibility sets (docs/BENCHMARKS.md,
+// "Visibility sets: dense or Roaring"). Computes every candidate's set as the planner does, then
+// prints, per representation: the bytes of all sets, the time to encode and decode them (the form
+// they travel in between replicas, wire/voxel_set_codec.h), the union of all (selection's coverable
+// set) and the intersection counts of every pair among the first --pairs candidates (the overlap
+// matrix of registration). A site larger than the synthetic scenes: --tiles K copies the scene
+// K x K side by side (2 m apart); --max-range makes each station's view local, as on a campus.
+#include <roaring/roaring.h>
+#include <sys/resource.h>
+
+#include <CLI/CLI.hpp>
+#include <chrono>
+#include <cstdio>
+
+#include "vc/plan/stages.h"
+#include "vc/scene/scene_input.h"
+#include "vc/synth/synth.h"
+#include "vc/wire/voxel_set_codec.h"
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double Since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+double PeakRssMiB() {
+  rusage ru{};
+  getrusage(RUSAGE_SELF, &ru);
+  return double(ru.ru_maxrss) / 1024.0;
+}
+
+vc::Result<vc::SceneInput> Load(const std::string& scene, double spacing, int tiles) {
+  vc::SceneInput input;
+  if (scene.find('/') != std::string::npos || scene.find('.') != std::string::npos) {
+    VC_ASSIGN_OR_RETURN(input, vc::ReadSceneFile(scene));
+  } else {
+    vc::SynthOptions so;
+    so.spacing_m = spacing;
+    VC_ASSIGN_OR_RETURN(input.points, vc::GenerateScene(scene, so));
+  }
+  if (tiles <= 1) return input;
+  if (input.octree) return vc::InvalidArgumentError("--tiles needs a point cloud scene");
+  Eigen::Vector3f lo = input.points.front(), hi = lo;
+  for (const auto& p : input.points) {
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  }
+  const Eigen::Vector3f step = (hi - lo) + Eigen::Vector3f(2.0f, 2.0f, 0.0f);
+  const size_t n = input.points.size();
+  input.points.reserve(n * size_t(tiles * tiles));
+  for (int t = 1; t < tiles * tiles; ++t) {
+    const Eigen::Vector3f shift(step.x() * float(t % tiles), step.y() * float(t / tiles), 0.0f);
+    for (size_t i = 0; i < n; ++i) input.points.push_back(input.points[i] + shift);
+  }
+  return input;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::string scene = "hall";
+  double spacing = 0.05, resolution = 0.1, grid = 1.0, max_range = 75.0;
+  int tiles = 1, threads = 0;
+  size_t pairs = 300;
+  CLI::App app{"vc-set-bench: dense bitsets against Roaring bitmaps for a plan's visibility sets"};
+  app.add_option("--scene", scene, "synthetic scene spec (hall, comb:5, ...) or a file path")->capture_default_str();
+  app.add_option("--spacing", spacing, "point spacing of synthetic scenes, m")->capture_default_str();
+  app.add_option("--resolution", resolution, "working resolution, m")->capture_default_str();
+  app.add_option("--grid", grid, "candidate grid spacing, m")->capture_default_str();
+  app.add_option("--max-range", max_range, "scanner range, m")->capture_default_str();
+  app.add_option("--tiles", tiles, "copies of the scene, K x K")->capture_default_str();
+  app.add_option("--pairs", pairs, "intersection counts among the first N candidates")->capture_default_str();
+  app.add_option("--threads", threads, "threads for the visibility sets (0 = all)")->capture_default_str();
+  CLI11_PARSE(app, argc, argv);
+
+  auto input = Load(scene, spacing, tiles);
+  if (!input.ok()) {
+    std::fprintf(stderr, "vc-set-bench: %s\n", input.status().ToString().c_str());
+    return 1;
+  }
+  vc::PlanOptions options;
+  options.resolution_m = resolution;
+  options.grid_spacing_m = grid;
+  options.scanner.max_range_m = max_range;
+  options.threads = threads;
+  options.memory_budget_bytes = uint64_t{16} << 30;
+  auto voxelized = vc::planner::RunVoxelizeStage({*input}, options, {});
+  if (!voxelized.ok()) return std::fprintf(stderr, "%s\n", voxelized.status().ToString().c_str()), 1;
+  const vc::VoxelScene& s = voxelized->scene;
+  auto candidates = vc::planner::RunCandidatesStage({s}, options, {});
+  if (!candidates.ok()) return std::fprintf(stderr, "%s\n", candidates.status().ToString().c_str()), 1;
+  const size_t n = candidates->positions.size(), voxels = s.occupied.size();
+  auto t = Clock::now();
+  auto sets = vc::ComputeVisibilitySets(s, candidates->positions, vc::planner::VisibilitySetsOptionsFor(options));
+  if (!sets.ok()) return std::fprintf(stderr, "%s\n", sets.status().ToString().c_str()), 1;
+  const double visibility_s = Since(t);
+  uint64_t seen = 0, dense_bytes = 0;
+  for (const vc::VoxelSet& v : *sets) {
+    seen += v.count();
+    dense_bytes += v.words().size() * 8;
+  }
+  std::printf("scene %s x%d at %.2f m, range %.0f m: %zu voxels, %zu candidates, each sees %.1f %% (visibility %.1f s)\n",
+              scene.c_str(), tiles * tiles, resolution, max_range, voxels, n, 100.0 * double(seen) / double(n * voxels),
+              visibility_s);
+
+  // Encode and decode (the wire form), and the Roaring bitmaps for the set operations.
+  t = Clock::now();
+  std::vector<std::string> encoded;
+  uint64_t roaring_bytes = 0;
+  for (const vc::VoxelSet& v : *sets) {
+    encoded.push_back(vc::wire::EncodeVoxelSet(v));
+    roaring_bytes += encoded.back().size();
+  }
+  const double encode_s = Since(t);
+  t = Clock::now();
+  for (const std::string& e : encoded) (void)vc::wire::DecodeVoxelSet(e, voxels);
+  const double decode_s = Since(t);
+  std::vector<roaring_bitmap_t*> bitmaps;
+  for (const std::string& e : encoded) bitmaps.push_back(roaring_bitmap_portable_deserialize_safe(e.data(), e.size()));
+
+  t = Clock::now();
+  vc::VoxelSet dense_union(voxels);
+  for (const vc::VoxelSet& v : *sets) dense_union.Union(v);
+  const double dense_union_s = Since(t);
+  t = Clock::now();
+  roaring_bitmap_t* roaring_union = roaring_bitmap_or_many(bitmaps.size(), const_cast<const roaring_bitmap_t**>(bitmaps.data()));
+  const double roaring_union_s = Since(t);
+  const bool same_union = roaring_bitmap_get_cardinality(roaring_union) == dense_union.count();
+  roaring_bitmap_free(roaring_union);
+
+  const size_t m = std::min(pairs, n);
+  uint64_t dense_sum = 0, roaring_sum = 0;
+  t = Clock::now();
+  for (size_t i = 0; i < m; ++i) {
+    for (size_t j = i + 1; j < m; ++j) dense_sum += (*sets)[i].CountAnd((*sets)[j]);
+  }
+  const double dense_pairs_s = Since(t);
+  t = Clock::now();
+  for (size_t i = 0; i < m; ++i) {
+    for (size_t j = i + 1; j < m; ++j) roaring_sum += roaring_bitmap_and_cardinality(bitmaps[i], bitmaps[j]);
+  }
+  const double roaring_pairs_s = Since(t);
+  for (roaring_bitmap_t* b : bitmaps) roaring_bitmap_free(b);
+
+  std::printf("| representation | bytes of all sets | union of all | %zu pairs' intersections |\n", m * (m - 1) / 2);
+  std::printf("|---|---|---|---|\n");
+  std::printf("| dense | %.1f MiB | %.3f s | %.3f s |\n", double(dense_bytes) / 1048576.0, dense_union_s, dense_pairs_s);
+  std::printf("| Roaring | %.1f MiB (%.2fx smaller) | %.3f s | %.3f s |\n", double(roaring_bytes) / 1048576.0,
+              double(dense_bytes) / double(roaring_bytes), roaring_union_s, roaring_pairs_s);
+  std::printf("encode %.2f ms per set, decode %.2f ms per set; results agree: %s; peak RSS %.0f MiB\n",
+              1e3 * encode_s / double(n), 1e3 * decode_s / double(n),
+              same_union && dense_sum == roaring_sum ? "yes" : "NO", PeakRssMiB());
+  return same_union && dense_sum == roaring_sum ? 0 : 1;
+}

@@ -1,0 +1,231 @@
+// The calls between replicas (docs/DEPLOY.md, "Scaling out"): PeerHello, ShareScene and
+// ComputeShard, a peer's side of a plan fanned out by another replica's PeerFanOut (peers.h).
+// Authenticated like every vc.v1 call; a shard runs on the worker pool like a job, so a busy
+// replica answers RESOURCE_EXHAUSTED and the coordinator gives the shard to another.
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include <chrono>
+
+#include "job_reactor.h"
+#include "vc/plan/stages.h"
+#include "vc/server/service.h"
+#include "vc/wire/sha256.h"
+#include "vc/wire/voxel_set_codec.h"
+
+namespace vc::server {
+namespace internal {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// ComputeShard's work, on a worker thread.
+Status RunShard(ServiceState& state, const v1::ShardRequest& request, v1::ShardResponse* response,
+                const JobContext& ctx) {
+  const SceneCache::Bytes bytes = state.cache.Get(request.scene_sha256());
+  if (!bytes) {
+    return NotFoundError("scene " + request.scene_sha256().substr(0, 12) +
+                         "... is not in this replica's scene cache; share it (ShareScene) and call again");
+  }
+  VC_ASSIGN_OR_RETURN(PlanOptions options, wire::FromProto(request.parameters()));
+  options.memory_budget_bytes = std::min(options.memory_budget_bytes, state.options.max_memory_budget_bytes);
+  options.threads = state.options.EffectiveThreadsPerJob();
+  VC_RETURN_IF_ERROR(options.Validate());
+  std::vector<WorldPoint> viewpoints;
+  viewpoints.reserve(size_t(request.viewpoints_size()));
+  for (const v1::Point& p : request.viewpoints()) viewpoints.push_back(wire::FromProto(p));
+  const std::string key = fmt::format("{}@{:a}", request.scene_sha256(), options.resolution_m);
+  VC_ASSIGN_OR_RETURN(const VoxelizedScenes::Scene scene, state.voxelized.Get(key, [&]() -> Result<VoxelScene> {
+    const std::string source = request.source_name().empty() ? "shared scene" : request.source_name();
+    VC_ASSIGN_OR_RETURN(const SceneInput input,
+                        state.backend.read_scene(
+                            *bytes, source, ReadLimits(state.options.max_upload_bytes, options.memory_budget_bytes)));
+    VC_ASSIGN_OR_RETURN(planner::VoxelizeOutput v, planner::RunVoxelizeStage({input}, options, ctx));
+    return std::move(v.scene);
+  }));
+  VC_RETURN_IF_ERROR(planner::CheckVisibilitySetBudget(viewpoints.size(), scene->occupied.size(),
+                                                       options.memory_budget_bytes, "this shard"));
+  VC_ASSIGN_OR_RETURN(const std::vector<VoxelSet> sets,
+                      ComputeVisibilitySets(*scene, viewpoints, planner::VisibilitySetsOptionsFor(options), ctx));
+  response->set_replica_id(state.replica_id);
+  response->set_occupied_voxels(scene->occupied.size());
+  response->set_scene_crc32c(SceneFingerprint(*scene));
+  for (const VoxelSet& s : sets) response->add_sets(wire::EncodeVoxelSet(s));
+  return Status::Ok();
+}
+
+// One ComputeShard call: admitted to the worker pool like a job, cancelled with its call.
+class ShardReactor final : public grpc::ServerUnaryReactor {
+ public:
+  ShardReactor(grpc::CallbackServerContext* ctx, ServiceState* state, const v1::ShardRequest* request,
+               v1::ShardResponse* response)
+      : ctx_(ctx), state_(state), request_(request), response_(response), start_(Clock::now()) {}
+
+  void Start() {
+    const auto deadline = ctx_->deadline();
+    if (deadline != std::chrono::system_clock::time_point::max()) {
+      token_.SetDeadline(Clock::now() +
+                         std::chrono::duration_cast<Clock::duration>(deadline - std::chrono::system_clock::now()));
+    }
+    registered_ = state_->Register(&token_);
+    if (!registered_) return Done(UnavailableError("this vc-server is shutting down; give the shard to another"));
+    std::string owner, why;
+    if (!Authenticate(*ctx_, state_->options.tokens, &owner, &why)) return Done(UnauthenticatedError(why));
+    std::optional<WorkerPool::Ticket> ticket = state_->pool.TryAdmit();
+    if (!ticket) {
+      ctx_->AddTrailingMetadata("retry-after-ms", "500");
+      return Done(ResourceExhaustedError("this replica's workers and queue are all taken; give the shard to another"));
+    }
+    state_->pool.Submit(
+        std::move(*ticket), [](uint32_t) {},
+        [this](WorkerPool::Ticket place) {
+          JobContext ctx;
+          ctx.cancel = &token_;
+          Status s = ctx.CheckCancelled("the shard (while queued)");
+          if (s.ok()) {
+            try {
+              s = RunShard(*state_, *request_, response_, ctx);
+            } catch (const std::bad_alloc&) {
+              s = ResourceExhaustedError("this replica ran out of memory on the shard");
+            } catch (const std::exception& e) {
+              s = InternalError(std::string("this replica failed on the shard: ") + e.what());
+            }
+          }
+          place.Release();
+          Done(s);
+        });
+  }
+
+  void OnCancel() override { token_.Cancel(); }
+  void OnDone() override {
+    if (registered_) state_->Unregister(&token_);
+    delete this;
+  }
+
+ private:
+  void Done(const Status& s) {
+    spdlog::log(s.ok() ? spdlog::level::info : spdlog::level::warn,
+                "rpc ComputeShard peer={} scene={} viewpoints={}+{} elapsed={:.3f}s status={}", ctx_->peer(),
+                request_->scene_sha256().substr(0, 12), request_->first_index(), request_->viewpoints_size(),
+                std::chrono::duration<double>(Clock::now() - start_).count(), s.ok() ? "OK" : s.ToString());
+    if (s.ok()) response_->set_compute_seconds(std::chrono::duration<double>(Clock::now() - start_).count());
+    Finish(wire::ToGrpcStatus(s));  // last touch: OnDone may delete this at once
+  }
+
+  grpc::CallbackServerContext* const ctx_;
+  ServiceState* const state_;
+  const v1::ShardRequest* const request_;
+  v1::ShardResponse* const response_;
+  const Clock::time_point start_;
+  CancelToken token_;
+  bool registered_ = false;
+};
+
+// One ShareScene call: the chunks into one string, checked against the first chunk's size and
+// hash, then into the scene cache.
+class ShareSceneReactor final : public grpc::ServerReadReactor<v1::SceneChunk> {
+ public:
+  ShareSceneReactor(grpc::CallbackServerContext* ctx, ServiceState* state, v1::ShareSceneResponse* response)
+      : ctx_(ctx), state_(state), response_(response) {
+    std::string owner, why;
+    if (!Authenticate(*ctx_, state_->options.tokens, &owner, &why)) {
+      Done(UnauthenticatedError(why));
+      return;
+    }
+    StartRead(&chunk_);
+  }
+
+  void OnReadDone(bool ok) override {
+    if (!ok) {
+      Done(Check());
+      return;
+    }
+    if (first_) {
+      first_ = false;
+      sha256_ = chunk_.sha256();
+      size_ = chunk_.total_size_bytes();
+      if (sha256_.size() != 64) return Done(InvalidArgumentError("ShareScene: the first chunk must name the SHA-256"));
+      if (size_ > state_->options.max_upload_bytes) {
+        return Done(
+            ResourceExhaustedError(fmt::format("ShareScene: {} is over this replica's --max-upload-bytes ({})",
+                                               HumanBytes(size_), HumanBytes(state_->options.max_upload_bytes))));
+      }
+      if (size_ > state_->cache.capacity_bytes()) {
+        return Done(ResourceExhaustedError(
+            fmt::format("ShareScene: {} does not fit this replica's scene cache ({}); raise its --scene-cache-bytes",
+                        HumanBytes(size_), HumanBytes(state_->cache.capacity_bytes()))));
+      }
+      data_.reserve(size_);
+    }
+    if (data_.size() + chunk_.data().size() > size_) {
+      return Done(InvalidArgumentError(fmt::format("ShareScene: more than the {} bytes announced", size_)));
+    }
+    data_ += chunk_.data();
+    StartRead(&chunk_);
+  }
+
+  void OnDone() override { delete this; }
+
+ private:
+  Status Check() {
+    if (data_.size() != size_) {
+      return InvalidArgumentError(fmt::format("ShareScene: {} bytes arrived of {} announced", data_.size(), size_));
+    }
+    if (wire::Sha256Hex(data_) != sha256_)
+      return InvalidArgumentError("ShareScene: the bytes' SHA-256 is not " + sha256_);
+    const bool kept = state_->cache.Put(sha256_, std::make_shared<const std::string>(std::move(data_)));
+    if (!kept) return ResourceExhaustedError("ShareScene: this replica's scene cache could not keep the scene");
+    response_->set_kept(true);
+    spdlog::info("rpc ShareScene peer={} scene={} size={}", ctx_->peer(), sha256_.substr(0, 12), HumanBytes(size_));
+    return Status::Ok();
+  }
+  void Done(const Status& s) {
+    if (done_) return;
+    done_ = true;
+    if (!s.ok()) spdlog::warn("rpc ShareScene peer={} status={}", ctx_->peer(), s.ToString());
+    Finish(wire::ToGrpcStatus(s));
+  }
+
+  grpc::CallbackServerContext* const ctx_;
+  ServiceState* const state_;
+  v1::ShareSceneResponse* const response_;
+  v1::SceneChunk chunk_;
+  bool first_ = true;
+  bool done_ = false;
+  std::string sha256_;
+  uint64_t size_ = 0;
+  std::string data_;
+};
+
+}  // namespace
+}  // namespace internal
+
+grpc::ServerUnaryReactor* StationPlannerService::PeerHello(grpc::CallbackServerContext* ctx,
+                                                           const v1::PeerHelloRequest* request,
+                                                           v1::PeerHelloResponse* response) {
+  auto* reactor = ctx->DefaultReactor();
+  std::string owner, why;
+  if (!internal::Authenticate(*ctx, state_->options.tokens, &owner, &why)) {
+    reactor->Finish(wire::ToGrpcStatus(UnauthenticatedError(why)));
+    return reactor;
+  }
+  response->set_replica_id(state_->replica_id);
+  response->set_has_scene(!request->scene_sha256().empty() && state_->cache.Get(request->scene_sha256()) != nullptr);
+  reactor->Finish(grpc::Status::OK);
+  return reactor;
+}
+
+grpc::ServerReadReactor<v1::SceneChunk>* StationPlannerService::ShareScene(grpc::CallbackServerContext* ctx,
+                                                                           v1::ShareSceneResponse* response) {
+  return new internal::ShareSceneReactor(ctx, state_.get(), response);
+}
+
+grpc::ServerUnaryReactor* StationPlannerService::ComputeShard(grpc::CallbackServerContext* ctx,
+                                                              const v1::ShardRequest* request,
+                                                              v1::ShardResponse* response) {
+  auto* reactor = new internal::ShardReactor(ctx, state_.get(), request, response);
+  reactor->Start();
+  return reactor;
+}
+
+}  // namespace vc::server

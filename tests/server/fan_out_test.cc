@@ -1,0 +1,355 @@
+// Scaling out (docs/DEPLOY.md, "Scaling out"): a plan fanned out over replicas is the plan of one
+// replica, station for station; a peer that hangs, dies, answers for another scene or refuses the
+// token costs time, not the plan; the calls between replicas check what they are sent.
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <cmath>
+
+#include "server/test_server.h"
+#include "vc/client/client.h"
+#include "vc/wire/sha256.h"
+#include "vc/wire/status_mapping.h"
+#include "vc/wire/voxel_set_codec.h"
+
+namespace vc {
+namespace {
+
+// An 8 x 6 m room: about 35 candidates at the 1 m grid, so shards of 4 make nine.
+const std::string& Room() {
+  static const std::string ply = testing::BoxRoomPly({8, 6, 2.5}, 0.1);
+  return ply;
+}
+
+PlanOptions Options() {
+  PlanOptions o;
+  o.solver = SelectionSolver::kGreedy;
+  o.threads = 1;
+  return o;
+}
+
+server::ServerOptions Replica() {
+  server::ServerOptions o;
+  o.workers = 2;
+  o.threads_per_job = 1;
+  return o;
+}
+
+server::ServerOptions Coordinator(std::vector<std::string> peers) {
+  server::ServerOptions o = Replica();
+  o.peers = std::move(peers);
+  o.shard_candidates = 4;
+  return o;
+}
+
+Result<PlanResult> PlanOn(const std::string& address, const std::string& token = "") {
+  client::ConnectionOptions conn;
+  conn.server = address;
+  conn.token = token;
+  conn.max_attempts = 1;
+  VC_ASSIGN_OR_RETURN(auto c, client::Client::Create(conn));
+  return c->Plan({Room(), "room.ply"}, Options());
+}
+
+// The same plan: stations, coverage, G and every candidate's count.
+void ExpectSamePlan(const PlanResult& a, const PlanResult& b) {
+  ASSERT_EQ(a.stations.size(), b.stations.size());
+  for (size_t k = 0; k < a.stations.size(); ++k) {
+    EXPECT_EQ(a.stations[k].position, b.stations[k].position) << "station " << k;
+    EXPECT_EQ(a.stations[k].visible_voxels, b.stations[k].visible_voxels) << "station " << k;
+  }
+  EXPECT_EQ(a.covered_voxels, b.covered_voxels);
+  EXPECT_EQ(a.coverable_voxels, b.coverable_voxels);
+  EXPECT_EQ(a.evaluation.overall.global_visibility, b.evaluation.overall.global_visibility);
+  EXPECT_EQ(a.heat_map.visible_voxels, b.heat_map.visible_voxels);
+}
+
+bool HasWarning(const PlanResult& r, const std::string& part) {
+  for (const std::string& w : r.warnings) {
+    if (w.find(part) != std::string::npos) return true;
+  }
+  return false;
+}
+
+std::string Warnings(const PlanResult& r) {
+  std::string out;
+  for (const std::string& w : r.warnings) out += w + "\n";
+  return out;
+}
+
+// A peer that misbehaves: it hangs on every shard until cancelled (kHang), dies with its first
+// shard in flight (kDie: the test shuts it down), or answers with sets of another scene
+// (kOtherScene).
+class FakePeer final : public v1::StationPlanner::CallbackService {
+ public:
+  enum class Mode { kHang, kDie, kOtherScene };
+  explicit FakePeer(Mode mode) : mode_(mode) {
+    grpc::ServerBuilder b;
+    b.AddListeningPort("127.0.0.1:0", grpc::InsecureServerCredentials(), &port_);
+    b.RegisterService(this);
+    server_ = b.BuildAndStart();
+  }
+  ~FakePeer() override { Kill(); }
+  std::string address() const { return "127.0.0.1:" + std::to_string(port_); }
+  void Kill() {
+    if (server_) server_->Shutdown(std::chrono::system_clock::now());
+    if (server_) server_->Wait();
+    server_.reset();
+  }
+  int shards() const { return shards_.load(); }
+  testing::Latch first_shard;
+
+  grpc::ServerUnaryReactor* PeerHello(grpc::CallbackServerContext* ctx, const v1::PeerHelloRequest*,
+                                      v1::PeerHelloResponse* response) override {
+    response->set_replica_id("fake");
+    response->set_has_scene(true);
+    auto* r = ctx->DefaultReactor();
+    r->Finish(grpc::Status::OK);
+    return r;
+  }
+  grpc::ServerUnaryReactor* ComputeShard(grpc::CallbackServerContext* ctx, const v1::ShardRequest* request,
+                                         v1::ShardResponse* response) override {
+    ++shards_;
+    first_shard.Set();
+    if (mode_ == Mode::kOtherScene) {
+      response->set_occupied_voxels(3);
+      response->set_scene_crc32c(7);
+      for (int i = 0; i < request->viewpoints_size(); ++i) response->add_sets(wire::EncodeVoxelSet(VoxelSet(3)));
+      auto* r = ctx->DefaultReactor();
+      r->Finish(grpc::Status::OK);
+      return r;
+    }
+    return new Hang();
+  }
+
+ private:
+  // Answers only when the call is cancelled (by the coordinator, or a shutdown).
+  struct Hang : grpc::ServerUnaryReactor {
+    void OnCancel() override { Finish(grpc::Status(grpc::StatusCode::CANCELLED, "gone")); }
+    void OnDone() override { delete this; }
+  };
+  const Mode mode_;
+  int port_ = 0;
+  std::atomic<int> shards_{0};
+  std::unique_ptr<grpc::Server> server_;
+};
+
+TEST(FanOut, ThreeReplicasPlanExactlyAsOne) {
+  auto b = testing::StartServer(Replica());
+  auto c = testing::StartServer(Replica());
+  ASSERT_TRUE(b && c);
+  const auto alone = PlanOn(testing::Address(*b));
+  ASSERT_TRUE(alone.ok()) << alone.status().ToString();
+  EXPECT_EQ(alone->distribution.shards, 0);
+
+  // A leaves every shard to B and C: both must have computed some.
+  server::ServerOptions o = Coordinator({testing::Address(*b), testing::Address(*c)});
+  o.local_shards = false;
+  auto a = testing::StartServer(o);
+  ASSERT_TRUE(a);
+  const auto fanned = PlanOn(testing::Address(*a));
+  ASSERT_TRUE(fanned.ok()) << fanned.status().ToString();
+  ExpectSamePlan(*alone, *fanned);
+  const size_t viewpoints = fanned->candidate_count;
+  EXPECT_EQ(fanned->distribution.shards, int((viewpoints + 3) / 4));
+  EXPECT_EQ(fanned->distribution.replicas, 2) << Warnings(*fanned);
+  EXPECT_GT(fanned->distribution.bytes_exchanged, Room().size());  // the scene went to both, then sets came back
+  EXPECT_TRUE(fanned->warnings.empty()) << Warnings(*fanned);
+
+  // A coordinator that computes shards too: the same plan again (B and C now hold the scene).
+  auto a2 = testing::StartServer(Coordinator({testing::Address(*b), testing::Address(*c)}));
+  ASSERT_TRUE(a2);
+  const auto mixed = PlanOn(testing::Address(*a2));
+  ASSERT_TRUE(mixed.ok()) << mixed.status().ToString();
+  ExpectSamePlan(*alone, *mixed);
+  EXPECT_GE(mixed->distribution.replicas, 1);
+  EXPECT_LE(mixed->distribution.replicas, 3);
+}
+
+TEST(FanOut, AReplicaListedAmongItsOwnPeersIsSkipped) {
+  // The Kubernetes case: the headless Service resolves to every replica, this one included.
+  server::ServerOptions o = Coordinator({});
+  o.local_shards = false;
+  auto b = testing::StartServer(Replica());
+  ASSERT_TRUE(b);
+  o.peers = {testing::Address(*b)};
+  auto a = testing::StartServer(o);
+  ASSERT_TRUE(a);
+  // Restart A listing itself too: its own lane answers PeerHello with its own id and is dropped.
+  const std::string self = testing::Address(*a);
+  a.reset();
+  o.listen = self;
+  o.peers = {self, testing::Address(*b)};
+  auto started = server::Server::Start(o);  // testing::StartServer would pick another port
+  ASSERT_TRUE(started.ok()) << started.status().ToString();
+  a = std::move(*started);
+  const auto r = PlanOn(self);
+  ASSERT_TRUE(r.ok()) << r.status().ToString();
+  EXPECT_EQ(r->distribution.replicas, 1) << "only B computed: " << Warnings(*r);
+  EXPECT_TRUE(r->warnings.empty()) << Warnings(*r);
+}
+
+TEST(FanOut, AHungPeersShardIsStartedAgainElsewhere) {
+  auto reference = testing::StartServer(Replica());
+  ASSERT_TRUE(reference);
+  const auto alone = PlanOn(testing::Address(*reference));
+  ASSERT_TRUE(alone.ok()) << alone.status().ToString();
+  FakePeer hung(FakePeer::Mode::kHang);
+  auto a = testing::StartServer(Coordinator({hung.address()}));
+  ASSERT_TRUE(a);
+  const auto r = PlanOn(testing::Address(*a));
+  ASSERT_TRUE(r.ok()) << r.status().ToString();
+  ExpectSamePlan(*alone, *r);
+  EXPECT_GE(hung.shards(), 1);
+  EXPECT_GE(r->distribution.retried, 1);
+  EXPECT_EQ(r->distribution.replicas, 1);  // this replica computed every shard in the end
+}
+
+TEST(FanOut, AReplicaThatDiesMidPlanCostsTimeNotThePlan) {
+  auto b = testing::StartServer(Replica());
+  ASSERT_TRUE(b);
+  const auto alone = PlanOn(testing::Address(*b));
+  ASSERT_TRUE(alone.ok()) << alone.status().ToString();
+  FakePeer dying(FakePeer::Mode::kDie);
+  server::ServerOptions o = Coordinator({testing::Address(*b), dying.address()});
+  o.local_shards = false;
+  auto a = testing::StartServer(o);
+  ASSERT_TRUE(a);
+  std::thread killer([&] {
+    if (dying.first_shard.WaitFor(std::chrono::seconds(60))) dying.Kill();
+  });
+  const auto r = PlanOn(testing::Address(*a));
+  killer.join();
+  ASSERT_TRUE(r.ok()) << r.status().ToString();
+  ExpectSamePlan(*alone, *r);
+  EXPECT_GE(r->distribution.retried, 1);
+  EXPECT_TRUE(HasWarning(*r, dying.address())) << Warnings(*r);
+}
+
+TEST(FanOut, APeerWithAnotherVoxelizationIsLeftOut) {
+  auto reference = testing::StartServer(Replica());
+  ASSERT_TRUE(reference);
+  const auto alone = PlanOn(testing::Address(*reference));
+  ASSERT_TRUE(alone.ok()) << alone.status().ToString();
+  FakePeer other(FakePeer::Mode::kOtherScene);
+  server::ServerOptions o = Coordinator({other.address()});
+  o.local_shards = false;
+  auto a = testing::StartServer(o);
+  ASSERT_TRUE(a);
+  const auto r = PlanOn(testing::Address(*a));
+  ASSERT_TRUE(r.ok()) << r.status().ToString();
+  ExpectSamePlan(*alone, *r);
+  EXPECT_EQ(other.shards(), 1);
+  EXPECT_TRUE(HasWarning(*r, "voxelization differs")) << Warnings(*r);
+}
+
+TEST(FanOut, AWrongTokenBetweenReplicasIsRefused) {
+  server::ServerOptions peer = Replica();
+  peer.tokens = {"right"};
+  auto b = testing::StartServer(peer);
+  ASSERT_TRUE(b);
+  server::ServerOptions o = Coordinator({testing::Address(*b)});
+  o.tokens = {"right"};
+  o.peer_token = "wrong";
+  auto a = testing::StartServer(o);
+  ASSERT_TRUE(a);
+  const auto r = PlanOn(testing::Address(*a), "right");
+  ASSERT_TRUE(r.ok()) << r.status().ToString();
+  EXPECT_EQ(r->distribution.replicas, 1);
+  EXPECT_TRUE(HasWarning(*r, "UNAUTHENTICATED")) << Warnings(*r);
+
+  // Without --peer-token the coordinator presents its own first token, which B accepts.
+  o.peer_token.clear();
+  auto a2 = testing::StartServer(o);
+  ASSERT_TRUE(a2);
+  const auto ok = PlanOn(testing::Address(*a2), "right");
+  ASSERT_TRUE(ok.ok()) << ok.status().ToString();
+  EXPECT_TRUE(ok->warnings.empty()) << Warnings(*ok);
+  ExpectSamePlan(*r, *ok);
+}
+
+// The calls themselves, as a coordinator makes them.
+class PeerCalls : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    server::ServerOptions o = Replica();
+    o.tokens = {"t"};
+    server_ = testing::StartServer(o);
+    ASSERT_TRUE(server_);
+    stub_ = v1::StationPlanner::NewStub(
+        grpc::CreateChannel(testing::Address(*server_), grpc::InsecureChannelCredentials()));
+  }
+  void Prepare(grpc::ClientContext* c, const std::string& token = "t") {
+    c->AddMetadata("authorization", "Bearer " + token);
+  }
+  grpc::Status Share(const std::string& sha, uint64_t size, const std::string& bytes, const std::string& token = "t") {
+    grpc::ClientContext c;
+    Prepare(&c, token);
+    v1::ShareSceneResponse resp;
+    auto w = stub_->ShareScene(&c, &resp);
+    v1::SceneChunk chunk;
+    chunk.set_sha256(sha);
+    chunk.set_total_size_bytes(size);
+    chunk.set_data(bytes);
+    w->Write(chunk);
+    w->WritesDone();
+    return w->Finish();
+  }
+  bool HasScene(const std::string& sha) {
+    grpc::ClientContext c;
+    Prepare(&c);
+    v1::PeerHelloRequest req;
+    req.set_scene_sha256(sha);
+    v1::PeerHelloResponse resp;
+    EXPECT_TRUE(stub_->PeerHello(&c, req, &resp).ok());
+    return resp.has_scene();
+  }
+  grpc::Status Shard(const std::string& sha, v1::ShardResponse* resp, const std::string& token = "t") {
+    grpc::ClientContext c;
+    Prepare(&c, token);
+    v1::ShardRequest req;
+    req.set_scene_sha256(sha);
+    *req.mutable_parameters() = wire::ToProto(Options());
+    *req.add_viewpoints() = wire::ToProto(WorldPoint(2, 2, 1.5));
+    *req.add_viewpoints() = wire::ToProto(WorldPoint(100, 100, 100));  // outside the room: sees nothing
+    return stub_->ComputeShard(&c, req, resp);
+  }
+  std::unique_ptr<server::Server> server_;
+  std::unique_ptr<v1::StationPlanner::Stub> stub_;
+};
+
+TEST_F(PeerCalls, ShareSceneChecksTheHashAndTheSize) {
+  const std::string sha = wire::Sha256Hex(Room());
+  EXPECT_FALSE(HasScene(sha));
+  EXPECT_EQ(Share(sha, Room().size(), Room(), "wrong").error_code(), grpc::StatusCode::UNAUTHENTICATED);
+  EXPECT_EQ(Share(sha, Room().size() + 1, Room()).error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_EQ(Share(sha, Room().size() - 1, Room()).error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_EQ(Share(std::string(64, '0'), Room().size(), Room()).error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_EQ(Share("short", Room().size(), Room()).error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_FALSE(HasScene(sha));
+  const grpc::Status s = Share(sha, Room().size(), Room());
+  EXPECT_TRUE(s.ok()) << s.error_message();
+  EXPECT_TRUE(HasScene(sha));
+}
+
+TEST_F(PeerCalls, ComputeShardNeedsTheTokenAndTheSceneAndAnswersWithCheckableSets) {
+  const std::string sha = wire::Sha256Hex(Room());
+  v1::ShardResponse resp;
+  EXPECT_EQ(Shard(sha, &resp, "wrong").error_code(), grpc::StatusCode::UNAUTHENTICATED);
+  const grpc::Status missing = Shard(sha, &resp);
+  EXPECT_EQ(missing.error_code(), grpc::StatusCode::NOT_FOUND);
+  EXPECT_NE(missing.error_message().find("ShareScene"), std::string::npos) << missing.error_message();
+  ASSERT_TRUE(Share(sha, Room().size(), Room()).ok());
+  const grpc::Status s = Shard(sha, &resp);
+  ASSERT_TRUE(s.ok()) << s.error_message();
+  ASSERT_EQ(resp.sets_size(), 2);
+  EXPECT_GT(resp.occupied_voxels(), 0u);
+  const auto inside = wire::DecodeVoxelSet(resp.sets(0), resp.occupied_voxels());
+  const auto outside = wire::DecodeVoxelSet(resp.sets(1), resp.occupied_voxels());
+  ASSERT_TRUE(inside.ok() && outside.ok());
+  EXPECT_GT(inside->count(), resp.occupied_voxels() / 10);
+  EXPECT_EQ(outside->count(), 0u);
+}
+
+}  // namespace
+}  // namespace vc
