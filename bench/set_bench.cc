@@ -98,7 +98,7 @@ int main(int argc, char** argv) {
     dense_bytes += v.words().size() * 8;
   }
   std::printf("scene %s x%d at %.2f m, range %.0f m: %zu voxels, %zu candidates, each sees %.1f %% (visibility %.1f s)\n",
-              scene.c_str(), tiles * tiles, resolution, max_range, voxels, n, 100.0 * double(seen) / double(n * voxels),
+              scene.c_str(), tiles * tiles, s.resolution_m, max_range, voxels, n, 100.0 * double(seen) / double(n * voxels),
               visibility_s);
 
   // Encode and decode (the wire form), and the Roaring bitmaps for the set operations.

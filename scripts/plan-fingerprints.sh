@@ -3,29 +3,48 @@
 # every known-optimum scene through a real vc-server and vc-client, and prints one line per scene:
 # stations, G, covered/coverable voxels and a hash of the stations' coordinates. Run it on two
 # builds and diff the output (docs/BENCHMARKS.md, "Plans must not change by accident").
-# Usage: scripts/plan-fingerprints.sh [BUILD_DIR (default build/release)] [--quick]
+# Usage: scripts/plan-fingerprints.sh [BUILD_DIR (default build/release)] [--quick] [--fan-out]
 #   --quick: geb079 and the known-optimum scenes only (skips the 1.7 M-point synthetic hall).
+#   --fan-out: plan through a coordinator that leaves every shard of 16 candidates to two peer
+#     vc-servers (docs/DEPLOY.md, "Scaling out"): the lines must be the same as without.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bin=${1:-build/release}
-quick=${2:-}
+quick="" fan_out=""
+for a in "${@:2}"; do
+  case "$a" in
+    --quick) quick=--quick ;;
+    --fan-out) fan_out=1 ;;
+    *) echo "plan-fingerprints: unknown option $a" >&2; exit 2 ;;
+  esac
+done
 work=$(mktemp -d)
-server_pid=""
+pids=()
 cleanup() {
-  [[ -n "$server_pid" ]] && kill "$server_pid" 2>/dev/null && wait "$server_pid" 2>/dev/null || true
+  for p in "${pids[@]}"; do kill "$p" 2>/dev/null || true; wait "$p" 2>/dev/null || true; done
   rm -rf "$work"
 }
 trap cleanup EXIT
 
-"$bin/server/vc-server" --listen 127.0.0.1:0 --workers 1 >"$work/server.log" 2>&1 &
-server_pid=$!
-port=""
-for _ in $(seq 1 100); do
-  port=$(sed -n 's/.*listening on .* (port \([0-9]*\)).*/\1/p' "$work/server.log" | head -1)
-  [[ -n "$port" ]] && break
-  sleep 0.1
-done
-[[ -n "$port" ]] || { cat "$work/server.log"; exit 1; }
+start_server() {  # start_server LOG [flags...]: prints the port
+  "$bin/server/vc-server" --listen 127.0.0.1:0 --workers 1 "${@:2}" >"$work/$1" 2>&1 &
+  pids+=($!)
+  local p=""
+  for _ in $(seq 1 100); do
+    p=$(sed -n 's/.*listening on .* (port \([0-9]*\)).*/\1/p' "$work/$1" | head -1)
+    [[ -n "$p" ]] && break
+    sleep 0.1
+  done
+  [[ -n "$p" ]] || { cat "$work/$1" >&2; exit 1; }
+  port=$p
+}
+if [[ -n "$fan_out" ]]; then
+  start_server peer1.log; p1=$port
+  start_server peer2.log; p2=$port
+  start_server server.log --peers "127.0.0.1:$p1,127.0.0.1:$p2" --shard-candidates 16 --local-shards=false
+else
+  start_server server.log
+fi
 
 scenes=(box lroom comb:3 comb:5 rooms:3 twofloor)
 [[ "$quick" == "--quick" ]] || scenes+=(hall)
