@@ -85,5 +85,57 @@ TEST_F(Tls, MissingCertificateFileIsNotFound) {
   EXPECT_EQ(s.status().code(), StatusCode::kNotFound);
 }
 
+// Replicas speak TLS to each other when they speak it to clients (docs/DEPLOY.md, "Scaling out"):
+// with mutual TLS the coordinator presents its own certificate; a peer whose certificate the
+// --peer-tls-ca does not verify is left out with a warning, and the plan is the same.
+TEST_F(Tls, ReplicasFanOutOverMutualTls) {
+  server::ServerOptions o;
+  o.workers = 2;
+  o.threads_per_job = 1;
+  o.tls_cert_file = F("server.pem");
+  o.tls_key_file = F("server.key");
+  o.tls_client_ca_file = F("ca.pem");
+  auto peer = testing::StartServer(o);
+  ASSERT_TRUE(peer);
+  o.peers = {testing::Address(*peer)};
+  o.shard_candidates = 4;
+  o.local_shards = false;
+  o.peer_tls_ca_file = F("ca.pem");
+  auto coordinator = testing::StartServer(o);
+  ASSERT_TRUE(coordinator);
+  o.peer_tls_ca_file = F("client.pem");  // not a CA that signed the peer's certificate
+  auto misconfigured = testing::StartServer(o);
+  ASSERT_TRUE(misconfigured);
+
+  client::ConnectionOptions conn;
+  conn.tls_ca_file = F("ca.pem");
+  conn.tls_cert_file = F("client.pem");
+  conn.tls_key_file = F("client.key");
+  conn.max_attempts = 1;
+  PlanOptions plan;
+  plan.solver = SelectionSolver::kGreedy;
+  const client::Upload room{testing::BoxRoomPly({6, 4, 2.5}, 0.1), "room.ply"};
+  auto plan_on = [&](const server::Server& s) {
+    conn.server = testing::Address(s);
+    auto c = client::Client::Create(conn);
+    EXPECT_TRUE(c.ok());
+    return (*c)->Plan(room, plan);
+  };
+  const auto fanned = plan_on(*coordinator);
+  ASSERT_TRUE(fanned.ok()) << fanned.status().ToString();
+  EXPECT_EQ(fanned->distribution.replicas, 1);  // the peer computed every shard
+  EXPECT_GT(fanned->distribution.shards, 1);
+  EXPECT_TRUE(fanned->warnings.empty());
+  const auto alone = plan_on(*misconfigured);
+  ASSERT_TRUE(alone.ok()) << alone.status().ToString();
+  ASSERT_FALSE(alone->warnings.empty());
+  EXPECT_NE(alone->warnings[0].find(testing::Address(*peer)), std::string::npos) << alone->warnings[0];
+  ASSERT_EQ(alone->stations.size(), fanned->stations.size());
+  for (size_t k = 0; k < alone->stations.size(); ++k) {
+    EXPECT_EQ(alone->stations[k].position, fanned->stations[k].position);
+  }
+  EXPECT_EQ(alone->covered_voxels, fanned->covered_voxels);
+}
+
 }  // namespace
 }  // namespace vc
