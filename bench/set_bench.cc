@@ -12,6 +12,7 @@
 #include <chrono>
 #include <cstdio>
 
+#include "vc/plan/planner.h"
 #include "vc/plan/stages.h"
 #include "vc/scene/scene_input.h"
 #include "vc/synth/synth.h"
@@ -53,6 +54,59 @@ vc::Result<vc::SceneInput> Load(const std::string& scene, double spacing, int ti
   return input;
 }
 
+int PlanEndToEnd(const std::string& scene, double spacing, int tiles, double resolution, double grid, double max_range,
+                 int threads, const std::string& solver, double sparse_gain, uint64_t budget, bool consolidate,
+                 bool reduce) {
+  auto t = Clock::now();
+  auto input = Load(scene, spacing, tiles);
+  if (!input.ok()) return std::fprintf(stderr, "%s\n", input.status().ToString().c_str()), 1;
+  std::printf("scene %s x%d: %zu points, loaded in %.1f s\n", scene.c_str(), tiles * tiles, input->points.size(),
+              Since(t));
+  vc::PlanOptions options;
+  options.resolution_m = resolution;
+  options.grid_spacing_m = grid;
+  options.scanner.max_range_m = max_range;
+  options.threads = threads;
+  options.sparse_set_gain = sparse_gain;
+  options.memory_budget_bytes = budget;
+  options.consolidate = consolidate;
+  options.reduce = reduce;
+  options.solver = solver == "greedy"  ? vc::SelectionSolver::kGreedy
+                   : solver == "exact" ? vc::SelectionSolver::kExact
+                                       : vc::SelectionSolver::kAuto;
+  vc::JobContext ctx;
+  int last = -1;
+  ctx.progress = [&](const vc::ProgressEvent& e) {
+    const int pct = int(e.fraction * 10);
+    if (pct == last) return;
+    last = pct;
+    std::fprintf(stderr, "  %s %3.0f %%%s%s\n", std::string(vc::StageName(e.stage)).c_str(), 100 * e.fraction,
+                 e.message.empty() ? "" : ": ", e.message.c_str());
+  };
+  t = Clock::now();
+  auto result = vc::Plan(*input, options, ctx);
+  if (!result.ok()) {
+    std::printf("plan failed after %.1f s: %s (peak RSS %.0f MiB)\n", Since(t), result.status().ToString().c_str(),
+                PeakRssMiB());
+    return 1;
+  }
+  std::printf("greedy picks %d, consolidation saved %d\n", result->greedy_stations, result->consolidated);
+  std::printf(
+      "plan: %zu stations, coverage %.4f of %llu coverable voxels (%llu occupied), G %.4f, %llu candidates, "
+      "%s (bound %.0f)\n",
+      result->stations.size(), double(result->covered_voxels) / double(result->coverable_voxels),
+      (unsigned long long)result->coverable_voxels, (unsigned long long)result->occupied_voxels,
+      result->evaluation.overall.global_visibility, (unsigned long long)result->candidate_count,
+      result->optimality.solver.c_str(), result->optimality.lower_bound);
+  for (const auto& st : result->timings) {
+    std::printf("  %-11s %8.1f s\n", std::string(vc::StageName(st.stage)).c_str(), st.seconds);
+  }
+  std::printf("total %.1f s, peak RSS %.0f MiB (budget %.1f GiB)\n", result->total_seconds, PeakRssMiB(),
+              double(budget) / 1073741824.0);
+  for (const std::string& w : result->warnings) std::printf("warning: %s\n", w.c_str());
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -69,7 +123,24 @@ int main(int argc, char** argv) {
   app.add_option("--tiles", tiles, "copies of the scene, K x K")->capture_default_str();
   app.add_option("--pairs", pairs, "intersection counts among the first N candidates")->capture_default_str();
   app.add_option("--threads", threads, "threads for the visibility sets (0 = all)")->capture_default_str();
+  bool plan = false;
+  std::string solver = "auto";
+  double sparse_gain = 4.0;
+  uint64_t budget = uint64_t{4} << 30;
+  app.add_flag("--plan", plan,
+               "instead: plan the scene end to end (vc::Plan, default parameters but these) and print the stages' "
+               "times, the plan and the peak memory");
+  app.add_option("--solver", solver, "with --plan: greedy, exact or auto")->capture_default_str();
+  app.add_option("--sparse-set-gain", sparse_gain, "with --plan: PlanOptions::sparse_set_gain")->capture_default_str();
+  app.add_option("--memory-budget-bytes", budget, "with --plan: the plan's memory budget")->capture_default_str();
+  bool no_consolidate = false, no_reduce = false;
+  app.add_flag("--no-consolidate", no_consolidate, "with --plan: no consolidation after greedy");
+  app.add_flag("--no-reduce", no_reduce, "with --plan: no reduction");
   CLI11_PARSE(app, argc, argv);
+  if (plan) {
+    return PlanEndToEnd(scene, spacing, tiles, resolution, grid, max_range, threads, solver, sparse_gain, budget,
+                        !no_consolidate, !no_reduce);
+  }
 
   auto input = Load(scene, spacing, tiles);
   if (!input.ok()) {
@@ -97,9 +168,10 @@ int main(int argc, char** argv) {
     seen += v.count();
     dense_bytes += v.words().size() * 8;
   }
-  std::printf("scene %s x%d at %.2f m, range %.0f m: %zu voxels, %zu candidates, each sees %.1f %% (visibility %.1f s)\n",
-              scene.c_str(), tiles * tiles, s.resolution_m, max_range, voxels, n, 100.0 * double(seen) / double(n * voxels),
-              visibility_s);
+  std::printf(
+      "scene %s x%d at %.2f m, range %.0f m: %zu voxels, %zu candidates, each sees %.1f %% (visibility %.1f s)\n",
+      scene.c_str(), tiles * tiles, s.resolution_m, max_range, voxels, n, 100.0 * double(seen) / double(n * voxels),
+      visibility_s);
 
   // Encode and decode (the wire form), and the Roaring bitmaps for the set operations.
   t = Clock::now();
@@ -121,7 +193,8 @@ int main(int argc, char** argv) {
   for (const vc::VoxelSet& v : *sets) dense_union.Union(v);
   const double dense_union_s = Since(t);
   t = Clock::now();
-  roaring_bitmap_t* roaring_union = roaring_bitmap_or_many(bitmaps.size(), const_cast<const roaring_bitmap_t**>(bitmaps.data()));
+  roaring_bitmap_t* roaring_union =
+      roaring_bitmap_or_many(bitmaps.size(), const_cast<const roaring_bitmap_t**>(bitmaps.data()));
   const double roaring_union_s = Since(t);
   const bool same_union = roaring_bitmap_get_cardinality(roaring_union) == dense_union.count();
   roaring_bitmap_free(roaring_union);
@@ -142,7 +215,8 @@ int main(int argc, char** argv) {
 
   std::printf("| representation | bytes of all sets | union of all | %zu pairs' intersections |\n", m * (m - 1) / 2);
   std::printf("|---|---|---|---|\n");
-  std::printf("| dense | %.1f MiB | %.3f s | %.3f s |\n", double(dense_bytes) / 1048576.0, dense_union_s, dense_pairs_s);
+  std::printf("| dense | %.1f MiB | %.3f s | %.3f s |\n", double(dense_bytes) / 1048576.0, dense_union_s,
+              dense_pairs_s);
   std::printf("| Roaring | %.1f MiB (%.2fx smaller) | %.3f s | %.3f s |\n", double(roaring_bytes) / 1048576.0,
               double(dense_bytes) / double(roaring_bytes), roaring_union_s, roaring_pairs_s);
   std::printf("encode %.2f ms per set, decode %.2f ms per set; results agree: %s; peak RSS %.0f MiB\n",

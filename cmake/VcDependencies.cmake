@@ -10,6 +10,7 @@ find_package(PNG REQUIRED)
 find_package(nlohmann_json 3.11 REQUIRED)
 find_package(CLI11 REQUIRED)
 find_package(Threads REQUIRED)
+find_package(roaring CONFIG REQUIRED)  # sparse visibility sets (vc/visibility/voxel_set.h; Debian libroaring-dev)
 find_package(PkgConfig REQUIRED)
 pkg_check_modules(HWY REQUIRED IMPORTED_TARGET libhwy)
 # COIN-OR CBC (coinor-libcbc-dev): the exact station selector (vc::plan only).

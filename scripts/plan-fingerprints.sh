@@ -7,14 +7,17 @@
 #   --quick: geb079 and the known-optimum scenes only (skips the 1.7 M-point synthetic hall).
 #   --fan-out: plan through a coordinator that leaves every shard of 16 candidates to two peer
 #     vc-servers (docs/DEPLOY.md, "Scaling out"): the lines must be the same as without.
+#   --sparse: every visibility set sparse (--sparse-set-gain 1e-9; vc/visibility/voxel_set.h):
+#     the lines must be the same as without.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bin=${1:-build/release}
-quick="" fan_out=""
+quick="" fan_out="" client_flags=()
 for a in "${@:2}"; do
   case "$a" in
     --quick) quick=--quick ;;
     --fan-out) fan_out=1 ;;
+    --sparse) client_flags+=(--sparse-set-gain 1e-9) ;;
     *) echo "plan-fingerprints: unknown option $a" >&2; exit 2 ;;
   esac
 done
@@ -56,7 +59,7 @@ for s in "${scenes[@]}"; do
 done
 for f in "${files[@]}"; do
   out="$work/out-$(basename "$f")"
-  "$bin/client/vc-client" submit "$f" --server "127.0.0.1:$port" --out "$out" >/dev/null 2>"$work/err" ||
+  "$bin/client/vc-client" submit "$f" --server "127.0.0.1:$port" --out "$out" "${client_flags[@]}" >/dev/null 2>"$work/err" ||
     { cat "$work/err"; exit 1; }
   python3 - "$f" "$out/plan.json" <<'PY'
 import hashlib, json, os, sys

@@ -219,6 +219,7 @@ struct LaneJob {
   const std::string& token;
   const std::string& self_id;
   Clock::duration shard_deadline;
+  double compact_gain;  // the sets arrive sparse where the plan keeps them sparse
 };
 
 class PeerLane {
@@ -323,7 +324,7 @@ class PeerLane {
     std::vector<VoxelSet> sets;
     sets.reserve(end - begin);
     for (const std::string& b : resp.sets()) {
-      VC_ASSIGN_OR_RETURN(VoxelSet s, wire::DecodeVoxelSet(b, job_.occupied_voxels));
+      VC_ASSIGN_OR_RETURN(VoxelSet s, wire::DecodeVoxelSet(b, job_.occupied_voxels, job_.compact_gain));
       sets.push_back(std::move(s));
     }
     return sets;
@@ -487,7 +488,8 @@ Result<DistributedSets> PeerFanOut::Compute(const SceneRef& ref, const v1::PlanP
                     SceneFingerprint(scene),
                     token,
                     self_id_,
-                    options_.shard_deadline};
+                    options_.shard_deadline,
+                    options.compact_gain};
   std::vector<std::unique_ptr<PeerLane>> lanes;
   std::vector<std::thread> threads;
   for (size_t i = 0; i < addresses.size(); ++i) {
@@ -529,6 +531,16 @@ Result<DistributedSets> PeerFanOut::Compute(const SceneRef& ref, const v1::PlanP
   finish();
   VC_RETURN_IF_ERROR(status);
   DistributedSets out = std::move(board).Collect();
+  if (options.max_set_bytes > 0) {
+    uint64_t bytes = 0;
+    for (const VoxelSet& s : out.sets) bytes += s.MemoryBytes();
+    if (bytes > options.max_set_bytes) {
+      return ResourceExhaustedError("the visibility sets of " + std::to_string(viewpoints.size()) + " positions need " +
+                                    HumanBytes(bytes) +
+                                    ", over half the memory budget; raise grid_spacing_m or "
+                                    "resolution_m, lower max_range_m, or raise the memory budget");
+    }
+  }
   spdlog::info("fan-out: {} viewpoints in {} shards over {} replicas, {} retried, {} exchanged", viewpoints.size(),
                out.distribution.shards, out.distribution.replicas, out.distribution.retried,
                HumanBytes(out.distribution.bytes_exchanged));

@@ -250,7 +250,7 @@ TEST(PlanResultChunks, ASoleViewerNamingAMissingStationOrOnSomeChunksOnlyIsDataL
 // field in proto/vc/v1/planner.proto and proto/src/convert.cc (both ways), then update the sizes.
 TEST(PlanResultChunks, EveryCoreFieldIsCarried) {
   EXPECT_EQ(sizeof(PlanResult), 1408u) << "PlanResult changed: update the vc.v1 PlanResult and vc::wire";
-  EXPECT_EQ(sizeof(PlanOptions), 400u) << "PlanOptions changed: update vc.v1 PlanParameters and vc::wire";
+  EXPECT_EQ(sizeof(PlanOptions), 408u) << "PlanOptions changed: update vc.v1 PlanParameters and vc::wire";
 }
 
 TEST(PlanResultChunks, MissingChunkIsDataLoss) {

@@ -37,10 +37,7 @@ double SecondsSince(Clock::time_point t0) { return std::chrono::duration<double>
 // Calls f(v) for every set bit v of s.
 template <typename F>
 void ForEachBit(const VoxelSet& s, F&& f) {
-  const std::vector<uint64_t>& w = s.words();
-  for (size_t i = 0; i < w.size(); ++i) {
-    for (uint64_t bits = w[i]; bits != 0; bits &= bits - 1) f(i * 64 + static_cast<size_t>(std::countr_zero(bits)));
-  }
+  s.ForEach(f);
 }
 
 // The smallest voxel count k with k >= target * coverable (the greedy's stopping test).

@@ -1,6 +1,7 @@
 #include "vc/plan/greedy.h"
 
 #include <algorithm>
+#include <bit>
 #include <cstdio>
 #include <numeric>
 #include <optional>
@@ -16,20 +17,12 @@ uint64_t CountAnd(const VoxelSet& a, const VoxelSet& b) { return a.CountAnd(b); 
 
 uint64_t CountBits(const VoxelSet& a) { return a.count(); }
 
-void UnionInto(VoxelSet& a, const VoxelSet& b) {
-  auto& wa = a.words();
-  const auto& wb = b.words();
-  for (size_t i = 0; i < wa.size(); ++i) wa[i] |= wb[i];
-}
+void UnionInto(VoxelSet& a, const VoxelSet& b) { a.Union(b); }
 
 namespace {
 
 // uncovered &= ~s.
-void SubtractFrom(VoxelSet& uncovered, const VoxelSet& s) {
-  auto& wu = uncovered.words();
-  const auto& ws = s.words();
-  for (size_t i = 0; i < wu.size(); ++i) wu[i] &= ~ws[i];
-}
+void SubtractFrom(VoxelSet& uncovered, const VoxelSet& s) { uncovered.Subtract(s); }
 
 // Heap entry: a gain that is exact when `round` is the current round, an upper bound otherwise.
 struct Entry {
@@ -356,7 +349,18 @@ Result<ConsolidateResult> ConsolidatePicks(const std::vector<VoxelSet>& sets, st
     out.picks = std::move(picks);
     return out;
   }
-  const size_t words = sets[0].words().size();
+  const size_t words = (sets[0].size() + 63) / 64;
+  // The picks' words (a sparse pick is made dense once; picks are few), and any candidate's word k.
+  std::unordered_map<int, VoxelSet> dense_copies;
+  auto pick_words = [&](int c) -> const std::vector<uint64_t>& {
+    if (!sets[c].sparse()) return sets[c].words();
+    auto it = dense_copies.find(c);
+    if (it == dense_copies.end()) {
+      it = dense_copies.emplace(c, sets[c]).first;
+      it->second.Densify();
+    }
+    return it->second.words();
+  };
   std::vector<int> order;
   for (size_t i = static_cast<size_t>(std::max(fixed, 0)); i < sets.size(); ++i) order.push_back(static_cast<int>(i));
   auto is_fixed = [&](int candidate) { return candidate < fixed; };
@@ -387,7 +391,7 @@ Result<ConsolidateResult> ConsolidatePicks(const std::vector<VoxelSet>& sets, st
     std::fill(c2.begin(), c2.end(), 0);
     std::fill(c3.begin(), c3.end(), 0);
     for (int p : picks) {
-      const auto& w = sets[p].words();
+      const auto& w = pick_words(p);
       for (size_t k = 0; k < words; ++k) {
         c3[k] |= c2[k] & w[k];
         c2[k] |= c1[k] & w[k];
@@ -397,7 +401,7 @@ Result<ConsolidateResult> ConsolidatePicks(const std::vector<VoxelSet>& sets, st
     // A pick nobody needs: all its voxels are covered twice. The latest such pick goes first.
     for (size_t i = picks.size(); i-- > 0 && picks.size() > 1;) {
       if (is_fixed(picks[i])) continue;
-      const auto& w = sets[picks[i]].words();
+      const auto& w = pick_words(picks[i]);
       bool needed = false;
       for (size_t k = 0; k < words && !needed; ++k) needed = (w[k] & ~c2[k]) != 0;
       if (!needed) {
@@ -415,24 +419,34 @@ Result<ConsolidateResult> ConsolidatePicks(const std::vector<VoxelSet>& sets, st
     for (size_t a = 0; a < picks.size() && !changed; ++a) {
       VC_RETURN_IF_ERROR(ctx.CheckCancelled("consolidation"));
       if (is_fixed(picks[a])) continue;
-      const auto& wa = sets[picks[a]].words();
+      const auto& wa = pick_words(picks[a]);
       for (size_t b = a + 1; b < picks.size() && !changed; ++b) {
         if (is_fixed(picks[b])) continue;
-        const auto& wb = sets[picks[b]].words();
+        const auto& wb = pick_words(picks[b]);
         // Voxels only a or b cover: in both and covered exactly twice, or in one and covered once.
         nonzero.clear();
         for (size_t k = 0; k < words; ++k) {
           rest[k] = (wa[k] & wb[k] & ~c3[k]) | ((wa[k] ^ wb[k]) & ~c2[k]);
           if (rest[k]) nonzero.push_back(k);
         }
+        // A voxel of `rest` every candidate standing in must see: one test rules most out.
+        const std::optional<size_t> probe =
+            nonzero.empty()
+                ? std::nullopt
+                : std::optional<size_t>(nonzero[0] * 64 + static_cast<size_t>(std::countr_zero(rest[nonzero[0]])));
         for (int c : order) {
-          const auto& wc = sets[c].words();
+          const VoxelSet& sc = sets[c];
+          if (probe && !sc.test(*probe)) continue;
           bool covers = true;
           for (size_t k : nonzero) {
-            if (rest[k] & ~wc[k]) {
-              covers = false;
-              break;
+            if (!sc.sparse()) {
+              if (rest[k] & ~sc.words()[k]) covers = false;
+            } else {
+              for (uint64_t bits = rest[k]; bits != 0 && covers; bits &= bits - 1) {
+                covers = sc.test(k * 64 + static_cast<size_t>(std::countr_zero(bits)));
+              }
             }
+            if (!covers) break;
           }
           if (!covers) continue;
           std::vector<int> after = picks;

@@ -130,9 +130,11 @@ Result<PlanResult> Plan(const SceneInput& input, const PlanOptions& options, con
   result.cells_failing_clearance = candidates.cells_failing_clearance;
   result.warnings = candidates.warnings;
 
-  VC_RETURN_IF_ERROR(planner::CheckVisibilitySetBudget(candidates.positions.size() + options.fixed_stations.size(),
-                                                       result.occupied_voxels, options.memory_budget_bytes,
-                                                       "visibility counts"));
+  if (options.sparse_set_gain <= 0) {  // sparse sets are checked as they are computed
+    VC_RETURN_IF_ERROR(planner::CheckVisibilitySetBudget(candidates.positions.size() + options.fixed_stations.size(),
+                                                         result.occupied_voxels, options.memory_budget_bytes,
+                                                         "visibility counts"));
+  }
   VC_ASSIGN_OR_RETURN(planner::VisibilityOutput visibility, runner.Run(Stage::kVisibility, [&](const JobContext& c) {
     return planner::RunVisibilityStage(
         {scene, candidates.positions, candidates.floor_z_m, options.fixed_stations, callbacks}, options, c);

@@ -14,6 +14,7 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <optional>
 
 #include "vc/base/parallel.h"
 #include "vc/base/popcount.h"
@@ -186,37 +187,25 @@ double FaceVisibility(const OccupancyGrid& grid, const WorldPoint& o, const Voxe
   return FaceValue(PerceiveFace(grid, o, v, f), o, v, f, grid.resolution_m(), scanner, limits);
 }
 
-VC_POPCOUNT_CLONES size_t VoxelSet::count() const {
-  size_t n = 0;
-  for (uint64_t w : words_) n += std::popcount(w);
-  return n;
-}
+namespace {
 
-VC_POPCOUNT_CLONES size_t VoxelSet::CountAnd(const VoxelSet& other) const {
-  size_t n = 0;
-  const size_t m = std::min(words_.size(), other.words_.size());
-  for (size_t i = 0; i < m; ++i) n += std::popcount(words_[i] & other.words_[i]);
-  return n;
-}
+// What every batch of viewpoints shares: the voxels' indices, those that can pass either test, and
+// (grouped surface test) the targets.
+struct SetsContext {
+  const OccupancyGrid& g;
+  size_t n;
+  std::vector<VoxelIndex> index;
+  std::vector<uint32_t> candidates;
+  std::optional<internal::SurfaceTargets> targets;
+};
 
-void VoxelSet::Subtract(const VoxelSet& other) {
-  const size_t m = std::min(words_.size(), other.words_.size());
-  for (size_t i = 0; i < m; ++i) words_[i] &= ~other.words_[i];
-}
-
-void VoxelSet::Union(const VoxelSet& other) {
-  const size_t m = std::min(words_.size(), other.words_.size());
-  for (size_t i = 0; i < m; ++i) words_[i] |= other.words_[i];
-}
-
-Result<std::vector<VoxelSet>> ComputeVisibilitySets(const VoxelScene& scene, const std::vector<WorldPoint>& viewpoints,
-                                                    const VisibilitySetsOptions& options, const JobContext& ctx) {
-  const OccupancyGrid& g = scene.grid;
-  const size_t n = scene.occupied.size();
-  std::vector<VoxelIndex> index(n);
-  for (size_t i = 0; i < n; ++i) index[i] = KeyToIndex(scene.occupied[i]);
-  // Voxels that can pass either test.
-  const std::vector<uint32_t> candidates = NotEnclosed(g, index);
+// The dense sets of `viewpoints` (ComputeVisibilitySets without compaction).
+Result<std::vector<VoxelSet>> ComputeDenseSets(const SetsContext& sc, const std::vector<WorldPoint>& viewpoints,
+                                               const VisibilitySetsOptions& options, const JobContext& ctx) {
+  const OccupancyGrid& g = sc.g;
+  const size_t n = sc.n;
+  const std::vector<VoxelIndex>& index = sc.index;
+  const std::vector<uint32_t>& candidates = sc.candidates;
   std::vector<VoxelSet> sets(viewpoints.size());
   std::vector<Vector3d> uo(viewpoints.size());
   std::vector<ScannerLimits> limits(viewpoints.size());
@@ -234,7 +223,7 @@ Result<std::vector<VoxelSet>> ComputeVisibilitySets(const VoxelScene& scene, con
     // every thread busy, a task is one viewpoint and owns its set. Otherwise tasks are
     // (viewpoint, run of bricks); tasks of one viewpoint share its set's words, so bits are set
     // atomically.
-    const internal::SurfaceTargets targets(g, index, candidates);
+    const internal::SurfaceTargets& targets = *sc.targets;
     const bool task_per_viewpoint =
         viewpoints.size() >= 8 * uint64_t(ResolveThreads(options.threads, viewpoints.size()));
     // The sets are allocated here, in the calling thread (running out of memory must not happen
@@ -301,6 +290,65 @@ Result<std::vector<VoxelSet>> ComputeVisibilitySets(const VoxelScene& scene, con
   });
   VC_RETURN_IF_ERROR(st);
   return sets;
+}
+
+}  // namespace
+
+Result<std::vector<VoxelSet>> ComputeVisibilitySets(const VoxelScene& scene, const std::vector<WorldPoint>& viewpoints,
+                                                    const VisibilitySetsOptions& options, const JobContext& ctx) {
+  SetsContext sc{scene.grid, scene.occupied.size(), std::vector<VoxelIndex>(scene.occupied.size()), {}, {}};
+  for (size_t i = 0; i < sc.n; ++i) sc.index[i] = KeyToIndex(scene.occupied[i]);
+  sc.candidates = NotEnclosed(sc.g, sc.index);
+  if (options.test == SelectionTest::kSurfaceVisibility && !options.per_voxel) {
+    sc.targets.emplace(sc.g, sc.index, sc.candidates);
+  }
+  auto check_bytes = [&](uint64_t bytes) -> Status {
+    if (options.max_set_bytes == 0 || bytes <= options.max_set_bytes) return Status::Ok();
+    return ResourceExhaustedError("the visibility sets of " + std::to_string(viewpoints.size()) + " positions x " +
+                                  std::to_string(sc.n) + " occupied voxels need more than " +
+                                  std::to_string(options.max_set_bytes >> 20) +
+                                  " MiB even where kept sparse; raise grid_spacing_m or resolution_m, lower "
+                                  "max_range_m, or raise the memory budget");
+  };
+  if (options.compact_gain <= 0) {
+    VC_ASSIGN_OR_RETURN(std::vector<VoxelSet> sets, ComputeDenseSets(sc, viewpoints, options, ctx));
+    uint64_t bytes = 0;
+    for (const VoxelSet& s : sets) bytes += s.MemoryBytes();
+    VC_RETURN_IF_ERROR(check_bytes(bytes));
+    return sets;
+  }
+  // Batches whose dense sets fit batch_bytes, each compacted before the next is computed, so the
+  // dense form of all sets never exists at once.
+  const uint64_t dense_bytes = std::max<uint64_t>(8, (sc.n + 63) / 64 * 8);
+  const size_t batch = size_t(std::max<uint64_t>(1, options.batch_bytes / dense_bytes));
+  std::vector<VoxelSet> out;
+  out.reserve(viewpoints.size());
+  uint64_t kept = 0;
+  const size_t total = viewpoints.size();
+  for (size_t b0 = 0; b0 < total; b0 += batch) {
+    const size_t b1 = std::min(total, b0 + batch);
+    JobContext sub{ctx.cancel, {}};
+    if (ctx.progress) {
+      sub.progress = [&, b0, b1](const ProgressEvent& e) {
+        ProgressEvent m = e;
+        m.fraction = (double(b0) + e.fraction * double(b1 - b0)) / double(total);
+        m.done = b0 + e.done;
+        m.total = total;
+        ctx.progress(m);
+      };
+    }
+    const std::vector<WorldPoint> part(viewpoints.begin() + std::ptrdiff_t(b0),
+                                       viewpoints.begin() + std::ptrdiff_t(b1));
+    VC_ASSIGN_OR_RETURN(std::vector<VoxelSet> sets, ComputeDenseSets(sc, part, options, sub));
+    for (VoxelSet& s : sets) {
+      s.Compact(options.compact_gain);
+      if (!s.sparse()) s.words().shrink_to_fit();
+      kept += s.MemoryBytes();
+      out.push_back(std::move(s));
+    }
+    VC_RETURN_IF_ERROR(check_bytes(kept));
+  }
+  return out;
 }
 
 }  // namespace vc

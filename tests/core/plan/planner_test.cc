@@ -169,6 +169,74 @@ TEST(PlannerTest, LocalCandidatesReachTheCombsOptimumWhereA2mGridCannot) {
   }
 }
 
+// Sparse visibility sets (vc/visibility/voxel_set.h) change memory and time, never the plan: with
+// every set sparse, each stage that takes sets (greedy and consolidation, the exact solver, local
+// candidates, refinement, registration) gives the plan of dense sets.
+TEST(PlannerTest, SparseSetsGiveTheSamePlanAsDenseOnes) {
+  struct Case {
+    const char* spec;
+    SelectionSolver solver;
+    double min_overlap;
+    bool local_candidates, refine;
+  };
+  // Greedy wherever the solver is not the point: a time-limited solve may differ between two runs.
+  for (const Case& c : {Case{"comb:5", SelectionSolver::kGreedy, 0.0, false, true},
+                        Case{"comb:3", SelectionSolver::kExact, 0.0, false, false},
+                        Case{"comb:3", SelectionSolver::kGreedy, 0.0, true, false},
+                        Case{"rooms:3", SelectionSolver::kGreedy, 0.3, false, false}}) {
+    PlanOptions o = TestOptions();
+    o.solver = c.solver;
+    o.min_overlap = c.min_overlap;
+    o.local_candidates = c.local_candidates;
+    o.refine = c.refine;
+    if (c.local_candidates) o.grid_spacing_m = 2.0;
+    o.sparse_set_gain = 0;
+    Result<PlanResult> dense = Plan(Synthetic(c.spec), o);
+    o.sparse_set_gain = 1e-9;  // every set sparse
+    Result<PlanResult> sparse = Plan(Synthetic(c.spec), o);
+    ASSERT_TRUE(dense.ok() && sparse.ok()) << c.spec << ": " << dense.status().ToString() << sparse.status().ToString();
+    SCOPED_TRACE(c.spec);
+    ASSERT_EQ(dense->stations.size(), sparse->stations.size());
+    for (size_t k = 0; k < dense->stations.size(); ++k) {
+      EXPECT_EQ(dense->stations[k].position, sparse->stations[k].position);
+      EXPECT_EQ(dense->stations[k].marginal_gain, sparse->stations[k].marginal_gain);
+    }
+    EXPECT_EQ(dense->covered_voxels, sparse->covered_voxels);
+    EXPECT_EQ(dense->coverable_voxels, sparse->coverable_voxels);
+    EXPECT_EQ(dense->heat_map.visible_voxels, sparse->heat_map.visible_voxels);
+    EXPECT_EQ(dense->evaluation.overall.global_visibility, sparse->evaluation.overall.global_visibility);
+    EXPECT_EQ(dense->scan_graph.edges.size(), sparse->scan_graph.edges.size());
+    EXPECT_EQ(dense->optimality.status, sparse->optimality.status);
+    EXPECT_EQ(dense->optimality.lower_bound, sparse->optimality.lower_bound);
+  }
+}
+
+// Sparse sets are held to the memory budget as they are computed: a budget they cannot fit in is
+// RESOURCE_EXHAUSTED naming what to change, not an allocation failure.
+TEST(PlannerTest, SparseSetsOverTheBudgetAreRefusedAsTheyAreKept) {
+  const VoxelScene scene = *Voxelize(Synthetic("rooms:3"), {});
+  std::vector<WorldPoint> positions;
+  for (double x = 1; x < 10; x += 1) positions.emplace_back(x, 2, 1.5);
+  VisibilitySetsOptions so;
+  so.compact_gain = 1e-9;
+  so.batch_bytes = 1;  // one position per batch
+  so.max_set_bytes = 1;
+  const auto r = ComputeVisibilitySets(scene, positions, so);
+  EXPECT_EQ(r.status().code(), StatusCode::kResourceExhausted);
+  EXPECT_NE(r.status().message().find("raise grid_spacing_m"), std::string::npos) << r.status().message();
+  so.max_set_bytes = 0;
+  const auto ok = ComputeVisibilitySets(scene, positions, so);
+  ASSERT_TRUE(ok.ok());
+  ASSERT_EQ(ok->size(), positions.size());
+  const auto dense = ComputeVisibilitySets(scene, positions, VisibilitySetsOptions{});
+  ASSERT_TRUE(dense.ok());
+  for (size_t k = 0; k < positions.size(); ++k) {
+    EXPECT_TRUE((*ok)[k].sparse());
+    EXPECT_EQ((*ok)[k].count(), (*dense)[k].count());
+    EXPECT_EQ((*ok)[k].CountAnd((*dense)[k]), (*dense)[k].count());
+  }
+}
+
 // A fixed station with local candidates: it stays first and fixed, the added positions are told
 // apart from the grid's candidates (candidate index -1) and from the fixed station.
 TEST(PlannerTest, LocalCandidatesWithAFixedStationKeepItFirst) {

@@ -72,7 +72,7 @@ Result<LocalRefinementResult> SelectWithLocalCandidates(const SelectionInput& in
                "local candidates: visibility of " + std::to_string(positions.size()) + " positions");
     VC_ASSIGN_OR_RETURN(std::vector<VoxelSet> out, ComputeVisibilitySets(in.scene, positions, set_options, quiet));
     for (VoxelSet& s : out) {
-      for (size_t w = 0; w < s.words().size(); ++w) s.words()[w] &= coverable.words()[w];
+      s.Intersect(coverable);
     }
     return out;
   };

@@ -24,6 +24,13 @@ VisibilitySetsOptions VisibilitySetsOptionsFor(const PlanOptions& options) {
   set_options.test = options.selection_test;
   set_options.threads = options.threads;
   set_options.scanner = options.scanner;
+  set_options.compact_gain = options.sparse_set_gain;
+  // Sparse sets: their size is known only once computed, so the budget is checked as they are
+  // (CheckVisibilitySetBudget checks dense ones before).
+  if (options.sparse_set_gain > 0) {
+    set_options.max_set_bytes = options.memory_budget_bytes / 2;
+    set_options.batch_bytes = std::min<uint64_t>(set_options.batch_bytes, options.memory_budget_bytes / 8);
+  }
   return set_options;
 }
 

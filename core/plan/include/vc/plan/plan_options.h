@@ -34,6 +34,10 @@
 //   reduction keep the stations' scan graph connected at this overlap.
 // - setup_seconds, scan_seconds, walk_speed_mps: the field time (route.h): per station set-up and
 //   scan, plus the walking route's length at this speed.
+// - sparse_set_gain: the visibility sets' form (vc/visibility/voxel_set.h): a set goes sparse
+//   (Roaring) when that is at least this many times smaller than its dense bitset; no indoor scene
+//   of ours gains 4 x (docs/BENCHMARKS.md), a large site with a range limit gains 9-36 x. The
+//   form never changes the plan, only its memory and time.
 #define VC_PLAN_PARAMETERS(X)                                                                                          \
   X(double, resolution_m, 0.0, "m", "resolution", kNonNegative,                                                        \
     "working resolution (0 = the octree's own, or 0.1 m for clouds)")                                                  \
@@ -68,6 +72,8 @@
   X(int32_t, reduce_to, 0, "stations", "reduce-to", kNonNegative,                                                      \
     "reduce to at most this many stations (0 = zero-loss removals only)")                                              \
   X(int32_t, threads, 0, "threads", "threads", kNonNegative, "threads for the job (0 = all, or the server's share)")   \
+  X(double, sparse_set_gain, 4.0, "x", "sparse-set-gain", kNonNegative,                                                \
+    "keep a candidate's visibility set as a Roaring bitmap when that is this many times smaller (0 = always dense)")   \
   X(double, min_overlap, 0.0, "fraction", "min-overlap", kUnitInterval,                                                \
     "keep the scan graph connected at this overlap (0 = off; 0.3 for target-less registration)")                       \
   X(double, setup_seconds, 120.0, "s", "setup-seconds", kNonNegative, "field time to set up the scanner per station")  \

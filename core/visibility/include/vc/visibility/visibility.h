@@ -26,6 +26,7 @@
 #include "vc/base/progress.h"
 #include "vc/base/status.h"
 #include "vc/scene/voxel_scene.h"
+#include "vc/visibility/voxel_set.h"
 
 namespace vc {
 
@@ -108,37 +109,6 @@ bool ViewpointInRange(const WorldPoint& o, double resolution_m);
 
 // --- Bulk: many viewpoints x all occupied voxels ---
 
-// A set of occupied-voxel ids (VoxelScene::occupied positions) as a bitset.
-class VoxelSet {
- public:
-  VoxelSet() = default;
-  explicit VoxelSet(size_t n) : n_(n), words_((n + 63) / 64, 0) {}
-  size_t size() const { return n_; }
-  // Makes the set hold n voxels: ids below the old size keep their bits, the others are clear.
-  // Allocates nothing when words().capacity() already holds (n + 63) / 64 words.
-  void Resize(size_t n) {
-    n_ = n;
-    words_.resize((n + 63) / 64, 0);
-    if (n % 64) words_.back() &= (uint64_t{1} << (n % 64)) - 1;
-  }
-  bool test(size_t i) const { return (words_[i >> 6] >> (i & 63)) & 1u; }
-  void set(size_t i) { words_[i >> 6] |= uint64_t{1} << (i & 63); }
-  void reset(size_t i) { words_[i >> 6] &= ~(uint64_t{1} << (i & 63)); }
-  size_t count() const;
-  // |this AND other|.
-  size_t CountAnd(const VoxelSet& other) const;
-  // this &= ~other.
-  void Subtract(const VoxelSet& other);
-  // this |= other.
-  void Union(const VoxelSet& other);
-  const std::vector<uint64_t>& words() const { return words_; }
-  std::vector<uint64_t>& words() { return words_; }
-
- private:
-  size_t n_ = 0;
-  std::vector<uint64_t> words_;
-};
-
 struct VisibilitySetsOptions {
   SelectionTest test = SelectionTest::kSurfaceVisibility;
   // Worker threads; 0 = hardware concurrency.
@@ -151,6 +121,13 @@ struct VisibilitySetsOptions {
   // None: no limit at all, not even the range (the paper's tests, as the planner used them
   // before the scanner model; the planner always passes its scanner).
   std::optional<ScannerModel> scanner;
+  // Sparse sets (voxel_set.h): each set is kept as a Roaring bitmap when that is at least this
+  // many times smaller than its dense words; 0 = every set dense. With it the viewpoints are
+  // computed in batches whose dense sets take at most batch_bytes, each compacted before the next.
+  double compact_gain = 0;
+  uint64_t batch_bytes = uint64_t{256} << 20;
+  // RESOURCE_EXHAUSTED as soon as the sets kept exceed this many bytes (0 = no limit).
+  uint64_t max_set_bytes = 0;
 };
 
 // For each viewpoint, the occupied voxels that pass the selection test. Viewpoints inside an
