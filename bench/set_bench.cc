@@ -6,12 +6,12 @@
 // matrix of registration). A site larger than the synthetic scenes: --tiles K copies the scene
 // K x K side by side (2 m apart); --max-range makes each station's view local, as on a campus.
 #include <roaring/roaring.h>
-#include <sys/resource.h>
 
 #include <CLI/CLI.hpp>
 #include <chrono>
 #include <cstdio>
 
+#include "bench_scene.h"
 #include "vc/plan/planner.h"
 #include "vc/plan/stages.h"
 #include "vc/scene/scene_input.h"
@@ -22,36 +22,11 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 double Since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
-double PeakRssMiB() {
-  rusage ru{};
-  getrusage(RUSAGE_SELF, &ru);
-  return double(ru.ru_maxrss) / 1024.0;
-}
+using vc::bench::PeakRssMiB;
 
+// The scene, tiles x tiles copies of it.
 vc::Result<vc::SceneInput> Load(const std::string& scene, double spacing, int tiles) {
-  vc::SceneInput input;
-  if (scene.find('/') != std::string::npos || scene.find('.') != std::string::npos) {
-    VC_ASSIGN_OR_RETURN(input, vc::ReadSceneFile(scene));
-  } else {
-    vc::SynthOptions so;
-    so.spacing_m = spacing;
-    VC_ASSIGN_OR_RETURN(input.points, vc::GenerateScene(scene, so));
-  }
-  if (tiles <= 1) return input;
-  if (input.octree) return vc::InvalidArgumentError("--tiles needs a point cloud scene");
-  Eigen::Vector3f lo = input.points.front(), hi = lo;
-  for (const auto& p : input.points) {
-    lo = lo.cwiseMin(p);
-    hi = hi.cwiseMax(p);
-  }
-  const Eigen::Vector3f step = (hi - lo) + Eigen::Vector3f(2.0f, 2.0f, 0.0f);
-  const size_t n = input.points.size();
-  input.points.reserve(n * size_t(tiles * tiles));
-  for (int t = 1; t < tiles * tiles; ++t) {
-    const Eigen::Vector3f shift(step.x() * float(t % tiles), step.y() * float(t / tiles), 0.0f);
-    for (size_t i = 0; i < n; ++i) input.points.push_back(input.points[i] + shift);
-  }
-  return input;
+  return vc::bench::LoadScene(scene, spacing, tiles * tiles);
 }
 
 int PlanEndToEnd(const std::string& scene, double spacing, int tiles, double resolution, double grid, double max_range,

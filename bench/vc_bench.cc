@@ -17,6 +17,7 @@
 #include <string>
 #include <thread>
 
+#include "bench_scene.h"
 #include "vc/plan/candidates.h"
 #include "vc/plan/planner.h"
 #include "vc/raycast/ray_traversal.h"
@@ -36,40 +37,8 @@ double Median(std::vector<double> v) {
   return v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
 }
 
-double PeakRssMiB() {
-  rusage ru{};
-  getrusage(RUSAGE_SELF, &ru);
-  return double(ru.ru_maxrss) / 1024.0;
-}
-
-vc::Result<vc::SceneInput> LoadScene(const std::string& scene, double spacing, int tiles) {
-  vc::SceneInput input;
-  if (scene.find('/') != std::string::npos || scene.find('.') != std::string::npos) {
-    auto r = vc::ReadSceneFile(scene);
-    if (!r.ok() || tiles == 1) return r;
-    input = std::move(*r);
-  } else {
-    vc::SynthOptions so;
-    so.spacing_m = spacing;
-    VC_ASSIGN_OR_RETURN(input.points, vc::GenerateScene(scene, so));
-  }
-  if (tiles > 1) {
-    if (input.octree) return vc::InvalidArgumentError("tiling needs a point cloud scene");
-    // Footprint scaling: copies side by side (2: along x; 4: 2 x 2).
-    Eigen::Vector3f lo = input.points.front(), hi = lo;
-    for (const auto& p : input.points) {
-      lo = lo.cwiseMin(p);
-      hi = hi.cwiseMax(p);
-    }
-    const Eigen::Vector3f step = (hi - lo) + Eigen::Vector3f(2.0f, 2.0f, 0.0f);
-    const size_t n = input.points.size();
-    for (int t = 1; t < tiles; ++t) {
-      const Eigen::Vector3f shift(step.x() * float(t % 2), step.y() * float(t / 2), 0.0f);
-      for (size_t i = 0; i < n; ++i) input.points.push_back(input.points[i] + shift);
-    }
-  }
-  return input;
-}
+using vc::bench::LoadScene;
+using vc::bench::PeakRssMiB;
 
 // The two costliest stages on their own, for A/B runs of two builds (docs/BENCHMARKS.md, "The
 // machine"): the grouped surface-visibility sets of every `every`-th candidate of the plan's

@@ -116,8 +116,8 @@ class VoxelSet {
   void Free();
 
   size_t n_ = 0;
-  std::vector<uint64_t> words_;          // dense form (empty when sparse)
-  roaring_bitmap_s* sparse_ = nullptr;   // sparse form, owned
+  std::vector<uint64_t> words_;         // dense form (empty when sparse)
+  roaring_bitmap_s* sparse_ = nullptr;  // sparse form, owned
 };
 
 }  // namespace vc
