@@ -128,6 +128,7 @@ int main(int argc, char** argv) {
   options.scanner.max_range_m = max_range;
   options.threads = threads;
   options.memory_budget_bytes = uint64_t{16} << 30;
+  options.sparse_set_gain = 0;  // the dense sets, to compare with their Roaring form
   auto voxelized = vc::planner::RunVoxelizeStage({*input}, options, {});
   if (!voxelized.ok()) return std::fprintf(stderr, "%s\n", voxelized.status().ToString().c_str()), 1;
   const vc::VoxelScene& s = voxelized->scene;

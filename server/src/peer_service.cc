@@ -40,7 +40,8 @@ Status RunShard(ServiceState& state, const v1::ShardRequest& request, v1::ShardR
     VC_ASSIGN_OR_RETURN(const SceneInput input,
                         state.backend.read_scene(
                             *bytes, source, ReadLimits(state.options.max_upload_bytes, options.memory_budget_bytes)));
-    VC_ASSIGN_OR_RETURN(planner::VoxelizeOutput v, planner::RunVoxelizeStage({input}, options, ctx));
+    // Not cancelled with this shard: other shards may be waiting for the same scene.
+    VC_ASSIGN_OR_RETURN(planner::VoxelizeOutput v, planner::RunVoxelizeStage({input}, options, JobContext{}));
     return std::move(v.scene);
   }));
   VC_RETURN_IF_ERROR(planner::CheckVisibilitySetBudget(viewpoints.size(), scene->occupied.size(),

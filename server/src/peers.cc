@@ -35,7 +35,9 @@ constexpr int kMaxLaneFailures = 2;
 constexpr double kSlowFactor = 3.0;
 constexpr double kMinSlowSeconds = 2.0;
 constexpr double kSlowWithoutMeasure = 30.0;
-constexpr int kMaxAttemptsPerShard = 3;
+constexpr int kMaxRestartsPerShard = 2;
+// A peer that answers "busy" (RESOURCE_EXHAUSTED) this many times in a row is left out.
+constexpr int kMaxBusyAnswers = 20;
 const std::string kSelf = "this replica";
 
 double Seconds(Clock::duration d) { return std::chrono::duration<double>(d).count(); }
@@ -66,8 +68,10 @@ class ShardBoard {
     const auto until = Clock::now() + wait;
     while (true) {
       if (stopped_ || done_ == shards_.size()) return std::nullopt;
-      if (std::optional<size_t> k = Pick(!defer || lanes_ == 0 || Slowest())) {
+      // Deferring ends when no peer lane is left or one of them has stalled on a shard.
+      if (std::optional<size_t> k = !defer || lanes_ == 0 || Stalled() ? Pick() : std::nullopt) {
         Shard& s = shards_[*k];
+        if (s.running > 0) ++s.restarts;
         ++s.running;
         ++s.attempts;
         s.started = Clock::now();
@@ -170,25 +174,38 @@ class ShardBoard {
     bool done = false;
     int running = 0;   // attempts in flight
     int attempts = 0;  // attempts started
+    int restarts = 0;  // attempts started while another still ran (a slow shard)
     Clock::time_point started;
   };
-  // Under mu_: the first shard nobody runs (if `fresh`), else the longest-running slow one.
-  std::optional<size_t> Pick(bool fresh) const {
-    for (size_t k = 0; fresh && k < shards_.size(); ++k) {
+  // Under mu_: the first shard nobody runs, else the longest-running slow one.
+  std::optional<size_t> Pick() const {
+    for (size_t k = 0; k < shards_.size(); ++k) {
       if (!shards_[k].done && shards_[k].running == 0) return k;
     }
     return Slowest();
   }
+  // Under mu_: whether some shard has run longer than the slow threshold.
+  bool Stalled() const {
+    const double slow_s = SlowSeconds();
+    const auto now = Clock::now();
+    for (const Shard& s : shards_) {
+      if (!s.done && s.running > 0 && Seconds(now - s.started) >= slow_s) return true;
+    }
+    return false;
+  }
+  double SlowSeconds() const {
+    return done_ == 0 ? kSlowWithoutMeasure
+                      : std::max(kMinSlowSeconds, kSlowFactor * finished_seconds_ / double(done_));
+  }
   // Under mu_: the longest-running shard among those running longer than kSlowFactor times the
   // mean finished shard (kSlowWithoutMeasure before any finished), run once and not too often.
   std::optional<size_t> Slowest() const {
-    const double slow_s =
-        done_ == 0 ? kSlowWithoutMeasure : std::max(kMinSlowSeconds, kSlowFactor * finished_seconds_ / double(done_));
+    const double slow_s = SlowSeconds();
     std::optional<size_t> best;
     const auto now = Clock::now();
     for (size_t k = 0; k < shards_.size(); ++k) {
       const Shard& s = shards_[k];
-      if (s.done || s.running != 1 || s.attempts >= kMaxAttemptsPerShard) continue;
+      if (s.done || s.running != 1 || s.restarts >= kMaxRestartsPerShard) continue;
       if (Seconds(now - s.started) < slow_s) continue;
       if (!best || s.started < shards_[*best].started) best = k;
     }
@@ -232,6 +249,7 @@ class PeerLane {
     try {
       RunLane();
     } catch (const std::exception& e) {
+      if (held_) board_.Release(*held_);
       board_.Warn(fmt::format("replica {} was left out of the plan: {}", address_, e.what()));
     }
     board_.LaneEnded();
@@ -242,13 +260,28 @@ class PeerLane {
     c.set_deadline(std::chrono::system_clock::now() + deadline);
     if (!job_.token.empty()) c.AddMetadata("authorization", "Bearer " + job_.token);
   }
-  // A call in flight that the board can cancel; false when the board has stopped.
+  // While alive, `c` is the lane's call the board cancels when it stops (exception-safe: the
+  // board never sees a context that is gone).
+  class LiveCall {
+   public:
+    LiveCall(ShardBoard& board, size_t lane, grpc::ClientContext& c)
+        : board_(board), lane_(lane), live_(board.SetLive(lane, &c)) {}
+    ~LiveCall() {
+      if (live_) board_.SetLive(lane_, nullptr);
+    }
+    bool live() const { return live_; }
+
+   private:
+    ShardBoard& board_;
+    size_t lane_;
+    bool live_;
+  };
+  // A call in flight that the board can cancel; nullopt when the board has stopped.
   template <class F>
   std::optional<grpc::Status> Call(grpc::ClientContext& c, F&& call) {
-    if (!board_.SetLive(index_, &c)) return std::nullopt;
-    grpc::Status s = call();
-    board_.SetLive(index_, nullptr);
-    return s;
+    LiveCall live(board_, index_, c);
+    if (!live.live()) return std::nullopt;
+    return call();
   }
 
   void Retire(const std::string& why) {
@@ -281,7 +314,8 @@ class PeerLane {
   bool Share() {
     grpc::ClientContext c;
     Prepare(c, std::chrono::minutes(10));
-    if (!board_.SetLive(index_, &c)) return false;
+    LiveCall live(board_, index_, c);
+    if (!live.live()) return false;
     v1::ShareSceneResponse resp;
     std::unique_ptr<grpc::ClientWriter<v1::SceneChunk>> w(stub_->ShareScene(&c, &resp));
     const std::string& bytes = *job_.ref.bytes;
@@ -301,7 +335,6 @@ class PeerLane {
     }
     w->WritesDone();
     const grpc::Status s = w->Finish();
-    board_.SetLive(index_, nullptr);
     board_.AddBytes(sent);
     if (!s.ok()) {
       Retire("it could not take the scene: " + GrpcError(s));
@@ -335,13 +368,14 @@ class PeerLane {
     if (!Hello(&has_scene)) return;
     if (!has_scene && !Share()) return;
     bool shared_again = false;
-    int failures = 0;
+    int failures = 0, busy = 0;
     while (true) {
       const std::optional<size_t> k = board_.Take(std::chrono::hours(1));
       if (!k) {
         if (board_.Finished()) return;
         continue;
       }
+      held_ = k;
       const auto [begin, end] = board_.range(*k);
       v1::ShardRequest req;
       req.set_scene_sha256(job_.ref.sha256);
@@ -356,6 +390,7 @@ class PeerLane {
       const auto s = Call(c, [&] { return stub_->ComputeShard(&c, req, &resp); });
       if (!s) {
         board_.Release(*k);
+        held_.reset();
         return;
       }
       board_.AddBytes(req.ByteSizeLong() + resp.ByteSizeLong());
@@ -363,14 +398,17 @@ class PeerLane {
         Result<std::vector<VoxelSet>> sets = Decode(resp, begin, end);
         if (!sets.ok()) {
           board_.Release(*k);
+          held_.reset();
           Retire(sets.status().message());
           return;
         }
         board_.Deliver(*k, address_, std::move(*sets), Seconds(Clock::now() - t0));
-        failures = 0;
+        held_.reset();
+        failures = busy = 0;
         continue;
       }
       board_.Release(*k);
+      held_.reset();
       if (board_.Finished()) return;
       switch (s->error_code()) {
         case grpc::StatusCode::NOT_FOUND:  // the scene was evicted from its cache: share it once more
@@ -381,6 +419,10 @@ class PeerLane {
           shared_again = true;
           break;
         case grpc::StatusCode::RESOURCE_EXHAUSTED:  // busy: the others take the shard meanwhile
+          if (++busy >= kMaxBusyAnswers) {
+            Retire(GrpcError(*s) + fmt::format(" ({} times in a row)", busy));
+            return;
+          }
           board_.Sleep(std::chrono::milliseconds(500));
           break;
         case grpc::StatusCode::UNAUTHENTICATED:
@@ -404,6 +446,7 @@ class PeerLane {
   const std::shared_ptr<v1::StationPlanner::Stub> stub_;
   const LaneJob& job_;
   ShardBoard& board_;
+  std::optional<size_t> held_;  // the shard this lane runs, released if the lane throws
 };
 
 std::string JoinHostPort(const sockaddr* sa, const std::string& port) {
@@ -481,27 +524,37 @@ Result<DistributedSets> PeerFanOut::Compute(const SceneRef& ref, const v1::PlanP
   const std::string token = !options_.peer_token.empty() ? options_.peer_token
                             : options_.tokens.empty()    ? std::string()
                                                          : options_.tokens.front();
-  const LaneJob job{ref,
-                    parameters,
-                    viewpoints,
-                    scene.occupied.size(),
-                    SceneFingerprint(scene),
-                    token,
-                    self_id_,
-                    options_.shard_deadline,
-                    options.compact_gain};
+  // What a peer needs of the plan's parameters: the voxelization and the selection test, not the
+  // lists (user candidates, keep-out zones, fixed stations), which may be long.
+  v1::PlanParameters shard_parameters = parameters;
+  shard_parameters.clear_candidates();
+  shard_parameters.clear_keep_out();
+  shard_parameters.clear_fixed_stations();
+  shard_parameters.clear_tripod_heights_m();
+  shard_parameters.clear_route_start();
+  const LaneJob job{
+      ref,      shard_parameters,        viewpoints,          scene.occupied.size(), SceneFingerprint(scene), token,
+      self_id_, options_.shard_deadline, options.compact_gain};
   std::vector<std::unique_ptr<PeerLane>> lanes;
   std::vector<std::thread> threads;
+  // Every way out of here (an exception included) stops the lanes and joins their threads first:
+  // they hold references to `board` and `job`.
+  struct Joiner {
+    ShardBoard& board;
+    std::vector<std::thread>& threads;
+    ~Joiner() {
+      board.Stop();
+      board.CancelLive();
+      for (std::thread& t : threads) {
+        if (t.joinable()) t.join();
+      }
+    }
+  } joiner{board, threads};
   for (size_t i = 0; i < addresses.size(); ++i) {
     lanes.push_back(std::make_unique<PeerLane>(i, addresses[i], StubFor(addresses[i]), job, board));
     board.LaneStarted();
     threads.emplace_back([lane = lanes.back().get()] { lane->Run(); });
   }
-  auto finish = [&] {
-    board.Stop();
-    board.CancelLive();
-    for (std::thread& t : threads) t.join();
-  };
   // This replica's own lane, on the plan's thread: progress and cancellation are checked here.
   JobContext local = ctx;
   local.progress = nullptr;
@@ -528,7 +581,9 @@ Result<DistributedSets> PeerFanOut::Compute(const SceneRef& ref, const v1::PlanP
     }
     board.Deliver(*k, kSelf, std::move(*sets), Seconds(Clock::now() - t0));
   }
-  finish();
+  board.Stop();
+  board.CancelLive();
+  for (std::thread& t : threads) t.join();
   VC_RETURN_IF_ERROR(status);
   DistributedSets out = std::move(board).Collect();
   if (options.max_set_bytes > 0) {

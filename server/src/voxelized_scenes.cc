@@ -37,7 +37,14 @@ Result<VoxelizedScenes::Scene> VoxelizedScenes::Get(const std::string& key, cons
     }
   }
   if (existing.valid()) return existing.get();
-  Result<VoxelScene> made = make();
+  Result<VoxelScene> made = InternalError("voxelizing the scene failed");
+  try {
+    made = make();
+  } catch (const std::bad_alloc&) {
+    made = ResourceExhaustedError("this replica ran out of memory voxelizing the scene");
+  } catch (const std::exception& e) {
+    made = InternalError(std::string("voxelizing the scene failed: ") + e.what());
+  }
   Result<Scene> result =
       made.ok() ? Result<Scene>(std::make_shared<const VoxelScene>(std::move(*made))) : Result<Scene>(made.status());
   promise.set_value(result);

@@ -205,6 +205,23 @@ TEST(FanOut, AHungPeersShardIsStartedAgainElsewhere) {
   EXPECT_EQ(r->distribution.replicas, 1);  // this replica computed every shard in the end
 }
 
+TEST(FanOut, AHungPeerDoesNotStallACoordinatorThatLeavesShardsToItsPeers) {
+  auto b = testing::StartServer(Replica());
+  ASSERT_TRUE(b);
+  const auto alone = PlanOn(testing::Address(*b));
+  ASSERT_TRUE(alone.ok()) << alone.status().ToString();
+  FakePeer hung(FakePeer::Mode::kHang);
+  server::ServerOptions o = Coordinator({testing::Address(*b), hung.address()});
+  o.local_shards = false;
+  auto a = testing::StartServer(o);
+  ASSERT_TRUE(a);
+  const auto r = PlanOn(testing::Address(*a));
+  ASSERT_TRUE(r.ok()) << r.status().ToString();
+  ExpectSamePlan(*alone, *r);
+  EXPECT_GE(hung.shards(), 1);
+  EXPECT_GE(r->distribution.retried, 1);  // the hung shard, started again by B or this replica
+}
+
 TEST(FanOut, AReplicaThatDiesMidPlanCostsTimeNotThePlan) {
   auto b = testing::StartServer(Replica());
   ASSERT_TRUE(b);

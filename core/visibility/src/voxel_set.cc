@@ -255,7 +255,13 @@ void VoxelSet::Densify() {
 }
 
 size_t VoxelSet::MemoryBytes() const {
-  return sparse_ ? roaring_bitmap_size_in_bytes(sparse_) : words_.capacity() * sizeof(uint64_t);
+  if (!sparse_) return words_.capacity() * sizeof(uint64_t);
+  // The containers' allocated bytes, plus each container's struct and index entry (about 48
+  // bytes), plus the bitmap itself.
+  roaring_statistics_t st;
+  roaring_bitmap_statistics(sparse_, &st);
+  return sizeof(roaring_bitmap_t) + uint64_t{st.n_bytes_array_containers} + st.n_bytes_run_containers +
+         st.n_bytes_bitset_containers + 48 * uint64_t{st.n_containers};
 }
 
 std::string VoxelSet::ToPortable() const {
@@ -279,11 +285,29 @@ Result<VoxelSet> VoxelSet::FromPortable(std::string_view bytes, size_t n, double
     return DataLossError("a visibility set from a peer is not a whole portable Roaring bitmap (" +
                          std::to_string(bytes.size()) + " bytes)");
   }
-  if (!roaring_bitmap_is_empty(r) && roaring_bitmap_maximum(r) >= n) {
-    const uint32_t max = roaring_bitmap_maximum(r);
-    roaring_bitmap_free(r);
-    return DataLossError("a visibility set from a peer names voxel " + std::to_string(max) + " of a scene of " +
-                         std::to_string(n));
+  // CRoaring's safe deserialization only keeps its reads within the buffer; the content may still
+  // be out of order (a key or value that is not ascending would make maximum() lie). One walk
+  // checks that every id ascends and lies in the scene, and that the walk sees every member.
+  {
+    roaring_uint32_iterator_t* it = roaring_create_iterator(r);
+    if (it == nullptr) {
+      roaring_bitmap_free(r);
+      throw std::bad_alloc();
+    }
+    uint64_t walked = 0;
+    int64_t previous = -1;
+    bool ordered = true;
+    for (; it->has_value && ordered; roaring_advance_uint32_iterator(it)) {
+      ordered = int64_t{it->current_value} > previous && it->current_value < n;
+      previous = it->current_value;
+      ++walked;
+    }
+    roaring_free_uint32_iterator(it);
+    if (!ordered || walked != roaring_bitmap_get_cardinality(r)) {
+      roaring_bitmap_free(r);
+      return DataLossError("a visibility set from a peer is not an ascending set of ids below the scene's " +
+                           std::to_string(n) + " voxels");
+    }
   }
   VoxelSet s;
   s.n_ = n;

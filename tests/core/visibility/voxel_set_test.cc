@@ -146,6 +146,16 @@ TEST(VoxelSetTest, PortableFormRoundTripsAndRefusesForeignIds) {
     ExpectEquals(*dense, r);
     ExpectEquals(*sparse, r);
   }
+  // Bytes CRoaring's safe deserialization accepts (it only keeps its reads in the buffer) but whose
+  // ids do not ascend: {3, 5} with its two array values swapped.
+  VoxelSet two(10);
+  two.set(3);
+  two.set(5);
+  std::string swapped = two.ToPortable();
+  ASSERT_GE(swapped.size(), 4u);
+  std::swap(swapped[swapped.size() - 4], swapped[swapped.size() - 2]);
+  std::swap(swapped[swapped.size() - 3], swapped[swapped.size() - 1]);
+  EXPECT_EQ(VoxelSet::FromPortable(swapped, 10, 0).status().code(), StatusCode::kDataLoss);
   VoxelSet big(10);
   big.set(9);
   EXPECT_EQ(VoxelSet::FromPortable(big.ToPortable(), 9, 0).status().code(), StatusCode::kDataLoss);
