@@ -430,13 +430,11 @@ Result<ConsolidateResult> ConsolidatePicks(const std::vector<VoxelSet>& sets, st
           if (rest[k]) nonzero.push_back(k);
         }
         // A voxel of `rest` every candidate standing in must see: one test rules most out.
-        const std::optional<size_t> probe =
-            nonzero.empty()
-                ? std::nullopt
-                : std::optional<size_t>(nonzero[0] * 64 + static_cast<size_t>(std::countr_zero(rest[nonzero[0]])));
+        const bool has_probe = !nonzero.empty();
+        const size_t probe = has_probe ? nonzero[0] * 64 + static_cast<size_t>(std::countr_zero(rest[nonzero[0]])) : 0;
         for (int c : order) {
           const VoxelSet& sc = sets[c];
-          if (probe && !sc.test(*probe)) continue;
+          if (has_probe && !sc.test(probe)) continue;
           bool covers = true;
           for (size_t k : nonzero) {
             if (!sc.sparse()) {
