@@ -9,6 +9,7 @@
 
 #include <CLI/CLI.hpp>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 
 #include "bench_scene.h"
@@ -82,6 +83,37 @@ int PlanEndToEnd(const std::string& scene, double spacing, int tiles, double res
   return 0;
 }
 
+// Evaluates `count` candidates spread over the site (every k-th), all in one vc::Evaluate and each
+// alone (the reduction's per-station evaluation), and prints the time per station and G.
+int EvaluateStations(const vc::VoxelScene& s, const std::vector<vc::WorldPoint>& candidates, size_t count,
+                     const vc::PlanOptions& options) {
+  std::vector<vc::WorldPoint> stations;
+  const size_t step = std::max<size_t>(1, candidates.size() / std::max<size_t>(count, 1));
+  for (size_t k = 0; k < candidates.size() && stations.size() < count; k += step) stations.push_back(candidates[k]);
+  vc::EvaluateOptions eval;
+  eval.scanner = options.scanner;
+  eval.threads = options.threads;
+  auto t = Clock::now();
+  auto all = vc::Evaluate(s, stations, eval);
+  if (!all.ok()) return std::fprintf(stderr, "%s\n", all.status().ToString().c_str()), 1;
+  const double together_s = Since(t);
+  t = Clock::now();
+  const size_t alone = std::min<size_t>(stations.size(), 4);
+  for (size_t k = 0; k < alone; ++k) {
+    auto one = vc::Evaluate(s, {stations[k]}, eval);
+    if (!one.ok()) return std::fprintf(stderr, "%s\n", one.status().ToString().c_str()), 1;
+    if (std::abs(all->per_viewpoint[k].global_visibility - one->overall.global_visibility) > 1e-12) {
+      std::printf("station %zu: G together %.12f, alone %.12f\n", k, all->per_viewpoint[k].global_visibility,
+                  one->overall.global_visibility);
+    }
+  }
+  const double alone_s = Since(t);
+  std::printf("evaluate %zu stations: together %.3f s (%.1f ms each), the first %zu alone %.1f ms each; G %.9f\n",
+              stations.size(), together_s, 1e3 * together_s / double(stations.size()), alone,
+              1e3 * alone_s / double(alone), all->overall.global_visibility);
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -111,6 +143,9 @@ int main(int argc, char** argv) {
   bool no_consolidate = false, no_reduce = false;
   app.add_flag("--no-consolidate", no_consolidate, "with --plan: no consolidation after greedy");
   app.add_flag("--no-reduce", no_reduce, "with --plan: no reduction");
+  size_t evaluate = 0;
+  app.add_option("--evaluate", evaluate,
+                 "instead: time vc::Evaluate of this many candidates spread over the site, together and alone");
   CLI11_PARSE(app, argc, argv);
   if (plan) {
     return PlanEndToEnd(scene, spacing, tiles, resolution, grid, max_range, threads, solver, sparse_gain, budget,
@@ -135,6 +170,7 @@ int main(int argc, char** argv) {
   auto candidates = vc::planner::RunCandidatesStage({s}, options, {});
   if (!candidates.ok()) return std::fprintf(stderr, "%s\n", candidates.status().ToString().c_str()), 1;
   const size_t n = candidates->positions.size(), voxels = s.occupied.size();
+  if (evaluate > 0) return EvaluateStations(s, candidates->positions, evaluate, options);
   auto t = Clock::now();
   auto sets = vc::ComputeVisibilitySets(s, candidates->positions, vc::planner::VisibilitySetsOptionsFor(options));
   if (!sets.ok()) return std::fprintf(stderr, "%s\n", sets.status().ToString().c_str()), 1;

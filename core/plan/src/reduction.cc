@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <string>
+#include <unordered_map>
 #include <utility>
 
 #include "vc/base/huge_pages.h"
@@ -35,34 +36,48 @@ ReductionMatrix ComputeReductionMatrix(const std::vector<FaceTop3>& top3, int nu
   m.loss.assign(n * n, 0.0);
   if (top3.empty() || n == 0 || faces_total == 0) return m;
   const uint64_t chunks = (top3.size() + kChunk - 1) / kChunk;
-  // Per chunk: G sum, then n singles, then n*n pair corrections (upper triangle used).
-  std::vector<std::vector<double>> partial(chunks);
+  // Per chunk: G, the n singles, and the pair corrections of the pairs that are some face's two
+  // best (few: a chunk is a run of neighbouring voxels), each summed in face order; the chunks are
+  // then added in chunk order, so the sums do not depend on the threads. (A dense n x n block per
+  // chunk, as before sparse sets, took gigabytes at hundreds of stations.)
+  struct Partial {
+    double g = 0;
+    std::vector<double> singles;
+    std::unordered_map<uint64_t, double> pairs;  // key a * n + z, a < z
+  };
+  std::vector<Partial> partial(chunks);
   const Status st = ParallelChunks(top3.size(), kChunk, threads, {}, [&](uint64_t c, uint64_t b, uint64_t e) {
-    std::vector<double> acc(1 + n + n * n, 0.0);
+    Partial& p = partial[c];
+    p.singles.assign(n, 0.0);
+    uint64_t last_key = ~uint64_t{0};
+    double* last = nullptr;  // the last pair's sum: neighbouring faces mostly share their two best
     for (uint64_t f = b; f < e; ++f) {
       const FaceTop3& t = top3[f];
       if (t.s[0] < 0) continue;
-      acc[0] += t.v[0];
-      acc[1 + t.s[0]] += static_cast<double>(t.v[0]) - t.v[1];
+      p.g += t.v[0];
+      p.singles[t.s[0]] += static_cast<double>(t.v[0]) - t.v[1];
       if (t.s[1] >= 0) {
-        const int a = std::min(t.s[0], t.s[1]), z = std::max(t.s[0], t.s[1]);
-        acc[1 + n + static_cast<size_t>(a) * n + z] += static_cast<double>(t.v[1]) - t.v[2];
+        const uint64_t key = static_cast<uint64_t>(std::min(t.s[0], t.s[1])) * n + std::max(t.s[0], t.s[1]);
+        if (key != last_key) last = &p.pairs[key], last_key = key;
+        *last += static_cast<double>(t.v[1]) - t.v[2];
       }
     }
-    partial[c] = std::move(acc);
   });
   (void)st;  // no token: cannot fail
-  std::vector<double> total(1 + n + n * n, 0.0);
-  for (const auto& p : partial) {
-    for (size_t k = 0; k < total.size(); ++k) total[k] += p[k];
+  double g = 0;
+  std::vector<double> singles(n, 0.0), pairs(n * n, 0.0);
+  for (const Partial& p : partial) {
+    g += p.g;
+    for (size_t k = 0; k < n; ++k) singles[k] += p.singles[k];
+    for (const auto& [key, v] : p.pairs) pairs[key] += v;
   }
   const double inv = 1.0 / static_cast<double>(faces_total);
-  m.global_visibility = total[0] * inv;
-  for (size_t i = 0; i < n; ++i) m.loss[i * n + i] = total[1 + i] * inv;
+  m.global_visibility = g * inv;
+  for (size_t i = 0; i < n; ++i) m.loss[i * n + i] = singles[i] * inv;
   for (size_t i = 0; i < n; ++i) {
     for (size_t j = i + 1; j < n; ++j) {
       // Summed in the same order on both sides, so a zero-loss pair is exactly 0.
-      const double v = (total[1 + i] + total[1 + j] + total[1 + n + i * n + j]) * inv;
+      const double v = (singles[i] + singles[j] + pairs[i * n + j]) * inv;
       m.loss[i * n + j] = v;
       m.loss[j * n + i] = v;
     }
@@ -122,20 +137,45 @@ std::vector<int> ChooseRemoval(const ReductionMatrix& m, const std::vector<int>&
 
 namespace {
 
-// Rebuilds every face's top-3 from the active stations' cached values.
-Status RefillFromCache(const std::vector<std::vector<float>>& cache, const std::vector<int>& active,
+// Rebuilds the top-3 of every face that names a station just removed, from the active stations'
+// cached values (inserted in ascending station order, as the first build did).
+Status RefillFromCache(const std::vector<SparseFaceValues>& cache, const std::vector<int>& active,
                        const std::vector<bool>& removed_now, int threads, const JobContext& ctx,
                        std::vector<FaceTop3>& top3) {
-  return ParallelChunks(top3.size(), kChunk, threads, ctx, [&](uint64_t, uint64_t b, uint64_t e) {
+  std::vector<uint8_t> affected(top3.size(), 0);
+  std::vector<uint8_t> chunk_affected((top3.size() + kChunk - 1) / kChunk, 0);
+  VC_RETURN_IF_ERROR(ParallelChunks(top3.size(), kChunk, threads, ctx, [&](uint64_t c, uint64_t b, uint64_t e) {
     for (uint64_t f = b; f < e; ++f) {
       FaceTop3& t = top3[f];
-      bool affected = false;
-      for (int k = 0; k < 3; ++k) affected |= t.s[k] >= 0 && removed_now[t.s[k]];
-      if (!affected) continue;
+      bool hit = false;
+      for (int k = 0; k < 3; ++k) hit |= t.s[k] >= 0 && removed_now[t.s[k]];
+      if (!hit) continue;
       t = FaceTop3{};
-      for (int s : active) InsertTop3(t, cache[s][f], s);
+      affected[f] = 1;
+      chunk_affected[c] = 1;
+    }
+  }));
+  return ParallelChunks(top3.size(), kChunk, threads, ctx, [&](uint64_t c, uint64_t b, uint64_t e) {
+    if (!chunk_affected[c]) return;
+    for (int s : active) {
+      const SparseFaceValues& v = cache[s];
+      auto it = std::lower_bound(v.faces.begin(), v.faces.end(), static_cast<uint32_t>(b));
+      for (; it != v.faces.end() && *it < e; ++it) {
+        if (affected[*it]) InsertTop3(top3[*it], v.values[it - v.faces.begin()], s);
+      }
     }
   });
+}
+
+// Whether `v` lists faces in ascending order below faces_total, with a value for each.
+Status CheckFaceValues(const SparseFaceValues& v, int station, uint64_t faces_total) {
+  bool ok = v.values.size() == v.faces.size();
+  for (size_t k = 0; ok && k < v.faces.size(); ++k) {
+    ok = v.faces[k] < faces_total && (k == 0 || v.faces[k - 1] < v.faces[k]);
+  }
+  if (ok) return Status::Ok();
+  return InternalError("station " + std::to_string(station) + ": face values not ascending within the " +
+                       std::to_string(faces_total) + " faces");
 }
 
 }  // namespace
@@ -144,35 +184,52 @@ Result<ReductionRun> RunReduction(int num_stations, uint64_t faces_total, const 
                                   const ReductionRunOptions& options, const JobContext& ctx) {
   ReductionRun run;
   if (num_stations <= 0) return run;
-  const bool use_cache =
-      static_cast<uint64_t>(num_stations) * faces_total * sizeof(float) <= options.cache_budget_bytes;
-  std::vector<std::vector<float>> cache(use_cache ? num_stations : 0);
+  // Every station's values are kept while they fit the budget (decided as they arrive: sparse
+  // values take what each station sees); past it, each removal recomputes them.
+  bool use_cache = true;
+  uint64_t cache_bytes = 0;
+  std::vector<SparseFaceValues> cache(num_stations);
   std::vector<FaceTop3> top3 = internal::FilledOnHugePages(faces_total, FaceTop3{});
+  const size_t batch = static_cast<size_t>(std::max(options.batch_stations, 1));
 
-  // Streams every active station's values into a fresh top-3 table.
+  // Streams every active station's values into a fresh top-3 table, a batch at a time.
   auto build = [&](const std::vector<int>& stations, double progress_from, double progress_to) -> Status {
     std::fill(top3.begin(), top3.end(), FaceTop3{});
-    for (size_t k = 0; k < stations.size(); ++k) {
-      const int s = stations[k];
+    for (size_t first = 0; first < stations.size(); first += batch) {
+      const std::vector<int> part(stations.begin() + first,
+                                  stations.begin() + std::min(first + batch, stations.size()));
       JobContext sub = ctx;
-      const double lo = progress_from + (progress_to - progress_from) * k / stations.size();
-      const double hi = progress_from + (progress_to - progress_from) * (k + 1) / stations.size();
+      const double lo = progress_from + (progress_to - progress_from) * first / stations.size();
+      const double hi = progress_from + (progress_to - progress_from) * (first + part.size()) / stations.size();
       sub.progress = [&ctx, lo, hi](const ProgressEvent& e) {
         ctx.Report(Stage::kReduction, lo + (hi - lo) * e.fraction);
       };
       if (!ctx.progress) sub.progress = nullptr;
-      Result<std::vector<float>> v = values(s, sub);
+      Result<std::vector<SparseFaceValues>> v = values(part, sub);
       if (!v.ok()) return v.status();
-      if (v->size() != faces_total) {
-        return InternalError("station " + std::to_string(s) + ": " + std::to_string(v->size()) +
-                             " face values, expected " + std::to_string(faces_total));
+      if (v->size() != part.size()) {
+        return InternalError(std::to_string(v->size()) + " stations' face values for " + std::to_string(part.size()) +
+                             " stations");
       }
-      const std::vector<float>& vals = *v;
-      VC_RETURN_IF_ERROR(
-          ParallelChunks(faces_total, kChunk, options.threads, ctx, [&](uint64_t, uint64_t b, uint64_t e) {
-            for (uint64_t f = b; f < e; ++f) InsertTop3(top3[f], vals[f], s);
-          }));
-      if (use_cache) cache[s] = std::move(*v);
+      for (size_t k = 0; k < part.size(); ++k) {
+        const int s = part[k];
+        SparseFaceValues& vals = (*v)[k];
+        VC_RETURN_IF_ERROR(CheckFaceValues(vals, s, faces_total));
+        // One station's faces are distinct, so its entries go in in parallel.
+        VC_RETURN_IF_ERROR(
+            ParallelChunks(vals.size(), kChunk, options.threads, ctx, [&](uint64_t, uint64_t b, uint64_t e) {
+              for (uint64_t j = b; j < e; ++j) InsertTop3(top3[vals.faces[j]], vals.values[j], s);
+            }));
+        if (use_cache) {
+          cache_bytes += vals.MemoryBytes();
+          if (cache_bytes <= options.cache_budget_bytes) {
+            cache[s] = std::move(vals);
+          } else {
+            use_cache = false;
+            cache = {};
+          }
+        }
+      }
       ctx.Report(Stage::kReduction, hi);
     }
     return Status::Ok();

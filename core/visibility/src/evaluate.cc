@@ -8,6 +8,7 @@
 #include <array>
 #include <bit>
 #include <cmath>
+#include <limits>
 #include <memory>
 #include <mutex>
 #include <random>
@@ -165,6 +166,30 @@ EvaluationJob Prepare(const VoxelScene& scene, const std::vector<WorldPoint>& vi
   return job;
 }
 
+// Bounding boxes (index space) of consecutive blocks of kCullBlock points (corners or voxels, in
+// their sorted order: a block is a short run of rows), for skipping what no face centre in the
+// scanner's range needs (ScannerLimits::BoxVerdict): outside the range V is 0 whatever is seen.
+constexpr uint64_t kCullBlock = 256;
+struct BlockBoxes {
+  std::vector<Vector3d> lo, hi;
+  // Block b's box, when each point p of it stands for the box [p - below, p + above].
+  template <typename PointOf>
+  BlockBoxes(size_t count, const PointOf& point_of, double below, double above) {
+    const size_t blocks = (count + kCullBlock - 1) / kCullBlock;
+    lo.assign(blocks, Vector3d::Constant(std::numeric_limits<double>::infinity()));
+    hi.assign(blocks, Vector3d::Constant(-std::numeric_limits<double>::infinity()));
+    for (size_t i = 0; i < count; ++i) {
+      const VoxelIndex v = point_of(i);
+      const Vector3d p(v.x, v.y, v.z);
+      lo[i / kCullBlock] = lo[i / kCullBlock].cwiseMin(p - Vector3d::Constant(below));
+      hi[i / kCullBlock] = hi[i / kCullBlock].cwiseMax(p + Vector3d::Constant(above));
+    }
+  }
+  bool OutOfRange(const ScannerLimits& limits, uint64_t block) const {
+    return limits.BoxVerdict(lo[block], hi[block]) == ScannerLimits::Verdict::kNone;
+  }
+};
+
 // The distinct lattice corners of the voxels (packed, ascending) and each voxel's 8 corner ids.
 struct LatticeCorners {
   std::vector<uint64_t> corners;
@@ -311,6 +336,7 @@ Result<Evaluation> EvaluateExact(const EvaluationJob& job, Evaluation ev) {
   // Allocated here, in the calling thread, like every large allocation of this mode: running out
   // of memory must not happen in a worker thread. Each viewpoint's values are filled by the
   // thread that evaluates it (huge_pages.h: first touch is the costly part).
+  if (options.keep_sparse_per_viewpoint_values) ev.per_viewpoint_sparse_values.resize(nv);
   if (options.keep_per_viewpoint_values) {
     ev.per_viewpoint_face_values.resize(nv);
     for (std::vector<float>& values : ev.per_viewpoint_face_values) {
@@ -319,6 +345,15 @@ Result<Evaluation> EvaluateExact(const EvaluationJob& job, Evaluation ev) {
   }
   constexpr uint64_t kCornerChunk = 64 * 256;
   constexpr uint64_t kVoxelChunk = 4096;
+  static_assert(kCornerChunk % kCullBlock == 0 && kVoxelChunk % kCullBlock == 0);
+  // The scanner's range, block by block. A face centre lies in its voxel's cube [v, v + 1] and
+  // within 1 (per axis) of each of its corners: a block of voxels whose cubes, or of corners whose
+  // boxes [c - 1, c + 1], are all out of range holds nothing that changes a face's V (> 0), so it
+  // is skipped; skipped corners count as unseen, which only faces out of range could notice.
+  const BlockBoxes corner_boxes(
+      corners.size(), [&](size_t c) { return UnpackCorner(corners[c]); }, 1.0, 1.0);
+  const BlockBoxes voxel_boxes(
+      n, [&](size_t i) { return index[i]; }, 0.0, 1.0);
   const uint64_t voxel_chunks = (n + kVoxelChunk - 1) / kVoxelChunk;
   StageProgress progress(ctx, Stage::kEvaluation, nv, nv, "stations");
   // Corners that groups of faces decide at once (surface_groups.h), per viewpoint.
@@ -335,7 +370,8 @@ Result<Evaluation> EvaluateExact(const EvaluationJob& job, Evaluation ev) {
           tallies(voxel_chunks),
           best(internal::FilledOnHugePages(slots, 0.0)),
           best_p(internal::FilledOnHugePages(slots, uint8_t{0})),
-          viewer(viewer_slots, kNoViewer) {}
+          viewer(viewer_slots, kNoViewer),
+          sparse(voxel_chunks) {}
     std::vector<uint64_t> visible_bits, decided_bits;
     std::vector<Tally> tallies;  // per chunk of voxels, for the viewpoint at hand
     std::vector<double> best;
@@ -343,6 +379,8 @@ Result<Evaluation> EvaluateExact(const EvaluationJob& job, Evaluation ev) {
     // With keep_face_values: per voxel, the viewpoint that alone gives it V > 0 so far (or
     // kNoViewer / kSeveralViewers).
     std::vector<int32_t> viewer;
+    // With keep_sparse_per_viewpoint_values: per chunk of voxels, the viewpoint's faces with V > 0.
+    std::vector<SparseFaceValues> sparse;
   };
   const size_t corner_words = (corners.size() + 63) / 64;
   // Viewpoint k into `w`, on `threads` workers (1: all in the calling thread, with no atomics).
@@ -364,7 +402,7 @@ Result<Evaluation> EvaluateExact(const EvaluationJob& job, Evaluation ev) {
         walk.around = around;
         std::vector<internal::SurfaceTargets::CornerDecision> decisions;
         const size_t b0 = task * kBricksPerTask, b1 = std::min<size_t>(b0 + kBricksPerTask, targets.brick_count());
-        targets.AppendCornerDecisions(uo[k], b0, b1, walk, decisions);
+        targets.AppendCornerDecisions(uo[k], limits[k], b0, b1, walk, decisions);
         for (const auto& d : decisions) {
           auto apply = [&](int q) {
             const uint32_t c = voxel_corners[d.id][q];
@@ -382,10 +420,13 @@ Result<Evaluation> EvaluateExact(const EvaluationJob& job, Evaluation ev) {
     VC_RETURN_IF_ERROR(
         ParallelChunks(corners.size(), kCornerChunk, threads, ctx, [&](uint64_t, uint64_t b, uint64_t e) {
           OccluderCache cache(shortcuts[k]);
-          for (uint64_t c = b; c < e; ++c) {
-            if ((w.decided_bits[c >> 6] >> (c & 63)) & 1) continue;
-            if (CornerVisibleCached(g, uo[k], UnpackCorner(corners[c]), cache)) {
-              w.visible_bits[c >> 6] |= uint64_t{1} << (c & 63);
+          for (uint64_t block_begin = b; block_begin < e; block_begin += kCullBlock) {
+            if (corner_boxes.OutOfRange(limits[k], block_begin / kCullBlock)) continue;
+            for (uint64_t c = block_begin; c < std::min(block_begin + kCullBlock, e); ++c) {
+              if ((w.decided_bits[c >> 6] >> (c & 63)) & 1) continue;
+              if (CornerVisibleCached(g, uo[k], UnpackCorner(corners[c]), cache)) {
+                w.visible_bits[c >> 6] |= uint64_t{1} << (c & 63);
+              }
             }
           }
         }));
@@ -394,9 +435,16 @@ Result<Evaluation> EvaluateExact(const EvaluationJob& job, Evaluation ev) {
     std::fill(tallies.begin(), tallies.end(), Tally{});
     std::vector<float>* keep = options.keep_per_viewpoint_values ? &ev.per_viewpoint_face_values[k] : nullptr;
     if (keep) keep->resize(n * kFacesPerVoxel);  // zeros, in the capacity reserved above
+    const bool keep_sparse = options.keep_sparse_per_viewpoint_values;
     VC_RETURN_IF_ERROR(ParallelChunks(n, kVoxelChunk, threads, ctx, [&](uint64_t chunk, uint64_t b, uint64_t e) {
       Tally& t = tallies[chunk];
+      SparseFaceValues& sparse = w.sparse[chunk];
+      if (keep_sparse) sparse.faces.clear(), sparse.values.clear();
       for (uint64_t i = b; i < e; ++i) {
+        if (i % kCullBlock == 0 && voxel_boxes.OutOfRange(limits[k], i / kCullBlock)) {
+          i += kCullBlock - 1;  // the whole block (chunks hold whole blocks)
+          continue;
+        }
         unsigned corner_bits = 0;  // bit q: corner q of voxel i is visible
         for (int q = 0; q < 8; ++q) {
           const uint32_t c = voxel_corners[i][q];
@@ -413,6 +461,10 @@ Result<Evaluation> EvaluateExact(const EvaluationJob& job, Evaluation ev) {
           t.Add(p, val);
           const size_t slot = i * kFacesPerVoxel + f;
           if (keep) (*keep)[slot] = float(val);
+          if (keep_sparse && val > 0) {
+            sparse.faces.push_back(uint32_t(slot));
+            sparse.values.push_back(float(val));
+          }
           KeepBest(val, uint8_t(p), w.best[slot], w.best_p[slot]);
           seen |= val > 0;
         }
@@ -422,6 +474,17 @@ Result<Evaluation> EvaluateExact(const EvaluationJob& job, Evaluation ev) {
     Tally total;
     for (const Tally& t : tallies) total.Merge(t);
     ev.per_viewpoint[k] = total.Figures(faces_total);
+    if (keep_sparse) {  // the chunks in order: faces ascending
+      SparseFaceValues& out = ev.per_viewpoint_sparse_values[k];
+      size_t count = 0;
+      for (const SparseFaceValues& c : w.sparse) count += c.size();
+      out.faces.reserve(count);
+      out.values.reserve(count);
+      for (const SparseFaceValues& c : w.sparse) {
+        out.faces.insert(out.faces.end(), c.faces.begin(), c.faces.end());
+        out.values.insert(out.values.end(), c.values.begin(), c.values.end());
+      }
+    }
     progress.Add(1);
     return Status::Ok();
   };
@@ -514,6 +577,11 @@ Result<Evaluation> Evaluate(const VoxelScene& scene, const std::vector<WorldPoin
   if (std::adjacent_find(scene.occupied.begin(), scene.occupied.end(),
                          [](const VoxelKey& a, const VoxelKey& b) { return !(a < b); }) != scene.occupied.end()) {
     return InvalidArgumentError("the scene's voxels must be sorted and unique (VoxelScene::occupied)");
+  }
+  if (options.keep_sparse_per_viewpoint_values && scene.occupied.size() * kFacesPerVoxel > UINT32_MAX) {
+    return InvalidArgumentError("the scene has " + std::to_string(scene.occupied.size()) +
+                                " occupied voxels; sparse face values index at most 715,827,882: use a coarser "
+                                "resolution");
   }
   return EvaluateExact(job, std::move(ev));
 }

@@ -796,11 +796,15 @@ struct SurfaceTargets::CornerKind {
   }
 };
 
-void SurfaceTargets::AppendCornerDecisions(const Vector3d& uo, size_t brick_begin, size_t brick_end, GroupWalk& walk,
+void SurfaceTargets::AppendCornerDecisions(const Vector3d& uo, const ScannerLimits& limits, size_t brick_begin,
+                                           size_t brick_end, GroupWalk& walk,
                                            std::vector<CornerDecision>& decisions) const {
   for (size_t b = brick_begin; b < brick_end; ++b) {
     const Brick& brick = bricks_[b];
     const int base[3] = {brick.base.x, brick.base.y, brick.base.z};
+    const Vector3d lo(base[0] + brick.lo[0], base[1] + brick.lo[1], base[2] + brick.lo[2]);
+    const Vector3d hi(base[0] + brick.hi[0] + 1, base[1] + brick.hi[1] + 1, base[2] + brick.hi[2] + 1);
+    if (limits.BoxVerdict(lo, hi) == ScannerLimits::Verdict::kNone) continue;
     CornerKind kind{grid_, uo, &targets_[brick.begin], base, {}, decisions, walk.around};
     FacingTable(uo, base, kind.facing);
     WalkGroups(uo, brick, walk, kind);

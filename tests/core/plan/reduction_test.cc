@@ -47,7 +47,16 @@ Values RandomValues(std::mt19937& rng, int stations, int faces, double seen) {
 }
 
 StationFaceValuesFn FromTable(const Values& v) {
-  return [v](int s, const JobContext&) -> Result<std::vector<float>> { return v[s]; };
+  return [v](const std::vector<int>& stations, const JobContext&) -> Result<std::vector<SparseFaceValues>> {
+    std::vector<SparseFaceValues> out(stations.size());
+    for (size_t k = 0; k < stations.size(); ++k) {
+      const std::vector<float>& row = v[stations[k]];
+      for (size_t f = 0; f < row.size(); ++f) {
+        if (row[f] > 0) out[k].faces.push_back(static_cast<uint32_t>(f)), out[k].values.push_back(row[f]);
+      }
+    }
+    return out;
+  };
 }
 
 TEST(ReductionTest, InsertTop3KeepsTheThreeLargestInOrder) {
@@ -262,17 +271,61 @@ TEST(ReductionTest, MatrixIsTheSameForAnyThreadCount) {
 }
 
 TEST(ReductionTest, ErrorsFromTheValueSourcePropagate) {
-  StationFaceValuesFn failing = [](int s, const JobContext&) -> Result<std::vector<float>> {
-    if (s == 1) return CancelledError("evaluation was cancelled");
-    return std::vector<float>(4, 0.5f);
+  StationFaceValuesFn failing = [](const std::vector<int>& stations,
+                                   const JobContext&) -> Result<std::vector<SparseFaceValues>> {
+    if (stations[0] == 1) return CancelledError("evaluation was cancelled");
+    return std::vector<SparseFaceValues>(stations.size(), SparseFaceValues{{0, 1, 2, 3}, {0.5f, 0.5f, 0.5f, 0.5f}});
   };
-  Result<ReductionRun> run = RunReduction(2, 4, failing, {});
+  ReductionRunOptions one_at_a_time;
+  one_at_a_time.batch_stations = 1;
+  Result<ReductionRun> run = RunReduction(2, 4, failing, one_at_a_time);
   ASSERT_FALSE(run.ok());
   EXPECT_EQ(run.status().code(), StatusCode::kCancelled);
-  StationFaceValuesFn short_values = [](int, const JobContext&) -> Result<std::vector<float>> {
-    return std::vector<float>(3, 0.5f);
+  // A source that answers for fewer stations than asked, or with faces out of order or range.
+  StationFaceValuesFn too_few = [](const std::vector<int>&,
+                                   const JobContext&) -> Result<std::vector<SparseFaceValues>> {
+    return std::vector<SparseFaceValues>{};
   };
-  EXPECT_EQ(RunReduction(1, 4, short_values, {}).status().code(), StatusCode::kInternal);
+  EXPECT_EQ(RunReduction(1, 4, too_few, {}).status().code(), StatusCode::kInternal);
+  for (const SparseFaceValues& bad : {SparseFaceValues{{2, 1}, {0.5f, 0.5f}}, SparseFaceValues{{1, 4}, {0.5f, 0.5f}},
+                                      SparseFaceValues{{1, 1}, {0.5f, 0.5f}}, SparseFaceValues{{1}, {}}}) {
+    StationFaceValuesFn source = [bad](const std::vector<int>&,
+                                       const JobContext&) -> Result<std::vector<SparseFaceValues>> {
+      return std::vector<SparseFaceValues>{bad};
+    };
+    EXPECT_EQ(RunReduction(1, 4, source, {}).status().code(), StatusCode::kInternal);
+  }
+}
+
+TEST(ReductionTest, BatchesAndAPartlyFilledCacheGiveTheSameRun) {
+  // The cache budget running out part-way through the first build (then every removal asks for
+  // the values again), and any batch size, must not change a removal.
+  std::mt19937 rng(21);
+  for (int trial = 0; trial < 10; ++trial) {
+    const int n = 6 + static_cast<int>(rng() % 5);
+    Values v = RandomValues(rng, n, 400, 0.2);
+    v.push_back(v[2]);
+    v.push_back(v[4]);
+    ReductionRunOptions reference;
+    reference.reduce_to = 3;
+    const Result<ReductionRun> a = RunReduction(n + 2, 400, FromTable(v), reference);
+    ReductionRunOptions other = reference;
+    other.batch_stations = 1 + trial % 3;
+    other.cache_budget_bytes = 400 * 8 * 2;  // about two stations' values
+    int calls = 0;
+    const StationFaceValuesFn counted = [&](const std::vector<int>& stations, const JobContext& ctx) {
+      ++calls;
+      return FromTable(v)(stations, ctx);
+    };
+    const Result<ReductionRun> b = RunReduction(n + 2, 400, counted, other);
+    ASSERT_TRUE(a.ok() && b.ok());
+    EXPECT_EQ(a->removed, b->removed);
+    EXPECT_EQ(a->global_visibility_after, b->global_visibility_after);
+    EXPECT_EQ(a->initial.loss, b->initial.loss);
+    // Without the cache, each removal step rebuilt from fresh values: more calls than one build.
+    const int one_build = (n + 2 + other.batch_stations - 1) / other.batch_stations;
+    EXPECT_GT(calls, one_build) << "trial " << trial;
+  }
 }
 
 }  // namespace

@@ -17,38 +17,36 @@ ReductionOutput KeepAllStations(size_t count) {
   return out;
 }
 
-// Reduction on every station's V of every face. One Evaluate of all stations keeps them when
-// they fit the cache budget (and is the final evaluation if nothing is removed); otherwise each
-// station is evaluated alone, as often as the reduction needs.
+// Reduction on every station's V of every face it sees. Stations are evaluated a batch at a time
+// into sparse values (what each sees), which RunReduction keeps while they fit the cache budget
+// (otherwise it asks for them again after each removal). When all stations fit one batch, that
+// evaluation also keeps the face values the evaluation stage needs, and is the final evaluation
+// if nothing is removed.
 Result<ReductionOutput> RunReductionStage(const ReductionInput& in, const PlanOptions& options, const JobContext& ctx) {
   const std::vector<WorldPoint>& stations = in.stations.positions;
-  const EvaluateOptions eval_options = StationEvaluateOptions(options);
   const uint64_t faces_total = in.scene.occupied.size() * kFacesPerVoxel;
   const uint64_t cache_budget = std::min<uint64_t>(options.memory_budget_bytes / 4, uint64_t{1} << 30);
-  const bool batch = stations.size() * faces_total * sizeof(float) <= cache_budget;
   std::optional<Evaluation> all_evaluation;
-  StationFaceValuesFn values;
-  if (batch) {
-    EvaluateOptions batch_options = eval_options;
-    batch_options.keep_per_viewpoint_values = true;
-    VC_ASSIGN_OR_RETURN(all_evaluation, Evaluate(in.scene, stations, batch_options, ProgressRange(ctx, 0.0, 0.9)));
-    values = [&](int s, const JobContext&) -> Result<std::vector<float>> {
-      return std::move(all_evaluation->per_viewpoint_face_values[s]);  // read once: RunReduction caches
-    };
-  } else {
-    EvaluateOptions single_options = eval_options;
-    single_options.keep_face_values = false;
-    single_options.keep_per_viewpoint_values = true;
-    // single_options by value: this block ends before RunReduction calls `values`.
-    values = [&in, &stations, single_options](int s, const JobContext& sub) -> Result<std::vector<float>> {
-      VC_ASSIGN_OR_RETURN(Evaluation e, Evaluate(in.scene, {stations[s]}, single_options, sub));
-      return std::move(e.per_viewpoint_face_values[0]);
-    };
-  }
+  const StationFaceValuesFn values = [&](const std::vector<int>& batch,
+                                         const JobContext& sub) -> Result<std::vector<SparseFaceValues>> {
+    std::vector<WorldPoint> positions;
+    positions.reserve(batch.size());
+    for (int s : batch) positions.push_back(stations[s]);
+    EvaluateOptions eval_options = StationEvaluateOptions(options);
+    eval_options.keep_sparse_per_viewpoint_values = true;
+    const bool whole = batch.size() == stations.size() && !all_evaluation;  // the first call, every station
+    eval_options.keep_face_values = whole;
+    VC_ASSIGN_OR_RETURN(Evaluation e, Evaluate(in.scene, positions, eval_options, sub));
+    std::vector<SparseFaceValues> out = std::move(e.per_viewpoint_sparse_values);
+    e.per_viewpoint_sparse_values.clear();
+    if (whole) all_evaluation = std::move(e);
+    return out;
+  };
   ReductionRunOptions red_options;
   red_options.reduce_to = options.reduce_to;
   red_options.threads = options.threads;
   red_options.cache_budget_bytes = cache_budget;
+  red_options.batch_stations = kReductionStationsPerBatch;
   red_options.fixed = in.stations.fixed;
   // Registration: no removal may split the stations' scan graph into more groups.
   OverlapMatrix overlaps;
@@ -62,9 +60,8 @@ Result<ReductionOutput> RunReductionStage(const ReductionInput& in, const PlanOp
       return CountComponents(overlaps, remaining, options.min_overlap) <= groups;
     };
   }
-  VC_ASSIGN_OR_RETURN(ReductionRun run, RunReduction(static_cast<int>(stations.size()), faces_total, values,
-                                                     red_options, ProgressRange(ctx, batch ? 0.9 : 0.0, 1.0)));
-  if (all_evaluation) all_evaluation->per_viewpoint_face_values.clear();
+  VC_ASSIGN_OR_RETURN(ReductionRun run,
+                      RunReduction(static_cast<int>(stations.size()), faces_total, values, red_options, ctx));
   ReductionOutput out;
   Reduction& reduction = out.reduction;
   reduction.size = run.initial.size;

@@ -7,8 +7,9 @@
 // the whole |P| x |P| matrix comes from one pass over a per-face top-3 table, exactly:
 //   loss{i}    = sum over faces with s1 = i of (v1 - v2)
 //   loss{i,j}  = loss{i} + loss{j} + sum over faces with {s1, s2} = {i, j} of (v2 - v3)
-// divided by |F|. Face values come from a callback (the planner wraps vc::Evaluate of one station
-// with keep_face_values), so this file is testable on hand-made values. Internal to vc_core.
+// divided by |F|. Face values come from a callback, a batch of stations at a time, as each
+// station's faces with V > 0 (the planner wraps vc::Evaluate with keep_sparse_per_viewpoint_values,
+// or hands the batch to replicas), so this file is testable on hand-made values. Internal to vc_core.
 #pragma once
 
 #include <array>
@@ -18,6 +19,7 @@
 
 #include "vc/base/progress.h"
 #include "vc/base/status.h"
+#include "vc/visibility/visibility.h"
 
 namespace vc::planner {
 
@@ -54,17 +56,20 @@ using RemovalCheck = std::function<bool(const std::vector<int>& remaining)>;
 std::vector<int> ChooseRemoval(const ReductionMatrix& m, const std::vector<int>& active, int reduce_to,
                                const std::vector<bool>& fixed = {}, const RemovalCheck& keeps = {});
 
-// V of every face (F order) seen from one station.
-using StationFaceValuesFn = std::function<Result<std::vector<float>>(int station, const JobContext& ctx)>;
+// For each of `stations` (indices, ascending), its faces with V > 0 (F order).
+using StationFaceValuesFn =
+    std::function<Result<std::vector<SparseFaceValues>>(const std::vector<int>& stations, const JobContext& ctx)>;
 
 struct ReductionRunOptions {
   int reduce_to = 0;        // 0 = zero-loss rule only
   bool remove = true;       // false: only compute the matrix
   std::vector<bool> fixed;  // per station: never removed (fixed stations); empty = none
   RemovalCheck keeps;       // when set, a removal must leave stations it accepts (ChooseRemoval)
-  // Keep every station's face values in memory (for exact top-3 refills after a removal) when
+  // Keep every station's face values in memory (for exact top-3 refills after a removal) while
   // they fit in this many bytes; otherwise the values are recomputed after each removal.
   uint64_t cache_budget_bytes = uint64_t{1} << 30;
+  // Stations per call of the values callback.
+  int batch_stations = 256;
   int threads = 0;
 };
 

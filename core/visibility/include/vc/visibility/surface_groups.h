@@ -83,9 +83,10 @@ class SurfaceTargets {
 
   // Appends corner-visibility decisions (ALGORITHM.md s.4, the 8-voxel corner rule) that groups
   // of faces facing uo in bricks [brick_begin, brick_end) prove; corners not mentioned are
-  // undecided. One corner may be decided more than once, always the same way.
-  void AppendCornerDecisions(const Eigen::Vector3d& uo, size_t brick_begin, size_t brick_end, GroupWalk& walk,
-                             std::vector<CornerDecision>& decisions) const;
+  // undecided. One corner may be decided more than once, always the same way. Bricks where no
+  // face centre of a target passes `limits`' range are skipped (their corners stay undecided).
+  void AppendCornerDecisions(const Eigen::Vector3d& uo, const ScannerLimits& limits, size_t brick_begin,
+                             size_t brick_end, GroupWalk& walk, std::vector<CornerDecision>& decisions) const;
 
  private:
   struct Target {

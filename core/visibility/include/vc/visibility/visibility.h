@@ -163,10 +163,23 @@ struct EvaluateOptions {
   // Keep every viewpoint's V of every face (needed by reduction). Exact mode only; costs
   // 24 bytes per occupied voxel and viewpoint.
   bool keep_per_viewpoint_values = false;
+  // Keep every viewpoint's faces with V > 0 (SparseFaceValues: 8 bytes per face it sees, not 24
+  // per voxel of the scene; what the reduction holds). Exact mode only; the scene must have fewer
+  // than 2^32 / 6 voxels (INVALID_ARGUMENT otherwise).
+  bool keep_sparse_per_viewpoint_values = false;
   // Exact mode: decide every lattice corner on its own (its ray, after the per-ray shortcuts: the
   // occluder cache and the grazing-layer test) instead of first by groups of faces (same answers,
   // slower; kept as the reference for tests and benchmarks).
   bool per_corner = false;
+};
+
+// One viewpoint's faces with V > 0: their indices in F order (voxel id * 6 + face), ascending,
+// and V of each.
+struct SparseFaceValues {
+  std::vector<uint32_t> faces;
+  std::vector<float> values;
+  size_t size() const { return faces.size(); }
+  uint64_t MemoryBytes() const { return faces.capacity() * sizeof(uint32_t) + values.capacity() * sizeof(float); }
 };
 
 // Evaluation::sole_viewer's values for a voxel no viewpoint sees, and one several viewpoints see.
@@ -187,6 +200,8 @@ struct Evaluation {
   // With keep_per_viewpoint_values: per viewpoint, V of every face at index voxel_id * 6 + face.
   // Faces outside F hold 0.
   std::vector<std::vector<float>> per_viewpoint_face_values;
+  // With keep_sparse_per_viewpoint_values: per viewpoint, its faces with V > 0.
+  std::vector<SparseFaceValues> per_viewpoint_sparse_values;
   // With keep_face_values: per voxel id, the index of the only viewpoint that gives any of its
   // faces V > 0 ("what only this station sees"); kNoViewer if none does, kSeveralViewers if
   // several do.
