@@ -361,6 +361,38 @@ Result<ConsolidateResult> ConsolidatePicks(const std::vector<VoxelSet>& sets, st
     }
     return it->second.words();
   };
+  // A pick's nonzero words: on a large site a station sees a small share of it, so a pair's
+  // `rest` below is computed on these, not on every word of the scene.
+  std::unordered_map<int, std::vector<size_t>> nonzero_words;
+  auto pick_nonzero = [&](int c) -> const std::vector<size_t>& {
+    auto it = nonzero_words.find(c);
+    if (it == nonzero_words.end()) {
+      std::vector<size_t> nz;
+      const auto& w = pick_words(c);
+      for (size_t k = 0; k < w.size(); ++k) {
+        if (w[k]) nz.push_back(k);
+      }
+      it = nonzero_words.emplace(c, std::move(nz)).first;
+    }
+    return it->second;
+  };
+  // The candidates that see any voxel of a pick, as bits: one standing in for picks a and b must
+  // see the voxels only they cover, so it is a neighbour of a (of b) when some of those lie in a
+  // (in b). Far-apart picks have no common neighbour and are passed over at once.
+  const size_t candidate_words = (sets.size() + 63) / 64;
+  std::unordered_map<int, std::vector<uint64_t>> neighbour_bits;
+  auto neighbours = [&](int p) -> const std::vector<uint64_t>& {
+    auto it = neighbour_bits.find(p);
+    if (it == neighbour_bits.end()) {
+      std::vector<uint64_t> bits(candidate_words, 0);
+      for (size_t c = 0; c < sets.size(); ++c) {
+        if (sets[c].Intersects(sets[p])) bits[c >> 6] |= uint64_t{1} << (c & 63);
+      }
+      it = neighbour_bits.emplace(p, std::move(bits)).first;
+    }
+    return it->second;
+  };
+  auto has = [](const std::vector<uint64_t>* bits, int c) { return !bits || (((*bits)[c >> 6] >> (c & 63)) & 1); };
   std::vector<int> order;
   for (size_t i = static_cast<size_t>(std::max(fixed, 0)); i < sets.size(); ++i) order.push_back(static_cast<int>(i));
   auto is_fixed = [&](int candidate) { return candidate < fixed; };
@@ -423,16 +455,34 @@ Result<ConsolidateResult> ConsolidatePicks(const std::vector<VoxelSet>& sets, st
       for (size_t b = a + 1; b < picks.size() && !changed; ++b) {
         if (is_fixed(picks[b])) continue;
         const auto& wb = pick_words(picks[b]);
-        // Voxels only a or b cover: in both and covered exactly twice, or in one and covered once.
+        // Voxels only a or b cover: in both and covered exactly twice, or in one and covered once
+        // (only in words where a or b has a voxel).
         nonzero.clear();
-        for (size_t k = 0; k < words; ++k) {
+        bool in_a = false, in_b = false;
+        const std::vector<size_t>& za = pick_nonzero(picks[a]);
+        const std::vector<size_t>& zb = pick_nonzero(picks[b]);
+        for (size_t i = 0, j = 0; i < za.size() || j < zb.size();) {
+          const size_t k = j == zb.size() || (i < za.size() && za[i] < zb[j]) ? za[i] : zb[j];
+          i += i < za.size() && za[i] == k;
+          j += j < zb.size() && zb[j] == k;
           rest[k] = (wa[k] & wb[k] & ~c3[k]) | ((wa[k] ^ wb[k]) & ~c2[k]);
-          if (rest[k]) nonzero.push_back(k);
+          if (!rest[k]) continue;
+          nonzero.push_back(k);
+          in_a |= (rest[k] & wa[k]) != 0;
+          in_b |= (rest[k] & wb[k]) != 0;
+        }
+        const std::vector<uint64_t>* need_a = in_a ? &neighbours(picks[a]) : nullptr;
+        const std::vector<uint64_t>* need_b = in_b ? &neighbours(picks[b]) : nullptr;
+        if (need_a && need_b) {
+          bool any = false;
+          for (size_t k = 0; k < candidate_words && !any; ++k) any = ((*need_a)[k] & (*need_b)[k]) != 0;
+          if (!any) continue;  // no candidate sees into both
         }
         // A voxel of `rest` every candidate standing in must see: one test rules most out.
         const bool has_probe = !nonzero.empty();
         const size_t probe = has_probe ? nonzero[0] * 64 + static_cast<size_t>(std::countr_zero(rest[nonzero[0]])) : 0;
         for (int c : order) {
+          if (!has(need_a, c) || !has(need_b, c)) continue;
           const VoxelSet& sc = sets[c];
           if (has_probe && !sc.test(probe)) continue;
           bool covers = true;

@@ -114,6 +114,25 @@ VC_POPCOUNT_CLONES size_t VoxelSet::CountAnd(const VoxelSet& other) const {
   return n;
 }
 
+bool VoxelSet::Intersects(const VoxelSet& other) const {
+  if (sparse_ && other.sparse_) return roaring_bitmap_intersect(sparse_, other.sparse_);
+  if (sparse_ || other.sparse_) {
+    const VoxelSet& s = sparse_ ? *this : other;
+    const VoxelSet& d = sparse_ ? other : *this;
+    roaring_uint32_iterator_t it;
+    roaring_init_iterator(s.sparse_, &it);
+    for (; it.has_value; roaring_advance_uint32_iterator(&it)) {
+      if (it.current_value < d.n_ && d.test(it.current_value)) return true;
+    }
+    return false;
+  }
+  const size_t m = std::min(words_.size(), other.words_.size());
+  for (size_t i = 0; i < m; ++i) {
+    if (words_[i] & other.words_[i]) return true;
+  }
+  return false;
+}
+
 void VoxelSet::Subtract(const VoxelSet& other) {
   if (sparse_ && other.sparse_) return roaring_bitmap_andnot_inplace(sparse_, other.sparse_);
   if (other.sparse_) {  // dense -= sparse

@@ -81,6 +81,9 @@ TEST(VoxelSetTest, EveryOperationAgreesInBothForms) {
         for (size_t i = 0; i < n; ++i) r[i] = ra[i] && !rb[i];
         ExpectEquals(d, r);
         EXPECT_EQ(d.CountAnd(y), 0u);
+        EXPECT_EQ(x.Intersects(y), and_count > 0);
+        EXPECT_FALSE(d.Intersects(y));
+        EXPECT_FALSE(y.Intersects(d));
         VoxelSet m = x;
         m.Intersect(y);
         for (size_t i = 0; i < n; ++i) r[i] = ra[i] && rb[i];

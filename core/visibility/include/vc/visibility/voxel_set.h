@@ -53,6 +53,8 @@ class VoxelSet {
   size_t count() const;
   // |this AND other|.
   size_t CountAnd(const VoxelSet& other) const;
+  // Whether this and other share a member (stops at the first).
+  bool Intersects(const VoxelSet& other) const;
   // this &= ~other.
   void Subtract(const VoxelSet& other);
   // this |= other.
