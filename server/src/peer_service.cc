@@ -10,6 +10,7 @@
 #include "job_reactor.h"
 #include "vc/plan/stages.h"
 #include "vc/server/service.h"
+#include "vc/wire/face_values_codec.h"
 #include "vc/wire/sha256.h"
 #include "vc/wire/voxel_set_codec.h"
 
@@ -44,15 +45,34 @@ Status RunShard(ServiceState& state, const v1::ShardRequest& request, v1::ShardR
     VC_ASSIGN_OR_RETURN(planner::VoxelizeOutput v, planner::RunVoxelizeStage({input}, options, JobContext{}));
     return std::move(v.scene);
   }));
-  VC_RETURN_IF_ERROR(planner::CheckVisibilitySetBudget(viewpoints.size(), scene->occupied.size(),
-                                                       options.memory_budget_bytes, "this shard"));
-  VC_ASSIGN_OR_RETURN(const std::vector<VoxelSet> sets,
-                      ComputeVisibilitySets(*scene, viewpoints, planner::VisibilitySetsOptionsFor(options), ctx));
   response->set_replica_id(state.replica_id);
   response->set_occupied_voxels(scene->occupied.size());
   response->set_scene_crc32c(SceneFingerprint(*scene));
-  for (const VoxelSet& s : sets) response->add_sets(wire::EncodeVoxelSet(s));
-  return Status::Ok();
+  switch (request.kind()) {
+    case v1::SHARD_KIND_VISIBILITY_SETS: {
+      VC_RETURN_IF_ERROR(planner::CheckVisibilitySetBudget(viewpoints.size(), scene->occupied.size(),
+                                                           options.memory_budget_bytes, "this shard"));
+      VC_ASSIGN_OR_RETURN(const std::vector<VoxelSet> sets,
+                          ComputeVisibilitySets(*scene, viewpoints, planner::VisibilitySetsOptionsFor(options), ctx));
+      for (const VoxelSet& s : sets) response->add_sets(wire::EncodeVoxelSet(s));
+      return Status::Ok();
+    }
+    case v1::SHARD_KIND_FACE_VALUES: {  // the reduction's evaluation (RunReductionStage's options)
+      EvaluateOptions eval_options = planner::StationEvaluateOptions(options);
+      eval_options.keep_face_values = false;
+      eval_options.keep_sparse_per_viewpoint_values = true;
+      VC_ASSIGN_OR_RETURN(const Evaluation e, Evaluate(*scene, viewpoints, eval_options, ctx));
+      for (const SparseFaceValues& v : e.per_viewpoint_sparse_values) {
+        *response->add_face_values() = wire::EncodeFaceValues(v);
+      }
+      return Status::Ok();
+    }
+    default:
+      return InvalidArgumentError(
+          fmt::format("ComputeShard: unknown shard kind {}; is this replica older than the "
+                      "coordinator?",
+                      int(request.kind())));
+  }
 }
 
 // One ComputeShard call: admitted to the worker pool like a job, cancelled with its call.

@@ -18,10 +18,21 @@
 #include "vc/server/upload_assembler.h"
 #include "vc/server/voxelized_scenes.h"
 #include "vc/wire/convert.h"
+#include "vc/wire/face_values_codec.h"
 #include "vc/wire/status_mapping.h"
 #include "vc/wire/voxel_set_codec.h"
 
 namespace vc::server {
+
+// What a fan-out collects: the items of every viewpoint in order (visibility sets or face values),
+// how they were spread, and the warnings.
+template <class T>
+struct FanOutResult {
+  std::vector<T> items;
+  Distribution distribution;
+  std::vector<std::string> warnings;
+};
+
 namespace {
 
 using Clock = std::chrono::steady_clock;
@@ -44,7 +55,8 @@ double Seconds(Clock::duration d) { return std::chrono::duration<double>(d).coun
 
 std::string GrpcError(const grpc::Status& s) { return wire::FromGrpcStatus(s).ToString(); }
 
-// One Compute call's shards, shared by its lanes.
+// One fan-out's shards, shared by its lanes; T is what a viewpoint yields.
+template <class T>
 class ShardBoard {
  public:
   ShardBoard(size_t viewpoints, size_t per_shard) {
@@ -85,14 +97,14 @@ class ShardBoard {
       }
     }
   }
-  // An attempt of shard k ended with these sets (from `who`); the first answer is kept.
-  void Deliver(size_t k, const std::string& who, std::vector<VoxelSet> sets, double seconds) {
+  // An attempt of shard k ended with these items (from `who`); the first answer is kept.
+  void Deliver(size_t k, const std::string& who, std::vector<T> items, double seconds) {
     std::lock_guard lock(mu_);
     Shard& s = shards_[k];
     --s.running;
     if (s.done) return;
     s.done = true;
-    results_[k] = std::move(sets);
+    results_[k] = std::move(items);
     ++done_;
     contributors_.insert(who);
     finished_seconds_ += seconds;
@@ -155,10 +167,10 @@ class ShardBoard {
   }
 
   // Once the lanes are joined.
-  DistributedSets Collect() && {
-    DistributedSets out;
-    for (std::vector<VoxelSet>& r : results_) {
-      for (VoxelSet& s : r) out.sets.push_back(std::move(s));
+  FanOutResult<T> Collect() && {
+    FanOutResult<T> out;
+    for (std::vector<T>& r : results_) {
+      for (T& s : r) out.items.push_back(std::move(s));
     }
     out.distribution.replicas = int(contributors_.size());
     out.distribution.shards = int(shards_.size());
@@ -215,7 +227,7 @@ class ShardBoard {
   mutable std::mutex mu_;
   std::condition_variable cv_;
   std::vector<Shard> shards_;
-  std::vector<std::vector<VoxelSet>> results_;
+  std::vector<std::vector<T>> results_;
   size_t done_ = 0;
   int lanes_ = 0;
   bool stopped_ = false;
@@ -236,13 +248,46 @@ struct LaneJob {
   const std::string& token;
   const std::string& self_id;
   Clock::duration shard_deadline;
+  v1::ShardKind kind;
   double compact_gain;  // the sets arrive sparse where the plan keeps them sparse
+  const char* what;     // the stage, for messages
 };
 
+// A shard's items from a peer's answer (its voxelization already checked).
+template <class T>
+Result<std::vector<T>> DecodeItems(const v1::ShardResponse& resp, size_t count, const LaneJob& job);
+template <>
+Result<std::vector<VoxelSet>> DecodeItems(const v1::ShardResponse& resp, size_t count, const LaneJob& job) {
+  if (size_t(resp.sets_size()) != count) {
+    return DataLossError(fmt::format("it answered {} sets for {} viewpoints", resp.sets_size(), count));
+  }
+  std::vector<VoxelSet> sets;
+  sets.reserve(count);
+  for (const std::string& b : resp.sets()) {
+    VC_ASSIGN_OR_RETURN(VoxelSet s, wire::DecodeVoxelSet(b, job.occupied_voxels, job.compact_gain));
+    sets.push_back(std::move(s));
+  }
+  return sets;
+}
+template <>
+Result<std::vector<SparseFaceValues>> DecodeItems(const v1::ShardResponse& resp, size_t count, const LaneJob& job) {
+  if (size_t(resp.face_values_size()) != count) {
+    return DataLossError(fmt::format("it answered face values of {} stations for {}", resp.face_values_size(), count));
+  }
+  std::vector<SparseFaceValues> values;
+  values.reserve(count);
+  for (const v1::FaceValues& m : resp.face_values()) {
+    VC_ASSIGN_OR_RETURN(SparseFaceValues v, wire::DecodeFaceValues(m, job.occupied_voxels * kFacesPerVoxel));
+    values.push_back(std::move(v));
+  }
+  return values;
+}
+
+template <class T>
 class PeerLane {
  public:
   PeerLane(size_t index, std::string address, std::shared_ptr<v1::StationPlanner::Stub> stub, const LaneJob& job,
-           ShardBoard& board)
+           ShardBoard<T>& board)
       : index_(index), address_(std::move(address)), stub_(std::move(stub)), job_(job), board_(board) {}
 
   void Run() {
@@ -264,7 +309,7 @@ class PeerLane {
   // board never sees a context that is gone).
   class LiveCall {
    public:
-    LiveCall(ShardBoard& board, size_t lane, grpc::ClientContext& c)
+    LiveCall(ShardBoard<T>& board, size_t lane, grpc::ClientContext& c)
         : board_(board), lane_(lane), live_(board.SetLive(lane, &c)) {}
     ~LiveCall() {
       if (live_) board_.SetLive(lane_, nullptr);
@@ -272,7 +317,7 @@ class PeerLane {
     bool live() const { return live_; }
 
    private:
-    ShardBoard& board_;
+    ShardBoard<T>& board_;
     size_t lane_;
     bool live_;
   };
@@ -286,10 +331,8 @@ class PeerLane {
 
   void Retire(const std::string& why) {
     if (board_.Finished()) return;  // the plan is done or cancelled: nothing to report
-    board_.Warn(
-        fmt::format("replica {} was left out of the rest of this plan ({}); the other replicas computed its "
-                    "shards",
-                    address_, why));
+    board_.Warn(fmt::format("replica {} was left out of the rest of {} ({}); the other replicas computed its shards",
+                            address_, job_.what, why));
     spdlog::warn("fan-out: replica {} retired: {}", address_, why);
   }
 
@@ -344,23 +387,14 @@ class PeerLane {
   }
 
   // Decodes and checks a peer's answer for shard k.
-  Result<std::vector<VoxelSet>> Decode(const v1::ShardResponse& resp, size_t begin, size_t end) const {
+  Result<std::vector<T>> Decode(const v1::ShardResponse& resp, size_t begin, size_t end) const {
     if (resp.occupied_voxels() != job_.occupied_voxels || resp.scene_crc32c() != job_.fingerprint) {
       return FailedPreconditionError(fmt::format(
           "its voxelization differs from this replica's ({} voxels, CRC32C {:08x}, against {} and {:08x}): is it "
           "another version of vc-server?",
           resp.occupied_voxels(), resp.scene_crc32c(), job_.occupied_voxels, job_.fingerprint));
     }
-    if (size_t(resp.sets_size()) != end - begin) {
-      return DataLossError(fmt::format("it answered {} sets for {} viewpoints", resp.sets_size(), end - begin));
-    }
-    std::vector<VoxelSet> sets;
-    sets.reserve(end - begin);
-    for (const std::string& b : resp.sets()) {
-      VC_ASSIGN_OR_RETURN(VoxelSet s, wire::DecodeVoxelSet(b, job_.occupied_voxels, job_.compact_gain));
-      sets.push_back(std::move(s));
-    }
-    return sets;
+    return DecodeItems<T>(resp, end - begin, job_);
   }
 
   void RunLane() {
@@ -382,6 +416,7 @@ class PeerLane {
       req.set_source_name(job_.ref.source_name);
       *req.mutable_parameters() = job_.parameters;
       req.set_first_index(begin);
+      req.set_kind(job_.kind);
       for (size_t i = begin; i < end; ++i) *req.add_viewpoints() = wire::ToProto(job_.viewpoints[i]);
       v1::ShardResponse resp;
       grpc::ClientContext c;
@@ -395,14 +430,14 @@ class PeerLane {
       }
       board_.AddBytes(req.ByteSizeLong() + resp.ByteSizeLong());
       if (s->ok()) {
-        Result<std::vector<VoxelSet>> sets = Decode(resp, begin, end);
-        if (!sets.ok()) {
+        Result<std::vector<T>> items = Decode(resp, begin, end);
+        if (!items.ok()) {
           board_.Release(*k);
           held_.reset();
-          Retire(sets.status().message());
+          Retire(items.status().message());
           return;
         }
-        board_.Deliver(*k, address_, std::move(*sets), Seconds(Clock::now() - t0));
+        board_.Deliver(*k, address_, std::move(*items), Seconds(Clock::now() - t0));
         held_.reset();
         failures = busy = 0;
         continue;
@@ -445,7 +480,7 @@ class PeerLane {
   const std::string address_;
   const std::shared_ptr<v1::StationPlanner::Stub> stub_;
   const LaneJob& job_;
-  ShardBoard& board_;
+  ShardBoard<T>& board_;
   std::optional<size_t> held_;  // the shard this lane runs, released if the lane throws
 };
 
@@ -514,33 +549,42 @@ std::shared_ptr<v1::StationPlanner::Stub> PeerFanOut::StubFor(const std::string&
   return stub;
 }
 
-Result<DistributedSets> PeerFanOut::Compute(const SceneRef& ref, const v1::PlanParameters& parameters,
-                                            const VoxelScene& scene, const std::vector<WorldPoint>& viewpoints,
-                                            const VisibilitySetsOptions& options, const JobContext& ctx) {
-  ShardBoard board(viewpoints.size(), size_t(options_.shard_candidates));
+template <class T>
+Result<FanOutResult<T>> PeerFanOut::FanOut(const SceneRef& ref, const v1::PlanParameters& parameters,
+                                           const VoxelScene& scene, const std::vector<WorldPoint>& viewpoints,
+                                           const ShardSpec& spec, const LocalShard<T>& local, const JobContext& ctx) {
+  ShardBoard<T> board(viewpoints.size(), size_t(options_.shard_candidates));
   std::vector<std::string> warnings;
   const std::vector<std::string> addresses = board.size() > 1 ? Addresses(&warnings) : std::vector<std::string>{};
   for (std::string& w : warnings) board.Warn(std::move(w));
   const std::string token = !options_.peer_token.empty() ? options_.peer_token
                             : options_.tokens.empty()    ? std::string()
                                                          : options_.tokens.front();
-  // What a peer needs of the plan's parameters: the voxelization and the selection test, not the
-  // lists (user candidates, keep-out zones, fixed stations), which may be long.
+  // What a peer needs of the plan's parameters: the voxelization, the selection test and the
+  // scanner, not the lists (user candidates, keep-out zones, fixed stations), which may be long.
   v1::PlanParameters shard_parameters = parameters;
   shard_parameters.clear_candidates();
   shard_parameters.clear_keep_out();
   shard_parameters.clear_fixed_stations();
   shard_parameters.clear_tripod_heights_m();
   shard_parameters.clear_route_start();
-  const LaneJob job{
-      ref,      shard_parameters,        viewpoints,          scene.occupied.size(), SceneFingerprint(scene), token,
-      self_id_, options_.shard_deadline, options.compact_gain};
-  std::vector<std::unique_ptr<PeerLane>> lanes;
+  const LaneJob job{ref,
+                    shard_parameters,
+                    viewpoints,
+                    scene.occupied.size(),
+                    SceneFingerprint(scene),
+                    token,
+                    self_id_,
+                    options_.shard_deadline,
+                    spec.kind,
+                    spec.compact_gain,
+                    spec.what};
+  std::vector<std::unique_ptr<PeerLane<T>>> lanes;
   std::vector<std::thread> threads;
   // Every way out of here (an exception included) stops the lanes and joins their threads first:
   // they hold references to `board` and `job`.
   struct Joiner {
-    ShardBoard& board;
+    ShardBoard<T>& board;
     std::vector<std::thread>& threads;
     ~Joiner() {
       board.Stop();
@@ -551,19 +595,18 @@ Result<DistributedSets> PeerFanOut::Compute(const SceneRef& ref, const v1::PlanP
     }
   } joiner{board, threads};
   for (size_t i = 0; i < addresses.size(); ++i) {
-    lanes.push_back(std::make_unique<PeerLane>(i, addresses[i], StubFor(addresses[i]), job, board));
+    lanes.push_back(std::make_unique<PeerLane<T>>(i, addresses[i], StubFor(addresses[i]), job, board));
     board.LaneStarted();
     threads.emplace_back([lane = lanes.back().get()] { lane->Run(); });
   }
   // This replica's own lane, on the plan's thread: progress and cancellation are checked here.
-  JobContext local = ctx;
-  local.progress = nullptr;
+  JobContext quiet = ctx;
+  quiet.progress = nullptr;
   Status status;
   while (status.ok()) {
-    status = ctx.CheckCancelled("the visibility stage");
+    status = ctx.CheckCancelled(spec.what);
     if (!status.ok()) break;
-    ctx.ReportCount(Stage::kVisibility, board.done(), board.size(), "shards",
-                    fmt::format("{} peers", addresses.size()));
+    ctx.ReportCount(spec.stage, board.done(), board.size(), "shards", fmt::format("{} peers", addresses.size()));
     const std::optional<size_t> k = board.Take(std::chrono::milliseconds(200), !options_.local_shards);
     if (!k) {
       if (board.Finished()) break;
@@ -573,19 +616,36 @@ Result<DistributedSets> PeerFanOut::Compute(const SceneRef& ref, const v1::PlanP
     const auto t0 = Clock::now();
     const std::vector<WorldPoint> slice(viewpoints.begin() + std::ptrdiff_t(begin),
                                         viewpoints.begin() + std::ptrdiff_t(end));
-    Result<std::vector<VoxelSet>> sets = ComputeVisibilitySets(scene, slice, options, local);
-    if (!sets.ok()) {
+    Result<std::vector<T>> items = local(slice, quiet);
+    if (!items.ok()) {
       board.Release(*k);
-      status = sets.status();
+      status = items.status();
       break;
     }
-    board.Deliver(*k, kSelf, std::move(*sets), Seconds(Clock::now() - t0));
+    board.Deliver(*k, kSelf, std::move(*items), Seconds(Clock::now() - t0));
   }
   board.Stop();
   board.CancelLive();
   for (std::thread& t : threads) t.join();
   VC_RETURN_IF_ERROR(status);
-  DistributedSets out = std::move(board).Collect();
+  FanOutResult<T> out = std::move(board).Collect();
+  spdlog::info("fan-out: {}: {} viewpoints in {} shards over {} replicas, {} retried, {} exchanged", spec.what,
+               viewpoints.size(), out.distribution.shards, out.distribution.replicas, out.distribution.retried,
+               HumanBytes(out.distribution.bytes_exchanged));
+  return out;
+}
+
+Result<DistributedSets> PeerFanOut::Compute(const SceneRef& ref, const v1::PlanParameters& parameters,
+                                            const VoxelScene& scene, const std::vector<WorldPoint>& viewpoints,
+                                            const VisibilitySetsOptions& options, const JobContext& ctx) {
+  const ShardSpec spec{v1::SHARD_KIND_VISIBILITY_SETS, options.compact_gain, Stage::kVisibility,
+                       "the visibility stage"};
+  const LocalShard<VoxelSet> local = [&](const std::vector<WorldPoint>& slice, const JobContext& c) {
+    return ComputeVisibilitySets(scene, slice, options, c);
+  };
+  VC_ASSIGN_OR_RETURN(FanOutResult<VoxelSet> got,
+                      FanOut<VoxelSet>(ref, parameters, scene, viewpoints, spec, local, ctx));
+  DistributedSets out{std::move(got.items), got.distribution, std::move(got.warnings)};
   if (options.max_set_bytes > 0) {
     uint64_t bytes = 0;
     for (const VoxelSet& s : out.sets) bytes += s.MemoryBytes();
@@ -596,10 +656,22 @@ Result<DistributedSets> PeerFanOut::Compute(const SceneRef& ref, const v1::PlanP
                                     "resolution_m, lower max_range_m, or raise the memory budget");
     }
   }
-  spdlog::info("fan-out: {} viewpoints in {} shards over {} replicas, {} retried, {} exchanged", viewpoints.size(),
-               out.distribution.shards, out.distribution.replicas, out.distribution.retried,
-               HumanBytes(out.distribution.bytes_exchanged));
   return out;
+}
+
+Result<DistributedFaceValues> PeerFanOut::ComputeFaceValues(const SceneRef& ref, const v1::PlanParameters& parameters,
+                                                            const VoxelScene& scene,
+                                                            const std::vector<WorldPoint>& stations,
+                                                            const EvaluateOptions& options, const JobContext& ctx) {
+  const ShardSpec spec{v1::SHARD_KIND_FACE_VALUES, 0, Stage::kReduction, "the reduction"};
+  const LocalShard<SparseFaceValues> local = [&](const std::vector<WorldPoint>& slice,
+                                                 const JobContext& c) -> Result<std::vector<SparseFaceValues>> {
+    VC_ASSIGN_OR_RETURN(Evaluation e, Evaluate(scene, slice, options, c));
+    return std::move(e.per_viewpoint_sparse_values);
+  };
+  VC_ASSIGN_OR_RETURN(FanOutResult<SparseFaceValues> got,
+                      FanOut<SparseFaceValues>(ref, parameters, scene, stations, spec, local, ctx));
+  return DistributedFaceValues{std::move(got.items), got.distribution, std::move(got.warnings)};
 }
 
 }  // namespace vc::server

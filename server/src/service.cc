@@ -88,14 +88,27 @@ class PlanReactor final : public JobReactor<v1::PlanRequest, v1::PlanResponse> {
       for (const PlannedStation& s : stations) *r.mutable_final_stations()->add_stations() = wire::ToProto(s);
       channel().Post(std::move(r));
     };
+    // The visibility stage and the reduction's evaluation over the replicas (the scene's hash once,
+    // for both; the callbacks run within backend().plan below).
+    std::optional<PeerFanOut::SceneRef> scene_ref;
+    auto ref = [this, &scene_ref]() -> const PeerFanOut::SceneRef& {
+      if (!scene_ref) {
+        scene_ref.emplace();
+        scene_ref->bytes = scene_bytes();
+        scene_ref->sha256 =
+            upload_spec().scene_sha256().empty() ? wire::Sha256Hex(*scene_ref->bytes) : upload_spec().scene_sha256();
+        scene_ref->source_name = upload_spec().source_name();
+      }
+      return *scene_ref;
+    };
     if (fan_out() != nullptr) {
-      callbacks.visibility_sets = [this](const VoxelScene& scene, const std::vector<WorldPoint>& viewpoints,
-                                         const VisibilitySetsOptions& set_options, const JobContext& c) {
-        PeerFanOut::SceneRef ref;
-        ref.bytes = scene_bytes();
-        ref.sha256 = upload_spec().scene_sha256().empty() ? wire::Sha256Hex(*ref.bytes) : upload_spec().scene_sha256();
-        ref.source_name = upload_spec().source_name();
-        return fan_out()->Compute(ref, wire::ToProto(options_), scene, viewpoints, set_options, c);
+      callbacks.visibility_sets = [this, ref](const VoxelScene& scene, const std::vector<WorldPoint>& viewpoints,
+                                              const VisibilitySetsOptions& set_options, const JobContext& c) {
+        return fan_out()->Compute(ref(), wire::ToProto(options_), scene, viewpoints, set_options, c);
+      };
+      callbacks.face_values = [this, ref](const VoxelScene& scene, const std::vector<WorldPoint>& stations,
+                                          const EvaluateOptions& eval_options, const JobContext& c) {
+        return fan_out()->ComputeFaceValues(ref(), wire::ToProto(options_), scene, stations, eval_options, c);
       };
     }
     VC_ASSIGN_OR_RETURN(const PlanResult result, backend().plan(input, options_, ctx, callbacks));

@@ -8,6 +8,9 @@
 
 #include "server/test_server.h"
 #include "vc/client/client.h"
+#include "vc/plan/stages.h"
+#include "vc/scene/scene_input.h"
+#include "vc/wire/face_values_codec.h"
 #include "vc/wire/sha256.h"
 #include "vc/wire/status_mapping.h"
 #include "vc/wire/voxel_set_codec.h"
@@ -42,13 +45,14 @@ server::ServerOptions Coordinator(std::vector<std::string> peers) {
   return o;
 }
 
-Result<PlanResult> PlanOn(const std::string& address, const std::string& token = "") {
+Result<PlanResult> PlanOn(const std::string& address, const std::string& token = "",
+                          const PlanOptions& options = Options()) {
   client::ConnectionOptions conn;
   conn.server = address;
   conn.token = token;
   conn.max_attempts = 1;
   VC_ASSIGN_OR_RETURN(auto c, client::Client::Create(conn));
-  return c->Plan({Room(), "room.ply"}, Options());
+  return c->Plan({Room(), "room.ply"}, options);
 }
 
 // The same plan: stations, coverage, G and every candidate's count.
@@ -62,6 +66,9 @@ void ExpectSamePlan(const PlanResult& a, const PlanResult& b) {
   EXPECT_EQ(a.coverable_voxels, b.coverable_voxels);
   EXPECT_EQ(a.evaluation.overall.global_visibility, b.evaluation.overall.global_visibility);
   EXPECT_EQ(a.heat_map.visible_voxels, b.heat_map.visible_voxels);
+  EXPECT_EQ(a.reduction.matrix, b.reduction.matrix);
+  EXPECT_EQ(a.reduction.removed, b.reduction.removed);
+  EXPECT_EQ(a.reduction.global_visibility_after, b.reduction.global_visibility_after);
 }
 
 bool HasWarning(const PlanResult& r, const std::string& part) {
@@ -150,8 +157,9 @@ TEST(FanOut, ThreeReplicasPlanExactlyAsOne) {
   const auto fanned = PlanOn(testing::Address(*a));
   ASSERT_TRUE(fanned.ok()) << fanned.status().ToString();
   ExpectSamePlan(*alone, *fanned);
-  const size_t viewpoints = fanned->candidate_count;
-  EXPECT_EQ(fanned->distribution.shards, int((viewpoints + 3) / 4));
+  // The visibility stage's shards of candidates, then the reduction's of stations.
+  const size_t viewpoints = fanned->candidate_count, stations = size_t(fanned->reduction.size);
+  EXPECT_EQ(fanned->distribution.shards, int((viewpoints + 3) / 4 + (stations + 3) / 4));
   EXPECT_EQ(fanned->distribution.replicas, 2) << Warnings(*fanned);
   EXPECT_GT(fanned->distribution.bytes_exchanged, Room().size());  // the scene went to both, then sets came back
   EXPECT_TRUE(fanned->warnings.empty()) << Warnings(*fanned);
@@ -164,6 +172,34 @@ TEST(FanOut, ThreeReplicasPlanExactlyAsOne) {
   ExpectSamePlan(*alone, *mixed);
   EXPECT_GE(mixed->distribution.replicas, 1);
   EXPECT_LE(mixed->distribution.replicas, 3);
+}
+
+// The reduction's evaluation of the stations is sharded too: with nine fixed stations (never
+// removed, all evaluated) besides greedy's, it makes three or more shards of 4, and the matrix, the
+// removals and G are the single replica's.
+TEST(FanOut, TheReductionsEvaluationIsShardedAcrossReplicas) {
+  PlanOptions options = Options();
+  for (double x : {1.0, 4.0, 7.0}) {
+    for (double y : {1.0, 3.0, 5.0}) options.fixed_stations.push_back(WorldPoint(x, y, 1.5));
+  }
+  auto b = testing::StartServer(Replica());
+  auto c = testing::StartServer(Replica());
+  ASSERT_TRUE(b && c);
+  const auto alone = PlanOn(testing::Address(*b), "", options);
+  ASSERT_TRUE(alone.ok()) << alone.status().ToString();
+  ASSERT_GE(alone->reduction.size, 9);
+  server::ServerOptions o = Coordinator({testing::Address(*b), testing::Address(*c)});
+  o.local_shards = false;
+  auto a = testing::StartServer(o);
+  ASSERT_TRUE(a);
+  const auto fanned = PlanOn(testing::Address(*a), "", options);
+  ASSERT_TRUE(fanned.ok()) << fanned.status().ToString();
+  ExpectSamePlan(*alone, *fanned);
+  const size_t viewpoints = fanned->candidate_count + options.fixed_stations.size();
+  const size_t stations = size_t(fanned->reduction.size);
+  EXPECT_EQ(fanned->distribution.shards, int((viewpoints + 3) / 4 + (stations + 3) / 4));
+  EXPECT_EQ(fanned->distribution.replicas, 2) << Warnings(*fanned);
+  EXPECT_TRUE(fanned->warnings.empty()) << Warnings(*fanned);
 }
 
 TEST(FanOut, AReplicaListedAmongItsOwnPeersIsSkipped) {
@@ -321,11 +357,13 @@ class PeerCalls : public ::testing::Test {
     EXPECT_TRUE(stub_->PeerHello(&c, req, &resp).ok());
     return resp.has_scene();
   }
-  grpc::Status Shard(const std::string& sha, v1::ShardResponse* resp, const std::string& token = "t") {
+  grpc::Status Shard(const std::string& sha, v1::ShardResponse* resp, const std::string& token = "t",
+                     v1::ShardKind kind = v1::SHARD_KIND_VISIBILITY_SETS) {
     grpc::ClientContext c;
     Prepare(&c, token);
     v1::ShardRequest req;
     req.set_scene_sha256(sha);
+    req.set_kind(kind);
     *req.mutable_parameters() = wire::ToProto(Options());
     *req.add_viewpoints() = wire::ToProto(WorldPoint(2, 2, 1.5));
     *req.add_viewpoints() = wire::ToProto(WorldPoint(100, 100, 100));  // outside the room: sees nothing
@@ -366,6 +404,35 @@ TEST_F(PeerCalls, ComputeShardNeedsTheTokenAndTheSceneAndAnswersWithCheckableSet
   ASSERT_TRUE(inside.ok() && outside.ok());
   EXPECT_GT(inside->count(), resp.occupied_voxels() / 10);
   EXPECT_EQ(outside->count(), 0u);
+}
+
+// The reduction's shards: each station's faces with V > 0, exactly as this process evaluates them.
+TEST_F(PeerCalls, ComputeShardAnswersFaceValuesAsEvaluateGivesThem) {
+  const std::string sha = wire::Sha256Hex(Room());
+  ASSERT_TRUE(Share(sha, Room().size(), Room()).ok());
+  v1::ShardResponse resp;
+  const grpc::Status s = Shard(sha, &resp, "t", v1::SHARD_KIND_FACE_VALUES);
+  ASSERT_TRUE(s.ok()) << s.error_message();
+  EXPECT_EQ(resp.sets_size(), 0);
+  ASSERT_EQ(resp.face_values_size(), 2);
+  auto input = ReadScene(Room(), "room.ply");
+  ASSERT_TRUE(input.ok()) << input.status().ToString();
+  auto voxelized = planner::RunVoxelizeStage({*input}, Options(), {});
+  ASSERT_TRUE(voxelized.ok());
+  ASSERT_EQ(voxelized->scene.occupied.size(), resp.occupied_voxels());
+  EvaluateOptions eval = planner::StationEvaluateOptions(Options());
+  eval.keep_face_values = false;
+  eval.keep_sparse_per_viewpoint_values = true;
+  auto local = Evaluate(voxelized->scene, {WorldPoint(2, 2, 1.5), WorldPoint(100, 100, 100)}, eval);
+  ASSERT_TRUE(local.ok());
+  for (int k = 0; k < 2; ++k) {
+    auto got = wire::DecodeFaceValues(resp.face_values(k), resp.occupied_voxels() * kFacesPerVoxel);
+    ASSERT_TRUE(got.ok()) << got.status().ToString();
+    EXPECT_EQ(got->faces, local->per_viewpoint_sparse_values[k].faces) << k;
+    EXPECT_EQ(got->values, local->per_viewpoint_sparse_values[k].values) << k;
+  }
+  EXPECT_GT(local->per_viewpoint_sparse_values[0].size(), 1000u);
+  EXPECT_EQ(local->per_viewpoint_sparse_values[1].size(), 0u);
 }
 
 }  // namespace

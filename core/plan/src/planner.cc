@@ -173,10 +173,12 @@ Result<PlanResult> Plan(const SceneInput& input, const PlanOptions& options, con
   planner::ReductionOutput reduced = planner::KeepAllStations(stations.size());
   if (options.reduce && !stations.empty()) {
     VC_ASSIGN_OR_RETURN(reduced, runner.Run(Stage::kReduction, [&](const JobContext& c) {
-      return planner::RunReductionStage({scene, stations}, options, c);
+      return planner::RunReductionStage({scene, stations, callbacks.face_values}, options, c);
     }));
   }
   result.reduction = std::move(reduced.reduction);
+  result.distribution.Add(reduced.distribution);
+  for (std::string& w : reduced.warnings) result.warnings.push_back(std::move(w));
 
   FinalStations final_stations = AssembleFinalStations(stations, reduced.keep, result.coverable_voxels);
   std::vector<double> final_floor_z;

@@ -148,7 +148,8 @@ bool PlainSurfaceVisible(const OccupancyGrid& g, const Vector3d& uo, const Voxel
   return false;
 }
 
-double PlainFaceValue(const OccupancyGrid& g, const WorldPoint& o, const VoxelIndex& v, int face) {
+double PlainFaceValue(const OccupancyGrid& g, const WorldPoint& o, const VoxelIndex& v, int face,
+                      double max_range = 75) {
   const Vector3d uo = o / g.resolution_m();
   const int axis = face / 2, side = face % 2;
   int visible = 0;
@@ -168,12 +169,12 @@ double PlainFaceValue(const OccupancyGrid& g, const WorldPoint& o, const VoxelIn
   center[axis] += side ? 0.5 : -0.5;
   center *= g.resolution_m();
   const double d = (center - o).norm();
-  if (d < 0.5 || d > 75) return 0;
+  if (d < 0.5 || d > max_range) return 0;
   if (visible < 4) return 0.3;
   Vector3d n = Vector3d::Zero();
   n[axis] = side ? 1 : -1;
   const double theta = std::acos(std::clamp((center - o).dot(n) / d, -1.0, 1.0));
-  return 0.5 + 0.3 * (1 - (d - 0.5) / 74.5) + 0.2 * std::abs(theta - kPi / 2) / (kPi / 2);
+  return 0.5 + 0.3 * (1 - (d - 0.5) / (max_range - 0.5)) + 0.2 * std::abs(theta - kPi / 2) / (kPi / 2);
 }
 
 VoxelScene RandomScene(std::mt19937_64& rng, int count, int extent, double r) {
@@ -357,6 +358,51 @@ TEST(EvaluateTest, GlobalVisibilityEqualsBruteForce) {
     for (size_t k = 0; k < vps.size(); ++k)
       EXPECT_NEAR(ev->per_viewpoint[k].global_visibility, sum_vp[k] / double(6 * n), 1e-9);
   }
+}
+
+// A short range: Evaluate skips the blocks of corners and voxels (and the bricks of face groups)
+// that lie out of it; every face must still get the oracle's V, and the sparse values must list
+// exactly the faces with V > 0, on one thread and on several (a task per viewpoint, and shared).
+TEST(EvaluateTest, AShortRangeGivesTheOraclesValuesAndSparseValuesListThem) {
+  std::mt19937_64 rng(17);
+  const double r = 0.1, range = 2.5;
+  const VoxelScene s = RandomScene(rng, 1500, 100, r);  // 10 m across
+  const auto vps = RandomViewpoints(rng, 8, 100, r);    // 2 threads: a task per viewpoint; 3: shared
+  size_t seen = 0, beyond = 0;
+  for (int threads : {1, 2, 3}) {
+    EvaluateOptions opt;
+    opt.threads = threads;
+    opt.scanner.max_range_m = range;
+    opt.keep_per_viewpoint_values = true;
+    opt.keep_sparse_per_viewpoint_values = true;
+    auto ev = Evaluate(s, vps, opt);
+    ASSERT_TRUE(ev.ok()) << ev.status().ToString();
+    ASSERT_EQ(ev->per_viewpoint_sparse_values.size(), vps.size());
+    for (size_t k = 0; k < vps.size(); ++k) {
+      const std::vector<float>& dense = ev->per_viewpoint_face_values[k];
+      const SparseFaceValues& sparse = ev->per_viewpoint_sparse_values[k];
+      ASSERT_EQ(sparse.faces.size(), sparse.values.size());
+      size_t next = 0;
+      for (size_t slot = 0; slot < dense.size(); ++slot) {
+        const VoxelIndex v = KeyToIndex(s.occupied[slot / 6]);
+        if (threads == 1) {
+          ASSERT_NEAR(dense[slot], PlainFaceValue(s.grid, vps[k], v, int(slot % 6), range), 1e-6)
+              << "viewpoint " << k << " voxel " << slot / 6 << " face " << slot % 6;
+          seen += dense[slot] > 0;
+          beyond += (Vector3d(v.x + 0.5, v.y + 0.5, v.z + 0.5) * r - vps[k]).norm() > range + r;
+        }
+        if (dense[slot] > 0) {
+          ASSERT_LT(next, sparse.size());
+          EXPECT_EQ(sparse.faces[next], slot);
+          EXPECT_EQ(sparse.values[next], dense[slot]);
+          ++next;
+        }
+      }
+      EXPECT_EQ(next, sparse.size());
+    }
+  }
+  EXPECT_GT(seen, 500u);
+  EXPECT_GT(beyond, 10000u);  // most of the scene lies out of range
 }
 
 // With enough viewpoints per thread each thread evaluates whole viewpoints and the threads' best

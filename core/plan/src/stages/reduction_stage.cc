@@ -27,6 +27,7 @@ Result<ReductionOutput> RunReductionStage(const ReductionInput& in, const PlanOp
   const uint64_t faces_total = in.scene.occupied.size() * kFacesPerVoxel;
   const uint64_t cache_budget = std::min<uint64_t>(options.memory_budget_bytes / 4, uint64_t{1} << 30);
   std::optional<Evaluation> all_evaluation;
+  ReductionOutput out;
   const StationFaceValuesFn values = [&](const std::vector<int>& batch,
                                          const JobContext& sub) -> Result<std::vector<SparseFaceValues>> {
     std::vector<WorldPoint> positions;
@@ -34,6 +35,17 @@ Result<ReductionOutput> RunReductionStage(const ReductionInput& in, const PlanOp
     for (int s : batch) positions.push_back(stations[s]);
     EvaluateOptions eval_options = StationEvaluateOptions(options);
     eval_options.keep_sparse_per_viewpoint_values = true;
+    if (in.face_values) {  // across replicas
+      eval_options.keep_face_values = false;
+      VC_ASSIGN_OR_RETURN(DistributedFaceValues d, in.face_values(in.scene, positions, eval_options, sub));
+      if (d.values.size() != positions.size()) {
+        return InternalError("the distributed reduction returned face values of " + std::to_string(d.values.size()) +
+                             " stations for " + std::to_string(positions.size()));
+      }
+      out.distribution.Add(d.distribution);
+      for (std::string& w : d.warnings) out.warnings.push_back(std::move(w));
+      return std::move(d.values);
+    }
     const bool whole = batch.size() == stations.size() && !all_evaluation;  // the first call, every station
     eval_options.keep_face_values = whole;
     VC_ASSIGN_OR_RETURN(Evaluation e, Evaluate(in.scene, positions, eval_options, sub));
@@ -46,7 +58,8 @@ Result<ReductionOutput> RunReductionStage(const ReductionInput& in, const PlanOp
   red_options.reduce_to = options.reduce_to;
   red_options.threads = options.threads;
   red_options.cache_budget_bytes = cache_budget;
-  red_options.batch_stations = kReductionStationsPerBatch;
+  // Across replicas, every station in one call: the replicas split it into shards among them.
+  red_options.batch_stations = in.face_values ? std::max<int>(1, int(stations.size())) : kReductionStationsPerBatch;
   red_options.fixed = in.stations.fixed;
   // Registration: no removal may split the stations' scan graph into more groups.
   OverlapMatrix overlaps;
@@ -62,7 +75,6 @@ Result<ReductionOutput> RunReductionStage(const ReductionInput& in, const PlanOp
   }
   VC_ASSIGN_OR_RETURN(ReductionRun run,
                       RunReduction(static_cast<int>(stations.size()), faces_total, values, red_options, ctx));
-  ReductionOutput out;
   Reduction& reduction = out.reduction;
   reduction.size = run.initial.size;
   reduction.matrix = run.initial.loss;

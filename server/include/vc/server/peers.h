@@ -17,6 +17,7 @@
 
 #include <grpcpp/grpcpp.h>
 
+#include <functional>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -30,6 +31,9 @@
 #include "vc/v1/planner.grpc.pb.h"
 
 namespace vc::server {
+
+template <class T>
+struct FanOutResult;  // peers.cc
 
 class PeerFanOut {
  public:
@@ -50,6 +54,13 @@ class PeerFanOut {
                                   const std::vector<WorldPoint>& viewpoints, const VisibilitySetsOptions& options,
                                   const JobContext& ctx);
 
+  // The faces with V > 0 of each of `stations` on `scene`, exactly as vc::Evaluate(scene, stations,
+  // options, ctx) with keep_sparse_per_viewpoint_values gives them (the reduction's evaluation);
+  // `options` must be what the plan's `parameters` make (peers rebuild them from those).
+  Result<DistributedFaceValues> ComputeFaceValues(const SceneRef& ref, const v1::PlanParameters& parameters,
+                                                  const VoxelScene& scene, const std::vector<WorldPoint>& stations,
+                                                  const EvaluateOptions& options, const JobContext& ctx);
+
   // The peers' addresses now (--peers, then what --peers-dns resolves to); `warnings` gets a
   // name that does not resolve.
   std::vector<std::string> Addresses(std::vector<std::string>* warnings) const;
@@ -58,6 +69,23 @@ class PeerFanOut {
   PeerFanOut(const ServerOptions& options, std::string self_id, std::shared_ptr<grpc::ChannelCredentials> creds)
       : options_(options), self_id_(std::move(self_id)), creds_(std::move(creds)) {}
   std::shared_ptr<v1::StationPlanner::Stub> StubFor(const std::string& address);
+
+  // One kind of shard: what peers are asked for, how decoded sets are kept, and for progress and
+  // messages, the stage and its name.
+  struct ShardSpec {
+    v1::ShardKind kind;
+    double compact_gain;
+    Stage stage;
+    const char* what;
+  };
+  template <class T>
+  using LocalShard = std::function<Result<std::vector<T>>(const std::vector<WorldPoint>&, const JobContext&)>;
+  // The fan-out itself, for either kind: shards of `viewpoints` to the peers' lanes and this
+  // replica's own, which computes with `local`.
+  template <class T>
+  Result<FanOutResult<T>> FanOut(const SceneRef& ref, const v1::PlanParameters& parameters, const VoxelScene& scene,
+                                 const std::vector<WorldPoint>& viewpoints, const ShardSpec& spec,
+                                 const LocalShard<T>& local, const JobContext& ctx);
 
   const ServerOptions options_;
   const std::string self_id_;

@@ -4,6 +4,7 @@
 // progress per stage. The stages are stages.h's functions, run by one StageRunner (stage_runner.h).
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <functional>
 #include <limits>
@@ -83,13 +84,20 @@ struct FieldTime {
 // The field time of `stations` stations and a walk of `walk_m` metres under `options`.
 FieldTime ComputeFieldTime(size_t stations, double walk_m, const PlanOptions& options);
 
-// How a plan's visibility stage was spread over vc-server replicas (docs/DEPLOY.md, "Scaling out").
-// All zero for a plan computed in one process.
+// How a plan's visibility stage and its reduction's evaluation of the stations were spread over
+// vc-server replicas (docs/DEPLOY.md, "Scaling out"). All zero for a plan computed in one process.
 struct Distribution {
-  int replicas = 0;              // replicas that computed at least one shard (this one included)
-  int shards = 0;                // shards of candidates the stage was split into
+  int replicas = 0;              // replicas that computed a shard (this one included; the larger stage's count)
+  int shards = 0;                // shards of candidates (visibility) and of stations (reduction)
   int retried = 0;               // shard attempts started again elsewhere (failed, refused or slow)
-  uint64_t bytes_exchanged = 0;  // bytes sent to and received from peers (scenes, requests, sets)
+  uint64_t bytes_exchanged = 0;  // bytes sent to and received from peers (scenes, requests, sets, values)
+  // Adds another stage's figures.
+  void Add(const Distribution& o) {
+    replicas = std::max(replicas, o.replicas);
+    shards += o.shards;
+    retried += o.retried;
+    bytes_exchanged += o.bytes_exchanged;
+  }
 };
 
 // The visibility sets of `viewpoints`, computed elsewhere than ComputeVisibilitySets (vc-server
@@ -103,6 +111,17 @@ struct DistributedSets {
 using VisibilitySetsFn =
     std::function<Result<DistributedSets>(const VoxelScene& scene, const std::vector<WorldPoint>& viewpoints,
                                           const VisibilitySetsOptions& options, const JobContext& ctx)>;
+
+// The reduction's per-station evaluation, by its caller (across replicas): for each station its
+// faces with V > 0, exactly as vc::Evaluate with keep_sparse_per_viewpoint_values gives them.
+struct DistributedFaceValues {
+  std::vector<SparseFaceValues> values;
+  Distribution distribution;
+  std::vector<std::string> warnings;
+};
+using FaceValuesFn =
+    std::function<Result<DistributedFaceValues>(const VoxelScene& scene, const std::vector<WorldPoint>& stations,
+                                                const EvaluateOptions& options, const JobContext& ctx)>;
 
 struct PlanResult {
   PlanOptions options;
@@ -143,7 +162,8 @@ struct PlanResult {
   // How the selection's station count relates to the optimum over the candidates (docs/PLANNING.md,
   // "Exact selection"): the selection stage's, before refinement and reduction.
   planner::Optimality optimality;
-  // The visibility stage across replicas (PlanCallbacks::visibility_sets); zero when local.
+  // The visibility stage and the reduction across replicas (PlanCallbacks::visibility_sets,
+  // face_values); zero when local.
   Distribution distribution;
 };
 
@@ -163,6 +183,9 @@ struct PlanCallbacks {
   // The visibility stage's sets (fixed stations first, then the candidates), when set: vc-server
   // fans them out over its peers. Unset: ComputeVisibilitySets in this process.
   VisibilitySetsFn visibility_sets;
+  // When set, the reduction asks it for its stations' face values (all stations in one call)
+  // instead of evaluating them itself; the same contract as visibility_sets.
+  FaceValuesFn face_values;
 };
 
 // Runs the whole pipeline on an already-read input. INVALID_ARGUMENT for bad options,

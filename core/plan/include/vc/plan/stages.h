@@ -149,6 +149,7 @@ struct RefineOutput {
 struct ReductionInput {
   const VoxelScene& scene;
   const Stations& stations;
+  const FaceValuesFn& face_values;  // when set, the stations' values come from it (PlanCallbacks)
 };
 struct ReductionOutput {
   Reduction reduction;    // the matrix, the removed stations and G before and after
@@ -156,6 +157,8 @@ struct ReductionOutput {
   // The evaluation of all stations (with face values), when it was computed and nothing was
   // removed, so the evaluation stage reuses it.
   std::optional<Evaluation> evaluation;
+  Distribution distribution;          // of the face values, when face_values computed them
+  std::vector<std::string> warnings;  // face_values' warnings, for PlanResult::warnings
 };
 // Stations the reduction evaluates at once (each call of vc::Evaluate pays for the scene's
 // lattice and face groups once, ~3 s on a 6.8 M-voxel site).

@@ -1,0 +1,21 @@
+// A station's faces with V > 0 (vc::SparseFaceValues) on the wire between replicas, as the
+// reduction's evaluation shards carry them (v1::FaceValues, docs/PROTOCOL.md "Between replicas"):
+// the face indices and the values as packed little-endian arrays. Packed arrays, not Roaring: the
+// values travel with the indices one for one, and a station's faces are a small share of the
+// site's, so the array is already the compact form. Pure functions, thread-safe.
+#pragma once
+
+#include <cstdint>
+
+#include "vc/base/status.h"
+#include "vc/v1/planner.pb.h"
+#include "vc/visibility/visibility.h"
+
+namespace vc::wire {
+
+v1::FaceValues EncodeFaceValues(const SparseFaceValues& values);
+// DATA_LOSS when the arrays are not whole, differ in length, or list faces that are not ascending
+// or not below faces_total.
+Result<SparseFaceValues> DecodeFaceValues(const v1::FaceValues& message, uint64_t faces_total);
+
+}  // namespace vc::wire
