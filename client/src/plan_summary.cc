@@ -105,7 +105,7 @@ std::string OptimalityLine(const PlanResult& r) {
 std::string DistributionLine(const PlanResult& r) {
   const Distribution& d = r.distribution;
   if (d.shards == 0) return "";
-  return Format("visibility: %d shard(s) on %d replica(s), %d retried, %.1f MiB exchanged\n", d.shards, d.replicas,
+  return Format("fanned out: %d shard(s) on %d replica(s), %d retried, %.1f MiB exchanged\n", d.shards, d.replicas,
                 d.retried, double(d.bytes_exchanged) / 1048576.0);
 }
 

@@ -62,7 +62,7 @@ assert d["shards"] == (n + 3) // 4, d
 assert d["replicas"] == 2, d
 assert d["bytes_exchanged"] > 0, d
 PY
-grep -q "visibility: .* shard(s) on 2 replica(s)" "$work/fanned.out" || fail "vc-client printed no distribution line"
+grep -q "fanned out: .* shard(s) on 2 replica(s)" "$work/fanned.out" || fail "vc-client printed no distribution line"
 grep -q "rpc ComputeShard .* status=OK" "$work/b.log" || fail "B computed no shard"
 grep -q "rpc ComputeShard .* status=OK" "$work/c.log" || fail "C computed no shard"
 

@@ -15,7 +15,8 @@ std::string PlanSummary(const PlanResult& result);
 // at most 4 more than the optimum (bound 33)"; empty for a greedy selection without a bound),
 // after a line on the local-candidates loop when it ran.
 std::string OptimalityLine(const PlanResult& result);
-// "visibility: N shard(s) on R replica(s), ..." for a plan fanned out over replicas; "" otherwise.
+// "fanned out: N shard(s) on R replica(s), ..." for a plan fanned out over replicas (visibility and
+// reduction shards together); "" otherwise.
 std::string DistributionLine(const PlanResult& result);
 
 // A duration as a crew reads it: "45 s", "12 min", "1 h 05 min".
