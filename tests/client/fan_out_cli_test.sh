@@ -2,6 +2,7 @@
 # Scaling out with the real binaries (docs/DEPLOY.md, "Scaling out"): three vc-server processes on
 # loopback plan a real scan exactly as one does (same stations.csv, coverage and G); then one of the
 # two peers is killed (SIGKILL) while it computes a shard, and the plan still completes, the same,
+# (the shards are of candidates in the visibility stage and of stations in the reduction)
 # with the retry in plan.json's `distribution` and a warning naming the dead replica.
 # Usage: fan_out_cli_test.sh VC_SERVER VC_CLIENT SCENE
 set -euo pipefail
@@ -57,8 +58,10 @@ same_plan fanned
 python3 - "$work/fanned/plan.json" <<'PY' || fail "fanned: wrong distribution"
 import json, sys
 d = json.load(open(sys.argv[1]))["distribution"]
-n = json.load(open(sys.argv[1]))["candidates"]["count"]
-assert d["shards"] == (n + 3) // 4, d
+p = json.load(open(sys.argv[1]))
+n, m = p["candidates"]["count"], p["reduction"]["size"]
+assert d["shards"] == (n + 3) // 4 + (m + 3) // 4, d  # the candidates', then the reduction's stations'
+assert p["reduction"]["size"] >= 69, p["reduction"]["size"]
 assert d["replicas"] == 2, d
 assert d["bytes_exchanged"] > 0, d
 PY

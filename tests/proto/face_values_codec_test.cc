@@ -32,10 +32,10 @@ TEST(FaceValuesCodec, RefusesWhatIsNotAStationsFaces) {
   auto code = [](const SparseFaceValues& s, uint64_t faces_total) {
     return wire::DecodeFaceValues(wire::EncodeFaceValues(s), faces_total).status().code();
   };
-  EXPECT_EQ(code({{3, 2}, {0.5f, 0.5f}}, 10), StatusCode::kDataLoss);  // not ascending
-  EXPECT_EQ(code({{2, 2}, {0.5f, 0.5f}}, 10), StatusCode::kDataLoss);  // repeated
+  EXPECT_EQ(code({{3, 2}, {0.5f, 0.5f}}, 10), StatusCode::kDataLoss);   // not ascending
+  EXPECT_EQ(code({{2, 2}, {0.5f, 0.5f}}, 10), StatusCode::kDataLoss);   // repeated
   EXPECT_EQ(code({{2, 10}, {0.5f, 0.5f}}, 10), StatusCode::kDataLoss);  // beyond the faces
-  EXPECT_EQ(code({{2, 3}, {0.5f}}, 10), StatusCode::kDataLoss);        // a value missing
+  EXPECT_EQ(code({{2, 3}, {0.5f}}, 10), StatusCode::kDataLoss);         // a value missing
   v1::FaceValues torn = wire::EncodeFaceValues({{1, 2}, {0.5f, 0.5f}});
   torn.mutable_faces()->pop_back();
   torn.mutable_values()->pop_back();
