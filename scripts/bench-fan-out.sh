@@ -2,8 +2,9 @@
 # One replica against three on this host (docs/BENCHMARKS.md, "Fanning out: overhead per shard"):
 # plans SCENE through a lone vc-server, then through a coordinator with two peers (all three on
 # loopback, sharing this machine's cores, so only the overhead shows, not a speed-up), in shards
-# of SHARD candidates, and prints the visibility stage's time both ways, the shards, the bytes
-# exchanged and per shard, and whether the stations agree. Greedy selection (deterministic).
+# of SHARD candidates (and stations, in the reduction), and prints the visibility stage's and the
+# reduction's time both ways, the shards, the bytes exchanged and per shard, and whether the
+# stations, coverage and reduction agree. Greedy selection (deterministic).
 # Usage: scripts/bench-fan-out.sh [BUILD_DIR (default build/release)] [SCENE (default geb079; hall, a file)]
 #   [SHARD (default 128)] [-- vc-client FLAGS...]
 set -euo pipefail
@@ -58,11 +59,22 @@ plan three "$a_addr"
 python3 - "$work/one/plan.json" "$work/three/plan.json" "$scene" "$shard" <<'PY'
 import json, sys
 one, three = (json.load(open(p)) for p in sys.argv[1:3])
-d = three["distribution"]
-same = one["viewpoints"] == three["viewpoints"] and one["coverage"] == three["coverage"]
-v1, v3 = one["timings_s"]["visibility"], three["timings_s"]["visibility"]
-print(f"| scene | candidates | shard | visibility, 1 replica | visibility, 3 replicas on 1 host | shards | replicas | retried | bytes exchanged | per shard | same plan |")
-print(f"|---|---|---|---|---|---|---|---|---|---|---|")
-print(f"| {sys.argv[3]} | {one['candidates']['count']} | {sys.argv[4]} | {v1:.2f} s | {v3:.2f} s ({v3 / v1:.2f}x) | {d['shards']} | {d['replicas']} | {d['retried']} | {d['bytes_exchanged'] / 1048576:.1f} MiB | {d['bytes_exchanged'] / d['shards'] / 1024:.0f} KiB, {(v3 - v1) / d['shards'] * 1000:+.0f} ms | {'yes' if same else 'NO'} |")
+d, shard = three["distribution"], int(sys.argv[4])
+same = (one["viewpoints"] == three["viewpoints"] and one["coverage"] == three["coverage"]
+        and one["reduction"] == three["reduction"])
+t1, t3 = one["timings_s"], three["timings_s"]
+v1, v3 = t1["visibility"], t3["visibility"]
+r1, r3 = t1.get("reduction", 0.0), t3.get("reduction", 0.0)
+vis_shards = -(-one["candidates"]["count"] // shard)
+red_shards = -(-one["reduction"]["size"] // shard) if one["reduction"]["size"] else 0
+if vis_shards + red_shards < 2:  # one shard per stage: computed locally, nothing fanned out
+    vis_shards = red_shards = 0
+print("| scene | candidates | stations | shard | visibility, 1 → 3 replicas | reduction, 1 → 3 replicas | shards (visibility + reduction) | replicas | retried | bytes exchanged | per shard | same plan |")
+print("|---|---|---|---|---|---|---|---|---|---|---|---|")
+per = (f"{d['bytes_exchanged'] / d['shards'] / 1024:.0f} KiB, {((v3 - v1) + (r3 - r1)) / d['shards'] * 1000:+.0f} ms"
+       if d and d["shards"] else "(computed locally)")
+print(f"| {sys.argv[3]} | {one['candidates']['count']} | {one['reduction']['size']} | {shard} | {v1:.2f} → {v3:.2f} s "
+      f"| {r1:.2f} → {r3:.2f} s | {d['shards'] if d else 0} ({vis_shards} + {red_shards}) | {d['replicas'] if d else 1} "
+      f"| {d['retried'] if d else 0} | {(d['bytes_exchanged'] if d else 0) / 1048576:.1f} MiB | {per} | {'yes' if same else 'NO'} |")
 sys.exit(0 if same else 1)
 PY

@@ -97,7 +97,7 @@ TEST(DistributionLineTest, OnlyAFannedOutPlanGetsOne) {
   EXPECT_EQ(DistributionLine(r), "");
   r.distribution = {3, 31, 2, 3 * 1048576 + 524288};
   EXPECT_EQ(DistributionLine(r), "fanned out: 31 shard(s) on 3 replica(s), 2 retried, 3.5 MiB exchanged\n");
-  EXPECT_NE(PlanSummary(r).find("visibility: 31 shard(s)"), std::string::npos);
+  EXPECT_NE(PlanSummary(r).find("fanned out: 31 shard(s)"), std::string::npos);
 }
 
 }  // namespace
