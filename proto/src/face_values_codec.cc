@@ -32,6 +32,10 @@ Result<SparseFaceValues> DecodeFaceValues(const v1::FaceValues& message, uint64_
       return DataLossError("face values: face " + std::to_string(out.faces[k]) + " at position " + std::to_string(k) +
                            " is not ascending below " + std::to_string(faces_total));
     }
+    if (!(out.values[k] > 0.f && out.values[k] <= 1.f)) {  // V of a face seen is in (0, 1]; NaN fails too
+      return DataLossError("face values: V " + std::to_string(out.values[k]) + " of face " +
+                           std::to_string(out.faces[k]) + " is not in (0, 1]");
+    }
   }
   return out;
 }

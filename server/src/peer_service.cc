@@ -19,6 +19,8 @@ namespace internal {
 namespace {
 
 using Clock = std::chrono::steady_clock;
+// The most a face-values shard's answer may carry (the coordinator computes a bigger one itself).
+constexpr uint64_t kMaxFaceValuesBytes = uint64_t{1} << 30;
 
 // ComputeShard's work, on a worker thread.
 Status RunShard(ServiceState& state, const v1::ShardRequest& request, v1::ShardResponse* response,
@@ -62,6 +64,14 @@ Status RunShard(ServiceState& state, const v1::ShardRequest& request, v1::ShardR
       eval_options.keep_face_values = false;
       eval_options.keep_sparse_per_viewpoint_values = true;
       VC_ASSIGN_OR_RETURN(const Evaluation e, Evaluate(*scene, viewpoints, eval_options, ctx));
+      uint64_t bytes = 0;
+      for (const SparseFaceValues& v : e.per_viewpoint_sparse_values) bytes += v.size() * 8;
+      if (bytes > kMaxFaceValuesBytes) {  // far below protobuf's 2 GiB per message
+        return InvalidArgumentError(fmt::format(
+            "ComputeShard: the face values of {} stations take {}, over {} per shard; lower the coordinator's "
+            "--shard-candidates",
+            viewpoints.size(), HumanBytes(bytes), HumanBytes(kMaxFaceValuesBytes)));
+      }
       for (const SparseFaceValues& v : e.per_viewpoint_sparse_values) {
         *response->add_face_values() = wire::EncodeFaceValues(v);
       }

@@ -617,6 +617,9 @@ Result<FanOutResult<T>> PeerFanOut::FanOut(const SceneRef& ref, const v1::PlanPa
     const std::vector<WorldPoint> slice(viewpoints.begin() + std::ptrdiff_t(begin),
                                         viewpoints.begin() + std::ptrdiff_t(end));
     Result<std::vector<T>> items = local(slice, quiet);
+    if (items.ok() && items->size() != slice.size()) {
+      items = InternalError(fmt::format("{}: {} results for {} viewpoints", spec.what, items->size(), slice.size()));
+    }
     if (!items.ok()) {
       board.Release(*k);
       status = items.status();

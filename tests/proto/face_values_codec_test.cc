@@ -1,10 +1,12 @@
 // Sparse face values between replicas: exact round trips (empty, one, many with every float bit
-// pattern kept) and DATA_LOSS for arrays that are torn, of unequal length, unsorted, repeated or
-// beyond the scene's faces.
+// pattern kept) and DATA_LOSS for arrays that are torn, of unequal length, unsorted, repeated,
+// beyond the scene's faces, or with a V outside (0, 1].
 #include "vc/wire/face_values_codec.h"
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <limits>
 #include <random>
 
 namespace vc {
@@ -36,6 +38,10 @@ TEST(FaceValuesCodec, RefusesWhatIsNotAStationsFaces) {
   EXPECT_EQ(code({{2, 2}, {0.5f, 0.5f}}, 10), StatusCode::kDataLoss);   // repeated
   EXPECT_EQ(code({{2, 10}, {0.5f, 0.5f}}, 10), StatusCode::kDataLoss);  // beyond the faces
   EXPECT_EQ(code({{2, 3}, {0.5f}}, 10), StatusCode::kDataLoss);         // a value missing
+  for (float bad : {0.f, -0.5f, 1.5f, std::numeric_limits<float>::infinity(), std::nanf("")}) {
+    EXPECT_EQ(code({{2, 3}, {0.5f, bad}}, 10), StatusCode::kDataLoss) << bad;  // V outside (0, 1]
+  }
+  EXPECT_EQ(code({{2, 3}, {0.3f, 1.f}}, 10), StatusCode::kOk);
   v1::FaceValues torn = wire::EncodeFaceValues({{1, 2}, {0.5f, 0.5f}});
   torn.mutable_faces()->pop_back();
   torn.mutable_values()->pop_back();

@@ -190,12 +190,21 @@ Result<ReductionRun> RunReduction(int num_stations, uint64_t faces_total, const 
   uint64_t cache_bytes = 0;
   std::vector<SparseFaceValues> cache(num_stations);
   std::vector<FaceTop3> top3 = internal::FilledOnHugePages(faces_total, FaceTop3{});
-  const size_t batch = static_cast<size_t>(std::max(options.batch_stations, 1));
+  // Stations per call: at most batch_stations, and as many as keep the batch in flight within the
+  // cache budget too — first for the worst case (every face seen: 8 bytes a face), then for what
+  // the stations asked so far saw on average.
+  const size_t most = static_cast<size_t>(std::max(options.batch_stations, 1));
+  auto batch_for = [&](uint64_t bytes_per_station) {
+    return static_cast<size_t>(
+        std::clamp<uint64_t>(options.cache_budget_bytes / std::max<uint64_t>(bytes_per_station, 1), 1, most));
+  };
+  size_t batch = batch_for(faces_total * (sizeof(uint32_t) + sizeof(float)));
+  uint64_t bytes_seen = 0, stations_seen = 0;
 
   // Streams every active station's values into a fresh top-3 table, a batch at a time.
   auto build = [&](const std::vector<int>& stations, double progress_from, double progress_to) -> Status {
     std::fill(top3.begin(), top3.end(), FaceTop3{});
-    for (size_t first = 0; first < stations.size(); first += batch) {
+    for (size_t first = 0; first < stations.size();) {
       const std::vector<int> part(stations.begin() + first,
                                   stations.begin() + std::min(first + batch, stations.size()));
       JobContext sub = ctx;
@@ -215,6 +224,8 @@ Result<ReductionRun> RunReduction(int num_stations, uint64_t faces_total, const 
         const int s = part[k];
         SparseFaceValues& vals = (*v)[k];
         VC_RETURN_IF_ERROR(CheckFaceValues(vals, s, faces_total));
+        bytes_seen += vals.MemoryBytes();
+        ++stations_seen;
         // One station's faces are distinct, so its entries go in in parallel.
         VC_RETURN_IF_ERROR(
             ParallelChunks(vals.size(), kChunk, options.threads, ctx, [&](uint64_t, uint64_t b, uint64_t e) {
@@ -231,6 +242,8 @@ Result<ReductionRun> RunReduction(int num_stations, uint64_t faces_total, const 
         }
       }
       ctx.Report(Stage::kReduction, hi);
+      first += part.size();
+      batch = batch_for(bytes_seen / stations_seen);
     }
     return Status::Ok();
   };

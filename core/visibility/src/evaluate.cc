@@ -336,7 +336,6 @@ Result<Evaluation> EvaluateExact(const EvaluationJob& job, Evaluation ev) {
   // Allocated here, in the calling thread, like every large allocation of this mode: running out
   // of memory must not happen in a worker thread. Each viewpoint's values are filled by the
   // thread that evaluates it (huge_pages.h: first touch is the costly part).
-  if (options.keep_sparse_per_viewpoint_values) ev.per_viewpoint_sparse_values.resize(nv);
   if (options.keep_per_viewpoint_values) {
     ev.per_viewpoint_face_values.resize(nv);
     for (std::vector<float>& values : ev.per_viewpoint_face_values) {
@@ -355,6 +354,12 @@ Result<Evaluation> EvaluateExact(const EvaluationJob& job, Evaluation ev) {
   const BlockBoxes voxel_boxes(
       n, [&](size_t i) { return index[i]; }, 0.0, 1.0);
   const uint64_t voxel_chunks = (n + kVoxelChunk - 1) / kVoxelChunk;
+  // With keep_sparse_per_viewpoint_values: per viewpoint and chunk of voxels, the faces with V > 0,
+  // joined in chunk order at the end, in this thread (the workers only fill chunk-sized pieces).
+  std::vector<std::vector<SparseFaceValues>> sparse_chunks;
+  if (options.keep_sparse_per_viewpoint_values) {
+    sparse_chunks.assign(nv, std::vector<SparseFaceValues>(voxel_chunks));
+  }
   StageProgress progress(ctx, Stage::kEvaluation, nv, nv, "stations");
   // Corners that groups of faces decide at once (surface_groups.h), per viewpoint.
   const internal::SurfaceTargets targets(g, index, NotEnclosed(g, index));
@@ -370,8 +375,7 @@ Result<Evaluation> EvaluateExact(const EvaluationJob& job, Evaluation ev) {
           tallies(voxel_chunks),
           best(internal::FilledOnHugePages(slots, 0.0)),
           best_p(internal::FilledOnHugePages(slots, uint8_t{0})),
-          viewer(viewer_slots, kNoViewer),
-          sparse(voxel_chunks) {}
+          viewer(viewer_slots, kNoViewer) {}
     std::vector<uint64_t> visible_bits, decided_bits;
     std::vector<Tally> tallies;  // per chunk of voxels, for the viewpoint at hand
     std::vector<double> best;
@@ -379,8 +383,6 @@ Result<Evaluation> EvaluateExact(const EvaluationJob& job, Evaluation ev) {
     // With keep_face_values: per voxel, the viewpoint that alone gives it V > 0 so far (or
     // kNoViewer / kSeveralViewers).
     std::vector<int32_t> viewer;
-    // With keep_sparse_per_viewpoint_values: per chunk of voxels, the viewpoint's faces with V > 0.
-    std::vector<SparseFaceValues> sparse;
   };
   const size_t corner_words = (corners.size() + 63) / 64;
   // Viewpoint k into `w`, on `threads` workers (1: all in the calling thread, with no atomics).
@@ -438,8 +440,7 @@ Result<Evaluation> EvaluateExact(const EvaluationJob& job, Evaluation ev) {
     const bool keep_sparse = options.keep_sparse_per_viewpoint_values;
     VC_RETURN_IF_ERROR(ParallelChunks(n, kVoxelChunk, threads, ctx, [&](uint64_t chunk, uint64_t b, uint64_t e) {
       Tally& t = tallies[chunk];
-      SparseFaceValues& sparse = w.sparse[chunk];
-      if (keep_sparse) sparse.faces.clear(), sparse.values.clear();
+      SparseFaceValues* sparse = keep_sparse ? &sparse_chunks[k][chunk] : nullptr;
       for (uint64_t i = b; i < e; ++i) {
         if (i % kCullBlock == 0 && voxel_boxes.OutOfRange(limits[k], i / kCullBlock)) {
           i += kCullBlock - 1;  // the whole block (chunks hold whole blocks)
@@ -461,9 +462,9 @@ Result<Evaluation> EvaluateExact(const EvaluationJob& job, Evaluation ev) {
           t.Add(p, val);
           const size_t slot = i * kFacesPerVoxel + f;
           if (keep) (*keep)[slot] = float(val);
-          if (keep_sparse && val > 0) {
-            sparse.faces.push_back(uint32_t(slot));
-            sparse.values.push_back(float(val));
+          if (sparse && val > 0) {
+            sparse->faces.push_back(uint32_t(slot));
+            sparse->values.push_back(float(val));
           }
           KeepBest(val, uint8_t(p), w.best[slot], w.best_p[slot]);
           seen |= val > 0;
@@ -474,17 +475,6 @@ Result<Evaluation> EvaluateExact(const EvaluationJob& job, Evaluation ev) {
     Tally total;
     for (const Tally& t : tallies) total.Merge(t);
     ev.per_viewpoint[k] = total.Figures(faces_total);
-    if (keep_sparse) {  // the chunks in order: faces ascending
-      SparseFaceValues& out = ev.per_viewpoint_sparse_values[k];
-      size_t count = 0;
-      for (const SparseFaceValues& c : w.sparse) count += c.size();
-      out.faces.reserve(count);
-      out.values.reserve(count);
-      for (const SparseFaceValues& c : w.sparse) {
-        out.faces.insert(out.faces.end(), c.faces.begin(), c.faces.end());
-        out.values.insert(out.values.end(), c.values.begin(), c.values.end());
-      }
-    }
     progress.Add(1);
     return Status::Ok();
   };
@@ -542,6 +532,21 @@ Result<Evaluation> EvaluateExact(const EvaluationJob& job, Evaluation ev) {
       KeepBest(works[t]->best[slot], works[t]->best_p[slot], best[slot], best_p[slot]);
     for (size_t i = 0; i < viewer.size(); ++i) viewer[i] = CombineViewers(viewer[i], works[t]->viewer[i]);
   }
+  if (options.keep_sparse_per_viewpoint_values) {  // each viewpoint's chunks in order: faces ascending
+    ev.per_viewpoint_sparse_values.resize(nv);
+    for (size_t k = 0; k < nv; ++k) {
+      SparseFaceValues& out = ev.per_viewpoint_sparse_values[k];
+      size_t count = 0;
+      for (const SparseFaceValues& c : sparse_chunks[k]) count += c.size();
+      out.faces.reserve(count);
+      out.values.reserve(count);
+      for (SparseFaceValues& c : sparse_chunks[k]) {
+        out.faces.insert(out.faces.end(), c.faces.begin(), c.faces.end());
+        out.values.insert(out.values.end(), c.values.begin(), c.values.end());
+        c = SparseFaceValues{};
+      }
+    }
+  }
   // Overall: the best V of each face over all viewpoints.
   Tally total;
   for (size_t i = 0; i < n; ++i)
@@ -571,6 +576,7 @@ Result<Evaluation> Evaluate(const VoxelScene& scene, const std::vector<WorldPoin
   ev.resolution_m = scene.resolution_m;
   ev.faces_total = job.faces_total;
   ev.per_viewpoint.resize(viewpoints.size());
+  if (options.keep_sparse_per_viewpoint_values) ev.per_viewpoint_sparse_values.resize(viewpoints.size());
   if (job.faces_total == 0) return ev;
   if (options.sample_faces > 0) return EvaluateSampled(job, std::move(ev));
   // Exact mode lists lattice corners by merging sorted streams, so it needs VoxelScene's order.

@@ -328,5 +328,28 @@ TEST(ReductionTest, BatchesAndAPartlyFilledCacheGiveTheSameRun) {
   }
 }
 
+// The batch in flight stays within the cache budget: the first is sized for the worst case (every
+// face seen, 8 bytes a face: one station here), the next ones for what the stations saw.
+TEST(ReductionTest, BatchesGrowFromTheWorstCaseToWhatStationsSee) {
+  std::mt19937 rng(33);
+  const int n = 12, faces = 1000;
+  const Values v = RandomValues(rng, n, faces, 0.05);  // ~50 faces a station: ~400 bytes
+  ReductionRunOptions o;
+  o.cache_budget_bytes = faces * 8;  // one station in the worst case
+  std::vector<size_t> sizes;
+  const StationFaceValuesFn counted = [&](const std::vector<int>& stations, const JobContext& ctx) {
+    sizes.push_back(stations.size());
+    return FromTable(v)(stations, ctx);
+  };
+  const Result<ReductionRun> run = RunReduction(n, faces, counted, o);
+  const Result<ReductionRun> reference = RunReduction(n, faces, FromTable(v), {});
+  ASSERT_TRUE(run.ok() && reference.ok());
+  ASSERT_GE(sizes.size(), 2u);
+  EXPECT_EQ(sizes[0], 1u);
+  EXPECT_GT(*std::max_element(sizes.begin(), sizes.end()), 1u);
+  EXPECT_EQ(run->initial.loss, reference->initial.loss);
+  EXPECT_EQ(run->removed, reference->removed);
+}
+
 }  // namespace
 }  // namespace vc::planner

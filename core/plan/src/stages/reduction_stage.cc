@@ -43,16 +43,20 @@ Result<ReductionOutput> RunReductionStage(const ReductionInput& in, const PlanOp
                              " stations for " + std::to_string(positions.size()));
       }
       out.distribution.Add(d.distribution);
-      for (std::string& w : d.warnings) out.warnings.push_back(std::move(w));
+      for (std::string& w : d.warnings) {  // once each, though every batch asks the replicas again
+        if (std::find(out.warnings.begin(), out.warnings.end(), w) == out.warnings.end()) {
+          out.warnings.push_back(std::move(w));
+        }
+      }
       return std::move(d.values);
     }
     const bool whole = batch.size() == stations.size() && !all_evaluation;  // the first call, every station
     eval_options.keep_face_values = whole;
     VC_ASSIGN_OR_RETURN(Evaluation e, Evaluate(in.scene, positions, eval_options, sub));
-    std::vector<SparseFaceValues> out = std::move(e.per_viewpoint_sparse_values);
+    std::vector<SparseFaceValues> batch_values = std::move(e.per_viewpoint_sparse_values);
     e.per_viewpoint_sparse_values.clear();
     if (whole) all_evaluation = std::move(e);
-    return out;
+    return batch_values;
   };
   ReductionRunOptions red_options;
   red_options.reduce_to = options.reduce_to;

@@ -14,8 +14,8 @@
 namespace vc::wire {
 
 v1::FaceValues EncodeFaceValues(const SparseFaceValues& values);
-// DATA_LOSS when the arrays are not whole, differ in length, or list faces that are not ascending
-// or not below faces_total.
+// DATA_LOSS when the arrays are not whole, differ in length, list faces that are not ascending or
+// not below faces_total, or a V that is not in (0, 1] (NaN and infinities included).
 Result<SparseFaceValues> DecodeFaceValues(const v1::FaceValues& message, uint64_t faces_total);
 
 }  // namespace vc::wire

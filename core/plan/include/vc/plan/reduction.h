@@ -68,7 +68,9 @@ struct ReductionRunOptions {
   // Keep every station's face values in memory (for exact top-3 refills after a removal) while
   // they fit in this many bytes; otherwise the values are recomputed after each removal.
   uint64_t cache_budget_bytes = uint64_t{1} << 30;
-  // Stations per call of the values callback.
+  // Stations per call of the values callback, at most; fewer while a batch's values could exceed
+  // cache_budget_bytes (at first judged by the worst case, every face seen; then by the average of
+  // the stations asked so far), so the values in flight stay within that budget too.
   int batch_stations = 256;
   int threads = 0;
 };
