@@ -7,6 +7,8 @@
 # Usage: detach_cli_test.sh VC_SERVER VC_CLIENT SCENE (a scene whose plan takes a few seconds)
 set -euo pipefail
 server_bin="$1" client_bin="$2" scene="$3"
+# The real scan lives in ../shared/data, which a container build does not have: skipped there.
+[[ -f "$scene" ]] || { echo "skipped: $scene is not here"; exit 77; }
 test_name=detach
 source "$(dirname "$0")/server_lib.sh"
 start_server "$server_bin" --workers 1 --shutdown-grace 2
