@@ -10,6 +10,7 @@ static_assert(std::endian::native == std::endian::little, "the packed arrays are
 
 v1::FaceValues EncodeFaceValues(const SparseFaceValues& values) {
   v1::FaceValues m;
+  if (values.faces.empty()) return m;  // no pointer into an empty vector
   m.set_faces(std::string(reinterpret_cast<const char*>(values.faces.data()), values.faces.size() * sizeof(uint32_t)));
   m.set_values(std::string(reinterpret_cast<const char*>(values.values.data()), values.values.size() * sizeof(float)));
   return m;
@@ -25,8 +26,10 @@ Result<SparseFaceValues> DecodeFaceValues(const v1::FaceValues& message, uint64_
   SparseFaceValues out;
   out.faces.resize(faces.size() / sizeof(uint32_t));
   out.values.resize(out.faces.size());
-  std::memcpy(out.faces.data(), faces.data(), faces.size());
-  std::memcpy(out.values.data(), values.data(), values.size());
+  if (!faces.empty()) {  // memcpy from an empty vector's null data() is undefined
+    std::memcpy(out.faces.data(), faces.data(), faces.size());
+    std::memcpy(out.values.data(), values.data(), values.size());
+  }
   for (size_t k = 0; k < out.faces.size(); ++k) {
     if (out.faces[k] >= faces_total || (k > 0 && out.faces[k - 1] >= out.faces[k])) {
       return DataLossError("face values: face " + std::to_string(out.faces[k]) + " at position " + std::to_string(k) +
