@@ -63,6 +63,7 @@ struct WalkGraph {
   }
   double TopZ(int n) const { return (z[n] + 1) * r; }
   int size() const { return int(z.size()); }
+  uint64_t cells() const { return uint64_t(nx) * uint64_t(ny); }
 };
 
 // In a CSR of (cell_begin, zs), the node of cell c with |z - zc| <= step closest to zc (the higher
@@ -87,137 +88,161 @@ Status MemoryCheck(uint64_t cells, uint64_t nodes, const RouteOptions& o, double
                                 " MiB; use a coarser walk cell (cell_m) or a larger budget");
 }
 
-Result<WalkGraph> BuildWalkGraph(const OccupancyGrid& grid, const RouteOptions& o, int k, const JobContext& ctx) {
-  WalkGraph g;
-  g.grid = &grid;
-  g.r = grid.resolution_m();
-  g.k = k;
-  const double r = g.r, cell_m = k * r;
-  g.nx = (grid.dims().x() + k - 1) / k;
-  g.ny = (grid.dims().y() + k - 1) / k;
-  g.step = std::min(63, static_cast<int>(std::floor(o.max_step_m / r + 1e-9)));
-  g.unknown_factor = static_cast<float>(o.unknown_cost_factor);
-  const uint64_t cells = uint64_t(g.nx) * uint64_t(g.ny);
-  VC_RETURN_IF_ERROR(MemoryCheck(cells, 0, o, r, k));
-  const int headroom = FreeVoxelsNeeded(r, o.headroom_m, 0);
+// Per cell, the standing surfaces of its centre column with headroom free voxels above them,
+// ascending z: node candidates in CSR form (cell c's are z[begin[c]] .. z[begin[c + 1] - 1]).
+struct CellSurfaces {
+  std::vector<uint32_t> begin;  // nx * ny + 1 entries
+  std::vector<int32_t> z;
+};
 
-  // 1. Standing surfaces with headroom, per cell, ascending z.
-  std::vector<uint32_t> raw_begin(cells + 1, 0);
-  std::vector<int32_t> raw_z;
+Result<CellSurfaces> StandingSurfaces(const WalkGraph& g, int headroom, const RouteOptions& o, const JobContext& ctx) {
+  const uint64_t cells = g.cells();
+  CellSurfaces out;
+  out.begin.assign(cells + 1, 0);
   std::vector<Surface> scratch;
   for (int j = 0; j < g.ny; ++j) {
     VC_RETURN_IF_ERROR(ctx.CheckCancelled("walking route"));
-    VC_RETURN_IF_ERROR(MemoryCheck(cells, raw_z.size(), o, r, k));
+    VC_RETURN_IF_ERROR(MemoryCheck(cells, out.z.size(), o, g.r, g.k));
     for (int i = 0; i < g.nx; ++i) {
       const uint32_t c = uint32_t(j) * uint32_t(g.nx) + uint32_t(i);
-      raw_begin[c] = uint32_t(raw_z.size());
-      ColumnSurfaces(grid, g.ColumnX(i), g.ColumnY(j), headroom, scratch);
-      for (auto s = scratch.rbegin(); s != scratch.rend(); ++s) raw_z.push_back(s->z);
+      out.begin[c] = uint32_t(out.z.size());
+      ColumnSurfaces(*g.grid, g.ColumnX(i), g.ColumnY(j), headroom, scratch);
+      for (auto s = scratch.rbegin(); s != scratch.rend(); ++s) out.z.push_back(s->z);
     }
   }
-  raw_begin[cells] = uint32_t(raw_z.size());
+  out.begin[cells] = uint32_t(out.z.size());
+  return out;
+}
 
-  // 2. Gaps up to max_gap_m between two surfaces within max_step_m of each other.
-  struct Candidate {
-    uint32_t cell;
-    int32_t z;
-    uint8_t lines;  // bridged: the orientations (x, y) of the gaps it lies in, a bit each; 0 = real
-    bool operator<(const Candidate& o) const { return std::tie(cell, z, lines) < std::tie(o.cell, o.z, o.lines); }
-  };
-  std::vector<Candidate> nodes;  // sorted below, so a real node precedes a bridged one at the same place
-  nodes.reserve(raw_z.size());
-  const int max_gap_cells = static_cast<int>(std::floor(o.max_gap_m / cell_m + 1e-9));
-  // Per cell, the lowest real surface (INT_MAX for none), and its minimum over the square window of
-  // max_gap_m around the cell (two passes of a 1D minimum: rows, then columns).
-  constexpr int kNone = std::numeric_limits<int>::max();
-  std::vector<int32_t> lowest(cells, kNone), window_low;
+// A walk node candidate: a real standing surface or a bridged one over unseen floor.
+struct Candidate {
+  uint32_t cell;
+  int32_t z;
+  uint8_t lines;  // bridged: the orientations (x, y) of the gaps it lies in, a bit each; 0 = real
+  bool operator<(const Candidate& o) const { return std::tie(cell, z, lines) < std::tie(o.cell, o.z, o.lines); }
+};
+
+// A cell's lowest real surface when it has none.
+constexpr int kNoSurface = std::numeric_limits<int>::max();
+
+// Per cell, the minimum of `lowest` over the square window of `radius` cells around it (two passes
+// of a 1D minimum: rows, then columns).
+Result<std::vector<int32_t>> WindowMinimum(const WalkGraph& g, const std::vector<int32_t>& lowest, int radius,
+                                           const JobContext& ctx) {
+  const uint64_t cells = g.cells();
+  std::vector<int32_t> rows(cells, kNoSurface);
+  for (int j = 0; j < g.ny; ++j) {
+    for (int i = 0; i < g.nx; ++i) {
+      int32_t m = kNoSurface;
+      for (int t = std::max(0, i - radius); t <= std::min(g.nx - 1, i + radius); ++t) {
+        m = std::min(m, lowest[uint64_t(j) * g.nx + t]);
+      }
+      rows[uint64_t(j) * g.nx + i] = m;
+    }
+  }
+  std::vector<int32_t> window_low(cells, kNoSurface);
+  for (int j = 0; j < g.ny; ++j) {
+    if ((j & 15) == 0) VC_RETURN_IF_ERROR(ctx.CheckCancelled("walking route"));
+    for (int i = 0; i < g.nx; ++i) {
+      int32_t m = kNoSurface;
+      for (int t = std::max(0, j - radius); t <= std::min(g.ny - 1, j + radius); ++t) {
+        m = std::min(m, rows[uint64_t(t) * g.nx + i]);
+      }
+      window_low[uint64_t(j) * g.nx + i] = m;
+    }
+  }
+  return window_low;
+}
+
+// The real surfaces as candidates, and bridged ones over gaps up to max_gap_m between two surfaces
+// within max_step_m of each other (file comment, "Holes"), cell by cell.
+Result<std::vector<Candidate>> ListCandidates(const WalkGraph& g, const CellSurfaces& surfaces, int headroom,
+                                              const RouteOptions& o, const JobContext& ctx) {
+  const uint64_t cells = g.cells();
+  std::vector<Candidate> nodes;
+  nodes.reserve(surfaces.z.size());
+  const int max_gap_cells = static_cast<int>(std::floor(o.max_gap_m / (g.k * g.r) + 1e-9));
+  // Per cell, the lowest real surface, and its minimum over the square window of max_gap_m around it.
+  std::vector<int32_t> lowest(cells, kNoSurface), window_low;
   for (uint64_t c = 0; c < cells; ++c) {
-    if (raw_begin[c] < raw_begin[c + 1]) lowest[c] = raw_z[raw_begin[c]];
+    if (surfaces.begin[c] < surfaces.begin[c + 1]) lowest[c] = surfaces.z[surfaces.begin[c]];
   }
   if (max_gap_cells > 0) {
-    std::vector<int32_t> rows(cells, kNone);
-    for (int j = 0; j < g.ny; ++j) {
-      for (int i = 0; i < g.nx; ++i) {
-        int32_t m = kNone;
-        for (int t = std::max(0, i - max_gap_cells); t <= std::min(g.nx - 1, i + max_gap_cells); ++t) {
-          m = std::min(m, lowest[uint64_t(j) * g.nx + t]);
-        }
-        rows[uint64_t(j) * g.nx + i] = m;
-      }
-    }
-    window_low.assign(cells, kNone);
-    for (int j = 0; j < g.ny; ++j) {
-      if ((j & 15) == 0) VC_RETURN_IF_ERROR(ctx.CheckCancelled("walking route"));
-      for (int i = 0; i < g.nx; ++i) {
-        int32_t m = kNone;
-        for (int t = std::max(0, j - max_gap_cells); t <= std::min(g.ny - 1, j + max_gap_cells); ++t) {
-          m = std::min(m, rows[uint64_t(t) * g.nx + i]);
-        }
-        window_low[uint64_t(j) * g.nx + i] = m;
-      }
-    }
+    VC_ASSIGN_OR_RETURN(window_low, WindowMinimum(g, lowest, max_gap_cells, ctx));
   }
   for (int j = 0; j < g.ny; ++j) {
     if ((j & 15) == 0) VC_RETURN_IF_ERROR(ctx.CheckCancelled("walking route"));
     for (int i = 0; i < g.nx; ++i) {
       const uint32_t c = uint32_t(j) * uint32_t(g.nx) + uint32_t(i);
-      for (uint32_t a = raw_begin[c]; a < raw_begin[c + 1]; ++a) nodes.push_back({c, raw_z[a], 0});
-      if (max_gap_cells == 0 || window_low[c] == kNone) continue;
+      for (uint32_t a = surfaces.begin[c]; a < surfaces.begin[c + 1]; ++a) nodes.push_back({c, surfaces.z[a], 0});
+      if (max_gap_cells == 0 || window_low[c] == kNoSurface) continue;
       // Unseen floor at the lowest real surface within max_gap_m: only over nothing seen (never in
       // the air beside a stair or above a floor that was seen), and with nothing at all from that
       // height up to the headroom.
       const int zb = window_low[c];
-      if (lowest[c] != kNone && lowest[c] <= zb + g.step) continue;
+      if (lowest[c] != kNoSurface && lowest[c] <= zb + g.step) continue;
       const int x = g.ColumnX(i), y = g.ColumnY(j);
-      if (grid.AnyOccupied({x, y, zb}, {x, y, zb + headroom})) continue;
+      if (g.grid->AnyOccupied({x, y, zb}, {x, y, zb + headroom})) continue;
       nodes.push_back({c, zb, 1});
     }
-    VC_RETURN_IF_ERROR(MemoryCheck(cells, nodes.size(), o, r, k));
+    VC_RETURN_IF_ERROR(MemoryCheck(cells, nodes.size(), o, g.r, g.k));
   }
-  raw_z = {};
-  raw_begin = {};
-  std::sort(nodes.begin(), nodes.end());
-  // Bridged candidates of a cell within max_step_m of each other are one, at the lowest; it is kept
-  // if no real surface is within max_step_m of it.
-  {
-    size_t out = 0;
-    for (size_t a = 0; a < nodes.size();) {
-      if (nodes[a].lines == 0) {
-        nodes[out++] = nodes[a++];
-        continue;
-      }
-      size_t b = a;
-      uint8_t lines = 0;
-      for (; b < nodes.size() && nodes[b].cell == nodes[a].cell && nodes[b].lines != 0 &&
-             nodes[b].z - nodes[a].z <= g.step;
-           ++b) {
-        lines |= nodes[b].lines;
-      }
-      bool near_real = false;
-      for (size_t e = out; e-- > 0 && nodes[e].cell == nodes[a].cell;)
-        near_real |= std::abs(nodes[e].z - nodes[a].z) <= g.step;
-      for (size_t e = b; e < nodes.size() && nodes[e].cell == nodes[a].cell; ++e) {
-        near_real |= nodes[e].lines == 0 && std::abs(nodes[e].z - nodes[a].z) <= g.step;
-      }
-      if (!near_real) nodes[out++] = {nodes[a].cell, nodes[a].z, lines};
-      a = b;
-    }
-    nodes.resize(out);
-  }
+  return nodes;
+}
 
-  // 3. A person fits: at most max_blocked_fraction of the columns of the cylinder of radius
-  // clearance_m hold an occupied voxel between max_step_m and headroom_m above the surface.
-  const double c_vox = o.clearance_m / r;
+// Sorts the candidates (a real one precedes a bridged one at the same place). Bridged candidates of
+// a cell within max_step_m of each other are one, at the lowest; it is kept if no real surface is
+// within max_step_m of it.
+void MergeBridgedCandidates(std::vector<Candidate>& nodes, int step) {
+  std::sort(nodes.begin(), nodes.end());
+  size_t out = 0;
+  for (size_t a = 0; a < nodes.size();) {
+    if (nodes[a].lines == 0) {
+      nodes[out++] = nodes[a++];
+      continue;
+    }
+    size_t b = a;
+    uint8_t lines = 0;
+    for (; b < nodes.size() && nodes[b].cell == nodes[a].cell && nodes[b].lines != 0 && nodes[b].z - nodes[a].z <= step;
+         ++b) {
+      lines |= nodes[b].lines;
+    }
+    bool near_real = false;
+    for (size_t e = out; e-- > 0 && nodes[e].cell == nodes[a].cell;)
+      near_real |= std::abs(nodes[e].z - nodes[a].z) <= step;
+    for (size_t e = b; e < nodes.size() && nodes[e].cell == nodes[a].cell; ++e) {
+      near_real |= nodes[e].lines == 0 && std::abs(nodes[e].z - nodes[a].z) <= step;
+    }
+    if (!near_real) nodes[out++] = {nodes[a].cell, nodes[a].z, lines};
+    a = b;
+  }
+  nodes.resize(out);
+}
+
+// The walking cylinder of radius clearance_voxels around a column's centre, row by row: entry
+// dy + rows is the half width (columns each side) of row dy, for dy in [-rows, rows].
+std::vector<int> CylinderHalfWidths(double clearance_voxels) {
   int rows = 0;
-  while (rows + 0.5 < c_vox) ++rows;
+  while (rows + 0.5 < clearance_voxels) ++rows;
   std::vector<int> half_width(2 * rows + 1);
   for (int dy = -rows; dy <= rows; ++dy) {
     // Columns whose square footprint comes closer than the clearance to the centre column's centre.
     const double ey = std::max(std::abs(dy) - 0.5, 0.0);
     int w = 0;
-    while (std::pow(w + 0.5, 2) + ey * ey < c_vox * c_vox) ++w;
+    while (std::pow(w + 0.5, 2) + ey * ey < clearance_voxels * clearance_voxels) ++w;
     half_width[dy + rows] = w;
   }
+  return half_width;
+}
+
+// The candidates where a person fits become g's nodes: at most max_blocked_fraction of the columns
+// of the cylinder of radius clearance_m hold an occupied voxel between max_step_m and headroom_m
+// above the surface. Then g's cell index (cell_begin).
+Status KeepNodesWhereAPersonFits(WalkGraph& g, const std::vector<Candidate>& nodes, int headroom, const RouteOptions& o,
+                                 const JobContext& ctx) {
+  const double r = g.r;
+  const std::vector<int> half_width = CylinderHalfWidths(o.clearance_m / r);
+  const int rows = int(half_width.size() / 2);
   for (size_t n = 0; n < nodes.size(); ++n) {
     if ((n & 0xffff) == 0) VC_RETURN_IF_ERROR(ctx.CheckCancelled("walking route"));
     const Candidate& cand = nodes[n];
@@ -228,7 +253,7 @@ Result<WalkGraph> BuildWalkGraph(const OccupancyGrid& grid, const RouteOptions& 
       const int w = half_width[dy + rows];
       for (int dx = -w; dx <= w; ++dx) {
         ++columns;
-        blocked += grid.AnyOccupied({x + dx, y + dy, lo}, {x + dx, y + dy, hi});
+        blocked += g.grid->AnyOccupied({x + dx, y + dy, lo}, {x + dx, y + dy, hi});
       }
     }
     if (blocked > o.max_blocked_fraction * columns) continue;
@@ -245,12 +270,16 @@ Result<WalkGraph> BuildWalkGraph(const OccupancyGrid& grid, const RouteOptions& 
     g.unknown.push_back(unknown);
     g.bridged += cand.lines != 0;
   }
+  const uint64_t cells = g.cells();
   g.cell_begin.assign(cells + 1, 0);
   for (uint32_t c : g.cell) ++g.cell_begin[c + 1];
   for (uint64_t c = 0; c < cells; ++c) g.cell_begin[c + 1] += g.cell_begin[c];
-  nodes = {};
+  return Status::Ok();
+}
 
-  // 4. Links to the 8 neighbours, mutual only, diagonals only with both sides walkable.
+// g's link costs and links to the 8 neighbours, mutual only, diagonals only with both sides walkable.
+Status LinkNeighbours(WalkGraph& g, const JobContext& ctx) {
+  const double r = g.r, cell_m = g.k * r;
   for (int dz = 0; dz < 64; ++dz) {
     g.cost[0][dz] = float(std::hypot(cell_m, dz * r));
     g.cost[1][dz] = float(std::sqrt(2 * cell_m * cell_m + dz * r * dz * r));
@@ -272,6 +301,30 @@ Result<WalkGraph> BuildWalkGraph(const OccupancyGrid& grid, const RouteOptions& 
       g.nbr[size_t(n) * kDirs + d] = found[d];
     }
   }
+  return Status::Ok();
+}
+
+// The walk graph of `grid` with cells of k x k columns (file comment).
+Result<WalkGraph> BuildWalkGraph(const OccupancyGrid& grid, const RouteOptions& o, int k, const JobContext& ctx) {
+  WalkGraph g;
+  g.grid = &grid;
+  g.r = grid.resolution_m();
+  g.k = k;
+  g.nx = (grid.dims().x() + k - 1) / k;
+  g.ny = (grid.dims().y() + k - 1) / k;
+  g.step = std::min(63, static_cast<int>(std::floor(o.max_step_m / g.r + 1e-9)));
+  g.unknown_factor = static_cast<float>(o.unknown_cost_factor);
+  VC_RETURN_IF_ERROR(MemoryCheck(g.cells(), 0, o, g.r, k));
+  const int headroom = FreeVoxelsNeeded(g.r, o.headroom_m, 0);
+  std::vector<Candidate> nodes;
+  {
+    VC_ASSIGN_OR_RETURN(const CellSurfaces surfaces, StandingSurfaces(g, headroom, o, ctx));
+    VC_ASSIGN_OR_RETURN(nodes, ListCandidates(g, surfaces, headroom, o, ctx));
+  }
+  MergeBridgedCandidates(nodes, g.step);
+  VC_RETURN_IF_ERROR(KeepNodesWhereAPersonFits(g, nodes, headroom, o, ctx));
+  nodes = {};
+  VC_RETURN_IF_ERROR(LinkNeighbours(g, ctx));
   return g;
 }
 
@@ -439,6 +492,275 @@ Status Validate(const std::vector<WorldPoint>& stations, const std::vector<doubl
   return Status::Ok();
 }
 
+// The walk cell's edge in voxels that cell_m asks for (0: one voxel), or INVALID_ARGUMENT when it
+// is coarser than twice the clearance (file comment).
+Result<int> WalkCellVoxels(const RouteOptions& options, double r) {
+  const int k_max = std::max(1, static_cast<int>(std::floor(2 * options.clearance_m / r + 1e-9)));
+  const int k = options.cell_m == 0 ? 1 : std::max(1, static_cast<int>(std::lround(options.cell_m / r)));
+  if (k > k_max) {
+    return InvalidArgumentError("cell_m " + Fmt("%.3g", options.cell_m) + " m is coarser than twice the clearance (" +
+                                Fmt("%.3g", k_max * r) + " m at most), so a thin wall could pass between two cells");
+  }
+  return k;
+}
+
+// PlanRoute over a built walk graph (file comment: "Stations", "Order"): snaps the stations and
+// the start, measures the walking distances, splits the stations into parts and walks each part
+// in order. One Plan per instance.
+class RoutePlanner {
+ public:
+  RoutePlanner(const WalkGraph& g, const std::vector<WorldPoint>& stations, const RouteOptions& options,
+               const JobContext& ctx)
+      : g_(g),
+        stations_(stations),
+        options_(options),
+        ctx_(ctx),
+        n_(int(stations.size())),
+        floor_point_(n_),
+        node_(n_, -1),
+        sp_(g),
+        dist_(size_t(n_) * n_, kNaN),
+        from_start_(n_, kNaN) {}
+
+  // The route; `floor_z_m` as PlanRoute's (validated).
+  Result<Route> Plan(const std::vector<double>& floor_z_m);
+
+ private:
+  // Each station's floor point and walk node (-1, with a warning, when it has none).
+  void SnapStations(const std::vector<double>& floor_z_m);
+  // The start's walk node and floor point when options.start is set (-1, with a warning: none).
+  void SnapStart();
+  // Walking distances between stations: one Dijkstra per station, on options.threads workers, each
+  // with its own state.
+  Status DistancesBetweenStations();
+  // Walking distances from the start to each station, when the start snapped to a node.
+  Status DistancesFromStart();
+  // Parts: stations linked by finite distances (connected components are transitive).
+  void FindParts();
+  // The order of the parts: the start's part first, then from the lowest floor up.
+  void OrderParts();
+  // Warnings about a start linked to no station and about each part after the first.
+  void WarnAboutUnlinkedParts();
+  // The open path problem of the stations of `part`, from the start when `from_the_start`.
+  OpenPathProblem PartProblem(const std::vector<int>& part, bool from_the_start) const;
+  // Orders the pi-th part in part order and appends its stations, legs and polylines to the route.
+  Status WalkPart(size_t pi);
+
+  // From station s's floor point to its walk node (m).
+  double Connector(int s) const { return (g_.Point(node_[s]) - floor_point_[s]).norm(); }
+  // The lowest floor (m) of the stations of `part`, infinity if none has a floor.
+  double LowestFloor(const std::vector<int>& part) const;
+
+  const WalkGraph& g_;
+  const std::vector<WorldPoint>& stations_;
+  const RouteOptions& options_;
+  const JobContext& ctx_;
+  const int n_;  // stations
+  Route route_;
+  std::vector<WorldPoint> floor_point_;
+  std::vector<int> node_;
+  int start_node_ = -1;
+  WorldPoint start_point_;
+  ShortestPaths sp_;
+  std::vector<double> dist_;  // n_ x n_, NaN: not linked
+  std::vector<double> from_start_;
+  std::vector<int> part_of_;
+  std::vector<std::vector<int>> parts_;
+  int start_part_ = -1;
+  std::vector<int> part_order_;
+};
+
+Result<Route> RoutePlanner::Plan(const std::vector<double>& floor_z_m) {
+  route_.walk_cells = g_.cells();
+  route_.walk_nodes = uint64_t(g_.size());
+  route_.bridged_nodes = g_.bridged;
+  route_.cell_m = g_.k * g_.r;
+  SnapStations(floor_z_m);
+  SnapStart();
+  VC_RETURN_IF_ERROR(DistancesBetweenStations());
+  VC_RETURN_IF_ERROR(DistancesFromStart());
+  FindParts();
+  OrderParts();
+  WarnAboutUnlinkedParts();
+  for (size_t pi = 0; pi < part_order_.size(); ++pi) VC_RETURN_IF_ERROR(WalkPart(pi));
+  return std::move(route_);
+}
+
+void RoutePlanner::SnapStations(const std::vector<double>& floor_z_m) {
+  const double tolerance_m = std::max(options_.max_step_m, 2 * g_.r);
+  for (int s = 0; s < n_; ++s) {
+    double f = floor_z_m.empty() ? kNaN : floor_z_m[s];
+    if (std::isnan(f)) f = FloorBelow(*g_.grid, stations_[s]);
+    floor_point_[s] = WorldPoint(stations_[s].x(), stations_[s].y(), f);
+    if (std::isnan(f)) {
+      route_.warnings.push_back("station " + std::to_string(s + options_.first_station_number) +
+                                " has no floor below it: it is a part of its own, walking to it is not counted");
+      continue;
+    }
+    node_[s] = SnapToFloor(g_, floor_point_[s], tolerance_m, options_.snap_radius_m);
+    if (node_[s] < 0) {
+      route_.warnings.push_back(
+          "station " + std::to_string(s + options_.first_station_number) +
+          Fmt(" has no walkable cell within %.2g m", options_.snap_radius_m) +
+          Fmt(" of (%.2f, %.2f)", stations_[s].x(), stations_[s].y()) +
+          Fmt(" on its floor (z = %.2f m): it is a part of its own, walking to it is not counted", f));
+    }
+  }
+}
+
+void RoutePlanner::SnapStart() {
+  if (!options_.start) return;
+  const WorldPoint& st = *options_.start;
+  double level = kNaN, nearest = kNaN;
+  ForNodesNear(g_, st.x(), st.y(), options_.snap_radius_m, [&](int m) {
+    const WorldPoint p = g_.Point(m);
+    if (Horizontal2(p, st) > options_.snap_radius_m * options_.snap_radius_m) return;
+    if (p.z() <= st.z() + options_.max_step_m + 1e-9 && !(p.z() <= level)) level = p.z();
+    if (std::isnan(nearest) || std::abs(p.z() - st.z()) < std::abs(nearest - st.z())) nearest = p.z();
+  });
+  if (std::isnan(level)) level = nearest;
+  if (!std::isnan(level)) {
+    start_node_ = SnapToFloor(g_, WorldPoint(st.x(), st.y(), level), options_.max_step_m, options_.snap_radius_m);
+    start_point_ = WorldPoint(st.x(), st.y(), level);
+  } else {
+    route_.warnings.push_back(Fmt("the start (%.2f, %.2f, %.2f) has no walkable cell within ", st.x(), st.y(), st.z()) +
+                              Fmt("%.2g m: the walk from it is not counted", options_.snap_radius_m));
+  }
+}
+
+Status RoutePlanner::DistancesBetweenStations() {
+  const int n = n_;
+  std::vector<Status> run_status(n, Status::Ok());
+  VC_RETURN_IF_ERROR(ParallelChunks(
+      uint64_t(n), 1, options_.threads, ctx_,
+      [&](uint64_t, uint64_t begin, uint64_t) {
+        const int s = int(begin);
+        if (node_[s] < 0) return;
+        dist_[size_t(s) * n + s] = 0;
+        std::vector<int> targets;
+        for (int t = s + 1; t < n; ++t) {
+          if (node_[t] >= 0) targets.push_back(node_[t]);
+        }
+        if (targets.empty()) return;
+        ShortestPaths own(g_);
+        run_status[s] = own.Run(node_[s], targets, ctx_);
+        if (!run_status[s].ok()) return;
+        for (int t = s + 1; t < n; ++t) {
+          if (node_[t] < 0 || own.Dist(node_[t]) == kInf) continue;
+          const double d = Connector(s) + double(own.Dist(node_[t])) + Connector(t);
+          dist_[size_t(s) * n + t] = dist_[size_t(t) * n + s] = d;  // each pair written by s only
+        }
+      },
+      "walking route"));
+  for (const Status& st : run_status) VC_RETURN_IF_ERROR(st);
+  return Status::Ok();
+}
+
+Status RoutePlanner::DistancesFromStart() {
+  if (start_node_ < 0) return Status::Ok();
+  VC_RETURN_IF_ERROR(sp_.Run(start_node_, node_, ctx_));
+  for (int s = 0; s < n_; ++s) {
+    if (node_[s] >= 0 && sp_.Dist(node_[s]) != kInf) {
+      from_start_[s] = (g_.Point(start_node_) - start_point_).norm() + double(sp_.Dist(node_[s])) + Connector(s);
+    }
+  }
+  return Status::Ok();
+}
+
+void RoutePlanner::FindParts() {
+  part_of_.assign(n_, -1);
+  for (int s = 0; s < n_; ++s) {
+    if (part_of_[s] >= 0) continue;
+    part_of_[s] = int(parts_.size());
+    parts_.push_back({s});
+    for (int t = s + 1; t < n_; ++t) {
+      if (part_of_[t] < 0 && !std::isnan(dist_[size_t(s) * n_ + t])) {
+        part_of_[t] = part_of_[s];
+        parts_.back().push_back(t);
+      }
+    }
+  }
+}
+
+double RoutePlanner::LowestFloor(const std::vector<int>& part) const {
+  double z = std::numeric_limits<double>::infinity();
+  for (int s : part) {
+    if (!std::isnan(floor_point_[s].z())) z = std::min(z, floor_point_[s].z());
+  }
+  return z;
+}
+
+void RoutePlanner::OrderParts() {
+  for (int s = 0; s < n_ && start_part_ < 0; ++s) {
+    if (!std::isnan(from_start_[s])) start_part_ = part_of_[s];
+  }
+  part_order_.resize(parts_.size());
+  std::iota(part_order_.begin(), part_order_.end(), 0);
+  std::stable_sort(part_order_.begin(), part_order_.end(), [&](int a, int b) {
+    if ((a == start_part_) != (b == start_part_)) return a == start_part_;
+    return LowestFloor(parts_[a]) < LowestFloor(parts_[b]);
+  });
+}
+
+void RoutePlanner::WarnAboutUnlinkedParts() {
+  if (options_.start && start_node_ >= 0 && start_part_ < 0) {
+    route_.warnings.push_back(
+        "the start is not linked to any station by a walkable path: the walk from it is not counted");
+  }
+  route_.parts = int(parts_.size());
+  for (size_t pi = 1; pi < part_order_.size(); ++pi) {
+    const std::vector<int>& part = parts_[part_order_[pi]];
+    const double z = LowestFloor(part);
+    route_.warnings.push_back(
+        StationList(part, options_.first_station_number) +
+        (std::isinf(z) ? std::string() : Fmt(" (floor z = %.2f m)", z)) +
+        " not linked to the others by any walkable path (no stairs or ramp found): the route has " +
+        std::to_string(parts_.size()) + " parts, walking between them is not counted");
+  }
+}
+
+OpenPathProblem RoutePlanner::PartProblem(const std::vector<int>& part, bool from_the_start) const {
+  OpenPathProblem problem;
+  problem.n = int(part.size());
+  problem.distance_m.resize(part.size() * part.size());
+  for (size_t a = 0; a < part.size(); ++a) {
+    for (size_t b = 0; b < part.size(); ++b)
+      problem.distance_m[a * part.size() + b] = dist_[size_t(part[a]) * n_ + part[b]];
+  }
+  if (from_the_start) {
+    for (int s : part) problem.from_start_m.push_back(from_start_[s]);
+  }
+  return problem;
+}
+
+Status RoutePlanner::WalkPart(size_t pi) {
+  const std::vector<int>& part = parts_[part_order_[pi]];
+  const bool from_the_start = part_order_[pi] == start_part_;
+  const OpenPathProblem problem = PartProblem(part, from_the_start);
+  VC_RETURN_IF_ERROR(ctx_.CheckCancelled("walking route"));
+  const std::vector<int> local = OrderOpenPath(problem);
+  for (size_t li = 0; li < local.size(); ++li) {
+    const int s = part[local[li]];
+    const bool first = li == 0;
+    route_.order.push_back(s);
+    if (first && !from_the_start) {
+      route_.legs_m.push_back(pi == 0 && !options_.start ? 0.0 : kNaN);
+      route_.polylines.emplace_back();
+      continue;
+    }
+    const int prev = first ? -1 : route_.order[route_.order.size() - 2];
+    const int src = first ? start_node_ : node_[prev];
+    VC_RETURN_IF_ERROR(sp_.Run(src, {node_[s]}, ctx_));
+    std::vector<WorldPoint> pts{first ? start_point_ : floor_point_[prev]};
+    for (int m : sp_.PathTo(node_[s])) pts.push_back(g_.Point(m));
+    pts.push_back(floor_point_[s]);
+    route_.polylines.push_back(Simplify(pts));
+    route_.legs_m.push_back(PolylineLength(route_.polylines.back()));
+    route_.length_m += route_.legs_m.back();
+  }
+  return Status::Ok();
+}
+
 }  // namespace
 
 double OpenPathLength(const OpenPathProblem& p, const std::vector<int>& order) {
@@ -560,188 +882,14 @@ std::vector<int> OrderOpenPath(const OpenPathProblem& p) {
 Result<Route> PlanRoute(const VoxelScene& scene, const std::vector<WorldPoint>& stations,
                         const std::vector<double>& floor_z_m, const RouteOptions& options, const JobContext& ctx) {
   VC_RETURN_IF_ERROR(Validate(stations, floor_z_m, options));
-  Route route;
-  if (stations.empty()) return route;
+  if (stations.empty()) return Route{};
   const OccupancyGrid& grid = scene.grid;
   const double r = grid.resolution_m();
   if (!(r > 0) || grid.brick_count() == 0) return InvalidArgumentError("the scene has no voxels to walk on");
-  const int k_max = std::max(1, static_cast<int>(std::floor(2 * options.clearance_m / r + 1e-9)));
-  const int k = options.cell_m == 0 ? 1 : std::max(1, static_cast<int>(std::lround(options.cell_m / r)));
-  if (k > k_max) {
-    return InvalidArgumentError("cell_m " + Fmt("%.3g", options.cell_m) + " m is coarser than twice the clearance (" +
-                                Fmt("%.3g", k_max * r) + " m at most), so a thin wall could pass between two cells");
-  }
+  VC_ASSIGN_OR_RETURN(const int k, WalkCellVoxels(options, r));
   VC_ASSIGN_OR_RETURN(const WalkGraph g, BuildWalkGraph(grid, options, k, ctx));
-  route.walk_cells = uint64_t(g.nx) * uint64_t(g.ny);
-  route.walk_nodes = uint64_t(g.size());
-  route.bridged_nodes = g.bridged;
-  route.cell_m = k * r;
-
-  // Snap the stations.
-  const int n = int(stations.size());
-  const double tolerance_m = std::max(options.max_step_m, 2 * r);
-  std::vector<WorldPoint> floor_point(n);
-  std::vector<int> node(n, -1);
-  for (int s = 0; s < n; ++s) {
-    double f = floor_z_m.empty() ? kNaN : floor_z_m[s];
-    if (std::isnan(f)) f = FloorBelow(grid, stations[s]);
-    floor_point[s] = WorldPoint(stations[s].x(), stations[s].y(), f);
-    if (std::isnan(f)) {
-      route.warnings.push_back("station " + std::to_string(s + options.first_station_number) +
-                               " has no floor below it: it is a part of its own, walking to it is not counted");
-      continue;
-    }
-    node[s] = SnapToFloor(g, floor_point[s], tolerance_m, options.snap_radius_m);
-    if (node[s] < 0) {
-      route.warnings.push_back(
-          "station " + std::to_string(s + options.first_station_number) +
-          Fmt(" has no walkable cell within %.2g m", options.snap_radius_m) +
-          Fmt(" of (%.2f, %.2f)", stations[s].x(), stations[s].y()) +
-          Fmt(" on its floor (z = %.2f m): it is a part of its own, walking to it is not counted", f));
-    }
-  }
-  int start_node = -1;
-  WorldPoint start_point;
-  if (options.start) {
-    const WorldPoint& st = *options.start;
-    double level = kNaN, nearest = kNaN;
-    ForNodesNear(g, st.x(), st.y(), options.snap_radius_m, [&](int m) {
-      const WorldPoint p = g.Point(m);
-      if (Horizontal2(p, st) > options.snap_radius_m * options.snap_radius_m) return;
-      if (p.z() <= st.z() + options.max_step_m + 1e-9 && !(p.z() <= level)) level = p.z();
-      if (std::isnan(nearest) || std::abs(p.z() - st.z()) < std::abs(nearest - st.z())) nearest = p.z();
-    });
-    if (std::isnan(level)) level = nearest;
-    if (!std::isnan(level)) {
-      start_node = SnapToFloor(g, WorldPoint(st.x(), st.y(), level), options.max_step_m, options.snap_radius_m);
-      start_point = WorldPoint(st.x(), st.y(), level);
-    } else {
-      route.warnings.push_back(
-          Fmt("the start (%.2f, %.2f, %.2f) has no walkable cell within ", st.x(), st.y(), st.z()) +
-          Fmt("%.2g m: the walk from it is not counted", options.snap_radius_m));
-    }
-  }
-
-  // Walking distances between stations (and from the start): one Dijkstra per station, on
-  // options.threads workers, each with its own state.
-  ShortestPaths sp(g);
-  std::vector<double> dist(size_t(n) * n, kNaN), from_start(n, kNaN);
-  auto connector = [&](int s) { return (g.Point(node[s]) - floor_point[s]).norm(); };
-  std::vector<Status> run_status(n, Status::Ok());
-  VC_RETURN_IF_ERROR(ParallelChunks(
-      uint64_t(n), 1, options.threads, ctx,
-      [&](uint64_t, uint64_t begin, uint64_t) {
-        const int s = int(begin);
-        if (node[s] < 0) return;
-        dist[size_t(s) * n + s] = 0;
-        std::vector<int> targets;
-        for (int t = s + 1; t < n; ++t) {
-          if (node[t] >= 0) targets.push_back(node[t]);
-        }
-        if (targets.empty()) return;
-        ShortestPaths own(g);
-        run_status[s] = own.Run(node[s], targets, ctx);
-        if (!run_status[s].ok()) return;
-        for (int t = s + 1; t < n; ++t) {
-          if (node[t] < 0 || own.Dist(node[t]) == kInf) continue;
-          const double d = connector(s) + double(own.Dist(node[t])) + connector(t);
-          dist[size_t(s) * n + t] = dist[size_t(t) * n + s] = d;  // each pair written by s only
-        }
-      },
-      "walking route"));
-  for (const Status& st : run_status) VC_RETURN_IF_ERROR(st);
-  if (start_node >= 0) {
-    VC_RETURN_IF_ERROR(sp.Run(start_node, node, ctx));
-    for (int s = 0; s < n; ++s) {
-      if (node[s] >= 0 && sp.Dist(node[s]) != kInf) {
-        from_start[s] = (g.Point(start_node) - start_point).norm() + double(sp.Dist(node[s])) + connector(s);
-      }
-    }
-  }
-
-  // Parts: stations linked by finite distances (connected components are transitive).
-  std::vector<int> part_of(n, -1);
-  std::vector<std::vector<int>> parts;
-  for (int s = 0; s < n; ++s) {
-    if (part_of[s] >= 0) continue;
-    part_of[s] = int(parts.size());
-    parts.push_back({s});
-    for (int t = s + 1; t < n; ++t) {
-      if (part_of[t] < 0 && !std::isnan(dist[size_t(s) * n + t])) {
-        part_of[t] = part_of[s];
-        parts.back().push_back(t);
-      }
-    }
-  }
-  auto lowest_floor = [&](const std::vector<int>& part) {
-    double z = std::numeric_limits<double>::infinity();
-    for (int s : part) {
-      if (!std::isnan(floor_point[s].z())) z = std::min(z, floor_point[s].z());
-    }
-    return z;
-  };
-  int start_part = -1;
-  for (int s = 0; s < n && start_part < 0; ++s) {
-    if (!std::isnan(from_start[s])) start_part = part_of[s];
-  }
-  std::vector<int> part_order(parts.size());
-  std::iota(part_order.begin(), part_order.end(), 0);
-  std::stable_sort(part_order.begin(), part_order.end(), [&](int a, int b) {
-    if ((a == start_part) != (b == start_part)) return a == start_part;
-    return lowest_floor(parts[a]) < lowest_floor(parts[b]);
-  });
-  if (options.start && start_node >= 0 && start_part < 0) {
-    route.warnings.push_back(
-        "the start is not linked to any station by a walkable path: the walk from it is not counted");
-  }
-  route.parts = int(parts.size());
-  for (size_t pi = 1; pi < part_order.size(); ++pi) {
-    const std::vector<int>& part = parts[part_order[pi]];
-    const double z = lowest_floor(part);
-    route.warnings.push_back(
-        StationList(part, options.first_station_number) +
-        (std::isinf(z) ? std::string() : Fmt(" (floor z = %.2f m)", z)) +
-        " not linked to the others by any walkable path (no stairs or ramp found): the route has " +
-        std::to_string(parts.size()) + " parts, walking between them is not counted");
-  }
-
-  // Order each part; legs and polylines.
-  for (size_t pi = 0; pi < part_order.size(); ++pi) {
-    const std::vector<int>& part = parts[part_order[pi]];
-    OpenPathProblem problem;
-    problem.n = int(part.size());
-    problem.distance_m.resize(part.size() * part.size());
-    for (size_t a = 0; a < part.size(); ++a) {
-      for (size_t b = 0; b < part.size(); ++b)
-        problem.distance_m[a * part.size() + b] = dist[size_t(part[a]) * n + part[b]];
-    }
-    const bool from_the_start = part_order[pi] == start_part;
-    if (from_the_start) {
-      for (int s : part) problem.from_start_m.push_back(from_start[s]);
-    }
-    VC_RETURN_IF_ERROR(ctx.CheckCancelled("walking route"));
-    const std::vector<int> local = OrderOpenPath(problem);
-    for (size_t li = 0; li < local.size(); ++li) {
-      const int s = part[local[li]];
-      const bool first = li == 0;
-      route.order.push_back(s);
-      if (first && !from_the_start) {
-        route.legs_m.push_back(pi == 0 && !options.start ? 0.0 : kNaN);
-        route.polylines.emplace_back();
-        continue;
-      }
-      const int prev = first ? -1 : route.order[route.order.size() - 2];
-      const int src = first ? start_node : node[prev];
-      VC_RETURN_IF_ERROR(sp.Run(src, {node[s]}, ctx));
-      std::vector<WorldPoint> pts{first ? start_point : floor_point[prev]};
-      for (int m : sp.PathTo(node[s])) pts.push_back(g.Point(m));
-      pts.push_back(floor_point[s]);
-      route.polylines.push_back(Simplify(pts));
-      route.legs_m.push_back(PolylineLength(route.polylines.back()));
-      route.length_m += route.legs_m.back();
-    }
-  }
-  return route;
+  RoutePlanner planner(g, stations, options, ctx);
+  return planner.Plan(floor_z_m);
 }
 
 }  // namespace vc::planner

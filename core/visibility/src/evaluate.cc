@@ -1,7 +1,7 @@
 // vc::Evaluate (ALGORITHM.md s.6; docs/VISIBILITY.md): the exact mode (every face of F, one ray per
 // distinct lattice corner and viewpoint, corners first decided by groups of faces) and the sampled
 // mode (a uniform random sample of F with replacement, with a 95 % confidence interval) are two
-// functions over shared pieces: viewpoint validation, the scene's voxel indices and |F|, the
+// code paths over shared pieces: viewpoint validation, the scene's voxel indices and |F|, the
 // viewpoints in index space with their shortcut margins, and the tallies of s.6. Evaluate
 // validates, prepares and dispatches. Thread-safe on a const scene (see visibility.h).
 #include <algorithm>
@@ -141,6 +141,11 @@ struct EvaluationJob {
   std::vector<Vector3d> uo;
   std::vector<char> shortcuts;
   std::vector<ScannerLimits> limits;  // the scanner's, per viewpoint
+
+  // V of face f of voxel v seen from viewpoint k with perception p (s.6).
+  double FaceValueFrom(size_t k, Perception p, const VoxelIndex& v, Face f) const {
+    return FaceValue(p, viewpoints[k], v, f, r, options.scanner, limits[k]);
+  }
 };
 
 // The job of evaluating `viewpoints` on `scene`: voxel indices and |F| always, the viewpoints in
@@ -236,56 +241,51 @@ std::vector<uint8_t> FacesInSetMask(const OccupancyGrid& g, const std::vector<Vo
   return faces_in_set;
 }
 
-// Sampled mode into `ev` (resolution, |F| and per_viewpoint's size already set).
-Result<Evaluation> EvaluateSampled(const EvaluationJob& job, Evaluation ev) {
-  // Named references, not a structured binding: clang before 16 cannot capture bindings in lambdas.
-  const OccupancyGrid& g = job.g;
-  const double r = job.r;
-  const size_t n = job.n, nv = job.nv;
-  const std::vector<WorldPoint>& viewpoints = job.viewpoints;
-  const EvaluateOptions& options = job.options;
-  const JobContext& ctx = job.ctx;
-  const std::vector<VoxelIndex>& index = job.index;
-  const std::vector<Vector3d>& uo = job.uo;
-  const std::vector<char>& shortcuts = job.shortcuts;
-  const std::vector<ScannerLimits>& limits = job.limits;
-  // Unbiased uniform sample of F with replacement: pick a voxel id and a face uniformly, and
-  // re-draw faces outside F (rejection keeps the distribution uniform over F).
-  ev.sampled = true;
-  ev.faces_evaluated = options.sample_faces;
-  std::mt19937_64 rng(options.seed);
-  std::uniform_int_distribution<uint64_t> pick(0, n * kFacesPerVoxel - 1);
-  std::vector<std::pair<uint32_t, uint8_t>> sample(options.sample_faces);
+// Unbiased uniform sample of F with replacement, as (voxel id, face) pairs: pick a voxel id and a
+// face uniformly, and re-draw faces outside F (rejection keeps the distribution uniform over F).
+std::vector<std::pair<uint32_t, uint8_t>> DrawSample(const EvaluationJob& job) {
+  std::mt19937_64 rng(job.options.seed);
+  std::uniform_int_distribution<uint64_t> pick(0, job.n * kFacesPerVoxel - 1);
+  std::vector<std::pair<uint32_t, uint8_t>> sample(job.options.sample_faces);
   for (auto& s : sample) {
     while (true) {
       const uint64_t p = pick(rng);
       const uint32_t id = uint32_t(p / kFacesPerVoxel);
       const uint8_t f = uint8_t(p % kFacesPerVoxel);
-      if (FaceInSet(g, index[id], Face(f), options.faces)) {
+      if (FaceInSet(job.g, job.index[id], Face(f), job.options.faces)) {
         s = {id, f};
         break;
       }
     }
   }
+  return sample;
+}
+
+// Sampled mode into `ev` (resolution, |F| and per_viewpoint's size already set).
+Result<Evaluation> EvaluateSampled(const EvaluationJob& job, Evaluation ev) {
+  const size_t nv = job.nv;
+  ev.sampled = true;
+  ev.faces_evaluated = job.options.sample_faces;
+  const std::vector<std::pair<uint32_t, uint8_t>> sample = DrawSample(job);
   constexpr uint64_t kChunk = 256;
   const uint64_t chunks = (sample.size() + kChunk - 1) / kChunk;
   std::vector<Tally> overall(chunks);
   std::vector<double> sum_sq(chunks, 0.0);
   std::vector<std::vector<Tally>> per(chunks, std::vector<Tally>(nv));
-  StageProgress progress(ctx, Stage::kEvaluation, chunks, sample.size(), "faces");
+  StageProgress progress(job.ctx, Stage::kEvaluation, chunks, sample.size(), "faces");
   VC_RETURN_IF_ERROR(
-      ParallelChunks(sample.size(), kChunk, options.threads, ctx, [&](uint64_t c, uint64_t b, uint64_t e) {
+      ParallelChunks(sample.size(), kChunk, job.options.threads, job.ctx, [&](uint64_t c, uint64_t b, uint64_t e) {
         for (uint64_t i = b; i < e; ++i) {
-          const VoxelIndex& v = index[sample[i].first];
+          const VoxelIndex& v = job.index[sample[i].first];
           const Face f = Face(sample[i].second);
           double best = 0;
           Perception best_p = Perception::kNone;
           for (size_t k = 0; k < nv; ++k) {
             int visible = 0;
-            OccluderCache cache(shortcuts[k]);
-            for (int q : kFaceCorners[int(f)]) visible += CornerVisibleCached(g, uo[k], Corner(v, q), cache);
+            OccluderCache cache(job.shortcuts[k]);
+            for (int q : kFaceCorners[int(f)]) visible += CornerVisibleCached(job.g, job.uo[k], Corner(v, q), cache);
             const Perception p = FromCount(visible);
-            const double val = FaceValue(p, viewpoints[k], v, f, r, options.scanner, limits[k]);
+            const double val = job.FaceValueFrom(k, p, v, f);
             per[c][k].Add(p, val);
             KeepBest(val, p, best, best_p);
           }
@@ -311,61 +311,29 @@ Result<Evaluation> EvaluateSampled(const EvaluationJob& job, Evaluation ev) {
   return ev;
 }
 
-// Exact mode into `ev` (resolution, |F| and per_viewpoint's size already set); the scene's
-// voxels are sorted and unique.
-Result<Evaluation> EvaluateExact(const EvaluationJob& job, Evaluation ev) {
-  // Named references, not a structured binding: clang before 16 cannot capture bindings in lambdas.
-  const OccupancyGrid& g = job.g;
-  const double r = job.r;
-  const size_t n = job.n, nv = job.nv;
-  const std::vector<WorldPoint>& viewpoints = job.viewpoints;
-  const EvaluateOptions& options = job.options;
-  const JobContext& ctx = job.ctx;
-  const std::vector<VoxelIndex>& index = job.index;
-  const uint64_t faces_total = job.faces_total;
-  const std::vector<Vector3d>& uo = job.uo;
-  const std::vector<char>& shortcuts = job.shortcuts;
-  const std::vector<ScannerLimits>& limits = job.limits;
-  ev.faces_evaluated = faces_total;
-  // Distinct lattice corners of all occupied voxels, and each voxel's 8 corner ids.
-  const LatticeCorners lattice = ListCorners(index);
-  const std::vector<uint64_t>& corners = lattice.corners;
-  const std::vector<std::array<uint32_t, 8>>& voxel_corners = lattice.voxel_corners;
-  VC_RETURN_IF_ERROR(ctx.CheckCancelled("evaluation"));
-  const std::vector<uint8_t> faces_in_set = FacesInSetMask(g, index, options.faces);
-  // Allocated here, in the calling thread, like every large allocation of this mode: running out
-  // of memory must not happen in a worker thread. Each viewpoint's values are filled by the
-  // thread that evaluates it (huge_pages.h: first touch is the costly part).
-  if (options.keep_per_viewpoint_values) {
-    ev.per_viewpoint_face_values.resize(nv);
-    for (std::vector<float>& values : ev.per_viewpoint_face_values) {
-      internal::ReserveOnHugePages(values, n * kFacesPerVoxel);
-    }
-  }
-  constexpr uint64_t kCornerChunk = 64 * 256;
-  constexpr uint64_t kVoxelChunk = 4096;
-  static_assert(kCornerChunk % kCullBlock == 0 && kVoxelChunk % kCullBlock == 0);
-  // The scanner's range, block by block. A face centre lies in its voxel's cube [v, v + 1] and
-  // within 1 (per axis) of each of its corners: a block of voxels whose cubes, or of corners whose
-  // boxes [c - 1, c + 1], are all out of range holds nothing that changes a face's V (> 0), so it
-  // is skipped; skipped corners count as unseen, which only faces out of range could notice.
-  const BlockBoxes corner_boxes(
-      corners.size(), [&](size_t c) { return UnpackCorner(corners[c]); }, 1.0, 1.0);
-  const BlockBoxes voxel_boxes(
-      n, [&](size_t i) { return index[i]; }, 0.0, 1.0);
-  const uint64_t voxel_chunks = (n + kVoxelChunk - 1) / kVoxelChunk;
-  // With keep_sparse_per_viewpoint_values: per viewpoint and chunk of voxels, the faces with V > 0,
-  // joined in chunk order at the end, in this thread (the workers only fill chunk-sized pieces).
-  std::vector<std::vector<SparseFaceValues>> sparse_chunks;
-  if (options.keep_sparse_per_viewpoint_values) {
-    sparse_chunks.assign(nv, std::vector<SparseFaceValues>(voxel_chunks));
-  }
-  StageProgress progress(ctx, Stage::kEvaluation, nv, nv, "stations");
-  // Corners that groups of faces decide at once (surface_groups.h), per viewpoint.
-  const internal::SurfaceTargets targets(g, index, NotEnclosed(g, index));
-  constexpr uint64_t kBricksPerTask = 256;
-  const uint64_t brick_chunks = (targets.brick_count() + kBricksPerTask - 1) / kBricksPerTask;
+// Exact mode's chunks: corners per ray-casting task, voxels per face-valuing task (whole blocks
+// of kCullBlock), and bricks of face groups per group task.
+constexpr uint64_t kCornerChunk = 64 * 256;
+constexpr uint64_t kVoxelChunk = 4096;
+constexpr uint64_t kBricksPerTask = 256;
+static_assert(kCornerChunk % kCullBlock == 0 && kVoxelChunk % kCullBlock == 0);
 
+// Exact mode over one job whose voxels are sorted and unique. Per viewpoint: the visible lattice
+// corners (first those that groups of faces decide, then one ray per remaining corner), then each
+// face's V from its corners, keeping each face's best V over the viewpoints; the overall figures
+// come from the best values. Run once; viewpoints may be evaluated on several threads at once,
+// each into its own Work.
+class ExactEvaluation {
+ public:
+  // `ev` has resolution, |F| and per_viewpoint's size set; `lattice` is ListCorners(job.index).
+  // Every large allocation of this mode happens here or in the calling thread of Run: running out
+  // of memory must not happen in a worker thread.
+  ExactEvaluation(const EvaluationJob& job, LatticeCorners lattice, Evaluation ev);
+
+  // Evaluates every viewpoint, then the overall figures (and the kept values the options ask for).
+  Result<Evaluation> Run();
+
+ private:
   // What evaluating viewpoints needs besides the scene: the corner bitsets of the viewpoint at
   // hand, and the best V (and its perception) of each face over the viewpoints evaluated so far.
   struct Work {
@@ -384,185 +352,304 @@ Result<Evaluation> EvaluateExact(const EvaluationJob& job, Evaluation ev) {
     // kNoViewer / kSeveralViewers).
     std::vector<int32_t> viewer;
   };
-  const size_t corner_words = (corners.size() + 63) / 64;
+
+  // Voxels with a sole-viewer slot in a Work: all with keep_face_values, else none.
+  size_t ViewerSlots() const { return job_.options.keep_face_values ? job_.n : 0; }
+  std::unique_ptr<Work> NewWork() const;
+
+  // Every viewpoint into works_ (at least one); the best values are spread over them until
+  // MergeWorks.
+  Status EvaluateViewpoints();
+  // The first nv - nv % workers viewpoints one per thread, each into a Work of its own, then the
+  // rest one after another on all threads.
+  Status EvaluateViewpointsPerThread(int workers);
+
   // Viewpoint k into `w`, on `threads` workers (1: all in the calling thread, with no atomics).
   // Its figures do not depend on `threads`: partial sums are merged in chunk order.
-  auto evaluate_viewpoint = [&](size_t k, int threads, Work& w) -> Status {
-    const bool shared = ResolveThreads(threads, brick_chunks) > 1;  // the group pass runs on several threads
-    // 1. Corners decided by face groups, then one ray per remaining corner. With several
-    // workers, tasks share words of the bitsets, so the group pass sets bits atomically.
-    std::fill(w.visible_bits.begin(), w.visible_bits.end(), 0);
-    std::fill(w.decided_bits.begin(), w.decided_bits.end(), 0);
-    // A corner is often decided many times (it is shared by up to 24 faces), so BitWriter's
-    // plain load before the atomic one pays.
-    const internal::BitWriter decided_out{w.decided_bits.data(), shared}, visible_out{w.visible_bits.data(), shared};
-    const bool grouped = !options.per_corner && shortcuts[k] && !InsideOccupied(g, uo[k]);
-    if (grouped) {
-      const internal::FreeBox around = internal::GrowFreeBox(g, uo[k]);  // once, for every chunk
-      VC_RETURN_IF_ERROR(ParallelChunks(brick_chunks, 1, threads, ctx, [&](uint64_t task, uint64_t, uint64_t) {
-        internal::GroupWalk walk;
-        walk.around = around;
-        std::vector<internal::SurfaceTargets::CornerDecision> decisions;
-        const size_t b0 = task * kBricksPerTask, b1 = std::min<size_t>(b0 + kBricksPerTask, targets.brick_count());
-        targets.AppendCornerDecisions(uo[k], limits[k], b0, b1, walk, decisions);
-        for (const auto& d : decisions) {
-          auto apply = [&](int q) {
-            const uint32_t c = voxel_corners[d.id][q];
-            decided_out.Set(c);
-            if (d.seen) visible_out.Set(c);
-          };
-          if (d.face == 0xff) {
-            apply(d.corner);
-          } else {
-            for (int q : kFaceCorners[d.face]) apply(q);
-          }
-        }
-      }));
-    }
-    VC_RETURN_IF_ERROR(
-        ParallelChunks(corners.size(), kCornerChunk, threads, ctx, [&](uint64_t, uint64_t b, uint64_t e) {
-          OccluderCache cache(shortcuts[k]);
-          for (uint64_t block_begin = b; block_begin < e; block_begin += kCullBlock) {
-            if (corner_boxes.OutOfRange(limits[k], block_begin / kCullBlock)) continue;
-            for (uint64_t c = block_begin; c < std::min(block_begin + kCullBlock, e); ++c) {
-              if ((w.decided_bits[c >> 6] >> (c & 63)) & 1) continue;
-              if (CornerVisibleCached(g, uo[k], UnpackCorner(corners[c]), cache)) {
-                w.visible_bits[c >> 6] |= uint64_t{1} << (c & 63);
-              }
-            }
-          }
-        }));
-    // 2. Faces from their corners.
-    std::vector<Tally>& tallies = w.tallies;
-    std::fill(tallies.begin(), tallies.end(), Tally{});
-    std::vector<float>* keep = options.keep_per_viewpoint_values ? &ev.per_viewpoint_face_values[k] : nullptr;
-    if (keep) keep->resize(n * kFacesPerVoxel);  // zeros, in the capacity reserved above
-    const bool keep_sparse = options.keep_sparse_per_viewpoint_values;
-    VC_RETURN_IF_ERROR(ParallelChunks(n, kVoxelChunk, threads, ctx, [&](uint64_t chunk, uint64_t b, uint64_t e) {
-      Tally& t = tallies[chunk];
-      SparseFaceValues* sparse = keep_sparse ? &sparse_chunks[k][chunk] : nullptr;
-      for (uint64_t i = b; i < e; ++i) {
-        if (i % kCullBlock == 0 && voxel_boxes.OutOfRange(limits[k], i / kCullBlock)) {
-          i += kCullBlock - 1;  // the whole block (chunks hold whole blocks)
-          continue;
-        }
-        unsigned corner_bits = 0;  // bit q: corner q of voxel i is visible
-        for (int q = 0; q < 8; ++q) {
-          const uint32_t c = voxel_corners[i][q];
-          corner_bits |= unsigned((w.visible_bits[c >> 6] >> (c & 63)) & 1) << q;
-        }
-        // No visible corner: every face is unperceived, V = 0, which adds nothing to the tally or
-        // the best values, and the kept values are zeros already.
-        if (corner_bits == 0) continue;
-        bool seen = false;
-        for (int f = 0; f < kFacesPerVoxel; ++f) {
-          if (!((faces_in_set[i] >> f) & 1)) continue;
-          const Perception p = FromCount(std::popcount(corner_bits & kFaceCornerMask[f]));
-          const double val = FaceValue(p, viewpoints[k], index[i], Face(f), r, options.scanner, limits[k]);
-          t.Add(p, val);
-          const size_t slot = i * kFacesPerVoxel + f;
-          if (keep) (*keep)[slot] = float(val);
-          if (sparse && val > 0) {
-            sparse->faces.push_back(uint32_t(slot));
-            sparse->values.push_back(float(val));
-          }
-          KeepBest(val, uint8_t(p), w.best[slot], w.best_p[slot]);
-          seen |= val > 0;
-        }
-        if (seen && !w.viewer.empty()) w.viewer[i] = CombineViewers(w.viewer[i], int32_t(k));
-      }
-    }));
-    Tally total;
-    for (const Tally& t : tallies) total.Merge(t);
-    ev.per_viewpoint[k] = total.Figures(faces_total);
-    progress.Add(1);
-    return Status::Ok();
-  };
+  Status EvaluateViewpoint(size_t k, int threads, Work& w);
+  // Into w's bitsets, the corners that groups of faces decide for viewpoint k (and whether each
+  // is seen). With several workers, tasks share words of the bitsets, so bits are set atomically.
+  Status DecideCornersByGroups(size_t k, int threads, Work& w) const;
+  // One ray from viewpoint k to each corner in the scanner's range that is not decided yet.
+  Status CastRaysToUndecidedCorners(size_t k, int threads, Work& w) const;
+  // Each face's V from viewpoint k, from its visible corners: into w's tallies and best values,
+  // the sole viewers, and the per-viewpoint values the options keep.
+  Status ValueFaces(size_t k, int threads, Work& w);
 
-  // With enough viewpoints per thread, a task is one viewpoint, evaluated by one thread into
-  // that thread's Work (no joins within a viewpoint, no atomics); the threads' best values are
-  // merged at the end. Otherwise the viewpoints are evaluated one after another, each on all
-  // threads. Both give the same figures: the best (V, perception) pair of a face is the same
-  // whatever the order of the viewpoints.
-  // Each extra thread's Work costs 9 bytes per face (and 4 per voxel for the sole viewers); beyond
-  // kEvaluateExtraWorkBytes in all, the viewpoints are evaluated one after another instead.
-  const int workers = ResolveThreads(options.threads, nv);
-  const size_t viewer_slots = options.keep_face_values ? n : 0;
-  const uint64_t extra_bytes = uint64_t(workers - 1) * (n * kFacesPerVoxel * (sizeof(double) + sizeof(uint8_t)) +
-                                                        viewer_slots * sizeof(int32_t));
-  std::vector<std::unique_ptr<Work>> works;
-  if (workers > 1 && nv >= kEvaluateViewpointsPerThread * uint64_t(workers) && extra_bytes <= kEvaluateExtraWorkBytes) {
-    // Allocated here, in the calling thread, so that running out of memory is not a worker's.
-    std::vector<Work*> idle;
-    for (int t = 0; t < workers; ++t) {
-      works.push_back(std::make_unique<Work>(corner_words, n * kFacesPerVoxel, voxel_chunks, viewer_slots));
-      idle.push_back(works.back().get());
+  // Folds the best values and sole viewers of every Work into the first.
+  void MergeWorks();
+  // Each viewpoint's sparse values: its chunks in order, so faces ascending.
+  void JoinSparseValues();
+  // The overall figures from the best V of each face over all viewpoints, and the kept values.
+  Evaluation Finish();
+
+  const EvaluationJob& job_;
+  const LatticeCorners lattice_;
+  Evaluation ev_;
+  const std::vector<uint8_t> faces_in_set_;
+  // The scanner's range, block by block. A face centre lies in its voxel's cube [v, v + 1] and
+  // within 1 (per axis) of each of its corners: a block of voxels whose cubes, or of corners whose
+  // boxes [c - 1, c + 1], are all out of range holds nothing that changes a face's V (> 0), so it
+  // is skipped; skipped corners count as unseen, which only faces out of range could notice.
+  const BlockBoxes corner_boxes_;
+  const BlockBoxes voxel_boxes_;
+  const uint64_t voxel_chunks_;
+  // With keep_sparse_per_viewpoint_values: per viewpoint and chunk of voxels, the faces with V > 0,
+  // joined in chunk order at the end, in the calling thread (the workers only fill chunk-sized pieces).
+  std::vector<std::vector<SparseFaceValues>> sparse_chunks_;
+  StageProgress progress_;
+  // Corners that groups of faces decide at once (surface_groups.h), per viewpoint.
+  const internal::SurfaceTargets targets_;
+  const uint64_t brick_chunks_;
+  const size_t corner_words_;
+  std::vector<std::unique_ptr<Work>> works_;
+};
+
+ExactEvaluation::ExactEvaluation(const EvaluationJob& job, LatticeCorners lattice, Evaluation ev)
+    : job_(job),
+      lattice_(std::move(lattice)),
+      ev_(std::move(ev)),
+      faces_in_set_(FacesInSetMask(job.g, job.index, job.options.faces)),
+      corner_boxes_(
+          lattice_.corners.size(), [&](size_t c) { return UnpackCorner(lattice_.corners[c]); }, 1.0, 1.0),
+      voxel_boxes_(
+          job.n, [&](size_t i) { return job.index[i]; }, 0.0, 1.0),
+      voxel_chunks_((job.n + kVoxelChunk - 1) / kVoxelChunk),
+      progress_(job.ctx, Stage::kEvaluation, job.nv, job.nv, "stations"),
+      targets_(job.g, job.index, NotEnclosed(job.g, job.index)),
+      brick_chunks_((targets_.brick_count() + kBricksPerTask - 1) / kBricksPerTask),
+      corner_words_((lattice_.corners.size() + 63) / 64) {
+  // Each viewpoint's values are filled by the thread that evaluates it (huge_pages.h: first touch
+  // is the costly part).
+  if (job.options.keep_per_viewpoint_values) {
+    ev_.per_viewpoint_face_values.resize(job.nv);
+    for (std::vector<float>& values : ev_.per_viewpoint_face_values) {
+      internal::ReserveOnHugePages(values, job.n * kFacesPerVoxel);
     }
-    std::mutex mu;
-    Status failed = Status::Ok();
-    // The last nv % workers viewpoints are evaluated one after another on all threads, so that
-    // no thread ends with a whole viewpoint of its own while the others wait.
-    const uint64_t alone = nv - nv % uint64_t(workers);
-    VC_RETURN_IF_ERROR(ParallelChunks(
-        alone, 1, workers, ctx,
-        [&](uint64_t k, uint64_t, uint64_t) {
-          Work* w = nullptr;
-          {
-            std::lock_guard<std::mutex> lock(mu);  // at most `workers` tasks run at once
-            w = idle.back();
-            idle.pop_back();
-          }
-          const Status st = evaluate_viewpoint(k, 1, *w);
-          std::lock_guard<std::mutex> lock(mu);
-          if (!st.ok() && failed.ok()) failed = st;
-          idle.push_back(w);
-        },
-        "evaluation"));
-    VC_RETURN_IF_ERROR(failed);
-    for (size_t k = alone; k < nv; ++k) VC_RETURN_IF_ERROR(evaluate_viewpoint(k, workers, *works[0]));
-  } else {
-    works.push_back(std::make_unique<Work>(corner_words, n * kFacesPerVoxel, voxel_chunks, viewer_slots));
-    for (size_t k = 0; k < nv; ++k) VC_RETURN_IF_ERROR(evaluate_viewpoint(k, options.threads, *works[0]));
   }
-  std::vector<double>& best = works[0]->best;
-  std::vector<uint8_t>& best_p = works[0]->best_p;
-  std::vector<int32_t>& viewer = works[0]->viewer;
-  for (size_t t = 1; t < works.size(); ++t) {
-    for (size_t slot = 0; slot < best.size(); ++slot)
-      KeepBest(works[t]->best[slot], works[t]->best_p[slot], best[slot], best_p[slot]);
-    for (size_t i = 0; i < viewer.size(); ++i) viewer[i] = CombineViewers(viewer[i], works[t]->viewer[i]);
+  if (job.options.keep_sparse_per_viewpoint_values) {
+    sparse_chunks_.assign(job.nv, std::vector<SparseFaceValues>(voxel_chunks_));
   }
-  if (options.keep_sparse_per_viewpoint_values) {  // each viewpoint's chunks in order: faces ascending
-    ev.per_viewpoint_sparse_values.resize(nv);
-    for (size_t k = 0; k < nv; ++k) {
-      SparseFaceValues& out = ev.per_viewpoint_sparse_values[k];
-      size_t count = 0;
-      for (const SparseFaceValues& c : sparse_chunks[k]) count += c.size();
-      out.faces.reserve(count);
-      out.values.reserve(count);
-      for (SparseFaceValues& c : sparse_chunks[k]) {
-        out.faces.insert(out.faces.end(), c.faces.begin(), c.faces.end());
-        out.values.insert(out.values.end(), c.values.begin(), c.values.end());
-        c = SparseFaceValues{};
+}
+
+Result<Evaluation> ExactEvaluation::Run() {
+  VC_RETURN_IF_ERROR(EvaluateViewpoints());
+  MergeWorks();
+  if (job_.options.keep_sparse_per_viewpoint_values) JoinSparseValues();
+  return Finish();
+}
+
+std::unique_ptr<ExactEvaluation::Work> ExactEvaluation::NewWork() const {
+  return std::make_unique<Work>(corner_words_, job_.n * kFacesPerVoxel, voxel_chunks_, ViewerSlots());
+}
+
+// With enough viewpoints per thread, a task is one viewpoint, evaluated by one thread into
+// that thread's Work (no joins within a viewpoint, no atomics); the threads' best values are
+// merged at the end. Otherwise the viewpoints are evaluated one after another, each on all
+// threads. Both give the same figures: the best (V, perception) pair of a face is the same
+// whatever the order of the viewpoints.
+// Each extra thread's Work costs 9 bytes per face (and 4 per voxel for the sole viewers); beyond
+// kEvaluateExtraWorkBytes in all, the viewpoints are evaluated one after another instead.
+Status ExactEvaluation::EvaluateViewpoints() {
+  const size_t n = job_.n, nv = job_.nv;
+  const int workers = ResolveThreads(job_.options.threads, nv);
+  const uint64_t extra_bytes = uint64_t(workers - 1) * (n * kFacesPerVoxel * (sizeof(double) + sizeof(uint8_t)) +
+                                                        ViewerSlots() * sizeof(int32_t));
+  if (workers > 1 && nv >= kEvaluateViewpointsPerThread * uint64_t(workers) && extra_bytes <= kEvaluateExtraWorkBytes) {
+    return EvaluateViewpointsPerThread(workers);
+  }
+  works_.push_back(NewWork());
+  for (size_t k = 0; k < nv; ++k) VC_RETURN_IF_ERROR(EvaluateViewpoint(k, job_.options.threads, *works_[0]));
+  return Status::Ok();
+}
+
+Status ExactEvaluation::EvaluateViewpointsPerThread(int workers) {
+  const size_t nv = job_.nv;
+  // Allocated here, in the calling thread, so that running out of memory is not a worker's.
+  std::vector<Work*> idle;
+  for (int t = 0; t < workers; ++t) {
+    works_.push_back(NewWork());
+    idle.push_back(works_.back().get());
+  }
+  std::mutex mu;
+  Status failed = Status::Ok();
+  // The last nv % workers viewpoints are evaluated one after another on all threads, so that
+  // no thread ends with a whole viewpoint of its own while the others wait.
+  const uint64_t alone = nv - nv % uint64_t(workers);
+  VC_RETURN_IF_ERROR(ParallelChunks(
+      alone, 1, workers, job_.ctx,
+      [&](uint64_t k, uint64_t, uint64_t) {
+        Work* w = nullptr;
+        {
+          std::lock_guard<std::mutex> lock(mu);  // at most `workers` tasks run at once
+          w = idle.back();
+          idle.pop_back();
+        }
+        const Status st = EvaluateViewpoint(k, 1, *w);
+        std::lock_guard<std::mutex> lock(mu);
+        if (!st.ok() && failed.ok()) failed = st;
+        idle.push_back(w);
+      },
+      "evaluation"));
+  VC_RETURN_IF_ERROR(failed);
+  for (size_t k = alone; k < nv; ++k) VC_RETURN_IF_ERROR(EvaluateViewpoint(k, workers, *works_[0]));
+  return Status::Ok();
+}
+
+Status ExactEvaluation::EvaluateViewpoint(size_t k, int threads, Work& w) {
+  std::fill(w.visible_bits.begin(), w.visible_bits.end(), 0);
+  std::fill(w.decided_bits.begin(), w.decided_bits.end(), 0);
+  const bool grouped = !job_.options.per_corner && job_.shortcuts[k] && !InsideOccupied(job_.g, job_.uo[k]);
+  if (grouped) VC_RETURN_IF_ERROR(DecideCornersByGroups(k, threads, w));
+  VC_RETURN_IF_ERROR(CastRaysToUndecidedCorners(k, threads, w));
+  VC_RETURN_IF_ERROR(ValueFaces(k, threads, w));
+  Tally total;
+  for (const Tally& t : w.tallies) total.Merge(t);
+  ev_.per_viewpoint[k] = total.Figures(job_.faces_total);
+  progress_.Add(1);
+  return Status::Ok();
+}
+
+Status ExactEvaluation::DecideCornersByGroups(size_t k, int threads, Work& w) const {
+  const bool shared = ResolveThreads(threads, brick_chunks_) > 1;  // the group pass runs on several threads
+  // A corner is often decided many times (it is shared by up to 24 faces), so BitWriter's
+  // plain load before the atomic one pays.
+  const internal::BitWriter decided_out{w.decided_bits.data(), shared}, visible_out{w.visible_bits.data(), shared};
+  const internal::FreeBox around = internal::GrowFreeBox(job_.g, job_.uo[k]);  // once, for every chunk
+  return ParallelChunks(brick_chunks_, 1, threads, job_.ctx, [&](uint64_t task, uint64_t, uint64_t) {
+    internal::GroupWalk walk;
+    walk.around = around;
+    std::vector<internal::SurfaceTargets::CornerDecision> decisions;
+    const size_t b0 = task * kBricksPerTask, b1 = std::min<size_t>(b0 + kBricksPerTask, targets_.brick_count());
+    targets_.AppendCornerDecisions(job_.uo[k], job_.limits[k], b0, b1, walk, decisions);
+    for (const auto& d : decisions) {
+      auto apply = [&](int q) {
+        const uint32_t c = lattice_.voxel_corners[d.id][q];
+        decided_out.Set(c);
+        if (d.seen) visible_out.Set(c);
+      };
+      if (d.face == 0xff) {
+        apply(d.corner);
+      } else {
+        for (int q : kFaceCorners[d.face]) apply(q);
       }
     }
+  });
+}
+
+Status ExactEvaluation::CastRaysToUndecidedCorners(size_t k, int threads, Work& w) const {
+  const std::vector<uint64_t>& corners = lattice_.corners;
+  return ParallelChunks(corners.size(), kCornerChunk, threads, job_.ctx, [&](uint64_t, uint64_t b, uint64_t e) {
+    OccluderCache cache(job_.shortcuts[k]);
+    for (uint64_t block_begin = b; block_begin < e; block_begin += kCullBlock) {
+      if (corner_boxes_.OutOfRange(job_.limits[k], block_begin / kCullBlock)) continue;
+      for (uint64_t c = block_begin; c < std::min(block_begin + kCullBlock, e); ++c) {
+        if ((w.decided_bits[c >> 6] >> (c & 63)) & 1) continue;
+        if (CornerVisibleCached(job_.g, job_.uo[k], UnpackCorner(corners[c]), cache)) {
+          w.visible_bits[c >> 6] |= uint64_t{1} << (c & 63);
+        }
+      }
+    }
+  });
+}
+
+Status ExactEvaluation::ValueFaces(size_t k, int threads, Work& w) {
+  std::vector<Tally>& tallies = w.tallies;
+  std::fill(tallies.begin(), tallies.end(), Tally{});
+  std::vector<float>* keep = job_.options.keep_per_viewpoint_values ? &ev_.per_viewpoint_face_values[k] : nullptr;
+  if (keep) keep->resize(job_.n * kFacesPerVoxel);  // zeros, in the capacity reserved above
+  const bool keep_sparse = job_.options.keep_sparse_per_viewpoint_values;
+  return ParallelChunks(job_.n, kVoxelChunk, threads, job_.ctx, [&](uint64_t chunk, uint64_t b, uint64_t e) {
+    Tally& t = tallies[chunk];
+    SparseFaceValues* sparse = keep_sparse ? &sparse_chunks_[k][chunk] : nullptr;
+    for (uint64_t i = b; i < e; ++i) {
+      if (i % kCullBlock == 0 && voxel_boxes_.OutOfRange(job_.limits[k], i / kCullBlock)) {
+        i += kCullBlock - 1;  // the whole block (chunks hold whole blocks)
+        continue;
+      }
+      unsigned corner_bits = 0;  // bit q: corner q of voxel i is visible
+      for (int q = 0; q < 8; ++q) {
+        const uint32_t c = lattice_.voxel_corners[i][q];
+        corner_bits |= unsigned((w.visible_bits[c >> 6] >> (c & 63)) & 1) << q;
+      }
+      // No visible corner: every face is unperceived, V = 0, which adds nothing to the tally or
+      // the best values, and the kept values are zeros already.
+      if (corner_bits == 0) continue;
+      bool seen = false;
+      for (int f = 0; f < kFacesPerVoxel; ++f) {
+        if (!((faces_in_set_[i] >> f) & 1)) continue;
+        const Perception p = FromCount(std::popcount(corner_bits & kFaceCornerMask[f]));
+        const double val = job_.FaceValueFrom(k, p, job_.index[i], Face(f));
+        t.Add(p, val);
+        const size_t slot = i * kFacesPerVoxel + f;
+        if (keep) (*keep)[slot] = float(val);
+        if (sparse && val > 0) {
+          sparse->faces.push_back(uint32_t(slot));
+          sparse->values.push_back(float(val));
+        }
+        KeepBest(val, uint8_t(p), w.best[slot], w.best_p[slot]);
+        seen |= val > 0;
+      }
+      if (seen && !w.viewer.empty()) w.viewer[i] = CombineViewers(w.viewer[i], int32_t(k));
+    }
+  });
+}
+
+void ExactEvaluation::MergeWorks() {
+  Work& first = *works_[0];
+  for (size_t t = 1; t < works_.size(); ++t) {
+    for (size_t slot = 0; slot < first.best.size(); ++slot)
+      KeepBest(works_[t]->best[slot], works_[t]->best_p[slot], first.best[slot], first.best_p[slot]);
+    for (size_t i = 0; i < first.viewer.size(); ++i)
+      first.viewer[i] = CombineViewers(first.viewer[i], works_[t]->viewer[i]);
   }
-  // Overall: the best V of each face over all viewpoints.
+}
+
+void ExactEvaluation::JoinSparseValues() {
+  ev_.per_viewpoint_sparse_values.resize(job_.nv);
+  for (size_t k = 0; k < job_.nv; ++k) {
+    SparseFaceValues& out = ev_.per_viewpoint_sparse_values[k];
+    size_t count = 0;
+    for (const SparseFaceValues& c : sparse_chunks_[k]) count += c.size();
+    out.faces.reserve(count);
+    out.values.reserve(count);
+    for (SparseFaceValues& c : sparse_chunks_[k]) {
+      out.faces.insert(out.faces.end(), c.faces.begin(), c.faces.end());
+      out.values.insert(out.values.end(), c.values.begin(), c.values.end());
+      c = SparseFaceValues{};
+    }
+  }
+}
+
+Evaluation ExactEvaluation::Finish() {
+  const size_t n = job_.n;
+  const std::vector<double>& best = works_[0]->best;
+  const std::vector<uint8_t>& best_p = works_[0]->best_p;
   Tally total;
   for (size_t i = 0; i < n; ++i)
     for (int f = 0; f < kFacesPerVoxel; ++f) {
-      if (!((faces_in_set[i] >> f) & 1)) continue;
+      if (!((faces_in_set_[i] >> f) & 1)) continue;
       const size_t slot = i * kFacesPerVoxel + f;
       total.Add(Perception(best_p[slot]), best[slot]);
     }
-  ev.overall = total.Figures(faces_total);
-  if (options.keep_face_values) {
-    ev.best_face_values.resize(n);
+  ev_.overall = total.Figures(job_.faces_total);
+  if (job_.options.keep_face_values) {
+    ev_.best_face_values.resize(n);
     for (size_t i = 0; i < n; ++i)
-      for (int f = 0; f < kFacesPerVoxel; ++f) ev.best_face_values[i][f] = float(best[i * kFacesPerVoxel + f]);
-    ev.sole_viewer = std::move(viewer);
+      for (int f = 0; f < kFacesPerVoxel; ++f) ev_.best_face_values[i][f] = float(best[i * kFacesPerVoxel + f]);
+    ev_.sole_viewer = std::move(works_[0]->viewer);
   }
-  return ev;
+  return std::move(ev_);
+}
+
+// Exact mode into `ev` (resolution, |F| and per_viewpoint's size already set); the scene's
+// voxels are sorted and unique.
+Result<Evaluation> EvaluateExact(const EvaluationJob& job, Evaluation ev) {
+  ev.faces_evaluated = job.faces_total;
+  LatticeCorners lattice = ListCorners(job.index);
+  VC_RETURN_IF_ERROR(job.ctx.CheckCancelled("evaluation"));
+  ExactEvaluation exact(job, std::move(lattice), std::move(ev));
+  return exact.Run();
 }
 
 }  // namespace
