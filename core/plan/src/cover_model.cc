@@ -46,8 +46,8 @@ CoverModel::CoverModel(const ReducedModel& reduced, std::vector<ScanArc> arcs, c
   weight_row_ = {class_rows_.end(), options_.cover_rows ? 0 : 1};
   budget_row_ = {weight_row_.end(), options_.max_mode ? 1 : 0};
   root_row_ = {budget_row_.end(), flow};
-  root_rows_ = {root_row_.end(), flow * n_stations};
-  source_flow_rows_ = {root_rows_.end(), flow * n_stations};
+  root_link_rows_ = {root_row_.end(), flow * n_stations};
+  source_flow_rows_ = {root_link_rows_.end(), flow * n_stations};
   conservation_rows_ = {source_flow_rows_.end(), flow * n_stations};
   capacity_rows_ = {conservation_rows_.end(), flow * 2 * n_arcs};
   n_rows_ = capacity_rows_.end();
@@ -82,7 +82,7 @@ void CoverModel::AppendStationColumns(Columns& cols) const {
     for (int k : col_classes[j]) cols.Add(class_rows_[k], options_.cover_rows ? 1.0 : -1.0);
     if (options_.max_mode) cols.Add(budget_row_[0], 1.0);
     if (options_.connect) {
-      cols.Add(root_rows_[j], -1.0);
+      cols.Add(root_link_rows_[j], -1.0);
       cols.Add(conservation_rows_[j], -1.0);
       for (int a : arcs_at_[j]) cols.Add(capacity_rows_[2 * a + (arcs_[a].from == j ? 0 : 1)], -(big_n_ - 1));
       if (m.columns[j] < options_.fixed) cols.lower[station_cols_[j]] = 1.0;  // fixed stations are in the plan
@@ -106,7 +106,7 @@ void CoverModel::AppendFlowColumns(Columns& cols) const {
   for (int j = 0; j < root_cols_.count; ++j) {
     cols.Start();
     cols.Add(root_row_[0], 1.0);
-    cols.Add(root_rows_[j], 1.0);
+    cols.Add(root_link_rows_[j], 1.0);
     cols.Add(source_flow_rows_[j], -big_n_);
     cols.End();
   }
@@ -140,7 +140,7 @@ void CoverModel::SetRowBounds(std::vector<double>& lower, std::vector<double>& u
   set(weight_row_, options_.max_mode ? -COIN_DBL_MAX : need, options_.max_mode ? need : COIN_DBL_MAX);
   set(budget_row_, -COIN_DBL_MAX, options_.max_stations);
   set(root_row_, 1.0, 1.0);
-  set(root_rows_, -COIN_DBL_MAX, 0.0);
+  set(root_link_rows_, -COIN_DBL_MAX, 0.0);
   set(source_flow_rows_, -COIN_DBL_MAX, 0.0);
   set(conservation_rows_, 0.0, 0.0);
   set(capacity_rows_, -COIN_DBL_MAX, 0.0);

@@ -86,7 +86,7 @@ class CoverModel {
   Block weight_row() const { return weight_row_; }                // sum w_k y_k >= need (max_mode: <= need)
   Block budget_row() const { return budget_row_; }                // max_mode: sum x <= max_stations
   Block root_row() const { return root_row_; }                    // sum r = 1
-  Block root_rows() const { return root_rows_; }                  // r_j - x_j <= 0
+  Block root_link_rows() const { return root_link_rows_; }        // r_j - x_j <= 0
   Block source_flow_rows() const { return source_flow_rows_; }    // g_j - N r_j <= 0
   Block conservation_rows() const { return conservation_rows_; }  // g_j + in_j - out_j - x_j = 0
   Block capacity_rows() const { return capacity_rows_; }          // per arc a: f_a - (N-1) x_from <= 0, then x_to
@@ -122,7 +122,7 @@ class CoverModel {
   CoverModelOptions options_;
   std::vector<std::vector<int>> arcs_at_;  // per column: the arcs it is an end of, ascending
   Block station_cols_, cover_cols_, root_cols_, source_flow_cols_, arc_flow_cols_;
-  Block class_rows_, weight_row_, budget_row_, root_row_, root_rows_, source_flow_rows_, conservation_rows_,
+  Block class_rows_, weight_row_, budget_row_, root_row_, root_link_rows_, source_flow_rows_, conservation_rows_,
       capacity_rows_;
   int n_columns_ = 0;
   int n_rows_ = 0;
