@@ -12,7 +12,6 @@
 #include <CglProbing.hpp>
 #include <CglZeroHalf.hpp>
 #include <ClpEventHandler.hpp>
-#include <CoinPackedMatrix.hpp>
 #include <OsiClpSolverInterface.hpp>
 #include <algorithm>
 #include <bit>
@@ -24,12 +23,17 @@
 #include <utility>
 #include <vector>
 
+#include "cover_model.h"
 #include "vc/plan/greedy.h"
 #include "vc/plan/scan_graph.h"
 
 namespace vc::planner {
 namespace {
 
+using internal::CoverModel;
+using internal::ReducedModel;
+using internal::ScanArc;
+using internal::WarmStart;
 using Clock = std::chrono::steady_clock;
 
 double SecondsSince(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
@@ -104,18 +108,41 @@ Result<Classes> BuildClasses(const std::vector<VoxelSet>& sets, const JobContext
   return out;
 }
 
-// The model after reduction: classes still to cover (merged again), the candidate columns, the
-// candidates forced to 1 and where each dropped candidate's role goes.
-struct ReducedModel {
-  std::vector<uint64_t> weight;           // per class
-  std::vector<std::vector<int>> seen_by;  // per class: column indices (into columns)
-  std::vector<int> columns;               // candidate index per column
-  std::vector<int> forced;                // candidates fixed to 1 (the fixed stations first)
-  uint64_t forced_covered = 0;            // voxels the forced candidates cover
-  std::vector<int> stand_in;              // per candidate: the candidate that replaces it, or -1
-  int dominated = 0;
-  int forced_sole_view = 0;
-};
+// Completes `m` once the reduction is done: resolves chains of stand-ins to a column or a forced
+// candidate, numbers the candidates still active as columns and merges the classes still to
+// cover by their (now smaller) sets of columns.
+void AssembleColumns(const Classes& cl, const std::vector<char>& active_class, const std::vector<char>& active,
+                     ReducedModel& m) {
+  const int n_candidates = static_cast<int>(active.size());
+  const int n_classes = static_cast<int>(active_class.size());
+  for (int c = 0; c < n_candidates; ++c) {
+    int s = c;
+    for (int hops = 0; s >= 0 && m.stand_in[s] != s && hops <= n_candidates; ++hops) s = m.stand_in[s];
+    m.stand_in[c] = s;
+  }
+  std::vector<int> column_of(n_candidates, -1);
+  for (int c = 0; c < n_candidates; ++c) {
+    if (active[c]) {
+      column_of[c] = static_cast<int>(m.columns.size());
+      m.columns.push_back(c);
+    }
+  }
+  std::map<std::vector<int>, int> index;
+  for (int k = 0; k < n_classes; ++k) {
+    if (!active_class[k]) continue;
+    std::vector<int> cols;
+    for (int c : cl.seen_by[k]) {
+      if (active[c]) cols.push_back(column_of[c]);
+    }
+    auto [it, inserted] = index.emplace(std::move(cols), static_cast<int>(m.weight.size()));
+    if (inserted) {
+      m.weight.push_back(cl.weight[k]);
+      m.seen_by.push_back(it->first);
+    } else {
+      m.weight[it->second] += cl.weight[k];
+    }
+  }
+}
 
 // keep_all (connectivity): every candidate that sees something, and every fixed one, stays a
 // column (a dominated candidate may be the link the scan graph needs); only the classes merge.
@@ -211,35 +238,7 @@ Result<ReducedModel> Reduce(const Classes& cl, int n_candidates, int fixed, bool
       }
     }
   }
-  // Resolve chains of stand-ins to a column or a forced candidate.
-  for (int c = 0; c < n_candidates; ++c) {
-    int s = c;
-    for (int hops = 0; s >= 0 && m.stand_in[s] != s && hops <= n_candidates; ++hops) s = m.stand_in[s];
-    m.stand_in[c] = s;
-  }
-  std::vector<int> column_of(n_candidates, -1);
-  for (int c = 0; c < n_candidates; ++c) {
-    if (active[c]) {
-      column_of[c] = static_cast<int>(m.columns.size());
-      m.columns.push_back(c);
-    }
-  }
-  // Classes left, merged again by their (now smaller) sets of columns.
-  std::map<std::vector<int>, int> index;
-  for (int k = 0; k < n_classes; ++k) {
-    if (!active_class[k]) continue;
-    std::vector<int> cols;
-    for (int c : cl.seen_by[k]) {
-      if (active[c]) cols.push_back(column_of[c]);
-    }
-    auto [it, inserted] = index.emplace(std::move(cols), static_cast<int>(m.weight.size()));
-    if (inserted) {
-      m.weight.push_back(cl.weight[k]);
-      m.seen_by.push_back(it->first);
-    } else {
-      m.weight[it->second] += cl.weight[k];
-    }
-  }
+  AssembleColumns(cl, active_class, active, m);
   return m;
 }
 
@@ -480,6 +479,385 @@ Result<std::vector<int>> SwapLocalSearch(const Classes& cl, std::vector<int> pic
   return picks;
 }
 
+// The directed arcs of the columns' scan graph: both directions of each edge, in order of the
+// edge's lower column, then its higher one.
+Result<std::vector<ScanArc>> ScanGraphArcs(const std::vector<VoxelSet>& sets, const std::vector<int>& columns,
+                                           double min_overlap, const JobContext& ctx) {
+  std::vector<ScanArc> arcs;
+  const int n_cols = static_cast<int>(columns.size());
+  for (int a = 0; a < n_cols; ++a) {
+    if (a % 32 == 0) VC_RETURN_IF_ERROR(ctx.CheckCancelled("exact selection (scan graph)"));
+    for (int b = a + 1; b < n_cols; ++b) {
+      if (IsEdge(Overlap(sets[columns[a]], sets[columns[b]]), min_overlap)) {
+        arcs.push_back({a, b});
+        arcs.push_back({b, a});
+      }
+    }
+  }
+  return arcs;
+}
+
+// What a CBC solve leaves behind (no CBC object outlives the solve).
+struct CbcOutcome {
+  bool root_lp_stopped = false;       // the time limit cut off the root LP; nothing below is set
+  bool lp_stopped = false;            // an LP in the search was cut off at the deadline
+  double root_bound = -COIN_DBL_MAX;  // the root LP's optimum, or -COIN_DBL_MAX when not proven
+  bool warm_connected = true;         // the warm start's stations are connected (always without connectivity)
+  bool proven_optimal = false;
+  bool proven_infeasible = false;
+  int status = 0;            // CbcModel::status()
+  int secondary_status = 0;  // CbcModel::secondaryStatus()
+  int node_count = 0;
+  double best_possible = 0;     // CBC's bound on the objective
+  bool has_solution = false;    // CBC holds a solution (its own or the warm start)
+  std::vector<int> candidates;  // the candidates of the x columns at 1 in that solution
+};
+
+// Adds CBC's cut generators (CbcModel keeps its own copies).
+void AddCutGenerators(CbcModel& cbc) {
+  CglProbing probing;
+  probing.setUsingObjective(1);
+  probing.setMaxPass(1);
+  probing.setMaxProbe(10);
+  probing.setMaxLook(10);
+  CglGomory gomory;
+  CglKnapsackCover knapsack;
+  CglClique clique;
+  clique.setStarCliqueReport(false);
+  clique.setRowCliqueReport(false);
+  CglMixedIntegerRounding2 mir;
+  CglZeroHalf zero_half;
+  cbc.addCutGenerator(&probing, -1, "Probing");
+  cbc.addCutGenerator(&gomory, -1, "Gomory");
+  cbc.addCutGenerator(&knapsack, -1, "Knapsack");
+  cbc.addCutGenerator(&clique, -1, "Clique");
+  cbc.addCutGenerator(&mir, -1, "MIR2");
+  cbc.addCutGenerator(&zero_half, -1, "ZeroHalf");
+}
+
+// Solves `model` with CBC until start + time_limit_s: the root LP first (primal simplex), then
+// branch and bound warm-started from `warm_picks` (candidate indices < n_candidates) where that
+// plan is feasible. CANCELLED / DEADLINE_EXCEEDED from ctx.
+Result<CbcOutcome> SolveWithCbc(const CoverModel& model, const std::vector<int>& warm_picks, int n_candidates,
+                                Clock::time_point start, double time_limit_s, const JobContext& ctx) {
+  const ReducedModel& m = model.reduced();
+  const bool max_mode = model.options().max_mode;
+  SolveWatch watch;
+  watch.ctx = &ctx;
+  watch.start = start;
+  watch.time_limit_s = time_limit_s;
+  watch.max_mode = max_mode;
+  watch.offset = max_mode ? double(m.forced_covered) : double(m.forced.size());
+  watch.last_report = start - std::chrono::seconds(1);
+  LpWatchHandler lp_handler(&watch);
+  OsiClpSolverInterface solver;
+  solver.messageHandler()->setLogLevel(0);
+  solver.getModelPtr()->passInEventHandler(&lp_handler);
+  model.LoadInto(solver);
+  // Primal simplex: on geb079 (49,706 classes) the root LP takes 11 s with it and over 2 min with
+  // the dual; with it in the resolves too, CBC proves 69 stations optimal in 67 s.
+  solver.setHintParam(OsiDoDualInInitial, false, OsiHintDo);
+  solver.setHintParam(OsiDoDualInResolve, false, OsiHintDo);
+  // The root LP first, under the deadline (CbcModel copies the solved basis).
+  solver.initialSolve();
+  VC_RETURN_IF_ERROR(watch.cancelled);
+  CbcOutcome out;
+  if (watch.lp_stopped) {
+    out.root_lp_stopped = true;
+    return out;
+  }
+  // The LP relaxation's optimum bounds the stations (min mode) from below.
+  out.root_bound = solver.isProvenOptimal() ? solver.getObjValue() : -COIN_DBL_MAX;
+  CbcModel cbc(solver);
+  cbc.setLogLevel(0);
+  cbc.messageHandler()->setLogLevel(0);
+  cbc.setUseElapsedTime(true);
+  cbc.setMaximumSeconds(std::max(0.01, time_limit_s - SecondsSince(start)));
+  if (!max_mode) cbc.setCutoffIncrement(1.0 - 1e-6);  // the objective is a station count
+  AddCutGenerators(cbc);
+  CbcRounding rounding(cbc);
+  cbc.addHeuristic(&rounding);
+  CbcHeuristicLocal local(cbc);
+  cbc.addHeuristic(&local);
+  CbcHeuristicFPump pump(cbc);
+  cbc.addHeuristic(&pump);
+  // The warm start: greedy's plan where it satisfies the model (none when it is not connected).
+  const WarmStart warm = model.WarmStartFrom(warm_picks, n_candidates);
+  out.warm_connected = warm.connected;
+  if (warm.feasible) cbc.setBestSolution(warm.values.data(), model.n_columns(), warm.objective, true);
+  WatchHandler handler(&watch);
+  cbc.passInEventHandler(&handler);
+  cbc.branchAndBound();
+  VC_RETURN_IF_ERROR(watch.cancelled);
+  VC_RETURN_IF_ERROR(ctx.CheckCancelled("exact selection"));
+  out.lp_stopped = watch.lp_stopped;
+  out.proven_optimal = cbc.isProvenOptimal();
+  out.proven_infeasible = cbc.isProvenInfeasible();
+  out.status = cbc.status();
+  out.secondary_status = cbc.secondaryStatus();
+  out.node_count = cbc.getNodeCount();
+  out.best_possible = cbc.getBestPossibleObjValue();
+  const double* best = cbc.bestSolution();
+  out.has_solution = best != nullptr;
+  for (int j = 0; best != nullptr && j < model.station_cols().count; ++j) {
+    if (best[model.station_cols()[j]] > 0.5) out.candidates.push_back(m.columns[j]);
+  }
+  return out;
+}
+
+// One ExactSelector::Select call after the greedy plan: builds the reduced model and the integer
+// program, solves it (or takes a fallback) and reads the plan, filling in the Selection.
+class ExactRun {
+ public:
+  ExactRun(const ExactSelectorOptions& options, const std::vector<VoxelSet>& sets, int fixed, const JobContext& ctx,
+           Clock::time_point start, Selection greedy);
+  Result<Selection> Select();
+
+ private:
+  Selection FinishForced(const ReducedModel& m, uint64_t need);
+  Result<Selection> SelectOverBudget(const Classes& cl, const ReducedModel& m, uint64_t need, uint64_t estimate);
+  Result<Selection> Read(const CoverModel& model, const CbcOutcome& outcome);
+  void SetCoveredBound(const CoverModel& model, const CbcOutcome& outcome, bool proven, const std::vector<int>& picks);
+  void SetStationBound(const CoverModel& model, const CbcOutcome& outcome, bool proven, size_t stations);
+  void SetCountingBound(const ReducedModel& m, uint64_t need);
+  bool AtLeastAsGoodAsGreedy(const std::vector<int>& picks) const;
+  bool StrictlyBetterThanGreedy(const std::vector<int>& picks) const;
+  Selection Finish(std::vector<int> picks);
+
+  const ExactSelectorOptions& options_;
+  const std::vector<VoxelSet>& sets_;
+  const int fixed_;
+  const JobContext& ctx_;
+  const Clock::time_point start_;
+  const bool max_mode_;
+  const bool connect_;
+  const uint64_t target_;  // voxels to cover (TargetVoxels)
+  // Greedy's plan: its picks, the voxels they cover, its first pass's covered count and stop reason.
+  const std::vector<int> greedy_picks_;
+  const uint64_t greedy_covered_;
+  const uint64_t greedy_pass_covered_;
+  const StopReason greedy_stop_;
+  bool greedy_connected_ = true;  // set once the flow model has checked greedy's plan
+  Selection out_;
+};
+
+ExactRun::ExactRun(const ExactSelectorOptions& options, const std::vector<VoxelSet>& sets, int fixed,
+                   const JobContext& ctx, Clock::time_point start, Selection greedy)
+    : options_(options),
+      sets_(sets),
+      fixed_(fixed),
+      ctx_(ctx),
+      start_(start),
+      max_mode_(options.greedy.max_stations > 0),
+      connect_(options.greedy.min_overlap > 0),
+      target_(TargetVoxels(options.greedy.target_coverage, greedy.coverable)),
+      greedy_picks_(greedy.picks),
+      greedy_covered_(Covered(sets, greedy.picks)),
+      greedy_pass_covered_(greedy.covered),
+      greedy_stop_(greedy.stop),
+      out_(std::move(greedy)) {
+  const uint64_t coverable = out_.coverable;
+  out_.optimality.solver = "exact";
+  out_.optimality.before = {static_cast<int>(sets.size()), static_cast<int>(coverable),
+                            static_cast<int>(coverable) + (target_ < coverable ? 1 : 0)};
+}
+
+Result<Selection> ExactRun::Select() {
+  const int n = static_cast<int>(sets_.size());
+  Optimality& opt = out_.optimality;
+  VC_ASSIGN_OR_RETURN(Classes cl, BuildClasses(sets_, ctx_));
+  const bool full = !max_mode_ && target_ == out_.coverable;
+  VC_ASSIGN_OR_RETURN(ReducedModel m, Reduce(cl, n, fixed_, full && !connect_, connect_, ctx_));
+  opt.forced = m.forced_sole_view;
+  opt.dominated = m.dominated;
+  const uint64_t need = target_ - std::min(target_, m.forced_covered);  // voxels the columns must add
+  std::vector<ScanArc> arcs;
+  if (connect_) {
+    VC_ASSIGN_OR_RETURN(arcs, ScanGraphArcs(sets_, m.columns, options_.greedy.min_overlap, ctx_));
+  }
+  const CoverModel model(m, std::move(arcs),
+                         {.max_mode = max_mode_,
+                          .cover_rows = full,
+                          .connect = connect_,
+                          .max_stations = options_.greedy.max_stations,
+                          .fixed = fixed_,
+                          .need = need});
+  opt.model = {model.station_cols().count, model.class_rows().count, model.n_rows()};
+  // Nothing left to decide: the forced candidates reach the target (or there are no columns).
+  if (model.station_cols().count == 0 || (!max_mode_ && need == 0)) return FinishForced(m, need);
+  const uint64_t estimate = model.EstimatedBytes();
+  if (estimate > options_.memory_budget_bytes) return SelectOverBudget(cl, m, need, estimate);
+  VC_ASSIGN_OR_RETURN(CbcOutcome outcome, SolveWithCbc(model, greedy_picks_, n, start_, options_.time_limit_s, ctx_));
+  return Read(model, outcome);
+}
+
+Selection ExactRun::FinishForced(const ReducedModel& m, uint64_t need) {
+  Optimality& opt = out_.optimality;
+  opt.status = OptimalityStatus::kOptimal;
+  std::vector<int> picks = m.forced;
+  if (!max_mode_ && need > 0) picks = greedy_picks_;  // unreachable: columns would remain
+  opt.lower_bound = static_cast<double>(picks.size());
+  opt.covered_bound = max_mode_ ? std::min(Covered(sets_, picks), target_) : 0;
+  return Finish(std::move(picks));
+}
+
+// Over the budget no integer program is built: greedy's plan, or greedy plus the swap local search.
+Result<Selection> ExactRun::SelectOverBudget(const Classes& cl, const ReducedModel& m, uint64_t need,
+                                             uint64_t estimate) {
+  Optimality& opt = out_.optimality;
+  const std::string too_large = "the integer program (about " + std::to_string(estimate >> 20) +
+                                " MiB) exceeds the memory budget (" +
+                                std::to_string(options_.memory_budget_bytes >> 20) + " MiB); ";
+  if (!options_.swap_search) {
+    opt.solver = "greedy";
+    opt.status = OptimalityStatus::kHeuristic;
+    opt.note = too_large + "greedy plan, with the counting bound";
+    SetCountingBound(m, need);
+    return Finish(greedy_picks_);
+  }
+  const Clock::time_point deadline =
+      start_ + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(options_.time_limit_s));
+  VC_ASSIGN_OR_RETURN(std::vector<int> picks, SwapLocalSearch(cl, greedy_picks_, fixed_, static_cast<int>(sets_.size()),
+                                                              target_, max_mode_, deadline, ctx_));
+  opt.solver = "greedy+swap";
+  opt.status = OptimalityStatus::kHeuristic;
+  opt.note = too_large + "greedy plus swap local search instead, with the counting bound";
+  SetCountingBound(m, need);
+  return Finish(std::move(picks));
+}
+
+// At a station-count target the counting bound (the forced candidates plus what the widest
+// candidate would need) still says how far off the plan can be, at no cost.
+void ExactRun::SetCountingBound(const ReducedModel& m, uint64_t need) {
+  if (max_mode_) return;
+  Optimality& opt = out_.optimality;
+  opt.lower_bound = static_cast<double>(m.forced.size()) + CountingBound(m, need);
+  if (opt.lower_bound > 0) opt.status = OptimalityStatus::kFeasible;
+}
+
+Result<Selection> ExactRun::Read(const CoverModel& model, const CbcOutcome& outcome) {
+  const ReducedModel& m = model.reduced();
+  const uint64_t need = model.options().need;
+  Optimality& opt = out_.optimality;
+  if (outcome.root_lp_stopped) {
+    opt.status = OptimalityStatus::kFeasible;
+    opt.lower_bound = static_cast<double>(m.forced.size()) + CountingBound(m, need);
+    opt.note = "the time limit cut off the LP relaxation; the bound is the counting bound";
+    return Finish(greedy_picks_);
+  }
+  greedy_connected_ = outcome.warm_connected;
+  if (connect_ && !outcome.lp_stopped && outcome.proven_infeasible) {
+    opt.solver = "greedy";
+    opt.status = OptimalityStatus::kHeuristic;
+    opt.note = "no connected plan over these candidates reaches the target at min_overlap " +
+               std::to_string(options_.greedy.min_overlap) + "; greedy plan";
+    return Finish(greedy_picks_);
+  }
+  if (!outcome.lp_stopped && (outcome.status == 2 || outcome.proven_infeasible)) {
+    return InternalError("exact selection: CBC could not solve the station problem (status " +
+                         std::to_string(outcome.status) + "/" + std::to_string(outcome.secondary_status) + ")");
+  }
+  // An LP cut off at the deadline proves nothing.
+  const bool proven = outcome.proven_optimal && !outcome.lp_stopped;
+  std::vector<int> picks = m.forced;
+  picks.insert(picks.end(), outcome.candidates.begin(), outcome.candidates.end());
+  if (!outcome.has_solution || !AtLeastAsGoodAsGreedy(picks)) picks = greedy_picks_;
+  opt.status = proven ? OptimalityStatus::kOptimal : OptimalityStatus::kFeasible;
+  if (max_mode_) {
+    SetCoveredBound(model, outcome, proven, picks);
+  } else {
+    SetStationBound(model, outcome, proven, picks.size());
+  }
+  return Finish(std::move(picks));
+}
+
+// CBC's bound is only kept when no LP was cut off or a node was solved (its bound stays valid).
+void ExactRun::SetCoveredBound(const CoverModel& model, const CbcOutcome& outcome, bool proven,
+                               const std::vector<int>& picks) {
+  const bool cbc_bound = !outcome.lp_stopped || outcome.node_count > 0;
+  const double b = std::max(cbc_bound ? outcome.best_possible : -COIN_DBL_MAX, outcome.root_bound);
+  const double bound_covered =
+      b <= -1e30 ? double(model.options().need) : std::floor(-b + model.eps() * options_.greedy.max_stations + 1e-6);
+  Optimality& opt = out_.optimality;
+  opt.covered_bound =
+      std::min<uint64_t>(target_, model.reduced().forced_covered + static_cast<uint64_t>(std::max(0.0, bound_covered)));
+  if (proven) opt.covered_bound = std::min(Covered(sets_, picks), target_);
+}
+
+void ExactRun::SetStationBound(const CoverModel& model, const CbcOutcome& outcome, bool proven, size_t stations) {
+  const bool cbc_bound = !outcome.lp_stopped || outcome.node_count > 0;
+  const double counting = CountingBound(model.reduced(), model.options().need);
+  const double ilp =
+      std::max(0.0, std::ceil(std::max(cbc_bound ? outcome.best_possible : 0.0, outcome.root_bound) - 1e-6));
+  Optimality& opt = out_.optimality;
+  opt.lower_bound = static_cast<double>(model.reduced().forced.size()) + std::max(counting, ilp);
+  if (proven) opt.lower_bound = static_cast<double>(stations);
+  if (outcome.lp_stopped)
+    opt.note = "the time limit cut off an LP in the search; the bound is the root LP's or CBC's last";
+}
+
+// Never worse than greedy: (reaches the target, fewer stations) or (more covered, fewer stations),
+// or greedy's plan is not connected where it must be.
+bool ExactRun::AtLeastAsGoodAsGreedy(const std::vector<int>& picks) const {
+  const uint64_t covered = Covered(sets_, picks);
+  if (max_mode_) {
+    return !greedy_connected_ ||
+           std::make_pair(std::min(covered, target_), -static_cast<int64_t>(picks.size())) >=
+               std::make_pair(std::min(greedy_covered_, target_), -static_cast<int64_t>(greedy_picks_.size()));
+  }
+  return covered >= target_ &&
+         (greedy_covered_ < target_ || picks.size() <= greedy_picks_.size() || !greedy_connected_);
+}
+
+// Whether `picks` is strictly better than greedy's plan: greedy's is not connected where it must
+// be (the integer program's plans are), or (reaches the target with fewer stations, or greedy's
+// does not reach it) or, with max_stations, (more covered, capped at the target; or as much with
+// fewer stations).
+bool ExactRun::StrictlyBetterThanGreedy(const std::vector<int>& picks) const {
+  if (!greedy_connected_) return true;
+  const uint64_t covered = Covered(sets_, picks);
+  if (max_mode_) {
+    return std::make_pair(std::min(covered, target_), -static_cast<int64_t>(picks.size())) >
+           std::make_pair(std::min(greedy_covered_, target_), -static_cast<int64_t>(greedy_picks_.size()));
+  }
+  return covered >= target_ && (greedy_covered_ < target_ || picks.size() < greedy_picks_.size());
+}
+
+// The Selection with `picks`: in greedy order among themselves (or greedy's plan as it was, with
+// prefer_greedy), the stop reason and the gap.
+Selection ExactRun::Finish(std::vector<int> picks) {
+  Optimality& opt = out_.optimality;
+  if (options_.prefer_greedy && !StrictlyBetterThanGreedy(picks)) picks = greedy_picks_;
+  if (options_.prefer_greedy && SameSet(picks, greedy_picks_)) {
+    // Greedy's plan as GreedySelector returned it: its order, its covered count and stop reason.
+    out_.picks = greedy_picks_;
+    out_.covered = greedy_pass_covered_;
+    out_.stop = greedy_stop_;
+  } else {
+    const bool greedys = SameSet(picks, greedy_picks_);
+    out_.picks = SortByMarginalGain(sets_, std::move(picks), fixed_);
+    out_.covered = Covered(sets_, out_.picks);
+    out_.stop = greedys                          ? greedy_stop_  // e.g. kMinGain, which no recount can tell
+                : out_.covered >= out_.coverable ? StopReason::kExhausted
+                : out_.covered >= target_        ? StopReason::kTargetReached
+                                                 : StopReason::kMaxStations;
+  }
+  opt.stations = static_cast<int>(out_.picks.size());
+  if (max_mode_) {
+    opt.lower_bound = opt.stations;
+    const uint64_t capped = std::min(out_.covered, target_);
+    opt.gap = opt.covered_bound > 0
+                  ? double(opt.covered_bound - std::min(capped, opt.covered_bound)) / opt.covered_bound
+                  : 0.0;
+    if (opt.status == OptimalityStatus::kHeuristic) opt.gap = 1;
+  } else {
+    opt.lower_bound = std::min<double>(opt.lower_bound, opt.stations);
+    opt.gap = opt.stations > 0 ? (opt.stations - opt.lower_bound) / opt.stations : 0.0;
+  }
+  opt.seconds = SecondsSince(start_);
+  return std::move(out_);
+}
+
 }  // namespace
 
 std::string_view OptimalityStatusName(OptimalityStatus status) {
@@ -501,424 +879,8 @@ Result<Selection> ExactSelector::Select(const std::vector<VoxelSet>& sets, int f
                                 std::to_string(options_.time_limit_s));
   }
   // The greedy plan: the warm start, the floor, and the argument checks.
-  VC_ASSIGN_OR_RETURN(Selection out, GreedySelector(options_.greedy).Select(sets, fixed, ctx));
-  const int n = static_cast<int>(sets.size());
-  const bool max_mode = options_.greedy.max_stations > 0;
-  const uint64_t coverable = out.coverable;
-  const uint64_t target = TargetVoxels(options_.greedy.target_coverage, coverable);
-  Optimality& opt = out.optimality;
-  opt.solver = "exact";
-  opt.before = {n, static_cast<int>(coverable), static_cast<int>(coverable) + (target < coverable ? 1 : 0)};
-  const std::vector<int> greedy_picks = out.picks;
-  const uint64_t greedy_covered = Covered(sets, greedy_picks);
-  const uint64_t greedy_pass_covered = out.covered;
-  const StopReason greedy_stop = out.stop;
-
-  // Whether `picks` is strictly better than greedy's plan: greedy's is not connected where it must
-  // be (the integer program's plans are), or (reaches the target with fewer stations, or greedy's
-  // does not reach it) or, with max_stations, (more covered, capped at the target; or as much with
-  // fewer stations).
-  bool greedy_connected = true;  // set once the flow model has checked greedy's plan
-  auto strictly_better = [&](const std::vector<int>& picks) {
-    if (!greedy_connected) return true;
-    const uint64_t covered = Covered(sets, picks);
-    if (max_mode) {
-      return std::make_pair(std::min(covered, target), -static_cast<int64_t>(picks.size())) >
-             std::make_pair(std::min(greedy_covered, target), -static_cast<int64_t>(greedy_picks.size()));
-    }
-    return covered >= target && (greedy_covered < target || picks.size() < greedy_picks.size());
-  };
-
-  auto finish = [&](std::vector<int> picks) {
-    if (options_.prefer_greedy && !strictly_better(picks)) picks = greedy_picks;
-    if (options_.prefer_greedy && SameSet(picks, greedy_picks)) {
-      // Greedy's plan as GreedySelector returned it: its order, its covered count and stop reason.
-      out.picks = greedy_picks;
-      out.covered = greedy_pass_covered;
-      out.stop = greedy_stop;
-    } else {
-      const bool greedys = SameSet(picks, greedy_picks);
-      out.picks = SortByMarginalGain(sets, std::move(picks), fixed);
-      out.covered = Covered(sets, out.picks);
-      out.stop = greedys                    ? greedy_stop  // e.g. kMinGain, which no recount can tell
-                 : out.covered >= coverable ? StopReason::kExhausted
-                 : out.covered >= target    ? StopReason::kTargetReached
-                                            : StopReason::kMaxStations;
-    }
-    opt.stations = static_cast<int>(out.picks.size());
-    if (max_mode) {
-      opt.lower_bound = opt.stations;
-      const uint64_t capped = std::min(out.covered, target);
-      opt.gap = opt.covered_bound > 0
-                    ? double(opt.covered_bound - std::min(capped, opt.covered_bound)) / opt.covered_bound
-                    : 0.0;
-      if (opt.status == OptimalityStatus::kHeuristic) opt.gap = 1;
-    } else {
-      opt.lower_bound = std::min<double>(opt.lower_bound, opt.stations);
-      opt.gap = opt.stations > 0 ? (opt.stations - opt.lower_bound) / opt.stations : 0.0;
-    }
-    opt.seconds = SecondsSince(start);
-    return out;
-  };
-
-  const bool connect = options_.greedy.min_overlap > 0;
-
-  VC_ASSIGN_OR_RETURN(Classes cl, BuildClasses(sets, ctx));
-  const bool full = !max_mode && target == coverable;
-  VC_ASSIGN_OR_RETURN(ReducedModel m, Reduce(cl, n, fixed, full && !connect, connect, ctx));
-  opt.forced = m.forced_sole_view;
-  opt.dominated = m.dominated;
-  const uint64_t need = target - std::min(target, m.forced_covered);  // voxels the columns must add
-  const int n_cols = static_cast<int>(m.columns.size());
-  const int n_classes = static_cast<int>(m.weight.size());
-  const bool cover_rows = full;  // set-cover rows, no y variables
-  const int cover_row_count = cover_rows ? n_classes : n_classes + 1 + (max_mode ? 1 : 0);
-  // Connectivity (min_overlap > 0): the directed arcs of the candidates' scan graph.
-  std::vector<std::pair<int, int>> arcs;
-  if (connect) {
-    for (int a = 0; a < n_cols; ++a) {
-      if (a % 32 == 0) VC_RETURN_IF_ERROR(ctx.CheckCancelled("exact selection (scan graph)"));
-      for (int b = a + 1; b < n_cols; ++b) {
-        if (IsEdge(Overlap(sets[m.columns[a]], sets[m.columns[b]]), options_.greedy.min_overlap)) {
-          arcs.emplace_back(a, b);
-          arcs.emplace_back(b, a);
-        }
-      }
-    }
-  }
-  const int n_arcs = static_cast<int>(arcs.size());
-  const int n_rows = cover_row_count + (connect ? 1 + 3 * n_cols + 2 * n_arcs : 0);
-  opt.model = {n_cols, n_classes, n_rows};
-
-  // Nothing left to decide: the forced candidates reach the target (or there are no columns).
-  if (n_cols == 0 || (!max_mode && need == 0)) {
-    opt.status = OptimalityStatus::kOptimal;
-    std::vector<int> picks = m.forced;
-    if (!max_mode && need > 0) picks = greedy_picks;  // unreachable: columns would remain
-    opt.lower_bound = static_cast<double>(picks.size());
-    opt.covered_bound = max_mode ? std::min(Covered(sets, picks), target) : 0;
-    return finish(std::move(picks));
-  }
-
-  // The memory estimate (CBC keeps row and column copies, the LP factorisation and cuts).
-  uint64_t nnz = 0;
-  for (const std::vector<int>& s : m.seen_by) nnz += s.size() + (cover_rows ? 0 : 2);
-  const uint64_t estimate = nnz * 200 + uint64_t(n_rows + n_cols + (cover_rows ? 0 : n_classes)) * 1000;
-  // Over the budget no integer program is built; at a station-count target the counting bound
-  // (the forced candidates plus what the widest candidate would need) still says how far off the
-  // plan can be, at no cost.
-  const auto counting_bound_only = [&] {
-    if (max_mode) return;
-    opt.lower_bound = static_cast<double>(m.forced.size()) + CountingBound(m, need);
-    if (opt.lower_bound > 0) opt.status = OptimalityStatus::kFeasible;
-  };
-  if (estimate > options_.memory_budget_bytes && !options_.swap_search) {
-    opt.solver = "greedy";
-    opt.status = OptimalityStatus::kHeuristic;
-    opt.note = "the integer program (about " + std::to_string(estimate >> 20) + " MiB) exceeds the memory budget (" +
-               std::to_string(options_.memory_budget_bytes >> 20) + " MiB); greedy plan, with the counting bound";
-    counting_bound_only();
-    return finish(greedy_picks);
-  }
-  if (estimate > options_.memory_budget_bytes) {
-    VC_ASSIGN_OR_RETURN(std::vector<int> picks,
-                        SwapLocalSearch(cl, greedy_picks, fixed, n, target, max_mode,
-                                        start + std::chrono::duration_cast<Clock::duration>(
-                                                    std::chrono::duration<double>(options_.time_limit_s)),
-                                        ctx));
-    opt.solver = "greedy+swap";
-    opt.status = OptimalityStatus::kHeuristic;
-    opt.note = "the integer program (about " + std::to_string(estimate >> 20) + " MiB) exceeds the memory budget (" +
-               std::to_string(options_.memory_budget_bytes >> 20) +
-               " MiB); greedy plus swap local search instead, with the counting bound";
-    counting_bound_only();
-    return finish(std::move(picks));
-  }
-
-  // Columns: x (one per candidate column), then y (one per class) unless cover_rows, then with
-  // connectivity the single-commodity flow (Dehbi et al. 2021): a root r_c (binary, one of them),
-  // the source's flow g_c <= N r_c into the root, and a flow f_a <= (N - 1) x on each arc of the
-  // scan graph; every chosen station consumes one unit (g_c + in - out = x_c), so the chosen
-  // stations are exactly those the root's flow reaches: the plan is connected.
-  const int r0 = cover_rows ? n_cols : n_cols + n_classes, g0 = r0 + n_cols, f0 = g0 + n_cols;
-  const int n_vars = connect ? f0 + n_arcs : r0;
-  const double big_n = max_mode ? std::min<double>(n_cols, options_.greedy.max_stations + fixed) : n_cols;
-  const int root_row = cover_row_count, rx_row = root_row + 1, gr_row = rx_row + n_cols, cons_row = gr_row + n_cols,
-            cap_row = cons_row + n_cols;
-  std::vector<std::vector<int>> arcs_at(n_cols);  // per column: the arcs it is an end of
-  for (int a = 0; a < n_arcs; ++a) {
-    arcs_at[arcs[a].first].push_back(a);
-    arcs_at[arcs[a].second].push_back(a);
-  }
-  const double eps = 1.0 / (n_cols + 1.0);
-  std::vector<double> col_lb(n_vars, 0.0), col_ub(n_vars, 1.0), obj(n_vars, 0.0);
-  std::vector<double> row_lb(n_rows), row_ub(n_rows);
-  std::vector<std::vector<int>> col_classes(n_cols);
-  for (int k = 0; k < n_classes; ++k) {
-    for (int j : m.seen_by[k]) col_classes[j].push_back(k);
-  }
-  const int weight_row = n_classes, budget_row = n_classes + 1;
-  // The column-ordered matrix in one piece (appending column by column reallocates each time).
-  std::vector<double> elements;
-  std::vector<int> indices;
-  std::vector<CoinBigIndex> starts;
-  std::vector<int> lengths;
-  elements.reserve(nnz + n_cols);
-  indices.reserve(nnz + n_cols);
-  auto add = [&](int row, double value) {
-    indices.push_back(row);
-    elements.push_back(value);
-  };
-  for (int j = 0; j < n_cols; ++j) {
-    starts.push_back(static_cast<CoinBigIndex>(indices.size()));
-    for (int k : col_classes[j]) add(k, cover_rows ? 1.0 : -1.0);
-    if (max_mode) add(budget_row, 1.0);
-    if (connect) {
-      add(rx_row + j, -1.0);
-      add(cons_row + j, -1.0);
-      for (int a : arcs_at[j]) add(cap_row + 2 * a + (arcs[a].first == j ? 0 : 1), -(big_n - 1));
-      if (m.columns[j] < fixed) col_lb[j] = 1.0;  // fixed stations are in the plan
-    }
-    lengths.push_back(static_cast<int>(indices.size()) - starts.back());
-    obj[j] = max_mode ? eps : 1.0;
-  }
-  if (!cover_rows) {
-    for (int k = 0; k < n_classes; ++k) {
-      starts.push_back(static_cast<CoinBigIndex>(indices.size()));
-      add(k, 1.0);
-      add(weight_row, static_cast<double>(m.weight[k]));
-      lengths.push_back(2);
-      obj[n_cols + k] = max_mode ? -static_cast<double>(m.weight[k]) : 0.0;
-    }
-  }
-  if (connect) {
-    for (int j = 0; j < n_cols; ++j) {  // r_j
-      starts.push_back(static_cast<CoinBigIndex>(indices.size()));
-      add(root_row, 1.0);
-      add(rx_row + j, 1.0);
-      add(gr_row + j, -big_n);
-      lengths.push_back(3);
-    }
-    for (int j = 0; j < n_cols; ++j) {  // g_j
-      starts.push_back(static_cast<CoinBigIndex>(indices.size()));
-      add(gr_row + j, 1.0);
-      add(cons_row + j, 1.0);
-      lengths.push_back(2);
-      col_ub[g0 + j] = big_n;
-    }
-    for (int a = 0; a < n_arcs; ++a) {  // f_a, from arcs[a].first to arcs[a].second
-      starts.push_back(static_cast<CoinBigIndex>(indices.size()));
-      add(cons_row + arcs[a].second, 1.0);
-      add(cons_row + arcs[a].first, -1.0);
-      add(cap_row + 2 * a, 1.0);
-      add(cap_row + 2 * a + 1, 1.0);
-      lengths.push_back(4);
-      col_ub[f0 + a] = big_n - 1;
-    }
-    row_lb[root_row] = row_ub[root_row] = 1.0;
-    for (int j = 0; j < n_cols; ++j) {
-      row_lb[rx_row + j] = row_lb[gr_row + j] = -COIN_DBL_MAX;
-      row_ub[rx_row + j] = row_ub[gr_row + j] = 0.0;
-      row_lb[cons_row + j] = row_ub[cons_row + j] = 0.0;
-    }
-    for (int a = 0; a < 2 * n_arcs; ++a) {
-      row_lb[cap_row + a] = -COIN_DBL_MAX;
-      row_ub[cap_row + a] = 0.0;
-    }
-  }
-  const CoinPackedMatrix matrix(true, n_rows, n_vars, static_cast<CoinBigIndex>(indices.size()), elements.data(),
-                                indices.data(), starts.data(), lengths.data());
-  for (int k = 0; k < n_classes; ++k) {
-    row_lb[k] = cover_rows ? 1.0 : -COIN_DBL_MAX;
-    row_ub[k] = cover_rows ? COIN_DBL_MAX : 0.0;
-  }
-  if (!cover_rows) {
-    row_lb[weight_row] = max_mode ? -COIN_DBL_MAX : static_cast<double>(need);
-    row_ub[weight_row] = max_mode ? static_cast<double>(need) : COIN_DBL_MAX;
-  }
-  if (max_mode) {
-    row_lb[budget_row] = -COIN_DBL_MAX;
-    row_ub[budget_row] = options_.greedy.max_stations;
-  }
-
-  SolveWatch watch;
-  watch.ctx = &ctx;
-  watch.start = start;
-  watch.time_limit_s = options_.time_limit_s;
-  watch.max_mode = max_mode;
-  watch.offset = max_mode ? double(m.forced_covered) : double(m.forced.size());
-  watch.last_report = start - std::chrono::seconds(1);
-  LpWatchHandler lp_handler(&watch);
-  OsiClpSolverInterface solver;
-  solver.messageHandler()->setLogLevel(0);
-  solver.getModelPtr()->passInEventHandler(&lp_handler);
-  solver.loadProblem(matrix, col_lb.data(), col_ub.data(), obj.data(), row_lb.data(), row_ub.data());
-  for (int j = 0; j < n_cols; ++j) solver.setInteger(j);
-  if (connect) {
-    for (int j = 0; j < n_cols; ++j) solver.setInteger(r0 + j);
-  }
-  // Primal simplex: on geb079 (49,706 classes) the root LP takes 11 s with it and over 2 min with
-  // the dual; with it in the resolves too, CBC proves 69 stations optimal in 67 s.
-  solver.setHintParam(OsiDoDualInInitial, false, OsiHintDo);
-  solver.setHintParam(OsiDoDualInResolve, false, OsiHintDo);
-  // The root LP first, under the deadline (CbcModel copies the solved basis).
-  solver.initialSolve();
-  VC_RETURN_IF_ERROR(watch.cancelled);
-  if (watch.lp_stopped) {
-    opt.status = OptimalityStatus::kFeasible;
-    opt.lower_bound = static_cast<double>(m.forced.size()) + CountingBound(m, need);
-    opt.note = "the time limit cut off the LP relaxation; the bound is the counting bound";
-    return finish(greedy_picks);
-  }
-  // The LP relaxation's optimum bounds the stations (min mode) from below.
-  const double root_bound = solver.isProvenOptimal() ? solver.getObjValue() : -COIN_DBL_MAX;
-  CbcModel model(solver);
-  model.setLogLevel(0);
-  model.messageHandler()->setLogLevel(0);
-  model.setUseElapsedTime(true);
-  model.setMaximumSeconds(std::max(0.01, options_.time_limit_s - SecondsSince(start)));
-  if (!max_mode) model.setCutoffIncrement(1.0 - 1e-6);  // the objective is a station count
-  CglProbing probing;
-  probing.setUsingObjective(1);
-  probing.setMaxPass(1);
-  probing.setMaxProbe(10);
-  probing.setMaxLook(10);
-  CglGomory gomory;
-  CglKnapsackCover knapsack;
-  CglClique clique;
-  clique.setStarCliqueReport(false);
-  clique.setRowCliqueReport(false);
-  CglMixedIntegerRounding2 mir;
-  CglZeroHalf zero_half;
-  model.addCutGenerator(&probing, -1, "Probing");
-  model.addCutGenerator(&gomory, -1, "Gomory");
-  model.addCutGenerator(&knapsack, -1, "Knapsack");
-  model.addCutGenerator(&clique, -1, "Clique");
-  model.addCutGenerator(&mir, -1, "MIR2");
-  model.addCutGenerator(&zero_half, -1, "ZeroHalf");
-  CbcRounding rounding(model);
-  model.addHeuristic(&rounding);
-  CbcHeuristicLocal local(model);
-  model.addHeuristic(&local);
-  CbcHeuristicFPump pump(model);
-  model.addHeuristic(&pump);
-
-  // The warm start: greedy's picks, each dropped candidate replaced by its stand-in.
-  std::vector<char> in_plan(n, 0);
-  for (int p : greedy_picks) {
-    if (m.stand_in[p] >= 0) in_plan[m.stand_in[p]] = 1;
-  }
-  std::vector<double> warm(n_vars, 0.0);
-  int warm_stations = 0;
-  for (int j = 0; j < n_cols; ++j) {
-    warm[j] = in_plan[m.columns[j]] ? 1.0 : 0.0;
-    warm_stations += in_plan[m.columns[j]];
-  }
-  uint64_t warm_covered = 0;
-  for (int k = 0; k < n_classes; ++k) {
-    bool seen = false;
-    for (int j : m.seen_by[k]) seen = seen || warm[j] > 0.5;
-    if (!seen) continue;
-    if (!cover_rows) {
-      const uint64_t room = max_mode ? need - std::min(need, warm_covered) : m.weight[k];
-      warm[n_cols + k] = std::min(1.0, double(room) / double(m.weight[k]));
-    }
-    warm_covered += m.weight[k];
-  }
-  // With connectivity: a spanning tree of the warm start's stations from its first one, each tree
-  // arc carrying the stations below it; no warm start when greedy's plan is not connected.
-  bool warm_connected = true;
-  if (connect && warm_stations > 0) {
-    int root = -1;
-    for (int j = 0; j < n_cols && root < 0; ++j) {
-      if (warm[j] > 0.5) root = j;
-    }
-    std::vector<int> parent_arc(n_cols, -2), order{root};
-    parent_arc[root] = -1;
-    for (size_t q = 0; q < order.size(); ++q) {
-      for (int a : arcs_at[order[q]]) {
-        const int to = arcs[a].second;
-        if (arcs[a].first == order[q] && warm[to] > 0.5 && parent_arc[to] == -2) {
-          parent_arc[to] = a;
-          order.push_back(to);
-        }
-      }
-    }
-    warm_connected = static_cast<int>(order.size()) == warm_stations;
-    if (warm_connected) {
-      std::vector<double> below(n_cols, 1.0);
-      for (size_t q = order.size(); q-- > 1;) {
-        const int a = parent_arc[order[q]];
-        warm[f0 + a] = below[order[q]];
-        below[arcs[a].first] += below[order[q]];
-      }
-      warm[r0 + root] = 1.0;
-      warm[g0 + root] = warm_stations;
-    }
-  }
-  greedy_connected = warm_connected;
-  const bool warm_ok =
-      warm_connected && (max_mode ? warm_stations <= options_.greedy.max_stations : warm_covered >= need);
-  if (warm_ok) {
-    const double warm_obj = max_mode ? -double(std::min(warm_covered, need)) + eps * warm_stations : warm_stations;
-    model.setBestSolution(warm.data(), n_vars, warm_obj, true);
-  }
-
-  WatchHandler handler(&watch);
-  model.passInEventHandler(&handler);
-  model.branchAndBound();
-  VC_RETURN_IF_ERROR(watch.cancelled);
-  VC_RETURN_IF_ERROR(ctx.CheckCancelled("exact selection"));
-  if (connect && !watch.lp_stopped && model.isProvenInfeasible()) {
-    opt.solver = "greedy";
-    opt.status = OptimalityStatus::kHeuristic;
-    opt.note = "no connected plan over these candidates reaches the target at min_overlap " +
-               std::to_string(options_.greedy.min_overlap) + "; greedy plan";
-    return finish(greedy_picks);
-  }
-  if (!watch.lp_stopped && (model.status() == 2 || model.isProvenInfeasible())) {
-    return InternalError("exact selection: CBC could not solve the station problem (status " +
-                         std::to_string(model.status()) + "/" + std::to_string(model.secondaryStatus()) + ")");
-  }
-  // An LP cut off at the deadline proves nothing; CBC's bound is then only kept when a node was
-  // solved (its bound stays valid).
-  const bool proven = model.isProvenOptimal() && !watch.lp_stopped;
-  const bool cbc_bound = !watch.lp_stopped || model.getNodeCount() > 0;
-  const double bound = model.getBestPossibleObjValue();
-
-  std::vector<int> picks = m.forced;
-  const double* best = model.bestSolution();
-  if (best != nullptr) {
-    for (int j = 0; j < n_cols; ++j) {
-      if (best[j] > 0.5) picks.push_back(m.columns[j]);
-    }
-  }
-  // Never worse than greedy: (reaches the target, fewer stations) or (more covered, fewer stations).
-  const uint64_t ilp_covered = best != nullptr ? Covered(sets, picks) : 0;
-  const bool ilp_better =
-      best != nullptr &&
-      (max_mode ? (!warm_connected ||
-                   std::make_pair(std::min(ilp_covered, target), -static_cast<int64_t>(picks.size())) >=
-                       std::make_pair(std::min(greedy_covered, target), -static_cast<int64_t>(greedy_picks.size())))
-                : (ilp_covered >= target &&
-                   (greedy_covered < target || picks.size() <= greedy_picks.size() || !warm_connected)));
-  if (!ilp_better) picks = greedy_picks;
-  opt.status = proven ? OptimalityStatus::kOptimal : OptimalityStatus::kFeasible;
-  if (max_mode) {
-    const double b = std::max(cbc_bound ? bound : -COIN_DBL_MAX, root_bound);
-    const double bound_covered = b <= -1e30 ? double(need) : std::floor(-b + eps * options_.greedy.max_stations + 1e-6);
-    opt.covered_bound =
-        std::min<uint64_t>(target, m.forced_covered + static_cast<uint64_t>(std::max(0.0, bound_covered)));
-    if (proven) opt.covered_bound = std::min(Covered(sets, picks), target);
-  } else {
-    const double counting = CountingBound(m, need);
-    const double ilp = std::max(0.0, std::ceil(std::max(cbc_bound ? bound : 0.0, root_bound) - 1e-6));
-    opt.lower_bound = static_cast<double>(m.forced.size()) + std::max(counting, ilp);
-    if (proven) opt.lower_bound = static_cast<double>(picks.size());
-    if (watch.lp_stopped)
-      opt.note = "the time limit cut off an LP in the search; the bound is the root LP's or CBC's last";
-  }
-  return finish(std::move(picks));
+  VC_ASSIGN_OR_RETURN(Selection greedy, GreedySelector(options_.greedy).Select(sets, fixed, ctx));
+  return ExactRun(options_, sets, fixed, ctx, start, std::move(greedy)).Select();
 }
 
 }  // namespace vc::planner
