@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Runs every test. Installs the dependencies, checks the layering and the formatting, then:
+# Runs every test. Installs the dependencies, checks the layering, the code's health (functions at
+# most 150 lines, every path named exists, every public header tested) and the formatting, then:
 #   release  - build everything, run every test (including the `slow` ones) and vc-bench --quick
 #   asan     - AddressSanitizer + UndefinedBehaviorSanitizer: every test except the `slow` label
 #   fuzz     - every libFuzzer target (fuzz/, clang + ASan + UBSan) for 10 s each
@@ -17,8 +18,9 @@ presets=(release asan tsan fuzz)
 if [[ "${1:-}" == "--quick" ]]; then presets=(release); fi
 
 start=$(date +%s)
-echo "=== layering (scripts/check-layers.py) and formatting (.clang-format)"
+echo "=== layering (scripts/check-layers.py), code health (scripts/check-code-health.py) and formatting"
 python3 scripts/check-layers.py
+python3 scripts/check-code-health.py
 git ls-files '*.h' '*.cc' | xargs clang-format --dry-run --Werror
 echo "clang-format: every tracked .h/.cc file is formatted"
 for p in "${presets[@]}"; do
@@ -27,8 +29,7 @@ for p in "${presets[@]}"; do
   case "$p" in
     tsan)
       # Only the service and its tests: the core is covered by the other presets.
-      cmake --build --preset "$p" --target status_mapping_test worker_pool_test upload_assembler_test outbox_test kept_jobs_test job_runner_test wire_test \
-        visibility_test
+      cmake --build --preset "$p" --target server_jobs_tests proto_tests visibility_tests
       echo "=== preset $p: tests labelled tsan"
       ctest --preset "$p" -L tsan
       ;;
