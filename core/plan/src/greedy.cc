@@ -179,7 +179,7 @@ Result<GreedyResult> SelectGreedy(const std::vector<VoxelSet>& sets, const Greed
   for (const VoxelSet& s : sets) UnionInto(uncovered, s);
   result.coverable = CountBits(uncovered);
   const double coverable = static_cast<double>(result.coverable);
-  const uint64_t min_gain = std::max<uint64_t>(options.min_marginal_gain, 1);
+  const uint64_t min_gain = std::max<uint64_t>(options.min_marginal_gain_voxels, 1);
   const size_t fixed = static_cast<size_t>(options.fixed);
   const double min_overlap = options.min_overlap;
   const bool registration = min_overlap > 0;
@@ -343,7 +343,9 @@ Result<GreedyResult> SelectGreedy(const std::vector<VoxelSet>& sets, const Greed
 }
 
 Result<ConsolidateResult> ConsolidatePicks(const std::vector<VoxelSet>& sets, std::vector<int> picks,
-                                           const JobContext& ctx, int fixed, double min_overlap) {
+                                           const GreedyOptions& options, const JobContext& ctx) {
+  const int fixed = options.fixed;
+  const double min_overlap = options.min_overlap;
   ConsolidateResult out;
   if (sets.empty() || picks.empty()) {
     out.picks = std::move(picks);
