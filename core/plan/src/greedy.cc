@@ -152,13 +152,11 @@ std::string FormatPercent(double fraction) {
   return text;
 }
 
-}  // namespace
-
-Result<GreedyResult> SelectGreedy(const std::vector<VoxelSet>& sets, const GreedyOptions& options,
-                                  const JobContext& ctx) {
+// INVALID_ARGUMENT for options out of range or `fixed` beyond the `candidates` sets.
+Status CheckOptions(const GreedyOptions& options, size_t candidates) {
   if (options.max_stations < 0) return InvalidArgumentError("max_stations must be >= 0");
-  if (options.fixed < 0 || static_cast<size_t>(options.fixed) > sets.size()) {
-    return InvalidArgumentError("fixed must be in [0, " + std::to_string(sets.size()) + "]");
+  if (options.fixed < 0 || static_cast<size_t>(options.fixed) > candidates) {
+    return InvalidArgumentError("fixed must be in [0, " + std::to_string(candidates) + "]");
   }
   if (!(options.target_coverage > 0.0 && options.target_coverage <= 1.0)) {
     return InvalidArgumentError("target_coverage must be in (0, 1]");
@@ -166,8 +164,11 @@ Result<GreedyResult> SelectGreedy(const std::vector<VoxelSet>& sets, const Greed
   if (!(options.min_overlap >= 0.0 && options.min_overlap <= 1.0)) {
     return InvalidArgumentError("min_overlap must be in [0, 1]");
   }
-  GreedyResult result;
-  if (sets.empty()) return result;
+  return Status::Ok();
+}
+
+// INVALID_ARGUMENT naming the first set whose size differs from the first's.
+Status CheckSameSizes(const std::vector<VoxelSet>& sets) {
   const size_t n = sets[0].size();
   for (size_t i = 1; i < sets.size(); ++i) {
     if (sets[i].size() != n) {
@@ -175,342 +176,486 @@ Result<GreedyResult> SelectGreedy(const std::vector<VoxelSet>& sets, const Greed
                                   " voxels, expected " + std::to_string(n));
     }
   }
-  VoxelSet uncovered(n);
-  for (const VoxelSet& s : sets) UnionInto(uncovered, s);
-  result.coverable = CountBits(uncovered);
-  const double coverable = static_cast<double>(result.coverable);
-  const uint64_t min_gain = std::max<uint64_t>(options.min_marginal_gain, 1);
-  const size_t fixed = static_cast<size_t>(options.fixed);
-  const double min_overlap = options.min_overlap;
-  const bool registration = min_overlap > 0;
-  std::optional<Overlaps> overlaps;
-  if (registration) overlaps.emplace(sets);
+  return Status::Ok();
+}
 
-  // Registration: which candidates have an edge to a pick; before the first pick, all compete.
-  std::vector<char> picked(sets.size(), 0), linked(sets.size(), 0);
-  std::vector<int> picked_list;
-  auto constrained = [&] { return registration && !picked_list.empty(); };
-  auto eligible = [&](int c) { return !constrained() || linked[c]; };
-  std::priority_queue<Entry, std::vector<Entry>, EntryLess> heap;
-  std::vector<Entry> parked;  // lazy: popped while not linked; back in the heap once linked
-  // Stations picked so far (the total is not known in advance) and the coverage reached.
-  auto report_selection = [&] {
-    if (!ctx.progress) return;
-    const double fraction = coverable > 0 ? std::min(1.0, double(result.covered) / coverable) : 1.0;
-    ctx.progress(ProgressEvent{Stage::kSelection, fraction, "coverage " + FormatPercent(fraction), result.picks.size(),
-                               0, "stations"});
-  };
-  auto pick = [&](int c, uint64_t gain, bool connector) {
-    SubtractFrom(uncovered, sets[c]);
-    result.covered += gain;
-    result.picks.push_back({c, gain, result.covered, connector});
-    result.connectors += connector;
-    picked[c] = 1;
-    picked_list.push_back(c);
-    if (!registration) return;
-    for (size_t i = fixed; i < sets.size(); ++i) {
-      if (!linked[i] && !picked[i] && overlaps->Edge(c, static_cast<int>(i), min_overlap)) linked[i] = 1;
+// One SelectGreedy over checked sets and options: the voxels still uncovered, the picks so far and,
+// with registration, which candidates have an edge to a pick (before the first pick all compete).
+class GreedyRun {
+ public:
+  GreedyRun(const std::vector<VoxelSet>& sets, const GreedyOptions& options, const JobContext& ctx)
+      : sets_(sets),
+        options_(options),
+        ctx_(ctx),
+        fixed_(static_cast<size_t>(options.fixed)),
+        min_gain_(std::max<uint64_t>(options.min_marginal_gain_voxels, 1)),
+        registration_(options.min_overlap > 0),
+        uncovered_(sets[0].size()),
+        picked_(sets.size(), 0),
+        linked_(sets.size(), 0) {
+    for (const VoxelSet& s : sets) UnionInto(uncovered_, s);
+    result_.coverable = CountBits(uncovered_);
+    coverable_ = static_cast<double>(result_.coverable);
+    if (registration_) overlaps_.emplace(sets);
+  }
+
+  // The fixed stations, the rounds until a stopping rule holds, then (registration) the groups
+  // the fixed stations left apart joined where a chain exists.
+  Result<GreedyResult> Run() {
+    for (size_t i = 0; i < fixed_; ++i) Pick(static_cast<int>(i), Gain(static_cast<int>(i)), false);
+    if (options_.lazy) SeedHeap();
+    while (true) {
+      VC_RETURN_IF_ERROR(ctx_.CheckCancelled("greedy selection"));
+      if (const std::optional<StopReason> stop = StopBeforeRound()) {
+        result_.stop = *stop;
+        break;
+      }
+      const Best best = options_.lazy ? BestLazy() : BestPlain();
+      const bool gains_enough = best.candidate >= 0 && best.gain >= min_gain_;
+      if (!gains_enough && Constrained()) {
+        VC_ASSIGN_OR_RETURN(const ChainOutcome chain, PickChainToAGain());
+        if (chain == ChainOutcome::kMaxStations) {
+          result_.stop = StopReason::kMaxStations;
+          break;
+        }
+        if (chain == ChainOutcome::kPicked) {
+          EndRound();
+          continue;
+        }
+      }
+      if (!gains_enough) {
+        result_.stop = StopReason::kMinGain;
+        break;
+      }
+      Pick(best.candidate, best.gain, false);
+      EndRound();
     }
-    for (size_t k = 0; k < parked.size();) {
-      if (linked[parked[k].index]) {
-        heap.push(parked[k]);
-        parked[k] = parked.back();
-        parked.pop_back();
+    if (registration_ && result_.stop != StopReason::kMaxStations) VC_RETURN_IF_ERROR(JoinGroups());
+    return std::move(result_);
+  }
+
+ private:
+  // The round's best candidate (-1: none eligible) and its gain.
+  struct Best {
+    int candidate = -1;
+    uint64_t gain = 0;
+  };
+  enum class ChainOutcome : uint8_t { kNoGain, kPicked, kMaxStations };
+
+  // Voxels candidate c would newly cover.
+  uint64_t Gain(int c) const { return CountAnd(sets_[c], uncovered_); }
+  // Registration after the first pick: only linked candidates compete.
+  bool Constrained() const { return registration_ && !picked_list_.empty(); }
+  bool Eligible(int c) const { return !Constrained() || linked_[c]; }
+  // Whether `more` picks would exceed max_stations (the fixed stations not counted).
+  bool AtMax(size_t more) const {
+    return options_.max_stations > 0 &&
+           picked_list_.size() - fixed_ + more > static_cast<size_t>(options_.max_stations);
+  }
+
+  // The stopping rule that holds before a round, if any, in the order exhausted, target, max.
+  std::optional<StopReason> StopBeforeRound() const {
+    if (result_.covered >= result_.coverable) return StopReason::kExhausted;
+    if (static_cast<double>(result_.covered) >= options_.target_coverage * coverable_) {
+      return StopReason::kTargetReached;
+    }
+    if (AtMax(1)) return StopReason::kMaxStations;
+    return std::nullopt;
+  }
+
+  // Only the fixed stations cover anything yet, so these are exact gains for round 0.
+  void SeedHeap() {
+    for (size_t i = fixed_; i < sets_.size(); ++i) {
+      heap_.push({fixed_ ? Gain(static_cast<int>(i)) : CountBits(sets_[i]), static_cast<int>(i), 0});
+      ++result_.gain_evaluations;
+    }
+  }
+
+  // CELF: stale gains are recounted until the top of the heap is exact for this round.
+  Best BestLazy() {
+    while (!heap_.empty()) {
+      Entry top = heap_.top();
+      heap_.pop();
+      if (picked_[top.index]) continue;  // picked as a link of a chain
+      if (!Eligible(top.index)) {
+        parked_.push_back(top);
+        continue;
+      }
+      if (top.round == round_) return {top.index, top.gain};  // exact, and no other bound beats it
+      top.gain = Gain(top.index);
+      top.round = round_;
+      ++result_.gain_evaluations;
+      heap_.push(top);
+    }
+    return {};
+  }
+
+  // Every eligible candidate recounted; ties keep the lowest index.
+  Best BestPlain() {
+    Best best;
+    for (size_t i = fixed_; i < sets_.size(); ++i) {
+      if (picked_[i] || !Eligible(static_cast<int>(i))) continue;
+      const uint64_t g = Gain(static_cast<int>(i));
+      ++result_.gain_evaluations;
+      if (g > best.gain) best = {static_cast<int>(i), g};
+    }
+    return best;
+  }
+
+  // Nothing linked gains enough: the shortest chain to the nearest unlinked candidates that do, or
+  // the best of them as a new group; kNoGain when none of them gains enough.
+  Result<ChainOutcome> PickChainToAGain() {
+    std::vector<uint64_t> gains(sets_.size(), 0);
+    int unlinked_best = -1;
+    for (size_t i = fixed_; i < sets_.size(); ++i) {
+      if (picked_[i] || linked_[i]) continue;
+      gains[i] = Gain(static_cast<int>(i));
+      ++result_.gain_evaluations;
+      if (gains[i] >= min_gain_ && (unlinked_best < 0 || gains[i] > gains[unlinked_best])) {
+        unlinked_best = static_cast<int>(i);
+      }
+    }
+    if (unlinked_best < 0) return ChainOutcome::kNoGain;
+    // The unlinked candidates that gain enough, scored by their gain; the others -1.
+    auto score = [&](int c) -> int64_t {
+      return !picked_[c] && !linked_[c] && gains[c] >= min_gain_ ? int64_t(gains[c]) : -1;
+    };
+    VC_ASSIGN_OR_RETURN(std::vector<int> chain,
+                        ShortestChain(*overlaps_, sets_.size(), picked_list_, options_.min_overlap, ctx_, score));
+    if (chain.empty()) {
+      ++result_.new_groups;
+      chain = {unlinked_best};
+    }
+    if (AtMax(chain.size())) return ChainOutcome::kMaxStations;
+    for (size_t k = 0; k < chain.size(); ++k) Pick(chain[k], Gain(chain[k]), k + 1 < chain.size());
+    return ChainOutcome::kPicked;
+  }
+
+  // Groups the fixed stations left apart, joined by the shortest chains that exist.
+  Status JoinGroups() {
+    while (true) {
+      const std::vector<std::vector<int>> groups = overlaps_->Groups(picked_list_, options_.min_overlap);
+      if (groups.size() <= 1) return Status::Ok();
+      std::vector<char> other(sets_.size(), 0);
+      for (size_t g = 1; g < groups.size(); ++g) {
+        for (int c : groups[g]) other[c] = 1;
+      }
+      VC_ASSIGN_OR_RETURN(std::vector<int> chain,
+                          ShortestChain(*overlaps_, sets_.size(), groups[0], options_.min_overlap, ctx_,
+                                        [&](int c) -> int64_t { return other[c] ? 0 : -1; }));
+      if (chain.size() < 2) return Status::Ok();  // none, or (impossible) a direct edge between two groups
+      chain.pop_back();                           // the station of another group it reaches
+      for (int c : chain) Pick(c, Gain(c), true);
+    }
+  }
+
+  // Candidate c picked: its voxels covered, its pick recorded, and (registration) its neighbours linked.
+  void Pick(int c, uint64_t gain, bool connector) {
+    SubtractFrom(uncovered_, sets_[c]);
+    result_.covered += gain;
+    result_.picks.push_back({c, gain, result_.covered, connector});
+    result_.connectors += connector;
+    picked_[c] = 1;
+    picked_list_.push_back(c);
+    if (registration_) LinkTo(c);
+  }
+
+  // Candidates with an edge to pick c become linked; parked heap entries of those go back.
+  void LinkTo(int c) {
+    for (size_t i = fixed_; i < sets_.size(); ++i) {
+      if (!linked_[i] && !picked_[i] && overlaps_->Edge(c, static_cast<int>(i), options_.min_overlap)) linked_[i] = 1;
+    }
+    for (size_t k = 0; k < parked_.size();) {
+      if (linked_[parked_[k].index]) {
+        heap_.push(parked_[k]);
+        parked_[k] = parked_.back();
+        parked_.pop_back();
       } else {
         ++k;
       }
     }
-  };
-  // The fixed stations first, whatever they add.
-  for (size_t i = 0; i < fixed; ++i) pick(static_cast<int>(i), CountAnd(sets[i], uncovered), false);
+  }
 
-  if (options.lazy) {
-    // Only the fixed stations cover anything yet, so these are exact gains for round 0.
-    for (size_t i = fixed; i < sets.size(); ++i) {
-      heap.push({fixed ? CountAnd(sets[i], uncovered) : CountBits(sets[i]), static_cast<int>(i), 0});
-      ++result.gain_evaluations;
-    }
+  // Stations picked so far (the total is not known in advance) and the coverage reached.
+  void EndRound() {
+    ++round_;
+    if (!ctx_.progress) return;
+    const double fraction = coverable_ > 0 ? std::min(1.0, double(result_.covered) / coverable_) : 1.0;
+    ctx_.progress(ProgressEvent{Stage::kSelection, fraction, "coverage " + FormatPercent(fraction),
+                                result_.picks.size(), 0, "stations"});
   }
-  auto at_max = [&](size_t more) {
-    return options.max_stations > 0 && picked_list.size() - fixed + more > static_cast<size_t>(options.max_stations);
-  };
 
-  int round = 0;
-  while (true) {
-    VC_RETURN_IF_ERROR(ctx.CheckCancelled("greedy selection"));
-    if (result.covered >= result.coverable) {
-      result.stop = StopReason::kExhausted;
-      break;
-    }
-    if (static_cast<double>(result.covered) >= options.target_coverage * coverable) {
-      result.stop = StopReason::kTargetReached;
-      break;
-    }
-    if (at_max(1)) {
-      result.stop = StopReason::kMaxStations;
-      break;
-    }
-    int best = -1;
-    uint64_t best_gain = 0;
-    if (options.lazy) {
-      while (!heap.empty()) {
-        Entry top = heap.top();
-        heap.pop();
-        if (picked[top.index]) continue;  // picked as a link of a chain
-        if (!eligible(top.index)) {
-          parked.push_back(top);
-          continue;
-        }
-        if (top.round == round) {  // exact, and no other bound beats it: the plain argmax
-          best = top.index;
-          best_gain = top.gain;
-          break;
-        }
-        top.gain = CountAnd(sets[top.index], uncovered);
-        top.round = round;
-        ++result.gain_evaluations;
-        heap.push(top);
-      }
-    } else {
-      for (size_t i = fixed; i < sets.size(); ++i) {
-        if (picked[i] || !eligible(static_cast<int>(i))) continue;
-        const uint64_t g = CountAnd(sets[i], uncovered);
-        ++result.gain_evaluations;
-        if (g > best_gain) {  // strict: ties keep the lowest index
-          best_gain = g;
-          best = static_cast<int>(i);
-        }
-      }
-    }
-    if ((best < 0 || best_gain < min_gain) && constrained()) {
-      // Nothing linked gains enough: a chain to the nearest candidates that do, or a new group.
-      std::vector<uint64_t> gains(sets.size(), 0);
-      int unlinked_best = -1;
-      for (size_t i = fixed; i < sets.size(); ++i) {
-        if (picked[i] || linked[i]) continue;
-        gains[i] = CountAnd(sets[i], uncovered);
-        ++result.gain_evaluations;
-        if (gains[i] >= min_gain && (unlinked_best < 0 || gains[i] > gains[unlinked_best])) {
-          unlinked_best = static_cast<int>(i);
-        }
-      }
-      if (unlinked_best >= 0) {
-        VC_ASSIGN_OR_RETURN(std::vector<int> chain,
-                            ShortestChain(*overlaps, sets.size(), picked_list, min_overlap, ctx, [&](int c) -> int64_t {
-                              return !picked[c] && !linked[c] && gains[c] >= min_gain ? int64_t(gains[c]) : -1;
-                            }));
-        if (chain.empty()) {
-          ++result.new_groups;
-          chain = {unlinked_best};
-        }
-        if (at_max(chain.size())) {
-          result.stop = StopReason::kMaxStations;
-          break;
-        }
-        for (size_t k = 0; k < chain.size(); ++k) {
-          pick(chain[k], CountAnd(sets[chain[k]], uncovered), k + 1 < chain.size());
-        }
-        ++round;
-        report_selection();
-        continue;
-      }
-    }
-    if (best < 0 || best_gain < min_gain) {
-      result.stop = StopReason::kMinGain;
-      break;
-    }
-    pick(best, best_gain, false);
-    ++round;
-    report_selection();
-  }
-  // Groups the fixed stations left apart: joined by the shortest chains that exist.
-  if (registration && result.stop != StopReason::kMaxStations) {
-    while (true) {
-      const std::vector<std::vector<int>> groups = overlaps->Groups(picked_list, min_overlap);
-      if (groups.size() <= 1) break;
-      std::vector<char> other(sets.size(), 0);
-      for (size_t g = 1; g < groups.size(); ++g) {
-        for (int c : groups[g]) other[c] = 1;
-      }
-      VC_ASSIGN_OR_RETURN(std::vector<int> chain, ShortestChain(*overlaps, sets.size(), groups[0], min_overlap, ctx,
-                                                                [&](int c) -> int64_t { return other[c] ? 0 : -1; }));
-      if (chain.size() < 2) break;  // none, or (impossible) a direct edge between two groups
-      chain.pop_back();             // the station of another group it reaches
-      for (int c : chain) pick(c, CountAnd(sets[c], uncovered), true);
-    }
-  }
-  return result;
-}
+  const std::vector<VoxelSet>& sets_;
+  const GreedyOptions& options_;
+  const JobContext& ctx_;
+  const size_t fixed_;
+  const uint64_t min_gain_;  // min_marginal_gain_voxels, at least 1: a 0 gain always stops
+  const bool registration_;
+  VoxelSet uncovered_;
+  double coverable_ = 0;  // result_.coverable
+  GreedyResult result_;
+  std::optional<Overlaps> overlaps_;  // with registration
+  std::vector<char> picked_, linked_;
+  std::vector<int> picked_list_;
+  std::priority_queue<Entry, std::vector<Entry>, EntryLess> heap_;  // lazy
+  std::vector<Entry> parked_;  // lazy: popped while not linked; back in the heap once linked
+  int round_ = 0;
+};
 
-Result<ConsolidateResult> ConsolidatePicks(const std::vector<VoxelSet>& sets, std::vector<int> picks,
-                                           const JobContext& ctx, int fixed, double min_overlap) {
-  ConsolidateResult out;
-  if (sets.empty() || picks.empty()) {
-    out.picks = std::move(picks);
-    return out;
-  }
-  const size_t words = (sets[0].size() + 63) / 64;
-  // The picks' words (a sparse pick is made dense once; picks are few), and any candidate's word k.
-  std::unordered_map<int, VoxelSet> dense_copies;
-  auto pick_words = [&](int c) -> const std::vector<uint64_t>& {
-    if (!sets[c].sparse()) return sets[c].words();
-    auto it = dense_copies.find(c);
-    if (it == dense_copies.end()) {
-      it = dense_copies.emplace(c, sets[c]).first;
-      it->second.Densify();
-    }
-    return it->second.words();
-  };
-  // A pick's nonzero words: on a large site a station sees a small share of it, so a pair's
-  // `rest` below is computed on these, not on every word of the scene.
-  std::unordered_map<int, std::vector<size_t>> nonzero_words;
-  auto pick_nonzero = [&](int c) -> const std::vector<size_t>& {
-    auto it = nonzero_words.find(c);
-    if (it == nonzero_words.end()) {
-      std::vector<size_t> nz;
-      const auto& w = pick_words(c);
-      for (size_t k = 0; k < w.size(); ++k) {
-        if (w[k]) nz.push_back(k);
-      }
-      it = nonzero_words.emplace(c, std::move(nz)).first;
-    }
+// A value per pick (its candidate index), computed on first use and kept: picks are few.
+template <typename Value>
+class PerPick {
+ public:
+  template <typename Compute>
+  const Value& Get(int pick, Compute compute) {
+    auto it = values_.find(pick);
+    if (it == values_.end()) it = values_.emplace(pick, compute()).first;
     return it->second;
-  };
+  }
+
+ private:
+  std::unordered_map<int, Value> values_;  // node-based: references stay valid as it grows
+};
+
+// One ConsolidatePicks over non-empty sets and picks: each pass counts how often the picks cover
+// each voxel, then drops one pick or merges one pair, until a pass changes nothing.
+class Consolidation {
+ public:
+  Consolidation(const std::vector<VoxelSet>& sets, std::vector<int> picks, const GreedyOptions& options,
+                const JobContext& ctx)
+      : sets_(sets),
+        ctx_(ctx),
+        fixed_(options.fixed),
+        min_overlap_(options.min_overlap),
+        words_((sets[0].size() + 63) / 64),
+        candidate_words_((sets.size() + 63) / 64),
+        picks_(std::move(picks)),
+        c1_(words_),
+        c2_(words_),
+        c3_(words_),
+        rest_(words_) {
+    for (size_t i = static_cast<size_t>(std::max(fixed_, 0)); i < sets.size(); ++i) {
+      order_.push_back(static_cast<int>(i));
+    }
+    std::vector<uint64_t> sizes(sets.size());
+    for (size_t i = 0; i < sets.size(); ++i) sizes[i] = CountBits(sets[i]);
+    std::stable_sort(order_.begin(), order_.end(), [&](int a, int b) { return sizes[a] > sizes[b]; });
+    if (min_overlap_ > 0) overlaps_.emplace(sets);
+    groups_ = overlaps_ ? overlaps_->Components(picks_, min_overlap_) : 1;
+  }
+
+  Result<ConsolidateResult> Run() {
+    while (true) {
+      VC_RETURN_IF_ERROR(ctx_.CheckCancelled("consolidation"));
+      CountCoverage();
+      if (DropOne()) continue;
+      VC_ASSIGN_OR_RETURN(const bool merged, MergeOne());
+      if (!merged) break;
+    }
+    out_.picks = std::move(picks_);
+    return std::move(out_);
+  }
+
+ private:
+  bool IsFixed(int candidate) const { return candidate < fixed_; }
+
+  // A pick's words (a sparse pick is made dense once).
+  const std::vector<uint64_t>& Words(int pick) {
+    if (!sets_[pick].sparse()) return sets_[pick].words();
+    const VoxelSet& dense = dense_copies_.Get(pick, [&] {
+      VoxelSet copy = sets_[pick];
+      copy.Densify();
+      return copy;
+    });
+    return dense.words();
+  }
+
+  // A pick's nonzero words: on a large site a station sees a small share of it, so a pair's rest_
+  // is computed on these, not on every word of the scene.
+  const std::vector<size_t>& NonzeroWords(int pick) {
+    return nonzero_words_.Get(pick, [&] {
+      std::vector<size_t> nonzero;
+      const std::vector<uint64_t>& w = Words(pick);
+      for (size_t k = 0; k < w.size(); ++k) {
+        if (w[k]) nonzero.push_back(k);
+      }
+      return nonzero;
+    });
+  }
+
   // The candidates that see any voxel of a pick, as bits: one standing in for picks a and b must
   // see the voxels only they cover, so it is a neighbour of a (of b) when some of those lie in a
   // (in b). Far-apart picks have no common neighbour and are passed over at once.
-  const size_t candidate_words = (sets.size() + 63) / 64;
-  std::unordered_map<int, std::vector<uint64_t>> neighbour_bits;
-  auto neighbours = [&](int p) -> const std::vector<uint64_t>& {
-    auto it = neighbour_bits.find(p);
-    if (it == neighbour_bits.end()) {
-      std::vector<uint64_t> bits(candidate_words, 0);
-      for (size_t c = 0; c < sets.size(); ++c) {
-        if (sets[c].Intersects(sets[p])) bits[c >> 6] |= uint64_t{1} << (c & 63);
+  const std::vector<uint64_t>& Neighbours(int pick) {
+    return neighbours_.Get(pick, [&] {
+      std::vector<uint64_t> bits(candidate_words_, 0);
+      for (size_t c = 0; c < sets_.size(); ++c) {
+        if (sets_[c].Intersects(sets_[pick])) bits[c >> 6] |= uint64_t{1} << (c & 63);
       }
-      it = neighbour_bits.emplace(p, std::move(bits)).first;
-    }
-    return it->second;
-  };
-  auto has = [](const std::vector<uint64_t>* bits, int c) { return !bits || (((*bits)[c >> 6] >> (c & 63)) & 1); };
-  std::vector<int> order;
-  for (size_t i = static_cast<size_t>(std::max(fixed, 0)); i < sets.size(); ++i) order.push_back(static_cast<int>(i));
-  auto is_fixed = [&](int candidate) { return candidate < fixed; };
-  std::vector<uint64_t> sizes(sets.size());
-  for (size_t i = 0; i < sets.size(); ++i) sizes[i] = CountBits(sets[i]);
-  std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return sizes[a] > sizes[b]; });
+      return bits;
+    });
+  }
 
-  // Registration: a change must not split the picks' scan graph into more groups.
-  std::optional<Overlaps> overlaps;
-  if (min_overlap > 0) overlaps.emplace(sets);
-  int groups = overlaps ? overlaps->Components(picks, min_overlap) : 1;
-  auto keeps_linked = [&](const std::vector<int>& after) {
-    if (!overlaps) return true;
-    const int n = overlaps->Components(after, min_overlap);
-    if (n > groups) return false;
-    groups = n;
+  // Whether candidate c is among `bits` (nullptr: no constraint).
+  static bool Has(const std::vector<uint64_t>* bits, int c) { return !bits || (((*bits)[c >> 6] >> (c & 63)) & 1); }
+
+  // Registration: `after` must not split the picks' scan graph into more groups.
+  bool KeepsLinked(const std::vector<int>& after) {
+    if (!overlaps_) return true;
+    const int n = overlaps_->Components(after, min_overlap_);
+    if (n > groups_) return false;
+    groups_ = n;
     return true;
-  };
+  }
 
-  std::vector<uint64_t> c1(words), c2(words), c3(words), rest(words);
-  std::vector<size_t> nonzero;
-  bool changed = true;
-  while (changed) {
-    changed = false;
-    VC_RETURN_IF_ERROR(ctx.CheckCancelled("consolidation"));
-    // Voxels covered at least once, twice, three times.
-    std::fill(c1.begin(), c1.end(), 0);
-    std::fill(c2.begin(), c2.end(), 0);
-    std::fill(c3.begin(), c3.end(), 0);
-    for (int p : picks) {
-      const auto& w = pick_words(p);
-      for (size_t k = 0; k < words; ++k) {
-        c3[k] |= c2[k] & w[k];
-        c2[k] |= c1[k] & w[k];
-        c1[k] |= w[k];
-      }
-    }
-    // A pick nobody needs: all its voxels are covered twice. The latest such pick goes first.
-    for (size_t i = picks.size(); i-- > 0 && picks.size() > 1;) {
-      if (is_fixed(picks[i])) continue;
-      const auto& w = pick_words(picks[i]);
-      bool needed = false;
-      for (size_t k = 0; k < words && !needed; ++k) needed = (w[k] & ~c2[k]) != 0;
-      if (!needed) {
-        std::vector<int> after = picks;
-        after.erase(after.begin() + static_cast<std::ptrdiff_t>(i));
-        if (!keeps_linked(after)) continue;
-        picks = std::move(after);
-        ++out.dropped;
-        changed = true;
-        break;
-      }
-    }
-    if (changed) continue;
-    // Two picks one candidate can stand in for.
-    for (size_t a = 0; a < picks.size() && !changed; ++a) {
-      VC_RETURN_IF_ERROR(ctx.CheckCancelled("consolidation"));
-      if (is_fixed(picks[a])) continue;
-      const auto& wa = pick_words(picks[a]);
-      for (size_t b = a + 1; b < picks.size() && !changed; ++b) {
-        if (is_fixed(picks[b])) continue;
-        const auto& wb = pick_words(picks[b]);
-        // Voxels only a or b cover: in both and covered exactly twice, or in one and covered once
-        // (only in words where a or b has a voxel).
-        nonzero.clear();
-        bool in_a = false, in_b = false;
-        const std::vector<size_t>& za = pick_nonzero(picks[a]);
-        const std::vector<size_t>& zb = pick_nonzero(picks[b]);
-        for (size_t i = 0, j = 0; i < za.size() || j < zb.size();) {
-          const size_t k = j == zb.size() || (i < za.size() && za[i] < zb[j]) ? za[i] : zb[j];
-          i += i < za.size() && za[i] == k;
-          j += j < zb.size() && zb[j] == k;
-          rest[k] = (wa[k] & wb[k] & ~c3[k]) | ((wa[k] ^ wb[k]) & ~c2[k]);
-          if (!rest[k]) continue;
-          nonzero.push_back(k);
-          in_a |= (rest[k] & wa[k]) != 0;
-          in_b |= (rest[k] & wb[k]) != 0;
-        }
-        const std::vector<uint64_t>* need_a = in_a ? &neighbours(picks[a]) : nullptr;
-        const std::vector<uint64_t>* need_b = in_b ? &neighbours(picks[b]) : nullptr;
-        if (need_a && need_b) {
-          bool any = false;
-          for (size_t k = 0; k < candidate_words && !any; ++k) any = ((*need_a)[k] & (*need_b)[k]) != 0;
-          if (!any) continue;  // no candidate sees into both
-        }
-        // A voxel of `rest` every candidate standing in must see: one test rules most out.
-        const bool has_probe = !nonzero.empty();
-        const size_t probe = has_probe ? nonzero[0] * 64 + static_cast<size_t>(std::countr_zero(rest[nonzero[0]])) : 0;
-        for (int c : order) {
-          if (!has(need_a, c) || !has(need_b, c)) continue;
-          const VoxelSet& sc = sets[c];
-          if (has_probe && !sc.test(probe)) continue;
-          bool covers = true;
-          for (size_t k : nonzero) {
-            if (!sc.sparse()) {
-              if (rest[k] & ~sc.words()[k]) covers = false;
-            } else {
-              for (uint64_t bits = rest[k]; bits != 0 && covers; bits &= bits - 1) {
-                covers = sc.test(k * 64 + static_cast<size_t>(std::countr_zero(bits)));
-              }
-            }
-            if (!covers) break;
-          }
-          if (!covers) continue;
-          std::vector<int> after = picks;
-          after[a] = c;
-          after.erase(after.begin() + static_cast<std::ptrdiff_t>(b));
-          if (!keeps_linked(after)) continue;
-          picks = std::move(after);
-          ++out.merged;
-          changed = true;
-          break;
-        }
+  // Voxels covered at least once (c1_), twice (c2_), three times (c3_).
+  void CountCoverage() {
+    std::fill(c1_.begin(), c1_.end(), 0);
+    std::fill(c2_.begin(), c2_.end(), 0);
+    std::fill(c3_.begin(), c3_.end(), 0);
+    for (int p : picks_) {
+      const std::vector<uint64_t>& w = Words(p);
+      for (size_t k = 0; k < words_; ++k) {
+        c3_[k] |= c2_[k] & w[k];
+        c2_[k] |= c1_[k] & w[k];
+        c1_[k] |= w[k];
       }
     }
   }
-  out.picks = std::move(picks);
-  return out;
+
+  // Drops a pick nobody needs (all its voxels covered twice), the latest such pick first.
+  bool DropOne() {
+    if (picks_.size() <= 1) return false;
+    for (size_t i = picks_.size(); i-- > 0;) {
+      if (IsFixed(picks_[i])) continue;
+      const std::vector<uint64_t>& w = Words(picks_[i]);
+      bool needed = false;
+      for (size_t k = 0; k < words_ && !needed; ++k) needed = (w[k] & ~c2_[k]) != 0;
+      if (needed) continue;
+      std::vector<int> after = picks_;
+      after.erase(after.begin() + static_cast<std::ptrdiff_t>(i));
+      if (!KeepsLinked(after)) continue;
+      picks_ = std::move(after);
+      ++out_.dropped;
+      return true;
+    }
+    return false;
+  }
+
+  // Replaces the first pair of picks (in pick order) one candidate can stand in for.
+  Result<bool> MergeOne() {
+    for (size_t a = 0; a < picks_.size(); ++a) {
+      VC_RETURN_IF_ERROR(ctx_.CheckCancelled("consolidation"));
+      if (IsFixed(picks_[a])) continue;
+      for (size_t b = a + 1; b < picks_.size(); ++b) {
+        if (!IsFixed(picks_[b]) && MergePair(a, b)) return true;
+      }
+    }
+    return false;
+  }
+
+  // Fills rest_ (on the words listed in nonzero_) with the voxels only picks a and b cover: in both
+  // and covered exactly twice, or in one and covered once (only in words where a or b has a voxel).
+  // Returns whether any of them lies in a and in b.
+  std::pair<bool, bool> FindRest(int a, int b) {
+    const std::vector<uint64_t>& wa = Words(a);
+    const std::vector<uint64_t>& wb = Words(b);
+    const std::vector<size_t>& za = NonzeroWords(a);
+    const std::vector<size_t>& zb = NonzeroWords(b);
+    nonzero_.clear();
+    bool in_a = false, in_b = false;
+    for (size_t i = 0, j = 0; i < za.size() || j < zb.size();) {
+      const size_t k = j == zb.size() || (i < za.size() && za[i] < zb[j]) ? za[i] : zb[j];
+      i += i < za.size() && za[i] == k;
+      j += j < zb.size() && zb[j] == k;
+      rest_[k] = (wa[k] & wb[k] & ~c3_[k]) | ((wa[k] ^ wb[k]) & ~c2_[k]);
+      if (!rest_[k]) continue;
+      nonzero_.push_back(k);
+      in_a |= (rest_[k] & wa[k]) != 0;
+      in_b |= (rest_[k] & wb[k]) != 0;
+    }
+    return {in_a, in_b};
+  }
+
+  // Whether `candidate` sees every voxel of rest_.
+  bool CoversRest(const VoxelSet& candidate) const {
+    for (size_t k : nonzero_) {
+      if (!candidate.sparse()) {
+        if (rest_[k] & ~candidate.words()[k]) return false;
+      } else {
+        for (uint64_t bits = rest_[k]; bits != 0; bits &= bits - 1) {
+          if (!candidate.test(k * 64 + static_cast<size_t>(std::countr_zero(bits)))) return false;
+        }
+      }
+    }
+    return true;
+  }
+
+  // Replaces picks a < b by the first candidate (in order_) that covers what only they cover and
+  // keeps the scan graph's groups.
+  bool MergePair(size_t a, size_t b) {
+    const auto [in_a, in_b] = FindRest(picks_[a], picks_[b]);
+    const std::vector<uint64_t>* need_a = in_a ? &Neighbours(picks_[a]) : nullptr;
+    const std::vector<uint64_t>* need_b = in_b ? &Neighbours(picks_[b]) : nullptr;
+    if (need_a && need_b) {
+      bool any = false;
+      for (size_t k = 0; k < candidate_words_ && !any; ++k) any = ((*need_a)[k] & (*need_b)[k]) != 0;
+      if (!any) return false;  // no candidate sees into both
+    }
+    // A voxel of rest_ every candidate standing in must see: one test rules most out.
+    const bool has_probe = !nonzero_.empty();
+    const size_t probe = has_probe ? nonzero_[0] * 64 + static_cast<size_t>(std::countr_zero(rest_[nonzero_[0]])) : 0;
+    for (int c : order_) {
+      if (!Has(need_a, c) || !Has(need_b, c)) continue;
+      if (has_probe && !sets_[c].test(probe)) continue;
+      if (!CoversRest(sets_[c])) continue;
+      std::vector<int> after = picks_;
+      after[a] = c;
+      after.erase(after.begin() + static_cast<std::ptrdiff_t>(b));
+      if (!KeepsLinked(after)) continue;
+      picks_ = std::move(after);
+      ++out_.merged;
+      return true;
+    }
+    return false;
+  }
+
+  const std::vector<VoxelSet>& sets_;
+  const JobContext& ctx_;
+  const int fixed_;
+  const double min_overlap_;
+  const size_t words_;            // per voxel set
+  const size_t candidate_words_;  // per candidate bitset (Neighbours)
+  std::vector<int> picks_;
+  std::vector<int> order_;            // the non-fixed candidates by decreasing |set|, then index
+  std::optional<Overlaps> overlaps_;  // with registration
+  int groups_ = 1;                    // components of the picks' scan graph
+  PerPick<VoxelSet> dense_copies_;    // sparse picks, made dense
+  PerPick<std::vector<size_t>> nonzero_words_;
+  PerPick<std::vector<uint64_t>> neighbours_;
+  std::vector<uint64_t> c1_, c2_, c3_, rest_;
+  std::vector<size_t> nonzero_;  // the words where rest_ has a voxel
+  ConsolidateResult out_;
+};
+
+}  // namespace
+
+Result<GreedyResult> SelectGreedy(const std::vector<VoxelSet>& sets, const GreedyOptions& options,
+                                  const JobContext& ctx) {
+  VC_RETURN_IF_ERROR(CheckOptions(options, sets.size()));
+  if (sets.empty()) return GreedyResult{};
+  VC_RETURN_IF_ERROR(CheckSameSizes(sets));
+  return GreedyRun(sets, options, ctx).Run();
+}
+
+Result<ConsolidateResult> ConsolidatePicks(const std::vector<VoxelSet>& sets, std::vector<int> picks,
+                                           const GreedyOptions& options, const JobContext& ctx) {
+  if (sets.empty() || picks.empty()) {
+    ConsolidateResult out;
+    out.picks = std::move(picks);
+    return out;
+  }
+  return Consolidation(sets, std::move(picks), options, ctx).Run();
 }
 
 }  // namespace vc::planner

@@ -39,13 +39,9 @@ namespace vc::planner {
 
 Result<Selection> GreedySelector::Select(const std::vector<VoxelSet>& sets, int fixed, const JobContext& ctx) const {
   const auto start = std::chrono::steady_clock::now();
-  GreedyOptions greedy_options;
-  greedy_options.fixed = fixed;
-  greedy_options.max_stations = options_.max_stations;
-  greedy_options.min_marginal_gain = options_.min_marginal_gain_voxels;
-  greedy_options.target_coverage = options_.target_coverage;
-  greedy_options.min_overlap = options_.min_overlap;
-  VC_ASSIGN_OR_RETURN(GreedyResult greedy, SelectGreedy(sets, greedy_options, ctx));
+  GreedyOptions options = options_;
+  options.fixed = fixed;
+  VC_ASSIGN_OR_RETURN(GreedyResult greedy, SelectGreedy(sets, options, ctx));
   Selection out;
   out.stop = greedy.stop;
   out.coverable = greedy.coverable;
@@ -54,9 +50,8 @@ Result<Selection> GreedySelector::Select(const std::vector<VoxelSet>& sets, int 
   out.new_groups = greedy.new_groups;
   for (const GreedyPick& pick : greedy.picks) out.picks.push_back(pick.candidate);
   out.first_pass_picks = static_cast<int>(out.picks.size()) - fixed;
-  if (options_.consolidate) {
-    VC_ASSIGN_OR_RETURN(ConsolidateResult merged,
-                        ConsolidatePicks(sets, std::move(out.picks), ctx, fixed, options_.min_overlap));
+  if (options.consolidate) {
+    VC_ASSIGN_OR_RETURN(ConsolidateResult merged, ConsolidatePicks(sets, std::move(out.picks), options, ctx));
     out.picks = std::move(merged.picks);
     out.saved_by_improvement = merged.dropped + merged.merged;
   }

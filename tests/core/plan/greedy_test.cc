@@ -49,7 +49,15 @@ uint64_t BestCoverageWith(const std::vector<VoxelSet>& sets, int k) {
   return best;
 }
 
-GreedyResult Greedy(const std::vector<VoxelSet>& sets, GreedyOptions o = {}) {
+// Chases every coverable voxel, as the exhaustive searches do (GreedyOptions' default target is the
+// plan's 0.99).
+GreedyOptions FullCoverage() {
+  GreedyOptions o;
+  o.target_coverage = 1.0;
+  return o;
+}
+
+GreedyResult Greedy(const std::vector<VoxelSet>& sets, GreedyOptions o = FullCoverage()) {
   Result<GreedyResult> r = SelectGreedy(sets, o);
   EXPECT_TRUE(r.ok()) << r.status().ToString();
   return r.ok() ? *r : GreedyResult{};
@@ -179,7 +187,7 @@ TEST(GreedyTest, LazyAndPlainPickIdenticallyOnRandomInstances) {
     }
     GreedyOptions o;
     o.max_stations = rng() % 3 == 0 ? static_cast<int>(1 + rng() % 5) : 0;
-    o.min_marginal_gain = rng() % 3 == 0 ? 1 + rng() % 4 : 1;
+    o.min_marginal_gain_voxels = rng() % 3 == 0 ? 1 + rng() % 4 : 1;
     o.target_coverage = rng() % 3 == 0 ? 0.5 + (rng() % 50) / 100.0 : 1.0;
     o.lazy = false;
     const GreedyResult plain = Greedy(sets, o);
@@ -222,7 +230,7 @@ TEST(GreedyTest, StopsAtMinimumMarginalGain) {
   // Gains 6, 3, 1: a threshold of 2 keeps the first two.
   std::vector<VoxelSet> sets = {MakeSet(10, {0, 1, 2, 3, 4, 5}), MakeSet(10, {6, 7, 8}), MakeSet(10, {9})};
   GreedyOptions o;
-  o.min_marginal_gain = 2;
+  o.min_marginal_gain_voxels = 2;
   const GreedyResult r = Greedy(sets, o);
   EXPECT_EQ(Picks(r), std::vector<int>({0, 1}));
   EXPECT_EQ(r.stop, StopReason::kMinGain);

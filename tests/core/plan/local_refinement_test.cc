@@ -56,7 +56,7 @@ class CountingSelector final : public Selector {
   using Selector::Select;
   Result<Selection> Select(const std::vector<VoxelSet>& sets, int fixed, const JobContext& ctx) const override {
     ++calls;
-    return GreedySelector(GreedySelectorOptions{}).Select(sets, fixed, ctx);
+    return GreedySelector(GreedyOptions{}).Select(sets, fixed, ctx);
   }
   mutable int calls = 0;
 };
@@ -255,7 +255,7 @@ class SmallExactSelector final : public Selector {
       }
     }
     if (!out.picks.empty()) return out;
-    GreedySelectorOptions g;
+    GreedyOptions g;
     g.target_coverage = target_;
     return GreedySelector(g).Select(sets, 0, ctx);
   }
@@ -321,7 +321,7 @@ TEST(LocalRefinementHubTest, AnExactSelectorReachesTheOptimumWithDoorwayCandidat
 TEST(LocalRefinementHubTest, OnTheGridAloneGreedyAndExactNeedThreeEvenWithTheLoop) {
   const Hub hub(false);
   for (const bool exact : {false, true}) {
-    GreedySelectorOptions g;
+    GreedyOptions g;
     g.target_coverage = 0.99;
     const GreedySelector greedy(g);
     const SmallExactSelector small(0.99);

@@ -113,7 +113,7 @@ TEST(GreedyRegistration, AChainOfConnectingStationsReachesAGainBeyondTheLinkedOn
   for (bool lazy : {true, false}) {
     GreedyOptions o;
     o.min_overlap = 0.3;
-    o.min_marginal_gain = 40;
+    o.min_marginal_gain_voxels = 40;
     o.lazy = lazy;
     Result<GreedyResult> r = SelectGreedy(sets, o);
     ASSERT_TRUE(r.ok());
@@ -158,7 +158,7 @@ TEST(GreedyRegistration, MaxStationsBoundsTheChainsToo) {
   const std::vector<VoxelSet> sets{Range(0, 100), Range(110, 210), Range(80, 130)};
   GreedyOptions o;
   o.min_overlap = 0.3;
-  o.min_marginal_gain = 40;
+  o.min_marginal_gain_voxels = 40;
   o.max_stations = 2;  // the chain 2 -> 1 needs two more
   Result<GreedyResult> r = SelectGreedy(sets, o);
   ASSERT_TRUE(r.ok());
@@ -177,7 +177,9 @@ TEST(ConsolidateRegistration, APickOthersCoverStaysWhenItIsTheOnlyLink) {
   Result<ConsolidateResult> off = ConsolidatePicks(sets, {0, 2, 1});
   ASSERT_TRUE(off.ok());
   EXPECT_EQ(off->picks, (std::vector<int>{0, 1}));  // 2 is covered twice over: dropped
-  Result<ConsolidateResult> on = ConsolidatePicks(sets, {0, 2, 1}, {}, 0, 0.3);
+  GreedyOptions linked;
+  linked.min_overlap = 0.3;
+  Result<ConsolidateResult> on = ConsolidatePicks(sets, {0, 2, 1}, linked);
   ASSERT_TRUE(on.ok());
   EXPECT_EQ(on->picks, (std::vector<int>{0, 2, 1}));
   EXPECT_EQ(on->dropped, 0);
@@ -186,7 +188,9 @@ TEST(ConsolidateRegistration, APickOthersCoverStaysWhenItIsTheOnlyLink) {
 TEST(ConsolidateRegistration, AReplacementThatKeepsTheGraphLinkedIsStillMade) {
   // 1 and 2 are covered by 3 alone, which also links to 0 (a pair merge keeps one group).
   const std::vector<VoxelSet> sets{Range(0, 100), Range(60, 120), Range(120, 180), Range(60, 180)};
-  Result<ConsolidateResult> on = ConsolidatePicks(sets, {0, 1, 2}, {}, 0, 0.3);
+  GreedyOptions linked;
+  linked.min_overlap = 0.3;
+  Result<ConsolidateResult> on = ConsolidatePicks(sets, {0, 1, 2}, linked);
   ASSERT_TRUE(on.ok());
   EXPECT_EQ(on->picks, (std::vector<int>{0, 3}));
   EXPECT_EQ(on->merged, 1);

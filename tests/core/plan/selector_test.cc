@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "vc/plan/greedy.h"
+#include "vc/plan/plan_options.h"
 #include "vc/plan/stages.h"
 #include "vc/synth/synth.h"
 
@@ -18,12 +19,8 @@ namespace vc::planner {
 namespace {
 
 // What the planner did before the Selector interface: lazy greedy, then consolidation.
-Selection Reference(const std::vector<VoxelSet>& sets, const GreedySelectorOptions& o) {
-  GreedyOptions g;
-  g.max_stations = o.max_stations;
-  g.min_marginal_gain = o.min_marginal_gain_voxels;
-  g.target_coverage = o.target_coverage;
-  Result<GreedyResult> greedy = SelectGreedy(sets, g);
+Selection Reference(const std::vector<VoxelSet>& sets, const GreedyOptions& o) {
+  Result<GreedyResult> greedy = SelectGreedy(sets, o);
   EXPECT_TRUE(greedy.ok()) << greedy.status().ToString();
   Selection s;
   if (!greedy.ok()) return s;
@@ -33,7 +30,7 @@ Selection Reference(const std::vector<VoxelSet>& sets, const GreedySelectorOptio
   s.covered = greedy->covered;
   s.first_pass_picks = static_cast<int>(s.picks.size());
   if (o.consolidate) {
-    Result<ConsolidateResult> merged = ConsolidatePicks(sets, s.picks);
+    Result<ConsolidateResult> merged = ConsolidatePicks(sets, s.picks, o);
     EXPECT_TRUE(merged.ok()) << merged.status().ToString();
     if (!merged.ok()) return s;
     s.picks = merged->picks;
@@ -80,7 +77,7 @@ TEST(GreedySelectorTest, PicksWhatGreedyThenConsolidationPickOnComb5) {
   ASSERT_GT(sets.size(), 10u);
   for (double target : {1.0, 0.99, 0.9}) {
     for (bool consolidate : {true, false}) {
-      GreedySelectorOptions o;
+      GreedyOptions o;
       o.target_coverage = target;
       o.consolidate = consolidate;
       Result<Selection> got = GreedySelector(o).Select(sets, {});
@@ -94,7 +91,7 @@ TEST(GreedySelectorTest, PicksWhatGreedyThenConsolidationPickOnComb5) {
     }
   }
   // At full coverage greedy needs more picks than the optimum 5 and consolidation repairs it.
-  GreedySelectorOptions full;
+  GreedyOptions full;
   full.target_coverage = 1.0;
   Result<Selection> got = GreedySelector(full).Select(sets, {});
   ASSERT_TRUE(got.ok());
@@ -115,7 +112,7 @@ TEST(GreedySelectorTest, PicksWhatGreedyThenConsolidationPickOnRandomSets) {
       for (size_t v = 0; v < len; ++v) s.set((start + v) % n);
       sets.push_back(s);
     }
-    GreedySelectorOptions o;
+    GreedyOptions o;
     o.max_stations = static_cast<int>(rng() % 4);  // 0 = no limit
     o.min_marginal_gain_voxels = 1 + rng() % 3;
     o.target_coverage = (rng() % 2) ? 1.0 : 0.8;
@@ -131,7 +128,7 @@ TEST(GreedySelectorTest, PicksWhatGreedyThenConsolidationPickOnRandomSets) {
 TEST(GreedySelectorTest, StopReasonComesFromTheGreedyPass) {
   std::vector<VoxelSet> sets(3, VoxelSet(30));
   for (int v = 0; v < 10; ++v) sets[0].set(v), sets[1].set(10 + v), sets[2].set(20 + v);
-  GreedySelectorOptions o;
+  GreedyOptions o;
   o.max_stations = 2;
   Result<Selection> got = GreedySelector(o).Select(sets, {});
   ASSERT_TRUE(got.ok());
@@ -142,7 +139,7 @@ TEST(GreedySelectorTest, StopReasonComesFromTheGreedyPass) {
 }
 
 TEST(GreedySelectorTest, RejectsSetsOfDifferentSizesAndStopsWhenCancelled) {
-  const GreedySelector selector(GreedySelectorOptions{});
+  const GreedySelector selector(GreedyOptions{});
   EXPECT_EQ(selector.Select({VoxelSet(10), VoxelSet(11)}, {}).status().code(), StatusCode::kInvalidArgument);
   CancelToken token;
   token.Cancel();
@@ -213,7 +210,7 @@ std::vector<VoxelSet> FixedAndCandidates() {
 }
 
 TEST(GreedySelectorTest, FixedStationsArePickedFirstAndKeptThroughConsolidation) {
-  GreedySelectorOptions o;
+  GreedyOptions o;
   o.target_coverage = 1.0;
   Result<Selection> got = GreedySelector(o).Select(FixedAndCandidates(), 1, {});
   ASSERT_TRUE(got.ok()) << got.status().ToString();
@@ -230,7 +227,7 @@ TEST(GreedySelectorTest, AFixedStationOthersCoverIsNotDropped) {
   std::vector<VoxelSet> sets = FixedAndCandidates();
   sets[0] = VoxelSet(12);
   sets[0].set(2);  // the fixed station sees only voxel 2, which candidate 3 sees too
-  GreedySelectorOptions o;
+  GreedyOptions o;
   o.target_coverage = 1.0;
   Result<Selection> got = GreedySelector(o).Select(sets, 1, {});
   ASSERT_TRUE(got.ok()) << got.status().ToString();
@@ -241,7 +238,7 @@ TEST(GreedySelectorTest, AFixedStationOthersCoverIsNotDropped) {
 
 TEST(GreedySelectorTest, FixedStationsReachingTheTargetAddNone) {
   std::vector<VoxelSet> sets = FixedAndCandidates();
-  GreedySelectorOptions o;
+  GreedyOptions o;
   o.target_coverage = 0.3;  // 4 of 12 voxels
   Result<Selection> got = GreedySelector(o).Select(sets, 1, {});
   ASSERT_TRUE(got.ok()) << got.status().ToString();
@@ -266,7 +263,7 @@ TEST(SelectionStageTest, FixedStationsComeFirstMarkedFixed) {
   callbacks.on_station = [&](const PlannedStation& s, int) { reported.push_back(s); };
   PlanOptions options;
   options.fixed_stations = {{9, 9, 1}};
-  GreedySelectorOptions go;
+  GreedyOptions go;
   go.target_coverage = 1.0;
   const GreedySelector selector(go);
   Result<SelectionOutput> out = RunSelectionStage(
@@ -282,6 +279,27 @@ TEST(SelectionStageTest, FixedStationsComeFirstMarkedFixed) {
   EXPECT_TRUE(reported[0].fixed);
   EXPECT_EQ(reported[0].marginal_gain, 4u);
   EXPECT_FALSE(reported[1].fixed);
+}
+
+// A value other than `v`, for each type of a VC_GREEDY_PARAMETERS row.
+bool Changed(bool v) { return !v; }
+int32_t Changed(int32_t v) { return v + 3; }
+uint64_t Changed(uint64_t v) { return v + 5; }
+double Changed(double v) { return v / 2; }
+
+TEST(SelectionStageTest, SelectorOptionsForCarriesEveryGreedyRowAndMinOverlap) {
+  PlanOptions plan;
+#define VC_CHANGE_ROW(type, name, ...) plan.name = Changed(plan.name);
+  VC_GREEDY_PARAMETERS(VC_CHANGE_ROW)
+#undef VC_CHANGE_ROW
+  plan.min_overlap = 0.3;
+  const GreedyOptions o = SelectorOptionsFor(plan);
+#define VC_EXPECT_ROW(type, name, ...) EXPECT_EQ(o.name, plan.name) << #name;
+  VC_GREEDY_PARAMETERS(VC_EXPECT_ROW)
+#undef VC_EXPECT_ROW
+  EXPECT_EQ(o.min_overlap, 0.3);
+  EXPECT_TRUE(o.lazy);
+  EXPECT_EQ(o.fixed, 0);
 }
 
 }  // namespace

@@ -102,15 +102,16 @@ Result<LocalRefinementResult> SelectWithLocalCandidates(const SelectionInput& in
 
 }  // namespace
 
-GreedySelectorOptions SelectorOptionsFor(const PlanOptions& options) {
-  GreedySelectorOptions out;
-  out.max_stations = options.max_stations;
-  out.min_marginal_gain_voxels = options.min_marginal_gain_voxels;
-  out.target_coverage = options.target_coverage;
-  out.consolidate = options.consolidate;
+#define VC_COPY_ROW(type, name, ...) out.name = options.name;
+
+GreedyOptions SelectorOptionsFor(const PlanOptions& options) {
+  GreedyOptions out;
+  VC_GREEDY_PARAMETERS(VC_COPY_ROW)
   out.min_overlap = options.min_overlap;
   return out;
 }
+
+#undef VC_COPY_ROW
 
 std::unique_ptr<Selector> SelectorFor(const PlanOptions& options) {
   if (options.solver == SelectionSolver::kGreedy) return std::make_unique<GreedySelector>(SelectorOptionsFor(options));

@@ -47,8 +47,8 @@
 namespace vc::planner {
 
 struct ExactSelectorOptions {
-  GreedySelectorOptions greedy;  // the warm start's options; max_stations and target_coverage define the ILP
-  double time_limit_s = 20;      // CBC's time limit, in seconds (> 0)
+  GreedyOptions greedy;      // the warm start's options; max_stations and target_coverage define the ILP
+  double time_limit_s = 20;  // CBC's time limit, in seconds (> 0)
   // The integer program may use about this many bytes (estimated from its non-zeros, rows and
   // columns); above it, the swap local search runs instead.
   uint64_t memory_budget_bytes = uint64_t{1} << 30;

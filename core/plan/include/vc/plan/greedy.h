@@ -20,30 +20,6 @@
 
 namespace vc::planner {
 
-struct GreedyOptions {
-  // At most this many picks; 0 = no limit.
-  int max_stations = 0;
-  // Stop when the best marginal gain is below this many voxels (a 0 gain always stops).
-  uint64_t min_marginal_gain = 1;
-  // Stop once covered / coverable >= this fraction, in (0, 1].
-  double target_coverage = 1.0;
-  // CELF lazy evaluation (true) or the plain recount of every candidate per round (false).
-  bool lazy = true;
-  // The first `fixed` sets are stations already placed: picked first, in order (whatever their
-  // gain), and not counted by max_stations; the stopping rules then apply to what they cover.
-  int fixed = 0;
-  // Registration (scan_graph.h): when > 0, the picks must form a connected scan graph at this
-  // overlap. After the first pick (or the fixed stations) only candidates with an edge to a
-  // picked station compete. When none of them gains min_marginal_gain but another candidate
-  // would, the shortest chain of candidates (fewest, by breadth-first search over edges) from the
-  // picks to the nearest such candidates is added, its links as connecting stations, then the one
-  // with the largest gain at that depth (lowest index on ties). When no chain reaches any gaining
-  // candidate, the best of them starts a new group (GreedyResult::new_groups; the plan reports
-  // the groups). At the end, groups the fixed stations left apart are joined the same way when a
-  // chain exists (unless max_stations stopped the picks). 0 = off: the plain greedy.
-  double min_overlap = 0;
-};
-
 struct GreedyPick {
   int candidate = -1;          // index into the sets
   uint64_t marginal_gain = 0;  // voxels newly covered by this pick
@@ -61,8 +37,10 @@ struct GreedyResult {
   int new_groups = 0;             // times no chain reached a gaining candidate (min_overlap > 0)
 };
 
-// Greedy maximum coverage over `sets` (all of the same size). INVALID_ARGUMENT for sets of
-// different sizes or bad options; CANCELLED / DEADLINE_EXCEEDED from ctx (checked every round).
+// Greedy maximum coverage over `sets` (all of the same size), with the options' stopping rules,
+// fixed stations and registration (GreedyOptions, selector.h; consolidate is not read here).
+// INVALID_ARGUMENT for sets of different sizes or bad options; CANCELLED / DEADLINE_EXCEEDED from
+// ctx (checked every round).
 Result<GreedyResult> SelectGreedy(const std::vector<VoxelSet>& sets, const GreedyOptions& options,
                                   const JobContext& ctx = {});
 
@@ -72,7 +50,9 @@ Result<GreedyResult> SelectGreedy(const std::vector<VoxelSet>& sets, const Greed
 // optimal (e.g. comb:5 on a 1 m grid: 7 greedy picks where 5 candidates suffice); this repairs the
 // typical case where two early picks each cover half of what one candidate sees. Candidates are
 // tried in order of decreasing |set|, then index; picks are examined in greedy order. Picks of the
-// first `fixed` sets (fixed stations) are never dropped or replaced, nor used as replacements.
+// first options.fixed sets (fixed stations) are never dropped or replaced, nor used as
+// replacements; with options.min_overlap > 0 a change must not add a group to the picks' scan
+// graph. The stopping rules and options.consolidate are not read here.
 struct ConsolidateResult {
   std::vector<int> picks;  // candidate indices; a replacement takes the place of the earlier pick
   int dropped = 0;         // picks removed as covered by the others
@@ -80,7 +60,7 @@ struct ConsolidateResult {
 };
 // CANCELLED / DEADLINE_EXCEEDED from ctx.
 Result<ConsolidateResult> ConsolidatePicks(const std::vector<VoxelSet>& sets, std::vector<int> picks,
-                                           const JobContext& ctx = {}, int fixed = 0, double min_overlap = 0);
+                                           const GreedyOptions& options = {}, const JobContext& ctx = {});
 
 // |a AND b| over the raw bitset words (equal sizes).
 uint64_t CountAnd(const VoxelSet& a, const VoxelSet& b);

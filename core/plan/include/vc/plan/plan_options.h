@@ -15,11 +15,9 @@
 #include "vc/scene/voxel_scene.h"
 #include "vc/visibility/visibility.h"
 
-// X(type, name, default, unit, flag, check, help). Notes on some rows:
-// - target_coverage: the default 0.99 stops chasing the last voxels of scan noise: on geb079, 1.0
-//   puts a station on every one of the 123 candidates, 0.99 needs 69 and 0.95 needs 37.
-// - consolidate: after greedy selection, drop picks the others cover and replace two picks by one
-//   candidate that sees all they alone covered (coverage never shrinks; docs/PLANNING.md).
+// X(type, name, default, unit, flag, check, help). Greedy selection's rows (max_stations,
+// min_marginal_gain_voxels, target_coverage, consolidate) are VC_GREEDY_PARAMETERS (selector.h),
+// which GreedyOptions is declared from. Notes on some rows:
 // - doorway_candidates: candidates in narrow passages (vc/plan/candidates.h; docs/PLANNING.md,
 //   "Doorway candidates").
 // - solver / solve_seconds: greedy, the exact integer program (CBC) with a time limit, or auto
@@ -38,47 +36,43 @@
 //   (Roaring) when that is at least this many times smaller than its dense bitset; no indoor scene
 //   of ours gains 4 x (docs/BENCHMARKS.md), a large site with a range limit gains 9-36 x. The
 //   form never changes the plan, only its memory and time.
-#define VC_PLAN_PARAMETERS(X)                                                                                          \
-  X(double, resolution_m, 0.0, "m", "resolution", kNonNegative,                                                        \
-    "working resolution (0 = the octree's own, or 0.1 m for clouds)")                                                  \
-  X(uint64_t, memory_budget_bytes, ::vc::kDefaultMemoryBudgetBytes, "bytes", "memory-budget-bytes", kPositive,         \
-    "memory budget of the job (capped by the server's --max-memory-budget-bytes)")                                     \
-  X(::vc::SelectionTest, selection_test, ::vc::SelectionTest::kSurfaceVisibility, "", "test", kAny,                    \
-    "selection test: surface or compatibility")                                                                        \
-  X(double, grid_spacing_m, 1.0, "m", "grid-spacing", kPositive, "candidate grid spacing")                             \
-  X(double, tripod_height_m, 1.5, "m", "tripod-height", kPositive, "scanner height above the floor")                   \
-  X(double, clearance_m, 0.2, "m", "clearance", kNonNegative, "free space required around a candidate")                \
-  X(bool, doorway_candidates, false, "", "doorway-candidates", kAny,                                                   \
-    "also candidates in doorways and narrow passages, on a finer grid")                                                \
-  X(int32_t, max_stations, 0, "stations", "max-stations", kNonNegative, "at most this many stations (0 = no limit)")   \
-  X(uint64_t, min_marginal_gain_voxels, 1, "voxels", "min-gain", kAny, "stop when the best station adds fewer voxels") \
-  X(double, target_coverage, 0.99, "fraction", "target-coverage", kFraction,                                           \
-    "stop at this covered fraction of the coverable voxels")                                                           \
-  X(bool, consolidate, true, "", "consolidate", kAny, "drop covered picks and merge pairs after greedy")               \
-  X(::vc::SelectionSolver, solver, ::vc::SelectionSolver::kAuto, "", "solver", kAny,                                   \
-    "station selection: greedy, exact (integer program, proven gap) or auto")                                          \
-  X(double, solve_seconds, 20.0, "s", "solve-seconds", kPositive, "time limit of the exact solver")                    \
-  X(bool, local_candidates, false, "", "local-candidates", kAny,                                                       \
-    "after selection, add candidates around each station and select again while it improves")                          \
-  X(double, local_candidates_radius_m, 0.5, "m", "local-candidates-radius", kPositive,                                 \
-    "half-width of the sub-grid around each station")                                                                  \
-  X(double, local_candidates_step_m, 0.25, "m", "local-candidates-step", kPositive, "sub-grid step")                   \
-  X(int32_t, local_candidates_rounds, 4, "rounds", "local-candidates-rounds", kPositive,                               \
-    "selections after the first, at most")                                                                             \
-  X(bool, refine, false, "", "refine", kAny, "refine each station on a local sub-grid")                                \
-  X(double, refine_radius_m, 0.5, "m", "refine-radius", kPositive, "refinement radius")                                \
-  X(double, refine_step_m, 0.25, "m", "refine-step", kPositive, "refinement step")                                     \
-  X(bool, reduce, true, "", "reduce", kAny, "remove redundant stations")                                               \
-  X(int32_t, reduce_to, 0, "stations", "reduce-to", kNonNegative,                                                      \
-    "reduce to at most this many stations (0 = zero-loss removals only)")                                              \
-  X(int32_t, threads, 0, "threads", "threads", kNonNegative, "threads for the job (0 = all, or the server's share)")   \
-  X(double, sparse_set_gain, 4.0, "x", "sparse-set-gain", kNonNegative,                                                \
-    "keep a candidate's visibility set as a Roaring bitmap when that is this many times smaller (0 = always dense)")   \
-  X(double, min_overlap, 0.0, "fraction", "min-overlap", kUnitInterval,                                                \
-    "keep the scan graph connected at this overlap (0 = off; 0.3 for target-less registration)")                       \
-  X(double, setup_seconds, 120.0, "s", "setup-seconds", kNonNegative, "field time to set up the scanner per station")  \
-  X(double, scan_seconds, 0.0, "s", "scan-seconds", kNonNegative,                                                      \
-    "field time of one scan (0 = the scanner preset's scan time)")                                                     \
+#define VC_PLAN_PARAMETERS(X)                                                                                         \
+  X(double, resolution_m, 0.0, "m", "resolution", kNonNegative,                                                       \
+    "working resolution (0 = the octree's own, or 0.1 m for clouds)")                                                 \
+  X(uint64_t, memory_budget_bytes, ::vc::kDefaultMemoryBudgetBytes, "bytes", "memory-budget-bytes", kPositive,        \
+    "memory budget of the job (capped by the server's --max-memory-budget-bytes)")                                    \
+  X(::vc::SelectionTest, selection_test, ::vc::SelectionTest::kSurfaceVisibility, "", "test", kAny,                   \
+    "selection test: surface or compatibility")                                                                       \
+  X(double, grid_spacing_m, 1.0, "m", "grid-spacing", kPositive, "candidate grid spacing")                            \
+  X(double, tripod_height_m, 1.5, "m", "tripod-height", kPositive, "scanner height above the floor")                  \
+  X(double, clearance_m, 0.2, "m", "clearance", kNonNegative, "free space required around a candidate")               \
+  X(bool, doorway_candidates, false, "", "doorway-candidates", kAny,                                                  \
+    "also candidates in doorways and narrow passages, on a finer grid")                                               \
+  VC_GREEDY_PARAMETERS(X)                                                                                             \
+  X(::vc::SelectionSolver, solver, ::vc::SelectionSolver::kAuto, "", "solver", kAny,                                  \
+    "station selection: greedy, exact (integer program, proven gap) or auto")                                         \
+  X(double, solve_seconds, 20.0, "s", "solve-seconds", kPositive, "time limit of the exact solver")                   \
+  X(bool, local_candidates, false, "", "local-candidates", kAny,                                                      \
+    "after selection, add candidates around each station and select again while it improves")                         \
+  X(double, local_candidates_radius_m, 0.5, "m", "local-candidates-radius", kPositive,                                \
+    "half-width of the sub-grid around each station")                                                                 \
+  X(double, local_candidates_step_m, 0.25, "m", "local-candidates-step", kPositive, "sub-grid step")                  \
+  X(int32_t, local_candidates_rounds, 4, "rounds", "local-candidates-rounds", kPositive,                              \
+    "selections after the first, at most")                                                                            \
+  X(bool, refine, false, "", "refine", kAny, "refine each station on a local sub-grid")                               \
+  X(double, refine_radius_m, 0.5, "m", "refine-radius", kPositive, "refinement radius")                               \
+  X(double, refine_step_m, 0.25, "m", "refine-step", kPositive, "refinement step")                                    \
+  X(bool, reduce, true, "", "reduce", kAny, "remove redundant stations")                                              \
+  X(int32_t, reduce_to, 0, "stations", "reduce-to", kNonNegative,                                                     \
+    "reduce to at most this many stations (0 = zero-loss removals only)")                                             \
+  X(int32_t, threads, 0, "threads", "threads", kNonNegative, "threads for the job (0 = all, or the server's share)")  \
+  X(double, sparse_set_gain, 4.0, "x", "sparse-set-gain", kNonNegative,                                               \
+    "keep a candidate's visibility set as a Roaring bitmap when that is this many times smaller (0 = always dense)")  \
+  X(double, min_overlap, 0.0, "fraction", "min-overlap", kUnitInterval,                                               \
+    "keep the scan graph connected at this overlap (0 = off; 0.3 for target-less registration)")                      \
+  X(double, setup_seconds, 120.0, "s", "setup-seconds", kNonNegative, "field time to set up the scanner per station") \
+  X(double, scan_seconds, 0.0, "s", "scan-seconds", kNonNegative,                                                     \
+    "field time of one scan (0 = the scanner preset's scan time)")                                                    \
   X(double, walk_speed_mps, 1.0, "m/s", "walk-speed", kPositive, "walking speed between stations, carrying the kit")
 
 namespace vc {

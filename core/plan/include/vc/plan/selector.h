@@ -12,6 +12,7 @@
 #include <string_view>
 #include <vector>
 
+#include "vc/base/parameter.h"
 #include "vc/base/progress.h"
 #include "vc/base/status.h"
 #include "vc/visibility/visibility.h"
@@ -23,7 +24,7 @@ enum class StopReason : uint8_t {
   kExhausted,      // every coverable voxel is covered (or nothing was coverable)
   kTargetReached,  // target_coverage reached
   kMaxStations,    // max_stations picks made
-  kMinGain,        // best marginal gain below min_marginal_gain
+  kMinGain,        // best marginal gain below min_marginal_gain_voxels
 };
 // "exhausted", "target_reached", "max_stations", "min_gain".
 std::string_view StopReasonName(StopReason reason);
@@ -114,18 +115,48 @@ class Selector {
   }
 };
 
-struct GreedySelectorOptions {
-  int max_stations = 0;                   // at most this many greedy picks; 0 = no limit
-  uint64_t min_marginal_gain_voxels = 1;  // stop when the best gain is below this (voxels)
-  double target_coverage = 1.0;           // stop at this fraction of coverable voxels, in (0, 1]
-  bool consolidate = true;                // run ConsolidatePicks on the greedy picks
-  double min_overlap = 0;                 // > 0: keep the picks' scan graph connected (greedy.h)
+// Greedy selection's plan parameters (vc/base/parameter.h): X(type, name, default, unit, flag, check,
+// help). VC_PLAN_PARAMETERS splices these rows in, so a greedy parameter is declared here once and
+// reaches PlanOptions, its flag, its proto field's conversion, plan.json and GreedyOptions. Notes:
+// - target_coverage: the default 0.99 stops chasing the last voxels of scan noise: on geb079, 1.0
+//   puts a station on every one of the 123 candidates, 0.99 needs 69 and 0.95 needs 37.
+// - consolidate: after greedy selection, drop picks the others cover and replace two picks by one
+//   candidate that sees all they alone covered (coverage never shrinks; docs/PLANNING.md).
+#define VC_GREEDY_PARAMETERS(X)                                                                                        \
+  X(int32_t, max_stations, 0, "stations", "max-stations", kNonNegative, "at most this many stations (0 = no limit)")   \
+  X(uint64_t, min_marginal_gain_voxels, 1, "voxels", "min-gain", kAny, "stop when the best station adds fewer voxels") \
+  X(double, target_coverage, 0.99, "fraction", "target-coverage", kFraction,                                           \
+    "stop at this covered fraction of the coverable voxels")                                                           \
+  X(bool, consolidate, true, "", "consolidate", kAny, "drop covered picks and merge pairs after greedy")
+
+// The options of greedy selection: of GreedySelector, SelectGreedy and ConsolidatePicks (greedy.h).
+// The rows above, with the plan's defaults (max_stations: greedy picks, fixed stations not
+// counted; consolidate: GreedySelector only), then what is not a row of its own here.
+struct GreedyOptions {
+  VC_GREEDY_PARAMETERS(VC_DECLARE_PARAMETER)
+  // Registration (scan_graph.h; the plan row min_overlap, which the later stages use too): when
+  // > 0, the picks must form a connected scan graph at this overlap. After the first pick (or the
+  // fixed stations) only candidates with an edge to a picked station compete. When none of them
+  // gains min_marginal_gain_voxels but another candidate would, the shortest chain of candidates
+  // (fewest, by breadth-first search over edges) from the picks to the nearest such candidates is
+  // added, its links as connecting stations, then the one with the largest gain at that depth
+  // (lowest index on ties). When no chain reaches any gaining candidate, the best of them starts a
+  // new group (GreedyResult::new_groups; the plan reports the groups). At the end, groups the fixed
+  // stations left apart are joined the same way when a chain exists (unless max_stations stopped
+  // the picks). Consolidation keeps the number of groups. 0 = off: the plain greedy.
+  double min_overlap = 0;
+  // CELF lazy evaluation (true) or the plain recount of every candidate per round (false).
+  bool lazy = true;
+  // The first `fixed` sets are stations already placed: picked first, in order (whatever their
+  // gain), never dropped or replaced; the stopping rules then apply to what they cover.
+  // GreedySelector::Select sets it from its argument.
+  int fixed = 0;
 };
 
-// Lazy greedy (SelectGreedy with lazy = true), then, if enabled, ConsolidatePicks.
+// SelectGreedy (lazy unless options.lazy is false), then, with options.consolidate, ConsolidatePicks.
 class GreedySelector final : public Selector {
  public:
-  explicit GreedySelector(const GreedySelectorOptions& options) : options_(options) {}
+  explicit GreedySelector(const GreedyOptions& options) : options_(options) {}
   using Selector::Select;
   // The fixed stations, then the greedy picks, consolidated (fixed stations kept); stop, coverable
   // and covered are the greedy pass's (covered includes what the fixed stations cover).
@@ -133,7 +164,7 @@ class GreedySelector final : public Selector {
                                          const JobContext& ctx) const override;
 
  private:
-  GreedySelectorOptions options_;
+  GreedyOptions options_;
 };
 
 }  // namespace vc::planner

@@ -125,8 +125,8 @@ struct SelectionOutput {
 [[nodiscard]] Result<SelectionOutput> RunSelectionStage(SelectionInput in, const PlanOptions& options,
                                                         const JobContext& ctx);
 
-// The Selector a plan with `options` uses: GreedySelector with its stopping rules.
-[[nodiscard]] GreedySelectorOptions SelectorOptionsFor(const PlanOptions& options);
+// GreedySelector's options for a plan with `options`: its VC_GREEDY_PARAMETERS rows and min_overlap.
+[[nodiscard]] GreedyOptions SelectorOptionsFor(const PlanOptions& options);
 // The selector options.solver names: GreedySelector, or ExactSelector with options.solve_seconds
 // and half the job's memory budget (the visibility sets hold the rest). With local_candidates its
 // solves share options.solve_seconds counted from this call: make it right before the stage.
