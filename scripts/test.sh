@@ -27,7 +27,7 @@ for p in "${presets[@]}"; do
   case "$p" in
     tsan)
       # Only the service and its tests: the core is covered by the other presets.
-      cmake --build --preset "$p" --target status_mapping_test worker_pool_test upload_assembler_test outbox_test kept_jobs_test job_runner_test wire_test \
+      cmake --build --preset "$p" --target status_mapping_test worker_pool_test upload_assembler_test outbox_test kept_jobs_test job_runner_test convert_test \
         visibility_test
       echo "=== preset $p: tests labelled tsan"
       ctest --preset "$p" -L tsan
