@@ -28,7 +28,7 @@ for p in "${presets[@]}"; do
     tsan)
       # Only the service and its tests: the core is covered by the other presets.
       cmake --build --preset "$p" --target status_mapping_test worker_pool_test upload_assembler_test outbox_test kept_jobs_test job_runner_test convert_test \
-        visibility_test parallel_test
+        voxelized_scenes_test visibility_test parallel_test
       echo "=== preset $p: tests labelled tsan"
       ctest --preset "$p" -L tsan
       ;;
