@@ -29,7 +29,7 @@ for p in "${presets[@]}"; do
   case "$p" in
     tsan)
       # Only the service and its tests: the core is covered by the other presets.
-      cmake --build --preset "$p" --target server_jobs_tests proto_tests visibility_tests
+      cmake --build --preset "$p" --target base_tests server_jobs_tests proto_tests visibility_tests
       echo "=== preset $p: tests labelled tsan"
       ctest --preset "$p" -L tsan
       ;;

@@ -4,7 +4,7 @@
 
 #include <gtest/gtest.h>
 
-#include "server/test_server.h"
+#include "testing/test_server.h"
 
 namespace vc {
 namespace {

@@ -14,7 +14,7 @@
 
 #include <thread>
 
-#include "server/test_server.h"
+#include "testing/test_server.h"
 #include "vc/client/client.h"
 #include "vc/server/service.h"
 

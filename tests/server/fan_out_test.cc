@@ -6,7 +6,7 @@
 #include <atomic>
 #include <cmath>
 
-#include "server/test_server.h"
+#include "testing/test_server.h"
 #include "vc/client/client.h"
 #include "vc/plan/stages.h"
 #include "vc/scene/scene_input.h"

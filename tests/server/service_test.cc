@@ -9,7 +9,7 @@
 #include <thread>
 
 #include "grpc/health/v1/health.grpc.pb.h"
-#include "server/test_server.h"
+#include "testing/test_server.h"
 #include "vc/client/client.h"
 #include "vc/wire/convert.h"
 #include "vc/wire/sha256.h"

@@ -3,8 +3,8 @@
 
 #include <cstdlib>
 
-#include "server/test_server.h"
 #include "testing/test_paths.h"
+#include "testing/test_server.h"
 #include "vc/client/client.h"
 #include "vc/wire/status_mapping.h"
 

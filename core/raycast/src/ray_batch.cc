@@ -24,7 +24,7 @@
 //   crossing comes first. FirstOccupied may walk through such a near-tie, or jump across another
 //   box around it (walk.h); either order of the two crossings passes through a free voxel and
 //   leaves the walk in the same voxel after both, so its answer is the lane's.
-// tests/core/ray_batch_test.cc compares every answer with FirstOccupied, near-ties included.
+// tests/core/raycast/ray_batch_test.cc compares every answer with FirstOccupied, near-ties included.
 //
 // The lanes' control flow depends on the gathers' answers as little as possible, so that the
 // out-of-order core can issue the next voxel's gathers before the last ones have answered (a

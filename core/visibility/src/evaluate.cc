@@ -38,8 +38,6 @@ using internal::Neighbour;
 using internal::NotEnclosed;
 using internal::OccluderCache;
 using internal::StageProgress;
-using planner::ParallelChunks;
-using planner::ResolveThreads;
 
 // Exact evaluation gives each thread whole viewpoints once there are this many per thread (fewer
 // leave threads idle at the end; see Evaluate).

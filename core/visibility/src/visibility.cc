@@ -40,8 +40,6 @@ using internal::Neighbour;
 using internal::NotEnclosed;
 using internal::OccluderCache;
 using internal::StageProgress;
-using planner::ParallelChunks;
-using planner::ResolveThreads;
 
 bool CompatibleCached(const OccupancyGrid& g, const Vector3d& uo, const VoxelIndex& v, const ScannerLimits& limits,
                       OccluderCache& cache) {

@@ -20,6 +20,7 @@
 #include <new>
 #include <sstream>
 #include <string>
+#include <utility>
 
 #include "vc/scene/octomap_adapter.h"
 #include "vc/scene/scene_input.h"
@@ -216,10 +217,16 @@ std::string PcdHeader(const std::string& points, const std::string& data) {
 }
 
 TEST(LyingHeaderTest, Pcd) {
-  for (const char* data : {"ascii", "binary"}) {
+  // Without the limits the body is read, and does not hold what the header says: the ASCII body is
+  // one line of one value, the binary one ends after 85 points (1024 bytes of 12-byte points).
+  const std::pair<const char*, const char*> lies[] = {
+      {"ascii", "lie.pcd: line 10: expected 3 values per point (FIELDS times COUNT), found 1"},
+      {"binary", "lie.pcd: PCD header declares 2147483648 points but the body ends after 85; file truncated?"},
+  };
+  for (const auto& [data, refusal] : lies) {
     const std::string pcd = PcdHeader("2147483648", data) + std::string(1024, '1');
     ExpectRefusedSmall(pcd, "lie.pcd", StatusCode::kResourceExhausted, "2147483648 points");
-    ExpectRefusedSmall(pcd, "lie.pcd", StatusCode::kInvalidArgument, "", Unlimited());
+    ExpectRefusedSmall(pcd, "lie.pcd", StatusCode::kInvalidArgument, refusal, Unlimited());
   }
   // binary_compressed: sizes that agree with the header, a 1 KiB block.
   std::string lzf = PcdHeader("100000000", "binary_compressed");

@@ -1,4 +1,4 @@
-// Grouped surface visibility (core/src/surface_groups.cc): the same sets as the per-voxel test on
+// Grouped surface visibility (core/visibility/src/surface_groups.cc): the same sets as the per-voxel test on
 // structured synthetic scenes, cluttered planes and a real scan, plus the certificates' parts
 // (FreeCone, solid occluder boxes) on hand-made cases.
 #include "vc/visibility/surface_groups.h"

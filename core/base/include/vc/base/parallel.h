@@ -1,6 +1,6 @@
-// A minimal fork-join loop for the planner's bulk passes. Work is cut into fixed-size chunks so
-// that per-chunk partial sums, combined in chunk order, are identical for any thread count.
-// Internal to vc_core.
+// A minimal fork-join loop for the bulk passes of the visibility and planning layers. Work is cut
+// into fixed-size chunks so that per-chunk partial sums, combined in chunk order, are identical for
+// any thread count. Internal to vc_core.
 #pragma once
 
 #include <algorithm>
@@ -13,7 +13,7 @@
 #include "vc/base/progress.h"
 #include "vc/base/status.h"
 
-namespace vc::planner {
+namespace vc {
 
 // Worker threads for `requested` (0 = hardware concurrency), at least 1 and at most `chunks`.
 inline int ResolveThreads(int requested, uint64_t chunks) {
@@ -55,4 +55,4 @@ inline Status ParallelChunks(uint64_t n, uint64_t chunk_size, int threads, const
   return ctx.CheckCancelled(what);
 }
 
-}  // namespace vc::planner
+}  // namespace vc

@@ -8,7 +8,7 @@
 // conversion (proto/src/convert.cc: the generated `set_<name>` / `has_<name>` accessors, so a
 // row without a proto field does not compile), vc-client's flags (client/src/parameter_flags.cc)
 // and plan.json's `parameters` (core/report). Adding a parameter is one row plus its doc line in
-// docs/PLANNING.md; tests/client/parameters_test.cc fails when a row is missing from a derived
+// docs/PLANNING.md; tests/client/parameter_flags_test.cc fails when a row is missing from a derived
 // place, or a proto field has no row.
 //
 // Why an X-macro rather than a constexpr table of member pointers or proto field options: the

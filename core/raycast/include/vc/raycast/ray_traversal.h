@@ -6,7 +6,7 @@
 // edge or a corner exactly) are broken by a fixed rule, the one OctoMap's castRay uses: among the
 // axes whose boundary is crossed at the same parameter, step z first, then y, then x. Each axis
 // takes exactly |floor(b) - floor(a)| steps, so the walk always ends in the voxel containing b.
-// The rule is documented in docs/VISIBILITY.md and pinned by tests/core/ray_traversal_test.cc.
+// The rule is documented in docs/VISIBILITY.md and pinned by tests/core/raycast/ray_traversal_test.cc.
 //
 // RayTraversal is the plain, readable range used by tests and cold paths
 // (`for (const VoxelIndex& v : RayTraversal(a, b))`). FirstOccupied is the hot path: the same

@@ -3,7 +3,7 @@
 // perform exactly its operations: a jump adds n * t_delta in one go, so the jump policy itself
 // decides later tie-breaks. The SIMD kernel (ray_batch.cc) re-states Walk's set-up and
 // JumpAcrossBox lane-wise, operation for operation; a change here must be made there too, and
-// tests/core/ray_batch_test.cc fails if the two disagree. Plain scalar double code for the
+// tests/core/raycast/ray_batch_test.cc fails if the two disagree. Plain scalar double code for the
 // baseline ISA. Re-entrant; no state beyond the Walk. FreeCone (surface_groups.cc) uses
 // FreeBrickBox too, so that the cone test skips the same boxes the walks jump across.
 #pragma once

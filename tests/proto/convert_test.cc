@@ -1,9 +1,10 @@
-// The proto <-> core conversions (vc::wire).
+// The proto <-> core conversions of vc/wire/convert.h: plan parameters both ways, and a result
+// cut into chunks and reassembled (the scanner model's conversion: scanner_convert_test.cc).
+#include "vc/wire/convert.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
-
-#include "vc/wire/convert.h"
 
 namespace vc::wire {
 namespace {

@@ -1,4 +1,4 @@
-#include "server/test_server.h"
+#include "testing/test_server.h"
 
 #include <sstream>
 #include <thread>

@@ -1,0 +1,113 @@
+// vc/client/compact_upload.h: a point cloud goes up as its voxels (and those are the voxels the
+// server would make of the file), everything PrepareUpload must not shrink goes up as it is with
+// the reason, and DescribeUpload's line for each.
+#include "vc/client/compact_upload.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <octomap/OcTree.h>
+
+#include <cstdio>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "testing/e57_writer.h"
+#include "vc/scene/octomap_adapter.h"
+#include "vc/scene/scene_input.h"
+#include "vc/scene/voxel_scene.h"
+
+namespace vc::client {
+namespace {
+
+using ::testing::HasSubstr;
+using ::testing::StartsWith;
+
+// A 2 m x 2 m floor sampled every centimetre, as ASCII XYZ: 40,000 points, 400 voxels of 0.1 m.
+std::string FloorXyz() {
+  std::string xyz;
+  char line[64];
+  for (int i = 0; i < 200; ++i) {
+    for (int j = 0; j < 200; ++j) {
+      std::snprintf(line, sizeof line, "%.3f %.3f 0.005\n", 0.01 * i + 0.005, 0.01 * j + 0.005);
+      xyz += line;
+    }
+  }
+  return xyz;
+}
+
+std::vector<VoxelKey> Keys(const std::string& bytes, const std::string& name, double r) {
+  Result<SceneInput> in = ReadScene(bytes, name);
+  EXPECT_TRUE(in.ok()) << in.status().ToString();
+  if (!in.ok()) return {};
+  Result<std::vector<VoxelKey>> keys = OccupiedKeys(*in, r, kDefaultMemoryBudgetBytes);
+  EXPECT_TRUE(keys.ok()) << keys.status().ToString();
+  return keys.ok() ? *keys : std::vector<VoxelKey>{};
+}
+
+TEST(PrepareUploadTest, ACloudGoesUpAsTheVoxelsTheServerWouldMakeOfIt) {
+  const std::string xyz = FloorXyz();
+  for (const double r : {0.0, 0.2}) {
+    const PreparedUpload p = PrepareUpload({xyz, "floor.xyz"}, r, false);
+    const double used = r > 0 ? r : kDefaultResolutionM;
+    EXPECT_EQ(p.summary.format, "vc-voxels");
+    EXPECT_EQ(p.summary.resolution_m, used);
+    EXPECT_EQ(p.summary.file_bytes, xyz.size());
+    EXPECT_EQ(p.summary.bytes_sent, p.upload.bytes.size());
+    EXPECT_LT(p.summary.bytes_sent, xyz.size() / 10);
+    EXPECT_TRUE(p.summary.why_raw.empty());
+    EXPECT_EQ(p.upload.source_name, "floor.xyz");
+    const std::vector<VoxelKey> sent = Keys(p.upload.bytes, "floor.xyz", used);
+    EXPECT_EQ(sent, Keys(xyz, "floor.xyz", used));
+    EXPECT_EQ(p.summary.voxels, sent.size());
+    EXPECT_EQ(sent.size(), r > 0 ? 100u : 400u);
+  }
+}
+
+void ExpectRaw(const Upload& file, bool raw, const std::string& why) {
+  const PreparedUpload p = PrepareUpload(file, 0, raw);
+  EXPECT_EQ(p.summary.format, "raw") << why;
+  EXPECT_THAT(p.summary.why_raw, StartsWith(why));
+  EXPECT_EQ(p.upload.bytes, file.bytes) << why;
+  EXPECT_EQ(p.upload.source_name, file.source_name);
+  EXPECT_EQ(p.summary.bytes_sent, file.bytes.size());
+  EXPECT_EQ(p.summary.file_bytes, file.bytes.size());
+  EXPECT_EQ(p.summary.voxels, 0u);
+}
+
+TEST(PrepareUploadTest, WhatMustNotShrinkGoesUpAsItIsWithTheReason) {
+  const std::string xyz = FloorXyz();
+  ExpectRaw({xyz, "floor.xyz"}, true, "--raw-upload");
+  ExpectRaw({"ply\nformat nonsense\n", "bad.ply"}, false, "not read here: ");
+  ExpectRaw({"1 2 3\n", "one.xyz"}, false, "the vc-voxels stream is not smaller");
+
+  std::stringstream bt;
+  ASSERT_TRUE(BuildOctree(0.1, {VoxelKey{32768, 32768, 32768}})->writeBinary(bt));
+  ExpectRaw({bt.str(), "tree.bt"}, false, "an octree is uploaded as it is");
+
+  testing::E57Spec spec;
+  spec.scans.resize(1);
+  for (int i = 0; i < 50; ++i) spec.scans[0].points.emplace_back(1 + 0.01 * i, 2, 0.5);
+  ExpectRaw({testing::WriteE57(spec), "scan.e57"}, false, "the scan origins it carries are kept");
+
+  const PreparedUpload compact = PrepareUpload({xyz, "floor.xyz"}, 0, false);
+  ExpectRaw(compact.upload, false, "already a vc-voxels stream");
+}
+
+TEST(DescribeUploadTest, OneLineForEachKind) {
+  UploadSummary s;
+  s.format = "vc-voxels";
+  s.voxels = 131705;
+  s.resolution_m = 0.1;
+  s.bytes_sent = 212000;
+  s.file_bytes = 4600000;
+  EXPECT_EQ(DescribeUpload(s), "compact upload: 131705 voxels of 0.1 m, 212000 bytes instead of the file's 4600000");
+  UploadSummary raw;
+  raw.format = "raw";
+  raw.bytes_sent = 1200;
+  raw.why_raw = "an octree is uploaded as it is";
+  EXPECT_EQ(DescribeUpload(raw), "raw upload of 1200 bytes (an octree is uploaded as it is)");
+}
+
+}  // namespace
+}  // namespace vc::client
