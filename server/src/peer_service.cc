@@ -59,11 +59,9 @@ Status RunShard(ServiceState& state, const v1::ShardRequest& request, v1::ShardR
       for (const VoxelSet& s : sets) response->add_sets(wire::EncodeVoxelSet(s));
       return Status::Ok();
     }
-    case v1::SHARD_KIND_FACE_VALUES: {  // the reduction's evaluation (RunReductionStage's options)
-      EvaluateOptions eval_options = planner::StationEvaluateOptions(options);
-      eval_options.keep_face_values = false;
-      eval_options.keep_sparse_per_viewpoint_values = true;
-      VC_ASSIGN_OR_RETURN(const Evaluation e, Evaluate(*scene, viewpoints, eval_options, ctx));
+    case v1::SHARD_KIND_FACE_VALUES: {
+      VC_ASSIGN_OR_RETURN(const Evaluation e,
+                          Evaluate(*scene, viewpoints, planner::ReductionEvaluateOptions(options), ctx));
       uint64_t bytes = 0;
       for (const SparseFaceValues& v : e.per_viewpoint_sparse_values) bytes += v.size() * 8;
       if (bytes > kMaxFaceValuesBytes) {  // far below protobuf's 2 GiB per message
