@@ -98,8 +98,9 @@ class ShardReactor final : public grpc::ServerUnaryReactor {
     }
     registered_ = state_->Register(&token_);
     if (!registered_) return Done(UnavailableError("this vc-server is shutting down; give the shard to another"));
-    std::string owner, why;
-    if (!Authenticate(*ctx_, state_->options.tokens, &owner, &why)) return Done(UnauthenticatedError(why));
+    if (const Result<Caller> caller = AuthenticateCall(*ctx_, state_->options.tokens); !caller.ok()) {
+      return Done(caller.status());
+    }
     std::optional<WorkerPool::Ticket> ticket = state_->pool.TryAdmit();
     if (!ticket) {
       ctx_->AddTrailingMetadata("retry-after-ms", "500");
@@ -156,9 +157,8 @@ class ShareSceneReactor final : public grpc::ServerReadReactor<v1::SceneChunk> {
  public:
   ShareSceneReactor(grpc::CallbackServerContext* ctx, ServiceState* state, v1::ShareSceneResponse* response)
       : ctx_(ctx), state_(state), response_(response) {
-    std::string owner, why;
-    if (!Authenticate(*ctx_, state_->options.tokens, &owner, &why)) {
-      Done(UnauthenticatedError(why));
+    if (const Result<Caller> caller = AuthenticateCall(*ctx_, state_->options.tokens); !caller.ok()) {
+      Done(caller.status());
       return;
     }
     StartRead(&chunk_);
@@ -233,9 +233,8 @@ grpc::ServerUnaryReactor* StationPlannerService::PeerHello(grpc::CallbackServerC
                                                            const v1::PeerHelloRequest* request,
                                                            v1::PeerHelloResponse* response) {
   auto* reactor = ctx->DefaultReactor();
-  std::string owner, why;
-  if (!internal::Authenticate(*ctx, state_->options.tokens, &owner, &why)) {
-    reactor->Finish(wire::ToGrpcStatus(UnauthenticatedError(why)));
+  if (const Result<Caller> caller = internal::AuthenticateCall(*ctx, state_->options.tokens); !caller.ok()) {
+    reactor->Finish(wire::ToGrpcStatus(caller.status()));
     return reactor;
   }
   response->set_replica_id(state_->replica_id);

@@ -12,33 +12,6 @@
 namespace vc::server {
 namespace internal {
 
-bool Authenticate(const grpc::CallbackServerContext& ctx, const std::vector<std::string>& tokens, std::string* owner,
-                  std::string* why) {
-  owner->clear();
-  if (tokens.empty()) return true;
-  const auto& md = ctx.client_metadata();
-  const auto it = md.find("authorization");
-  if (it == md.end()) {
-    *why = "this server requires a bearer token: pass --token (or set VC_TOKEN)";
-    return false;
-  }
-  const std::string_view got(it->second.data(), it->second.size());
-  // Every token is compared in full (constant time in the token's content).
-  const std::string* matched = nullptr;
-  for (const std::string& token : tokens) {
-    const std::string expected = "Bearer " + token;
-    unsigned diff = got.size() == expected.size() ? 0u : 1u;
-    for (size_t i = 0; i < expected.size(); ++i) diff |= unsigned(expected[i] ^ (i < got.size() ? got[i] : 0));
-    if (diff == 0) matched = &token;
-  }
-  if (matched == nullptr) {
-    *why = "the bearer token is wrong: check --token (or VC_TOKEN)";
-    return false;
-  }
-  *owner = *matched;
-  return true;
-}
-
 std::string NewJobId(ServiceState& state) {
   static const uint64_t salt = [] {
     std::random_device rd;
@@ -211,10 +184,9 @@ class AttachReactor final : public grpc::ServerWriteReactor<Response> {
       return UnavailableError("this vc-server is shutting down; its jobs end with it");
     }
     registered_ = true;
-    std::string owner, why;
-    if (!Authenticate(*ctx_, state_->options.tokens, &owner, &why)) return UnauthenticatedError(why);
+    VC_ASSIGN_OR_RETURN(const Caller caller, AuthenticateCall(*ctx_, state_->options.tokens));
     if (job_id.empty()) return InvalidArgumentError("job_id is empty: pass the id the Accepted event gave");
-    VC_ASSIGN_OR_RETURN(std::shared_ptr<KeptJob> job, state_->kept.Find(job_id, owner));
+    VC_ASSIGN_OR_RETURN(std::shared_ptr<KeptJob> job, state_->kept.Find(job_id, caller.owner));
     auto channel = std::dynamic_pointer_cast<JobChannel<Response>>(job);
     if (!channel) {
       return FailedPreconditionError("job " + job_id + " is a" + (job->method() == "Evaluate" ? "n " : " ") +
@@ -267,10 +239,9 @@ grpc::ServerWriteReactor<Response>* StartAttach(grpc::CallbackServerContext* ctx
 // CancelJob: a queued or running job is cancelled (its worker is free within a second); a finished
 // one's kept result is discarded.
 Result<std::string> CancelKeptJob(const grpc::CallbackServerContext& ctx, ServiceState& state, const std::string& id) {
-  std::string owner, why;
-  if (!Authenticate(ctx, state.options.tokens, &owner, &why)) return UnauthenticatedError(why);
+  VC_ASSIGN_OR_RETURN(const Caller caller, AuthenticateCall(ctx, state.options.tokens));
   if (id.empty()) return InvalidArgumentError("job_id is empty: pass the id the Accepted event gave");
-  VC_ASSIGN_OR_RETURN(std::shared_ptr<KeptJob> job, state.kept.Find(id, owner));
+  VC_ASSIGN_OR_RETURN(std::shared_ptr<KeptJob> job, state.kept.Find(id, caller.owner));
   if (job->state().done) {
     state.kept.Erase(id);
     return std::string("discarded");
