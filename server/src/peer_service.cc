@@ -30,10 +30,9 @@ Status RunShard(ServiceState& state, const v1::ShardRequest& request, v1::ShardR
     return NotFoundError("scene " + request.scene_sha256().substr(0, 12) +
                          "... is not in this replica's scene cache; share it (ShareScene) and call again");
   }
-  VC_ASSIGN_OR_RETURN(PlanOptions options, wire::FromProto(request.parameters()));
-  options.memory_budget_bytes = std::min(options.memory_budget_bytes, state.options.max_memory_budget_bytes);
-  options.threads = state.options.EffectiveThreadsPerJob();
-  VC_RETURN_IF_ERROR(options.Validate());
+  VC_ASSIGN_OR_RETURN(PlanOptions requested, wire::FromProto(request.parameters()));
+  requested.threads = 0;  // this replica's share, whatever the coordinator's own job had
+  VC_ASSIGN_OR_RETURN(const PlanOptions options, ApplyServerLimits(state.options, std::move(requested)));
   std::vector<WorldPoint> viewpoints;
   viewpoints.reserve(size_t(request.viewpoints_size()));
   for (const v1::Point& p : request.viewpoints()) viewpoints.push_back(wire::FromProto(p));

@@ -2,7 +2,6 @@
 
 #include <fmt/format.h>
 
-#include <algorithm>
 #include <random>
 #include <vector>
 
@@ -23,23 +22,14 @@ std::string NewJobId(ServiceState& state) {
 
 namespace {
 
-// The job's thread count: the request's, capped by the server's per-job share (0 = the share).
-int JobThreads(int requested, const ServerOptions& o) {
-  const int share = o.EffectiveThreadsPerJob();
-  return requested <= 0 ? share : std::min(requested, share);
-}
-
 class PlanReactor final : public JobReactor<v1::PlanRequest, v1::PlanResponse> {
  public:
   using JobReactor::JobReactor;
 
  private:
   Result<v1::UploadSpec> TakeSpec(const v1::PlanRequest& request) override {
-    VC_ASSIGN_OR_RETURN(options_, wire::FromProto(request.spec().parameters()));
-    options_.memory_budget_bytes = std::min(options_.memory_budget_bytes, options().max_memory_budget_bytes);
-    if (options_.threads < 0) return InvalidArgumentError("threads must be >= 0 (0 = the server's share)");
-    options_.threads = JobThreads(options_.threads, options());
-    VC_RETURN_IF_ERROR(options_.Validate());
+    VC_ASSIGN_OR_RETURN(PlanOptions requested, wire::FromProto(request.spec().parameters()));
+    VC_ASSIGN_OR_RETURN(options_, ApplyServerLimits(options(), std::move(requested)));
     return request.spec().upload();
   }
 
@@ -120,10 +110,8 @@ class EvaluateReactor final : public JobReactor<v1::EvaluateRequest, v1::Evaluat
 
  private:
   Result<v1::UploadSpec> TakeSpec(const v1::EvaluateRequest& request) override {
-    VC_ASSIGN_OR_RETURN(options_, wire::FromProto(request.spec().parameters()));
-    options_.memory_budget_bytes = std::min(options_.memory_budget_bytes, options().max_memory_budget_bytes);
-    VC_RETURN_IF_ERROR(options_.Validate());
-    options_.threads = JobThreads(options_.threads, options());
+    VC_ASSIGN_OR_RETURN(EvaluateJobOptions requested, wire::FromProto(request.spec().parameters()));
+    VC_ASSIGN_OR_RETURN(options_, ApplyServerLimits(options(), std::move(requested)));
     return request.spec().upload();
   }
 
