@@ -24,10 +24,13 @@
 #include <optional>
 #include <set>
 #include <string>
+#include <string_view>
+#include <vector>
 
 #include "vc/base/progress.h"
 #include "vc/base/status.h"
 #include "vc/scene/scene_input.h"
+#include "vc/server/authenticate.h"
 #include "vc/server/backend.h"
 #include "vc/server/job_runner.h"
 #include "vc/server/kept_jobs.h"
@@ -109,10 +112,13 @@ struct ServiceState {
   WorkerPool pool;  // the workers
 };
 
-// Checks the call's bearer token against `tokens` (constant time; any token when `tokens` is
-// empty). On success `owner` is the token matched ("" without tokens); else `why` says what to do.
-bool Authenticate(const grpc::CallbackServerContext& ctx, const std::vector<std::string>& tokens, std::string* owner,
-                  std::string* why);
+// Authenticate (vc/server/authenticate.h) with the call's "authorization" metadata.
+inline Result<Caller> AuthenticateCall(const grpc::CallbackServerContext& ctx, const std::vector<std::string>& tokens) {
+  const auto& metadata = ctx.client_metadata();
+  const auto it = metadata.find("authorization");
+  if (it == metadata.end()) return Authenticate(std::nullopt, tokens);
+  return Authenticate(std::string_view(it->second.data(), it->second.size()), tokens);
+}
 // A fresh job id ("j-" + 12 hex digits).
 std::string NewJobId(ServiceState& state);
 
@@ -150,12 +156,12 @@ class JobReactor : public grpc::ServerBidiReactor<Request, Response> {
       Reject(UnavailableError("this vc-server is shutting down; retry (another replica will take the job)"));
       return;
     }
-    std::string owner, why;
-    if (!Authenticate(*ctx_, state_->options.tokens, &owner, &why)) {
-      Reject(UnauthenticatedError(why));
+    Result<Caller> caller = AuthenticateCall(*ctx_, state_->options.tokens);
+    if (!caller.ok()) {
+      Reject(caller.status());
       return;
     }
-    channel_->set_owner(std::move(owner));
+    channel_->set_owner(std::move(caller->owner));
     this->StartRead(&request_);
   }
 

@@ -30,10 +30,9 @@ Status RunShard(ServiceState& state, const v1::ShardRequest& request, v1::ShardR
     return NotFoundError("scene " + request.scene_sha256().substr(0, 12) +
                          "... is not in this replica's scene cache; share it (ShareScene) and call again");
   }
-  VC_ASSIGN_OR_RETURN(PlanOptions options, wire::FromProto(request.parameters()));
-  options.memory_budget_bytes = std::min(options.memory_budget_bytes, state.options.max_memory_budget_bytes);
-  options.threads = state.options.EffectiveThreadsPerJob();
-  VC_RETURN_IF_ERROR(options.Validate());
+  VC_ASSIGN_OR_RETURN(PlanOptions requested, wire::FromProto(request.parameters()));
+  requested.threads = 0;  // this replica's share, whatever the coordinator's own job had
+  VC_ASSIGN_OR_RETURN(const PlanOptions options, ApplyServerLimits(state.options, std::move(requested)));
   std::vector<WorldPoint> viewpoints;
   viewpoints.reserve(size_t(request.viewpoints_size()));
   for (const v1::Point& p : request.viewpoints()) viewpoints.push_back(wire::FromProto(p));
@@ -59,11 +58,9 @@ Status RunShard(ServiceState& state, const v1::ShardRequest& request, v1::ShardR
       for (const VoxelSet& s : sets) response->add_sets(wire::EncodeVoxelSet(s));
       return Status::Ok();
     }
-    case v1::SHARD_KIND_FACE_VALUES: {  // the reduction's evaluation (RunReductionStage's options)
-      EvaluateOptions eval_options = planner::StationEvaluateOptions(options);
-      eval_options.keep_face_values = false;
-      eval_options.keep_sparse_per_viewpoint_values = true;
-      VC_ASSIGN_OR_RETURN(const Evaluation e, Evaluate(*scene, viewpoints, eval_options, ctx));
+    case v1::SHARD_KIND_FACE_VALUES: {
+      VC_ASSIGN_OR_RETURN(const Evaluation e,
+                          Evaluate(*scene, viewpoints, planner::ReductionEvaluateOptions(options), ctx));
       uint64_t bytes = 0;
       for (const SparseFaceValues& v : e.per_viewpoint_sparse_values) bytes += v.size() * 8;
       if (bytes > kMaxFaceValuesBytes) {  // far below protobuf's 2 GiB per message
@@ -100,8 +97,9 @@ class ShardReactor final : public grpc::ServerUnaryReactor {
     }
     registered_ = state_->Register(&token_);
     if (!registered_) return Done(UnavailableError("this vc-server is shutting down; give the shard to another"));
-    std::string owner, why;
-    if (!Authenticate(*ctx_, state_->options.tokens, &owner, &why)) return Done(UnauthenticatedError(why));
+    if (const Result<Caller> caller = AuthenticateCall(*ctx_, state_->options.tokens); !caller.ok()) {
+      return Done(caller.status());
+    }
     std::optional<WorkerPool::Ticket> ticket = state_->pool.TryAdmit();
     if (!ticket) {
       ctx_->AddTrailingMetadata("retry-after-ms", "500");
@@ -158,9 +156,8 @@ class ShareSceneReactor final : public grpc::ServerReadReactor<v1::SceneChunk> {
  public:
   ShareSceneReactor(grpc::CallbackServerContext* ctx, ServiceState* state, v1::ShareSceneResponse* response)
       : ctx_(ctx), state_(state), response_(response) {
-    std::string owner, why;
-    if (!Authenticate(*ctx_, state_->options.tokens, &owner, &why)) {
-      Done(UnauthenticatedError(why));
+    if (const Result<Caller> caller = AuthenticateCall(*ctx_, state_->options.tokens); !caller.ok()) {
+      Done(caller.status());
       return;
     }
     StartRead(&chunk_);
@@ -235,9 +232,8 @@ grpc::ServerUnaryReactor* StationPlannerService::PeerHello(grpc::CallbackServerC
                                                            const v1::PeerHelloRequest* request,
                                                            v1::PeerHelloResponse* response) {
   auto* reactor = ctx->DefaultReactor();
-  std::string owner, why;
-  if (!internal::Authenticate(*ctx, state_->options.tokens, &owner, &why)) {
-    reactor->Finish(wire::ToGrpcStatus(UnauthenticatedError(why)));
+  if (const Result<Caller> caller = internal::AuthenticateCall(*ctx, state_->options.tokens); !caller.ok()) {
+    reactor->Finish(wire::ToGrpcStatus(caller.status()));
     return reactor;
   }
   response->set_replica_id(state_->replica_id);

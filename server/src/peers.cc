@@ -8,13 +8,13 @@
 
 #include <algorithm>
 #include <chrono>
-#include <condition_variable>
 #include <exception>
 #include <optional>
-#include <set>
 #include <thread>
+#include <type_traits>
 
 #include "vc/server/server.h"
+#include "vc/server/shard_board.h"
 #include "vc/server/upload_assembler.h"
 #include "vc/server/voxelized_scenes.h"
 #include "vc/wire/convert.h"
@@ -35,208 +35,39 @@ struct FanOutResult {
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
+using Attempt = ShardBoard::Attempt;
 
+// ShareScene sends the scene in chunks of this many bytes.
 constexpr size_t kSceneChunkBytes = size_t{1} << 20;
 constexpr auto kHelloDeadline = std::chrono::seconds(10);
-// A lane retires after this many failed calls in a row (a peer that is gone fails at once).
-constexpr int kMaxLaneFailures = 2;
-// A shard running longer than this many times the mean of the finished ones (and at least
-// kMinSlowSeconds) is started again by an idle lane.
-constexpr double kSlowFactor = 3.0;
-constexpr double kMinSlowSeconds = 2.0;
-constexpr double kSlowWithoutMeasure = 30.0;
-constexpr int kMaxRestartsPerShard = 2;
-// A peer that answers "busy" (RESOURCE_EXHAUSTED) this many times in a row is left out.
-constexpr int kMaxBusyAnswers = 20;
+constexpr auto kShareSceneDeadline = std::chrono::minutes(10);
+// A peer lane waits this long for a shard at a time; it ends only when the board finishes.
+constexpr auto kPeerLaneWait = std::chrono::hours(1);
+// This replica's own lane checks cancellation and reports progress this often while it waits.
+constexpr auto kOwnLaneWait = std::chrono::milliseconds(200);
 const std::string kSelf = "this replica";
-
-double Seconds(Clock::duration d) { return std::chrono::duration<double>(d).count(); }
 
 std::string GrpcError(const grpc::Status& s) { return wire::FromGrpcStatus(s).ToString(); }
 
-// One fan-out's shards, shared by its lanes; T is what a viewpoint yields.
-template <class T>
-class ShardBoard {
- public:
-  ShardBoard(size_t viewpoints, size_t per_shard) {
-    for (size_t b = 0; b < viewpoints; b += per_shard) {
-      Shard s;
-      s.begin = b;
-      s.end = std::min(viewpoints, b + per_shard);
-      shards_.push_back(s);
-    }
-    results_.resize(shards_.size());
-  }
-  size_t size() const { return shards_.size(); }
-  std::pair<size_t, size_t> range(size_t k) const { return {shards_[k].begin, shards_[k].end}; }
+// The bearer token this replica presents to its peers: --peer-token, else its first --token.
+std::string PeerToken(const ServerOptions& options) {
+  if (!options.peer_token.empty()) return options.peer_token;
+  return options.tokens.empty() ? std::string() : options.tokens.front();
+}
 
-  // The next shard for a lane: one nobody runs, else one that runs too long; nullopt when every
-  // shard is done or the board is stopped, or after `wait` (the caller checks Finished()). With
-  // `defer`, a shard nobody runs is taken only once no peer lane is left (the coordinator's own
-  // lane with --local-shards=false).
-  std::optional<size_t> Take(Clock::duration wait, bool defer = false) {
-    std::unique_lock lock(mu_);
-    const auto until = Clock::now() + wait;
-    while (true) {
-      if (stopped_ || done_ == shards_.size()) return std::nullopt;
-      // Deferring ends when no peer lane is left or one of them has stalled on a shard.
-      if (std::optional<size_t> k = !defer || lanes_ == 0 || Stalled() ? Pick() : std::nullopt) {
-        Shard& s = shards_[*k];
-        if (s.running > 0) ++s.restarts;
-        ++s.running;
-        ++s.attempts;
-        s.started = Clock::now();
-        return k;
-      }
-      // Nothing now; something may turn slow, or come back, before long.
-      if (cv_.wait_until(lock, std::min(until, Clock::now() + std::chrono::milliseconds(200))) ==
-              std::cv_status::timeout &&
-          Clock::now() >= until) {
-        return std::nullopt;
-      }
-    }
-  }
-  // An attempt of shard k ended with these items (from `who`); the first answer is kept.
-  void Deliver(size_t k, const std::string& who, std::vector<T> items, double seconds) {
-    std::lock_guard lock(mu_);
-    Shard& s = shards_[k];
-    --s.running;
-    if (s.done) return;
-    s.done = true;
-    results_[k] = std::move(items);
-    ++done_;
-    contributors_.insert(who);
-    finished_seconds_ += seconds;
-    cv_.notify_all();
-  }
-  // An attempt of shard k failed; the shard is free for any lane again.
-  void Release(size_t k) {
-    std::lock_guard lock(mu_);
-    --shards_[k].running;
-    cv_.notify_all();
-  }
-  // Peer lanes running (started, not yet ended).
-  void LaneStarted() {
-    std::lock_guard lock(mu_);
-    ++lanes_;
-  }
-  void LaneEnded() {
-    std::lock_guard lock(mu_);
-    --lanes_;
-    cv_.notify_all();
-  }
-  void Stop() {
-    std::lock_guard lock(mu_);
-    stopped_ = true;
-    cv_.notify_all();
-  }
-  bool Finished() const {
-    std::lock_guard lock(mu_);
-    return stopped_ || done_ == shards_.size();
-  }
-  // Waits up to `d` or until the board stops (for a lane's back-off).
-  void Sleep(Clock::duration d) {
-    std::unique_lock lock(mu_);
-    cv_.wait_for(lock, d, [&] { return stopped_ || done_ == shards_.size(); });
-  }
-  size_t done() const {
-    std::lock_guard lock(mu_);
-    return done_;
-  }
-  void Warn(std::string w) {
-    std::lock_guard lock(mu_);
-    warnings_.push_back(std::move(w));
-  }
-  void AddBytes(uint64_t b) {
-    std::lock_guard lock(mu_);
-    bytes_ += b;
-  }
-  // A lane's call in flight, cancelled when the board stops (TryCancel).
-  bool SetLive(size_t lane, grpc::ClientContext* c) {
-    std::lock_guard lock(mu_);
-    if (c != nullptr && stopped_) return false;
-    live_[lane] = c;
-    return true;
-  }
-  void CancelLive() {
-    std::lock_guard lock(mu_);
-    for (auto& [lane, c] : live_) {
-      if (c != nullptr) c->TryCancel();
-    }
-  }
-
-  // Once the lanes are joined.
-  FanOutResult<T> Collect() && {
-    FanOutResult<T> out;
-    for (std::vector<T>& r : results_) {
-      for (T& s : r) out.items.push_back(std::move(s));
-    }
-    out.distribution.replicas = int(contributors_.size());
-    out.distribution.shards = int(shards_.size());
-    for (const Shard& s : shards_) out.distribution.retried += std::max(0, s.attempts - 1);
-    out.distribution.bytes_exchanged = bytes_;
-    out.warnings = std::move(warnings_);
-    return out;
-  }
-
- private:
-  struct Shard {
-    size_t begin = 0, end = 0;
-    bool done = false;
-    int running = 0;   // attempts in flight
-    int attempts = 0;  // attempts started
-    int restarts = 0;  // attempts started while another still ran (a slow shard)
-    Clock::time_point started;
-  };
-  // Under mu_: the first shard nobody runs, else the longest-running slow one.
-  std::optional<size_t> Pick() const {
-    for (size_t k = 0; k < shards_.size(); ++k) {
-      if (!shards_[k].done && shards_[k].running == 0) return k;
-    }
-    return Slowest();
-  }
-  // Under mu_: whether some shard has run longer than the slow threshold.
-  bool Stalled() const {
-    const double slow_s = SlowSeconds();
-    const auto now = Clock::now();
-    for (const Shard& s : shards_) {
-      if (!s.done && s.running > 0 && Seconds(now - s.started) >= slow_s) return true;
-    }
-    return false;
-  }
-  double SlowSeconds() const {
-    return done_ == 0 ? kSlowWithoutMeasure
-                      : std::max(kMinSlowSeconds, kSlowFactor * finished_seconds_ / double(done_));
-  }
-  // Under mu_: the longest-running shard among those running longer than kSlowFactor times the
-  // mean finished shard (kSlowWithoutMeasure before any finished), run once and not too often.
-  std::optional<size_t> Slowest() const {
-    const double slow_s = SlowSeconds();
-    std::optional<size_t> best;
-    const auto now = Clock::now();
-    for (size_t k = 0; k < shards_.size(); ++k) {
-      const Shard& s = shards_[k];
-      if (s.done || s.running != 1 || s.restarts >= kMaxRestartsPerShard) continue;
-      if (Seconds(now - s.started) < slow_s) continue;
-      if (!best || s.started < shards_[*best].started) best = k;
-    }
-    return best;
-  }
-
-  mutable std::mutex mu_;
-  std::condition_variable cv_;
-  std::vector<Shard> shards_;
-  std::vector<std::vector<T>> results_;
-  size_t done_ = 0;
-  int lanes_ = 0;
-  bool stopped_ = false;
-  double finished_seconds_ = 0;
-  std::set<std::string> contributors_;
-  std::vector<std::string> warnings_;
-  uint64_t bytes_ = 0;
-  std::map<size_t, grpc::ClientContext*> live_;
-};
+// What a peer needs of the plan's parameters (RunShard in peer_service.cc): the voxelization
+// (resolution, memory budget), the selection test, the scanner and the sets' form. The others keep
+// their defaults there (the peer computes with its own thread share), and the lists (candidates,
+// keep-out zones, fixed stations), which may be long, are not sent.
+v1::PlanParameters ShardParameters(const v1::PlanParameters& plan) {
+  v1::PlanParameters shard;
+  if (plan.has_resolution_m()) shard.set_resolution_m(plan.resolution_m());
+  if (plan.has_memory_budget_bytes()) shard.set_memory_budget_bytes(plan.memory_budget_bytes());
+  if (plan.has_selection_test()) shard.set_selection_test(plan.selection_test());
+  if (plan.has_scanner()) *shard.mutable_scanner() = plan.scanner();
+  if (plan.has_sparse_set_gain()) shard.set_sparse_set_gain(plan.sparse_set_gain());
+  return shard;
+}
 
 // Everything one peer lane needs.
 struct LaneJob {
@@ -247,48 +78,58 @@ struct LaneJob {
   uint32_t fingerprint;
   const std::string& token;
   const std::string& self_id;
-  Clock::duration shard_deadline;
+  std::chrono::milliseconds shard_deadline;
   v1::ShardKind kind;
   double compact_gain;  // the sets arrive sparse where the plan keeps them sparse
   const char* what;     // the stage, for messages
 };
 
-// A shard's items from a peer's answer (its voxelization already checked).
-template <class T>
-Result<std::vector<T>> DecodeItems(const v1::ShardResponse& resp, size_t count, const LaneJob& job);
-template <>
-Result<std::vector<VoxelSet>> DecodeItems(const v1::ShardResponse& resp, size_t count, const LaneJob& job) {
-  if (size_t(resp.sets_size()) != count) {
-    return DataLossError(fmt::format("it answered {} sets for {} viewpoints", resp.sets_size(), count));
+// `count` items decoded one by one from `encoded` with `decode`; DATA_LOSS saying `mismatch(n)`
+// when a peer answered n items instead.
+template <class T, class Encoded, class Decode, class Mismatch>
+Result<std::vector<T>> DecodeEach(const google::protobuf::RepeatedPtrField<Encoded>& encoded, size_t count,
+                                  const Decode& decode, const Mismatch& mismatch) {
+  if (size_t(encoded.size()) != count) return DataLossError(mismatch(encoded.size()));
+  std::vector<T> items;
+  items.reserve(count);
+  for (const Encoded& e : encoded) {
+    VC_ASSIGN_OR_RETURN(T item, decode(e));
+    items.push_back(std::move(item));
   }
-  std::vector<VoxelSet> sets;
-  sets.reserve(count);
-  for (const std::string& b : resp.sets()) {
-    VC_ASSIGN_OR_RETURN(VoxelSet s, wire::DecodeVoxelSet(b, job.occupied_voxels, job.compact_gain));
-    sets.push_back(std::move(s));
-  }
-  return sets;
-}
-template <>
-Result<std::vector<SparseFaceValues>> DecodeItems(const v1::ShardResponse& resp, size_t count, const LaneJob& job) {
-  if (size_t(resp.face_values_size()) != count) {
-    return DataLossError(fmt::format("it answered face values of {} stations for {}", resp.face_values_size(), count));
-  }
-  std::vector<SparseFaceValues> values;
-  values.reserve(count);
-  for (const v1::FaceValues& m : resp.face_values()) {
-    VC_ASSIGN_OR_RETURN(SparseFaceValues v, wire::DecodeFaceValues(m, job.occupied_voxels * kFacesPerVoxel));
-    values.push_back(std::move(v));
-  }
-  return values;
+  return items;
 }
 
+// A shard's items from a peer's answer (its voxelization already checked).
+template <class T>
+Result<std::vector<T>> DecodeItems(const v1::ShardResponse& resp, size_t count, const LaneJob& job) {
+  if constexpr (std::is_same_v<T, VoxelSet>) {
+    return DecodeEach<VoxelSet>(
+        resp.sets(), count,
+        [&](const std::string& b) { return wire::DecodeVoxelSet(b, job.occupied_voxels, job.compact_gain); },
+        [&](int n) { return fmt::format("it answered {} sets for {} viewpoints", n, count); });
+  } else {
+    static_assert(std::is_same_v<T, SparseFaceValues>);
+    return DecodeEach<SparseFaceValues>(
+        resp.face_values(), count,
+        [&](const v1::FaceValues& m) { return wire::DecodeFaceValues(m, job.occupied_voxels * kFacesPerVoxel); },
+        [&](int n) { return fmt::format("it answered face values of {} stations for {}", n, count); });
+  }
+}
+
+// One peer's lane: PeerHello, ShareScene if the peer lacks the scene, then ComputeShard for one
+// shard after another from the board, until the board finishes or the peer is retired
+// (LaneRetryPolicy). Answers go into `results`, by shard.
 template <class T>
 class PeerLane {
  public:
   PeerLane(size_t index, std::string address, std::shared_ptr<v1::StationPlanner::Stub> stub, const LaneJob& job,
-           ShardBoard<T>& board)
-      : index_(index), address_(std::move(address)), stub_(std::move(stub)), job_(job), board_(board) {}
+           ShardBoard& board, std::vector<std::vector<T>>& results)
+      : index_(index),
+        address_(std::move(address)),
+        stub_(std::move(stub)),
+        job_(job),
+        board_(board),
+        results_(results) {}
 
   void Run() {
     try {
@@ -301,7 +142,7 @@ class PeerLane {
   }
 
  private:
-  void Prepare(grpc::ClientContext& c, Clock::duration deadline) const {
+  void Prepare(grpc::ClientContext& c, std::chrono::milliseconds deadline) const {
     c.set_deadline(std::chrono::system_clock::now() + deadline);
     if (!job_.token.empty()) c.AddMetadata("authorization", "Bearer " + job_.token);
   }
@@ -309,15 +150,15 @@ class PeerLane {
   // board never sees a context that is gone).
   class LiveCall {
    public:
-    LiveCall(ShardBoard<T>& board, size_t lane, grpc::ClientContext& c)
-        : board_(board), lane_(lane), live_(board.SetLive(lane, &c)) {}
+    LiveCall(ShardBoard& board, size_t lane, grpc::ClientContext& c)
+        : board_(board), lane_(lane), live_(board.SetLive(lane, [&c] { c.TryCancel(); })) {}
     ~LiveCall() {
       if (live_) board_.SetLive(lane_, nullptr);
     }
     bool live() const { return live_; }
 
    private:
-    ShardBoard<T>& board_;
+    ShardBoard& board_;
     size_t lane_;
     bool live_;
   };
@@ -356,7 +197,7 @@ class PeerLane {
 
   bool Share() {
     grpc::ClientContext c;
-    Prepare(c, std::chrono::minutes(10));
+    Prepare(c, kShareSceneDeadline);
     LiveCall live(board_, index_, c);
     if (!live.live()) return false;
     v1::ShareSceneResponse resp;
@@ -386,93 +227,89 @@ class PeerLane {
     return true;
   }
 
-  // Decodes and checks a peer's answer for shard k.
-  Result<std::vector<T>> Decode(const v1::ShardResponse& resp, size_t begin, size_t end) const {
+  // ComputeShard for the attempt's viewpoints; nullopt when the board has stopped.
+  std::optional<grpc::Status> ComputeShard(const Attempt& a, v1::ShardResponse* resp) {
+    v1::ShardRequest req;
+    req.set_scene_sha256(job_.ref.sha256);
+    req.set_source_name(job_.ref.source_name);
+    *req.mutable_parameters() = job_.parameters;
+    req.set_first_index(a.begin);
+    req.set_kind(job_.kind);
+    for (size_t i = a.begin; i < a.end; ++i) *req.add_viewpoints() = wire::ToProto(job_.viewpoints[i]);
+    grpc::ClientContext c;
+    Prepare(c, job_.shard_deadline);
+    const auto s = Call(c, [&] { return stub_->ComputeShard(&c, req, resp); });
+    if (s) board_.AddBytes(req.ByteSizeLong() + resp->ByteSizeLong());
+    return s;
+  }
+
+  // Decodes and checks a peer's answer for the attempt's viewpoints.
+  Result<std::vector<T>> Decode(const v1::ShardResponse& resp, const Attempt& a) const {
     if (resp.occupied_voxels() != job_.occupied_voxels || resp.scene_crc32c() != job_.fingerprint) {
       return FailedPreconditionError(fmt::format(
           "its voxelization differs from this replica's ({} voxels, CRC32C {:08x}, against {} and {:08x}): is it "
           "another version of vc-server?",
           resp.occupied_voxels(), resp.scene_crc32c(), job_.occupied_voxels, job_.fingerprint));
     }
-    return DecodeItems<T>(resp, end - begin, job_);
+    return DecodeItems<T>(resp, a.end - a.begin, job_);
+  }
+
+  // The attempt failed: its shard goes back to the board.
+  void ReleaseHeld() {
+    board_.Release(*held_);
+    held_.reset();
+  }
+
+  // One attempt on the peer; false when the lane ends.
+  bool RunAttempt(const Attempt a) {
+    v1::ShardResponse resp;
+    const std::optional<grpc::Status> s = ComputeShard(a, &resp);
+    if (!s) {
+      ReleaseHeld();
+      return false;
+    }
+    if (s->ok()) {
+      Result<std::vector<T>> items = Decode(resp, a);
+      if (!items.ok()) {
+        ReleaseHeld();
+        Retire(items.status().message());
+        return false;
+      }
+      const bool first = board_.Deliver(a, address_);
+      held_.reset();
+      if (first) results_[a.shard] = std::move(*items);
+      policy_.OnAnswer();
+      return true;
+    }
+    ReleaseHeld();
+    if (board_.Finished()) return false;
+    const LaneRetryPolicy::Decision d = policy_.OnFailure(wire::FromGrpcStatus(*s));
+    switch (d.action) {
+      case LaneRetryPolicy::Action::kRetry:
+        return true;
+      case LaneRetryPolicy::Action::kShareSceneAgain:
+        return Share();
+      case LaneRetryPolicy::Action::kBackOff:
+        board_.Sleep(kBusyBackOff);
+        return true;
+      case LaneRetryPolicy::Action::kRetire:
+        Retire(d.retire_reason);
+        return false;
+    }
+    return false;
   }
 
   void RunLane() {
     bool has_scene = false;
     if (!Hello(&has_scene)) return;
     if (!has_scene && !Share()) return;
-    bool shared_again = false;
-    int failures = 0, busy = 0;
     while (true) {
-      const std::optional<size_t> k = board_.Take(std::chrono::hours(1));
-      if (!k) {
+      held_ = board_.Take(kPeerLaneWait);
+      if (!held_) {
         if (board_.Finished()) return;
         continue;
       }
-      held_ = k;
-      const auto [begin, end] = board_.range(*k);
-      v1::ShardRequest req;
-      req.set_scene_sha256(job_.ref.sha256);
-      req.set_source_name(job_.ref.source_name);
-      *req.mutable_parameters() = job_.parameters;
-      req.set_first_index(begin);
-      req.set_kind(job_.kind);
-      for (size_t i = begin; i < end; ++i) *req.add_viewpoints() = wire::ToProto(job_.viewpoints[i]);
-      v1::ShardResponse resp;
-      grpc::ClientContext c;
-      Prepare(c, job_.shard_deadline);
-      const auto t0 = Clock::now();
-      const auto s = Call(c, [&] { return stub_->ComputeShard(&c, req, &resp); });
-      if (!s) {
-        board_.Release(*k);
-        held_.reset();
-        return;
-      }
-      board_.AddBytes(req.ByteSizeLong() + resp.ByteSizeLong());
-      if (s->ok()) {
-        Result<std::vector<T>> items = Decode(resp, begin, end);
-        if (!items.ok()) {
-          board_.Release(*k);
-          held_.reset();
-          Retire(items.status().message());
-          return;
-        }
-        board_.Deliver(*k, address_, std::move(*items), Seconds(Clock::now() - t0));
-        held_.reset();
-        failures = busy = 0;
-        continue;
-      }
-      board_.Release(*k);
-      held_.reset();
-      if (board_.Finished()) return;
-      switch (s->error_code()) {
-        case grpc::StatusCode::NOT_FOUND:  // the scene was evicted from its cache: share it once more
-          if (shared_again || !Share()) {
-            if (shared_again) Retire("it lost the scene twice: " + GrpcError(*s));
-            return;
-          }
-          shared_again = true;
-          break;
-        case grpc::StatusCode::RESOURCE_EXHAUSTED:  // busy: the others take the shard meanwhile
-          if (++busy >= kMaxBusyAnswers) {
-            Retire(GrpcError(*s) + fmt::format(" ({} times in a row)", busy));
-            return;
-          }
-          board_.Sleep(std::chrono::milliseconds(500));
-          break;
-        case grpc::StatusCode::UNAUTHENTICATED:
-        case grpc::StatusCode::PERMISSION_DENIED:
-        case grpc::StatusCode::INVALID_ARGUMENT:
-        case grpc::StatusCode::FAILED_PRECONDITION:
-        case grpc::StatusCode::UNIMPLEMENTED:
-          Retire(GrpcError(*s));
-          return;
-        default:
-          if (++failures >= kMaxLaneFailures) {
-            Retire(GrpcError(*s));
-            return;
-          }
-      }
+      if (!RunAttempt(*held_)) return;
     }
   }
 
@@ -480,9 +317,82 @@ class PeerLane {
   const std::string address_;
   const std::shared_ptr<v1::StationPlanner::Stub> stub_;
   const LaneJob& job_;
-  ShardBoard<T>& board_;
-  std::optional<size_t> held_;  // the shard this lane runs, released if the lane throws
+  ShardBoard& board_;
+  std::vector<std::vector<T>>& results_;
+  LaneRetryPolicy policy_;
+  std::optional<Attempt> held_;  // the attempt this lane runs, released if the lane throws
 };
+
+// The peer lanes' threads. Every way out of a fan-out (an exception included) stops the board and
+// joins them first: they hold references to the board, the job and the results.
+class LaneThreads {
+ public:
+  explicit LaneThreads(ShardBoard& board) : board_(board) {}
+  LaneThreads(const LaneThreads&) = delete;
+  LaneThreads& operator=(const LaneThreads&) = delete;
+  ~LaneThreads() { StopAndJoin(); }
+
+  void Start(std::function<void()> run) { threads_.emplace_back(std::move(run)); }
+  void StopAndJoin() {
+    board_.Stop();
+    for (std::thread& t : threads_) {
+      if (t.joinable()) t.join();
+    }
+  }
+
+ private:
+  ShardBoard& board_;
+  std::vector<std::thread> threads_;
+};
+
+// How this replica's own lane runs: for progress and messages, the stage, its name and the
+// number of peers; whether it leaves fresh shards to the peers (--local-shards=false).
+struct OwnLane {
+  Stage stage;
+  const char* what;
+  size_t peers;
+  bool defer;
+};
+
+// This replica's own lane, on the plan's thread (progress and cancellation are checked here):
+// shards computed with `local` until the board finishes. CANCELLED / DEADLINE_EXCEEDED from ctx,
+// and `local`'s errors.
+template <class T, class Local>
+Status RunOwnLane(ShardBoard& board, const std::vector<WorldPoint>& viewpoints, const Local& local, const OwnLane& lane,
+                  std::vector<std::vector<T>>& results, const JobContext& ctx) {
+  JobContext quiet = ctx;
+  quiet.progress = nullptr;
+  while (true) {
+    VC_RETURN_IF_ERROR(ctx.CheckCancelled(lane.what));
+    ctx.ReportCount(lane.stage, board.done(), board.size(), "shards", fmt::format("{} peers", lane.peers));
+    const std::optional<Attempt> a = board.Take(kOwnLaneWait, lane.defer);
+    if (!a) {
+      if (board.Finished()) return Status::Ok();
+      continue;
+    }
+    const std::vector<WorldPoint> slice(viewpoints.begin() + std::ptrdiff_t(a->begin),
+                                        viewpoints.begin() + std::ptrdiff_t(a->end));
+    Result<std::vector<T>> items = local(slice, quiet);
+    if (items.ok() && items->size() != slice.size()) {
+      items = InternalError(fmt::format("{}: {} results for {} viewpoints", lane.what, items->size(), slice.size()));
+    }
+    if (!items.ok()) {
+      board.Release(*a);
+      return items.status();
+    }
+    if (board.Deliver(*a, kSelf)) results[a->shard] = std::move(*items);
+  }
+}
+
+// The shards' items, in viewpoint order.
+template <class T>
+std::vector<T> Concatenate(std::vector<std::vector<T>>& results) {
+  std::vector<T> items;
+  for (std::vector<T>& r : results) {
+    for (T& item : r) items.push_back(std::move(item));
+  }
+  return items;
+}
 
 std::string JoinHostPort(const sockaddr* sa, const std::string& port) {
   char host[INET6_ADDRSTRLEN] = {};
@@ -553,21 +463,13 @@ template <class T>
 Result<FanOutResult<T>> PeerFanOut::FanOut(const SceneRef& ref, const v1::PlanParameters& parameters,
                                            const VoxelScene& scene, const std::vector<WorldPoint>& viewpoints,
                                            const ShardSpec& spec, const LocalShard<T>& local, const JobContext& ctx) {
-  ShardBoard<T> board(viewpoints.size(), size_t(options_.shard_candidates));
+  ShardBoard board(viewpoints.size(), size_t(options_.shard_candidates));
+  std::vector<std::vector<T>> results(board.size());
   std::vector<std::string> warnings;
   const std::vector<std::string> addresses = board.size() > 1 ? Addresses(&warnings) : std::vector<std::string>{};
   for (std::string& w : warnings) board.Warn(std::move(w));
-  const std::string token = !options_.peer_token.empty() ? options_.peer_token
-                            : options_.tokens.empty()    ? std::string()
-                                                         : options_.tokens.front();
-  // What a peer needs of the plan's parameters: the voxelization, the selection test and the
-  // scanner, not the lists (user candidates, keep-out zones, fixed stations), which may be long.
-  v1::PlanParameters shard_parameters = parameters;
-  shard_parameters.clear_candidates();
-  shard_parameters.clear_keep_out();
-  shard_parameters.clear_fixed_stations();
-  shard_parameters.clear_tripod_heights_m();
-  shard_parameters.clear_route_start();
+  const std::string token = PeerToken(options_);
+  const v1::PlanParameters shard_parameters = ShardParameters(parameters);
   const LaneJob job{ref,
                     shard_parameters,
                     viewpoints,
@@ -580,58 +482,17 @@ Result<FanOutResult<T>> PeerFanOut::FanOut(const SceneRef& ref, const v1::PlanPa
                     spec.compact_gain,
                     spec.what};
   std::vector<std::unique_ptr<PeerLane<T>>> lanes;
-  std::vector<std::thread> threads;
-  // Every way out of here (an exception included) stops the lanes and joins their threads first:
-  // they hold references to `board` and `job`.
-  struct Joiner {
-    ShardBoard<T>& board;
-    std::vector<std::thread>& threads;
-    ~Joiner() {
-      board.Stop();
-      board.CancelLive();
-      for (std::thread& t : threads) {
-        if (t.joinable()) t.join();
-      }
-    }
-  } joiner{board, threads};
+  LaneThreads threads(board);  // declared after what the lanes use, so joined before it goes
   for (size_t i = 0; i < addresses.size(); ++i) {
-    lanes.push_back(std::make_unique<PeerLane<T>>(i, addresses[i], StubFor(addresses[i]), job, board));
+    lanes.push_back(std::make_unique<PeerLane<T>>(i, addresses[i], StubFor(addresses[i]), job, board, results));
     board.LaneStarted();
-    threads.emplace_back([lane = lanes.back().get()] { lane->Run(); });
+    threads.Start([lane = lanes.back().get()] { lane->Run(); });
   }
-  // This replica's own lane, on the plan's thread: progress and cancellation are checked here.
-  JobContext quiet = ctx;
-  quiet.progress = nullptr;
-  Status status;
-  while (status.ok()) {
-    status = ctx.CheckCancelled(spec.what);
-    if (!status.ok()) break;
-    ctx.ReportCount(spec.stage, board.done(), board.size(), "shards", fmt::format("{} peers", addresses.size()));
-    const std::optional<size_t> k = board.Take(std::chrono::milliseconds(200), !options_.local_shards);
-    if (!k) {
-      if (board.Finished()) break;
-      continue;
-    }
-    const auto [begin, end] = board.range(*k);
-    const auto t0 = Clock::now();
-    const std::vector<WorldPoint> slice(viewpoints.begin() + std::ptrdiff_t(begin),
-                                        viewpoints.begin() + std::ptrdiff_t(end));
-    Result<std::vector<T>> items = local(slice, quiet);
-    if (items.ok() && items->size() != slice.size()) {
-      items = InternalError(fmt::format("{}: {} results for {} viewpoints", spec.what, items->size(), slice.size()));
-    }
-    if (!items.ok()) {
-      board.Release(*k);
-      status = items.status();
-      break;
-    }
-    board.Deliver(*k, kSelf, std::move(*items), Seconds(Clock::now() - t0));
-  }
-  board.Stop();
-  board.CancelLive();
-  for (std::thread& t : threads) t.join();
+  const OwnLane own{spec.stage, spec.what, addresses.size(), !options_.local_shards};
+  const Status status = RunOwnLane<T>(board, viewpoints, local, own, results, ctx);
+  threads.StopAndJoin();
   VC_RETURN_IF_ERROR(status);
-  FanOutResult<T> out = std::move(board).Collect();
+  FanOutResult<T> out{Concatenate(results), board.distribution(), board.TakeWarnings()};
   spdlog::info("fan-out: {}: {} viewpoints in {} shards over {} replicas, {} retried, {} exchanged", spec.what,
                viewpoints.size(), out.distribution.shards, out.distribution.replicas, out.distribution.retried,
                HumanBytes(out.distribution.bytes_exchanged));
@@ -648,18 +509,10 @@ Result<DistributedSets> PeerFanOut::Compute(const SceneRef& ref, const v1::PlanP
   };
   VC_ASSIGN_OR_RETURN(FanOutResult<VoxelSet> got,
                       FanOut<VoxelSet>(ref, parameters, scene, viewpoints, spec, local, ctx));
-  DistributedSets out{std::move(got.items), got.distribution, std::move(got.warnings)};
-  if (options.max_set_bytes > 0) {
-    uint64_t bytes = 0;
-    for (const VoxelSet& s : out.sets) bytes += s.MemoryBytes();
-    if (bytes > options.max_set_bytes) {
-      return ResourceExhaustedError("the visibility sets of " + std::to_string(viewpoints.size()) + " positions need " +
-                                    HumanBytes(bytes) +
-                                    ", over half the memory budget; raise grid_spacing_m or "
-                                    "resolution_m, lower max_range_m, or raise the memory budget");
-    }
-  }
-  return out;
+  uint64_t set_bytes = 0;
+  for (const VoxelSet& s : got.items) set_bytes += s.MemoryBytes();
+  VC_RETURN_IF_ERROR(CheckSetBytes(set_bytes, viewpoints.size(), scene.occupied.size(), options.max_set_bytes));
+  return DistributedSets{std::move(got.items), got.distribution, std::move(got.warnings)};
 }
 
 Result<DistributedFaceValues> PeerFanOut::ComputeFaceValues(const SceneRef& ref, const v1::PlanParameters& parameters,

@@ -2,11 +2,22 @@
 
 #include <algorithm>
 #include <thread>
+#include <utility>
 
 namespace vc::server {
 namespace {
 
 int Cores() { return std::max(1, int(std::thread::hardware_concurrency())); }
+
+template <class JobOptions>
+Result<JobOptions> ApplyLimits(const ServerOptions& server, JobOptions options) {
+  options.memory_budget_bytes = std::min(options.memory_budget_bytes, server.max_memory_budget_bytes);
+  if (options.threads < 0) return InvalidArgumentError("threads must be >= 0 (0 = the server's share)");
+  const int share = server.EffectiveThreadsPerJob();
+  options.threads = options.threads == 0 ? share : std::min(options.threads, share);
+  VC_RETURN_IF_ERROR(options.Validate());
+  return options;
+}
 
 }  // namespace
 
@@ -54,6 +65,14 @@ int ServerOptions::EffectiveWorkers() const { return workers > 0 ? workers : Cor
 
 int ServerOptions::EffectiveThreadsPerJob() const {
   return threads_per_job > 0 ? threads_per_job : std::max(1, Cores() / EffectiveWorkers());
+}
+
+Result<PlanOptions> ApplyServerLimits(const ServerOptions& server, PlanOptions options) {
+  return ApplyLimits(server, std::move(options));
+}
+
+Result<EvaluateJobOptions> ApplyServerLimits(const ServerOptions& server, EvaluateJobOptions options) {
+  return ApplyLimits(server, std::move(options));
 }
 
 }  // namespace vc::server

@@ -2,7 +2,6 @@
 
 #include <fmt/format.h>
 
-#include <algorithm>
 #include <random>
 #include <vector>
 
@@ -11,33 +10,6 @@
 
 namespace vc::server {
 namespace internal {
-
-bool Authenticate(const grpc::CallbackServerContext& ctx, const std::vector<std::string>& tokens, std::string* owner,
-                  std::string* why) {
-  owner->clear();
-  if (tokens.empty()) return true;
-  const auto& md = ctx.client_metadata();
-  const auto it = md.find("authorization");
-  if (it == md.end()) {
-    *why = "this server requires a bearer token: pass --token (or set VC_TOKEN)";
-    return false;
-  }
-  const std::string_view got(it->second.data(), it->second.size());
-  // Every token is compared in full (constant time in the token's content).
-  const std::string* matched = nullptr;
-  for (const std::string& token : tokens) {
-    const std::string expected = "Bearer " + token;
-    unsigned diff = got.size() == expected.size() ? 0u : 1u;
-    for (size_t i = 0; i < expected.size(); ++i) diff |= unsigned(expected[i] ^ (i < got.size() ? got[i] : 0));
-    if (diff == 0) matched = &token;
-  }
-  if (matched == nullptr) {
-    *why = "the bearer token is wrong: check --token (or VC_TOKEN)";
-    return false;
-  }
-  *owner = *matched;
-  return true;
-}
 
 std::string NewJobId(ServiceState& state) {
   static const uint64_t salt = [] {
@@ -50,23 +22,14 @@ std::string NewJobId(ServiceState& state) {
 
 namespace {
 
-// The job's thread count: the request's, capped by the server's per-job share (0 = the share).
-int JobThreads(int requested, const ServerOptions& o) {
-  const int share = o.EffectiveThreadsPerJob();
-  return requested <= 0 ? share : std::min(requested, share);
-}
-
 class PlanReactor final : public JobReactor<v1::PlanRequest, v1::PlanResponse> {
  public:
   using JobReactor::JobReactor;
 
  private:
   Result<v1::UploadSpec> TakeSpec(const v1::PlanRequest& request) override {
-    VC_ASSIGN_OR_RETURN(options_, wire::FromProto(request.spec().parameters()));
-    options_.memory_budget_bytes = std::min(options_.memory_budget_bytes, options().max_memory_budget_bytes);
-    if (options_.threads < 0) return InvalidArgumentError("threads must be >= 0 (0 = the server's share)");
-    options_.threads = JobThreads(options_.threads, options());
-    VC_RETURN_IF_ERROR(options_.Validate());
+    VC_ASSIGN_OR_RETURN(PlanOptions requested, wire::FromProto(request.spec().parameters()));
+    VC_ASSIGN_OR_RETURN(options_, ApplyServerLimits(options(), std::move(requested)));
     return request.spec().upload();
   }
 
@@ -147,10 +110,8 @@ class EvaluateReactor final : public JobReactor<v1::EvaluateRequest, v1::Evaluat
 
  private:
   Result<v1::UploadSpec> TakeSpec(const v1::EvaluateRequest& request) override {
-    VC_ASSIGN_OR_RETURN(options_, wire::FromProto(request.spec().parameters()));
-    options_.memory_budget_bytes = std::min(options_.memory_budget_bytes, options().max_memory_budget_bytes);
-    VC_RETURN_IF_ERROR(options_.Validate());
-    options_.threads = JobThreads(options_.threads, options());
+    VC_ASSIGN_OR_RETURN(EvaluateJobOptions requested, wire::FromProto(request.spec().parameters()));
+    VC_ASSIGN_OR_RETURN(options_, ApplyServerLimits(options(), std::move(requested)));
     return request.spec().upload();
   }
 
@@ -211,10 +172,9 @@ class AttachReactor final : public grpc::ServerWriteReactor<Response> {
       return UnavailableError("this vc-server is shutting down; its jobs end with it");
     }
     registered_ = true;
-    std::string owner, why;
-    if (!Authenticate(*ctx_, state_->options.tokens, &owner, &why)) return UnauthenticatedError(why);
+    VC_ASSIGN_OR_RETURN(const Caller caller, AuthenticateCall(*ctx_, state_->options.tokens));
     if (job_id.empty()) return InvalidArgumentError("job_id is empty: pass the id the Accepted event gave");
-    VC_ASSIGN_OR_RETURN(std::shared_ptr<KeptJob> job, state_->kept.Find(job_id, owner));
+    VC_ASSIGN_OR_RETURN(std::shared_ptr<KeptJob> job, state_->kept.Find(job_id, caller.owner));
     auto channel = std::dynamic_pointer_cast<JobChannel<Response>>(job);
     if (!channel) {
       return FailedPreconditionError("job " + job_id + " is a" + (job->method() == "Evaluate" ? "n " : " ") +
@@ -267,10 +227,9 @@ grpc::ServerWriteReactor<Response>* StartAttach(grpc::CallbackServerContext* ctx
 // CancelJob: a queued or running job is cancelled (its worker is free within a second); a finished
 // one's kept result is discarded.
 Result<std::string> CancelKeptJob(const grpc::CallbackServerContext& ctx, ServiceState& state, const std::string& id) {
-  std::string owner, why;
-  if (!Authenticate(ctx, state.options.tokens, &owner, &why)) return UnauthenticatedError(why);
+  VC_ASSIGN_OR_RETURN(const Caller caller, AuthenticateCall(ctx, state.options.tokens));
   if (id.empty()) return InvalidArgumentError("job_id is empty: pass the id the Accepted event gave");
-  VC_ASSIGN_OR_RETURN(std::shared_ptr<KeptJob> job, state.kept.Find(id, owner));
+  VC_ASSIGN_OR_RETURN(std::shared_ptr<KeptJob> job, state.kept.Find(id, caller.owner));
   if (job->state().done) {
     state.kept.Erase(id);
     return std::string("discarded");

@@ -420,10 +420,8 @@ TEST_F(PeerCalls, ComputeShardAnswersFaceValuesAsEvaluateGivesThem) {
   auto voxelized = planner::RunVoxelizeStage({*input}, Options(), {});
   ASSERT_TRUE(voxelized.ok());
   ASSERT_EQ(voxelized->scene.occupied.size(), resp.occupied_voxels());
-  EvaluateOptions eval = planner::StationEvaluateOptions(Options());
-  eval.keep_face_values = false;
-  eval.keep_sparse_per_viewpoint_values = true;
-  auto local = Evaluate(voxelized->scene, {WorldPoint(2, 2, 1.5), WorldPoint(100, 100, 100)}, eval);
+  auto local = Evaluate(voxelized->scene, {WorldPoint(2, 2, 1.5), WorldPoint(100, 100, 100)},
+                        planner::ReductionEvaluateOptions(Options()));
   ASSERT_TRUE(local.ok());
   for (int k = 0; k < 2; ++k) {
     auto got = wire::DecodeFaceValues(resp.face_values(k), resp.occupied_voxels() * kFacesPerVoxel);

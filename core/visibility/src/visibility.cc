@@ -292,6 +292,15 @@ Result<std::vector<VoxelSet>> ComputeDenseSets(const SetsContext& sc, const std:
 
 }  // namespace
 
+Status CheckSetBytes(uint64_t set_bytes, uint64_t positions, uint64_t voxels, uint64_t max_set_bytes) {
+  if (max_set_bytes == 0 || set_bytes <= max_set_bytes) return Status::Ok();
+  return ResourceExhaustedError("the visibility sets of " + std::to_string(positions) + " positions x " +
+                                std::to_string(voxels) + " occupied voxels need more than " +
+                                std::to_string(max_set_bytes >> 20) +
+                                " MiB even where kept sparse; raise grid_spacing_m or resolution_m, lower "
+                                "max_range_m, or raise the memory budget");
+}
+
 Result<std::vector<VoxelSet>> ComputeVisibilitySets(const VoxelScene& scene, const std::vector<WorldPoint>& viewpoints,
                                                     const VisibilitySetsOptions& options, const JobContext& ctx) {
   SetsContext sc{scene.grid, scene.occupied.size(), std::vector<VoxelIndex>(scene.occupied.size()), {}, {}};
@@ -300,13 +309,8 @@ Result<std::vector<VoxelSet>> ComputeVisibilitySets(const VoxelScene& scene, con
   if (options.test == SelectionTest::kSurfaceVisibility && !options.per_voxel) {
     sc.targets.emplace(sc.g, sc.index, sc.candidates);
   }
-  auto check_bytes = [&](uint64_t bytes) -> Status {
-    if (options.max_set_bytes == 0 || bytes <= options.max_set_bytes) return Status::Ok();
-    return ResourceExhaustedError("the visibility sets of " + std::to_string(viewpoints.size()) + " positions x " +
-                                  std::to_string(sc.n) + " occupied voxels need more than " +
-                                  std::to_string(options.max_set_bytes >> 20) +
-                                  " MiB even where kept sparse; raise grid_spacing_m or resolution_m, lower "
-                                  "max_range_m, or raise the memory budget");
+  auto check_bytes = [&](uint64_t bytes) {
+    return CheckSetBytes(bytes, viewpoints.size(), sc.n, options.max_set_bytes);
   };
   if (options.compact_gain <= 0) {
     VC_ASSIGN_OR_RETURN(std::vector<VoxelSet> sets, ComputeDenseSets(sc, viewpoints, options, ctx));

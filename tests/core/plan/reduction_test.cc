@@ -7,6 +7,8 @@
 #include <algorithm>
 #include <random>
 
+#include "vc/plan/stages.h"
+
 namespace vc::planner {
 namespace {
 
@@ -349,6 +351,21 @@ TEST(ReductionTest, BatchesGrowFromTheWorstCaseToWhatStationsSee) {
   EXPECT_GT(*std::max_element(sizes.begin(), sizes.end()), 1u);
   EXPECT_EQ(run->initial.loss, reference->initial.loss);
   EXPECT_EQ(run->removed, reference->removed);
+}
+
+// The reduction's evaluation, here and on a peer computing a shard of it: the plan's scanner and
+// threads over all faces, each station's sparse values kept and not the face values.
+TEST(ReductionTest, StationsAreEvaluatedWithThePlansScannerKeepingTheirSparseValues) {
+  PlanOptions options;
+  options.threads = 3;
+  options.scanner.max_range_m = 12;
+  const EvaluateOptions e = ReductionEvaluateOptions(options);
+  EXPECT_EQ(e.threads, 3);
+  EXPECT_EQ(e.scanner.max_range_m, 12);
+  EXPECT_EQ(e.faces, FaceSet::kAll);
+  EXPECT_EQ(e.sample_faces, 0u);
+  EXPECT_TRUE(e.keep_sparse_per_viewpoint_values);
+  EXPECT_FALSE(e.keep_face_values);
 }
 
 }  // namespace

@@ -254,6 +254,17 @@ TEST(ComputeVisibilitySetsTest, TaskPerViewpointSetsMatchTheOracle) {
   EXPECT_EQ(sets->back().count(), 0u);  // the viewpoint inside an occupied voxel sees nothing
 }
 
+TEST(CheckSetBytesTest, SetsOverTheLimitAreRefusedNamingWhatToChange) {
+  const uint64_t limit = uint64_t{4} << 20;
+  EXPECT_TRUE(CheckSetBytes(uint64_t{1} << 40, 3, 1000, 0).ok()) << "0 = no limit";
+  EXPECT_TRUE(CheckSetBytes(limit, 3, 1000, limit).ok()) << "at the limit";
+  EXPECT_EQ(
+      CheckSetBytes(limit + 1, 3, 1000, limit),
+      ResourceExhaustedError("the visibility sets of 3 positions x 1000 occupied voxels need more than 4 MiB even "
+                             "where kept sparse; raise grid_spacing_m or resolution_m, lower max_range_m, or "
+                             "raise the memory budget"));
+}
+
 TEST(VoxelSetTest, ResizeKeepsBitsBelowTheSizeAndClearsTheRest) {
   VoxelSet s(130);
   for (size_t i : {0, 63, 64, 100, 129}) s.set(i);

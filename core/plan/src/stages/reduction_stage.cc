@@ -17,6 +17,13 @@ ReductionOutput KeepAllStations(size_t count) {
   return out;
 }
 
+EvaluateOptions ReductionEvaluateOptions(const PlanOptions& options) {
+  EvaluateOptions eval_options = StationEvaluateOptions(options);
+  eval_options.keep_face_values = false;
+  eval_options.keep_sparse_per_viewpoint_values = true;
+  return eval_options;
+}
+
 // Reduction on every station's V of every face it sees. Stations are evaluated a batch at a time
 // into sparse values (what each sees), which RunReduction keeps while they fit the cache budget
 // (otherwise it asks for them again after each removal). When all stations fit one batch, that
@@ -33,10 +40,8 @@ Result<ReductionOutput> RunReductionStage(const ReductionInput& in, const PlanOp
     std::vector<WorldPoint> positions;
     positions.reserve(batch.size());
     for (int s : batch) positions.push_back(stations[s]);
-    EvaluateOptions eval_options = StationEvaluateOptions(options);
-    eval_options.keep_sparse_per_viewpoint_values = true;
+    EvaluateOptions eval_options = ReductionEvaluateOptions(options);
     if (in.face_values) {  // across replicas
-      eval_options.keep_face_values = false;
       VC_ASSIGN_OR_RETURN(DistributedFaceValues d, in.face_values(in.scene, positions, eval_options, sub));
       if (d.values.size() != positions.size()) {
         return InternalError("the distributed reduction returned face values of " + std::to_string(d.values.size()) +

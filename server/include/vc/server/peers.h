@@ -8,7 +8,9 @@
 // whose peer fails is retired and its shard goes back to the others, so a peer that dies costs
 // time, not the plan: this replica alone can always finish. The sets are the same whoever
 // computes them (the computation is deterministic, and each peer's voxelization is checked
-// against this replica's by SceneFingerprint), so the plan is the single-replica plan.
+// against this replica's by SceneFingerprint), so the plan is the single-replica plan. The rules
+// for shards and lanes are ShardBoard's and LaneRetryPolicy's (shard_board.h); peers.cc holds the
+// gRPC lanes, the DNS lookup and the glue.
 //
 // Peers are --peers addresses and every address --peers-dns resolves to, resolved again for each
 // plan; a peer whose PeerHello answers with this replica's own id is this replica and is skipped.
@@ -56,7 +58,8 @@ class PeerFanOut {
 
   // The faces with V > 0 of each of `stations` on `scene`, exactly as vc::Evaluate(scene, stations,
   // options, ctx) with keep_sparse_per_viewpoint_values gives them (the reduction's evaluation);
-  // `options` must be what the plan's `parameters` make (peers rebuild them from those).
+  // `options` must be planner::ReductionEvaluateOptions of the plan's options (peers rebuild them
+  // from `parameters`).
   Result<DistributedFaceValues> ComputeFaceValues(const SceneRef& ref, const v1::PlanParameters& parameters,
                                                   const VoxelScene& scene, const std::vector<WorldPoint>& stations,
                                                   const EvaluateOptions& options, const JobContext& ctx);

@@ -7,6 +7,8 @@
 #include <vector>
 
 #include "vc/base/status.h"
+#include "vc/plan/evaluate_job.h"
+#include "vc/plan/plan_options.h"
 #include "vc/scene/scene_input.h"
 #include "vc/scene/voxel_scene.h"
 
@@ -77,5 +79,11 @@ struct ServerOptions {
   // Whether plans fan out (peers or peers_dns given).
   bool HasPeers() const { return !peers.empty() || !peers_dns.empty(); }
 };
+
+// A job's options within this server's limits: the memory budget capped at
+// max_memory_budget_bytes, the threads at the per-job share (0 = the share); then validated.
+// INVALID_ARGUMENT for negative threads (before any other check), or from options.Validate().
+[[nodiscard]] Result<PlanOptions> ApplyServerLimits(const ServerOptions& server, PlanOptions options);
+[[nodiscard]] Result<EvaluateJobOptions> ApplyServerLimits(const ServerOptions& server, EvaluateJobOptions options);
 
 }  // namespace vc::server

@@ -163,6 +163,10 @@ struct ReductionOutput {
 // Stations the reduction evaluates at once (each call of vc::Evaluate pays for the scene's
 // lattice and face groups once, ~3 s on a 6.8 M-voxel site).
 inline constexpr int kReductionStationsPerBatch = 256;
+// What the reduction evaluates stations with (here, and on a peer computing a shard of them):
+// StationEvaluateOptions keeping each station's sparse values (faces with V > 0), not the face
+// values (the stage keeps those too when one evaluation covers every station).
+[[nodiscard]] EvaluateOptions ReductionEvaluateOptions(const PlanOptions& options);
 // Every one of `count` stations kept, nothing evaluated: the output when reduction does not run.
 [[nodiscard]] ReductionOutput KeepAllStations(size_t count);
 // Errors of Evaluate and RunReduction (CANCELLED / DEADLINE_EXCEEDED from ctx).

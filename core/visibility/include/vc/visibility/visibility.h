@@ -135,6 +135,11 @@ struct VisibilitySetsOptions {
 Result<std::vector<VoxelSet>> ComputeVisibilitySets(const VoxelScene& scene, const std::vector<WorldPoint>& viewpoints,
                                                     const VisibilitySetsOptions& options, const JobContext& ctx = {});
 
+// RESOURCE_EXHAUSTED when the visibility sets of `positions` viewpoints over `voxels` occupied
+// voxels take `set_bytes`, more than `max_set_bytes` (0 = no limit): ComputeVisibilitySets' check
+// of VisibilitySetsOptions::max_set_bytes, for sets computed elsewhere too.
+[[nodiscard]] Status CheckSetBytes(uint64_t set_bytes, uint64_t positions, uint64_t voxels, uint64_t max_set_bytes);
+
 // Per-viewpoint and overall figures of s.6.
 struct VisibilityFigures {
   double global_visibility = 0;           // G = mean over faces of the (best) V
