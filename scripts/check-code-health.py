@@ -6,11 +6,11 @@
      bench/ and fuzz/. Tests are exempt: a TEST body is a script, not an abstraction.
   2. Every repository path named in a tracked source, script or doc exists (a path is a word that
      starts with one of the top-level folders, e.g. `core/plan/src/route.cc` or `docs/PLANNING.md`;
-     globs like `tests/core/*_test.cc` are matched as globs; `build/...` and `../shared/...` are
+     globs like `tests/core/*/*_test.cc` are matched as globs; `build/...` and `../shared/...` are
      outputs and data, not checked).
-  3. Every public header has a mirrored test (core/<layer>/include/vc/<layer>/x.h ->
-     tests/core/<layer>/x_test.cc; server/include/vc/server/x.h -> tests/server/x_test.cc; client/ ->
-     tests/client/; proto/include/vc/wire/x.h -> tests/proto/x_test.cc) or a line in
+  3. Every public header has a mirrored test (core/<layer>/include/vc/<layer>/<x>.h ->
+     tests/core/<layer>/<x>_test.cc; server/include/vc/server/<x>.h -> tests/server/<x>_test.cc;
+     client/ -> tests/client/; proto/include/vc/wire/<x>.h -> tests/proto/<x>_test.cc) or a line in
      scripts/header-test-exemptions.txt saying why not.
 
 The function scanner strips comments, strings and raw strings, then matches braces; a brace opens a
