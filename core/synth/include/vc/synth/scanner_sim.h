@@ -12,12 +12,16 @@
 // meets returns one point at the measured range (true range + Gaussian noise along the beam), no
 // intensity, no multiple returns, every surface is opaque and returns (no reflectance, no incidence
 // limit). A surface nearer than min_range_m blocks the beam and returns nothing, as in a real
-// instrument. Beams are laid on a regular azimuth x elevation grid; the noise and the dropout of a
-// beam depend only on the seed and the beam's index, so the same options give the same points.
+// instrument. Beams are laid on a regular azimuth x elevation grid (at +-90 deg elevation every
+// azimuth's beam points the same way, as a real scanner's do near its poles); the noise and the
+// dropout of a beam depend only on the seed and the beam's index, so the same options give the same
+// points.
 //
-// Cost: beams x primitives ray tests, a linear scan (no acceleration structure), which is fine for
-// tens of primitives: a 0.1 deg step over 360 x 180 deg is 3600 x 1801 = 6.5e6 beams, a few seconds
-// on RoomWithClutterScene; tests use 0.5-2 deg steps. More than kMaxSimulatedBeams is refused.
+// Cost: beams x primitives ray tests, a linear scan on one thread (no acceleration structure), which
+// is fine for tens of primitives: a 0.1 deg step over 360 x 180 deg is 3600 x 1801 = 6.5e6 beams,
+// about 3 s of CPU on RoomWithClutterScene's 21 primitives, and 16 bytes of output per point; tests
+// use 0.25-1 deg steps. More than kMaxSimulatedBeams is refused. For hundreds of primitives, add a
+// BVH or a uniform grid in front of IntersectScene.
 //
 // Thread-safety: all functions are pure and may be called concurrently.
 #pragma once
@@ -108,6 +112,7 @@ struct SceneHit {
 
 // The nearest surface point origin_m + t * direction on the scene with min_distance_m < t <=
 // max_distance_m; direction must be unit length; the scene must be valid (ValidateScene). Nullopt if none.
+// Prepares the scene on each call (O(primitives)); SimulateScan prepares it once per scan.
 std::optional<SceneHit> IntersectScene(const AnalyticScene& scene, const WorldPoint& origin_m,
                                        const Eigen::Vector3d& direction, double min_distance_m, double max_distance_m);
 
