@@ -279,8 +279,43 @@ TEST(ScannerSimTest, AngularDensityMatchesTheStep) {
     scanner.horizontal_step_deg = scanner.vertical_step_deg = step_deg;
     const SimulatedScan scan = Scan(*plane, scanner);
     const double expected = ExpectedHeadOnCount(4.0, 3.0, step_deg);
-    EXPECT_NEAR(static_cast<double>(scan.points_m.size()) / expected, 1.0, 0.03) << step_deg;
+    EXPECT_NEAR(static_cast<double>(scan.points_m.size()) / expected, 1.0, 0.01) << step_deg;
   }
+}
+
+// Beams of a step_deg grid that meet TiltedPlaneScene(tilt_deg, distance_m, side_m), from a surface
+// integral: a patch dA at p subtends dOmega = cos(incidence) dA / |p|^2, and the grid holds
+// dOmega / (cos(elevation) step^2) beams per patch.
+double ExpectedTiltedCount(double tilt_deg, double distance_m, double side_m, double step_deg) {
+  const Eigen::Vector3d normal(std::cos(Radians(tilt_deg)), std::sin(Radians(tilt_deg)), 0.0);
+  const Eigen::Vector3d across(-normal.y(), normal.x(), 0.0);
+  const int n = 400;
+  const double cell = side_m / n;
+  double beams = 0.0;
+  for (int i = 0; i < n; ++i) {
+    for (int j = 0; j < n; ++j) {
+      const Eigen::Vector3d p = Eigen::Vector3d(distance_m, 0, 0) + (-0.5 * side_m + (i + 0.5) * cell) * across +
+                                Eigen::Vector3d(0, 0, -0.5 * side_m + (j + 0.5) * cell);
+      const double r = p.norm();
+      const double cos_incidence = std::abs(normal.dot(p)) / r;
+      const double cos_elevation = p.head<2>().norm() / r;
+      beams += cos_incidence * cell * cell / (r * r * cos_elevation);
+    }
+  }
+  return beams / (Radians(step_deg) * Radians(step_deg));
+}
+
+TEST(ScannerSimTest, AngularDensityOnTiltedPlanesMatchesTheStep) {
+  for (double tilt_deg : {0.0, 30.0, 60.0}) {
+    Result<AnalyticScene> plane = TiltedPlaneScene(tilt_deg, 3.0, 4.0);
+    ASSERT_TRUE(plane.ok());
+    SimulatedScanner scanner;
+    scanner.horizontal_step_deg = scanner.vertical_step_deg = 0.25;
+    const SimulatedScan scan = Scan(*plane, scanner);
+    const double expected = ExpectedTiltedCount(tilt_deg, 3.0, 4.0, 0.25);
+    EXPECT_NEAR(static_cast<double>(scan.points_m.size()) / expected, 1.0, 0.01) << tilt_deg;
+  }
+  EXPECT_NEAR(ExpectedTiltedCount(0.0, 3.0, 4.0, 0.5) / ExpectedHeadOnCount(4.0, 3.0, 0.5), 1.0, 1e-3);
 }
 
 TEST(ScannerSimTest, TiltedPlanePointsLieOnTheTiltedPlane) {
