@@ -464,7 +464,7 @@ AnalyticScene RoomWithClutterScene() {
   const Eigen::Vector3d x(1, 0, 0), y(0, 1, 0), z(0, 0, 1);
   add(Rectangle({4, 3, 0}, 4 * x, 3 * y));      // floor
   add(Rectangle({4, 3, 3}, 4 * x, 3 * y));      // ceiling
-  add(Rectangle({0, 3, 1.5}, 3 * y, 1.5 * z));  // walls
+  add(Rectangle({0, 3, 1.5}, 3 * y, 1.5 * z));  // walls x = 0, x = 8, y = 0, y = 6
   add(Rectangle({8, 3, 1.5}, 3 * y, 1.5 * z));
   add(Rectangle({4, 0, 1.5}, 4 * x, 1.5 * z));
   add(Rectangle({4, 6, 1.5}, 4 * x, 1.5 * z));
@@ -475,11 +475,12 @@ AnalyticScene RoomWithClutterScene() {
     }
   }
   add(SceneCylinder{{5.5, 4.2, 0.0}, {5.5, 4.2, 3.0}, 0.2});  // column
-  for (const SceneBox& step : StairFlight({.foot_m = {1.0, 5.5, 0.0}, .step_count = 6, .run_m = 0.3, .width_m = 0.9})) {
-    add(step);
-  }
-  add(SceneCylinder{{1.0, 5.05, 0.9}, {2.8, 5.05, 0.9 + 6 * 0.18}, 0.02});  // handrail along the stairs
-  add(SceneCylinder{{0.5, 1.0, 1.0}, {3.5, 1.0, 1.0}, 0.01});               // thin rail
+  const StairOptions stairs{.foot_m = {1.0, 5.5, 0.0}, .step_count = 6, .run_m = 0.3, .width_m = 0.9};
+  for (const SceneBox& step : StairFlight(stairs)) add(step);
+  const WorldPoint handrail_foot = stairs.foot_m + Eigen::Vector3d(0.0, -0.5 * stairs.width_m, 0.9);
+  add(SceneCylinder{handrail_foot,
+                    handrail_foot + stairs.step_count * Eigen::Vector3d(stairs.run_m, 0.0, stairs.rise_m), 0.02});
+  add(SceneCylinder{{0.5, 1.0, 1.0}, {3.5, 1.0, 1.0}, 0.01});  // thin rail
   const double lean = Radians(30.0);
   add(Rectangle({8.0 - 0.75 * std::sin(lean), 1.5, 0.75 * std::cos(lean)}, 0.5 * y,
                 0.75 * Eigen::Vector3d(std::sin(lean), 0.0, std::cos(lean))));  // board leaning on the wall x = 8
