@@ -168,83 +168,83 @@ struct Ray {
   Eigen::Vector3d direction;  // unit, as OctoMap normalises it (float)
 };
 
-}  // namespace
-
-int main(int argc, char** argv) {
-  CLI::App app{"vc-bench: end-to-end and ray-casting benchmarks against OctoMap"};
+// The command line.
+struct BenchOptions {
   std::string scene = "hall";
   double spacing = 0.05, resolution = 0.1, grid = 1.0;
   int rays = 200000, octomap_rays = 20000, threads = 2, repeat = 5;
   bool quick = false, scaling = true, rays_only = false, fine_eval = false, all_targets = false, sets = true;
   bool visibility_only = false;
   int every = 4;
-  app.add_option("--scene", scene, "synthetic scene spec (hall, box, comb:5, ...) or a file path");
-  app.add_option("--spacing", spacing, "point spacing of synthetic scenes, m");
-  app.add_option("--resolution", resolution, "working resolution, m");
-  app.add_option("--grid", grid, "candidate grid spacing, m");
-  app.add_option("--rays", rays, "rays for our traversal");
-  app.add_option("--octomap-rays", octomap_rays, "rays (a prefix of ours) for OctoMap castRay");
-  app.add_option("--threads", threads, "worker threads for the plan");
-  app.add_option("--repeat", repeat, "interleaved timing rounds of the ray engines (medians are printed)")
+};
+
+void AddFlags(CLI::App& app, BenchOptions* o) {
+  app.add_option("--scene", o->scene, "synthetic scene spec (hall, box, comb:5, ...) or a file path");
+  app.add_option("--spacing", o->spacing, "point spacing of synthetic scenes, m");
+  app.add_option("--resolution", o->resolution, "working resolution, m");
+  app.add_option("--grid", o->grid, "candidate grid spacing, m");
+  app.add_option("--rays", o->rays, "rays for our traversal");
+  app.add_option("--octomap-rays", o->octomap_rays, "rays (a prefix of ours) for OctoMap castRay");
+  app.add_option("--threads", o->threads, "worker threads for the plan");
+  app.add_option("--repeat", o->repeat, "interleaved timing rounds of the ray engines (medians are printed)")
       ->check(CLI::Range(1, 1000));
-  app.add_flag("--quick", quick, "small scene, few rays, no scaling tables (CI)");
-  app.add_flag("!--no-scaling", scaling, "skip the scaling tables");
-  app.add_flag("!--no-sets", sets, "skip the three full visibility-set computations after the plan");
-  app.add_flag("--rays-only", rays_only, "only the ray comparison with OctoMap");
-  app.add_flag("--visibility-only", visibility_only,
+  app.add_flag("--quick", o->quick, "small scene, few rays, no scaling tables (CI)");
+  app.add_flag("!--no-scaling", o->scaling, "skip the scaling tables");
+  app.add_flag("!--no-sets", o->sets, "skip the three full visibility-set computations after the plan");
+  app.add_flag("--rays-only", o->rays_only, "only the ray comparison with OctoMap");
+  app.add_flag("--visibility-only", o->visibility_only,
                "only the grouped visibility sets of every --every-th candidate and the exact evaluation of 15 "
                "candidates, best of --repeat rounds (A/B runs of two builds)");
-  app.add_option("--every", every, "with --visibility-only: every how many candidates")->check(CLI::Range(1, 1000000));
-  app.add_flag("--all-targets", all_targets, "also time the SIMD batch kernel on every other instruction set");
-  app.add_flag("--fine-eval", fine_eval,
+  app.add_option("--every", o->every, "with --visibility-only: every how many candidates")
+      ->check(CLI::Range(1, 1000000));
+  app.add_flag("--all-targets", o->all_targets, "also time the SIMD batch kernel on every other instruction set");
+  app.add_flag("--fine-eval", o->fine_eval,
                "only the fine evaluation: the hall sampled at 0.005 m, a 10-station plan evaluated at 0.01 m "
                "by sampling to a 95 % interval of +-0.5 %");
-  CLI11_PARSE(app, argc, argv);
-  std::setvbuf(stdout, nullptr, _IOLBF, 0);  // figures appear as they are measured
-  if (fine_eval) return FineEvaluation(threads);
-  if (quick) {
-    scene = "rooms:3";
-    rays = 20000;
-    octomap_rays = 2000;
-    scaling = false;
-    repeat = 1;
-  }
+}
 
-  std::printf("vc-bench: scene %s, resolution %.3f m, candidate grid %.2f m, %d threads (hardware: %u)\n",
-              scene.c_str(), resolution, grid, threads, std::thread::hardware_concurrency());
+// --quick: a small scene, few rays, one round, no scaling tables.
+void ApplyQuick(BenchOptions* o) {
+  o->scene = "rooms:3";
+  o->rays = 20000;
+  o->octomap_rays = 2000;
+  o->scaling = false;
+  o->repeat = 1;
+}
+
+// The scene as read and as voxelised for the benchmarks.
+struct LoadedScene {
+  vc::SceneInput input;
+  vc::VoxelizeOptions voxelize;
+  vc::VoxelScene voxels;
+};
+
+// Loads and voxelises the scene and prints its size and the seconds each step took.
+vc::Result<LoadedScene> LoadAndVoxelize(const BenchOptions& o) {
   auto t0 = Clock::now();
-  auto input = LoadScene(scene, spacing, 1);
-  if (!input.ok()) {
-    std::fprintf(stderr, "vc-bench: %s\n", input.status().ToString().c_str());
-    return 2;
-  }
+  VC_ASSIGN_OR_RETURN(vc::SceneInput input, LoadScene(o.scene, o.spacing, 1));
   const double load_s = Seconds(t0);
   vc::VoxelizeOptions vo;
-  vo.resolution_m = input->octree ? 0.0 : resolution;
+  vo.resolution_m = input.octree ? 0.0 : o.resolution;
   t0 = Clock::now();
-  auto vs = vc::Voxelize(*input, vo);
-  if (!vs.ok()) {
-    std::fprintf(stderr, "vc-bench: %s\n", vs.status().ToString().c_str());
-    return 2;
-  }
+  VC_ASSIGN_OR_RETURN(vc::VoxelScene s, vc::Voxelize(input, vo));
   const double vox_s = Seconds(t0);
-  const vc::VoxelScene& s = *vs;
   std::printf("scene: %zu points, %zu occupied voxels at %.3f m, grid %.1f MiB; load %.2f s, voxelise %.2f s\n",
-              input->points.size(), s.occupied.size(), s.resolution_m, double(s.grid.memory_bytes()) / (1 << 20),
-              load_s, vox_s);
-  if (visibility_only) return VisibilityOnly(s, grid, every, threads, repeat);
+              input.points.size(), s.occupied.size(), s.resolution_m, double(s.grid.memory_bytes()) / (1 << 20), load_s,
+              vox_s);
+  return LoadedScene{std::move(input), vo, std::move(s)};
+}
 
-  // ---- Rays: identical for both ----
-  auto tree = input->octree ? std::const_pointer_cast<octomap::OcTree>(input->octree)
-                            : vc::BuildOctree(s.resolution_m, s.occupied);
+// `count` rays from random free points of the scene's bounds to random occupied voxel centres
+// (the same rays on every run).
+std::vector<Ray> MakeRays(const vc::VoxelScene& s, int count) {
   const vc::WorldPoint lo = s.BoundsMin(), hi = s.BoundsMax();
-  const double length = (hi - lo).norm();
   std::mt19937_64 rng(2014);
   std::uniform_real_distribution<double> ux(lo.x(), hi.x()), uy(lo.y(), hi.y()), uz(lo.z(), hi.z());
   std::uniform_int_distribution<size_t> pick(0, s.occupied.size() - 1);
   std::vector<Ray> ray_set;
-  ray_set.reserve(rays);
-  while (int(ray_set.size()) < rays) {
+  ray_set.reserve(count);
+  while (int(ray_set.size()) < count) {
     const Eigen::Vector3f o(float(ux(rng)), float(uy(rng)), float(uz(rng)));
     if (s.grid.Occupied(s.grid.WorldToIndex(o.cast<double>()))) continue;
     const Eigen::Vector3f target = s.Center(pick(rng)).cast<float>();
@@ -254,139 +254,222 @@ int main(int argc, char** argv) {
     d /= d.norm();
     ray_set.push_back({o.cast<double>(), d.cast<double>()});
   }
-  // Each ray as an index-space segment, the input of both of our kernels.
-  std::vector<Eigen::Vector3d> seg_a(ray_set.size()), seg_b(ray_set.size());
+  return ray_set;
+}
+
+// Each ray as an index-space segment of `length_m`, the input of both of our kernels.
+struct Segments {
+  std::vector<Eigen::Vector3d> a, b;
+};
+
+Segments ToSegments(const vc::VoxelScene& s, const std::vector<Ray>& ray_set, double length_m) {
+  Segments seg{std::vector<Eigen::Vector3d>(ray_set.size()), std::vector<Eigen::Vector3d>(ray_set.size())};
   for (size_t i = 0; i < ray_set.size(); ++i) {
-    seg_a[i] = ray_set[i].origin * s.grid.inv_resolution();
-    seg_b[i] = (ray_set[i].origin + ray_set[i].direction * length) * s.grid.inv_resolution();
+    seg.a[i] = ray_set[i].origin * s.grid.inv_resolution();
+    seg.b[i] = (ray_set[i].origin + ray_set[i].direction * length_m) * s.grid.inv_resolution();
   }
-  // The three engines are timed in `repeat` interleaved rounds (OctoMap, FirstOccupied, the batch
-  // kernel, then again), so that a slow spell of this shared machine hits all of them alike; each
-  // rate is the median over the rounds, and so is the ratio of each round's rates.
-  const int m = std::min<int>(octomap_rays, int(ray_set.size()));
-  std::vector<std::optional<vc::VoxelIndex>> ours(ray_set.size()), batch(ray_set.size());
-  std::vector<vc::CastRayOutcome> theirs(m);
+  return seg;
+}
+
+// What the three ray engines found, and their rates (rays/s) and ratios to OctoMap per round.
+struct RayRounds {
+  std::vector<vc::CastRayOutcome> theirs;  // the first `m` rays only
+  std::vector<std::optional<vc::VoxelIndex>> ours, batch;
   size_t rechecked = 0;
   std::string batch_target;
   std::vector<double> theirs_r, ours_r, batch_r, ours_x, batch_x;
+};
+
+// The three engines are timed in `repeat` interleaved rounds (OctoMap, FirstOccupied, the batch
+// kernel, then again), so that a slow spell of this shared machine hits all of them alike; each
+// rate is the median over the rounds, and so is the ratio of each round's rates.
+RayRounds TimeRayEngines(const vc::VoxelScene& s, const octomap::OcTree& tree, const std::vector<Ray>& ray_set,
+                         const Segments& seg, int m, double length_m, int repeat) {
+  RayRounds r;
+  r.ours.resize(ray_set.size());
+  r.batch.resize(ray_set.size());
+  r.theirs.resize(m);
   for (int round = 0; round < repeat; ++round) {
+    auto t0 = Clock::now();
+    for (int i = 0; i < m; ++i)
+      r.theirs[i] = vc::OctomapCastRay(tree, ray_set[i].origin, ray_set[i].direction, length_m);
+    r.theirs_r.push_back(double(m) / Seconds(t0));
     t0 = Clock::now();
-    for (int i = 0; i < m; ++i) theirs[i] = vc::OctomapCastRay(*tree, ray_set[i].origin, ray_set[i].direction, length);
-    theirs_r.push_back(double(m) / Seconds(t0));
-    t0 = Clock::now();
-    for (size_t i = 0; i < ray_set.size(); ++i) ours[i] = vc::FirstOccupied(s.grid, seg_a[i], seg_b[i]);
-    ours_r.push_back(double(ray_set.size()) / Seconds(t0));
+    for (size_t i = 0; i < ray_set.size(); ++i) r.ours[i] = vc::FirstOccupied(s.grid, seg.a[i], seg.b[i]);
+    r.ours_r.push_back(double(ray_set.size()) / Seconds(t0));
     // The same segments through the SIMD batch kernel (one ray per lane, target chosen at run time).
     t0 = Clock::now();
-    batch_target = vc::FirstOccupiedBatch(s.grid, seg_a, seg_b, batch, vc::BatchKernel::kAuto, &rechecked);
-    batch_r.push_back(double(ray_set.size()) / Seconds(t0));
-    ours_x.push_back(ours_r.back() / theirs_r.back());
-    batch_x.push_back(batch_r.back() / theirs_r.back());
+    r.batch_target = vc::FirstOccupiedBatch(s.grid, seg.a, seg.b, r.batch, vc::BatchKernel::kAuto, &r.rechecked);
+    r.batch_r.push_back(double(ray_set.size()) / Seconds(t0));
+    r.ours_x.push_back(r.ours_r.back() / r.theirs_r.back());
+    r.batch_x.push_back(r.batch_r.back() / r.theirs_r.back());
   }
+  return r;
+}
+
+// The lanes kernel on every instruction set compiled in and supported here, forced through
+// Highway's test mock: what the lanes would give on a CPU without the best one. The best one is
+// skipped when the rounds already used its lanes. Prints a table row each; returns how many differ.
+int TimeForcedTargets(const vc::VoxelScene& s, const Segments& seg, const RayRounds& r, double theirs_rps) {
+  int forced_differ = 0;
+  const std::vector<int64_t> targets = hwy::SupportedAndGeneratedTargets();
+  for (size_t k = r.batch_target.ends_with(" lanes") ? 1 : 0; k < targets.size(); ++k) {
+    hwy::SetSupportedTargetsForTest(targets[k]);
+    std::vector<std::optional<vc::VoxelIndex>> forced(seg.a.size());
+    const auto t0 = Clock::now();
+    const std::string name = vc::FirstOccupiedBatch(s.grid, seg.a, seg.b, forced, vc::BatchKernel::kLanes);
+    const double rps = double(seg.a.size()) / Seconds(t0);
+    const bool same = forced == r.ours;
+    std::printf("| vc FirstOccupiedBatch (%s, forced) | %zu | %.0f | %.1fx | one round |%s\n", name.c_str(),
+                seg.a.size(), rps, rps / theirs_rps, same ? "" : " DIFFERENT");
+    forced_differ += !same;
+  }
+  hwy::SetSupportedTargetsForTest(0);
+  return forced_differ;
+}
+
+// OctoMap castRay, FirstOccupied and the batch kernel on identical rays: prints the rates and the
+// identity checks; returns the number of rays where the engines disagree.
+int CompareRays(const vc::VoxelScene& s, const octomap::OcTree& tree, const BenchOptions& o) {
+  const double length = (s.BoundsMax() - s.BoundsMin()).norm();
+  const std::vector<Ray> ray_set = MakeRays(s, o.rays);
+  const Segments seg = ToSegments(s, ray_set, length);
+  const int m = std::min<int>(o.octomap_rays, int(ray_set.size()));
+  const RayRounds r = TimeRayEngines(s, tree, ray_set, seg, m, length, o.repeat);
   size_t batch_differ = 0;
-  for (size_t i = 0; i < batch.size(); ++i) batch_differ += batch[i] != ours[i];
+  for (size_t i = 0; i < r.batch.size(); ++i) batch_differ += r.batch[i] != r.ours[i];
   int mismatches = 0, hits = 0;
   for (int i = 0; i < m; ++i) {
-    const bool hit = theirs[i].kind == vc::CastRayOutcome::Kind::kHitOccupied;
+    const bool hit = r.theirs[i].kind == vc::CastRayOutcome::Kind::kHitOccupied;
     hits += hit;
-    if (hit != ours[i].has_value() || (hit && vc::IndexToKey(*ours[i]) != theirs[i].hit)) ++mismatches;
+    if (hit != r.ours[i].has_value() || (hit && vc::IndexToKey(*r.ours[i]) != r.theirs[i].hit)) ++mismatches;
   }
-  const double theirs_rps = Median(theirs_r);
+  const double theirs_rps = Median(r.theirs_r);
   std::printf("\n## Rays (single core, identical rays; first occupied voxel; median of %d interleaved rounds)\n",
-              repeat);
+              o.repeat);
   std::printf("| engine | rays | rays/s | ratio per core | ratio, lowest-highest round |\n|---|---|---|---|---|\n");
   std::printf("| OctoMap castRay | %d | %.0f | 1.0 | |\n", m, theirs_rps);
-  std::printf("| vc FirstOccupied | %zu | %.0f | %.1fx | %.1f-%.1fx |\n", ray_set.size(), Median(ours_r),
-              Median(ours_x), *std::min_element(ours_x.begin(), ours_x.end()),
-              *std::max_element(ours_x.begin(), ours_x.end()));
-  std::printf("| vc FirstOccupiedBatch (%s) | %zu | %.0f | %.1fx | %.1f-%.1fx |\n", batch_target.c_str(),
-              ray_set.size(), Median(batch_r), Median(batch_x), *std::min_element(batch_x.begin(), batch_x.end()),
-              *std::max_element(batch_x.begin(), batch_x.end()));
-  int forced_differ = 0;
-  if (all_targets) {
-    // The lanes kernel on every instruction set compiled in and supported here, forced through
-    // Highway's test mock: what the lanes would give on a CPU without the best one. The best one
-    // is skipped when the run above already used its lanes.
-    const std::vector<int64_t> targets = hwy::SupportedAndGeneratedTargets();
-    for (size_t k = batch_target.ends_with(" lanes") ? 1 : 0; k < targets.size(); ++k) {
-      hwy::SetSupportedTargetsForTest(targets[k]);
-      std::vector<std::optional<vc::VoxelIndex>> forced(ray_set.size());
-      t0 = Clock::now();
-      const std::string name = vc::FirstOccupiedBatch(s.grid, seg_a, seg_b, forced, vc::BatchKernel::kLanes);
-      const double rps = double(ray_set.size()) / Seconds(t0);
-      const bool same = forced == ours;
-      std::printf("| vc FirstOccupiedBatch (%s, forced) | %zu | %.0f | %.1fx | one round |%s\n", name.c_str(),
-                  ray_set.size(), rps, rps / theirs_rps, same ? "" : " DIFFERENT");
-      forced_differ += !same;
-    }
-    hwy::SetSupportedTargetsForTest(0);
-  }
+  std::printf("| vc FirstOccupied | %zu | %.0f | %.1fx | %.1f-%.1fx |\n", ray_set.size(), Median(r.ours_r),
+              Median(r.ours_x), *std::min_element(r.ours_x.begin(), r.ours_x.end()),
+              *std::max_element(r.ours_x.begin(), r.ours_x.end()));
+  std::printf("| vc FirstOccupiedBatch (%s) | %zu | %.0f | %.1fx | %.1f-%.1fx |\n", r.batch_target.c_str(),
+              ray_set.size(), Median(r.batch_r), Median(r.batch_x),
+              *std::min_element(r.batch_x.begin(), r.batch_x.end()),
+              *std::max_element(r.batch_x.begin(), r.batch_x.end()));
+  const int forced_differ = o.all_targets ? TimeForcedTargets(s, seg, r, theirs_rps) : 0;
   std::printf("identity check on the %d shared rays: %d mismatches (%d hits) -> %s\n", m, mismatches, hits,
               mismatches == 0 ? "IDENTICAL" : "DIFFERENT");
   std::printf("batch: %zu of %zu rays had a near-tie (crossings within 2^-20) and were walked by FirstOccupied\n",
-              rechecked, ray_set.size());
+              r.rechecked, ray_set.size());
   std::printf("batch against FirstOccupied on all %zu rays: %zu differ -> %s\n", ray_set.size(), batch_differ,
               batch_differ == 0 ? "IDENTICAL" : "DIFFERENT");
-  mismatches += int(batch_differ) + forced_differ;
+  return mismatches + int(batch_differ) + forced_differ;
+}
 
-  if (rays_only) return mismatches == 0 ? 0 : 1;
+// A plan and its wall seconds (voxelisation included).
+struct TimedPlan {
+  std::optional<vc::PlanResult> plan;  // empty when it failed
+  double seconds = -1;                 // -1 when it failed
+};
 
-  // ---- Plan end to end ----
-  auto plan_once = [&](const vc::SceneInput& in, double grid_m, bool print) -> double {
-    vc::PlanOptions po;
-    po.resolution_m = in.octree ? 0.0 : resolution;
-    po.grid_spacing_m = grid_m;
-    po.threads = threads;
-    const auto start = Clock::now();
-    auto plan = vc::Plan(in, po);
-    const double total = Seconds(start);
-    if (!plan.ok()) {
-      std::printf("plan failed: %s\n", plan.status().ToString().c_str());
-      return -1;
-    }
-    if (print) {
-      std::printf("\n## End-to-end plan (%d threads)\n| stage | seconds |\n|---|---|\n", threads);
-      for (const auto& t : plan->timings)
-        std::printf("| %s | %.3f |\n", std::string(vc::StageName(t.stage)).c_str(), t.seconds);
-      std::printf("| total | %.3f |\n", plan->total_seconds);
-      std::printf("| **total (wall, incl. voxelise)** | **%.3f** |\n", total);
-      std::printf("%zu stations from %llu candidates; %llu occupied, %llu coverable, %llu covered voxels; G = %.4f\n",
-                  plan->stations.size(), (unsigned long long)plan->candidate_count,
-                  (unsigned long long)plan->occupied_voxels, (unsigned long long)plan->coverable_voxels,
-                  (unsigned long long)plan->covered_voxels, plan->evaluation.overall.global_visibility);
-      // The full visibility-set computation for both tests, on the plan's candidates; the surface
-      // test also per voxel (no face groups), the baseline of the grouped method.
-      for (int run = 0; run < (sets ? 3 : 0); ++run) {
-        vc::VisibilitySetsOptions vo2;
-        vo2.test = run == 2 ? vc::SelectionTest::kCompatibility : vc::SelectionTest::kSurfaceVisibility;
-        vo2.per_voxel = run == 1;
-        vo2.threads = threads;
-        const auto c0 = Clock::now();
-        auto sets = vc::ComputeVisibilitySets(s, plan->heat_map.positions, vo2);
-        std::printf("visibility sets (%s%s): %zu candidates x %zu voxels in %.3f s\n",
-                    std::string(vc::SelectionTestName(vo2.test)).c_str(), run == 1 ? ", per voxel" : "",
-                    plan->heat_map.positions.size(), s.occupied.size(), Seconds(c0));
-      }
-    }
-    return total;
-  };
-  plan_once(*input, grid, true);
-  std::printf("\npeak RSS: %.1f MiB\n", PeakRssMiB());
-
-  if (scaling && !input->octree) {
-    std::printf(
-        "\n## Scaling: footprint (candidate grid %.2f m)\n| footprint | occupied voxels | plan s |\n|---|---|---|\n",
-        grid);
-    for (int tiles : {1, 2, 4}) {
-      auto in = LoadScene(scene, spacing, tiles);
-      if (!in.ok()) continue;
-      auto v = vc::Voxelize(*in, vo);
-      const double secs = plan_once(*in, grid, false);
-      std::printf("| %dx | %zu | %.2f |\n", tiles, v.ok() ? v->occupied.size() : size_t{0}, secs);
-    }
-    std::printf("\n## Scaling: candidate spacing (footprint 1x)\n| spacing m | plan s |\n|---|---|\n");
-    for (double g : {2.0, 1.0, 0.5}) std::printf("| %.2f | %.2f |\n", g, plan_once(*input, g, false));
+// Plans `in` with the candidate grid `grid_m`; prints "plan failed" when it fails.
+TimedPlan RunPlan(const vc::SceneInput& in, const BenchOptions& o, double grid_m) {
+  vc::PlanOptions po;
+  po.resolution_m = in.octree ? 0.0 : o.resolution;
+  po.grid_spacing_m = grid_m;
+  po.threads = o.threads;
+  const auto start = Clock::now();
+  auto plan = vc::Plan(in, po);
+  const double total = Seconds(start);
+  if (!plan.ok()) {
+    std::printf("plan failed: %s\n", plan.status().ToString().c_str());
+    return {};
   }
+  return {std::move(plan).value(), total};
+}
+
+void PrintPlan(const vc::PlanResult& plan, double wall_s, int threads) {
+  std::printf("\n## End-to-end plan (%d threads)\n| stage | seconds |\n|---|---|\n", threads);
+  for (const auto& t : plan.timings)
+    std::printf("| %s | %.3f |\n", std::string(vc::StageName(t.stage)).c_str(), t.seconds);
+  std::printf("| total | %.3f |\n", plan.total_seconds);
+  std::printf("| **total (wall, incl. voxelise)** | **%.3f** |\n", wall_s);
+  std::printf("%zu stations from %llu candidates; %llu occupied, %llu coverable, %llu covered voxels; G = %.4f\n",
+              plan.stations.size(), (unsigned long long)plan.candidate_count, (unsigned long long)plan.occupied_voxels,
+              (unsigned long long)plan.coverable_voxels, (unsigned long long)plan.covered_voxels,
+              plan.evaluation.overall.global_visibility);
+}
+
+// The full visibility-set computation for both tests, on the plan's candidates; the surface test
+// also per voxel (no face groups), the baseline of the grouped method.
+void TimeVisibilitySets(const vc::VoxelScene& s, const std::vector<vc::WorldPoint>& candidates, int threads) {
+  for (int run = 0; run < 3; ++run) {
+    vc::VisibilitySetsOptions vo;
+    vo.test = run == 2 ? vc::SelectionTest::kCompatibility : vc::SelectionTest::kSurfaceVisibility;
+    vo.per_voxel = run == 1;
+    vo.threads = threads;
+    const auto c0 = Clock::now();
+    auto sets = vc::ComputeVisibilitySets(s, candidates, vo);
+    std::printf("visibility sets (%s%s): %zu candidates x %zu voxels in %.3f s\n",
+                std::string(vc::SelectionTestName(vo.test)).c_str(), run == 1 ? ", per voxel" : "", candidates.size(),
+                s.occupied.size(), Seconds(c0));
+  }
+}
+
+// Plan seconds against the footprint (1, 2 and 4 copies of the scene) and the candidate spacing.
+void PrintScaling(const LoadedScene& scene, const BenchOptions& o) {
+  std::printf(
+      "\n## Scaling: footprint (candidate grid %.2f m)\n| footprint | occupied voxels | plan s |\n|---|---|---|\n",
+      o.grid);
+  for (int tiles : {1, 2, 4}) {
+    auto in = LoadScene(o.scene, o.spacing, tiles);
+    if (!in.ok()) continue;
+    auto v = vc::Voxelize(*in, scene.voxelize);
+    const double secs = RunPlan(*in, o, o.grid).seconds;
+    std::printf("| %dx | %zu | %.2f |\n", tiles, v.ok() ? v->occupied.size() : size_t{0}, secs);
+  }
+  std::printf("\n## Scaling: candidate spacing (footprint 1x)\n| spacing m | plan s |\n|---|---|\n");
+  for (double g : {2.0, 1.0, 0.5}) std::printf("| %.2f | %.2f |\n", g, RunPlan(scene.input, o, g).seconds);
+}
+
+// The rays, the plan and the scaling tables (as the flags select); 0 when the ray engines agree.
+int RunBench(const BenchOptions& o) {
+  std::printf("vc-bench: scene %s, resolution %.3f m, candidate grid %.2f m, %d threads (hardware: %u)\n",
+              o.scene.c_str(), o.resolution, o.grid, o.threads, std::thread::hardware_concurrency());
+  auto loaded = LoadAndVoxelize(o);
+  if (!loaded.ok()) {
+    std::fprintf(stderr, "vc-bench: %s\n", loaded.status().ToString().c_str());
+    return 2;
+  }
+  const vc::SceneInput& input = loaded->input;
+  const vc::VoxelScene& s = loaded->voxels;
+  if (o.visibility_only) return VisibilityOnly(s, o.grid, o.every, o.threads, o.repeat);
+
+  auto tree = input.octree ? std::const_pointer_cast<octomap::OcTree>(input.octree)
+                           : vc::BuildOctree(s.resolution_m, s.occupied);
+  const int mismatches = CompareRays(s, *tree, o);
+  if (o.rays_only) return mismatches == 0 ? 0 : 1;
+
+  const TimedPlan timed = RunPlan(input, o, o.grid);
+  if (timed.plan) {
+    PrintPlan(*timed.plan, timed.seconds, o.threads);
+    if (o.sets) TimeVisibilitySets(s, timed.plan->heat_map.positions, o.threads);
+  }
+  std::printf("\npeak RSS: %.1f MiB\n", PeakRssMiB());
+  if (o.scaling && !input.octree) PrintScaling(*loaded, o);
   std::printf("\npeak RSS (all runs): %.1f MiB\n", PeakRssMiB());
   return mismatches == 0 ? 0 : 1;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"vc-bench: end-to-end and ray-casting benchmarks against OctoMap"};
+  BenchOptions o;
+  AddFlags(app, &o);
+  CLI11_PARSE(app, argc, argv);
+  std::setvbuf(stdout, nullptr, _IOLBF, 0);  // figures appear as they are measured
+  if (o.fine_eval) return FineEvaluation(o.threads);
+  if (o.quick) ApplyQuick(&o);
+  return RunBench(o);
 }

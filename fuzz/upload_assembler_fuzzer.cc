@@ -120,190 +120,237 @@ WorkerPool& Pool(int queue) {
   return queue == 0 ? pool0 : pool1;
 }
 
-void Run(Reader& in) {
-  const uint64_t max_upload = in.Byte();
-  const int queue = in.Byte() & 1;
-  WorkerPool& pool = Pool(queue);
-  const int capacity = kWorkers + queue;
-  CHECK(pool.admitted() == 0);
+// One input's state: the limit, the pool and the three calls.
+struct Session {
+  uint64_t max_upload = 0;
+  WorkerPool* pool = nullptr;
+  int capacity = 0;  // workers + queue
   std::array<Call, kSlots> calls;
 
-  const auto places = [&] {
+  // The places the live tickets hold: in an assembler, or held by the harness.
+  int places() const {
     int n = 0;
     for (const Call& c : calls) n += int(c.model.ticket) + int(c.held.has_value());
     return n;
-  };
-
-  while (!in.empty()) {
-    const uint8_t op = in.Byte();
-    Call& call = calls[(op >> 4) % kSlots];
-    Model& m = call.model;
-    const int admitted_before = pool.admitted();
-    switch ((op & 15) % 10) {
-      case 0:
-        call.assembler.reset();
-        call.assembler.emplace(max_upload, &pool);
-        m = Model{};
-        break;
-      case 1:
-        call.assembler.reset();
-        m = Model{};
-        break;
-      case 2: {
-        if (!call.assembler) break;
-        UploadAssembler& a = *call.assembler;
-        const uint8_t flags = in.Byte();
-        vc::v1::UploadSpec spec;
-        uint64_t size = 0;
-        switch ((flags >> 2) & 3) {
-          case 0:
-            size = in.Byte();
-            break;
-          case 1:
-            size = max_upload;
-            break;
-          case 2:
-            size = max_upload + 1;
-            break;
-          default:
-            size = in.Uint(8);
-            break;
-        }
-        spec.set_total_size_bytes(size);
-        const uint8_t f = in.Byte();
-        const int32_t format = f < 16 ? int32_t(f) : int32_t(uint32_t(in.Uint(4)));
-        spec.set_format(vc::v1::InputFormat(format));
-        std::string payload;
-        if (flags & 2) {
-          payload = in.Bytes(size_t(std::min<uint64_t>(size, 4096)));
-          spec.set_crc32c(ReferenceCrc32c(payload));
-        } else {
-          spec.set_crc32c(uint32_t(in.Uint(4)));
-        }
-        spec.set_source_name(in.Bytes(in.Byte() % 64));
-
-        const Status start = a.StartSpec();
-        CheckStatus(start);
-        CHECK(start.ok() == !m.started);
-        if (!start.ok()) {
-          CHECK(start.code() == StatusCode::kInvalidArgument);
-          break;
-        }
-        m.started = true;
-        CHECK(a.has_spec());
-        if (flags & 1) break;  // the RPC refused its own parameters (TakeSpec): no AcceptSpec
-
-        // Every value the enum names (E57 = 8 and vc-voxels = 9 came after this fuzzer).
-        const bool format_ok = vc::v1::InputFormat_IsValid(format);
-        const bool size_ok = size > 0 && size <= max_upload;
-        const bool room = admitted_before < capacity;
-        const Status s = a.AcceptSpec(spec);
-        CheckStatus(s);
-        CHECK(a.declared_bytes() == size);  // also after a refusal: the log line names it
-        if (!format_ok || size == 0) {
-          CHECK(s.code() == StatusCode::kInvalidArgument);
-        } else if (!size_ok || !room) {
-          CHECK(s.code() == StatusCode::kResourceExhausted);
-        } else {
-          CHECK(s.ok());
-        }
-        CHECK(a.busy() == (format_ok && size_ok && !room));
-        if (s.ok()) {
-          m.accepted = true;
-          m.ticket = true;
-          m.declared = size;
-          m.crc = spec.crc32c();
-          m.payload = std::move(payload);
-          CHECK(pool.admitted() == admitted_before + 1);
-        } else {
-          CHECK(pool.admitted() == admitted_before);  // a refused spec reserves no place
-        }
-        break;
-      }
-      case 3: {
-        if (!call.assembler) break;
-        UploadAssembler& a = *call.assembler;
-        const uint8_t b = in.Byte();
-        std::string chunk;
-        if ((b & 0x80) && m.payload_pos < m.payload.size()) {
-          const size_t left = m.payload.size() - m.payload_pos;
-          const size_t n = (b & 0x7f) == 0 ? left : std::min<size_t>(b & 0x7f, left);
-          chunk = m.payload.substr(m.payload_pos, n);
-          m.payload_pos += n;
-        } else {
-          chunk = in.Bytes(b & 0x7f);
-        }
-        if (m.data_taken) break;  // the call was submitted: no more chunks reach it
-        const Status s = a.AddChunk(chunk);
-        CheckStatus(s);
-        const bool fits = m.accepted && m.data.size() + chunk.size() <= m.declared;
-        CHECK(s.ok() == fits);
-        if (!s.ok()) CHECK(s.code() == StatusCode::kInvalidArgument);
-        if (s.ok()) m.data += chunk;
-        if (m.accepted) {
-          CHECK(a.data().size() <= a.declared_bytes());
-          CHECK(a.data() == m.data);
-        }
-        break;
-      }
-      case 4: {
-        if (!call.assembler || m.data_taken) break;
-        const Status s = call.assembler->Finish();
-        CheckStatus(s);
-        const bool complete = m.accepted && m.data.size() == m.declared;
-        const bool whole = complete && ReferenceCrc32c(m.data) == m.crc;
-        CHECK(s.ok() == whole);
-        if (s.ok()) {
-          CHECK(m.ticket || m.ticket_taken);  // the reactor submits *TakeTicket() next
-          m.finished = true;
-        } else {
-          CHECK(s.code() == (complete ? StatusCode::kDataLoss : StatusCode::kInvalidArgument));
-        }
-        break;
-      }
-      case 5:
-        if (!call.assembler || !m.finished || m.data_taken) break;
-        CHECK(call.assembler->TakeData() == m.data);
-        m.data_taken = true;
-        break;
-      case 6:
-      case 7: {
-        if (!call.assembler) break;
-        std::optional<WorkerPool::Ticket> t = call.assembler->TakeTicket();
-        CHECK(t.has_value() == m.ticket);
-        CHECK(!call.assembler->TakeTicket().has_value());
-        m.ticket = false;
-        m.ticket_taken = true;
-        if ((op & 15) % 10 == 6 && t) {
-          call.held = std::move(t);
-        }
-        break;
-      }
-      case 8:
-        if (call.held) {
-          call.held->Release();
-          call.held->Release();
-          CHECK(pool.admitted() == admitted_before - 1);
-          call.held.reset();
-        }
-        break;
-      case 9:
-        call.held.reset();
-        break;
-    }
-    for (const Call& c : calls) {
-      if (!c.assembler) continue;
-      CHECK(c.assembler->has_spec() == c.model.started);
-      if (c.model.accepted && !c.model.data_taken) CHECK(c.assembler->data().size() <= c.assembler->declared_bytes());
-    }
-    CHECK(pool.admitted() == places());
-    CHECK(pool.admitted() <= capacity);
   }
-  for (Call& c : calls) {
+};
+
+// A spec message as the input describes it (action 2), and the flags that say how to send it.
+struct SpecInput {
+  uint8_t flags = 0;
+  int32_t format = 0;
+  uint64_t size = 0;
+  vc::v1::UploadSpec spec;
+  std::string payload;  // matching the spec's CRC (flag bit 1), sent later by chunks
+};
+
+SpecInput ReadSpec(Reader& in, uint64_t max_upload) {
+  SpecInput s;
+  s.flags = in.Byte();
+  switch ((s.flags >> 2) & 3) {
+    case 0:
+      s.size = in.Byte();
+      break;
+    case 1:
+      s.size = max_upload;
+      break;
+    case 2:
+      s.size = max_upload + 1;
+      break;
+    default:
+      s.size = in.Uint(8);
+      break;
+  }
+  s.spec.set_total_size_bytes(s.size);
+  const uint8_t f = in.Byte();
+  s.format = f < 16 ? int32_t(f) : int32_t(uint32_t(in.Uint(4)));
+  s.spec.set_format(vc::v1::InputFormat(s.format));
+  if (s.flags & 2) {
+    s.payload = in.Bytes(size_t(std::min<uint64_t>(s.size, 4096)));
+    s.spec.set_crc32c(ReferenceCrc32c(s.payload));
+  } else {
+    s.spec.set_crc32c(uint32_t(in.Uint(4)));
+  }
+  s.spec.set_source_name(in.Bytes(in.Byte() % 64));
+  return s;
+}
+
+// Action 2: StartSpec, then AcceptSpec unless the RPC refused its own parameters.
+void SendSpec(Reader& in, Session& session, Call& call, int admitted_before) {
+  if (!call.assembler) return;
+  UploadAssembler& a = *call.assembler;
+  Model& m = call.model;
+  SpecInput input = ReadSpec(in, session.max_upload);
+
+  const Status start = a.StartSpec();
+  CheckStatus(start);
+  CHECK(start.ok() == !m.started);
+  if (!start.ok()) {
+    CHECK(start.code() == StatusCode::kInvalidArgument);
+    return;
+  }
+  m.started = true;
+  CHECK(a.has_spec());
+  if (input.flags & 1) return;  // the RPC refused its own parameters (TakeSpec): no AcceptSpec
+
+  // Every value the enum names (E57 = 8 and vc-voxels = 9 came after this fuzzer).
+  const bool format_ok = vc::v1::InputFormat_IsValid(input.format);
+  const bool size_ok = input.size > 0 && input.size <= session.max_upload;
+  const bool room = admitted_before < session.capacity;
+  const Status s = a.AcceptSpec(input.spec);
+  CheckStatus(s);
+  CHECK(a.declared_bytes() == input.size);  // also after a refusal: the log line names it
+  if (!format_ok || input.size == 0) {
+    CHECK(s.code() == StatusCode::kInvalidArgument);
+  } else if (!size_ok || !room) {
+    CHECK(s.code() == StatusCode::kResourceExhausted);
+  } else {
+    CHECK(s.ok());
+  }
+  CHECK(a.busy() == (format_ok && size_ok && !room));
+  if (s.ok()) {
+    m.accepted = true;
+    m.ticket = true;
+    m.declared = input.size;
+    m.crc = input.spec.crc32c();
+    m.payload = std::move(input.payload);
+    CHECK(session.pool->admitted() == admitted_before + 1);
+  } else {
+    CHECK(session.pool->admitted() == admitted_before);  // a refused spec reserves no place
+  }
+}
+
+// Action 3: a chunk of the payload or of the input.
+void SendChunk(Reader& in, Call& call) {
+  if (!call.assembler) return;
+  UploadAssembler& a = *call.assembler;
+  Model& m = call.model;
+  const uint8_t b = in.Byte();
+  std::string chunk;
+  if ((b & 0x80) && m.payload_pos < m.payload.size()) {
+    const size_t left = m.payload.size() - m.payload_pos;
+    const size_t n = (b & 0x7f) == 0 ? left : std::min<size_t>(b & 0x7f, left);
+    chunk = m.payload.substr(m.payload_pos, n);
+    m.payload_pos += n;
+  } else {
+    chunk = in.Bytes(b & 0x7f);
+  }
+  if (m.data_taken) return;  // the call was submitted: no more chunks reach it
+  const Status s = a.AddChunk(chunk);
+  CheckStatus(s);
+  const bool fits = m.accepted && m.data.size() + chunk.size() <= m.declared;
+  CHECK(s.ok() == fits);
+  if (!s.ok()) CHECK(s.code() == StatusCode::kInvalidArgument);
+  if (s.ok()) m.data += chunk;
+  if (m.accepted) {
+    CHECK(a.data().size() <= a.declared_bytes());
+    CHECK(a.data() == m.data);
+  }
+}
+
+// Action 4.
+void FinishUpload(Call& call) {
+  Model& m = call.model;
+  if (!call.assembler || m.data_taken) return;
+  const Status s = call.assembler->Finish();
+  CheckStatus(s);
+  const bool complete = m.accepted && m.data.size() == m.declared;
+  const bool whole = complete && ReferenceCrc32c(m.data) == m.crc;
+  CHECK(s.ok() == whole);
+  if (s.ok()) {
+    CHECK(m.ticket || m.ticket_taken);  // the reactor submits *TakeTicket() next
+    m.finished = true;
+  } else {
+    CHECK(s.code() == (complete ? StatusCode::kDataLoss : StatusCode::kInvalidArgument));
+  }
+}
+
+// Actions 6 (`hold`: the harness keeps the ticket) and 7.
+void TakeTicket(Call& call, bool hold) {
+  if (!call.assembler) return;
+  std::optional<WorkerPool::Ticket> t = call.assembler->TakeTicket();
+  CHECK(t.has_value() == call.model.ticket);
+  CHECK(!call.assembler->TakeTicket().has_value());
+  call.model.ticket = false;
+  call.model.ticket_taken = true;
+  if (hold && t) call.held = std::move(t);
+}
+
+// One action read from the input.
+void Step(Reader& in, Session& session) {
+  const uint8_t op = in.Byte();
+  Call& call = session.calls[(op >> 4) % kSlots];
+  Model& m = call.model;
+  const int admitted_before = session.pool->admitted();
+  switch ((op & 15) % 10) {
+    case 0:
+      call.assembler.reset();
+      call.assembler.emplace(session.max_upload, session.pool);
+      m = Model{};
+      break;
+    case 1:
+      call.assembler.reset();
+      m = Model{};
+      break;
+    case 2:
+      SendSpec(in, session, call, admitted_before);
+      break;
+    case 3:
+      SendChunk(in, call);
+      break;
+    case 4:
+      FinishUpload(call);
+      break;
+    case 5:
+      if (!call.assembler || !m.finished || m.data_taken) break;
+      CHECK(call.assembler->TakeData() == m.data);
+      m.data_taken = true;
+      break;
+    case 6:
+    case 7:
+      TakeTicket(call, (op & 15) % 10 == 6);
+      break;
+    case 8:
+      if (call.held) {
+        call.held->Release();
+        call.held->Release();
+        CHECK(session.pool->admitted() == admitted_before - 1);
+        call.held.reset();
+      }
+      break;
+    case 9:
+      call.held.reset();
+      break;
+  }
+}
+
+// What holds after every action.
+void CheckSession(const Session& session) {
+  for (const Call& c : session.calls) {
+    if (!c.assembler) continue;
+    CHECK(c.assembler->has_spec() == c.model.started);
+    if (c.model.accepted && !c.model.data_taken) CHECK(c.assembler->data().size() <= c.assembler->declared_bytes());
+  }
+  CHECK(session.pool->admitted() == session.places());
+  CHECK(session.pool->admitted() <= session.capacity);
+}
+
+void Run(Reader& in) {
+  Session session;
+  session.max_upload = in.Byte();
+  const int queue = in.Byte() & 1;
+  session.pool = &Pool(queue);
+  session.capacity = kWorkers + queue;
+  CHECK(session.pool->admitted() == 0);
+  while (!in.empty()) {
+    Step(in, session);
+    CheckSession(session);
+  }
+  for (Call& c : session.calls) {
     c.assembler.reset();
     c.held.reset();
   }
-  CHECK(pool.admitted() == 0);
+  CHECK(session.pool->admitted() == 0);
 }
 
 }  // namespace

@@ -19,7 +19,7 @@ cleanup() { for p in "${pids[@]}"; do kill "$p" 2>/dev/null || true; done; rm -r
 trap cleanup EXIT
 files=("$@")
 if ((${#files[@]} == 0)); then
-  "$b/client/vc-synth" hall --spacing 0.05 --out "$work/hall.ply" >/dev/null
+  "$b/core/vc-synth" hall --spacing 0.05 --out "$work/hall.ply" >/dev/null
   files=("$work/hall.ply" ../shared/data/geb079/geb079.bt)
 fi
 

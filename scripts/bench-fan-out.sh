@@ -40,7 +40,7 @@ case "$scene" in
   geb079) f=../shared/data/geb079/geb079.bt ;;
   hall-scan) f=../shared/data/hall-scan/scan.dat.bz2 ;;
   */* | *.*) f="$scene" ;;
-  *) f="$work/${scene/:/_}.ply"; "$bin/client/vc-synth" "$scene" --spacing 0.05 --out "$f" >/dev/null ;;
+  *) f="$work/${scene/:/_}.ply"; "$bin/core/vc-synth" "$scene" --spacing 0.05 --out "$f" >/dev/null ;;
 esac
 
 start lone

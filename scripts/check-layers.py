@@ -29,7 +29,7 @@ DEPENDS = {
     "synth": ["base"],
     "wire": ["plan"],
     "server": ["wire"],
-    "client": ["wire", "report", "synth"],  # client/ also holds vc-synth
+    "client": ["wire", "report"],
 }
 HEADER_LAYER = {"vc/" + l + "/": l for l in DEPENDS if l not in ("wire",)}
 HEADER_LAYER["vc/wire/"] = "wire"

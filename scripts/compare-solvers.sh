@@ -37,7 +37,7 @@ for s in $scenes; do
   case "$s" in
     geb079) f=../shared/data/geb079/geb079.bt ;;
     hall-scan) f=../shared/data/hall-scan/scan.dat.bz2 ;;
-    *) f="$work/${s/:/_}.ply"; [[ -f "$f" ]] || "$bin/client/vc-synth" "$s" --spacing 0.05 --out "$f" >/dev/null ;;
+    *) f="$work/${s/:/_}.ply"; [[ -f "$f" ]] || "$bin/core/vc-synth" "$s" --spacing 0.05 --out "$f" >/dev/null ;;
   esac
   for solver in $solvers; do
     out="$work/out-${s/:/_}-$solver"

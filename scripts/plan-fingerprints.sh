@@ -54,7 +54,7 @@ scenes=(box lroom comb:3 comb:5 rooms:3 twofloor)
 files=(../shared/data/geb079/geb079.bt)
 [[ "$quick" == "--quick" ]] || files+=(../shared/data/hall-scan/scan.dat.bz2)
 for s in "${scenes[@]}"; do
-  "$bin/client/vc-synth" "$s" --spacing 0.05 --out "$work/${s/:/_}.ply" >/dev/null
+  "$bin/core/vc-synth" "$s" --spacing 0.05 --out "$work/${s/:/_}.ply" >/dev/null
   files+=("$work/${s/:/_}.ply")
 done
 for f in "${files[@]}"; do

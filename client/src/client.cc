@@ -339,6 +339,27 @@ Result<EvaluateOutcome> Client::AttachEvaluate(const std::string& job_id, const 
   return out;
 }
 
+Result<AttachedJob> Client::Attach(const std::string& job_id, const JobObserver& observer) {
+  AttachedJob job;
+  Result<PlanResult> plan = AttachPlan(job_id, observer);
+  if (plan.ok()) {
+    job.plan = std::move(plan).value();
+    return job;
+  }
+  if (plan.status().code() != StatusCode::kFailedPrecondition) return plan.status();
+  VC_ASSIGN_OR_RETURN(job.evaluation, AttachEvaluate(job_id, observer));
+  job.kind = AttachedJob::Kind::kEvaluation;
+  return job;
+}
+
+Result<std::string> CancelDetachedJob(ConnectionOptions options, const JobTicket& ticket) {
+  options.max_attempts = 1;
+  options.timeout = std::chrono::seconds(3);
+  if (!ticket.attach_address.empty()) options.server = ticket.attach_address;
+  VC_ASSIGN_OR_RETURN(std::unique_ptr<Client> client, Client::Create(options));
+  return client->CancelJob(ticket.job_id);
+}
+
 Result<std::string> Client::CancelJob(const std::string& job_id) {
   auto stub = v1::StationPlanner::NewStub(channel_);
   std::string outcome;

@@ -83,11 +83,7 @@ class InterruptCancelsTheJob {
     }
     const std::string& id = job.job_id;
     if (!id.empty() && job.detach_grace_s > 0) {  // else the job ends with this process's stream
-      conn_.max_attempts = 1;
-      conn_.timeout = std::chrono::seconds(3);
-      if (!job.attach_address.empty()) conn_.server = job.attach_address;  // the replica running it
-      auto client = vc::client::Client::Create(conn_);
-      const auto r = client.ok() ? (*client)->CancelJob(id) : vc::Result<std::string>(client.status());
+      const auto r = vc::client::CancelDetachedJob(conn_, job);
       std::fprintf(
           stderr, "\nvc-client: interrupted; job %s %s\n", id.c_str(),
           r.ok() ? (*r + " on the server").c_str()
@@ -141,15 +137,52 @@ vc::client::JobObserver Observe(vc::client::ProgressDisplay& display, InterruptC
   return o;
 }
 
-}  // namespace
+// Writes the plan's reports and prints its stations.
+int WritePlan(const vc::PlanResult& r, const std::string& out_dir, const vc::UploadSummary* upload) {
+  vc::Status written = vc::WritePlanOutputs(r, out_dir, upload);
+  if (!written.ok()) return Fail("cannot write the reports", written);
+  PrintStations(r);
+  std::printf("wrote plan.json, stations.csv, visibility.ply, heatmap.png, reduction.png, report.html to %s\n",
+              out_dir.c_str());
+  return 0;
+}
 
-int main(int argc, char** argv) {
-  CLI::App app{"vc-client: plan laser-scanner stations with vc-server, or inspect a scene locally"};
-  app.require_subcommand(1);
-  app.fallthrough();
+constexpr const char* kRawUploadHelp =
+    "upload the file's bytes as they are, not a point cloud's voxels at the working resolution (vc-voxels)";
+constexpr const char* kDetachHelp =
+    "seconds the job runs on if this connection drops (re-attached automatically, or with vc-client attach); "
+    "0 = the job ends with the connection";
 
+// What the command line says; each subcommand reads its own fields.
+struct CommandLine {
   vc::client::ConnectionOptions conn;
   double timeout_s = 0;
+  std::string file;
+  std::string out_dir = "./vc-out";
+  bool raw_upload = false;
+  vc::PlanOptions plan;                  // submit
+  vc::client::PlanFileFlags plan_files;  // submit
+  vc::EvaluateJobOptions eval;           // evaluate
+  std::string viewpoints_csv;            // evaluate
+  std::string job_id;                    // attach, cancel
+  std::string health_service;            // health
+  double inspect_resolution = 0;         // inspect
+  bool json = false;                     // inspect
+};
+
+// The subcommands, to tell which one was given.
+struct Subcommands {
+  CLI::App* submit;
+  CLI::App* evaluate;
+  CLI::App* attach;
+  CLI::App* cancel;
+  CLI::App* health;
+  CLI::App* scanners;
+  CLI::App* inspect;
+};
+
+void AddConnectionFlags(CLI::App& app, CommandLine* cl) {
+  vc::client::ConnectionOptions& conn = cl->conn;
   app.add_option("--server", conn.server, "vc-server address host:port")->envname("VC_SERVER")->capture_default_str();
   app.add_flag("--tls", conn.tls, "use TLS with the system's root certificates")->envname("VC_TLS");
   app.add_option("--tls-ca", conn.tls_ca_file, "CA certificate (PEM) to verify the server; implies --tls")
@@ -164,167 +197,175 @@ int main(int argc, char** argv) {
                "name the scene by its SHA-256 first; upload it only when the server does not hold it")
       ->capture_default_str();
   app.add_option("--retries", conn.max_attempts, "attempts when the server is unavailable")->capture_default_str();
-  app.add_option("--timeout", timeout_s, "deadline per call in seconds (0 = none)")->capture_default_str();
+  app.add_option("--timeout", cl->timeout_s, "deadline per call in seconds (0 = none)")->capture_default_str();
+}
 
-  // submit: every planning parameter's flag comes from the parameter table (parameter_flags.h).
-  vc::PlanOptions plan;
-  std::string file, out_dir = "./vc-out";
-  vc::client::PlanFileFlags plan_files;
+// submit: every planning parameter's flag comes from the parameter table (parameter_flags.h).
+CLI::App* AddSubmitCommand(CLI::App& app, CommandLine* cl) {
   auto* submit = app.add_subcommand("submit", "plan stations for a scene on the server; write the reports");
-  submit->add_option("FILE", file, "scene: PLY, PCD, XYZ, LAS, or OctoMap .bt/.ot/.graph")->required();
-  submit->add_option("--out", out_dir, "output directory")->capture_default_str();
-  bool raw_upload = false;
-  const char* kRawUploadHelp =
-      "upload the file's bytes as they are, not a point cloud's voxels at the working resolution (vc-voxels)";
-  submit->add_flag("--raw-upload", raw_upload, kRawUploadHelp);
-  conn.detach_grace_s = 600;
-  const char* kDetachHelp =
-      "seconds the job runs on if this connection drops (re-attached automatically, or with vc-client attach); "
-      "0 = the job ends with the connection";
-  submit->add_option("--detach-grace", conn.detach_grace_s, kDetachHelp)->capture_default_str();
-  vc::client::AddPlanFileFlags(submit, &plan_files);
-  vc::client::AddPlanFlags(submit, &plan);
+  submit->add_option("FILE", cl->file, "scene: PLY, PCD, XYZ, LAS, or OctoMap .bt/.ot/.graph")->required();
+  submit->add_option("--out", cl->out_dir, "output directory")->capture_default_str();
+  submit->add_flag("--raw-upload", cl->raw_upload, kRawUploadHelp);
+  cl->conn.detach_grace_s = 600;
+  submit->add_option("--detach-grace", cl->conn.detach_grace_s, kDetachHelp)->capture_default_str();
+  vc::client::AddPlanFileFlags(submit, &cl->plan_files);
+  vc::client::AddPlanFlags(submit, &cl->plan);
+  return submit;
+}
 
-  // evaluate
-  vc::EvaluateJobOptions eval;
-  std::string viewpoints_csv;
+CLI::App* AddEvaluateCommand(CLI::App& app, CommandLine* cl) {
   auto* evaluate =
       app.add_subcommand("evaluate", "evaluate viewpoints on a scene on the server; write evaluation.json");
-  evaluate->add_option("FILE", file, "scene file")->required();
-  evaluate->add_option("--viewpoints", viewpoints_csv, "CSV of viewpoints x,y,z (e.g. stations.csv)")->required();
-  evaluate->add_option("--out", out_dir, "output directory")->capture_default_str();
-  evaluate->add_flag("--raw-upload", raw_upload, kRawUploadHelp);
-  evaluate->add_option("--detach-grace", conn.detach_grace_s, kDetachHelp)->capture_default_str();
-  vc::client::AddEvaluateFlags(evaluate, &eval);
+  evaluate->add_option("FILE", cl->file, "scene file")->required();
+  evaluate->add_option("--viewpoints", cl->viewpoints_csv, "CSV of viewpoints x,y,z (e.g. stations.csv)")->required();
+  evaluate->add_option("--out", cl->out_dir, "output directory")->capture_default_str();
+  evaluate->add_flag("--raw-upload", cl->raw_upload, kRawUploadHelp);
+  evaluate->add_option("--detach-grace", cl->conn.detach_grace_s, kDetachHelp)->capture_default_str();
+  vc::client::AddEvaluateFlags(evaluate, &cl->eval);
+  return evaluate;
+}
 
-  // attach, cancel
-  std::string job_id;
-  auto* attach = app.add_subcommand(
+Subcommands AddCommands(CLI::App& app, CommandLine* cl) {
+  AddConnectionFlags(app, cl);
+  Subcommands sub;
+  sub.submit = AddSubmitCommand(app, cl);
+  sub.evaluate = AddEvaluateCommand(app, cl);
+
+  sub.attach = app.add_subcommand(
       "attach", "re-attach to a detached job (plan or evaluation) by its id; write its reports like submit/evaluate");
-  attach->add_option("JOB_ID", job_id, "the id submit printed (j-...)")->required();
-  attach->add_option("--out", out_dir, "output directory")->capture_default_str();
-  auto* cancel = app.add_subcommand("cancel", "cancel a detached job, or discard its kept result");
-  cancel->add_option("JOB_ID", job_id, "the id submit printed (j-...)")->required();
+  sub.attach->add_option("JOB_ID", cl->job_id, "the id submit printed (j-...)")->required();
+  sub.attach->add_option("--out", cl->out_dir, "output directory")->capture_default_str();
+  sub.cancel = app.add_subcommand("cancel", "cancel a detached job, or discard its kept result");
+  sub.cancel->add_option("JOB_ID", cl->job_id, "the id submit printed (j-...)")->required();
 
-  // health
-  std::string health_service;
-  auto* health = app.add_subcommand("health", "check the server's gRPC health service");
-  health->add_option("--service", health_service, "service name (empty = the whole server)");
+  sub.health = app.add_subcommand("health", "check the server's gRPC health service");
+  sub.health->add_option("--service", cl->health_service, "service name (empty = the whole server)");
 
-  // scanners
-  auto* scanners = app.add_subcommand("scanners", "list the instrument presets for --scanner (no server)");
+  sub.scanners = app.add_subcommand("scanners", "list the instrument presets for --scanner (no server)");
 
-  // inspect
-  double inspect_resolution = 0;
-  bool json = false;
-  auto* inspect = app.add_subcommand("inspect", "describe a scene file locally (no server)");
-  inspect->add_option("FILE", file, "scene file")->required();
-  inspect->add_option("--resolution", inspect_resolution, "resolution in m for the voxel count (0 = default)")
+  sub.inspect = app.add_subcommand("inspect", "describe a scene file locally (no server)");
+  sub.inspect->add_option("FILE", cl->file, "scene file")->required();
+  sub.inspect->add_option("--resolution", cl->inspect_resolution, "resolution in m for the voxel count (0 = default)")
       ->capture_default_str();
-  inspect->add_flag("--json", json, "print JSON");
+  sub.inspect->add_flag("--json", cl->json, "print JSON");
+  return sub;
+}
 
+int RunScanners() {
+  std::cout << vc::client::ScannerPresetsTable();
+  return 0;
+}
+
+int RunInspect(const CommandLine& cl) {
+  const std::string& file = cl.file;
+  // The limits vc-server applies with its defaults, so inspect accepts what a plan would.
+  auto input = vc::ReadSceneFile(file, vc::ReadLimits(vc::kDefaultMaxUploadBytes, vc::kDefaultMemoryBudgetBytes));
+  if (!input.ok()) return Fail("cannot read " + file, input.status());
+  auto summary = vc::Summarize(*input, cl.inspect_resolution, vc::kDefaultMemoryBudgetBytes);
+  if (!summary.ok()) return Fail("cannot summarise " + file, summary.status());
+  if (input->format == vc::InputFormat::kE57 && input->compression == vc::Compression::kNone) {
+    auto bytes = vc::client::ReadUpload(file);
+    if (!bytes.ok()) return Fail("cannot read " + file, bytes.status());
+    auto scans = vc::ReadE57Scans(bytes->bytes, file);
+    if (!scans.ok()) return Fail("cannot list the scans of " + file, scans.status());
+    summary->e57_scans = std::move(scans).value();
+  }
+  std::cout << (cl.json ? vc::SummaryToJson(*summary) : vc::SummaryToText(*summary, file)) << "\n";
+  return 0;
+}
+
+int RunHealth(vc::client::Client& client, const CommandLine& cl) {
+  auto r = client.Health(cl.health_service);
+  if (!r.ok()) return FailCall("health check", r.status(), cl.conn.server);
+  std::cout << *r << "\n";
+  return 0;
+}
+
+int RunCancel(vc::client::Client& client, const CommandLine& cl) {
+  auto r = client.CancelJob(cl.job_id);
+  if (!r.ok()) return FailCall("cancel", r.status(), cl.conn.server);
+  std::cout << "job " << cl.job_id << ": " << *r << "\n";
+  return 0;
+}
+
+int RunAttach(vc::client::Client& client, const CommandLine& cl) {
+  vc::client::ProgressDisplay display(stderr, isatty(fileno(stderr)) != 0);
+  auto job = client.Attach(cl.job_id, Observe(display));
+  display.Done();
+  if (!job.ok()) return FailCall("attach", job.status(), cl.conn.server);
+  if (job->kind == vc::client::AttachedJob::Kind::kEvaluation) {
+    return WriteEvaluation(job->evaluation.evaluation, job->evaluation.viewpoints, cl.out_dir);
+  }
+  return WritePlan(job->plan, cl.out_dir, nullptr);
+}
+
+// The scene's upload at `resolution_m`, announced on `display`.
+vc::client::PreparedUpload StartUpload(vc::client::Upload file_bytes, double resolution_m, const CommandLine& cl,
+                                       vc::client::ProgressDisplay& display) {
+  vc::client::PreparedUpload prepared = vc::client::PrepareUpload(std::move(file_bytes), resolution_m, cl.raw_upload);
+  display.Note(vc::client::DescribeUpload(prepared.summary));
+  display.Uploading(prepared.upload.source_name, prepared.upload.bytes.size(), cl.conn.server);
+  return prepared;
+}
+
+int RunSubmit(vc::client::Client& client, const CommandLine& cl, InterruptCancelsTheJob* interrupt) {
+  auto file_bytes = vc::client::ReadUpload(cl.file);
+  if (!file_bytes.ok()) return Fail("cannot read the scene", file_bytes.status());
+  vc::PlanOptions plan = cl.plan;
+  if (vc::Status loaded = vc::client::LoadPlanFiles(cl.plan_files, &plan); !loaded.ok()) {
+    return Fail("bad input file", loaded);
+  }
+  vc::client::ProgressDisplay display(stderr, isatty(fileno(stderr)) != 0);
+  vc::client::PreparedUpload prepared = StartUpload(std::move(file_bytes).value(), plan.resolution_m, cl, display);
+  auto r = client.Plan(prepared.upload, plan, Observe(display, interrupt));
+  display.Done();
+  if (!r.ok()) return FailCall("plan", r.status(), cl.conn.server);
+  NoteCache(client.last_upload(), &prepared.summary, display);
+  return WritePlan(*r, cl.out_dir, &prepared.summary);
+}
+
+int RunEvaluate(vc::client::Client& client, const CommandLine& cl, InterruptCancelsTheJob* interrupt) {
+  auto file_bytes = vc::client::ReadUpload(cl.file);
+  if (!file_bytes.ok()) return Fail("cannot read the scene", file_bytes.status());
+  vc::client::ProgressDisplay display(stderr, isatty(fileno(stderr)) != 0);
+  vc::client::PreparedUpload prepared = StartUpload(std::move(file_bytes).value(), cl.eval.resolution_m, cl, display);
+  auto text = vc::client::ReadUpload(cl.viewpoints_csv);
+  if (!text.ok()) return Fail("cannot read the viewpoints", text.status());
+  auto points = vc::ParseStationsCsv(text->bytes, cl.viewpoints_csv);
+  if (!points.ok()) return Fail("bad viewpoints file", points.status());
+  vc::EvaluateJobOptions eval = cl.eval;
+  eval.viewpoints = std::move(points).value();
+  auto r = client.Evaluate(prepared.upload, eval, Observe(display, interrupt));
+  display.Done();
+  if (!r.ok()) return FailCall("evaluate", r.status(), cl.conn.server);
+  NoteCache(client.last_upload(), &prepared.summary, display);
+  return WriteEvaluation(*r, eval.viewpoints, cl.out_dir);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"vc-client: plan laser-scanner stations with vc-server, or inspect a scene locally"};
+  app.require_subcommand(1);
+  app.fallthrough();
+  CommandLine cl;
+  const Subcommands sub = AddCommands(app, &cl);
   CLI11_PARSE(app, argc, argv);
-  conn.timeout = std::chrono::milliseconds(int64_t(timeout_s * 1000));
+  cl.conn.timeout = std::chrono::milliseconds(int64_t(cl.timeout_s * 1000));
 
-  if (*scanners) {
-    std::cout << vc::client::ScannerPresetsTable();
-    return 0;
-  }
-
-  if (*inspect) {
-    // The limits vc-server applies with its defaults, so inspect accepts what a plan would.
-    auto input = vc::ReadSceneFile(file, vc::ReadLimits(vc::kDefaultMaxUploadBytes, vc::kDefaultMemoryBudgetBytes));
-    if (!input.ok()) return Fail("cannot read " + file, input.status());
-    auto summary = vc::Summarize(*input, inspect_resolution, vc::kDefaultMemoryBudgetBytes);
-    if (!summary.ok()) return Fail("cannot summarise " + file, summary.status());
-    if (input->format == vc::InputFormat::kE57 && input->compression == vc::Compression::kNone) {
-      auto bytes = vc::client::ReadUpload(file);
-      if (!bytes.ok()) return Fail("cannot read " + file, bytes.status());
-      auto scans = vc::ReadE57Scans(bytes->bytes, file);
-      if (!scans.ok()) return Fail("cannot list the scans of " + file, scans.status());
-      summary->e57_scans = std::move(scans).value();
-    }
-    std::cout << (json ? vc::SummaryToJson(*summary) : vc::SummaryToText(*summary, file)) << "\n";
-    return 0;
-  }
+  if (*sub.scanners) return RunScanners();
+  if (*sub.inspect) return RunInspect(cl);
 
   // Before any gRPC thread exists, so that every thread inherits the blocked signals.
   InterruptCancelsTheJob* interrupt = nullptr;  // never freed: its watcher thread lives as long as the process
   // (attach leaves SIGINT as it is: interrupting it stops following, and the job runs on.)
-  if (*submit || *evaluate) interrupt = new InterruptCancelsTheJob(conn);
-  auto client = vc::client::Client::Create(conn);
+  if (*sub.submit || *sub.evaluate) interrupt = new InterruptCancelsTheJob(cl.conn);
+  auto client = vc::client::Client::Create(cl.conn);
   if (!client.ok()) return Fail("cannot set up the connection", client.status());
 
-  if (*health) {
-    auto r = (*client)->Health(health_service);
-    if (!r.ok()) return FailCall("health check", r.status(), conn.server);
-    std::cout << *r << "\n";
-    return 0;
-  }
-
-  if (*cancel) {
-    auto r = (*client)->CancelJob(job_id);
-    if (!r.ok()) return FailCall("cancel", r.status(), conn.server);
-    std::cout << "job " << job_id << ": " << *r << "\n";
-    return 0;
-  }
-
-  if (*attach) {
-    vc::client::ProgressDisplay display(stderr, isatty(fileno(stderr)) != 0);
-    auto r = (*client)->AttachPlan(job_id, Observe(display));
-    if (r.ok() || r.status().code() != vc::StatusCode::kFailedPrecondition) {
-      display.Done();
-      if (!r.ok()) return FailCall("attach", r.status(), conn.server);
-      if (vc::Status written = vc::WritePlanOutputs(*r, out_dir); !written.ok()) {
-        return Fail("cannot write the reports", written);
-      }
-      PrintStations(*r);
-      std::printf("wrote plan.json, stations.csv, visibility.ply, heatmap.png, reduction.png, report.html to %s\n",
-                  out_dir.c_str());
-      return 0;
-    }
-    auto e = (*client)->AttachEvaluate(job_id, Observe(display));  // an Evaluate job
-    display.Done();
-    if (!e.ok()) return FailCall("attach", e.status(), conn.server);
-    return WriteEvaluation(e->evaluation, e->viewpoints, out_dir);
-  }
-
-  auto file_bytes = vc::client::ReadUpload(file);
-  if (!file_bytes.ok()) return Fail("cannot read the scene", file_bytes.status());
-  if (*submit) {
-    if (vc::Status loaded = vc::client::LoadPlanFiles(plan_files, &plan); !loaded.ok()) {
-      return Fail("bad input file", loaded);
-    }
-  }
-  vc::client::ProgressDisplay display(stderr, isatty(fileno(stderr)) != 0);
-  vc::client::PreparedUpload prepared = vc::client::PrepareUpload(
-      std::move(file_bytes).value(), *submit ? plan.resolution_m : eval.resolution_m, raw_upload);
-  const vc::client::Upload* upload = &prepared.upload;
-  display.Note(vc::client::DescribeUpload(prepared.summary));
-  display.Uploading(upload->source_name, upload->bytes.size(), conn.server);
-
-  if (*submit) {
-    auto r = (*client)->Plan(*upload, plan, Observe(display, interrupt));
-    display.Done();
-    if (!r.ok()) return FailCall("plan", r.status(), conn.server);
-    NoteCache((*client)->last_upload(), &prepared.summary, display);
-    vc::Status written = vc::WritePlanOutputs(*r, out_dir, &prepared.summary);
-    if (!written.ok()) return Fail("cannot write the reports", written);
-    PrintStations(*r);
-    std::printf("wrote plan.json, stations.csv, visibility.ply, heatmap.png, reduction.png, report.html to %s\n",
-                out_dir.c_str());
-    return 0;
-  }
-
-  // evaluate
-  auto text = vc::client::ReadUpload(viewpoints_csv);
-  if (!text.ok()) return Fail("cannot read the viewpoints", text.status());
-  auto points = vc::ParseStationsCsv(text->bytes, viewpoints_csv);
-  if (!points.ok()) return Fail("bad viewpoints file", points.status());
-  eval.viewpoints = std::move(points).value();
-  auto r = (*client)->Evaluate(*upload, eval, Observe(display, interrupt));
-  display.Done();
-  if (!r.ok()) return FailCall("evaluate", r.status(), conn.server);
-  NoteCache((*client)->last_upload(), &prepared.summary, display);
-  return WriteEvaluation(*r, eval.viewpoints, out_dir);
+  if (*sub.health) return RunHealth(**client, cl);
+  if (*sub.cancel) return RunCancel(**client, cl);
+  if (*sub.attach) return RunAttach(**client, cl);
+  if (*sub.submit) return RunSubmit(**client, cl, interrupt);
+  return RunEvaluate(**client, cl, interrupt);
 }

@@ -1,5 +1,5 @@
 # Shared helpers of the scripts in scripts/load/ (sourced, not run). They build nothing: BIN is a
-# build directory holding server/vc-server, client/vc-client and client/vc-synth. Every server is
+# build directory holding server/vc-server, client/vc-client and core/vc-synth. Every server is
 # started on 127.0.0.1 with port 0 (a free port) and stopped by the EXIT trap; every wait is bounded.
 set -uo pipefail
 
@@ -10,7 +10,7 @@ load_init() {  # load_init BUILD_DIR
   BIN=${1:-$LOAD_ROOT/build/release}
   SERVER="$BIN/server/vc-server"
   CLIENT="$BIN/client/vc-client"
-  SYNTH="$BIN/client/vc-synth"
+  SYNTH="$BIN/core/vc-synth"
   for b in "$SERVER" "$CLIENT" "$SYNTH"; do
     [[ -x "$b" ]] || { echo "$(basename "$0"): $b not found; build it first (cmake --build --preset release)" >&2; exit 2; }
   done

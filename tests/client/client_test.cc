@@ -1,8 +1,11 @@
 // vc::client::Client against an in-process server with a fake backend: the streamed result is
-// rebuilt exactly, events arrive, and UNAVAILABLE is retried.
+// rebuilt exactly, events arrive, UNAVAILABLE is retried, Attach finds a job of either kind, and
+// CancelDetachedJob reaches the replica running the job.
 #include "vc/client/client.h"
 
 #include <gtest/gtest.h>
+
+#include <thread>
 
 #include "testing/test_server.h"
 
@@ -106,6 +109,152 @@ TEST(Client, MissingTlsFileIsNotFound) {
   auto c = client::Client::Create(conn);
   ASSERT_FALSE(c.ok());
   EXPECT_EQ(c.status().code(), StatusCode::kNotFound);
+}
+
+// BlockingBackend's scene reading, with a plan and an evaluation that wait for `gate` (or the
+// job's cancellation) and then return fixed results.
+struct GatedBackend {
+  static constexpr double kEvaluationG = 0.625;
+  testing::BlockingBackend blocking;
+  testing::Latch gate;
+  PlanResult plan_result = BigResult();
+
+  server::Backend Make() {
+    server::Backend b = blocking.Make();
+    auto wait = [this](const JobContext& ctx) -> Status {
+      while (!gate.WaitFor(std::chrono::milliseconds(5))) {
+        if (Status s = ctx.CheckCancelled("gated job"); !s.ok()) return s;
+      }
+      return Status::Ok();
+    };
+    b.plan = [this, wait](const SceneInput&, const PlanOptions&, const JobContext& ctx,
+                          const PlanCallbacks&) -> Result<PlanResult> {
+      VC_RETURN_IF_ERROR(wait(ctx));
+      return plan_result;
+    };
+    b.evaluate = [wait](const SceneInput&, const EvaluateJobOptions&, const JobContext& ctx) -> Result<Evaluation> {
+      VC_RETURN_IF_ERROR(wait(ctx));
+      Evaluation e;
+      e.overall.global_visibility = kEvaluationG;
+      return e;
+    };
+    return b;
+  }
+};
+
+// A job submitted with `submit(client, observer)` by a client with a detach grace, then attached
+// to with Client::Attach by a second client, which takes it over (the first ends with ABORTED);
+// the gate opens once the second client has the job's replayed Accepted event.
+template <typename Submit>
+Result<client::AttachedJob> SubmitThenAttach(GatedBackend& backend, Submit&& submit) {
+  server::ServerOptions o;
+  o.workers = 1;
+  auto server = testing::StartServer(o, backend.Make());
+  if (!server) return InternalError("no server");
+  client::ConnectionOptions conn;
+  conn.server = testing::Address(*server);
+  conn.detach_grace_s = 30;
+  auto submitter = client::Client::Create(conn);
+  auto attacher = client::Client::Create(conn);
+  if (!submitter.ok() || !attacher.ok()) return InternalError("no client");
+  testing::Latch accepted;
+  std::string job_id;
+  client::JobObserver submitted;
+  submitted.on_accepted = [&](const std::string& id, uint32_t) {
+    job_id = id;
+    accepted.Set();
+  };
+  Status submit_status;
+  std::thread submitting([&] { submit_status = submit(**submitter, submitted); });
+  if (!accepted.WaitFor(std::chrono::seconds(10))) {
+    backend.gate.Set();
+    submitting.join();
+    return InternalError("the job was not accepted: " + submit_status.ToString());
+  }
+  std::vector<std::string> replayed;
+  client::JobObserver attached;
+  attached.on_accepted = [&](const std::string& id, uint32_t) {
+    replayed.push_back(id);
+    backend.gate.Set();
+  };
+  auto job = (*attacher)->Attach(job_id, attached);
+  backend.gate.Set();
+  submitting.join();
+  EXPECT_EQ(submit_status.code(), StatusCode::kAborted) << submit_status.ToString();
+  EXPECT_EQ(replayed, std::vector<std::string>{job_id});
+  return job;
+}
+
+TEST(Client, AttachFollowsAPlanJob) {
+  GatedBackend backend;
+  const auto job = SubmitThenAttach(backend, [](client::Client& c, const client::JobObserver& observer) {
+    return c.Plan({"some scene bytes", "x.ply"}, PlanOptions{}, observer).status();
+  });
+  ASSERT_TRUE(job.ok()) << job.status().ToString();
+  EXPECT_EQ(job->kind, client::AttachedJob::Kind::kPlan);
+  EXPECT_EQ(job->plan.voxel_centers, backend.plan_result.voxel_centers);
+  EXPECT_EQ(job->plan.stations.size(), backend.plan_result.stations.size());
+}
+
+TEST(Client, AttachFallsBackToAttachEvaluateForAnEvaluateJob) {
+  GatedBackend backend;
+  EvaluateJobOptions eval;
+  eval.viewpoints = {{2, 1.5, 1.2}, {1, 1, 1.5}};
+  const auto job = SubmitThenAttach(backend, [&](client::Client& c, const client::JobObserver& observer) {
+    return c.Evaluate({"some scene bytes", "x.ply"}, eval, observer).status();
+  });
+  ASSERT_TRUE(job.ok()) << job.status().ToString();
+  EXPECT_EQ(job->kind, client::AttachedJob::Kind::kEvaluation);
+  EXPECT_EQ(job->evaluation.evaluation.overall.global_visibility, GatedBackend::kEvaluationG);
+  EXPECT_EQ(job->evaluation.viewpoints, eval.viewpoints) << "the server echoes the viewpoints";
+}
+
+TEST(Client, AttachToAnUnknownJobIsNotFound) {
+  server::ServerOptions o;
+  o.workers = 1;
+  auto server = testing::StartServer(o);
+  ASSERT_TRUE(server);
+  client::ConnectionOptions conn;
+  conn.server = testing::Address(*server);
+  auto c = client::Client::Create(conn);
+  ASSERT_TRUE(c.ok());
+  EXPECT_EQ((*c)->Attach("j-unknown").status().code(), StatusCode::kNotFound);
+}
+
+TEST(Client, CancelDetachedJobCancelsOnTheReplicaNamedInTheTicket) {
+  testing::BlockingBackend backend;
+  server::ServerOptions o;
+  o.workers = 1;
+  auto server = testing::StartServer(o, backend.Make());
+  ASSERT_TRUE(server);
+  client::ConnectionOptions conn;
+  conn.server = testing::Address(*server);
+  conn.detach_grace_s = 30;
+  auto c = client::Client::Create(conn);
+  ASSERT_TRUE(c.ok());
+  testing::Latch accepted;
+  client::JobTicket ticket;
+  client::JobObserver observer;
+  observer.on_job = [&](const client::JobTicket& t) {
+    ticket = t;
+    accepted.Set();
+  };
+  Status planned;
+  std::thread submitting([&] {
+    planned = (*c)->Plan({"some scene bytes", "x.ply"}, PlanOptions{}, observer).status();
+  });
+  ASSERT_TRUE(accepted.WaitFor(std::chrono::seconds(10)));
+  ASSERT_TRUE(backend.started.WaitFor(std::chrono::seconds(10)));
+
+  // The ticket names the replica running the job; the address the client was given is elsewhere.
+  ticket.attach_address = testing::Address(*server);
+  client::ConnectionOptions elsewhere = conn;
+  elsewhere.server = "127.0.0.1:1";
+  const auto r = client::CancelDetachedJob(elsewhere, ticket);
+  submitting.join();
+  ASSERT_TRUE(r.ok()) << r.status().ToString();
+  EXPECT_EQ(*r, "cancelled");
+  EXPECT_EQ(planned.code(), StatusCode::kCancelled) << planned.ToString();
 }
 
 }  // namespace

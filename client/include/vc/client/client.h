@@ -73,6 +73,14 @@ struct EvaluateOutcome {
   std::vector<WorldPoint> viewpoints;
 };
 
+// A re-attached job's outcome: a plan or an evaluation, whichever kind the job is.
+struct AttachedJob {
+  enum class Kind { kPlan, kEvaluation };
+  Kind kind = Kind::kPlan;
+  PlanResult plan;             // when kind is kPlan
+  EvaluateOutcome evaluation;  // when kind is kEvaluation
+};
+
 // How the last Plan or Evaluate call got its scene to the server.
 struct UploadOutcome {
   std::string scene_sha256;  // empty without the scene cache
@@ -109,6 +117,11 @@ struct Upload {
 // Reads a file into an Upload. NOT_FOUND if it cannot be read.
 Result<Upload> ReadUpload(const std::string& path);
 
+// Cancels `ticket`'s job the way a client about to exit does: on the replica running it (its
+// attach_address, else options.server), in one attempt with a 3 s deadline. "cancelled" or
+// "discarded"; the call's failure otherwise (the job may then run on for its grace).
+Result<std::string> CancelDetachedJob(ConnectionOptions options, const JobTicket& ticket);
+
 class Client {
  public:
   // Reads the TLS files and makes the channel (connecting lazily). NOT_FOUND for a missing file.
@@ -122,6 +135,9 @@ class Client {
   // other kind; NOT_FOUND when the server does not hold it (any more).
   Result<PlanResult> AttachPlan(const std::string& job_id, const JobObserver& observer = {});
   Result<EvaluateOutcome> AttachEvaluate(const std::string& job_id, const JobObserver& observer = {});
+  // Re-attaches to a job of either kind: AttachPlan, then AttachEvaluate when the server answers
+  // FAILED_PRECONDITION (the job is an Evaluate job). NOT_FOUND when the server does not hold it.
+  Result<AttachedJob> Attach(const std::string& job_id, const JobObserver& observer = {});
   // Cancels a detachable job, or discards its kept result: "cancelled" or "discarded".
   Result<std::string> CancelJob(const std::string& job_id);
   // grpc.health.v1.Health/Check of `service` ("" = the whole server). The value is the serving

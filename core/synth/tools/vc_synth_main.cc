@@ -1,4 +1,4 @@
-// vc-synth: writes a synthetic scene (core/include/vc/core/synth.h) as a binary PLY point cloud.
+// vc-synth: writes a synthetic scene (core/synth/include/vc/synth/synth.h) as a binary PLY point cloud.
 //   vc-synth SCENE [--spacing S] [--seed N] --out FILE.ply
 //   vc-synth --list
 // Exit codes: 0 success, 2 bad usage or failure (one sentence on stderr).
