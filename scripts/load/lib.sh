@@ -1,5 +1,5 @@
 # Shared helpers of the scripts in scripts/load/ (sourced, not run). They build nothing: BIN is a
-# build directory holding server/vc-server, client/vc-client and core/vc-synth. Every server is
+# build directory holding BIN/server/vc-server, BIN/client/vc-client and BIN/core/vc-synth. Every server is
 # started on 127.0.0.1 with port 0 (a free port) and stopped by the EXIT trap; every wait is bounded.
 set -uo pipefail
 
