@@ -86,7 +86,6 @@ TEST(ServerOptionsTest, ZeroWorkersAndThreadsResolveToTheCores) {
   EXPECT_EQ(o.EffectiveThreadsPerJob(), 7);
 }
 
-}  // namespace
 ServerOptions Server() {
   ServerOptions o;
   o.max_memory_budget_bytes = uint64_t{1} << 30;
