@@ -41,9 +41,10 @@ Status CheckInputs(const std::vector<CapturedScan>& scans, const ValidationOptio
 Result<VoxelScene> BuildModel(const std::vector<CapturedScan>& scans, const ValidationOptions& options,
                               const JobContext& ctx) {
   VoxelAccumulator accumulator(options.resolution_m, options.memory_budget_bytes);
-  for (const CapturedScan& scan : scans) {
-    for (const auto& p : scan.points_m) accumulator.Add(p);
-    VC_RETURN_IF_ERROR(accumulator.status());
+  for (size_t i = 0; i < scans.size(); ++i) {
+    for (const auto& p : scans[i].points_m) accumulator.Add(p);
+    const Status& status = accumulator.status();
+    if (!status.ok()) return Status(status.code(), ScanLabel(scans[i], i) + ": " + status.message());
   }
   return accumulator.Finish(ctx);
 }

@@ -129,6 +129,26 @@ TEST(ValidateAgainstScansTest, PositionBeyondRangeOfTheModelIsRefusedByName) {
   EXPECT_NE(report.status().message().find("scan 1 (\"far\")"), std::string::npos) << report.status().ToString();
 }
 
+TEST(ValidateAgainstScansTest, PointOutsideTheKeyRangeIsRefusedByName) {
+  CapturedScan scan = Scan(TwoWalls(), {0, 0, 0}, "wild");
+  scan.points_m.push_back({1e6f, 0, 0});  // beyond OctoMap's 16-bit keys at 0.1 m (+-3276.8 m)
+  auto report = ValidateAgainstScans({scan}, {});
+  ASSERT_FALSE(report.ok());
+  EXPECT_EQ(report.status().code(), StatusCode::kInvalidArgument);
+  EXPECT_NE(report.status().message().find("scan 1 (\"wild\")"), std::string::npos) << report.status().ToString();
+}
+
+TEST(ValidateAgainstScansTest, PositionInAnOccupiedVoxelIsReportedAndPredictsNothing) {
+  CapturedScan scan = Scan(TwoWalls(), {0, 0, 0}, "in-wall");
+  scan.position_m = {2.0, 0.05, 0.05};  // on wall A
+  auto report = ValidateAgainstScans({scan}, {});
+  ASSERT_TRUE(report.ok()) << report.status().ToString();
+  EXPECT_TRUE(report->scans[0].position_occupied);
+  EXPECT_EQ(report->scans[0].predicted, 0u);
+  EXPECT_EQ(report->scans[0].recall, 0.0);
+  EXPECT_EQ(report->scans[0].precision, 0.0);  // 0 / 0 is reported as 0
+}
+
 TEST(ValidateAgainstScansTest, NoScansOrBadOptionsAreRefused) {
   EXPECT_EQ(ValidateAgainstScans({}, {}).status().code(), StatusCode::kInvalidArgument);
   const CapturedScan scan = Scan(TwoWalls(), {0, 0, 0}, "s");
