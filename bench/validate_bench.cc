@@ -1,0 +1,221 @@
+// vc-validate-bench: how well today's selection tests predict what a scanner captures (issue 34;
+// docs/VISIBILITY.md "Measured against captured points", docs/BENCHMARKS.md). Prints, for each
+// selection test, ValidateAgainstScans' recall and precision, with no slack and with one voxel of
+// slack, on: simulated planes tilted 0-60 deg to the lattice (with and without 1 cm range noise),
+// two simulated stations in RoomWithClutterScene, the real hall scan and the two real room scans.
+// Figures only, no assertions.
+//
+// Real scans: points nearer than the scanner's min_range_m to their own station are dropped (the
+// room scans hold returns from the scanning platform within ~0.3 m, which would put the station in
+// an occupied voxel); the room's second scan is moved into the first's frame by the estimated pose
+// of ../shared/data/README.md (yaw +40.8 deg, translation (1.974, 0.058, 0.016) m), whose direction
+// the tool checks by the overlap of the two scans. The prediction has no horizontal field of view:
+// the hall scan covers -91..+91 deg of azimuth only.
+#include <CLI/CLI.hpp>
+#include <Eigen/Geometry>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <numbers>
+#include <string>
+#include <vector>
+
+#include "vc/scene/occupancy_grid.h"
+#include "vc/scene/scene_input.h"
+#include "vc/synth/scanner_sim.h"
+#include "vc/visibility/validation.h"
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double Since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+
+constexpr vc::SelectionTest kTests[] = {vc::SelectionTest::kSurfaceVisibility, vc::SelectionTest::kCompatibility};
+
+struct BenchOptions {
+  double resolution_m = vc::kDefaultResolutionM;
+  double step_deg = 0.1;
+  double noise_m = 0.01;
+  int threads = 0;
+  std::string data_dir = "../shared/data";
+};
+
+void PrintHeader() {
+  std::printf("%-34s %-13s %-6s %9s %9s %9s %7s %7s %7s %7s\n", "scene", "test", "scan", "captured", "predicted",
+              "both", "recall", "prec", "recall1", "prec1");
+}
+
+// Runs every selection test on `scans` and prints one line per test and scan.
+int Report(const std::string& label, const std::vector<vc::CapturedScan>& scans, const BenchOptions& bench) {
+  for (const vc::SelectionTest test : kTests) {
+    vc::ValidationOptions options;
+    options.resolution_m = bench.resolution_m;
+    options.selection_test = test;
+    options.threads = bench.threads;
+    auto report = vc::ValidateAgainstScans(scans, options);
+    if (!report.ok()) return std::fprintf(stderr, "%s: %s\n", label.c_str(), report.status().ToString().c_str()), 1;
+    for (const vc::ScanAgreement& a : report->scans) {
+      char precision[16], precision_slack[16];
+      std::snprintf(precision, sizeof precision, "%.3f", a.precision);
+      std::snprintf(precision_slack, sizeof precision_slack, "%.3f", a.precision_slack);
+      std::printf("%-34s %-13s %-6s %9llu %9llu %9llu %7.3f %7s %7.3f %7s%s\n", label.c_str(),
+                  std::string(vc::SelectionTestName(test)).c_str(), a.name.c_str(), (unsigned long long)a.captured,
+                  (unsigned long long)a.predicted, (unsigned long long)a.both, a.recall,
+                  report->precision_meaningful ? precision : "-", a.recall_slack,
+                  report->precision_meaningful ? precision_slack : "-",
+                  a.position_occupied ? "  (station in an occupied voxel)" : "");
+    }
+  }
+  return 0;
+}
+
+vc::Result<vc::CapturedScan> Simulate(const vc::AnalyticScene& scene, vc::SimulatedScanner scanner, std::string name) {
+  VC_ASSIGN_OR_RETURN(vc::SimulatedScan scan, vc::SimulateScan(scene, scanner));
+  return vc::CapturedScan{std::move(name), scanner.position_m, std::move(scan.points_m)};
+}
+
+int TiltedPlanes(const BenchOptions& bench) {
+  for (const double distance_m : {3.0, 3.05}) {
+    for (const double noise_m : {0.0, bench.noise_m}) {
+      for (const double tilt_deg : {0.0, 15.0, 30.0, 45.0, 60.0}) {
+        auto scene = vc::TiltedPlaneScene(tilt_deg, distance_m);
+        if (!scene.ok()) return std::fprintf(stderr, "%s\n", scene.status().ToString().c_str()), 1;
+        vc::SimulatedScanner scanner;
+        scanner.hfov_deg = 100.0;
+        scanner.vfov_min_deg = -45.0;
+        scanner.vfov_max_deg = 45.0;
+        scanner.horizontal_step_deg = scanner.vertical_step_deg = bench.step_deg;
+        scanner.range_noise_sigma_m = noise_m;
+        auto scan = Simulate(*scene, scanner, "1");
+        if (!scan.ok()) return std::fprintf(stderr, "%s\n", scan.status().ToString().c_str()), 1;
+        char label[64];
+        std::snprintf(label, sizeof label, "plane %2.0f deg at %.2f m, noise %.0f cm", tilt_deg, distance_m,
+                      100 * noise_m);
+        if (Report(label, {*scan}, bench) != 0) return 1;
+      }
+    }
+  }
+  return 0;
+}
+
+int Room(const BenchOptions& bench) {
+  const vc::AnalyticScene scene = vc::RoomWithClutterScene();
+  for (const double noise_m : {0.0, bench.noise_m}) {
+    std::vector<vc::CapturedScan> scans;
+    int index = 0;
+    for (const vc::WorldPoint& station : {vc::kRoomWithClutterStationM, vc::WorldPoint(6.5, 3.0, 1.2)}) {
+      vc::SimulatedScanner scanner;
+      scanner.position_m = station;
+      scanner.horizontal_step_deg = scanner.vertical_step_deg = bench.step_deg;
+      scanner.range_noise_sigma_m = noise_m;
+      scanner.seed = uint64_t(++index);
+      auto scan = Simulate(scene, scanner, std::to_string(index));
+      if (!scan.ok()) return std::fprintf(stderr, "%s\n", scan.status().ToString().c_str()), 1;
+      scans.push_back(std::move(*scan));
+    }
+    char label[64];
+    std::snprintf(label, sizeof label, "room with clutter, noise %.0f cm", 100 * noise_m);
+    if (Report(label, scans, bench) != 0) return 1;
+  }
+  return 0;
+}
+
+// A real scan's points (its own frame), those nearer than min_range_m to the origin dropped.
+vc::Result<std::vector<Eigen::Vector3f>> ReadScan(const std::string& path, double min_range_m) {
+  VC_ASSIGN_OR_RETURN(vc::SceneInput input, vc::ReadSceneFile(path));
+  std::vector<Eigen::Vector3f> kept;
+  kept.reserve(input.points.size());
+  for (const auto& p : input.points) {
+    if (p.cast<double>().norm() >= min_range_m) kept.push_back(p);
+  }
+  std::printf("# %s: %zu points, %zu nearer than %.2f m dropped\n", path.c_str(), input.points.size(),
+              input.points.size() - kept.size(), min_range_m);
+  return kept;
+}
+
+// Whether `set` holds voxel `id` of `model` or one of its 26 neighbours.
+bool HasMemberWithinOneVoxel(const vc::VoxelScene& model, const vc::VoxelSet& set, size_t id) {
+  const vc::VoxelIndex v = vc::KeyToIndex(model.occupied[id]);
+  for (int dz = -1; dz <= 1; ++dz) {
+    for (int dy = -1; dy <= 1; ++dy) {
+      for (int dx = -1; dx <= 1; ++dx) {
+        const int64_t n = model.IdOf(vc::IndexToKey({v.x + dx, v.y + dy, v.z + dz}));
+        if (n >= 0 && set.test(size_t(n))) return true;
+      }
+    }
+  }
+  return false;
+}
+
+// Share of `moved`'s voxels with a voxel of `fixed` within one voxel (a check of a relative pose).
+double Overlap(const std::vector<Eigen::Vector3f>& fixed, const std::vector<Eigen::Vector3f>& moved,
+               const BenchOptions& bench) {
+  vc::ValidationOptions options;
+  options.resolution_m = bench.resolution_m;
+  options.keep_sets = true;
+  options.threads = bench.threads;
+  auto report = vc::ValidateAgainstScans({{"fixed", {0, 0, 0}, fixed}, {"moved", {0, 0, 0}, moved}}, options);
+  if (!report.ok()) return -1;
+  const vc::ScanAgreement& f = report->scans[0];
+  const vc::ScanAgreement& m = report->scans[1];
+  uint64_t near = 0;
+  m.captured_set.ForEach([&](size_t id) { near += HasMemberWithinOneVoxel(report->model, f.captured_set, id); });
+  return double(near) / double(m.captured);
+}
+
+int RealScans(const BenchOptions& bench) {
+  const double min_range_m = vc::ScannerModel{}.min_range_m;
+  auto hall = ReadScan(bench.data_dir + "/hall-scan/scan.dat.bz2", min_range_m);
+  if (!hall.ok()) return std::fprintf(stderr, "%s\n", hall.status().ToString().c_str()), 1;
+  std::printf("# the hall scan covers -91..+91 deg of azimuth; the prediction has no horizontal field of view\n");
+  if (Report("hall (real, one station)", {{"1", {0, 0, 0}, std::move(*hall)}}, bench) != 0) return 1;
+
+  auto room1 = ReadScan(bench.data_dir + "/room-2scans/room_scan1.pcd", min_range_m);
+  auto room2 = ReadScan(bench.data_dir + "/room-2scans/room_scan2.pcd", min_range_m);
+  if (!room1.ok() || !room2.ok()) return std::fprintf(stderr, "room scans unreadable\n"), 1;
+  const Eigen::Matrix3f yaw =
+      Eigen::AngleAxisf(float(40.8 * std::numbers::pi / 180.0), Eigen::Vector3f::UnitZ()).toRotationMatrix();
+  const Eigen::Vector3f t(1.974f, 0.058f, 0.016f);
+  std::vector<Eigen::Vector3f> as_readme, inverse;
+  for (const auto& p : *room2) {
+    as_readme.push_back(yaw * p + t);
+    inverse.push_back(yaw.transpose() * (p - t));
+  }
+  const double overlap_readme = Overlap(*room1, as_readme, bench);
+  const double overlap_inverse = Overlap(*room1, inverse, bench);
+  const bool use_readme = overlap_readme >= overlap_inverse;
+  std::printf(
+      "# room pose check: share of scan 2's voxels within one voxel of scan 1's: %.3f (p1 = R p2 + t, as "
+      "README) vs %.3f (inverse); using %s\n",
+      overlap_readme, overlap_inverse, use_readme ? "README's" : "the inverse");
+  const Eigen::Vector3f station2 = use_readme ? t : Eigen::Vector3f(-(yaw.transpose() * t));
+  return Report("room (real, two stations)",
+                {{"1", {0, 0, 0}, std::move(*room1)}, {"2", station2.cast<double>(), use_readme ? as_readme : inverse}},
+                bench);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  BenchOptions bench;
+  bool simulated_only = false;
+  CLI::App app{"vc-validate-bench: selection tests' recall and precision against captured points"};
+  app.add_option("--resolution", bench.resolution_m, "voxel edge, m")->capture_default_str();
+  app.add_option("--step", bench.step_deg, "simulated scanner's angular step, deg")->capture_default_str();
+  app.add_option("--noise", bench.noise_m, "range noise of the noisy simulated scans, m")->capture_default_str();
+  app.add_option("--threads", bench.threads, "threads for the visibility sets (0 = all)")->capture_default_str();
+  app.add_option("--data", bench.data_dir, "folder of the real scans")->capture_default_str();
+  app.add_flag("--simulated-only", simulated_only, "skip the real scans");
+  CLI11_PARSE(app, argc, argv);
+
+  const auto start = Clock::now();
+  std::printf(
+      "# resolution %.3f m, simulated step %.2f deg; recall1 / prec1: with one voxel of slack; "
+      "prec '-': one scan, so only recall is meaningful\n",
+      bench.resolution_m, bench.step_deg);
+  PrintHeader();
+  if (TiltedPlanes(bench) != 0 || Room(bench) != 0) return 1;
+  if (!simulated_only && RealScans(bench) != 0) return 1;
+  std::printf("# %.1f s\n", Since(start));
+  return 0;
+}

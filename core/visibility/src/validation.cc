@@ -1,0 +1,159 @@
+#include "vc/visibility/validation.h"
+
+#include <cmath>
+#include <string>
+#include <utility>
+
+#include "vc/scene/occupancy_grid.h"
+
+namespace vc {
+namespace {
+
+std::string ScanLabel(const CapturedScan& scan, size_t index) {
+  return "scan " + std::to_string(index + 1) + " (\"" + scan.name + "\")";
+}
+
+bool IsFinite(const Eigen::Vector3f& p) { return std::isfinite(p.x()) && std::isfinite(p.y()) && std::isfinite(p.z()); }
+
+Status CheckInputs(const std::vector<CapturedScan>& scans, const ValidationOptions& options) {
+  if (scans.empty()) return InvalidArgumentError("validation needs at least one scan");
+  if (!std::isfinite(options.resolution_m) || options.resolution_m <= 0) {
+    return InvalidArgumentError("validation resolution_m must be > 0, got " + std::to_string(options.resolution_m));
+  }
+  VC_RETURN_IF_ERROR(options.scanner.Validate());
+  for (size_t i = 0; i < scans.size(); ++i) {
+    const CapturedScan& scan = scans[i];
+    if (!scan.position_m.allFinite()) {
+      return InvalidArgumentError(ScanLabel(scan, i) + " has a scanner position that is not finite");
+    }
+    bool any_finite = false;
+    for (const auto& p : scan.points_m) {
+      if (IsFinite(p)) {
+        any_finite = true;
+        break;
+      }
+    }
+    if (!any_finite) return InvalidArgumentError(ScanLabel(scan, i) + " has no points (none finite)");
+  }
+  return Status::Ok();
+}
+
+Result<VoxelScene> BuildModel(const std::vector<CapturedScan>& scans, const ValidationOptions& options,
+                              const JobContext& ctx) {
+  VoxelAccumulator accumulator(options.resolution_m, options.memory_budget_bytes);
+  for (size_t i = 0; i < scans.size(); ++i) {
+    for (const auto& p : scans[i].points_m) accumulator.Add(p);
+    const Status& status = accumulator.status();
+    if (!status.ok()) return Status(status.code(), ScanLabel(scans[i], i) + ": " + status.message());
+  }
+  return accumulator.Finish(ctx);
+}
+
+// Distance (m) from p to the box [lo, hi]; 0 inside.
+double DistanceToBox(const WorldPoint& p, const WorldPoint& lo, const WorldPoint& hi) {
+  const WorldPoint outside = (lo - p).cwiseMax(p - hi).cwiseMax(WorldPoint::Zero());
+  return outside.norm();
+}
+
+Status CheckPositions(const std::vector<CapturedScan>& scans, const VoxelScene& model, const ScannerModel& scanner) {
+  const WorldPoint lo = model.BoundsMin(), hi = model.BoundsMax();
+  for (size_t i = 0; i < scans.size(); ++i) {
+    const double distance_m = DistanceToBox(scans[i].position_m, lo, hi);
+    if (distance_m > scanner.max_range_m || !ViewpointInRange(scans[i].position_m, model.resolution_m)) {
+      return InvalidArgumentError(ScanLabel(scans[i], i) + "'s scanner position is " + std::to_string(distance_m) +
+                                  " m outside the scans' bounding box, beyond the scanner's max_range_m (" +
+                                  std::to_string(scanner.max_range_m) + " m); is it in the points' frame?");
+    }
+  }
+  return Status::Ok();
+}
+
+// The model's voxels holding a finite point of `scan`.
+VoxelSet CapturedSet(const CapturedScan& scan, const VoxelScene& model) {
+  VoxelSet captured(model.occupied.size());
+  VoxelKey key;
+  for (const auto& p : scan.points_m) {
+    if (!IsFinite(p) || !CoordToKey(model.resolution_m, p.cast<double>(), &key)) continue;
+    const int64_t id = model.IdOf(key);
+    if (id >= 0) captured.set(size_t(id));
+  }
+  return captured;
+}
+
+// The model's voxels in the 26-neighbourhood of a member of `set`, or members themselves.
+VoxelSet Dilate(const VoxelSet& set, const VoxelScene& model) {
+  VoxelSet dilated(model.occupied.size());
+  set.ForEach([&](size_t id) {
+    const VoxelIndex v = KeyToIndex(model.occupied[id]);
+    for (int dz = -1; dz <= 1; ++dz) {
+      for (int dy = -1; dy <= 1; ++dy) {
+        for (int dx = -1; dx <= 1; ++dx) {
+          const int64_t n = model.IdOf(IndexToKey({v.x + dx, v.y + dy, v.z + dz}));
+          if (n >= 0) dilated.set(size_t(n));
+        }
+      }
+    }
+  });
+  return dilated;
+}
+
+double Ratio(uint64_t part, uint64_t whole) { return whole == 0 ? 0.0 : double(part) / double(whole); }
+
+ScanAgreement Compare(const CapturedScan& scan, const VoxelScene& model, VoxelSet predicted, bool keep_sets) {
+  ScanAgreement a;
+  a.name = scan.name;
+  VoxelSet captured = CapturedSet(scan, model);
+  a.captured = captured.count();
+  a.predicted = predicted.count();
+  a.both = captured.CountAnd(predicted);
+  a.captured_near_predicted = captured.CountAnd(Dilate(predicted, model));
+  a.predicted_near_captured = predicted.CountAnd(Dilate(captured, model));
+  a.recall = Ratio(a.both, a.captured);
+  a.precision = Ratio(a.both, a.predicted);
+  a.recall_slack = Ratio(a.captured_near_predicted, a.captured);
+  a.precision_slack = Ratio(a.predicted_near_captured, a.predicted);
+  VoxelKey key;
+  a.position_occupied = CoordToKey(model.resolution_m, scan.position_m, &key) && model.IdOf(key) >= 0;
+  if (keep_sets) {
+    a.captured_set = std::move(captured);
+    a.predicted_set = std::move(predicted);
+  }
+  return a;
+}
+
+}  // namespace
+
+Result<ValidationReport> ValidateAgainstScans(const std::vector<CapturedScan>& scans, const ValidationOptions& options,
+                                              const JobContext& ctx) {
+  VC_RETURN_IF_ERROR(CheckInputs(scans, options));
+  VC_ASSIGN_OR_RETURN(VoxelScene model, BuildModel(scans, options, ctx));
+  VC_RETURN_IF_ERROR(CheckPositions(scans, model, options.scanner));
+
+  std::vector<WorldPoint> positions;
+  positions.reserve(scans.size());
+  for (const CapturedScan& scan : scans) positions.push_back(scan.position_m);
+  VisibilitySetsOptions sets_options;
+  sets_options.test = options.selection_test;
+  sets_options.threads = options.threads;
+  sets_options.scanner = options.scanner;
+  VC_ASSIGN_OR_RETURN(std::vector<VoxelSet> predicted, ComputeVisibilitySets(model, positions, sets_options, ctx));
+
+  ValidationReport report;
+  report.resolution_m = model.resolution_m;
+  report.selection_test = options.selection_test;
+  report.model_voxels = model.occupied.size();
+  if (scans.size() == 1) {
+    report.precision_meaningful = false;
+    report.note =
+        "a single scan: the model is the scan itself, so every model voxel is captured and only recall is "
+        "meaningful";
+  }
+  report.scans.reserve(scans.size());
+  for (size_t i = 0; i < scans.size(); ++i) {
+    report.scans.push_back(Compare(scans[i], model, std::move(predicted[i]), options.keep_sets));
+  }
+  if (options.keep_sets) report.model = std::move(model);
+  return report;
+}
+
+}  // namespace vc
