@@ -12,6 +12,7 @@
 #include <string>
 
 #include "testing/e57_writer.h"
+#include "testing/test_paths.h"
 
 namespace vc {
 namespace {
@@ -121,6 +122,16 @@ TEST(StationFileTest, PcdViewpoint) {
   EXPECT_EQ((*r)[0].position_m, WorldPoint(4, 5, 1.6));
   EXPECT_NEAR(*(*r)[0].heading_rad, M_PI / 4, 1e-5);  // the quaternion written to 6 decimals
   EXPECT_EQ((*r)[0].source, "scan.pcd:9");
+}
+
+TEST(StationFileTest, ARealBinaryCompressedPcdGivesItsViewpoint) {
+  // room_scan1.pcd (shared data) keeps PCL's default VIEWPOINT 0 0 0 1 0 0 0 on line 9.
+  Result<std::vector<KnownStation>> r = ReadStationFile(testing::SharedDataPath("room-2scans/room_scan1.pcd"));
+  ASSERT_TRUE(r.ok()) << r.status().ToString();
+  ASSERT_EQ(r->size(), 1u);
+  EXPECT_EQ((*r)[0].position_m, WorldPoint(0, 0, 0));
+  EXPECT_DOUBLE_EQ(*(*r)[0].heading_rad, 0);
+  EXPECT_THAT((*r)[0].source, ::testing::EndsWith("room_scan1.pcd:9"));
 }
 
 // The error's code and that its message holds `where`.
