@@ -33,12 +33,16 @@ std::string Lower(std::string_view s) {
   return out;
 }
 
-// A row's fields: split at ',' or ';' when the line has either, else at runs of spaces and tabs.
+// A row's fields: split at ';' when the line has one (so "1,5" stays one field, a decimal comma the
+// number check then refuses), else at ',' when it has one, else at runs of spaces and tabs.
 std::vector<std::string_view> SplitRow(std::string_view line) {
-  if (line.find_first_of(",;") == std::string_view::npos) return readers::SplitWhitespace(line);
+  const char separator = line.find(';') != std::string_view::npos   ? ';'
+                         : line.find(',') != std::string_view::npos ? ','
+                                                                    : '\0';
+  if (separator == '\0') return readers::SplitWhitespace(line);
   std::vector<std::string_view> fields;
   for (size_t pos = 0;;) {
-    const size_t end = line.find_first_of(",;", pos);
+    const size_t end = line.find(separator, pos);
     fields.push_back(Trim(line.substr(pos, end == std::string_view::npos ? std::string_view::npos : end - pos)));
     if (end == std::string_view::npos) break;
     pos = end + 1;
@@ -135,6 +139,8 @@ Result<KnownStation> ParseRow(const std::vector<std::string_view>& fields, const
 }
 
 Result<std::vector<KnownStation>> ParseText(std::string_view bytes, std::string_view source) {
+  constexpr std::string_view kUtf8Bom = "\xEF\xBB\xBF";  // spreadsheet exports start with one
+  if (bytes.substr(0, kUtf8Bom.size()) == kUtf8Bom) bytes.remove_prefix(kUtf8Bom.size());
   std::vector<KnownStation> out;
   Columns columns;
   bool first_row = true;

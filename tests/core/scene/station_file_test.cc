@@ -48,6 +48,18 @@ TEST(StationFileTest, HeaderColumnsInAnyOrderWithRadiansAndWhitespace) {
   EXPECT_DOUBLE_EQ(*(*r)[0].heading_rad, 0.5);
 }
 
+TEST(StationFileTest, ASpreadsheetExportWithABomAndSemicolons) {
+  Result<std::vector<KnownStation>> r = ParseStationFile("\xEF\xBB\xBFID;X;Y;Z\r\nA;1.5;2;1.6\r\n", "excel.csv");
+  ASSERT_TRUE(r.ok()) << r.status().ToString();
+  ASSERT_EQ(r->size(), 1u);
+  EXPECT_EQ((*r)[0].position_m, WorldPoint(1.5, 2, 1.6));
+  EXPECT_EQ((*r)[0].name, "A");
+  // A decimal comma is one field, refused as a number, not read as two.
+  Result<std::vector<KnownStation>> comma = ParseStationFile("x;y;z\n1,5;2;1,6\n", "comma.csv");
+  ASSERT_FALSE(comma.ok());
+  EXPECT_THAT(comma.status().message(), HasSubstr("comma.csv:2: x (column 1) \"1,5\" is not a number"));
+}
+
 TEST(StationFileTest, HeaderlessRowsAreXyzAndMore) {
   // vc's own stations.csv has a header; a bare "x y z route_order" file works too.
   Result<std::vector<KnownStation>> r = ParseStationFile("1,2,3,1\n4 5 6 2 extra\n", "bare.csv");
