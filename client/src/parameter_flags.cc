@@ -12,7 +12,7 @@
 
 #include "vc/plan/keep_out.h"
 #include "vc/report/plan_report.h"
-#include "vc/scene/e57.h"
+#include "vc/scene/station_file.h"
 #include "vc/visibility/scanner_presets.h"
 
 namespace vc::client {
@@ -130,8 +130,9 @@ std::string ScannerPresetsTable() {
 void AddPlanFileFlags(CLI::App* command, PlanFileFlags* files) {
   command->add_option("--candidates", files->candidates, "CSV of candidate positions x,y,z (replaces the grid)");
   command->add_option("--fixed-stations", files->fixed_stations,
-                      "stations already placed, the plan adds to them: a CSV x,y,z (e.g. stations.csv), or an "
-                      "E57 file whose scans' origins are taken");
+                      "stations already placed, the plan adds to them: a CSV with or without a header naming "
+                      "x,y,z (e.g. stations.csv, or a pose table x,y,z,roll,pitch,yaw), an E57 file or an "
+                      "OctoMap .graph (its scans' origins), or a PCD file (its VIEWPOINT)");
   command->add_option("--keep-out", files->keep_out,
                       "CSV of keep-out zones: box,xmin,ymin,zmin,xmax,ymax,zmax or polygon,zmin,zmax,x1,y1,...");
   command->add_option("--start", files->start,
@@ -177,18 +178,9 @@ Status LoadPlanFiles(const PlanFileFlags& files, PlanOptions* o) {
     VC_ASSIGN_OR_RETURN(o->candidates, ParseStationsCsv(text, files.candidates));
   }
   if (!files.fixed_stations.empty()) {
-    VC_ASSIGN_OR_RETURN(std::string text, ReadText(files.fixed_stations, "fixed stations"));
-    if (LooksLikeE57(text)) {
-      // What was already scanned: each scan's origin (its pose translation) is a station.
-      VC_ASSIGN_OR_RETURN(const std::vector<E57Scan> scans, ReadE57Scans(text, files.fixed_stations));
-      if (scans.empty()) {
-        return InvalidArgumentError(files.fixed_stations + ": the E57 file holds no scans, so no fixed stations");
-      }
-      o->fixed_stations.clear();
-      for (const E57Scan& scan : scans) o->fixed_stations.push_back(scan.translation_m);
-    } else {
-      VC_ASSIGN_OR_RETURN(o->fixed_stations, ParseStationsCsv(text, files.fixed_stations));
-    }
+    VC_ASSIGN_OR_RETURN(const std::vector<KnownStation> stations, ReadStationFile(files.fixed_stations));
+    o->fixed_stations.clear();
+    for (const KnownStation& s : stations) o->fixed_stations.push_back(s.position_m);
   }
   if (!files.keep_out.empty()) {
     VC_ASSIGN_OR_RETURN(std::string text, ReadText(files.keep_out, "keep-out"));

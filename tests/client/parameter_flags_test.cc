@@ -321,6 +321,19 @@ TEST(ListParametersTest, FixedStationsFromAnE57FilesScanOrigins) {
   EXPECT_NE(s.message().find("damaged.e57: E57 page 1"), std::string::npos) << s.message();
 }
 
+// --fixed-stations takes a pose table with a header and extra columns (3DTK-style), its rows in
+// order; every other source is tested with vc::ParseStationFile (tests/core/scene/station_file_test.cc).
+TEST(ListParametersTest, FixedStationsFromAPoseCsvWithAHeader) {
+  client::PlanFileFlags files;
+  files.fixed_stations = WriteTemp("poses.csv", "name,x,y,z,roll,pitch,yaw\ns1,1,2,1.5,0,0,90\ns2,-4,0.5,1.7,1,2,3\n");
+  PlanOptions o;
+  const Status s = client::LoadPlanFiles(files, &o);
+  ASSERT_TRUE(s.ok()) << s.ToString();
+  ASSERT_EQ(o.fixed_stations.size(), 2u);
+  EXPECT_EQ(o.fixed_stations[0], WorldPoint(1, 2, 1.5));
+  EXPECT_EQ(o.fixed_stations[1], WorldPoint(-4, 0.5, 1.7));
+}
+
 TEST(ListParametersTest, StationsCarryFixedAndTheHeatMapItsFloorsOverTheWire) {
   PlannedStation s;
   s.fixed = true;

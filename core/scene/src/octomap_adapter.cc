@@ -319,6 +319,7 @@ Result<ScanGraphData> ReadScanGraph(std::string_view bytes, std::string_view sou
     rot.normalize();
     const Eigen::Vector3d trans(t[0], t[1], t[2]);
     out.origins.push_back(trans);
+    out.origin_rotations.push_back(rot);
     out.points.reserve(out.points.size() + count);
     for (const Eigen::Vector3d& l : local) {
       const Eigen::Vector3d w = rot * l + trans;

@@ -33,7 +33,7 @@ std::string ScannerPresetsTable();
 // The plan's list parameters that come from files (paths; empty = not given).
 struct PlanFileFlags {
   std::string candidates;      // stations.csv format: user candidates
-  std::string fixed_stations;  // stations already placed: stations.csv format, or an E57 file (its scans' origins)
+  std::string fixed_stations;  // stations already placed: any file ReadStationFile reads (vc/scene/station_file.h)
   std::string keep_out;        // keep-out CSV (docs/PLANNING.md, "Keep-out zones")
   std::string start;           // "x,y" or "x,y,z" (m): where the walking route starts
 };

@@ -27,6 +27,54 @@ Status CheckUserPositions(const VoxelScene& scene, const std::vector<WorldPoint>
   return Status::Ok();
 }
 
+// How far outside the occupied voxels' bounding box a fixed station may lie (m): a tripod over a
+// scanned floor with nothing scanned above it.
+constexpr double kFixedStationBoundsMargin_m = 2.0;
+// A fixed station whose nearest occupied voxel straight below is farther than this (m) gets a warning.
+constexpr double kFixedStationFloorWithin_m = 3.0;
+
+std::string Bounds(const WorldPoint& lo, const WorldPoint& hi) {
+  return "x " + Num(lo.x()) + ".." + Num(hi.x()) + ", y " + Num(lo.y()) + ".." + Num(hi.y()) + ", z " + Num(lo.z()) +
+         ".." + Num(hi.z()) + " m";
+}
+
+// Distance (m) from p down to the top of the nearest occupied voxel straight below it; NaN if none.
+double DistanceToFloorBelow(const VoxelScene& scene, const WorldPoint& p) {
+  const VoxelIndex v = scene.grid.WorldToIndex(p);
+  for (int z = v.z; z >= scene.grid.min_index().z; --z) {
+    if (scene.grid.Occupied(v.x, v.y, z)) return p.z() - (z + 1) * scene.resolution_m;
+  }
+  return std::nan("");
+}
+
+// INVALID_ARGUMENT naming fixed_stations[i] (the i+1-th station of the user's file) and the scene's
+// bounds when one lies outside them (widened by kFixedStationBoundsMargin_m); a warning for each one
+// without an occupied voxel within kFixedStationFloorWithin_m straight below.
+Result<std::vector<std::string>> CheckFixedStations(const VoxelScene& scene, const std::vector<WorldPoint>& fixed) {
+  std::vector<std::string> warnings;
+  if (fixed.empty()) return warnings;
+  const Eigen::Vector3d margin = Eigen::Vector3d::Constant(kFixedStationBoundsMargin_m);
+  const WorldPoint lo = scene.BoundsMin(), hi = scene.BoundsMax();
+  for (size_t i = 0; i < fixed.size(); ++i) {
+    const WorldPoint& p = fixed[i];
+    const std::string name = "fixed_stations[" + std::to_string(i) + "] (station " + std::to_string(i + 1) +
+                             " of the file, at " + Num(p.x()) + ", " + Num(p.y()) + ", " + Num(p.z()) + ")";
+    if ((p.array() < (lo - margin).array()).any() || (p.array() > (hi + margin).array()).any()) {
+      return InvalidArgumentError(name + " lies outside the scene's bounds (" + Bounds(lo, hi) + ", widened by " +
+                                  Num(kFixedStationBoundsMargin_m) +
+                                  " m); is it in another frame or unit than the scene?");
+    }
+    const double below_m = DistanceToFloorBelow(scene, p);
+    if (std::isnan(below_m)) {
+      warnings.push_back(name + " has no floor below it: no occupied voxel lies straight below");
+    } else if (below_m > kFixedStationFloorWithin_m) {
+      warnings.push_back(name + " has no floor within " + Num(kFixedStationFloorWithin_m) +
+                         " m below it: the nearest occupied voxel straight below is " + Num(below_m) + " m down");
+    }
+  }
+  return warnings;
+}
+
 // The user's candidates, checked: in range, and not inside an occupied voxel; those in a keep-out
 // zone are dropped (with a warning). FAILED_PRECONDITION when none is left.
 Result<CandidatesOutput> UserCandidates(const VoxelScene& scene, const PlanOptions& options) {
@@ -109,8 +157,11 @@ Result<CandidatesOutput> GridCandidates(const VoxelScene& scene, const PlanOptio
 Result<CandidatesOutput> RunCandidatesStage(const CandidatesInput& in, const PlanOptions& options,
                                             const JobContext& ctx) {
   VC_RETURN_IF_ERROR(CheckUserPositions(in.scene, options.fixed_stations, "fixed_stations"));
-  if (!options.candidates.empty()) return UserCandidates(in.scene, options);
-  return GridCandidates(in.scene, options, ctx);
+  VC_ASSIGN_OR_RETURN(std::vector<std::string> fixed_warnings, CheckFixedStations(in.scene, options.fixed_stations));
+  Result<CandidatesOutput> out =
+      options.candidates.empty() ? GridCandidates(in.scene, options, ctx) : UserCandidates(in.scene, options);
+  if (out.ok()) out->warnings.insert(out->warnings.begin(), fixed_warnings.begin(), fixed_warnings.end());
+  return out;
 }
 
 }  // namespace vc::planner

@@ -67,7 +67,9 @@ struct CandidatesOutput {
 };
 // Generated candidates at every height of options.TripodHeights(), or the user's; either without
 // those in a keep-out zone. INVALID_ARGUMENT for a user candidate or fixed station out of range or
-// inside an occupied voxel; FAILED_PRECONDITION when no floor is found or no candidate survives.
+// inside an occupied voxel, or a fixed station outside the scene's bounds (widened by 2 m, naming
+// them); a warning for a fixed station without an occupied voxel within 3 m straight below.
+// FAILED_PRECONDITION when no floor is found or no candidate survives.
 [[nodiscard]] Result<CandidatesOutput> RunCandidatesStage(const CandidatesInput& in, const PlanOptions& options,
                                                           const JobContext& ctx);
 

@@ -7,6 +7,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -38,10 +39,11 @@ Result<std::shared_ptr<octomap::OcTree>> ReadOctreeBinary(std::string_view bytes
 Result<std::shared_ptr<octomap::OcTree>> ReadOctreeText(std::string_view bytes, std::string_view source,
                                                         uint64_t max_tree_bytes = UINT64_MAX);
 
-// A scan graph (.graph): every node's points transformed to the world frame, and each node's origin.
+// A scan graph (.graph): every node's points transformed to the world frame, and each node's pose.
 struct ScanGraphData {
   std::vector<Eigen::Vector3f> points;
-  std::vector<Eigen::Vector3d> origins;
+  std::vector<Eigen::Vector3d> origins;              // Each node's origin (m), world frame.
+  std::vector<Eigen::Quaterniond> origin_rotations;  // Each node's rotation (unit), scanner to world.
   uint64_t dropped_nonfinite = 0;
 };
 Result<ScanGraphData> ReadScanGraph(std::string_view bytes, std::string_view source);
