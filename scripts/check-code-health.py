@@ -11,7 +11,8 @@
   3. Every public header has a mirrored test (core/<layer>/include/vc/<layer>/<x>.h ->
      tests/core/<layer>/<x>_test.cc; server/include/vc/server/<x>.h -> tests/server/<x>_test.cc;
      client/ -> tests/client/; proto/include/vc/wire/<x>.h -> tests/proto/<x>_test.cc) or a line in
-     scripts/header-test-exemptions.txt saying why not.
+     scripts/header-test-exemptions.txt saying why not; and every tests/**/<x>_test.cc is compiled into
+     a test executable (named in a tests/**/CMakeLists.txt).
 
 The function scanner strips comments, strings and raw strings, then matches braces; a brace opens a
 function body when the text before it ends in a parameter list (with qualifiers, a trailing return
@@ -44,8 +45,20 @@ def blank(text):
     return re.sub(r"[^\n]", " ", text)
 
 
+LITERAL_PREFIXES = ("", "u", "U", "L", "u8")
+
+
+def word_before(src, i):
+    """The identifier or number that ends just before src[i] ("" when none)."""
+    j = i
+    while j > 0 and (src[j - 1].isalnum() or src[j - 1] == "_"):
+        j -= 1
+    return src[j:i]
+
+
 def strip_code(src):
-    """src with comments, string and character literals blanked out (newlines kept)."""
+    """src with comments, string and character literals blanked out (newlines kept). Literal
+    prefixes (u8"", L'x', LR"(...)") are literals too; a ' inside a number (1'000) is not."""
     out, i, n = [], 0, len(src)
     while i < n:
         if src.startswith("//", i):
@@ -54,11 +67,11 @@ def strip_code(src):
         elif src.startswith("/*", i):
             j = src.find("*/", i + 2)
             j = n if j < 0 else j + 2
-        elif src.startswith('R"', i) and (i == 0 or not (src[i - 1].isalnum() or src[i - 1] == "_")):
+        elif src.startswith('R"', i) and word_before(src, i) in LITERAL_PREFIXES:
             m = re.match(r'R"([^(\s]*)\(', src[i:])
             end = src.find(")" + m.group(1) + '"', i) if m else -1
             j = n if end < 0 else end + len(m.group(1)) + 2
-        elif src[i] in "\"'" and not (src[i] == "'" and i > 0 and src[i - 1].isalnum()):  # 1'000 digit separators
+        elif src[i] in "\"'" and word_before(src, i) in LITERAL_PREFIXES:
             quote, j = src[i], i + 1
             while j < n and src[j] != quote and src[j] != "\n":
                 j += 2 if src[j] == "\\" else 1
@@ -72,8 +85,14 @@ def strip_code(src):
     return "".join(out)
 
 
+# What may stand between a function's parameter list and its body: qualifiers, a trailing return
+# type, a requires clause, a macro (VC_NOEXCEPT), `try`, and a constructor's initialiser list.
 FUNCTION_HEAD = re.compile(
-    r"\)\s*((const|override|final|noexcept|mutable|&&?|->\s*[\w:<>,\s*&]+|\[\[[\w:]+\]\])\s*)*(:[^;{}]*)?$")
+    r"\)\s*((const|override|final|noexcept|mutable|try|&&?|->\s*[\w:<>,\s*&]+|\[\[[\w:]+\]\]|[A-Z][A-Z0-9_]+"
+    r"|requires\s+[^;{}]+?)\s*)*(:[^;]*)?$")
+LAMBDA_HEAD = re.compile(r"\[[^\[\]]*\]\s*(mutable\s*)?$")  # [] { ... } without a parameter list
+# A braced member initialiser (`: a_(x), b_{y}`): the brace follows a name in the initialiser list.
+MEMBER_INIT = re.compile(r"\)\s*(noexcept\s*)?:[^;]*[\w>]$")
 CONTROL = re.compile(r"\b(if|for|while|switch|catch|namespace|class|struct|enum|union)\b[^()]*(\(|$)")
 
 
@@ -86,18 +105,24 @@ def functions(path):
         if m.group() == "{":
             head = " ".join(text[last:pos].split())
             inside = any(kind == "fn" for kind, _, _ in stack)
-            is_fn = not inside and FUNCTION_HEAD.search(head) and not CONTROL.match(head)
+            if not inside and not CONTROL.match(head) and MEMBER_INIT.search(head):
+                stack.append(("init", 0, ""))  # the head goes on to the body's brace
+                continue
+            is_fn = not inside and not CONTROL.match(head) and (FUNCTION_HEAD.search(head) or LAMBDA_HEAD.search(head))
             names = re.findall(r"([~\w:]+)\s*\(", head)
             stack.append(("fn" if is_fn else "block", text.count("\n", 0, pos) + 1, names[0] if names else head[:40]))
         elif m.group() == "}" and stack:
             kind, line, name = stack.pop()
+            if kind == "init":
+                continue
             if kind == "fn":
                 found.append((name, line, text.count("\n", 0, pos) + 1 - line + 1))
         last = pos + 1
     return found
 
 
-PATH = re.compile(r"(?<![\w./-])((?:" + "|".join(re.escape(t) for t in TOP) + r")/[\w./*{}-]*[\w*}])")
+# A path from the repository root, bare or after "./" (not inside $BIN/... or build/...).
+PATH = re.compile(r"(?:(?<![\w./-])|(?<=(?<![\w./-])\./))((?:" + "|".join(re.escape(t) for t in TOP) + r")/[\w./*{}-]*[\w*}])")
 
 
 def path_exists(ref, files, dirs):
@@ -162,6 +187,12 @@ def main():
                 problems.append(f"{f}: no mirrored test ({test}) and no line in scripts/header-test-exemptions.txt")
         elif f in exempt:
             problems.append(f"scripts/header-test-exemptions.txt: {f} has a test ({test}); drop its exemption")
+
+    cmake_text = "\n".join((ROOT / f).read_text() for f in files if f.startswith("tests/") and f.endswith("CMakeLists.txt"))
+    for f in files:
+        if f.startswith("tests/") and f.endswith("_test.cc") and not re.search(
+                r"(^|[\s/])" + re.escape(pathlib.PurePosixPath(f).name) + r"(\s|\))", cmake_text):
+            problems.append(f"{f}: a test file in no test executable (tests/**/CMakeLists.txt names no {pathlib.PurePosixPath(f).name})")
 
     if "--list" in sys.argv:
         for lines, where in sorted(longest, reverse=True)[:30]:

@@ -796,7 +796,7 @@ void ExactRun::SetStationBound(const CoverModel& model, const CbcOutcome& outcom
     opt.note = "the time limit cut off an LP in the search; the bound is the root LP's or CBC's last";
 }
 
-// Never worse than greedy: (reaches the target, fewer stations) or (more covered, fewer stations),
+// Never worse than greedy: (reaches the target, no more stations) or (more covered, no more stations),
 // or greedy's plan is not connected where it must be.
 bool ExactRun::AtLeastAsGoodAsGreedy(const std::vector<int>& picks) const {
   const uint64_t covered = Covered(sets_, picks);

@@ -246,11 +246,13 @@ Status ValidateCylinder(const SceneCylinder& cylinder, const std::string& where)
 }
 
 // Number of beams across an angular span: every step once around for a full 360 deg circle, else
-// both ends of the span included.
+// both ends of the span included. Counted in double and saturated just past kMaxSimulatedBeams, so
+// a tiny step is refused by the limit instead of overflowing the cast (or the product of two counts).
 uint64_t BeamsAcross(double span_deg, double step_deg, bool full_circle) {
   const double steps = std::floor(span_deg / step_deg + kAngleSlack);
-  if (full_circle) return std::max<uint64_t>(1, static_cast<uint64_t>(steps));
-  return static_cast<uint64_t>(steps) + 1;
+  const double beams = full_circle ? std::max(1.0, steps) : steps + 1;
+  if (!(beams <= static_cast<double>(kMaxSimulatedBeams))) return kMaxSimulatedBeams + 1;
+  return static_cast<uint64_t>(beams);
 }
 
 bool IsFullCircle(const SimulatedScanner& s) { return s.hfov_deg >= 360.0 - kAngleSlack; }

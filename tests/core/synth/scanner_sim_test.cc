@@ -404,6 +404,19 @@ TEST(ScannerSimTest, TooManyBeamsIsResourceExhausted) {
   EXPECT_NE(scan.status().message().find("horizontal_step_deg"), std::string::npos);
 }
 
+// Steps so small that the beam counts overflow a uint64 (or their product wraps below the limit)
+// are refused by the limit too, never cast out of range.
+TEST(ScannerSimTest, AVanishingStepIsResourceExhaustedNotAnOverflow) {
+  for (const double step : {1e-300, 1e-10, 1e-7}) {
+    SimulatedScanner scanner;
+    scanner.horizontal_step_deg = scanner.vertical_step_deg = step;
+    EXPECT_GT(scanner.BeamCount(), kMaxSimulatedBeams) << step;
+    const Result<SimulatedScan> scan = SimulateScan(WallAt(3.0, 1.0), scanner);
+    ASSERT_FALSE(scan.ok()) << step;
+    EXPECT_EQ(scan.status().code(), StatusCode::kResourceExhausted) << step;
+  }
+}
+
 struct BadScene {
   const char* message_start;
   ScenePrimitive primitive;

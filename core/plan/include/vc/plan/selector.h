@@ -131,7 +131,9 @@ class Selector {
 
 // The options of greedy selection: of GreedySelector, SelectGreedy and ConsolidatePicks (greedy.h).
 // The rows above, with the plan's defaults (max_stations: greedy picks, fixed stations not
-// counted; consolidate: GreedySelector only), then what is not a row of its own here.
+// counted; consolidate: GreedySelector only), then what is not a row of its own here. A default
+// GreedyOptions stops at the plan's target_coverage, 0.99, not at full coverage: set 1.0 to cover
+// every coverable voxel.
 struct GreedyOptions {
   VC_GREEDY_PARAMETERS(VC_DECLARE_PARAMETER)
   // Registration (scan_graph.h; the plan row min_overlap, which the later stages use too): when
