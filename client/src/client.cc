@@ -321,11 +321,20 @@ Status Client::AttachEvaluateOnce(const JobObserver& observer, EvaluateOutcome* 
   return FollowEvaluate(*stream, observer, &last_job_, followed, out);
 }
 
-Result<PlanResult> Client::AttachPlan(const std::string& job_id, const JobObserver& observer) {
+Status Client::FollowPlanJob(const std::string& job_id, const JobObserver& observer, PlanResult* out, bool* accepted) {
   last_job_ = {job_id, "", 0};
+  const auto once = [&](bool* followed) {
+    const Status s = AttachPlanOnce(observer, out, followed);
+    *accepted = *accepted || *followed;
+    return s;
+  };
+  return Reattach(WithRetries(observer, once), observer, once);
+}
+
+Result<PlanResult> Client::AttachPlan(const std::string& job_id, const JobObserver& observer) {
   PlanResult out;
-  const auto once = [&](bool* followed) { return AttachPlanOnce(observer, &out, followed); };
-  const Status s = Reattach(WithRetries(observer, once), observer, once);
+  bool accepted = false;
+  const Status s = FollowPlanJob(job_id, observer, &out, &accepted);
   if (!s.ok()) return s;
   return out;
 }
@@ -341,12 +350,10 @@ Result<EvaluateOutcome> Client::AttachEvaluate(const std::string& job_id, const 
 
 Result<AttachedJob> Client::Attach(const std::string& job_id, const JobObserver& observer) {
   AttachedJob job;
-  Result<PlanResult> plan = AttachPlan(job_id, observer);
-  if (plan.ok()) {
-    job.plan = std::move(plan).value();
-    return job;
-  }
-  if (plan.status().code() != StatusCode::kFailedPrecondition) return plan.status();
+  bool is_plan = false;  // AttachPlan replayed the job's Accepted event: the job is a plan
+  const Status plan = FollowPlanJob(job_id, observer, &job.plan, &is_plan);
+  if (plan.ok()) return job;
+  if (is_plan || plan.code() != StatusCode::kFailedPrecondition) return plan;
   VC_ASSIGN_OR_RETURN(job.evaluation, AttachEvaluate(job_id, observer));
   job.kind = AttachedJob::Kind::kEvaluation;
   return job;

@@ -112,12 +112,13 @@ TEST(Client, MissingTlsFileIsNotFound) {
 }
 
 // BlockingBackend's scene reading, with a plan and an evaluation that wait for `gate` (or the
-// job's cancellation) and then return fixed results.
+// job's cancellation) and then return fixed results (the plan fails with `plan_failure` if set).
 struct GatedBackend {
   static constexpr double kEvaluationG = 0.625;
   testing::BlockingBackend blocking;
   testing::Latch gate;
   PlanResult plan_result = BigResult();
+  Status plan_failure;
 
   server::Backend Make() {
     server::Backend b = blocking.Make();
@@ -130,6 +131,7 @@ struct GatedBackend {
     b.plan = [this, wait](const SceneInput&, const PlanOptions&, const JobContext& ctx,
                           const PlanCallbacks&) -> Result<PlanResult> {
       VC_RETURN_IF_ERROR(wait(ctx));
+      if (!plan_failure.ok()) return plan_failure;
       return plan_result;
     };
     b.evaluate = [wait](const SceneInput&, const EvaluateJobOptions&, const JobContext& ctx) -> Result<Evaluation> {
@@ -194,6 +196,18 @@ TEST(Client, AttachFollowsAPlanJob) {
   EXPECT_EQ(job->kind, client::AttachedJob::Kind::kPlan);
   EXPECT_EQ(job->plan.voxel_centers, backend.plan_result.voxel_centers);
   EXPECT_EQ(job->plan.stations.size(), backend.plan_result.stations.size());
+}
+
+TEST(Client, AttachToAPlanJobThatFailsWithFailedPreconditionReturnsThePlansError) {
+  GatedBackend backend;
+  backend.plan_failure = FailedPreconditionError("no floor found: try a lower tripod_height_m");
+  const auto job = SubmitThenAttach(backend, [](client::Client& c, const client::JobObserver& observer) {
+    return c.Plan({"some scene bytes", "x.ply"}, PlanOptions{}, observer).status();
+  });
+  ASSERT_FALSE(job.ok()) << "the plan failed";
+  EXPECT_EQ(job.status().code(), StatusCode::kFailedPrecondition) << job.status().ToString();
+  EXPECT_NE(job.status().message().find("no floor found: try a lower tripod_height_m"), std::string::npos)
+      << "the plan's own message, not AttachEvaluate's: " << job.status().ToString();
 }
 
 TEST(Client, AttachFallsBackToAttachEvaluateForAnEvaluateJob) {

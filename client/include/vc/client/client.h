@@ -135,8 +135,9 @@ class Client {
   // other kind; NOT_FOUND when the server does not hold it (any more).
   Result<PlanResult> AttachPlan(const std::string& job_id, const JobObserver& observer = {});
   Result<EvaluateOutcome> AttachEvaluate(const std::string& job_id, const JobObserver& observer = {});
-  // Re-attaches to a job of either kind: AttachPlan, then AttachEvaluate when the server answers
-  // FAILED_PRECONDITION (the job is an Evaluate job). NOT_FOUND when the server does not hold it.
+  // Re-attaches to a job of either kind: AttachPlan, then AttachEvaluate when the server refuses it
+  // with FAILED_PRECONDITION before any event (the job is an Evaluate job); a plan job's own
+  // failure is returned as it is. NOT_FOUND when the server does not hold the job.
   Result<AttachedJob> Attach(const std::string& job_id, const JobObserver& observer = {});
   // Cancels a detachable job, or discards its kept result: "cancelled" or "discarded".
   Result<std::string> CancelJob(const std::string& job_id);
@@ -157,13 +158,16 @@ class Client {
   void Prepare(grpc::ClientContext* ctx) const;
   // The channel to re-attach through: this client's, or one to the ticket's attach_address.
   std::shared_ptr<grpc::Channel> AttachChannel(const JobTicket& ticket);
-  // After a broken stream: re-attaches with `attach(bool* followed)` while the failure is
-  // UNAVAILABLE and the job may still be alive (its grace since the stream was last alive), with
-  // backoff; the original status when the job is not detachable.
   // One AttachPlan / AttachEvaluate call to last_job_, followed to its end; `followed` says
   // whether the job's events came (the stream was alive) before it ended.
   Status AttachPlanOnce(const JobObserver& observer, PlanResult* out, bool* followed);
   Status AttachEvaluateOnce(const JobObserver& observer, EvaluateOutcome* out, bool* followed);
+  // AttachPlan's calls to `job_id`, retried and re-attached, into `out`; `accepted` says whether
+  // the job's Accepted event came (the server holds it as a plan job).
+  Status FollowPlanJob(const std::string& job_id, const JobObserver& observer, PlanResult* out, bool* accepted);
+  // After a broken stream: re-attaches with `attach(bool* followed)` while the failure is
+  // UNAVAILABLE and the job may still be alive (its grace since the stream was last alive), with
+  // backoff; the original status when the job is not detachable.
   template <typename Fn>
   Status Reattach(const Status& broken, const JobObserver& observer, Fn&& attach);
   template <typename Fn>
