@@ -5,8 +5,8 @@
 #   asan     - AddressSanitizer + UndefinedBehaviorSanitizer: every test except the `slow` label
 #   fuzz     - every libFuzzer target (fuzz/, clang + ASan + UBSan) for 10 s each
 #   tsan     - ThreadSanitizer on the tests whose concurrency is all ours (label `tsan`): the worker
-#              pool, upload assembler, outbox, job runner, status mapping, wire code and the
-#              multi-threaded visibility engine. The gRPC
+#              pool, upload assembler, outbox, job runner, shard board, status mapping, wire code,
+#              ParallelChunks and the multi-threaded visibility engine. The gRPC
 #              service tests are not run here: Debian's gRPC, absl and protobuf are not instrumented,
 #              so tsan cannot see the ordering gRPC provides between its threads (README, Testing).
 # Usage: scripts/test.sh [--quick]   (--quick: the release preset only)
