@@ -6,7 +6,8 @@
 
 namespace vc::server {
 
-ShardBoard::ShardBoard(size_t viewpoints, size_t per_shard, NowFn now) : now_(std::move(now)) {
+ShardBoard::ShardBoard(size_t viewpoints, size_t per_shard, NowFn now, Clock::duration poll_interval)
+    : now_(std::move(now)), poll_interval_(poll_interval) {
   for (size_t b = 0; b < viewpoints; b += per_shard) {
     Shard s;
     s.begin = b;
@@ -27,8 +28,9 @@ std::optional<ShardBoard::Attempt> ShardBoard::Take(Clock::duration wait, bool d
     if (std::optional<Attempt> a = TryTakeLocked(defer)) return a;
     const Clock::time_point now = now_();
     if (FinishedLocked() || now >= until) return std::nullopt;
-    // Nothing now; a shard may come back, or one that runs turn slow, before long.
-    cv_.wait_for(lock, std::min<Clock::duration>(until - now, kShardPollInterval));
+    // Nothing now; a shard may come back, or one that runs turn slow, before long. The slice is
+    // real time, bounded so that a deadline on an injected clock is seen within one slice.
+    cv_.wait_for(lock, std::min<Clock::duration>(until - now, poll_interval_));
   }
 }
 

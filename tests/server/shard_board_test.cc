@@ -1,11 +1,19 @@
-// ShardBoard and LaneRetryPolicy: the fan-out's rules, on a fake clock (no sleeps, no sockets).
+// ShardBoard and LaneRetryPolicy: the fan-out's rules, on a fake clock (no sleeps, no sockets);
+// then lanes waiting in Take on other threads, woken by what the board's other calls do.
 #include "vc/server/shard_board.h"
 
 #include <gtest/gtest.h>
 
+#include <array>
+#include <atomic>
 #include <chrono>
+#include <condition_variable>
+#include <future>
+#include <latch>
+#include <mutex>
 #include <optional>
 #include <string>
+#include <thread>
 #include <vector>
 
 namespace vc::server {
@@ -15,16 +23,82 @@ using Attempt = ShardBoard::Attempt;
 using std::chrono::milliseconds;
 using std::chrono::seconds;
 
-// A clock that moves only when told.
+// How long a test waits for another thread before it reports a failure (real time).
+constexpr auto kTestWait = seconds(30);
+// A poll interval no test outlives: a lane that misses its wake-up stays asleep.
+constexpr auto kNoPoll = std::chrono::hours(24);
+
+// A clock that moves only when told; several threads may read and advance it. It counts its
+// reads: the board reads its clock only under its lock.
 class FakeClock {
  public:
   ShardBoard::NowFn fn() {
-    return [this] { return now_; };
+    return [this] { return Read(); };
   }
-  void Advance(ShardBoard::Clock::duration d) { now_ += d; }
+  void Advance(ShardBoard::Clock::duration d) {
+    std::lock_guard lock(mu_);
+    now_ += d;
+  }
+  // Times the clock was read.
+  size_t reads() const {
+    std::lock_guard lock(mu_);
+    return reads_;
+  }
+  // Waits up to kTestWait until the clock has been read more than `n` times; false if it was not.
+  bool AwaitReadsOver(size_t n) {
+    std::unique_lock lock(mu_);
+    return read_.wait_for(lock, kTestWait, [&] { return reads_ > n; });
+  }
 
  private:
+  ShardBoard::Clock::time_point Read() {
+    std::lock_guard lock(mu_);
+    ++reads_;
+    read_.notify_all();
+    return now_;
+  }
+
+  mutable std::mutex mu_;
+  std::condition_variable read_;
   ShardBoard::Clock::time_point now_{seconds(1000)};
+  size_t reads_ = 0;
+};
+
+// A lane on its own thread, in Take(wait, defer) on a board that has nothing for it yet. Once it
+// has read the board's clock it holds the board's lock until it waits, so whatever the test does
+// to the board next happens while the lane waits and must wake it. Joined on destruction (after
+// stopping the board, if the lane is still waiting then).
+class WaitingLane {
+ public:
+  WaitingLane(ShardBoard& board, FakeClock& clock, ShardBoard::Clock::duration wait, bool defer = false)
+      : board_(board) {
+    const size_t reads = clock.reads();
+    std::packaged_task<std::optional<Attempt>()> take([&board, wait, defer] { return board.Take(wait, defer); });
+    answer_ = take.get_future().share();
+    thread_ = std::thread(std::move(take));
+    in_take_ = clock.AwaitReadsOver(reads);
+  }
+  WaitingLane(const WaitingLane&) = delete;
+  WaitingLane& operator=(const WaitingLane&) = delete;
+  ~WaitingLane() {
+    if (!Returned(milliseconds(0))) board_.Stop();
+    thread_.join();
+  }
+
+  // The lane is in Take (it read the board's clock).
+  bool in_take() const { return in_take_; }
+  // Take returned within `wait` (real time).
+  bool Returned(std::chrono::milliseconds wait = kTestWait) const {
+    return answer_.wait_for(wait) == std::future_status::ready;
+  }
+  // What Take returned (once Returned()).
+  std::optional<Attempt> answer() const { return answer_.get(); }
+
+ private:
+  ShardBoard& board_;
+  std::shared_future<std::optional<Attempt>> answer_;
+  std::thread thread_;
+  bool in_take_ = false;
 };
 
 // The shards TryTake hands out until it hands out none.
@@ -248,6 +322,119 @@ TEST(ShardBoard, StopCancelsTheLiveCallsAndHandsOutNothingMore) {
   EXPECT_FALSE(board.SetLive(2, [] {})) << "a call starting after the stop is refused";
   EXPECT_TRUE(board.SetLive(0, nullptr));
   board.Sleep(std::chrono::hours(1));  // returns at once: the board is finished
+}
+
+TEST(ShardBoard, AWaitingTakeWakesWhenAnotherLaneReleasesAShardAndTakesIt) {
+  FakeClock clock;
+  ShardBoard board(4, 4, clock.fn(), kNoPoll);
+  const std::optional<Attempt> failing = board.TryTake();
+  ASSERT_TRUE(failing);
+  WaitingLane lane(board, clock, std::chrono::hours(1));
+  ASSERT_TRUE(lane.in_take());
+  board.Release(*failing);
+  ASSERT_TRUE(lane.Returned()) << "Release did not wake the waiting lane";
+  const std::optional<Attempt> again = lane.answer();
+  ASSERT_TRUE(again);
+  EXPECT_EQ(again->shard, 0u);
+  EXPECT_EQ(board.distribution().retried, 1);
+}
+
+TEST(ShardBoard, StopWakesEveryWaitingTakeWithNothing) {
+  FakeClock clock;
+  ShardBoard board(4, 4, clock.fn(), kNoPoll);
+  ASSERT_TRUE(board.TryTake());
+  WaitingLane first(board, clock, std::chrono::hours(1));
+  WaitingLane second(board, clock, std::chrono::hours(1));
+  ASSERT_TRUE(first.in_take() && second.in_take());
+  board.Stop();
+  ASSERT_TRUE(first.Returned()) << "Stop did not wake the first lane";
+  ASSERT_TRUE(second.Returned()) << "Stop did not wake the second lane";
+  EXPECT_FALSE(first.answer().has_value());
+  EXPECT_FALSE(second.answer().has_value());
+  EXPECT_TRUE(board.Finished());
+}
+
+TEST(ShardBoard, ADeferringTakeWakesWhenTheLastPeerLaneEndsAndTakesAFreshShard) {
+  FakeClock clock;
+  ShardBoard board(8, 4, clock.fn(), kNoPoll);
+  board.LaneStarted();
+  ASSERT_TRUE(board.TryTake());  // the peer lane runs shard 0
+  WaitingLane own(board, clock, std::chrono::hours(1), /*defer=*/true);
+  ASSERT_TRUE(own.in_take());
+  board.LaneEnded();
+  ASSERT_TRUE(own.Returned()) << "LaneEnded did not wake the deferring lane";
+  const std::optional<Attempt> fresh = own.answer();
+  ASSERT_TRUE(fresh);
+  EXPECT_EQ(fresh->shard, 1u);
+}
+
+TEST(ShardBoard, AWaitingTakeWakesWithNothingWhenTheLastShardIsDelivered) {
+  FakeClock clock;
+  ShardBoard board(8, 4, clock.fn(), kNoPoll);
+  const std::optional<Attempt> a = board.TryTake();
+  const std::optional<Attempt> b = board.TryTake();
+  ASSERT_TRUE(a && b);
+  ASSERT_TRUE(board.Deliver(*a, "peer-1"));
+  WaitingLane lane(board, clock, std::chrono::hours(1));
+  ASSERT_TRUE(lane.in_take());
+  ASSERT_TRUE(board.Deliver(*b, "peer-2"));
+  ASSERT_TRUE(lane.Returned()) << "the last Deliver did not wake the waiting lane";
+  EXPECT_FALSE(lane.answer().has_value());
+  EXPECT_TRUE(board.Finished());
+  EXPECT_EQ(board.done(), 2u);
+}
+
+TEST(ShardBoard, AWaitingTakeEndsOnceAnotherThreadAdvancesTheFakeClockPastItsDeadline) {
+  FakeClock clock;
+  ShardBoard board(4, 4, clock.fn());  // the production poll interval: no wake-up comes
+  board.LaneStarted();                 // a peer lane that runs nothing: the deferring lane waits on
+  WaitingLane own(board, clock, std::chrono::hours(1), /*defer=*/true);
+  ASSERT_TRUE(own.in_take());
+  clock.Advance(std::chrono::hours(1));
+  ASSERT_TRUE(own.Returned()) << "Take did not see the fake clock pass its deadline";
+  EXPECT_FALSE(own.answer().has_value());
+  EXPECT_FALSE(board.Finished());
+}
+
+TEST(ShardBoard, AWaitingTakeStartsAShardAgainOnceTheFakeClockMakesItSlow) {
+  FakeClock clock;
+  ShardBoard board(4, 4, clock.fn());
+  ASSERT_TRUE(board.TryTake());
+  WaitingLane lane(board, clock, std::chrono::hours(1));
+  ASSERT_TRUE(lane.in_take());
+  clock.Advance(kSlowShardBeforeAnyFinished);
+  ASSERT_TRUE(lane.Returned()) << "Take did not look again at the running shard";
+  const std::optional<Attempt> restart = lane.answer();
+  ASSERT_TRUE(restart);
+  EXPECT_EQ(restart->shard, 0u);
+  EXPECT_EQ(board.distribution().retried, 1);
+}
+
+TEST(ShardBoard, ACallSetLiveWhileTheBoardStopsIsCancelledExactlyOnceOrRefused) {
+  constexpr size_t kLanes = 4;
+  for (int round = 0; round < 100; ++round) {
+    FakeClock clock;
+    ShardBoard board(4, 4, clock.fn());
+    std::array<std::atomic<int>, kLanes> cancelled{};
+    std::array<bool, kLanes> live{};
+    std::latch go(kLanes + 1);
+    std::vector<std::thread> lanes;
+    for (size_t k = 0; k < kLanes; ++k) {
+      lanes.emplace_back([&, k] {
+        go.arrive_and_wait();
+        live[k] = board.SetLive(k, [&cancelled, k] { ++cancelled[k]; });
+      });
+    }
+    go.arrive_and_wait();
+    board.Stop();
+    for (std::thread& t : lanes) t.join();
+    for (size_t k = 0; k < kLanes; ++k) {
+      EXPECT_EQ(cancelled[k].load(), live[k] ? 1 : 0) << "round " << round << ", lane " << k;
+      EXPECT_TRUE(board.SetLive(k, nullptr));
+    }
+    board.Stop();  // the calls ended: a second stop cancels nothing
+    for (size_t k = 0; k < kLanes; ++k) EXPECT_EQ(cancelled[k].load(), live[k] ? 1 : 0) << "round " << round;
+  }
 }
 
 TEST(ShardBoard, KeepsWarningsInOrderAndSumsBytes) {

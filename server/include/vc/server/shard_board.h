@@ -12,8 +12,16 @@
 // Kept apart from peers.cc's gRPC lanes so the rules are tested alone: the clock is injected (a
 // fake one in tests) and each lane's call in flight is a cancel callback (gRPC's TryCancel there).
 //
-// Thread-safe: the lanes of a fan-out share one board. A cancel callback runs under the board's
-// lock and must not call the board. LaneRetryPolicy is one lane's and not thread-safe.
+// Waiting: Take's `wait` is measured on the injected clock, while the lane sleeps in real time on a
+// condition variable, in slices of at most the poll interval (kShardPollInterval unless a test
+// says otherwise). Deliver, Release, LaneEnded and Stop wake every waiting lane at once; at the end
+// of each slice Take reads the clock again (a running shard may have turned slow, or the deadline
+// passed). So with a fake clock that another thread advances, a waiting Take ends within one slice
+// of the deadline; with a frozen one it ends only with an attempt or a finished board. With the
+// real clock this is one wait of `wait` that wakes up every poll interval.
+//
+// Thread-safe: the lanes of a fan-out share one board. The clock and a cancel callback run under
+// the board's lock and must not call the board. LaneRetryPolicy is one lane's and not thread-safe.
 #pragma once
 
 #include <chrono>
@@ -61,8 +69,10 @@ class ShardBoard {
     Clock::time_point started;
   };
 
-  // Shards of `per_shard` (>= 1) of `viewpoints`, in order; the last may be smaller.
-  ShardBoard(size_t viewpoints, size_t per_shard, NowFn now = Clock::now);
+  // Shards of `per_shard` (>= 1) of `viewpoints`, in order; the last may be smaller. A waiting Take
+  // looks again every `poll_interval` (> 0) of real time.
+  ShardBoard(size_t viewpoints, size_t per_shard, NowFn now = Clock::now,
+             Clock::duration poll_interval = kShardPollInterval);
 
   // Number of shards.
   [[nodiscard]] size_t size() const { return shards_.size(); }
@@ -72,8 +82,8 @@ class ShardBoard {
   // stopped. With `defer`, a shard nobody runs is taken only once no peer lane is left or one of
   // them has stalled (a slow shard).
   [[nodiscard]] std::optional<Attempt> TryTake(bool defer = false);
-  // TryTake, waiting up to `wait` for an attempt (nullopt then; Finished() tells whether any
-  // will come).
+  // TryTake, waiting up to `wait` on the board's clock for an attempt (nullopt then; Finished()
+  // tells whether any will come). Returns at once when the board finishes.
   [[nodiscard]] std::optional<Attempt> Take(Clock::duration wait, bool defer = false);
   // The attempt ended with an answer from `who`. True when it is the shard's first answer (the
   // caller keeps its items); false when another attempt answered first.
@@ -124,6 +134,7 @@ class ShardBoard {
   std::optional<size_t> Slowest(Clock::time_point now) const;
 
   const NowFn now_;
+  const Clock::duration poll_interval_;
   mutable std::mutex mu_;
   std::condition_variable cv_;
   std::vector<Shard> shards_;
