@@ -156,6 +156,8 @@ def main():
         if not f.endswith((".h", ".cc", ".md", ".sh", ".py", ".txt", ".cmake", ".proto", ".yaml", ".yml")) and f not in (
                 "Dockerfile", ".ci/run"):
             continue
+        if f == "scripts/check_code_health_test.py":  # names missing paths on purpose
+            continue
         for n, text in enumerate((ROOT / f).read_text(errors="replace").splitlines(), 1):
             if INCLUDE.match(text):  # the compiler checks #include lines
                 continue
