@@ -79,6 +79,10 @@ struct SceneInput {
   std::vector<Eigen::Vector3f> points;
   // .graph and .e57 only: the sensor origin of each scan, in metres, world frame.
   std::vector<Eigen::Vector3d> scan_origins;
+  // Where the local frame's origin lies in the input's own frame, in metres: `points` and
+  // `scan_origins` are input coordinates minus this (docs/PLANNING.md, "Coordinates"). Zero for a
+  // scene near its frame's origin; a whole number of kilometres for survey coordinates.
+  Eigen::Vector3d frame_origin_m = Eigen::Vector3d::Zero();
   // .bt/.ot only: the tree as read, at its own resolution.
   std::shared_ptr<const octomap::OcTree> octree;
   // Points dropped because a coordinate was NaN or infinite.

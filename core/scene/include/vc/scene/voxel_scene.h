@@ -45,6 +45,9 @@ struct VoxelScene {
   OccupancyGrid grid;
   // Scanner origins carried from the input (.graph), in metres; may be empty.
   std::vector<WorldPoint> scan_origins;
+  // The input frame's coordinates of this scene's origin (SceneInput::frame_origin_m): every
+  // position here is local; add this to write it in the input's own frame.
+  WorldPoint frame_origin_m = WorldPoint::Zero();
 
   // Id of an occupied voxel, or -1 if `key` is not occupied.
   int64_t IdOf(const VoxelKey& key) const;
