@@ -154,6 +154,16 @@ std::string_view CompressionName(Compression c) {
   return "unknown";
 }
 
+Result<double> MetresPerUnit(std::string_view unit_name) {
+  if (unit_name == "m") return 1.0;
+  if (unit_name == "cm") return 0.01;
+  if (unit_name == "mm") return 0.001;
+  if (unit_name == "ft") return 0.3048;
+  if (unit_name == "us-ft") return 1200.0 / 3937.0;
+  return InvalidArgumentError("unknown length unit \"" + std::string(unit_name) +
+                              "\"; use one of m, cm, mm, ft (international foot), us-ft (US survey foot)");
+}
+
 ReadOptions ReadLimits(uint64_t max_upload_bytes, uint64_t memory_budget_bytes) {
   const uint64_t upload = std::max<uint64_t>(max_upload_bytes, 1);
   const uint64_t half_budget = std::max<uint64_t>(memory_budget_bytes / 2, 1);

@@ -353,5 +353,17 @@ TEST(SceneInputRealDataTest, Geb079Octree) {
   EXPECT_EQ(CountOccupiedLeaves(*r->octree), 143'729u);
 }
 
+TEST(MetresPerUnitTest, EachNamedUnitAndARefusal) {
+  EXPECT_EQ(*MetresPerUnit("m"), 1.0);
+  EXPECT_EQ(*MetresPerUnit("cm"), 0.01);
+  EXPECT_EQ(*MetresPerUnit("mm"), 0.001);
+  EXPECT_EQ(*MetresPerUnit("ft"), 0.3048);
+  EXPECT_NEAR(*MetresPerUnit("us-ft"), 0.3048006096, 1e-10);
+  Result<double> bad = MetresPerUnit("inch");
+  ASSERT_FALSE(bad.ok());
+  EXPECT_EQ(bad.status().code(), StatusCode::kInvalidArgument);
+  EXPECT_THAT(bad.status().message(), ::testing::HasSubstr("\"inch\"; use one of m, cm, mm, ft"));
+}
+
 }  // namespace
 }  // namespace vc

@@ -60,7 +60,14 @@ struct ReadOptions {
   uint64_t max_points = (uint64_t{2} << 30) / kBytesPerPoint;
   // Refuse inputs whose parsed form (points, OctoMap nodes) would take more than this many bytes.
   uint64_t max_result_bytes = uint64_t{2} << 30;
+  // Metres per unit of the input's coordinates (vc-client --units; MetresPerUnit): points are
+  // scaled by this as they are read. 1 for metres.
+  double metres_per_unit = 1.0;
 };
+
+// Metres per unit, by the unit's name: "m" 1, "cm" 0.01, "mm" 0.001, "ft" 0.3048 (international
+// foot), "us-ft" 1200/3937 (US survey foot). INVALID_ARGUMENT naming the accepted names otherwise.
+Result<double> MetresPerUnit(std::string_view unit_name);
 
 // The read limits for a job allowed `max_upload_bytes` of (compressed) upload and a memory budget
 // of `memory_budget_bytes`: decompressed bytes at most min(kMaxDecompressionRatio x the upload
