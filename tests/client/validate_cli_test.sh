@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # vc-client validate end to end (no server): a box room's points written by awk, validated with
 # its scanner position; the table, validation.json and validation_1.ply; and each input error's
-# exit status and message. Usage: validate_cli_test.sh VC_CLIENT
+# exit status and message; an E57's two scans. Usage: validate_cli_test.sh VC_CLIENT
 set -euo pipefail
 client_bin="$1"
 work="$(mktemp -d)"
@@ -32,6 +32,11 @@ assert s["captured"] > 0 and s["recall"] > 0.9, s  # a box seen from inside is i
 assert j["precision_meaningful"] is False
 PY
 head -c 600 "$work/out/validation_1.ply" | grep -aq "comment colour: green 40 180 40 = agree" || fail "PLY header"
+
+# An E57's scans with their poses (the fuzz seed written by the tests' E57 writer: 8 points each).
+e57="$(dirname "$0")/../../fuzz/corpus/e57_fuzzer/two_scans.e57"
+"$client_bin" validate "$e57" >"$work/e57.table" 2>"$work/err" || { cat "$work/err" >&2; fail "validate FILE.e57"; }
+grep -q "two_scans.e57, scan 2 (second)" "$work/e57.table" || { cat "$work/e57.table" >&2; fail "no E57 scan 2"; }
 
 # Each input error: the exit status (3 invalid argument, 5 not found) and the file and scan named.
 expect_error() {

@@ -316,6 +316,20 @@ TEST(ValidateCommandFlags, ParseTheTestTheScannerAndTheInputs) {
   EXPECT_EQ(command.options.resolution_m, 0.05);
   EXPECT_EQ(command.out_dir, "o");
   EXPECT_EQ(command.inputs.files, (std::vector<std::string>{"a.xyz", "b.xyz"}));
+  EXPECT_FALSE(command.inputs.scanner_frame);
+}
+
+TEST(ValidateCommandFlags, AScannerPresetFillsTheLimitsItsFlagsDoNotGive) {
+  CLI::App app;
+  ValidateCommand command;
+  AddValidateCommand(app, &command);
+  app.parse("validate a.pcd --scanner leica-blk360-g2 --max-range 30 --scanner-frame", false);
+  EXPECT_EQ(command.options.scanner.name, "leica-blk360-g2");
+  EXPECT_EQ(command.options.scanner.max_range_m, 30.0);    // the flag
+  EXPECT_EQ(command.options.scanner.vfov_min_deg, -45.0);  // the preset
+  EXPECT_EQ(command.options.selection_test, SelectionTest::kSurfaceVisibility);
+  EXPECT_TRUE(command.inputs.scanner_frame);
+  EXPECT_TRUE(command.inputs.positions_file.empty());
 }
 
 }  // namespace
