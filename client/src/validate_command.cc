@@ -195,12 +195,12 @@ std::string ValidationTable(const ValidationReport& report) {
   const bool precise = report.precision_meaningful;
   for (size_t i = 0; i < report.scans.size(); ++i) {
     const ScanAgreement& a = report.scans[i];
-    std::snprintf(line, sizeof line, "%-4zu %10llu %10llu %10llu %7.3f %9s %9.3f %11s  %s%s\n", i + 1,
+    std::snprintf(line, sizeof line, "%-4zu %10llu %10llu %10llu %7.3f %9s %9.3f %11s  ", i + 1,
                   static_cast<unsigned long long>(a.captured), static_cast<unsigned long long>(a.predicted),
                   static_cast<unsigned long long>(a.both), a.recall, Ratio(a.precision, precise).c_str(),
-                  a.recall_slack, Ratio(a.precision_slack, precise).c_str(), a.name.c_str(),
-                  a.position_occupied ? " (scanner position in an occupied voxel: nothing predicted)" : "");
-    out += line;
+                  a.recall_slack, Ratio(a.precision_slack, precise).c_str());
+    out += line + a.name;
+    out += a.position_occupied ? " (scanner position in an occupied voxel: nothing predicted)\n" : "\n";
   }
   std::snprintf(line, sizeof line, "model: %llu voxels of %.3f m; test %s; +1: with one voxel of slack\n",
                 static_cast<unsigned long long>(report.model_voxels), report.resolution_m,
