@@ -22,14 +22,16 @@
 namespace vc::client {
 namespace {
 
-// `s`, naming `file` when its message does not already.
-Status NamingFile(const Status& s, const std::string& file) {
-  if (s.message().find(file) != std::string::npos) return s;
-  return {s.code(), file + ": " + s.message()};
-}
-
 std::string PointFileLabel(const std::string& file, size_t scan_number) {
   return file + " (scan " + std::to_string(scan_number) + ")";
+}
+
+// `s` about the file that holds scan `scan_number`, prefixed "FILE (scan N): " (without the file's
+// name where the message starts with it already).
+Status NamingFile(const Status& s, const std::string& file, size_t scan_number) {
+  std::string message = s.message();
+  if (message.rfind(file + ": ", 0) == 0) message.erase(0, file.size() + 2);
+  return {s.code(), PointFileLabel(file, scan_number) + ": " + message};
 }
 
 // Reads the whole file (for the E57 scan listing).
@@ -129,16 +131,17 @@ Result<LoadedScans> LoadScans(const ValidateInputs& inputs, double min_range_m) 
   if (inputs.files.empty()) return InvalidArgumentError("validate needs at least one scan file");
   const ReadOptions limits = ReadLimits(kDefaultMaxUploadBytes, kDefaultMemoryBudgetBytes);
   std::vector<SceneInput> read;
-  size_t point_files = 0;
+  size_t point_files = 0, scans_read = 0;
   for (const std::string& file : inputs.files) {
     Result<SceneInput> input = ReadSceneFile(file, limits);
-    if (!input.ok()) return NamingFile(input.status(), file);
+    if (!input.ok()) return NamingFile(input.status(), file, scans_read + 1);
     if (input->is_octree() || input->format == InputFormat::kOctomapGraph ||
         input->format == InputFormat::kVoxelStream) {
       return InvalidArgumentError(file + " is " + std::string(InputFormatName(input->format)) +
                                   ": validate needs each scan's captured points (E57, PLY, PCD, XYZ or LAS)");
     }
     point_files += input->format != InputFormat::kE57;
+    scans_read += input->format == InputFormat::kE57 ? input->scan_origins.size() : 1;
     read.push_back(std::move(*input));
   }
   VC_ASSIGN_OR_RETURN(const std::vector<KnownStation> positions, ReadPositions(inputs, point_files));

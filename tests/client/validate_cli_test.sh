@@ -48,7 +48,7 @@ expect_error() {
 }
 expect_error 3 "box.xyz (scan 1) has no scanner position" "$work/box.xyz"
 expect_error 3 "holds 1 positions but 2 point files" "$work/box.xyz" "$work/box.xyz" --positions "$work/pos.csv"
-expect_error 5 "missing.xyz" "$work/missing.xyz" --positions "$work/pos.csv"
+expect_error 5 "missing.xyz (scan 1): " "$work/missing.xyz" --positions "$work/pos.csv"
 printf "900,2,1.5\n" >"$work/far.csv"
 expect_error 3 "scan 1 (\"$work/box.xyz\")'s scanner position is" "$work/box.xyz" --positions "$work/far.csv"
 echo "validate_cli_test: ok"

@@ -185,11 +185,13 @@ TEST_F(ValidateCommandTest, AnUnreadableFileIsRefusedNamingIt) {
   Result<LoadedScans> loaded = LoadScans({{Path("a.xyz"), Path("missing.xyz")}, Path("positions.csv"), false}, 0.5);
   ASSERT_FALSE(loaded.ok());
   EXPECT_EQ(loaded.status().code(), StatusCode::kNotFound);
-  EXPECT_NE(loaded.status().message().find(Path("missing.xyz")), std::string::npos) << loaded.status().message();
+  EXPECT_NE(loaded.status().message().find(Path("missing.xyz") + " (scan 2): "), std::string::npos)
+      << loaded.status().message();
   WriteText(Path("garbage.xyz"), "1 2 three\n");
   loaded = LoadScans({{Path("a.xyz"), Path("garbage.xyz")}, Path("positions.csv"), false}, 0.5);
   ASSERT_FALSE(loaded.ok());
-  EXPECT_NE(loaded.status().message().find(Path("garbage.xyz")), std::string::npos) << loaded.status().message();
+  EXPECT_NE(loaded.status().message().find(Path("garbage.xyz") + " (scan 2): "), std::string::npos)
+      << loaded.status().message();
 }
 
 TEST_F(ValidateCommandTest, APoseOutsideTheSceneIsRefusedNamingFileAndScan) {

@@ -49,7 +49,7 @@ struct LoadedScans {
 // and not a PCD with a VIEWPOINT), a number of positions that differs from the number of point
 // files, --positions with only E57 files, an octree or .graph file (no per-scan points), an E57 whose
 // dropped records cannot be assigned to their scans, or a scan left without points; NOT_FOUND /
-// INVALID_ARGUMENT naming the file when a file cannot be read or parsed.
+// INVALID_ARGUMENT naming the file and its scan ("FILE (scan N): ...") when a file cannot be read or parsed.
 Result<LoadedScans> LoadScans(const ValidateInputs& inputs, double min_range_m);
 
 // The table printed on stdout: one line per scan (captured, predicted, both, recall and precision
