@@ -166,36 +166,16 @@ std::string PlanStationsCsv(const PlanResult& r) {
 
 std::string VisibilityPly(const PlanResult& r) {
   const size_t n = std::min(r.voxel_centers.size(), r.evaluation.best_face_values.size());
-  std::string out =
-      "ply\nformat binary_little_endian 1.0\n"
-      "comment vc visibility: occupied voxel centres (m); visibility = best V over the voxel's 6 faces\n"
-      "comment colour: viridis of visibility in [0, 1]; grey = seen by no station (V = 0)\n"
-      "comment resolution_m " +
-      Fixed(r.resolution_m, 6) +
-      "\n"
-      "element vertex " +
-      std::to_string(n) +
-      "\n"
-      "property float x\nproperty float y\nproperty float z\n"
-      "property uchar red\nproperty uchar green\nproperty uchar blue\n"
-      "property float visibility\nend_header\n";
-  out.reserve(out.size() + n * 19);
-  auto put_float = [&out](float f) {
-    char b[4];
-    std::memcpy(b, &f, 4);  // x86-64 and ARM64 hosts are little-endian
-    out.append(b, 4);
-  };
+  std::vector<ColouredPoint> points(n);
   for (size_t i = 0; i < n; ++i) {
     const auto& faces = r.evaluation.best_face_values[i];
     const float v = *std::max_element(faces.begin(), faces.end());
-    const Rgb c = v > 0 ? raster::Viridis(v) : Rgb{128, 128, 128};
-    put_float(static_cast<float>(r.voxel_centers[i].x()));
-    put_float(static_cast<float>(r.voxel_centers[i].y()));
-    put_float(static_cast<float>(r.voxel_centers[i].z()));
-    out.append(reinterpret_cast<const char*>(c.data()), 3);
-    put_float(v);
+    points[i] = {r.voxel_centers[i], v > 0 ? raster::Viridis(v) : Rgb{128, 128, 128}, v};
   }
-  return out;
+  return ColouredPointsPly({"vc visibility: occupied voxel centres (m); visibility = best V over the voxel's 6 faces",
+                            "colour: viridis of visibility in [0, 1]; grey = seen by no station (V = 0)",
+                            "resolution_m " + Fixed(r.resolution_m, 6)},
+                           points, "visibility");
 }
 
 // ---------- heatmap.png ----------
@@ -743,6 +723,31 @@ ImageSize ReductionImageSize(int stations) {
   const int cell = ReductionCell(n);
   const int title_w = std::max(raster::TextWidth(kRedTitle, 2), raster::TextWidth(kRedSubtitle)) + 2 * kRedLeft;
   return {std::max(kRedLeft + n * cell + kRedLegend, title_w), kRedTop + std::max(n * cell, kRedMinH) + kRedBottom};
+}
+
+std::string ColouredPointsPly(const std::vector<std::string>& comments, const std::vector<ColouredPoint>& points,
+                              std::string_view value_name) {
+  std::string out = "ply\nformat binary_little_endian 1.0\n";
+  for (const std::string& c : comments) out += "comment " + c + "\n";
+  out += "element vertex " + std::to_string(points.size()) +
+         "\nproperty float x\nproperty float y\nproperty float z\n"
+         "property uchar red\nproperty uchar green\nproperty uchar blue\n";
+  if (!value_name.empty()) out += "property float " + std::string(value_name) + "\n";
+  out += "end_header\n";
+  out.reserve(out.size() + points.size() * (value_name.empty() ? 15 : 19));
+  auto put_float = [&out](float f) {
+    char b[4];
+    std::memcpy(b, &f, 4);  // x86-64 and ARM64 hosts are little-endian
+    out.append(b, 4);
+  };
+  for (const ColouredPoint& p : points) {
+    put_float(static_cast<float>(p.position_m.x()));
+    put_float(static_cast<float>(p.position_m.y()));
+    put_float(static_cast<float>(p.position_m.z()));
+    out.append(reinterpret_cast<const char*>(p.rgb.data()), 3);
+    if (!value_name.empty()) put_float(p.value);
+  }
+  return out;
 }
 
 Status WritePlanOutputs(const PlanResult& result, const std::string& out_dir, const UploadSummary* upload) {
