@@ -43,9 +43,11 @@ Result<SceneInput> FromCloud(Result<readers::PointCloud> read, InputFormat forma
 // An octree's keys are centred on its own origin, in metres: it is read as it is (frame origin 0).
 Status CheckOctreeUnits(std::string_view source, const ReadOptions& options) {
   if (options.metres_per_unit == 1.0) return Status::Ok();
-  return readers::InvalidInput(source, "OctoMap octrees are read in metres, but units of " +
-                                           std::to_string(options.metres_per_unit) +
-                                           " m were given; read the octree without units");
+  std::ostringstream units;
+  units << options.metres_per_unit;
+  return readers::InvalidInput(
+      source, "OctoMap octrees are read in metres (their resolution is in metres), but units of " + units.str() +
+                  " m were given; read the octree without units");
 }
 
 Result<SceneInput> FromOctree(Result<std::shared_ptr<octomap::OcTree>> read, InputFormat format) {

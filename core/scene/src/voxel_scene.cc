@@ -97,8 +97,8 @@ Status CheckExtent(const Eigen::Vector3d& lo_m, const Eigen::Vector3d& hi_m, dou
   if (need > budget) {
     const double factor = std::cbrt(double(need) / double(budget) * 1.25);
     std::ostringstream os;
-    os << scene << " at resolution " << r << " m its traversal grid alone needs " << double(need) / double(1 << 20)
-       << " MiB, over the memory budget of " << double(budget) / double(1 << 20)
+    os << scene << " needs " << double(need) / double(1 << 20) << " MiB for its traversal grid alone at resolution "
+       << r << " m, over the memory budget of " << double(budget) / double(1 << 20)
        << " MiB; use a resolution of at least " << std::ceil(r * factor * 1000) / 1000
        << " m, raise the budget, or crop the scene";
     return ResourceExhaustedError(os.str());

@@ -372,6 +372,8 @@ TEST(SceneInputRealDataTest, HallScanBzip2Xyz) {
   EXPECT_EQ(r->compression, Compression::kBzip2);
   EXPECT_EQ(r->points.size(), 88'206u);
   EXPECT_EQ(r->dropped_nonfinite, 0u);
+  // Within 500 m of its frame's origin: the local frame is the file's, so plans do not change.
+  EXPECT_EQ(r->frame_origin_m, Eigen::Vector3d::Zero());
 }
 
 TEST(SceneInputRealDataTest, RoomScansBinaryCompressedPcd) {
@@ -385,6 +387,7 @@ TEST(SceneInputRealDataTest, RoomScansBinaryCompressedPcd) {
     EXPECT_EQ(r->detail, "binary_compressed");
     EXPECT_EQ(r->points.size() + r->dropped_nonfinite, count);
     EXPECT_EQ(r->points.size(), count);
+    EXPECT_EQ(r->frame_origin_m, Eigen::Vector3d::Zero());
     // Scanner frame, z up: the floor is about 1.3 m below the scanner and the ceiling 1.7 m above.
     Eigen::Vector3f lo = r->points[0], hi = r->points[0];
     for (const auto& p : r->points) {

@@ -118,8 +118,8 @@ TEST(VoxelizeTest, AnImplausibleExtentNamesTheLikelyUnits) {
   coarse.memory_budget_bytes = 1 << 20;
   auto memory = Voxelize(Cloud({{0, 0, 0}, {27400, 18200, 3100}}), coarse);
   ASSERT_EQ(memory.status().code(), StatusCode::kResourceExhausted);
-  EXPECT_THAT(memory.status().message(), HasSubstr("--units mm"));
-  EXPECT_THAT(memory.status().message(), HasSubstr("MiB, over the memory budget"));
+  EXPECT_THAT(memory.status().message(), HasSubstr("for centimetres). As metres it needs "));
+  EXPECT_THAT(memory.status().message(), HasSubstr("MiB for its traversal grid alone at resolution 2 m, over the"));
   auto stray = Voxelize(Cloud({{0, 0, 0}, {0, 9e6, 0}}), {});
   ASSERT_EQ(stray.status().code(), StatusCode::kInvalidArgument);
   EXPECT_THAT(stray.status().message(), HasSubstr("stray points"));
