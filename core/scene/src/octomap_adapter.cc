@@ -16,6 +16,7 @@
 #include <mutex>
 #include <sstream>
 
+#include "readers/readers.h"
 #include "vc/scene/occupancy_grid.h"
 
 namespace vc {
@@ -259,7 +260,7 @@ Result<std::shared_ptr<octomap::OcTree>> ReadOctreeText(std::string_view bytes, 
   return std::shared_ptr<octomap::OcTree>(oc);
 }
 
-Result<ScanGraphData> ReadScanGraph(std::string_view bytes, std::string_view source) {
+Result<ScanGraphData> ReadScanGraph(std::string_view bytes, std::string_view source, double metres_per_unit) {
   auto err = [&](size_t pos, const std::string& m) {
     return InvalidArgumentError(std::string(source) + ": scan graph, byte " + std::to_string(pos) + ": " + m);
   };
@@ -274,6 +275,7 @@ Result<ScanGraphData> ReadScanGraph(std::string_view bytes, std::string_view sou
                       " bytes (not a scan graph, or truncated)");
   }
   ScanGraphData out;
+  readers::LocalFrame frame(metres_per_unit);
   auto read_vec = [&](int n, double* v) {
     int32_t count = 0;
     if (!ReadPod(bytes, &pos, &count)) return false;
@@ -300,8 +302,9 @@ Result<ScanGraphData> ReadScanGraph(std::string_view bytes, std::string_view sou
       double p[3];
       if (!read_vec(3, p))
         return err(pos, "scan " + std::to_string(n) + ", point " + std::to_string(i) + ": malformed");
-      // OctoMap keeps points as float.
-      local[i] = Eigen::Vector3d{double(float(p[0])), double(float(p[1])), double(float(p[2]))};
+      // In double, as written: OctoMap writes its float points as doubles, so this is exact for its
+      // files and keeps the precision of a graph written in world (survey) coordinates.
+      local[i] = Eigen::Vector3d{p[0], p[1], p[2]};
     }
     double t[3], q[4];
     uint32_t id = 0;
@@ -318,18 +321,19 @@ Result<ScanGraphData> ReadScanGraph(std::string_view bytes, std::string_view sou
     }
     rot.normalize();
     const Eigen::Vector3d trans(t[0], t[1], t[2]);
-    out.origins.push_back(trans);
+    out.origins.push_back(trans * metres_per_unit);
     out.origin_rotations.push_back(rot);
     out.points.reserve(out.points.size() + count);
     for (const Eigen::Vector3d& l : local) {
       const Eigen::Vector3d w = rot * l + trans;
-      if (!w.allFinite()) {
+      if (const std::optional<Eigen::Vector3f> p = frame.ToLocal(w.x(), w.y(), w.z())) {
+        out.points.push_back(*p);
+      } else {
         ++out.dropped_nonfinite;
-        continue;
       }
-      out.points.emplace_back(w.cast<float>());
     }
   }
+  out.frame_origin_m = frame.origin_m();
   // Edges (uint32 count, then per edge two ids, a pose and a weight) follow; vc does not use them.
   return out;
 }

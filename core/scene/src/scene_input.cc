@@ -35,8 +35,19 @@ Result<SceneInput> FromCloud(Result<readers::PointCloud> read, InputFormat forma
   in.format = format;
   in.detail = std::move(cloud.detail);
   in.points = std::move(cloud.points);
+  in.frame_origin_m = cloud.frame.origin_m();
   in.dropped_nonfinite = cloud.dropped_nonfinite;
   return in;
+}
+
+// An octree's keys are centred on its own origin, in metres: it is read as it is (frame origin 0).
+Status CheckOctreeUnits(std::string_view source, const ReadOptions& options) {
+  if (options.metres_per_unit == 1.0) return Status::Ok();
+  std::ostringstream units;
+  units << options.metres_per_unit;
+  return readers::InvalidInput(
+      source, "OctoMap octrees are read in metres (their resolution is in metres), but units of " + units.str() +
+                  " m were given; read the octree without units");
 }
 
 Result<SceneInput> FromOctree(Result<std::shared_ptr<octomap::OcTree>> read, InputFormat format) {
@@ -56,9 +67,11 @@ Result<SceneInput> FromOctree(Result<std::shared_ptr<octomap::OcTree>> read, Inp
 Result<SceneInput> ReadDecompressed(std::string_view bytes, std::string_view source, const ReadOptions& options) {
   if (bytes.empty()) return readers::InvalidInput(source, "input is empty (0 bytes)");
   if (StartsWith(bytes, "# Octomap OcTree binary file")) {
+    VC_RETURN_IF_ERROR(CheckOctreeUnits(source, options));
     return FromOctree(ReadOctreeBinary(bytes, source, options.max_result_bytes), InputFormat::kOctomapBinary);
   }
   if (StartsWith(bytes, "# Octomap OcTree file")) {
+    VC_RETURN_IF_ERROR(CheckOctreeUnits(source, options));
     return FromOctree(ReadOctreeText(bytes, source, options.max_result_bytes), InputFormat::kOctomapText);
   }
   if (readers::LooksLikeVoxelStream(bytes)) return readers::ReadVoxelStream(bytes, source, options);
@@ -72,7 +85,7 @@ Result<SceneInput> ReadDecompressed(std::string_view bytes, std::string_view sou
     Result<readers::E57Cloud> e57 = readers::ReadE57(bytes, source, options);
     if (!e57.ok()) return e57.status();
     std::vector<Eigen::Vector3d> origins;
-    for (const E57Scan& scan : e57->scans) origins.push_back(scan.translation_m);
+    for (const E57Scan& scan : e57->scans) origins.push_back(e57->cloud.frame.ToLocal(scan.translation_m));
     if (e57->cloud.points.empty()) {
       return readers::InvalidInput(source, e57->cloud.detail + ": no valid, finite point (" +
                                                std::to_string(e57->cloud.dropped_nonfinite) +
@@ -88,7 +101,7 @@ Result<SceneInput> ReadDecompressed(std::string_view bytes, std::string_view sou
   if (readers::LooksLikeText(bytes)) {
     return FromCloud(readers::ReadXyz(bytes, source, options), InputFormat::kXyz, source);
   }
-  Result<ScanGraphData> graph = ReadScanGraph(bytes, source);
+  Result<ScanGraphData> graph = ReadScanGraph(bytes, source, options.metres_per_unit);
   if (!graph.ok()) {
     std::string why = graph.status().message();
     const std::string prefix = std::string(source) + ": ";
@@ -111,7 +124,8 @@ Result<SceneInput> ReadDecompressed(std::string_view bytes, std::string_view sou
   in.format = InputFormat::kOctomapGraph;
   in.detail = std::to_string(graph->origins.size()) + " scans";
   in.points = std::move(graph->points);
-  in.scan_origins = std::move(graph->origins);
+  in.frame_origin_m = graph->frame_origin_m;
+  for (const Eigen::Vector3d& origin_m : graph->origins) in.scan_origins.push_back(origin_m - graph->frame_origin_m);
   in.dropped_nonfinite = graph->dropped_nonfinite;
   return in;
 }

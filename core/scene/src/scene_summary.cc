@@ -28,6 +28,9 @@ Result<SceneSummary> Summarize(const SceneInput& input, double resolution_m, uin
       s.bbox_min = s.bbox_min.cwiseMin(p.cast<double>());
       s.bbox_max = s.bbox_max.cwiseMax(p.cast<double>());
     }
+    s.frame_origin_m = input.frame_origin_m;
+    s.bbox_min += s.frame_origin_m;
+    s.bbox_max += s.frame_origin_m;
   }
   VoxelizeOptions vo;
   vo.resolution_m = resolution_m;
@@ -55,6 +58,7 @@ std::string SummaryToJson(const SceneSummary& s) {
   j["octree_resolution_m"] = s.octree_resolution_m;
   j["bbox_min"] = {s.bbox_min.x(), s.bbox_min.y(), s.bbox_min.z()};
   j["bbox_max"] = {s.bbox_max.x(), s.bbox_max.y(), s.bbox_max.z()};
+  j["frame_origin_m"] = {s.frame_origin_m.x(), s.frame_origin_m.y(), s.frame_origin_m.z()};
   j["resolution_m"] = s.resolution_m;
   j["occupied_voxels"] = s.occupied_voxels;
   if (!s.e57_scans.empty()) {
@@ -98,6 +102,10 @@ std::string SummaryToText(const SceneSummary& s, const std::string& source) {
   }
   os << "  bounding box:      [" << s.bbox_min.x() << ", " << s.bbox_min.y() << ", " << s.bbox_min.z() << "] .. ["
      << s.bbox_max.x() << ", " << s.bbox_max.y() << ", " << s.bbox_max.z() << "] m\n";
+  if (!s.frame_origin_m.isZero()) {
+    os << "  frame origin:      (" << s.frame_origin_m.x() << ", " << s.frame_origin_m.y() << ", "
+       << s.frame_origin_m.z() << ") m; the scene is planned relative to it\n";
+  }
   const WorldPoint e = s.bbox_max - s.bbox_min;
   os << "  extent:            " << e.x() << " x " << e.y() << " x " << e.z() << " m\n";
   os << "  occupied voxels:   " << s.occupied_voxels << " at " << s.resolution_m << " m\n";

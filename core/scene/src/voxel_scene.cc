@@ -34,19 +34,62 @@ Status CheckResolution(double r) {
   return Status::Ok();
 }
 
+// A length for people: "27,240" (whole metres, thousands grouped) from 1000 m, "12.35" below.
+std::string FormatLength(double m) {
+  std::ostringstream out;
+  if (!(std::fabs(m) >= 1000 && std::fabs(m) < 1e15)) {
+    out.precision(4);
+    out << m;
+    return out.str();
+  }
+  const std::string digits = std::to_string(std::llabs(std::llround(m)));
+  std::string grouped = m < 0 ? "-" : "";
+  for (size_t i = 0; i < digits.size(); ++i) {
+    if (i > 0 && (digits.size() - i) % 3 == 0) grouped += ',';
+    grouped += digits[i];
+  }
+  return grouped;
+}
+
+std::string FormatPoint(const Eigen::Vector3d& p_m) {
+  std::ostringstream out;
+  out << '(' << FormatLength(p_m.x()) << ", " << FormatLength(p_m.y()) << ", " << FormatLength(p_m.z()) << ')';
+  return out.str();
+}
+
+std::string FormatExtent(const Eigen::Vector3d& extent_m) {
+  return FormatLength(extent_m.x()) + " x " + FormatLength(extent_m.y()) + " x " + FormatLength(extent_m.z()) + " m";
+}
+
+// No terrestrial scan site is larger than this in any axis, in metres.
+constexpr double kLargestSiteM = 5000;
+
+// How a scene of this extent begins its message: when it is implausible for metres, what the file
+// probably is (docs/PLANNING.md "Coordinates": units).
+std::string DescribeExtent(const Eigen::Vector3d& extent_m) {
+  const double largest = extent_m.maxCoeff();
+  if (!(largest > kLargestSiteM)) return "the scene spans " + FormatExtent(extent_m) + " and";
+  std::string m = "the scene spans " + FormatExtent(extent_m) + " as metres, more than any terrestrial scan site: ";
+  if (largest / 1000 <= kLargestSiteM) {
+    m += "is the file in millimetres (it would span " + FormatExtent(extent_m / 1000) +
+         ")? Give its units (vc-client --units mm, or --units cm for centimetres). As metres it";
+  } else {
+    m += "check the file for stray points far from the rest, or scans in different frames. As metres it";
+  }
+  return m;
+}
+
 // Refuses a box of voxel indices [lo, hi] that cannot be represented or would not fit.
 Status CheckExtent(const Eigen::Vector3d& lo_m, const Eigen::Vector3d& hi_m, double r, uint64_t budget) {
   const Eigen::Vector3d lo = (lo_m / r).array().floor(), hi = (hi_m / r).array().floor();
-  std::ostringstream ext;
-  ext.precision(4);
-  ext << (hi_m - lo_m).x() << " x " << (hi_m - lo_m).y() << " x " << (hi_m - lo_m).z() << " m";
+  const std::string scene = DescribeExtent(hi_m - lo_m);
   if ((lo.array() < -kKeyOffset).any() || (hi.array() >= kKeyOffset).any()) {
     const double needed = std::max(lo_m.cwiseAbs().maxCoeff(), hi_m.cwiseAbs().maxCoeff()) / (kKeyOffset - 1);
     std::ostringstream os;
-    os << "the scene (extent " << ext.str() << ", bounding box " << lo_m.transpose() << " .. " << hi_m.transpose()
-       << " m) does not fit OctoMap's 65536-voxel key range at resolution " << r << " m; coordinates must lie within +-"
-       << kKeyOffset * r << " m of the origin. Use a resolution of at least " << std::ceil(needed * 1000) / 1000
-       << " m or move the scene near the origin";
+    os << scene << " does not fit OctoMap's 65536-voxel key range at resolution " << r << " m (coordinates within +-"
+       << kKeyOffset * r << " m of the local frame's origin; the scene's bounding box "
+       << "there is " << FormatPoint(lo_m) << " .. " << FormatPoint(hi_m) << " m); a resolution of at least "
+       << std::ceil(needed * 1000) / 1000 << " m fits";
     return InvalidArgumentError(os.str());
   }
   const VoxelIndex a{int(lo.x()), int(lo.y()), int(lo.z())}, b{int(hi.x()), int(hi.y()), int(hi.z())};
@@ -54,8 +97,8 @@ Status CheckExtent(const Eigen::Vector3d& lo_m, const Eigen::Vector3d& hi_m, dou
   if (need > budget) {
     const double factor = std::cbrt(double(need) / double(budget) * 1.25);
     std::ostringstream os;
-    os << "the scene spans " << ext.str() << "; at resolution " << r << " m its traversal grid alone needs "
-       << double(need) / double(1 << 20) << " MiB, over the memory budget of " << double(budget) / double(1 << 20)
+    os << scene << " needs " << double(need) / double(1 << 20) << " MiB for its traversal grid alone at resolution "
+       << r << " m, over the memory budget of " << double(budget) / double(1 << 20)
        << " MiB; use a resolution of at least " << std::ceil(r * factor * 1000) / 1000
        << " m, raise the budget, or crop the scene";
     return ResourceExhaustedError(os.str());
@@ -202,6 +245,7 @@ Result<VoxelScene> Voxelize(const SceneInput& input, const VoxelizeOptions& opti
     VC_ASSIGN_OR_RETURN(std::vector<VoxelKey> occupied, OccupiedKeys(input, r, options.memory_budget_bytes, ctx));
     VC_ASSIGN_OR_RETURN(VoxelScene scene, SceneFromKeys(r, std::move(occupied), options.memory_budget_bytes, ctx));
     scene.scan_origins = input.scan_origins;
+    scene.frame_origin_m = input.frame_origin_m;
     return scene;
   });
 }
@@ -311,9 +355,8 @@ void VoxelAccumulator::Grow() {
   const double factor = std::max(std::sqrt(need / double(std::max<uint64_t>(memory_budget_bytes_, 1)) * 1.25), 1.01);
   std::ostringstream os;
   os.precision(4);
-  os << "the cloud spans " << ext.x() << " x " << ext.y() << " x " << ext.z() << " m and has more than " << n
-     << " occupied voxels at resolution " << resolution_m_
-     << " m; streaming their keys needs more than the memory budget of "
+  os << DescribeExtent(ext.cast<double>()) << " has more than " << n << " occupied voxels at resolution "
+     << resolution_m_ << " m; streaming their keys needs more than the memory budget of "
      << double(memory_budget_bytes_) / double(1 << 20) << " MiB; use a resolution of at least "
      << std::ceil(resolution_m_ * factor * 1000) / 1000 << " m, raise the budget, or crop the scene";
   status_ = ResourceExhaustedError(os.str());
@@ -339,7 +382,9 @@ Result<VoxelScene> VoxelAccumulator::Finish(const JobContext& ctx) {
   std::vector<uint64_t>().swap(keys_);
   std::vector<uint64_t>().swap(recent_);
   sorted_ = 0;
-  return SceneFromKeys(resolution_m_, std::move(occupied), memory_budget_bytes_, ctx);
+  VC_ASSIGN_OR_RETURN(VoxelScene scene, SceneFromKeys(resolution_m_, std::move(occupied), memory_budget_bytes_, ctx));
+  scene.frame_origin_m = frame_origin_m_;
+  return scene;
 }
 
 }  // namespace vc

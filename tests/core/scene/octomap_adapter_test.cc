@@ -160,6 +160,26 @@ TEST(ReadScanGraphTest, PointsGoToTheWorldByTheirScansPose) {
   EXPECT_NEAR(r->points[1].z(), 1, 1e-5);
 }
 
+TEST(ReadScanGraphTest, SurveyCoordinatesGoToALocalFrameAndTheOriginsStayInTheWorld) {
+  const double identity[4] = {1, 0, 0, 0};
+  const Eigen::Vector3d station(512345.678, 5612330.123, 312.5);
+  Result<ScanGraphData> r = ReadScanGraph(Graph({{0.001, -0.002, 0.5}, {-3, 4, -1}}, station, identity), "g.graph");
+  ASSERT_TRUE(r.ok()) << r.status().ToString();
+  EXPECT_EQ(r->frame_origin_m, Eigen::Vector3d(512000, 5612000, 0));
+  ASSERT_EQ(r->origins.size(), 1u);
+  EXPECT_EQ(r->origins[0], station);
+  ASSERT_EQ(r->points.size(), 2u);
+  EXPECT_LE((r->points[0].cast<double>() + r->frame_origin_m - Eigen::Vector3d(512345.679, 5612330.121, 313)).norm(),
+            1e-4);
+  EXPECT_LE((r->points[1].cast<double>() + r->frame_origin_m - Eigen::Vector3d(512342.678, 5612334.123, 311.5)).norm(),
+            1e-4);
+
+  r = ReadScanGraph(Graph({{1000, 0, 0}}, {0, 0, 0}, identity), "mm.graph", 0.001);
+  ASSERT_TRUE(r.ok()) << r.status().ToString();
+  EXPECT_EQ(r->frame_origin_m, Eigen::Vector3d::Zero());
+  EXPECT_EQ(r->points[0], Eigen::Vector3f(1, 0, 0));
+}
+
 TEST(ReadScanGraphTest, BadGraphsAreRefusedNamingTheByte) {
   const double identity[4] = {1, 0, 0, 0}, zero[4] = {0, 0, 0, 0};
   Result<ScanGraphData> r = ReadScanGraph(Graph({{1, 0, 0}}, {0, 0, 0}, zero), "g.graph");

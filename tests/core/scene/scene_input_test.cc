@@ -13,6 +13,7 @@
 #include <sstream>
 #include <string>
 
+#include "testing/survey.h"
 #include "testing/test_paths.h"
 #include "vc/scene/octomap_adapter.h"
 
@@ -257,6 +258,57 @@ TEST(SceneInputTest, ScanGraphIsTriedLastForBinaryContent) {
   EXPECT_TRUE(r->points[2].isApprox(Eigen::Vector3f(-1, 0, 5), 1e-5f)) << r->points[2].transpose();
 }
 
+// A ScanGraph of two scans posed at survey coordinates (exact in OctoMap's float poses).
+std::string SurveyGraph() {
+  octomap::ScanGraph graph;
+  auto* scan1 = new octomap::Pointcloud();
+  scan1->push_back(1.5f, 0, 0);
+  scan1->push_back(0, 2.25f, -1);
+  graph.addNode(scan1, octomap::pose6d(512340.25, 5612328.5, 311, 0, 0, 0));
+  auto* scan2 = new octomap::Pointcloud();
+  scan2->push_back(0, 1, 0);
+  graph.addNode(scan2, octomap::pose6d(512344.125, 5612336, 310.5, 0, 0, M_PI / 2));
+  std::stringstream s;
+  graph.writeBinary(s);
+  return s.str();
+}
+
+TEST(SceneInputTest, ScanGraphAtSurveyCoordinatesReadsInALocalFrameWithLocalScanOrigins) {
+  Result<SceneInput> r = ReadScene(SurveyGraph(), "utm.graph");
+  ASSERT_TRUE(r.ok()) << r.status().ToString();
+  EXPECT_EQ(r->frame_origin_m, vc::testing::kSurveyOrigin);
+  EXPECT_TRUE(vc::testing::HoldsInInputFrame(
+      *r, {{512341.75, 5612328.5, 311}, {512340.25, 5612330.75, 310}, {512343.125, 5612336, 310.5}}, 1e-3));
+  ASSERT_EQ(r->scan_origins.size(), 2u);
+  EXPECT_EQ(r->scan_origins[0], Eigen::Vector3d(340.25, 328.5, 311));
+  EXPECT_EQ(r->scan_origins[1], Eigen::Vector3d(344.125, 336, 310.5));
+
+  ReadOptions in_feet;
+  in_feet.metres_per_unit = 0.3048;
+  r = ReadScene(SurveyGraph(), "ft.graph", in_feet);
+  ASSERT_TRUE(r.ok()) << r.status().ToString();
+  EXPECT_EQ(r->frame_origin_m, Eigen::Vector3d(156000, 1711000, 0));
+  ASSERT_EQ(r->scan_origins.size(), 2u);
+  EXPECT_NEAR((r->scan_origins[0] + r->frame_origin_m).x(), 512340.25 * 0.3048, 1e-6);
+}
+
+TEST(SceneInputTest, OctreesAreReadInMetresOnly) {
+  std::stringstream bt, ot;
+  ASSERT_TRUE(SmallTree()->writeBinary(bt));
+  ASSERT_TRUE(SmallTree()->write(ot));
+  ReadOptions in_mm;
+  in_mm.metres_per_unit = 0.001;
+  for (const std::string& tree : {bt.str(), ot.str()}) {
+    Result<SceneInput> r = ReadScene(tree, "t.tree", in_mm);
+    ASSERT_FALSE(r.ok());
+    EXPECT_EQ(r.status().code(), StatusCode::kInvalidArgument);
+    EXPECT_THAT(r.status().message(), HasSubstr("t.tree: OctoMap octrees are read in metres"));
+    r = ReadScene(tree, "t.tree");
+    ASSERT_TRUE(r.ok()) << r.status().ToString();
+    EXPECT_EQ(r->frame_origin_m, Eigen::Vector3d::Zero());
+  }
+}
+
 TEST(SceneInputTest, ReadSceneFileNotFound) {
   Result<SceneInput> r = ReadSceneFile("/nonexistent/dir/cloud.ply");
   ASSERT_FALSE(r.ok());
@@ -320,6 +372,8 @@ TEST(SceneInputRealDataTest, HallScanBzip2Xyz) {
   EXPECT_EQ(r->compression, Compression::kBzip2);
   EXPECT_EQ(r->points.size(), 88'206u);
   EXPECT_EQ(r->dropped_nonfinite, 0u);
+  // Within 500 m of its frame's origin: the local frame is the file's, so plans do not change.
+  EXPECT_EQ(r->frame_origin_m, Eigen::Vector3d::Zero());
 }
 
 TEST(SceneInputRealDataTest, RoomScansBinaryCompressedPcd) {
@@ -333,6 +387,7 @@ TEST(SceneInputRealDataTest, RoomScansBinaryCompressedPcd) {
     EXPECT_EQ(r->detail, "binary_compressed");
     EXPECT_EQ(r->points.size() + r->dropped_nonfinite, count);
     EXPECT_EQ(r->points.size(), count);
+    EXPECT_EQ(r->frame_origin_m, Eigen::Vector3d::Zero());
     // Scanner frame, z up: the floor is about 1.3 m below the scanner and the ceiling 1.7 m above.
     Eigen::Vector3f lo = r->points[0], hi = r->points[0];
     for (const auto& p : r->points) {

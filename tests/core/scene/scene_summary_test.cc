@@ -122,6 +122,29 @@ TEST(SummaryToJsonTest, EveryKeyWithItsValueAndE57ScansOnlyWhenThereAreAny) {
   EXPECT_EQ(scan["rotation_wxyz"], nlohmann::json({0.0, 0.0, 0.0, 1.0}));
 }
 
+TEST(SummarizeTest, ASurveySceneShowsItsFrameOriginAndItsBoundsInTheInputFrame) {
+  SceneInput survey = testing::Cloud({{345.5f, 330.25f, 12}, {346.5f, 331.25f, 13}});
+  survey.frame_origin_m = {512000, 5612000, 0};
+  Result<SceneSummary> s = Summarize(survey, 0, kDefaultMemoryBudgetBytes);
+  ASSERT_TRUE(s.ok()) << s.status().ToString();
+  EXPECT_EQ(s->frame_origin_m, WorldPoint(512000, 5612000, 0));
+  EXPECT_EQ(s->bbox_min, WorldPoint(512345.5, 5612330.25, 12));
+  EXPECT_EQ(s->bbox_max, WorldPoint(512346.5, 5612331.25, 13));
+  const std::string text = SummaryToText(*s, "utm.xyz");
+  EXPECT_THAT(text, HasSubstr("frame origin:      (512000.000, 5612000.000, 0.000) m"));
+  EXPECT_THAT(text, HasSubstr("bounding box:      [512345.500, 5612330.250, 12.000] .. [512346.500, 5612331.250, "
+                              "13.000] m\n"));
+  EXPECT_THAT(text, HasSubstr("extent:            1.000 x 1.000 x 1.000 m\n"));
+  const nlohmann::json j = nlohmann::json::parse(SummaryToJson(*s));
+  EXPECT_EQ(j["frame_origin_m"], nlohmann::json({512000.0, 5612000.0, 0.0}));
+
+  survey.frame_origin_m.setZero();
+  s = Summarize(survey, 0, kDefaultMemoryBudgetBytes);
+  ASSERT_TRUE(s.ok());
+  EXPECT_THAT(SummaryToText(*s, "local.xyz"), Not(HasSubstr("frame origin")));
+  EXPECT_EQ(nlohmann::json::parse(SummaryToJson(*s))["frame_origin_m"], nlohmann::json({0.0, 0.0, 0.0}));
+}
+
 TEST(SummaryToTextTest, ACloudsLinesAndAnOctreesLines) {
   SceneSummary s = *Summarize(GridCloud(), 0, kDefaultMemoryBudgetBytes);
   s.e57_scans = {Scan()};

@@ -22,6 +22,7 @@ Result<VoxelScene> Accumulate(const std::vector<Eigen::Vector3f>& pts, double r,
 // The two scenes are the same in every observable respect.
 void ExpectSameScene(const VoxelScene& a, const VoxelScene& b) {
   EXPECT_EQ(a.resolution_m, b.resolution_m);
+  EXPECT_EQ(a.frame_origin_m, b.frame_origin_m);
   ASSERT_EQ(a.occupied.size(), b.occupied.size());
   for (size_t i = 0; i < a.occupied.size(); ++i) ASSERT_EQ(a.occupied[i], b.occupied[i]) << i;
   EXPECT_EQ(a.grid.min_index(), b.grid.min_index());
@@ -236,6 +237,19 @@ TEST(VoxelAccumulatorTest, PointOutsideTheKeyRangeIsInvalidAsInVoxelize) {
   EXPECT_NE(acc.status().message().find("key range"), std::string::npos) << acc.status().message();
   EXPECT_EQ(acc.points_added(), 2u);  // the third point is ignored after the error
   EXPECT_EQ(acc.Finish().status().code(), want.status().code());
+}
+
+TEST(VoxelAccumulatorTest, FinishKeepsTheFrameOriginItWasTold) {
+  VoxelAccumulator survey(0.1);
+  EXPECT_EQ(survey.frame_origin_m(), WorldPoint::Zero());
+  survey.set_frame_origin_m({512000, 5612000, 1000});
+  survey.Add(Eigen::Vector3f(345.5f, 330.25f, -687.5f));
+  Result<VoxelScene> scene = survey.Finish();
+  ASSERT_TRUE(scene.ok()) << scene.status().ToString();
+  EXPECT_EQ(scene->frame_origin_m, WorldPoint(512000, 5612000, 1000));
+  SceneInput same = Cloud({{345.5f, 330.25f, -687.5f}});
+  same.frame_origin_m = {512000, 5612000, 1000};
+  ExpectSameScene(*scene, *Voxelize(same, {}));
 }
 
 TEST(VoxelAccumulatorTest, FinishTwiceIsAFailedPrecondition) {

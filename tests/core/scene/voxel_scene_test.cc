@@ -1,9 +1,12 @@
 #include "vc/scene/voxel_scene.h"
 
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <octomap/OcTree.h>
 
+#include <cstdio>
 #include <random>
+#include <string>
 
 #include "testing/scenes.h"
 #include "testing/test_paths.h"
@@ -13,6 +16,8 @@ namespace vc {
 namespace {
 
 using testing::Cloud;
+using ::testing::HasSubstr;
+using ::testing::Not;
 
 TEST(VoxelizeTest, CloudKeysMatchOctomapKeys) {
   std::mt19937_64 rng(9);
@@ -89,6 +94,72 @@ TEST(VoxelizeTest, RefusesAbsurdExtentsBeforeAllocating) {
   ASSERT_FALSE(big.ok());
   EXPECT_EQ(big.status().code(), StatusCode::kResourceExhausted);
   EXPECT_NE(big.status().message().find("use a resolution of at least"), std::string::npos);
+}
+
+TEST(VoxelizeTest, TheKeyRangeMessageNamesTheExtentAndAResolutionThatFits) {
+  auto far = Voxelize(Cloud({{0, 0, 0}, {5000, 0, 0}}), {});
+  ASSERT_FALSE(far.ok());
+  EXPECT_THAT(far.status().message(), HasSubstr("the scene spans 5,000 x 0 x 0 m and does not fit"));
+  EXPECT_THAT(far.status().message(), HasSubstr("a resolution of at least 0.153 m fits"));
+  EXPECT_THAT(far.status().message(), Not(HasSubstr("origin. ")));
+  EXPECT_THAT(far.status().message(), Not(HasSubstr("millimetres")));
+}
+
+// A cloud read as metres that spans more than any site is told what it probably is: millimetres
+// when a thousandth of it is a plausible site, else stray points.
+TEST(VoxelizeTest, AnImplausibleExtentNamesTheLikelyUnits) {
+  auto mm = Voxelize(Cloud({{0, 0, 0}, {27400, 18200, 3100}}), {});
+  ASSERT_EQ(mm.status().code(), StatusCode::kInvalidArgument);
+  EXPECT_THAT(mm.status().message(), HasSubstr("the scene spans 27,400 x 18,200 x 3,100 m as metres"));
+  EXPECT_THAT(mm.status().message(), HasSubstr("is the file in millimetres (it would span 27.4 x 18.2 x 3.1 m)?"));
+  EXPECT_THAT(mm.status().message(), HasSubstr("vc-client --units mm"));
+  VoxelizeOptions coarse;
+  coarse.resolution_m = 2;
+  coarse.memory_budget_bytes = 1 << 20;
+  auto memory = Voxelize(Cloud({{0, 0, 0}, {27400, 18200, 3100}}), coarse);
+  ASSERT_EQ(memory.status().code(), StatusCode::kResourceExhausted);
+  EXPECT_THAT(memory.status().message(), HasSubstr("for centimetres). As metres it needs "));
+  EXPECT_THAT(memory.status().message(), HasSubstr("MiB for its traversal grid alone at resolution 2 m, over the"));
+  auto stray = Voxelize(Cloud({{0, 0, 0}, {0, 9e6, 0}}), {});
+  ASSERT_EQ(stray.status().code(), StatusCode::kInvalidArgument);
+  EXPECT_THAT(stray.status().message(), HasSubstr("stray points"));
+  EXPECT_THAT(stray.status().message(), Not(HasSubstr("millimetres")));
+}
+
+TEST(VoxelizeTest, AMillimetreCopyOfTheHallScanIsToldItsUnitsAndReadsWithThem) {
+  Result<SceneInput> hall = ReadSceneFile(testing::SharedDataPath("hall-scan/scan.dat.bz2"));
+  ASSERT_TRUE(hall.ok()) << hall.status().ToString();
+  std::string in_mm;
+  for (const Eigen::Vector3f& p : hall->points) {
+    char line[96];
+    std::snprintf(line, sizeof line, "%.3f %.3f %.3f\n", 1000.0 * p.x(), 1000.0 * p.y(), 1000.0 * p.z());
+    in_mm += line;
+  }
+  Result<SceneInput> as_metres = ReadScene(in_mm, "hall-mm.xyz");
+  ASSERT_TRUE(as_metres.ok()) << as_metres.status().ToString();
+  auto refused = Voxelize(*as_metres, {});
+  ASSERT_EQ(refused.status().code(), StatusCode::kInvalidArgument);
+  EXPECT_THAT(refused.status().message(), HasSubstr("is the file in millimetres"));
+  EXPECT_THAT(refused.status().message(), HasSubstr("--units mm"));
+
+  ReadOptions mm;
+  mm.metres_per_unit = *MetresPerUnit("mm");
+  Result<SceneInput> with_units = ReadScene(in_mm, "hall-mm.xyz", mm);
+  ASSERT_TRUE(with_units.ok()) << with_units.status().ToString();
+  EXPECT_EQ(with_units->frame_origin_m, Eigen::Vector3d::Zero());
+  Result<VoxelScene> original = Voxelize(*hall, {}), from_mm = Voxelize(*with_units, {});
+  ASSERT_TRUE(original.ok() && from_mm.ok()) << from_mm.status().ToString();
+  EXPECT_EQ(from_mm->occupied, original->occupied);
+}
+
+TEST(VoxelizeTest, TheSceneKeepsTheInputsFrameOrigin) {
+  SceneInput survey = Cloud({{0.5f, 0.5f, 0.5f}, {3.25f, -1.5f, 2}});
+  survey.frame_origin_m = {512000, 5612000, 0};
+  Result<VoxelScene> scene = Voxelize(survey, {});
+  ASSERT_TRUE(scene.ok()) << scene.status().ToString();
+  EXPECT_EQ(scene->frame_origin_m, WorldPoint(512000, 5612000, 0));
+  EXPECT_EQ(scene->occupied.size(), 2u);
+  EXPECT_EQ(Voxelize(Cloud({{0, 0, 0}}), {})->frame_origin_m, WorldPoint::Zero());
 }
 
 TEST(VoxelizeTest, BadResolutionAndEmptyInputAreInvalid) {

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 #include <zlib.h>
 
+#include <cmath>
 #include <cstring>
 
 #include "testing/scenes.h"
@@ -21,21 +22,30 @@ void PutAt(std::string& s, size_t at, T v) {
   std::memcpy(s.data() + at, &v, sizeof(T));
 }
 
-// A stream with the given header fields over `varints` (deflated).
-std::string Stream(uint64_t count, const std::string& varints, double resolution_m = 0.1) {
+// Where a version 2 stream's voxel count lies (after the resolution and the frame origin).
+constexpr size_t kCountAt = 44;
+
+// A stream of `version` (2: with `frame_origin_m`; 1: without) with the given header fields over
+// `varints` (deflated).
+std::string Stream(uint64_t count, const std::string& varints, double resolution_m = 0.1, uint32_t version = 2,
+                   const Eigen::Vector3d& frame_origin_m = Eigen::Vector3d::Zero()) {
   uLongf size = compressBound(uLong(varints.size()));
   std::string deflated(size, '\0');
   EXPECT_EQ(compress2(reinterpret_cast<Bytef*>(deflated.data()), &size, reinterpret_cast<const Bytef*>(varints.data()),
                       uLong(varints.size()), 6),
             Z_OK);
   deflated.resize(size);
-  std::string s(kVoxelStreamHeaderBytes, '\0');
+  const size_t count_at = version == 1 ? 20 : kCountAt;
+  std::string s(count_at + 24, '\0');
   std::memcpy(s.data(), "VCVOXELS", 8);
-  PutAt<uint32_t>(s, 8, 1);
+  PutAt<uint32_t>(s, 8, version);
   PutAt<double>(s, 12, resolution_m);
-  PutAt<uint64_t>(s, 20, count);
-  PutAt<uint64_t>(s, 28, varints.size());
-  PutAt<uint64_t>(s, 36, deflated.size());
+  if (version != 1) {
+    for (int a = 0; a < 3; ++a) PutAt<double>(s, 20 + 8 * a, frame_origin_m[a]);
+  }
+  PutAt<uint64_t>(s, count_at, count);
+  PutAt<uint64_t>(s, count_at + 8, varints.size());
+  PutAt<uint64_t>(s, count_at + 16, deflated.size());
   return s + deflated;
 }
 
@@ -86,6 +96,41 @@ TEST(VoxelStream, APlanFromTheStreamIsThePlanFromTheCloud) {
   EXPECT_EQ(a->covered_voxels, b->covered_voxels);
 }
 
+TEST(VoxelStream, TheStreamCarriesTheFrameOriginOfASurveyScene) {
+  SceneInput cloud = Synthetic("rooms:3");
+  const Eigen::Vector3d origin(512000, 5612000, -1000);
+  cloud.frame_origin_m = origin;
+  Result<CompactScene> compact = CompactPointCloud(cloud, 0.1, kDefaultMemoryBudgetBytes);
+  ASSERT_TRUE(compact.ok()) << compact.status().ToString();
+  Result<SceneInput> back = ReadScene(compact->bytes, "upload");
+  ASSERT_TRUE(back.ok()) << back.status().ToString();
+  EXPECT_EQ(back->frame_origin_m, origin);
+  Result<VoxelScene> a = Voxelize(cloud, {}), b = Voxelize(*back, {});
+  ASSERT_TRUE(a.ok() && b.ok());
+  EXPECT_EQ(a->occupied, b->occupied);
+  EXPECT_EQ(b->frame_origin_m, origin);
+  // The stream is in metres already: units given for the upload do not scale it again.
+  ReadOptions in_mm;
+  in_mm.metres_per_unit = 0.001;
+  Result<SceneInput> with_units = ReadScene(compact->bytes, "upload", in_mm);
+  ASSERT_TRUE(with_units.ok()) << with_units.status().ToString();
+  EXPECT_EQ(with_units->points, back->points);
+  EXPECT_EQ(with_units->frame_origin_m, origin);
+  EXPECT_EQ(EncodeVoxelStream({{1, 0, 0}}, 0.1, {0, std::nan(""), 0}).status().code(), StatusCode::kInvalidArgument);
+}
+
+TEST(VoxelStream, Version1IsStillReadWithTheOriginAtZero) {
+  const std::string varints("\x05\x01", 2);
+  Result<SceneInput> v1 = ReadScene(Stream(2, varints, 0.1, 1), "upload");
+  Result<SceneInput> v2 = ReadScene(Stream(2, varints, 0.1, 2, {1000, 2000, 0}), "upload");
+  ASSERT_TRUE(v1.ok()) << v1.status().ToString();
+  ASSERT_TRUE(v2.ok()) << v2.status().ToString();
+  EXPECT_EQ(v1->frame_origin_m, Eigen::Vector3d::Zero());
+  EXPECT_EQ(v2->frame_origin_m, Eigen::Vector3d(1000, 2000, 0));
+  EXPECT_EQ(v1->points, v2->points);
+  EXPECT_EQ(v1->points.size(), 2u);
+}
+
 TEST(VoxelStream, AnotherResolutionIsRefusedNamingBoth) {
   Result<CompactScene> compact = CompactPointCloud(Synthetic("box"), 0.1, kDefaultMemoryBudgetBytes);
   ASSERT_TRUE(compact.ok());
@@ -119,14 +164,18 @@ TEST(VoxelStream, MalformedStreamsAreRefusedNamingWhat) {
     std::string says;
   };
   std::string bad_version = two;
-  PutAt<uint32_t>(bad_version, 8, 2);
+  PutAt<uint32_t>(bad_version, 8, 3);
+  std::string nan_origin = two;
+  PutAt<double>(nan_origin, 28, std::nan(""));
   std::string nan_resolution = two;
   PutAt<double>(nan_resolution, 12, std::nan(""));
   std::string flipped = two;
   flipped[kVoxelStreamHeaderBytes + 3] ^= 0x5A;
   const Case cases[] = {
       {two.substr(0, 20), "header truncated"},
-      {bad_version, "version 2"},
+      {two.substr(0, 50), "version 2 header truncated"},
+      {bad_version, "version 3"},
+      {nan_origin, "frame origin at byte 20"},
       {nan_resolution, "resolution"},
       {Stream(0, ""), "0 voxels"},
       {Stream(3, std::string("\x05\x01\x01", 3)).substr(0, two.size()), "compressed bytes"},  // cut short
@@ -151,7 +200,7 @@ TEST(VoxelStream, ADeclaredCountOverTheLimitsIsResourceExhaustedBeforeAnyAllocat
   ReadOptions small;
   small.max_points = 1000;
   std::string huge = Stream(2, std::string("\x05\x01", 2));
-  PutAt<uint64_t>(huge, 20, uint64_t{1} << 40);
+  PutAt<uint64_t>(huge, kCountAt, uint64_t{1} << 40);
   Result<SceneInput> r = ReadScene(huge, "upload", small);
   ASSERT_FALSE(r.ok());
   EXPECT_EQ(r.status().code(), StatusCode::kResourceExhausted) << r.status().ToString();

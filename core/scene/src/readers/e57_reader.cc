@@ -681,7 +681,7 @@ Result<E57Cloud> ReadE57(std::string_view bytes, std::string_view source, const 
                                   Str(total * kBytesPerPoint) + " bytes), more than the limit of " +
                                   Str(options.max_result_bytes) + " bytes" + std::string(kRaiseResultLimit));
   }
-  E57Cloud out;
+  E57Cloud out{PointCloud(options), {}};
   uint64_t invalid = 0;
   for (size_t i = 0; i < e57.scans.size(); ++i) {
     const ScanLayout& layout = e57.scans[i];

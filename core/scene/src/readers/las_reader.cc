@@ -121,7 +121,7 @@ Result<PointCloud> ReadLas(std::string_view bytes, std::string_view source, cons
                                       "; expected a finite non-zero scale and a finite offset");
     }
   }
-  PointCloud cloud;
+  PointCloud cloud(options);
   cloud.points.reserve(count);
   for (uint64_t i = 0; i < count; ++i) {
     const size_t p = point_offset + i * record_length;

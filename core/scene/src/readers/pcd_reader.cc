@@ -354,7 +354,7 @@ bool LooksLikePcd(std::string_view bytes) {
 Result<PointCloud> ReadPcd(std::string_view bytes, std::string_view source, const ReadOptions& options) {
   VC_ASSIGN_OR_RETURN(const Header h, ParseHeader(bytes, source));
   VC_RETURN_IF_ERROR(CheckPointLimit(h.points, "PCD header", source, options));
-  PointCloud cloud;
+  PointCloud cloud(options);
   switch (h.data) {
     case Data::kAscii:
       VC_RETURN_IF_ERROR(ReadAscii(bytes, source, h, &cloud));

@@ -411,7 +411,7 @@ bool LooksLikePly(std::string_view bytes) { return bytes.substr(0, 4) == "ply\n"
 Result<PointCloud> ReadPly(std::string_view bytes, std::string_view source, const ReadOptions& options) {
   VC_ASSIGN_OR_RETURN(const Header h, ParseHeader(bytes, source));
   VC_RETURN_IF_ERROR(CheckPointLimit(h.elements[h.vertex_index].count, "PLY header", source, options));
-  PointCloud cloud;
+  PointCloud cloud(options);
   if (h.encoding == Encoding::kAscii) {
     VC_RETURN_IF_ERROR(ReadAsciiBody(bytes, source, h, &cloud));
   } else {

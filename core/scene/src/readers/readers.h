@@ -11,6 +11,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -21,20 +22,60 @@
 
 namespace vc::readers {
 
+// The local frame of one read (docs/PLANNING.md "Coordinates"). Each coordinate is computed in
+// double, scaled by ReadOptions::metres_per_unit, and stored as float minus the frame's origin: per
+// axis, 1000 m x round(c / 1000 m) of the first point whose coordinates are all finite (as floats,
+// in metres). A scene within 500 m of its own origin keeps origin 0 and reads exactly as a plain
+// float conversion; a copy shifted by whole kilometres reads to the same local points; survey
+// coordinates (x ~ 512,345 m) keep float's precision near the origin (~3e-5 m at 500 m).
+class LocalFrame {
+ public:
+  // Coordinates in input units, `metres_per_unit` metres each.
+  explicit LocalFrame(double metres_per_unit) : metres_per_unit_(metres_per_unit) {}
+
+  // (x, y, z) in input units as a local point in metres, or nullopt if a coordinate is not finite
+  // as a float (NaN, infinite, beyond float range). The first point that is finite fixes the origin.
+  std::optional<Eigen::Vector3f> ToLocal(double x, double y, double z) {
+    const Eigen::Vector3d m(x * metres_per_unit_, y * metres_per_unit_, z * metres_per_unit_);
+    if (!origin_fixed_) {
+      if (!m.cast<float>().allFinite()) return std::nullopt;
+      origin_m_ = m.unaryExpr([](double c) { return 1000.0 * std::round(c / 1000.0); });
+      origin_fixed_ = true;
+    }
+    const Eigen::Vector3f local = (m - origin_m_).cast<float>();
+    if (!local.allFinite()) return std::nullopt;
+    return local;
+  }
+  // A position in input units (a scan's origin) in the local frame, in metres, in double.
+  Eigen::Vector3d ToLocal(const Eigen::Vector3d& input) const { return input * metres_per_unit_ - origin_m_; }
+  // The local origin in the input's frame, in metres; zero until the first finite point.
+  const Eigen::Vector3d& origin_m() const { return origin_m_; }
+
+ private:
+  double metres_per_unit_;
+  Eigen::Vector3d origin_m_ = Eigen::Vector3d::Zero();
+  bool origin_fixed_ = false;
+};
+
 // Points read by a point-cloud reader.
 struct PointCloud {
-  // Finite points, in the file's units (metres by convention).
+  // A cloud read with `options.metres_per_unit`.
+  explicit PointCloud(const ReadOptions& options) : frame(options.metres_per_unit) {}
+
+  // Finite points, in metres, in the local frame `frame`.
   std::vector<Eigen::Vector3f> points;
+  // The frame `points` are in; its origin is SceneInput::frame_origin_m.
+  LocalFrame frame;
   // Points dropped because a coordinate was NaN, infinite or beyond float range.
   uint64_t dropped_nonfinite = 0;
   // Format specifics for people, e.g. "binary_little_endian 1.0".
   std::string detail;
 
-  // Appends (x, y, z) if all are finite as floats, else counts it as dropped.
+  // Appends (x, y, z), in input units, in the local frame if it is finite there, else counts it as
+  // dropped.
   void Add(double x, double y, double z) {
-    const float fx = static_cast<float>(x), fy = static_cast<float>(y), fz = static_cast<float>(z);
-    if (std::isfinite(fx) && std::isfinite(fy) && std::isfinite(fz)) {
-      points.emplace_back(fx, fy, fz);
+    if (const std::optional<Eigen::Vector3f> local = frame.ToLocal(x, y, z)) {
+      points.push_back(*local);
     } else {
       ++dropped_nonfinite;
     }
@@ -73,7 +114,8 @@ bool LooksLikeLas(std::string_view bytes);
 // Reads ASPRS LAS 1.0-1.4, point formats 0-10, uncompressed (las_reader.cc).
 Result<PointCloud> ReadLas(std::string_view bytes, std::string_view source, const ReadOptions& options);
 
-// What ReadE57 read: the points of every scan in the world frame, and the scans.
+// What ReadE57 read: the points of every scan (world frame, then local), and the scans (their
+// poses in the file's world frame and units).
 struct E57Cloud {
   PointCloud cloud;
   std::vector<E57Scan> scans;
@@ -89,7 +131,8 @@ Result<PointCloud> ReadXyz(std::string_view bytes, std::string_view source, cons
 
 // vc-voxels (voxel_stream.cc; vc/scene/voxel_stream.h): starts with "VCVOXELS".
 bool LooksLikeVoxelStream(std::string_view bytes);
-// One point per voxel centre, voxel_resolution_m set. INVALID_ARGUMENT naming the byte or voxel,
+// One point per voxel centre (local frame), voxel_resolution_m and frame_origin_m set (version 1:
+// origin 0). INVALID_ARGUMENT naming the byte or voxel,
 // RESOURCE_EXHAUSTED past the limits.
 Result<SceneInput> ReadVoxelStream(std::string_view bytes, std::string_view source, const ReadOptions& options);
 

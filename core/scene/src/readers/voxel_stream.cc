@@ -19,7 +19,10 @@
 namespace vc {
 namespace {
 
-constexpr uint32_t kVersion = 1;
+constexpr uint32_t kVersion = 2;
+// Version 1 (no frame origin: the local frame is the input's) is still read.
+constexpr uint32_t kVersionWithoutOrigin = 1;
+constexpr size_t kVersion1HeaderBytes = 44;
 constexpr uint64_t kMaxPacked = (uint64_t{1} << 48) - 1;
 constexpr uint64_t kMaxVarintBytes = 7;  // a 48-bit value
 
@@ -52,10 +55,12 @@ static_assert(std::endian::native == std::endian::little, "the vc-voxels layout 
 
 }  // namespace
 
-Result<std::string> EncodeVoxelStream(const std::vector<VoxelKey>& keys, double resolution_m) {
+Result<std::string> EncodeVoxelStream(const std::vector<VoxelKey>& keys, double resolution_m,
+                                      const WorldPoint& frame_origin_m) {
   if (!(std::isfinite(resolution_m) && resolution_m > 0)) {
     return InvalidArgumentError("vc-voxels: the resolution must be finite and positive");
   }
+  if (!frame_origin_m.allFinite()) return InvalidArgumentError("vc-voxels: the frame origin must be finite");
   if (keys.empty()) return InvalidArgumentError("vc-voxels: no voxel to encode");
   std::string varints;
   varints.reserve(keys.size() * 2);
@@ -76,6 +81,7 @@ Result<std::string> EncodeVoxelStream(const std::vector<VoxelKey>& keys, double 
   std::string out(kVoxelStreamMagic);
   Put<uint32_t>(out, kVersion);
   Put<double>(out, resolution_m);
+  for (int a = 0; a < 3; ++a) Put<double>(out, frame_origin_m[a]);
   Put<uint64_t>(out, keys.size());
   Put<uint64_t>(out, varints.size());
   Put<uint64_t>(out, deflated.size());
@@ -91,7 +97,7 @@ Result<CompactScene> CompactPointCloud(const SceneInput& input, double resolutio
   }
   VC_ASSIGN_OR_RETURN(std::vector<VoxelKey> keys, OccupiedKeys(input, resolution_m, memory_budget_bytes, ctx));
   CompactScene compact;
-  VC_ASSIGN_OR_RETURN(compact.bytes, EncodeVoxelStream(keys, resolution_m));
+  VC_ASSIGN_OR_RETURN(compact.bytes, EncodeVoxelStream(keys, resolution_m, input.frame_origin_m));
   compact.resolution_m = resolution_m;
   compact.voxels = keys.size();
   return compact;
@@ -102,54 +108,69 @@ namespace readers {
 bool LooksLikeVoxelStream(std::string_view bytes) { return bytes.substr(0, 8) == kVoxelStreamMagic; }
 
 Result<SceneInput> ReadVoxelStream(std::string_view bytes, std::string_view source, const ReadOptions& options) {
-  if (bytes.size() < kVoxelStreamHeaderBytes) {
+  if (bytes.size() < kVersion1HeaderBytes) {
     return InvalidInput(source, "vc-voxels header truncated: " + std::to_string(bytes.size()) + " bytes of " +
-                                    std::to_string(kVoxelStreamHeaderBytes));
+                                    std::to_string(kVersion1HeaderBytes));
   }
   const auto version = Get<uint32_t>(bytes, 8);
-  if (version != kVersion) {
-    return InvalidInput(source, "vc-voxels version " + std::to_string(version) + " at byte 8; this server reads 1");
+  if (version != kVersion && version != kVersionWithoutOrigin) {
+    return InvalidInput(source,
+                        "vc-voxels version " + std::to_string(version) + " at byte 8; this server reads 1 and 2");
+  }
+  const size_t header_bytes = version == kVersion ? kVoxelStreamHeaderBytes : kVersion1HeaderBytes;
+  if (bytes.size() < header_bytes) {
+    return InvalidInput(source, "vc-voxels version 2 header truncated: " + std::to_string(bytes.size()) + " bytes of " +
+                                    std::to_string(header_bytes));
   }
   const auto resolution = Get<double>(bytes, 12);
   if (!(std::isfinite(resolution) && resolution > 0)) {
     return InvalidInput(source, "vc-voxels resolution at byte 12 is not finite and positive");
   }
-  const auto count = Get<uint64_t>(bytes, 20), varint_bytes = Get<uint64_t>(bytes, 28),
-             deflated = Get<uint64_t>(bytes, 36);
-  if (count == 0) return InvalidInput(source, "vc-voxels stream of 0 voxels (byte 20); the scene is empty");
+  WorldPoint frame_origin_m = WorldPoint::Zero();
+  if (version == kVersion) {
+    for (int a = 0; a < 3; ++a) frame_origin_m[a] = Get<double>(bytes, 20 + 8 * a);
+    if (!frame_origin_m.allFinite()) return InvalidInput(source, "vc-voxels frame origin at byte 20 is not finite");
+  }
+  // The three sizes follow the resolution (version 1) or the frame origin (version 2).
+  const size_t sizes_at = header_bytes - 24;
+  const auto count = Get<uint64_t>(bytes, sizes_at), varint_bytes = Get<uint64_t>(bytes, sizes_at + 8),
+             deflated = Get<uint64_t>(bytes, sizes_at + 16);
+  auto byte = [&](size_t field) { return " (byte " + std::to_string(sizes_at + 8 * field) + ")"; };
+  if (count == 0) return InvalidInput(source, "vc-voxels stream of 0 voxels" + byte(0) + "; the scene is empty");
   VC_RETURN_IF_ERROR(CheckPointLimit(count, "vc-voxels stream", source, options));
   if (count > options.max_result_bytes / kBytesPerPoint) {
     return ResourceExhaustedError(std::string(source) + ": vc-voxels stream of " + std::to_string(count) +
                                   " voxels needs more memory than allowed" + std::string(kRaiseResultLimit));
   }
   if (varint_bytes < count || varint_bytes > kMaxVarintBytes * count) {
-    return InvalidInput(source, "vc-voxels declares " + std::to_string(varint_bytes) + " key bytes (byte 28) for " +
-                                    std::to_string(count) + " voxels; expected " + std::to_string(count) + " to " +
-                                    std::to_string(kMaxVarintBytes * count));
+    return InvalidInput(source, "vc-voxels declares " + std::to_string(varint_bytes) + " key bytes" + byte(1) +
+                                    " for " + std::to_string(count) + " voxels; expected " + std::to_string(count) +
+                                    " to " + std::to_string(kMaxVarintBytes * count));
   }
   if (varint_bytes > options.max_decompressed_bytes) {
     return ResourceExhaustedError(std::string(source) + ": vc-voxels declares " + std::to_string(varint_bytes) +
                                   " key bytes, more than the limit of " +
                                   std::to_string(options.max_decompressed_bytes) + std::string(kRaiseInputLimit));
   }
-  if (deflated != bytes.size() - kVoxelStreamHeaderBytes) {
-    return InvalidInput(source, "vc-voxels declares " + std::to_string(deflated) + " compressed bytes (byte 36) but " +
-                                    std::to_string(bytes.size() - kVoxelStreamHeaderBytes) +
+  if (deflated != bytes.size() - header_bytes) {
+    return InvalidInput(source, "vc-voxels declares " + std::to_string(deflated) + " compressed bytes" + byte(2) +
+                                    " but " + std::to_string(bytes.size() - header_bytes) +
                                     " follow the header: truncated or padded");
   }
   std::string varints(varint_bytes, '\0');
   uLongf inflated = uLongf(varint_bytes);
   const int z = uncompress(reinterpret_cast<Bytef*>(varints.data()), &inflated,
-                           reinterpret_cast<const Bytef*>(bytes.data() + kVoxelStreamHeaderBytes), uLong(deflated));
+                           reinterpret_cast<const Bytef*>(bytes.data() + header_bytes), uLong(deflated));
   if (z != Z_OK || inflated != varint_bytes) {
-    return InvalidInput(
-        source, "vc-voxels keys at byte 44 do not inflate to the declared " + std::to_string(varint_bytes) +
-                    " bytes (" + (z == Z_BUF_ERROR ? std::string("more or truncated data") : std::string(zError(z))) +
-                    ")");
+    return InvalidInput(source,
+                        "vc-voxels keys at byte " + std::to_string(header_bytes) + " do not inflate to the declared " +
+                            std::to_string(varint_bytes) + " bytes (" +
+                            (z == Z_BUF_ERROR ? std::string("more or truncated data") : std::string(zError(z))) + ")");
   }
   SceneInput in;
   in.format = InputFormat::kVoxelStream;
   in.voxel_resolution_m = resolution;
+  in.frame_origin_m = frame_origin_m;
   in.points.reserve(count);
   size_t at = 0;
   uint64_t key = 0;

@@ -84,7 +84,7 @@ bool LooksLikeText(std::string_view bytes) {
 
 Result<PointCloud> ReadXyz(std::string_view bytes, std::string_view source, const ReadOptions& options) {
   if (bytes.substr(0, 3) == "\xEF\xBB\xBF") bytes.remove_prefix(3);  // UTF-8 byte-order mark.
-  PointCloud cloud;
+  PointCloud cloud(options);
   LineCursor lines(bytes);
   std::string_view line;
   bool seen_data_line = false;

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "testing/e57_writer.h"
+#include "testing/survey.h"
 #include "vc/scene/e57.h"
 #include "vc/scene/scene_input.h"
 
@@ -21,6 +22,9 @@ using testing::E57ScanSpec;
 using testing::E57Spec;
 using testing::E57ValueType;
 using ::testing::HasSubstr;
+using testing::HoldsInInputFrame;
+using testing::kSurveyOrigin;
+using testing::SurveyPoints;
 using testing::WriteE57;
 
 std::vector<Eigen::Vector3d> SomePoints() {
@@ -432,6 +436,48 @@ TEST(E57Reader, ChecksLimitsBeforeReadingPoints) {
   in = ReadScene(WriteE57(OneScan(Scan())), "t.e57", options);
   ASSERT_FALSE(in.ok());
   EXPECT_EQ(in.status().code(), StatusCode::kResourceExhausted);
+}
+
+// Two scans posed at survey coordinates, their points (scanner frame) turned and moved onto
+// SurveyPoints(): the first scan holds the first two points, the second the other three.
+E57Spec SurveyScans(double metres_per_unit = 1.0) {
+  const Eigen::Quaterniond turn(Eigen::AngleAxisd(0.7, Eigen::Vector3d::UnitZ()));
+  const Eigen::Vector3d stations[2] = {{512340.25, 5612328.5, 311.0}, {512344.125, 5612336.75, 310.5}};
+  const std::vector<Eigen::Vector3d> world = SurveyPoints();
+  E57Spec spec;
+  for (int s = 0; s < 2; ++s) {
+    E57ScanSpec scan = Scan();
+    scan.rotation = turn;
+    scan.translation_m = stations[s] / metres_per_unit;
+    scan.points.clear();
+    for (size_t i = s == 0 ? 0 : 2; i < (s == 0 ? 2u : world.size()); ++i) {
+      scan.points.push_back(turn.inverse() * (world[i] / metres_per_unit - scan.translation_m));
+    }
+    spec.scans.push_back(scan);
+  }
+  return spec;
+}
+
+TEST(E57Reader, ScansPosedAtSurveyCoordinatesReadInALocalFrameToTheMillimetre) {
+  Result<SceneInput> in = ReadScene(WriteE57(SurveyScans()), "utm.e57");
+  ASSERT_TRUE(in.ok()) << in.status().message();
+  EXPECT_EQ(in->frame_origin_m, kSurveyOrigin);
+  EXPECT_TRUE(HoldsInInputFrame(*in, SurveyPoints(), 1e-3));
+  ASSERT_EQ(in->scan_origins.size(), 2u);
+  // The scan origins are local too, in double.
+  EXPECT_LE((in->scan_origins[0] - Eigen::Vector3d(340.25, 328.5, 311.0)).norm(), 1e-9);
+  EXPECT_LE((in->scan_origins[1] - Eigen::Vector3d(344.125, 336.75, 310.5)).norm(), 1e-9);
+}
+
+TEST(E57Reader, UnitsScalePointsAndScanOrigins) {
+  ReadOptions options;
+  options.metres_per_unit = *MetresPerUnit("ft");
+  Result<SceneInput> in = ReadScene(WriteE57(SurveyScans(options.metres_per_unit)), "ft.e57", options);
+  ASSERT_TRUE(in.ok()) << in.status().message();
+  EXPECT_EQ(in->frame_origin_m, kSurveyOrigin);
+  EXPECT_TRUE(HoldsInInputFrame(*in, SurveyPoints(), 1e-3));
+  ASSERT_EQ(in->scan_origins.size(), 2u);
+  EXPECT_LE((in->scan_origins[1] - Eigen::Vector3d(344.125, 336.75, 310.5)).norm(), 1e-6);
 }
 
 }  // namespace

@@ -2,17 +2,24 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <Eigen/Core>
 #include <array>
+#include <cmath>
 #include <cstring>
 #include <string>
 #include <vector>
 
+#include "testing/survey.h"
 #include "vc/scene/scene_input.h"
 
 namespace vc {
 namespace {
 
 using ::testing::HasSubstr;
+using vc::testing::HoldsInInputFrame;
+using vc::testing::kSurveyOrigin;
+using vc::testing::Shifted;
+using vc::testing::SurveyPoints;
 
 template <typename T>
 void PutAt(std::string* s, size_t offset, T v) {
@@ -84,8 +91,10 @@ TEST(LasReaderTest, EveryVersionAndPointFormatAppliesScaleAndOffset) {
       EXPECT_EQ(r->format, InputFormat::kLas);
       EXPECT_EQ(r->detail, "LAS 1." + std::to_string(minor) + " PDRF " + std::to_string(format));
       ASSERT_EQ(r->points.size(), 2u);
-      EXPECT_EQ(r->points[0], Eigen::Vector3f(1001.0f, -50.2f, 152.0f));
-      EXPECT_EQ(r->points[1], Eigen::Vector3f(1000.0f, -50.0f, 2.0f));
+      // (1001, -50.2, 152) and (1000, -50, 2) in the file's frame; the local origin is at x = 1 km.
+      EXPECT_EQ(r->frame_origin_m, Eigen::Vector3d(1000, 0, 0));
+      EXPECT_EQ(r->points[0], Eigen::Vector3f(1.0f, -50.2f, 152.0f));
+      EXPECT_EQ(r->points[1], Eigen::Vector3f(0.0f, -50.0f, 2.0f));
     }
   }
 }
@@ -197,6 +206,49 @@ TEST(LasReaderTest, EveryTruncationFailsCleanly) {
   for (size_t n = 4; n < las.size(); ++n) {
     EXPECT_FALSE(ReadScene(std::string_view(las).substr(0, n), "cut.las").ok()) << n;
   }
+}
+
+// `points_m` as LAS records of `scale` (file units) about `offset` (file units), in file units
+// of `metres_per_unit` metres.
+std::string SurveyLas(const std::vector<Eigen::Vector3d>& points_m, const Eigen::Vector3d& offset, double scale,
+                      double metres_per_unit = 1.0) {
+  LasSpec spec;
+  spec.points.clear();
+  for (int a = 0; a < 3; ++a) {
+    spec.scale[a] = scale;
+    spec.offset[a] = offset[a];
+  }
+  for (const Eigen::Vector3d& p : points_m) {
+    std::array<int32_t, 3> record;
+    for (int a = 0; a < 3; ++a) record[a] = int32_t(std::lround((p[a] / metres_per_unit - offset[a]) / scale));
+    spec.points.push_back(record);
+  }
+  return MakeLas(spec);
+}
+
+TEST(LasReaderTest, SurveyCoordinatesFromScaleAndOffsetReadInALocalFrameToTheMillimetre) {
+  const Eigen::Vector3d offset(512000, 5612000, 0);
+  Result<SceneInput> r = ReadScene(SurveyLas(SurveyPoints(), offset, 0.001), "utm.las");
+  ASSERT_TRUE(r.ok()) << r.status().ToString();
+  EXPECT_EQ(r->frame_origin_m, kSurveyOrigin);
+  EXPECT_TRUE(HoldsInInputFrame(*r, SurveyPoints(), 1e-3));
+
+  const Eigen::Vector3d shift(4000, -3000, 0);
+  Result<SceneInput> shifted = ReadScene(SurveyLas(Shifted(SurveyPoints(), shift), offset + shift, 0.001), "s.las");
+  ASSERT_TRUE(shifted.ok()) << shifted.status().ToString();
+  EXPECT_EQ(shifted->frame_origin_m, kSurveyOrigin + shift);
+  EXPECT_EQ(shifted->points, r->points);
+}
+
+TEST(LasReaderTest, UnitsApplyAfterTheFilesScaleAndOffset) {
+  const double us_foot = *MetresPerUnit("us-ft");
+  const Eigen::Vector3d offset_ft(1680000, 18412000, 1000);
+  ReadOptions options;
+  options.metres_per_unit = us_foot;
+  Result<SceneInput> r = ReadScene(SurveyLas(SurveyPoints(), offset_ft, 0.001, us_foot), "ft.las", options);
+  ASSERT_TRUE(r.ok()) << r.status().ToString();
+  EXPECT_EQ(r->frame_origin_m, kSurveyOrigin);
+  EXPECT_TRUE(HoldsInInputFrame(*r, SurveyPoints(), 1e-3));
 }
 
 }  // namespace

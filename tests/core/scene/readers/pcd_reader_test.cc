@@ -3,17 +3,23 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstdio>
 #include <cstring>
 #include <limits>
 #include <string>
 #include <vector>
 
+#include "testing/survey.h"
 #include "vc/scene/scene_input.h"
 
 namespace vc {
 namespace {
 
 using ::testing::HasSubstr;
+using vc::testing::HoldsInInputFrame;
+using vc::testing::kSurveyOrigin;
+using vc::testing::Shifted;
+using vc::testing::SurveyPoints;
 
 template <typename T>
 void Put(std::string* s, T v) {
@@ -273,6 +279,50 @@ TEST(PcdReaderTest, EveryTruncationOfACompressedFileFailsCleanly) {
     bad[n] = static_cast<char>(bad[n] ^ 0x5a);
     (void)ReadScene(bad, "flip.pcd");
   }
+}
+
+// `points_m` as a PCD of F 8 fields x y z, binary or ascii.
+std::string DoublePcd(const std::vector<Eigen::Vector3d>& points_m, const std::string& data) {
+  std::string pcd = Header("x y z", "8 8 8", "F F F", "1 1 1", int(points_m.size()), data);
+  for (const Eigen::Vector3d& p : points_m) {
+    if (data == "binary") {
+      for (int a = 0; a < 3; ++a) Put<double>(&pcd, p[a]);
+    } else {
+      char line[96];
+      std::snprintf(line, sizeof line, "%.4f %.4f %.4f\n", p.x(), p.y(), p.z());
+      pcd += line;
+    }
+  }
+  return pcd;
+}
+
+TEST(PcdReaderTest, DoubleFieldsAtSurveyCoordinatesReadInALocalFrameToTheMillimetre) {
+  for (const char* data : {"binary", "ascii"}) {
+    Result<SceneInput> r = ReadScene(DoublePcd(SurveyPoints(), data), "utm.pcd");
+    ASSERT_TRUE(r.ok()) << data << ": " << r.status().ToString();
+    EXPECT_EQ(r->frame_origin_m, kSurveyOrigin) << data;
+    EXPECT_TRUE(HoldsInInputFrame(*r, SurveyPoints(), 1e-3)) << data;
+  }
+}
+
+TEST(PcdReaderTest, AWholeKilometreShiftReadsToTheSameLocalPoints) {
+  const Eigen::Vector3d shift(1000, 1000, -1000);
+  Result<SceneInput> survey = ReadScene(DoublePcd(SurveyPoints(), "binary"), "utm.pcd");
+  Result<SceneInput> shifted = ReadScene(DoublePcd(Shifted(SurveyPoints(), shift), "binary"), "shifted.pcd");
+  ASSERT_TRUE(survey.ok() && shifted.ok());
+  EXPECT_EQ(shifted->frame_origin_m, kSurveyOrigin + shift);
+  EXPECT_EQ(shifted->points, survey->points);
+}
+
+TEST(PcdReaderTest, UnitsScaleEveryField) {
+  ReadOptions options;
+  options.metres_per_unit = *MetresPerUnit("mm");
+  std::vector<Eigen::Vector3d> in_mm = SurveyPoints();
+  for (Eigen::Vector3d& p : in_mm) p *= 1000;
+  Result<SceneInput> r = ReadScene(DoublePcd(in_mm, "binary"), "mm.pcd", options);
+  ASSERT_TRUE(r.ok()) << r.status().ToString();
+  EXPECT_EQ(r->frame_origin_m, kSurveyOrigin);
+  EXPECT_TRUE(HoldsInInputFrame(*r, SurveyPoints(), 1e-3));
 }
 
 }  // namespace

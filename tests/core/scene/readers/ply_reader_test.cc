@@ -3,16 +3,23 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <limits>
 #include <string>
+#include <vector>
 
+#include "testing/survey.h"
 #include "vc/scene/scene_input.h"
 
 namespace vc {
 namespace {
 
 using ::testing::HasSubstr;
+using vc::testing::HoldsInInputFrame;
+using vc::testing::kSurveyOrigin;
+using vc::testing::Shifted;
+using vc::testing::SurveyPoints;
 
 // Appends `v` to `s` in little- or big-endian order.
 template <typename T>
@@ -113,7 +120,9 @@ TEST(PlyReaderTest, BinaryDoubleCoordinates) {
   Result<SceneInput> r = ReadScene(ply, "d.ply");
   ASSERT_TRUE(r.ok()) << r.status().ToString();
   ASSERT_EQ(r->points.size(), 1u);
-  EXPECT_EQ(r->points[0], Eigen::Vector3f(1e6f, -2.0f, 3.5f));
+  // x = 1e6 m: the local frame's origin is there (docs/PLANNING.md "Coordinates").
+  EXPECT_EQ(r->frame_origin_m, Eigen::Vector3d(1e6, 0, 0));
+  EXPECT_EQ(r->points[0], Eigen::Vector3f(0, -2.0f, 3.5f));
 }
 
 TEST(PlyReaderTest, BinaryIntegerCoordinatesOfEveryType) {
@@ -356,6 +365,56 @@ TEST(PlyReaderTest, EveryTruncationOfABinaryFileFailsCleanly) {
     Result<SceneInput> r = ReadScene(std::string_view(ply).substr(0, n), "cut.ply");
     EXPECT_FALSE(r.ok()) << "prefix of " << n << " bytes";
   }
+}
+
+// `points_m` as a binary little-endian PLY of double x, y, z.
+std::string DoublePly(const std::vector<Eigen::Vector3d>& points_m) {
+  std::string ply = BinaryHeader("binary_little_endian", int(points_m.size()),
+                                 "property double x\nproperty double y\nproperty double z\n");
+  for (const Eigen::Vector3d& p : points_m) {
+    for (int a = 0; a < 3; ++a) Put<double>(&ply, p[a]);
+  }
+  return ply;
+}
+
+TEST(PlyReaderTest, DoublePropertiesAtSurveyCoordinatesReadInALocalFrameToTheMillimetre) {
+  Result<SceneInput> r = ReadScene(DoublePly(SurveyPoints()), "utm.ply");
+  ASSERT_TRUE(r.ok()) << r.status().ToString();
+  EXPECT_EQ(r->frame_origin_m, kSurveyOrigin);
+  EXPECT_TRUE(HoldsInInputFrame(*r, SurveyPoints(), 1e-3));
+
+  std::string ascii =
+      "ply\nformat ascii 1.0\nelement vertex 5\nproperty double x\nproperty double y\n"
+      "property double z\nend_header\n";
+  for (const Eigen::Vector3d& p : SurveyPoints()) {
+    char line[96];
+    std::snprintf(line, sizeof line, "%.4f %.4f %.4f\n", p.x(), p.y(), p.z());
+    ascii += line;
+  }
+  Result<SceneInput> a = ReadScene(ascii, "utm-ascii.ply");
+  ASSERT_TRUE(a.ok()) << a.status().ToString();
+  EXPECT_EQ(a->frame_origin_m, kSurveyOrigin);
+  EXPECT_TRUE(HoldsInInputFrame(*a, SurveyPoints(), 1e-3));
+}
+
+TEST(PlyReaderTest, AWholeKilometreShiftReadsToTheSameLocalPoints) {
+  const Eigen::Vector3d shift(-7000, 12000, 0);
+  Result<SceneInput> survey = ReadScene(DoublePly(SurveyPoints()), "utm.ply");
+  Result<SceneInput> shifted = ReadScene(DoublePly(Shifted(SurveyPoints(), shift)), "shifted.ply");
+  ASSERT_TRUE(survey.ok() && shifted.ok());
+  EXPECT_EQ(shifted->frame_origin_m, kSurveyOrigin + shift);
+  EXPECT_EQ(shifted->points, survey->points);
+}
+
+TEST(PlyReaderTest, UnitsScaleDoubleProperties) {
+  ReadOptions options;
+  options.metres_per_unit = *MetresPerUnit("cm");
+  std::vector<Eigen::Vector3d> in_cm = SurveyPoints();
+  for (Eigen::Vector3d& p : in_cm) p *= 100;
+  Result<SceneInput> r = ReadScene(DoublePly(in_cm), "cm.ply", options);
+  ASSERT_TRUE(r.ok()) << r.status().ToString();
+  EXPECT_EQ(r->frame_origin_m, kSurveyOrigin);
+  EXPECT_TRUE(HoldsInInputFrame(*r, SurveyPoints(), 1e-3));
 }
 
 }  // namespace

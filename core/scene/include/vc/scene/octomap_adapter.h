@@ -41,12 +41,17 @@ Result<std::shared_ptr<octomap::OcTree>> ReadOctreeText(std::string_view bytes, 
 
 // A scan graph (.graph): every node's points transformed to the world frame, and each node's pose.
 struct ScanGraphData {
+  // Every point in metres, in the local frame: world minus frame_origin_m (scene_input.h).
   std::vector<Eigen::Vector3f> points;
-  std::vector<Eigen::Vector3d> origins;              // Each node's origin (m), world frame.
+  // The local frame's origin in the world frame, in metres (docs/PLANNING.md "Coordinates").
+  Eigen::Vector3d frame_origin_m = Eigen::Vector3d::Zero();
+  std::vector<Eigen::Vector3d> origins;              // Each node's origin (m), world frame (not local).
   std::vector<Eigen::Quaterniond> origin_rotations;  // Each node's rotation (unit), scanner to world.
   uint64_t dropped_nonfinite = 0;
 };
-Result<ScanGraphData> ReadScanGraph(std::string_view bytes, std::string_view source);
+// Reads a scan graph whose coordinates are in units of `metres_per_unit` metres (1: metres).
+// INVALID_ARGUMENT naming the byte when malformed.
+Result<ScanGraphData> ReadScanGraph(std::string_view bytes, std::string_view source, double metres_per_unit = 1.0);
 
 // Resolution of a tree, in metres.
 double OctreeResolution(const octomap::OcTree& tree);

@@ -5,7 +5,9 @@
 // failure is a Status whose message names the source, the byte offset or line, what was expected
 // and what was found. Non-finite points are dropped and counted. Sizes declared in headers are
 // checked against the bytes actually present before any allocation, so a lying header cannot
-// trigger a huge allocation. Thread-safe: functions here share no state.
+// trigger a huge allocation. Coordinates are read in double, scaled to metres and stored as floats
+// relative to a local frame chosen from the data, so survey coordinates keep their precision
+// (docs/PLANNING.md "Coordinates"). Thread-safe: functions here share no state.
 #pragma once
 
 #include <Eigen/Core>
@@ -61,7 +63,8 @@ struct ReadOptions {
   // Refuse inputs whose parsed form (points, OctoMap nodes) would take more than this many bytes.
   uint64_t max_result_bytes = uint64_t{2} << 30;
   // Metres per unit of the input's coordinates (vc-client --units; MetresPerUnit): points are
-  // scaled by this as they are read. 1 for metres.
+  // scaled by this as they are read. 1 for metres. Octrees are read in metres only (other units
+  // are INVALID_ARGUMENT); a vc-voxels stream is in metres already and is not scaled.
   double metres_per_unit = 1.0;
 };
 
@@ -81,14 +84,17 @@ struct SceneInput {
   Compression compression = Compression::kNone;
   // Format specifics for people, e.g. "binary_little_endian 1.0", "binary_compressed", "LAS 1.2 PDRF 1".
   std::string detail;
-  // Points in metres, world frame (LAS scale and offset applied; E57 scans transformed by their
-  // poses). Non-finite points, and E57 records marked invalid, are not here.
+  // Points in metres, local frame: the input's coordinates (LAS scale and offset applied; E57 and
+  // .graph scans transformed by their poses), computed in double, scaled by
+  // ReadOptions::metres_per_unit, minus frame_origin_m. Non-finite points, and E57 records marked
+  // invalid, are not here.
   std::vector<Eigen::Vector3f> points;
-  // .graph and .e57 only: the sensor origin of each scan, in metres, world frame.
+  // .graph and .e57 only: the sensor origin of each scan, in metres, local frame.
   std::vector<Eigen::Vector3d> scan_origins;
   // Where the local frame's origin lies in the input's own frame, in metres: `points` and
-  // `scan_origins` are input coordinates minus this (docs/PLANNING.md, "Coordinates"). Zero for a
-  // scene near its frame's origin; a whole number of kilometres for survey coordinates.
+  // `scan_origins` are input coordinates minus this (docs/PLANNING.md, "Coordinates"). Per axis
+  // 1000 m x round(c / 1000 m) of the first finite point: zero for a scene within 500 m of its
+  // frame's origin and for octrees; a whole number of kilometres for survey coordinates.
   Eigen::Vector3d frame_origin_m = Eigen::Vector3d::Zero();
   // .bt/.ot only: the tree as read, at its own resolution.
   std::shared_ptr<const octomap::OcTree> octree;

@@ -43,7 +43,7 @@ struct VoxelScene {
   // used by visibility bitsets and reports.
   std::vector<VoxelKey> occupied;
   OccupancyGrid grid;
-  // Scanner origins carried from the input (.graph), in metres; may be empty.
+  // Scanner origins carried from the input (.graph, .e57), in metres, local frame; may be empty.
   std::vector<WorldPoint> scan_origins;
   // The input frame's coordinates of this scene's origin (SceneInput::frame_origin_m): every
   // position here is local; add this to write it in the input's own frame.
@@ -77,7 +77,12 @@ class VoxelAccumulator {
   // added and, in Finish, the scene as in VoxelizeOptions. A bad resolution is reported by status().
   explicit VoxelAccumulator(double resolution_m, uint64_t memory_budget_bytes = kDefaultMemoryBudgetBytes);
 
-  // Adds one point (world, m). Points with a NaN or infinite coordinate are dropped and counted;
+  // The input frame's coordinates of the local frame the added points are in (m;
+  // SceneInput::frame_origin_m). Finish copies it into the scene. Zero unless set.
+  void set_frame_origin_m(const WorldPoint& frame_origin_m) { frame_origin_m_ = frame_origin_m; }
+  const WorldPoint& frame_origin_m() const { return frame_origin_m_; }
+
+  // Adds one point (local frame, m). Points with a NaN or infinite coordinate are dropped and counted;
   // once status() is not OK, points are ignored.
   void Add(const Eigen::Vector3f& point_m);
 
@@ -109,6 +114,7 @@ class VoxelAccumulator {
   double resolution_m_;
   double inv_resolution_;
   uint64_t memory_budget_bytes_;
+  WorldPoint frame_origin_m_ = WorldPoint::Zero();
   Status status_;
   bool finished_ = false;
   // Packed keys (z, y, x; 16 bits each): [0, sorted_) sorted and unique, then the unsorted tail.
