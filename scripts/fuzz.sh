@@ -1,19 +1,24 @@
 #!/usr/bin/env bash
-# Builds the libFuzzer targets (the `fuzz` preset: clang++, ASan + UBSan) and runs each in turn,
-# one process at a time, from the checked-in seeds plus slices of ../shared/data.
-# Usage: scripts/fuzz.sh [--seconds N] [--only TARGET]   (default 180 s per target; CI: --seconds 10)
-# Findings (crash-*, leak-*, timeout-*, oom-*) land in build/fuzz/findings/<target>/; the script
+# Builds the libFuzzer targets (the `fuzz` preset: clang++, ASan + UBSan, no tests; or the `asan`
+# preset, which builds the same targets beside its tests) and runs each in turn, one process at a
+# time, from the checked-in seeds plus slices of ../shared/data.
+# Usage: scripts/fuzz.sh [--seconds N] [--only TARGET] [--preset fuzz|asan]
+#        (default 180 s per target and the fuzz preset; CI: --seconds 10 --preset asan, whose build
+#        scripts/test.sh has just made, so the core is not compiled a third time)
+# Findings (crash-*, leak-*, timeout-*, oom-*) land in build/<preset>/findings/<target>/; the script
 # exits non-zero if any target found one. Turn each into a regression test (docs/RELIABILITY.md).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
 seconds=180
 only=""
+preset=fuzz
 while (($#)); do
   case "$1" in
     --seconds) seconds="$2"; shift 2 ;;
     --only) only="$2"; shift 2 ;;
-    *) echo "usage: scripts/fuzz.sh [--seconds N] [--only TARGET]" >&2; exit 2 ;;
+    --preset) preset="$2"; shift 2 ;;
+    *) echo "usage: scripts/fuzz.sh [--seconds N] [--only TARGET] [--preset fuzz|asan]" >&2; exit 2 ;;
   esac
 done
 
@@ -22,10 +27,14 @@ targets=(read_scene_fuzzer ply_fuzzer pcd_fuzzer xyz_fuzzer las_fuzzer e57_fuzze
          keep_out_csv_fuzzer upload_assembler_fuzzer)
 if [[ -n "$only" ]]; then targets=("$only"); fi
 
-cmake --preset fuzz >/dev/null
-cmake --build --preset fuzz --target "${targets[@]}"
+case "$preset" in
+  fuzz | asan) ;;
+  *) echo "scripts/fuzz.sh: --preset must be fuzz or asan (the presets that build the fuzzers)" >&2; exit 2 ;;
+esac
+cmake --preset "$preset" >/dev/null
+cmake --build --preset "$preset" --target "${targets[@]}"
 
-build=build/fuzz
+build="build/$preset"
 data=../shared/data
 work="$build/corpus"
 mkdir -p "$work"

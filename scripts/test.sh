@@ -2,8 +2,9 @@
 # Runs every test. Installs the dependencies, checks the layering, the code's health (functions at
 # most 150 lines, every path named exists, every public header tested) and the formatting, then:
 #   release  - build everything, run every test (including the `slow` ones) and vc-bench --quick
-#   asan     - AddressSanitizer + UndefinedBehaviorSanitizer: every test except the `slow` label
-#   fuzz     - every libFuzzer target (fuzz/, clang + ASan + UBSan) for 10 s each
+#   asan     - AddressSanitizer + UndefinedBehaviorSanitizer (clang++): every test except the `slow`
+#              label; the same build holds the libFuzzer targets
+#   fuzz     - every libFuzzer target (fuzz/, from the asan build) for 10 s each
 #   tsan     - ThreadSanitizer on the tests whose concurrency is all ours (label `tsan`): the worker
 #              pool, upload assembler, outbox, job runner, shard board, status mapping, wire code,
 #              ParallelChunks and the multi-threaded visibility engine. The gRPC
@@ -35,8 +36,9 @@ for p in "${presets[@]}"; do
       ctest --preset "$p" -L tsan
       ;;
     fuzz)
-      # Every libFuzzer target for 10 s from its seeds (scripts/fuzz.sh; long runs: docs/RELIABILITY.md).
-      bash scripts/fuzz.sh --seconds 10
+      # Every libFuzzer target for 10 s from its seeds, built by the asan stage (scripts/fuzz.sh;
+      # long runs: docs/RELIABILITY.md).
+      bash scripts/fuzz.sh --preset asan --seconds 10
       ;;
     asan)
       cmake --build --preset "$p"
