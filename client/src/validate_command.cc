@@ -84,24 +84,36 @@ Result<KnownStation> PointFilePosition(const std::string& file, InputFormat form
   return own->front();
 }
 
-// The input's points moved into the first file's local frame, and by the scanner's pose when the
-// file is in its own scanner's frame; points nearer than min_range_m to the scanner are dropped and
-// counted, measured in double before the move (many scans hold points on the min_range sphere).
-std::vector<Eigen::Vector3f> PlacePoints(const SceneInput& input, const Eigen::Vector3d& frame_shift_m,
+// The input's points in the scans' common local frame (`frame_origin_m` in the input's frame):
+// moved from the file's own local frame, or, when the file is in its own scanner's frame, by the
+// scanner's pose (whose translation is local). Points nearer than min_range_m to the scanner are
+// dropped and counted, measured in double before the move (many scans hold points on the min_range
+// sphere).
+std::vector<Eigen::Vector3f> PlacePoints(const SceneInput& input, const Eigen::Vector3d& frame_origin_m,
                                          const WorldPoint& position_m,
                                          const std::optional<Eigen::Isometry3d>& scanner_pose, double min_range_m,
                                          uint64_t* dropped) {
   std::vector<Eigen::Vector3f> out;
   out.reserve(input.points.size());
+  const Eigen::Vector3d shift_m =
+      scanner_pose ? input.frame_origin_m : Eigen::Vector3d(input.frame_origin_m - frame_origin_m);
   for (const Eigen::Vector3f& p : input.points) {
-    const Eigen::Vector3d local = p.cast<double>() + frame_shift_m;
-    if ((scanner_pose ? local : Eigen::Vector3d(local - position_m)).norm() < min_range_m) {
+    const Eigen::Vector3d q = p.cast<double>() + shift_m;
+    if ((scanner_pose ? q : Eigen::Vector3d(q - position_m)).norm() < min_range_m) {
       ++*dropped;
       continue;
     }
-    out.push_back((scanner_pose ? *scanner_pose * local : local).cast<float>());
+    out.push_back((scanner_pose ? *scanner_pose * q : q).cast<float>());
   }
   return out;
+}
+
+// The common local frame of scans whose points are in their scanners' frames: the first position's
+// whole kilometres per axis (the readers' rule, docs/PLANNING.md "Coordinates"), so posed points of
+// a georeferenced site stay small enough for floats.
+Eigen::Vector3d ScannerFrameOrigin(const std::vector<KnownStation>& positions) {
+  if (positions.empty()) return Eigen::Vector3d::Zero();
+  return (positions.front().position_m / 1000.0).array().round() * 1000.0;
 }
 
 Result<std::vector<KnownStation>> ReadPositions(const ValidateInputs& inputs, size_t point_files) {
@@ -147,7 +159,9 @@ Result<LoadedScans> LoadScans(const ValidateInputs& inputs, double min_range_m) 
   VC_ASSIGN_OR_RETURN(const std::vector<KnownStation> positions, ReadPositions(inputs, point_files));
 
   LoadedScans loaded;
-  const Eigen::Vector3d frame_origin_m = read.front().frame_origin_m;
+  const Eigen::Vector3d frame_origin_m =
+      inputs.scanner_frame ? ScannerFrameOrigin(positions) : Eigen::Vector3d(read.front().frame_origin_m);
+  loaded.frame_origin_m = frame_origin_m;
   size_t point_file_index = 0;
   for (size_t f = 0; f < read.size(); ++f) {
     const std::string& file = inputs.files[f];
@@ -169,15 +183,16 @@ Result<LoadedScans> LoadScans(const ValidateInputs& inputs, double min_range_m) 
     VC_ASSIGN_OR_RETURN(const KnownStation station,
                         PointFilePosition(file, read[f].format, scan_number, positions.empty() ? nullptr : &positions,
                                           point_file_index++));
+    const WorldPoint position_m = station.position_m - frame_origin_m;
     std::optional<Eigen::Isometry3d> pose;
     if (inputs.scanner_frame) {
-      pose = Eigen::Translation3d(station.position_m) *
+      pose = Eigen::Translation3d(position_m) *
              Eigen::AngleAxisd(station.heading_rad.value_or(0.0), Eigen::Vector3d::UnitZ());
     }
     loaded.dropped_near_scanner.resize(loaded.scans.size() + 1);
     loaded.scans.push_back(
-        {file, station.position_m,
-         PlacePoints(read[f], shift_m, station.position_m, pose, min_range_m, &loaded.dropped_near_scanner.back())});
+        {file, position_m,
+         PlacePoints(read[f], frame_origin_m, position_m, pose, min_range_m, &loaded.dropped_near_scanner.back())});
   }
   for (size_t i = 0; i < loaded.scans.size(); ++i) {
     if (loaded.scans[i].points_m.empty()) {
@@ -229,13 +244,14 @@ std::string ValidationToJson(const ValidationReport& report, const ValidateInput
                   {"max_incidence_deg", scanner.max_incidence_deg},
                   {"angular_step_deg", scanner.angular_step_deg},
                   {"max_spacing_m", scanner.max_spacing_m}};
+  j["frame_origin_m"] = {loaded.frame_origin_m.x(), loaded.frame_origin_m.y(), loaded.frame_origin_m.z()};
   j["model_voxels"] = report.model_voxels;
   j["precision_meaningful"] = report.precision_meaningful;
   j["note"] = report.note;
   nlohmann::ordered_json scans = nlohmann::ordered_json::array();
   for (size_t i = 0; i < report.scans.size(); ++i) {
     const ScanAgreement& a = report.scans[i];
-    const WorldPoint& p = loaded.scans[i].position_m;
+    const WorldPoint p = loaded.scans[i].position_m + loaded.frame_origin_m;
     scans.push_back({{"scan", i + 1},
                      {"name", a.name},
                      {"position_m", {p.x(), p.y(), p.z()}},
@@ -257,7 +273,7 @@ std::string ValidationToJson(const ValidationReport& report, const ValidateInput
   return j.dump(2) + "\n";
 }
 
-Result<std::string> ValidationPly(const ValidationReport& report, size_t scan) {
+Result<std::string> ValidationPly(const ValidationReport& report, size_t scan, const WorldPoint& frame_origin_m) {
   if (scan >= report.scans.size()) {
     return InvalidArgumentError("no scan " + std::to_string(scan + 1) + " in a report of " +
                                 std::to_string(report.scans.size()));
@@ -278,14 +294,21 @@ Result<std::string> ValidationPly(const ValidationReport& report, size_t scan) {
   }
   char resolution[32];
   std::snprintf(resolution, sizeof resolution, "%.6f", report.resolution_m);
-  return ColouredPointsPly({"vc validate: the model's voxel centres (m); scan " + std::to_string(scan + 1) + ": " +
-                                a.name + "; test " + std::string(SelectionTestName(report.selection_test)),
-                            "colour: green 40 180 40 = agree (captured and predicted)",
-                            "colour: red 230 40 40 = missed (captured, not predicted)",
-                            "colour: blue 40 90 230 = over-predicted (predicted, not captured)",
-                            "colour: grey 160 160 160 = neither (another scan's voxel, not predicted)",
-                            std::string("resolution_m ") + resolution},
-                           points);
+  std::vector<std::string> comments = {"vc validate: the model's voxel centres (m); scan " + std::to_string(scan + 1) +
+                                           ": " + a.name + "; test " +
+                                           std::string(SelectionTestName(report.selection_test)),
+                                       "colour: green 40 180 40 = agree (captured and predicted)",
+                                       "colour: red 230 40 40 = missed (captured, not predicted)",
+                                       "colour: blue 40 90 230 = over-predicted (predicted, not captured)",
+                                       "colour: grey 160 160 160 = neither (another scan's voxel, not predicted)",
+                                       std::string("resolution_m ") + resolution};
+  if (!frame_origin_m.isZero()) {
+    char origin[128];
+    std::snprintf(origin, sizeof origin, "frame_origin_m %.3f %.3f %.3f", frame_origin_m.x(), frame_origin_m.y(),
+                  frame_origin_m.z());
+    comments.push_back(std::string(origin) + " (vertices are local: add it for the input's frame)");
+  }
+  return ColouredPointsPly(comments, points);
 }
 
 Status WriteValidationOutputs(const ValidationReport& report, const ValidateInputs& inputs, const LoadedScans& loaded,
@@ -302,7 +325,7 @@ Status WriteValidationOutputs(const ValidationReport& report, const ValidateInpu
   const std::filesystem::path dir(out_dir);
   VC_RETURN_IF_ERROR(write(dir / "validation.json", ValidationToJson(report, inputs, loaded, scanner)));
   for (size_t i = 0; i < report.scans.size(); ++i) {
-    VC_ASSIGN_OR_RETURN(const std::string ply, ValidationPly(report, i));
+    VC_ASSIGN_OR_RETURN(const std::string ply, ValidationPly(report, i, loaded.frame_origin_m));
     VC_RETURN_IF_ERROR(write(dir / ("validation_" + std::to_string(i + 1) + ".ply"), ply));
   }
   return Status::Ok();

@@ -74,6 +74,37 @@ TEST_F(ValidateCommandTest, PointFilesTakeTheirPositionsInOrder) {
   EXPECT_EQ(loaded->dropped_near_scanner, (std::vector<uint64_t>{0, 0}));
 }
 
+TEST_F(ValidateCommandTest, SurveyCoordinatesGiveTheSameScansInALocalFrame) {
+  const Eigen::Vector3d shift_m(512000, 5612000, 0);
+  auto shifted = [&](const std::vector<Eigen::Vector3f>& points) {
+    std::string out;
+    char line[128];
+    for (const Eigen::Vector3f& p : points) {
+      const Eigen::Vector3d q = p.cast<double>() + shift_m;
+      std::snprintf(line, sizeof line, "%.6f %.6f %.6f\n", q.x(), q.y(), q.z());
+      out += line;
+    }
+    return out;
+  };
+  WriteText(Path("a-utm.xyz"), shifted(first_));
+  WriteText(Path("b-utm.xyz"), shifted(second_));
+  WriteText(Path("positions-utm.csv"), "x,y,z\n512002,5612003,1.5\n512006,5612002.5,1.2\n");
+  Result<LoadedScans> plain = LoadScans(TwoPointFiles(), 0.5);
+  Result<LoadedScans> utm = LoadScans({{Path("a-utm.xyz"), Path("b-utm.xyz")}, Path("positions-utm.csv"), false}, 0.5);
+  ASSERT_TRUE(plain.ok()) << plain.status().ToString();
+  ASSERT_TRUE(utm.ok()) << utm.status().ToString();
+  EXPECT_EQ(utm->frame_origin_m, shift_m);
+  ASSERT_EQ(utm->scans.size(), 2u);
+  for (size_t i = 0; i < 2; ++i) {
+    EXPECT_LT((utm->scans[i].position_m - plain->scans[i].position_m).norm(), 1e-9);
+    ASSERT_EQ(utm->scans[i].points_m.size(), plain->scans[i].points_m.size());
+    for (size_t k = 0; k < utm->scans[i].points_m.size(); ++k) {
+      ASSERT_LT((utm->scans[i].points_m[k] - plain->scans[i].points_m[k]).norm(), 1e-5f)
+          << "scan " << i << " point " << k;
+    }
+  }
+}
+
 TEST_F(ValidateCommandTest, PointsNearerThanTheMinimumRangeToTheirScannerAreDropped) {
   std::vector<Eigen::Vector3f> with_platform = first_;
   with_platform.push_back(kRoomWithClutterStationM.cast<float>() + Eigen::Vector3f(0.1f, 0, -0.2f));

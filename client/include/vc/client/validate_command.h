@@ -42,6 +42,10 @@ struct LoadedScans {
   std::vector<CapturedScan> scans;
   // Per scan: points dropped because they lie nearer than min_range_m to the scan's own scanner.
   std::vector<uint64_t> dropped_near_scanner;
+  // Where the scans' common local frame lies in the input's frame (m): every point and position in
+  // `scans` is local (the first file's frame, or, with scanner_frame, the first position's whole
+  // kilometres); add this to write them in the input's frame.
+  WorldPoint frame_origin_m = WorldPoint::Zero();
 };
 
 // Reads the scans of `inputs`, dropping points nearer than `min_range_m` to their scanner.
@@ -71,7 +75,8 @@ inline constexpr std::array<uint8_t, 3> kNeitherRgb{160, 160, 160};
 // validation_<scan + 1>.ply's bytes: every voxel of report.model at its centre (m), coloured as
 // above. FAILED_PRECONDITION unless the report kept its sets (ValidationOptions::keep_sets);
 // INVALID_ARGUMENT for a scan index out of range.
-Result<std::string> ValidationPly(const ValidationReport& report, size_t scan);
+Result<std::string> ValidationPly(const ValidationReport& report, size_t scan,
+                                  const WorldPoint& frame_origin_m = WorldPoint::Zero());
 
 // Writes validation.json and validation_<n>.ply for every scan into `out_dir` (created if missing).
 // Errors as ValidationPly, and INTERNAL naming the path on I/O errors.
