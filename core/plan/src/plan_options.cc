@@ -64,6 +64,19 @@ Status PlanOptions::Validate() const {
   return Status::Ok();
 }
 
+PlanOptions InLocalFrame(PlanOptions options, const WorldPoint& frame_origin_m) {
+  if (frame_origin_m.isZero()) return options;
+  for (WorldPoint& p : options.candidates) p -= frame_origin_m;
+  for (WorldPoint& p : options.fixed_stations) p -= frame_origin_m;
+  if (options.route_start) *options.route_start -= frame_origin_m;
+  for (KeepOutZone& zone : options.keep_out) {
+    zone.min -= frame_origin_m;
+    zone.max -= frame_origin_m;
+    for (size_t i = 0; i < zone.polygon_xy_m.size(); ++i) zone.polygon_xy_m[i] -= frame_origin_m[i % 2];
+  }
+  return options;
+}
+
 std::vector<double> PlanOptions::TripodHeights() const {
   if (!tripod_heights_m.empty()) return tripod_heights_m;
   return {tripod_height_m};
