@@ -7,6 +7,7 @@
 
 namespace vc {
 
+using planner::Coordinate;
 using planner::Num;
 
 Status PlanOptions::Validate() const {
@@ -53,8 +54,8 @@ Status PlanOptions::Validate() const {
     const std::string name = "fixed_stations[" + std::to_string(i) + "]";
     if (!p.allFinite()) return InvalidArgumentError(name + " is not finite");
     if (const int z = KeepOutZoneContaining(keep_out, p); z >= 0) {
-      return InvalidArgumentError(name + " (" + Num(p.x()) + ", " + Num(p.y()) + ", " + Num(p.z()) +
-                                  ") lies inside keep_out[" + std::to_string(z) + "]");
+      return InvalidArgumentError(name + " (" + Coordinate(p.x()) + ", " + Coordinate(p.y()) + ", " +
+                                  Coordinate(p.z()) + ") lies inside keep_out[" + std::to_string(z) + "]");
     }
   }
   if (route_start &&
