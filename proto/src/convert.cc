@@ -88,6 +88,17 @@ v1::SelectionSolver ToProto(SelectionSolver s) {
 
 namespace {
 
+// A local position in the input's frame, and back. A zero origin leaves the bits as they are
+// (-0.0 + 0.0 would be +0.0), so a scene near its origin travels exactly as before.
+WorldPoint PlusOrigin(const WorldPoint& p, const WorldPoint& origin) {
+  return origin.isZero() ? p : WorldPoint(p + origin);
+}
+WorldPoint LessOrigin(const WorldPoint& p, const WorldPoint& origin) {
+  return origin.isZero() ? p : WorldPoint(p - origin);
+}
+double PlusOrigin(double z, double origin_z) { return origin_z == 0 ? z : z + origin_z; }
+double LessOrigin(double z, double origin_z) { return origin_z == 0 ? z : z - origin_z; }
+
 // A parameter row's value to its proto field's type and back (vc/base/parameter.h). Numbers and
 // bools are the same on both sides; enums map through ToProto / FromProto, and an UNSPECIFIED
 // enum leaves the default in place.
@@ -190,7 +201,7 @@ v1::Reduction ToProto(const Reduction& r, const WorldPoint& frame_origin_m) {
   out.mutable_removed()->Add(r.removed.begin(), r.removed.end());
   out.set_global_visibility_before(r.global_visibility_before);
   out.set_global_visibility_after(r.global_visibility_after);
-  for (const auto& p : r.positions) *out.add_positions() = wire::ToProto(p + frame_origin_m);
+  for (const auto& p : r.positions) *out.add_positions() = wire::ToProto(PlusOrigin(p, frame_origin_m));
   return out;
 }
 
@@ -201,7 +212,7 @@ Reduction FromProto(const v1::Reduction& r, const WorldPoint& frame_origin_m) {
   out.removed.assign(r.removed().begin(), r.removed().end());
   out.global_visibility_before = r.global_visibility_before();
   out.global_visibility_after = r.global_visibility_after();
-  for (const auto& p : r.positions()) out.positions.push_back(wire::FromProto(p) - frame_origin_m);
+  for (const auto& p : r.positions()) out.positions.push_back(LessOrigin(wire::FromProto(p), frame_origin_m));
   return out;
 }
 
@@ -431,7 +442,7 @@ ProgressEvent FromProto(const v1::Progress& p) {
 
 v1::PlannedStation ToProto(const PlannedStation& s, const WorldPoint& frame_origin_m) {
   v1::PlannedStation p;
-  *p.mutable_position() = ToProto(s.position + frame_origin_m);
+  *p.mutable_position() = ToProto(PlusOrigin(s.position, frame_origin_m));
   p.set_visible_voxels(s.visible_voxels);
   p.set_marginal_gain(s.marginal_gain);
   p.set_cumulative_coverage(s.cumulative_coverage);
@@ -488,9 +499,9 @@ std::vector<v1::HeatMapChunk> HeatMapChunks(const HeatMap& h, const WorldPoint& 
     c.set_grid_spacing_m(h.grid_spacing_m);
     const size_t end = std::min(n, first + kCandidatesPerHeatMapChunk);
     for (size_t i = first; i < end; ++i) {
-      *c.add_positions() = ToProto(h.positions[i] + frame_origin_m);
+      *c.add_positions() = ToProto(PlusOrigin(h.positions[i], frame_origin_m));
       c.add_visible_voxels(i < h.visible_voxels.size() ? h.visible_voxels[i] : 0);
-      if (h.floor_z_m.size() == n) c.add_floor_z_m(h.floor_z_m[i] + frame_origin_m.z());
+      if (h.floor_z_m.size() == n) c.add_floor_z_m(PlusOrigin(h.floor_z_m[i], frame_origin_m.z()));
     }
     chunks.push_back(std::move(c));
   }
@@ -510,7 +521,7 @@ bool ForEachVoxelChunk(const PlanResult& result, const std::function<bool(v1::Vo
     c.set_total_voxels(n);
     c.mutable_centers_xyz_m()->Reserve(int((end - first) * 3));
     for (size_t i = first; i < end; ++i) {
-      for (int a = 0; a < 3; ++a) c.add_centers_xyz_m(centers[i][a] + result.frame_origin_m[a]);
+      for (int a = 0; a < 3; ++a) c.add_centers_xyz_m(PlusOrigin(centers[i][a], result.frame_origin_m[a]));
     }
     if (with_values) {
       c.mutable_best_face_values()->Reserve(int((end - first) * kFacesPerVoxel));
@@ -551,7 +562,7 @@ v1::PlanResult ToProto(const PlanResult& r) {
   for (const auto& w : r.warnings) p.add_warnings(w);
   p.set_heat_map_candidates(r.heat_map.positions.size());
   p.set_voxel_count(r.voxel_centers.size());
-  for (double z : r.floor_levels_m) p.add_floor_levels_m(z + origin.z());
+  for (double z : r.floor_levels_m) p.add_floor_levels_m(PlusOrigin(z, origin.z()));
   p.set_stop_reason(ToProto(r.stop_reason));
   p.set_total_seconds(r.total_seconds);
   p.set_greedy_stations(r.greedy_stations);
@@ -584,10 +595,10 @@ v1::PlanResult ToProto(const PlanResult& r) {
   route->set_length_m(r.route.length_m);
   for (const auto& line : r.route.polylines) {
     v1::Polyline* pl = route->add_polylines();
-    for (const auto& q : line) *pl->add_points() = ToProto(q + origin);
+    for (const auto& q : line) *pl->add_points() = ToProto(PlusOrigin(q, origin));
   }
   route->set_parts(r.route.parts);
-  if (r.route.start) *route->mutable_start() = ToProto(*r.route.start + origin);
+  if (r.route.start) *route->mutable_start() = ToProto(PlusOrigin(*r.route.start, origin));
   v1::FieldTime* t = p.mutable_field_time();
   t->set_setup_s(r.field_time.setup_s);
   t->set_scan_s(r.field_time.scan_s);
@@ -669,11 +680,11 @@ Result<PlanResult> PlanResultAssembler::Finish(const v1::PlanResult& p) && {
   VC_ASSIGN_OR_RETURN(r.selection_test, FromProto(p.selection_test()));
   for (const auto& s : p.stations()) {
     r.stations.push_back(FromProto(s));
-    r.stations.back().position -= origin;
+    r.stations.back().position = LessOrigin(r.stations.back().position, origin);
   }
   r.heat_map = std::move(heat_map_);
-  for (WorldPoint& q : r.heat_map.positions) q -= origin;
-  for (double& z : r.heat_map.floor_z_m) z -= origin.z();
+  for (WorldPoint& q : r.heat_map.positions) q = LessOrigin(q, origin);
+  for (double& z : r.heat_map.floor_z_m) z = LessOrigin(z, origin.z());
   r.reduction = FromProto(p.reduction(), origin);
   r.candidate_count = p.candidate_count();
   r.occupied_voxels = p.occupied_voxels();
@@ -696,7 +707,7 @@ Result<PlanResult> PlanResultAssembler::Finish(const v1::PlanResult& p) && {
   for (const auto& t : p.timings()) r.timings.push_back({FromProto(t.stage()), t.seconds()});
   r.total_seconds = p.total_seconds();
   r.warnings.assign(p.warnings().begin(), p.warnings().end());
-  for (double z : p.floor_levels_m()) r.floor_levels_m.push_back(z - origin.z());
+  for (double z : p.floor_levels_m()) r.floor_levels_m.push_back(LessOrigin(z, origin.z()));
   VC_ASSIGN_OR_RETURN(r.stop_reason, FromProto(p.stop_reason()));
   r.greedy_stations = p.greedy_stations();
   r.consolidated = p.consolidated();
@@ -733,14 +744,14 @@ Result<PlanResult> PlanResultAssembler::Finish(const v1::PlanResult& p) && {
   r.route.length_m = route.length_m();
   for (const auto& line : route.polylines()) {
     std::vector<WorldPoint>& out = r.route.polylines.emplace_back();
-    for (const auto& q : line.points()) out.push_back(FromProto(q) - origin);
+    for (const auto& q : line.points()) out.push_back(LessOrigin(FromProto(q), origin));
   }
   r.route.parts = route.parts();
-  if (route.has_start()) r.route.start = FromProto(route.start()) - origin;
+  if (route.has_start()) r.route.start = LessOrigin(FromProto(route.start()), origin);
   r.field_time = {p.field_time().setup_s(), p.field_time().scan_s(), p.field_time().walk_s(), p.field_time().total_s(),
                   p.field_time().scan_seconds_per_station()};
   r.voxel_centers = std::move(centers_);
-  for (WorldPoint& q : r.voxel_centers) q -= origin;
+  for (WorldPoint& q : r.voxel_centers) q = LessOrigin(q, origin);
   return r;
 }
 

@@ -313,6 +313,12 @@ TEST(PlanResultChunks, TheWireIsInTheInputsFrameAndTheResultComesBackLocal) {
   }
 }
 
+TEST(PlanResultChunks, AZeroOriginCarriesEveryBitAsBefore) {
+  PlannedStation s;
+  s.position = WorldPoint(-0.0, 1, 2);
+  EXPECT_TRUE(std::signbit(ToProto(s, WorldPoint::Zero()).position().x_m()));
+}
+
 TEST(PlanResultChunks, ANonFiniteFrameOriginIsDataLoss) {
   PlanResult r = BigResult(2, 1);
   PlanResultAssembler a;

@@ -117,7 +117,8 @@ Result<PlanResult> Plan(const SceneInput& input, const PlanOptions& options, con
     return planner::RunVoxelizeStage({input}, options, c);
   }));
   const VoxelScene& scene = voxelized.scene;
-  // The stages work in the scene's local frame; result.options stays as given (the input's frame).
+  // The stages work in the scene's local frame (SceneInput::frame_origin_m, which Voxelize copies into
+  // the scene); result.options stays as given, in the input's frame.
   const PlanOptions local_options = InLocalFrame(options, input.frame_origin_m);
   result.frame_origin_m = input.frame_origin_m;
   result.resolution_m = scene.resolution_m;

@@ -25,10 +25,15 @@ using raster::Rgb;
 
 Json Point(const WorldPoint& p) { return Json::array({p.x(), p.y(), p.z()}); }
 
-// A result's local position in the input's own frame (PlanResult::frame_origin_m added).
-WorldPoint InputFrame(const PlanResult& r, const WorldPoint& local) { return local + r.frame_origin_m; }
+// A result's local position in the input's own frame (PlanResult::frame_origin_m added). A zero
+// origin leaves the bits as they are (-0.0 + 0.0 would print as 0), so such a plan writes as before.
+WorldPoint InputFrame(const PlanResult& r, const WorldPoint& local) {
+  return r.frame_origin_m.isZero() ? local : WorldPoint(local + r.frame_origin_m);
+}
 // A result's local height (a floor level) in the input's own frame; NaN stays NaN.
-double InputFrameZ(const PlanResult& r, double local_z) { return local_z + r.frame_origin_m.z(); }
+double InputFrameZ(const PlanResult& r, double local_z) {
+  return r.frame_origin_m.z() == 0 ? local_z : local_z + r.frame_origin_m.z();
+}
 // Heights in the input's own frame.
 std::vector<double> InputFrameZ(const PlanResult& r, const std::vector<double>& local_z) {
   std::vector<double> out;

@@ -385,6 +385,10 @@ TEST(PlanReportTest, APlanNearItsOriginWritesFloatCoordinatesAsBefore) {
   EXPECT_EQ(ReadAll(dir + "/stations.csv"),
             "x,y,z,route_order\n0.500000,0.500000,1.600000,2\n"
             "3.500000,2.500000,1.600000,1\n");
+  PlanResult negative_zero = SamplePlan();
+  negative_zero.stations[0].position.x() = -0.0;  // adding a zero origin would print it as 0.000000
+  ASSERT_TRUE(WritePlanOutputs(negative_zero, dir).ok());
+  EXPECT_EQ(ReadAll(dir + "/stations.csv").substr(18, 10), "-0.000000,");
 }
 
 TEST(PlanReportTest, RefusesMissingFaceValues) {

@@ -12,7 +12,7 @@ namespace {
 
 // A local position as the user gave it: in the input's frame (VoxelScene::frame_origin_m added).
 std::string InputFrame(const VoxelScene& scene, const WorldPoint& local) {
-  const WorldPoint p = local + scene.frame_origin_m;
+  const WorldPoint p = scene.frame_origin_m.isZero() ? local : WorldPoint(local + scene.frame_origin_m);
   return Coordinate(p.x()) + ", " + Coordinate(p.y()) + ", " + Coordinate(p.z());
 }
 
@@ -40,7 +40,9 @@ constexpr double kFixedStationFloorWithin_m = 3.0;
 
 // The box [lo, hi] (local) in the input's frame.
 std::string Bounds(const VoxelScene& scene, const WorldPoint& local_lo, const WorldPoint& local_hi) {
-  const WorldPoint lo = local_lo + scene.frame_origin_m, hi = local_hi + scene.frame_origin_m;
+  const bool zero = scene.frame_origin_m.isZero();
+  const WorldPoint lo = zero ? local_lo : WorldPoint(local_lo + scene.frame_origin_m);
+  const WorldPoint hi = zero ? local_hi : WorldPoint(local_hi + scene.frame_origin_m);
   return "x " + Coordinate(lo.x()) + ".." + Coordinate(hi.x()) + ", y " + Coordinate(lo.y()) + ".." +
          Coordinate(hi.y()) + ", z " + Coordinate(lo.z()) + ".." + Coordinate(hi.z()) + " m";
 }
