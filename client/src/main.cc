@@ -18,6 +18,7 @@
 #include "vc/client/parameter_flags.h"
 #include "vc/client/plan_summary.h"
 #include "vc/client/progress_display.h"
+#include "vc/client/validate_command.h"
 #include "vc/report/plan_report.h"
 #include "vc/scene/e57.h"
 #include "vc/scene/scene_input.h"
@@ -369,11 +370,14 @@ int main(int argc, char** argv) {
   app.fallthrough();
   CommandLine cl;
   const Subcommands sub = AddCommands(app, &cl);
+  vc::client::ValidateCommand validate;
+  const CLI::App* validate_command = vc::client::AddValidateCommand(app, &validate);
   CLI11_PARSE(app, argc, argv);
   cl.conn.timeout = std::chrono::milliseconds(int64_t(cl.timeout_s * 1000));
 
   if (*sub.scanners) return RunScanners();
   if (*sub.inspect) return RunInspect(cl);
+  if (*validate_command) return vc::client::RunValidate(validate);
 
   // Before any gRPC thread exists, so that every thread inherits the blocked signals.
   InterruptCancelsTheJob* interrupt = nullptr;  // never freed: its watcher thread lives as long as the process

@@ -8,6 +8,7 @@
 #include <map>
 #include <sstream>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "vc/plan/keep_out.h"
@@ -104,6 +105,15 @@ void AddPlanFlags(CLI::App* command, PlanOptions* o) {
 void AddEvaluateFlags(CLI::App* command, EvaluateJobOptions* o) {
   VC_EVALUATE_PARAMETERS(VC_ROW_FLAG)
   AddScannerFlags(command, &o->scanner);
+}
+
+void AddScannerModelFlags(CLI::App* command, ScannerModel* scanner) { AddScannerFlags(command, scanner); }
+
+void AddSelectionTestFlag(CLI::App* command, SelectionTest* test) {
+#define VC_ROW_IF_TEST(type, name, ...) \
+  if (std::string_view(#name) == "selection_test") AddFlag(command, VC_PARAMETER_INFO(type, name, __VA_ARGS__), test);
+  VC_PLAN_PARAMETERS(VC_ROW_IF_TEST)
+#undef VC_ROW_IF_TEST
 }
 
 #undef VC_ROW_FLAG

@@ -186,42 +186,21 @@ std::string PlanStationsCsv(const PlanResult& r) {
 std::string VisibilityPly(const PlanResult& r) {
   const size_t n = std::min(r.voxel_centers.size(), r.evaluation.best_face_values.size());
   const bool shifted = !r.frame_origin_m.isZero();
-  const std::string coordinate = shifted ? "double" : "float";
-  std::string out =
-      "ply\nformat binary_little_endian 1.0\n"
-      "comment vc visibility: occupied voxel centres (m); visibility = best V over the voxel's 6 faces\n"
-      "comment colour: viridis of visibility in [0, 1]; grey = seen by no station (V = 0)\n"
-      "comment resolution_m " +
-      Fixed(r.resolution_m, 6) + "\n" +
-      (shifted ? "comment frame_origin_m " + Fixed(r.frame_origin_m.x(), 3) + " " + Fixed(r.frame_origin_m.y(), 3) +
-                     " " + Fixed(r.frame_origin_m.z(), 3) + " (coordinates are in the input's frame)\n"
-               : std::string()) +
-      "element vertex " + std::to_string(n) + "\nproperty " + coordinate + " x\nproperty " + coordinate +
-      " y\nproperty " + coordinate +
-      " z\n"
-      "property uchar red\nproperty uchar green\nproperty uchar blue\n"
-      "property float visibility\nend_header\n";
-  out.reserve(out.size() + n * (shifted ? 31 : 19));
-  auto put_float = [&out](float f) {
-    char b[4];
-    std::memcpy(b, &f, 4);  // x86-64 and ARM64 hosts are little-endian
-    out.append(b, 4);
-  };
-  auto put_double = [&out](double d) {
-    char b[8];
-    std::memcpy(b, &d, 8);
-    out.append(b, 8);
-  };
+  std::vector<ColouredPoint> points(n);
   for (size_t i = 0; i < n; ++i) {
     const auto& faces = r.evaluation.best_face_values[i];
     const float v = *std::max_element(faces.begin(), faces.end());
-    const Rgb c = v > 0 ? raster::Viridis(v) : Rgb{128, 128, 128};
-    const WorldPoint p = InputFrame(r, r.voxel_centers[i]);
-    for (int a = 0; a < 3; ++a) shifted ? put_double(p[a]) : put_float(static_cast<float>(p[a]));
-    out.append(reinterpret_cast<const char*>(c.data()), 3);
-    put_float(v);
+    points[i] = {InputFrame(r, r.voxel_centers[i]), v > 0 ? raster::Viridis(v) : Rgb{128, 128, 128}, v};
   }
-  return out;
+  std::vector<std::string> comments = {
+      "vc visibility: occupied voxel centres (m); visibility = best V over the voxel's 6 faces",
+      "colour: viridis of visibility in [0, 1]; grey = seen by no station (V = 0)",
+      "resolution_m " + Fixed(r.resolution_m, 6)};
+  if (shifted) {
+    comments.push_back("frame_origin_m " + Fixed(r.frame_origin_m.x(), 3) + " " + Fixed(r.frame_origin_m.y(), 3) + " " +
+                       Fixed(r.frame_origin_m.z(), 3) + " (coordinates are in the input's frame)");
+  }
+  return ColouredPointsPly(comments, points, "visibility", shifted ? PlyCoordinates::kDouble : PlyCoordinates::kFloat);
 }
 
 // ---------- heatmap.png ----------
@@ -777,6 +756,37 @@ ImageSize ReductionImageSize(int stations) {
   const int cell = ReductionCell(n);
   const int title_w = std::max(raster::TextWidth(kRedTitle, 2), raster::TextWidth(kRedSubtitle)) + 2 * kRedLeft;
   return {std::max(kRedLeft + n * cell + kRedLegend, title_w), kRedTop + std::max(n * cell, kRedMinH) + kRedBottom};
+}
+
+std::string ColouredPointsPly(const std::vector<std::string>& comments, const std::vector<ColouredPoint>& points,
+                              std::string_view value_name, PlyCoordinates coordinates) {
+  const bool doubles = coordinates == PlyCoordinates::kDouble;
+  const std::string type = doubles ? "double" : "float";
+  std::string out = "ply\nformat binary_little_endian 1.0\n";
+  for (const std::string& c : comments) out += "comment " + c + "\n";
+  out += "element vertex " + std::to_string(points.size()) + "\nproperty " + type + " x\nproperty " + type +
+         " y\nproperty " + type +
+         " z\n"
+         "property uchar red\nproperty uchar green\nproperty uchar blue\n";
+  if (!value_name.empty()) out += "property float " + std::string(value_name) + "\n";
+  out += "end_header\n";
+  out.reserve(out.size() + points.size() * ((doubles ? 27 : 15) + (value_name.empty() ? 0 : 4)));
+  auto put_float = [&out](float f) {
+    char b[4];
+    std::memcpy(b, &f, 4);  // x86-64 and ARM64 hosts are little-endian
+    out.append(b, 4);
+  };
+  auto put_double = [&out](double d) {
+    char b[8];
+    std::memcpy(b, &d, 8);
+    out.append(b, 8);
+  };
+  for (const ColouredPoint& p : points) {
+    for (int a = 0; a < 3; ++a) doubles ? put_double(p.position_m[a]) : put_float(static_cast<float>(p.position_m[a]));
+    out.append(reinterpret_cast<const char*>(p.rgb.data()), 3);
+    if (!value_name.empty()) put_float(p.value);
+  }
+  return out;
 }
 
 Status WritePlanOutputs(const PlanResult& result, const std::string& out_dir, const UploadSummary* upload) {

@@ -391,6 +391,24 @@ TEST(PlanReportTest, APlanNearItsOriginWritesFloatCoordinatesAsBefore) {
   EXPECT_EQ(ReadAll(dir + "/stations.csv").substr(18, 10), "-0.000000,");
 }
 
+TEST(PlanReportTest, ColouredPointsPlyWithoutAValueHoldsPositionAndColourOnly) {
+  const std::string ply = ColouredPointsPly({"first line", "colour: red = missed"},
+                                            {{{1.5, -2, 0.25}, {230, 40, 40}, 7.0f}, {{0, 0, 3}, {1, 2, 3}, 0.0f}});
+  const std::string header =
+      "ply\nformat binary_little_endian 1.0\ncomment first line\ncomment colour: red = missed\n"
+      "element vertex 2\nproperty float x\nproperty float y\nproperty float z\n"
+      "property uchar red\nproperty uchar green\nproperty uchar blue\nend_header\n";
+  ASSERT_EQ(ply.substr(0, header.size()), header);
+  ASSERT_EQ(ply.size(), header.size() + 2 * 15);
+  float y0, z1;
+  std::memcpy(&y0, ply.data() + header.size() + 4, 4);
+  std::memcpy(&z1, ply.data() + header.size() + 15 + 8, 4);
+  EXPECT_FLOAT_EQ(y0, -2.0f);
+  EXPECT_FLOAT_EQ(z1, 3.0f);
+  EXPECT_EQ(uint8_t(ply[header.size() + 12]), 230);
+  EXPECT_EQ(uint8_t(ply[header.size() + 15 + 14]), 3);
+}
+
 TEST(PlanReportTest, RefusesMissingFaceValues) {
   PlanResult plan = SamplePlan();
   plan.evaluation.best_face_values.pop_back();

@@ -26,6 +26,12 @@ void AddPlanFlags(CLI::App* command, PlanOptions* options);
 // The same for VC_EVALUATE_PARAMETERS and VC_SCANNER_PARAMETERS.
 void AddEvaluateFlags(CLI::App* command, EvaluateJobOptions* options);
 
+// Binds --scanner and every row of VC_SCANNER_PARAMETERS to `scanner`, as AddPlanFlags does (the
+// same callback rule), for a command that takes the scanner's limits without a plan's rows.
+void AddScannerModelFlags(CLI::App* command, ScannerModel* scanner);
+// Binds the plan's --test row (the selection test by name, surface|compatibility) to `test`.
+void AddSelectionTestFlag(CLI::App* command, SelectionTest* test);
+
 // `vc-client scanners`: one line per preset (name, instrument, range, vertical field of view,
 // angular step, scan time, the setting those are for) under a header line.
 std::string ScannerPresetsTable();

@@ -4,6 +4,7 @@
 // in docs/PLANNING.md and docs/PROTOCOL.md.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <string>
 #include <string_view>
@@ -39,6 +40,20 @@ std::string PlanToJson(const PlanResult& result, const UploadSummary* upload = n
 // visibility.ply in double precision when the frame's origin is not zero). visibility.ply needs result.voxel_centers
 // and result.evaluation.best_face_values. INTERNAL / FAILED_PRECONDITION with the path on I/O errors.
 Status WritePlanOutputs(const PlanResult& result, const std::string& out_dir, const UploadSummary* upload = nullptr);
+
+// One point of a coloured PLY: its position (m), its colour and, when the PLY has one, its value.
+struct ColouredPoint {
+  WorldPoint position_m{0, 0, 0};
+  std::array<uint8_t, 3> rgb{0, 0, 0};
+  float value = 0;
+};
+// How a PLY stores x, y, z: float, or double for coordinates float cannot hold (survey coordinates).
+enum class PlyCoordinates { kFloat, kDouble };
+// A binary little-endian PLY of `points` (the writer of visibility.ply): one header comment line per
+// entry of `comments`, then x y z (m) as `coordinates` say, uchar red green blue and, when
+// `value_name` is not empty, a float property of that name holding each point's value.
+std::string ColouredPointsPly(const std::vector<std::string>& comments, const std::vector<ColouredPoint>& points,
+                              std::string_view value_name = "", PlyCoordinates coordinates = PlyCoordinates::kFloat);
 
 // evaluation.json's content: resolution_m, global_visibility, per_viewpoint[...] and more;
 // `viewpoints` as the job was given them (the input's own frame).
