@@ -30,6 +30,7 @@ v1::UploadSpec MakeUploadSpec(const Upload& upload) {
   spec.set_total_size_bytes(upload.bytes.size());
   spec.set_crc32c(ComputeCrc32c(upload.bytes));
   spec.set_source_name(upload.source_name);
+  spec.set_units(upload.units);
   return spec;
 }
 

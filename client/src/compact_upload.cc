@@ -15,6 +15,7 @@ PreparedUpload Raw(Upload file, std::string why) {
   p.summary.bytes_sent = file.bytes.size();
   p.summary.file_bytes = file.bytes.size();
   p.summary.why_raw = std::move(why);
+  p.summary.units = file.units;
   p.upload = std::move(file);
   return p;
 }
@@ -24,8 +25,13 @@ PreparedUpload Raw(Upload file, std::string why) {
 PreparedUpload PrepareUpload(Upload file, double resolution_m, bool raw, const JobContext& ctx) {
   if (raw) return Raw(std::move(file), "--raw-upload");
   // The limits vc-server applies with its defaults; a server with larger ones still gets the file.
-  Result<SceneInput> input =
-      ReadScene(file.bytes, file.source_name, ReadLimits(kDefaultMaxUploadBytes, kDefaultMemoryBudgetBytes));
+  ReadOptions read_options = ReadLimits(kDefaultMaxUploadBytes, kDefaultMemoryBudgetBytes);
+  if (!file.units.empty()) {
+    Result<double> metres_per_unit = MetresPerUnit(file.units);
+    if (!metres_per_unit.ok()) return Raw(std::move(file), "not read here: " + metres_per_unit.status().message());
+    read_options.metres_per_unit = *metres_per_unit;
+  }
+  Result<SceneInput> input = ReadScene(file.bytes, file.source_name, read_options);
   if (!input.ok()) return Raw(std::move(file), "not read here: " + input.status().message());
   if (input->is_octree()) return Raw(std::move(file), "an octree is uploaded as it is");
   if (!input->scan_origins.empty()) return Raw(std::move(file), "the scan origins it carries are kept");
@@ -40,7 +46,9 @@ PreparedUpload PrepareUpload(Upload file, double resolution_m, bool raw, const J
   p.summary.file_bytes = file.bytes.size();
   p.summary.voxels = compact->voxels;
   p.summary.resolution_m = r;
-  p.upload = Upload{std::move(compact->bytes), std::move(file.source_name)};
+  p.summary.units = file.units;
+  // The stream's voxels are in metres already: it goes out without units.
+  p.upload = Upload{std::move(compact->bytes), std::move(file.source_name), ""};
   return p;
 }
 

@@ -154,6 +154,18 @@ constexpr const char* kDetachHelp =
     "seconds the job runs on if this connection drops (re-attached automatically, or with vc-client attach); "
     "0 = the job ends with the connection";
 
+constexpr const char* kUnitsHelp =
+    "unit of the file's coordinates when the file does not say: m, cm, mm, ft (international foot), us-ft "
+    "(US survey foot); default m";
+
+// --units on `command`, checked here with the server's own list (MetresPerUnit).
+void AddUnitsFlag(CLI::App* command, std::string* units) {
+  command->add_option("--units", *units, kUnitsHelp)->check([](const std::string& unit) {
+    const vc::Result<double> metres = vc::MetresPerUnit(unit);
+    return metres.ok() ? std::string() : metres.status().message();
+  });
+}
+
 // What the command line says; each subcommand reads its own fields.
 struct CommandLine {
   vc::client::ConnectionOptions conn;
@@ -161,6 +173,7 @@ struct CommandLine {
   std::string file;
   std::string out_dir = "./vc-out";
   bool raw_upload = false;
+  std::string units;                     // submit, evaluate, inspect (--units; empty = metres)
   vc::PlanOptions plan;                  // submit
   vc::client::PlanFileFlags plan_files;  // submit
   vc::EvaluateJobOptions eval;           // evaluate
@@ -207,6 +220,7 @@ CLI::App* AddSubmitCommand(CLI::App& app, CommandLine* cl) {
   submit->add_option("FILE", cl->file, "scene: PLY, PCD, XYZ, LAS, or OctoMap .bt/.ot/.graph")->required();
   submit->add_option("--out", cl->out_dir, "output directory")->capture_default_str();
   submit->add_flag("--raw-upload", cl->raw_upload, kRawUploadHelp);
+  AddUnitsFlag(submit, &cl->units);
   cl->conn.detach_grace_s = 600;
   submit->add_option("--detach-grace", cl->conn.detach_grace_s, kDetachHelp)->capture_default_str();
   vc::client::AddPlanFileFlags(submit, &cl->plan_files);
@@ -221,6 +235,7 @@ CLI::App* AddEvaluateCommand(CLI::App& app, CommandLine* cl) {
   evaluate->add_option("--viewpoints", cl->viewpoints_csv, "CSV of viewpoints x,y,z (e.g. stations.csv)")->required();
   evaluate->add_option("--out", cl->out_dir, "output directory")->capture_default_str();
   evaluate->add_flag("--raw-upload", cl->raw_upload, kRawUploadHelp);
+  AddUnitsFlag(evaluate, &cl->units);
   evaluate->add_option("--detach-grace", cl->conn.detach_grace_s, kDetachHelp)->capture_default_str();
   vc::client::AddEvaluateFlags(evaluate, &cl->eval);
   return evaluate;
@@ -249,6 +264,7 @@ Subcommands AddCommands(CLI::App& app, CommandLine* cl) {
   sub.inspect->add_option("--resolution", cl->inspect_resolution, "resolution in m for the voxel count (0 = default)")
       ->capture_default_str();
   sub.inspect->add_flag("--json", cl->json, "print JSON");
+  AddUnitsFlag(sub.inspect, &cl->units);
   return sub;
 }
 
@@ -260,7 +276,9 @@ int RunScanners() {
 int RunInspect(const CommandLine& cl) {
   const std::string& file = cl.file;
   // The limits vc-server applies with its defaults, so inspect accepts what a plan would.
-  auto input = vc::ReadSceneFile(file, vc::ReadLimits(vc::kDefaultMaxUploadBytes, vc::kDefaultMemoryBudgetBytes));
+  vc::ReadOptions read_options = vc::ReadLimits(vc::kDefaultMaxUploadBytes, vc::kDefaultMemoryBudgetBytes);
+  if (!cl.units.empty()) read_options.metres_per_unit = *vc::MetresPerUnit(cl.units);  // checked by --units
+  auto input = vc::ReadSceneFile(file, read_options);
   if (!input.ok()) return Fail("cannot read " + file, input.status());
   auto summary = vc::Summarize(*input, cl.inspect_resolution, vc::kDefaultMemoryBudgetBytes);
   if (!summary.ok()) return Fail("cannot summarise " + file, summary.status());
@@ -303,6 +321,7 @@ int RunAttach(vc::client::Client& client, const CommandLine& cl) {
 // The scene's upload at `resolution_m`, announced on `display`.
 vc::client::PreparedUpload StartUpload(vc::client::Upload file_bytes, double resolution_m, const CommandLine& cl,
                                        vc::client::ProgressDisplay& display) {
+  file_bytes.units = cl.units;
   vc::client::PreparedUpload prepared = vc::client::PrepareUpload(std::move(file_bytes), resolution_m, cl.raw_upload);
   display.Note(vc::client::DescribeUpload(prepared.summary));
   display.Uploading(prepared.upload.source_name, prepared.upload.bytes.size(), cl.conn.server);

@@ -42,11 +42,19 @@ std::string ScanGraphLine(const PlanResult& r) {
   return line + "\n";
 }
 
+// A local position of `r` in the input's frame, as stations.csv writes it (a zero origin keeps the bits).
+WorldPoint InputFrame(const PlanResult& r, const WorldPoint& local) {
+  return r.frame_origin_m.isZero() ? local : WorldPoint(local + r.frame_origin_m);
+}
+
 std::string RouteLines(const PlanResult& r) {
   const WalkingRoute& route = r.route;
   if (route.order.empty()) return "";
   std::string line = "route:";
-  if (route.start) line += Format(" start (%.2f, %.2f) ->", route.start->x(), route.start->y());
+  if (route.start) {
+    const WorldPoint start = InputFrame(r, *route.start);
+    line += Format(" start (%.2f, %.2f) ->", start.x(), start.y());
+  }
   for (size_t k = 0; k < route.order.size(); ++k) {
     if (k > 0) line += k < route.legs_m.size() && std::isnan(route.legs_m[k]) ? " //" : " ->";
     line += " " + std::to_string(route.order[k] + 1);
@@ -132,8 +140,9 @@ std::string PlanSummary(const PlanResult& r) {
   out += Format("  %3s %10s %10s %10s %12s %9s %6s\n", "#", "x_m", "y_m", "z_m", "gain_voxels", "coverage", "walk");
   for (size_t i = 0; i < r.stations.size(); ++i) {
     const PlannedStation& s = r.stations[i];
-    out += Format("  %3zu %10.3f %10.3f %10.3f %12llu %8.1f%% %6s%s\n", i + 1, s.position.x(), s.position.y(),
-                  s.position.z(), static_cast<unsigned long long>(s.marginal_gain), 100.0 * s.cumulative_coverage,
+    const WorldPoint p = InputFrame(r, s.position);
+    out += Format("  %3zu %10.3f %10.3f %10.3f %12llu %8.1f%% %6s%s\n", i + 1, p.x(), p.y(), p.z(),
+                  static_cast<unsigned long long>(s.marginal_gain), 100.0 * s.cumulative_coverage,
                   route_position[i] ? std::to_string(route_position[i]).c_str() : "-", s.fixed ? "  fixed" : "");
   }
   out += OptimalityLine(r);

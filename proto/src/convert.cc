@@ -88,6 +88,17 @@ v1::SelectionSolver ToProto(SelectionSolver s) {
 
 namespace {
 
+// A local position in the input's frame, and back. A zero origin leaves the bits as they are
+// (-0.0 + 0.0 would be +0.0), so a scene near its origin travels exactly as before.
+WorldPoint PlusOrigin(const WorldPoint& p, const WorldPoint& origin) {
+  return origin.isZero() ? p : WorldPoint(p + origin);
+}
+WorldPoint LessOrigin(const WorldPoint& p, const WorldPoint& origin) {
+  return origin.isZero() ? p : WorldPoint(p - origin);
+}
+double PlusOrigin(double z, double origin_z) { return origin_z == 0 ? z : z + origin_z; }
+double LessOrigin(double z, double origin_z) { return origin_z == 0 ? z : z - origin_z; }
+
 // A parameter row's value to its proto field's type and back (vc/base/parameter.h). Numbers and
 // bools are the same on both sides; enums map through ToProto / FromProto, and an UNSPECIFIED
 // enum leaves the default in place.
@@ -183,25 +194,25 @@ VisibilityFigures FromProto(const v1::VisibilityFigures& f) {
   return out;
 }
 
-v1::Reduction ToProto(const Reduction& r) {
+v1::Reduction ToProto(const Reduction& r, const WorldPoint& frame_origin_m) {
   v1::Reduction out;
   out.mutable_matrix()->Add(r.matrix.begin(), r.matrix.end());
   out.set_size(r.size);
   out.mutable_removed()->Add(r.removed.begin(), r.removed.end());
   out.set_global_visibility_before(r.global_visibility_before);
   out.set_global_visibility_after(r.global_visibility_after);
-  for (const auto& p : r.positions) *out.add_positions() = wire::ToProto(p);
+  for (const auto& p : r.positions) *out.add_positions() = wire::ToProto(PlusOrigin(p, frame_origin_m));
   return out;
 }
 
-Reduction FromProto(const v1::Reduction& r) {
+Reduction FromProto(const v1::Reduction& r, const WorldPoint& frame_origin_m) {
   Reduction out;
   out.matrix.assign(r.matrix().begin(), r.matrix().end());
   out.size = r.size();
   out.removed.assign(r.removed().begin(), r.removed().end());
   out.global_visibility_before = r.global_visibility_before();
   out.global_visibility_after = r.global_visibility_after();
-  for (const auto& p : r.positions()) out.positions.push_back(wire::FromProto(p));
+  for (const auto& p : r.positions()) out.positions.push_back(LessOrigin(wire::FromProto(p), frame_origin_m));
   return out;
 }
 
@@ -429,9 +440,9 @@ ProgressEvent FromProto(const v1::Progress& p) {
   return {FromProto(p.stage()), p.fraction(), p.message(), p.done(), p.total(), p.unit()};
 }
 
-v1::PlannedStation ToProto(const PlannedStation& s) {
+v1::PlannedStation ToProto(const PlannedStation& s, const WorldPoint& frame_origin_m) {
   v1::PlannedStation p;
-  *p.mutable_position() = ToProto(s.position);
+  *p.mutable_position() = ToProto(PlusOrigin(s.position, frame_origin_m));
   p.set_visible_voxels(s.visible_voxels);
   p.set_marginal_gain(s.marginal_gain);
   p.set_cumulative_coverage(s.cumulative_coverage);
@@ -478,7 +489,7 @@ Evaluation FromProto(const v1::Evaluation& p) {
   return e;
 }
 
-std::vector<v1::HeatMapChunk> HeatMapChunks(const HeatMap& h) {
+std::vector<v1::HeatMapChunk> HeatMapChunks(const HeatMap& h, const WorldPoint& frame_origin_m) {
   std::vector<v1::HeatMapChunk> chunks;
   const size_t n = h.positions.size();
   for (size_t first = 0; first < n; first += kCandidatesPerHeatMapChunk) {
@@ -488,9 +499,9 @@ std::vector<v1::HeatMapChunk> HeatMapChunks(const HeatMap& h) {
     c.set_grid_spacing_m(h.grid_spacing_m);
     const size_t end = std::min(n, first + kCandidatesPerHeatMapChunk);
     for (size_t i = first; i < end; ++i) {
-      *c.add_positions() = ToProto(h.positions[i]);
+      *c.add_positions() = ToProto(PlusOrigin(h.positions[i], frame_origin_m));
       c.add_visible_voxels(i < h.visible_voxels.size() ? h.visible_voxels[i] : 0);
-      if (h.floor_z_m.size() == n) c.add_floor_z_m(h.floor_z_m[i]);
+      if (h.floor_z_m.size() == n) c.add_floor_z_m(PlusOrigin(h.floor_z_m[i], frame_origin_m.z()));
     }
     chunks.push_back(std::move(c));
   }
@@ -510,9 +521,7 @@ bool ForEachVoxelChunk(const PlanResult& result, const std::function<bool(v1::Vo
     c.set_total_voxels(n);
     c.mutable_centers_xyz_m()->Reserve(int((end - first) * 3));
     for (size_t i = first; i < end; ++i) {
-      c.add_centers_xyz_m(centers[i].x());
-      c.add_centers_xyz_m(centers[i].y());
-      c.add_centers_xyz_m(centers[i].z());
+      for (int a = 0; a < 3; ++a) c.add_centers_xyz_m(PlusOrigin(centers[i][a], result.frame_origin_m[a]));
     }
     if (with_values) {
       c.mutable_best_face_values()->Reserve(int((end - first) * kFacesPerVoxel));
@@ -530,11 +539,13 @@ bool ForEachVoxelChunk(const PlanResult& result, const std::function<bool(v1::Vo
 
 v1::PlanResult ToProto(const PlanResult& r) {
   v1::PlanResult p;
+  const WorldPoint& origin = r.frame_origin_m;
   *p.mutable_options() = ToProto(r.options);
+  *p.mutable_frame_origin() = ToProto(origin);
   p.set_resolution_m(r.resolution_m);
   p.set_selection_test(ToProto(r.selection_test));
-  for (const auto& s : r.stations) *p.add_stations() = ToProto(s);
-  *p.mutable_reduction() = ToProto(r.reduction);
+  for (const auto& s : r.stations) *p.add_stations() = ToProto(s, origin);
+  *p.mutable_reduction() = ToProto(r.reduction, origin);
   p.set_candidate_count(r.candidate_count);
   p.set_occupied_voxels(r.occupied_voxels);
   p.set_coverable_voxels(r.coverable_voxels);
@@ -551,7 +562,7 @@ v1::PlanResult ToProto(const PlanResult& r) {
   for (const auto& w : r.warnings) p.add_warnings(w);
   p.set_heat_map_candidates(r.heat_map.positions.size());
   p.set_voxel_count(r.voxel_centers.size());
-  p.mutable_floor_levels_m()->Add(r.floor_levels_m.begin(), r.floor_levels_m.end());
+  for (double z : r.floor_levels_m) p.add_floor_levels_m(PlusOrigin(z, origin.z()));
   p.set_stop_reason(ToProto(r.stop_reason));
   p.set_total_seconds(r.total_seconds);
   p.set_greedy_stations(r.greedy_stations);
@@ -584,10 +595,10 @@ v1::PlanResult ToProto(const PlanResult& r) {
   route->set_length_m(r.route.length_m);
   for (const auto& line : r.route.polylines) {
     v1::Polyline* pl = route->add_polylines();
-    for (const auto& q : line) *pl->add_points() = ToProto(q);
+    for (const auto& q : line) *pl->add_points() = ToProto(PlusOrigin(q, origin));
   }
   route->set_parts(r.route.parts);
-  if (r.route.start) *route->mutable_start() = ToProto(*r.route.start);
+  if (r.route.start) *route->mutable_start() = ToProto(PlusOrigin(*r.route.start, origin));
   v1::FieldTime* t = p.mutable_field_time();
   t->set_setup_s(r.field_time.setup_s);
   t->set_scan_s(r.field_time.scan_s);
@@ -662,11 +673,19 @@ Result<PlanResult> PlanResultAssembler::Finish(const v1::PlanResult& p) && {
   }
   PlanResult r;
   VC_ASSIGN_OR_RETURN(r.options, FromProto(p.options()));
+  r.frame_origin_m = FromProto(p.frame_origin());
+  const WorldPoint& origin = r.frame_origin_m;
+  if (!origin.allFinite()) return ChunkError("the frame's origin is not finite");
   r.resolution_m = p.resolution_m();
   VC_ASSIGN_OR_RETURN(r.selection_test, FromProto(p.selection_test()));
-  for (const auto& s : p.stations()) r.stations.push_back(FromProto(s));
+  for (const auto& s : p.stations()) {
+    r.stations.push_back(FromProto(s));
+    r.stations.back().position = LessOrigin(r.stations.back().position, origin);
+  }
   r.heat_map = std::move(heat_map_);
-  r.reduction = FromProto(p.reduction());
+  for (WorldPoint& q : r.heat_map.positions) q = LessOrigin(q, origin);
+  for (double& z : r.heat_map.floor_z_m) z = LessOrigin(z, origin.z());
+  r.reduction = FromProto(p.reduction(), origin);
   r.candidate_count = p.candidate_count();
   r.occupied_voxels = p.occupied_voxels();
   r.coverable_voxels = p.coverable_voxels();
@@ -688,7 +707,7 @@ Result<PlanResult> PlanResultAssembler::Finish(const v1::PlanResult& p) && {
   for (const auto& t : p.timings()) r.timings.push_back({FromProto(t.stage()), t.seconds()});
   r.total_seconds = p.total_seconds();
   r.warnings.assign(p.warnings().begin(), p.warnings().end());
-  r.floor_levels_m.assign(p.floor_levels_m().begin(), p.floor_levels_m().end());
+  for (double z : p.floor_levels_m()) r.floor_levels_m.push_back(LessOrigin(z, origin.z()));
   VC_ASSIGN_OR_RETURN(r.stop_reason, FromProto(p.stop_reason()));
   r.greedy_stations = p.greedy_stations();
   r.consolidated = p.consolidated();
@@ -725,13 +744,14 @@ Result<PlanResult> PlanResultAssembler::Finish(const v1::PlanResult& p) && {
   r.route.length_m = route.length_m();
   for (const auto& line : route.polylines()) {
     std::vector<WorldPoint>& out = r.route.polylines.emplace_back();
-    for (const auto& q : line.points()) out.push_back(FromProto(q));
+    for (const auto& q : line.points()) out.push_back(LessOrigin(FromProto(q), origin));
   }
   r.route.parts = route.parts();
-  if (route.has_start()) r.route.start = FromProto(route.start());
+  if (route.has_start()) r.route.start = LessOrigin(FromProto(route.start()), origin);
   r.field_time = {p.field_time().setup_s(), p.field_time().scan_s(), p.field_time().walk_s(), p.field_time().total_s(),
                   p.field_time().scan_seconds_per_station()};
   r.voxel_centers = std::move(centers_);
+  for (WorldPoint& q : r.voxel_centers) q = LessOrigin(q, origin);
   return r;
 }
 

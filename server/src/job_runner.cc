@@ -53,7 +53,8 @@ Status JobRunner::Run(Job job, const CancelToken& cancel, ProgressFn progress, c
 
 Status JobRunner::Execute(Job& job, const JobContext& ctx, JobLog& log, const JobFn& fn) const {
   VC_RETURN_IF_ERROR(ctx.CheckCancelled("the job (while queued)"));
-  const ReadOptions read_options = ReadLimits(max_upload_bytes_, job.memory_budget_bytes);
+  ReadOptions read_options = ReadLimits(max_upload_bytes_, job.memory_budget_bytes);
+  VC_ASSIGN_OR_RETURN(read_options.metres_per_unit, SpecMetresPerUnit(job.upload.units(), "the spec's units"));
   const auto t0 = Job::Clock::now();
   if (job.data == nullptr) return InternalError("job " + job.id + " has no upload");
   const std::string& data = *job.data;

@@ -36,12 +36,13 @@ Status RunShard(ServiceState& state, const v1::ShardRequest& request, v1::ShardR
   std::vector<WorldPoint> viewpoints;
   viewpoints.reserve(size_t(request.viewpoints_size()));
   for (const v1::Point& p : request.viewpoints()) viewpoints.push_back(wire::FromProto(p));
-  const std::string key = fmt::format("{}@{:a}", request.scene_sha256(), options.resolution_m);
+  VC_ASSIGN_OR_RETURN(const double metres_per_unit, SpecMetresPerUnit(request.units(), "ComputeShard's units"));
+  const std::string key = VoxelizedSceneKey(request.scene_sha256(), options.resolution_m, request.units());
   VC_ASSIGN_OR_RETURN(const VoxelizedScenes::Scene scene, state.voxelized.Get(key, [&]() -> Result<VoxelScene> {
     const std::string source = request.source_name().empty() ? "shared scene" : request.source_name();
-    VC_ASSIGN_OR_RETURN(const SceneInput input,
-                        state.backend.read_scene(
-                            *bytes, source, ReadLimits(state.options.max_upload_bytes, options.memory_budget_bytes)));
+    ReadOptions read_options = ReadLimits(state.options.max_upload_bytes, options.memory_budget_bytes);
+    read_options.metres_per_unit = metres_per_unit;
+    VC_ASSIGN_OR_RETURN(const SceneInput input, state.backend.read_scene(*bytes, source, read_options));
     // Not cancelled with this shard: other shards may be waiting for the same scene.
     VC_ASSIGN_OR_RETURN(planner::VoxelizeOutput v, planner::RunVoxelizeStage({input}, options, JobContext{}));
     return std::move(v.scene);

@@ -232,6 +232,7 @@ class PeerLane {
     v1::ShardRequest req;
     req.set_scene_sha256(job_.ref.sha256);
     req.set_source_name(job_.ref.source_name);
+    req.set_units(job_.ref.units);
     *req.mutable_parameters() = job_.parameters;
     req.set_first_index(a.begin);
     req.set_kind(job_.kind);

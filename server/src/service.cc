@@ -37,18 +37,22 @@ class PlanReactor final : public JobReactor<v1::PlanRequest, v1::PlanResponse> {
 
   Status Run(const SceneInput& input, const JobContext& ctx, JobLog& log) override {
     log.set_details(" stations=0");
+    // The plan's positions are local; the wire is in the input's frame (convert.h).
+    frame_origin_m_ = input.frame_origin_m;
     PlanCallbacks callbacks;
     callbacks.on_heat_map = [this](const HeatMap& h) { PostHeatMap(h); };
     callbacks.on_station = [this](const PlannedStation& s, int index) {
       v1::PlanResponse r;
       r.mutable_station()->set_index(index);
       r.mutable_station()->set_provisional(true);
-      *r.mutable_station()->mutable_station() = wire::ToProto(s);
+      *r.mutable_station()->mutable_station() = wire::ToProto(s, frame_origin_m_);
       channel().Post(std::move(r));
     };
     callbacks.on_final_stations = [this](const std::vector<PlannedStation>& stations) {
       v1::PlanResponse r;
-      for (const PlannedStation& s : stations) *r.mutable_final_stations()->add_stations() = wire::ToProto(s);
+      for (const PlannedStation& s : stations) {
+        *r.mutable_final_stations()->add_stations() = wire::ToProto(s, frame_origin_m_);
+      }
       channel().Post(std::move(r));
     };
     // The visibility stage and the reduction's evaluation over the replicas (the scene's hash once,
@@ -61,6 +65,7 @@ class PlanReactor final : public JobReactor<v1::PlanRequest, v1::PlanResponse> {
         scene_ref->sha256 =
             upload_spec().scene_sha256().empty() ? wire::Sha256Hex(*scene_ref->bytes) : upload_spec().scene_sha256();
         scene_ref->source_name = upload_spec().source_name();
+        scene_ref->units = upload_spec().units();
       }
       return *scene_ref;
     };
@@ -93,7 +98,7 @@ class PlanReactor final : public JobReactor<v1::PlanRequest, v1::PlanResponse> {
 
   void PostHeatMap(const HeatMap& h) {
     heat_map_sent_ = true;
-    for (auto& c : wire::HeatMapChunks(h)) {
+    for (auto& c : wire::HeatMapChunks(h, frame_origin_m_)) {
       v1::PlanResponse r;
       *r.mutable_heat_map() = std::move(c);
       if (!channel().Post(std::move(r), /*bulk=*/true)) return;
@@ -101,7 +106,8 @@ class PlanReactor final : public JobReactor<v1::PlanRequest, v1::PlanResponse> {
   }
 
   PlanOptions options_;
-  bool heat_map_sent_ = false;  // on the worker thread
+  WorldPoint frame_origin_m_ = WorldPoint::Zero();  // the input's (SceneInput::frame_origin_m)
+  bool heat_map_sent_ = false;                      // on the worker thread
 };
 
 class EvaluateReactor final : public JobReactor<v1::EvaluateRequest, v1::EvaluateResponse> {

@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include "vc/scene/scene_input.h"
 #include "vc/wire/convert.h"
 #include "vc/wire/sha256.h"
 
@@ -12,6 +13,13 @@ std::string HumanBytes(uint64_t bytes) {
   if (bytes < (uint64_t{1} << 20)) return fmt::format("{:.1f} KiB", bytes / 1024.0);
   if (bytes < (uint64_t{1} << 30)) return fmt::format("{:.1f} MiB", bytes / 1048576.0);
   return fmt::format("{:.2f} GiB", bytes / 1073741824.0);
+}
+
+Result<double> SpecMetresPerUnit(std::string_view units, std::string_view field) {
+  if (units.empty()) return 1.0;
+  Result<double> metres = MetresPerUnit(units);
+  if (!metres.ok()) return InvalidArgumentError(std::string(field) + ": " + metres.status().message());
+  return metres;
 }
 
 Status UploadAssembler::StartSpec() {
@@ -26,6 +34,7 @@ Status UploadAssembler::AcceptSpec(const v1::UploadSpec& upload) {
   if (upload.format() != v1::INPUT_FORMAT_UNSPECIFIED) {
     VC_RETURN_IF_ERROR(wire::FromProto(upload.format()).status());
   }
+  VC_RETURN_IF_ERROR(SpecMetresPerUnit(upload.units(), "the spec's units").status());
   if (!upload.scene_sha256().empty() && !wire::IsSha256Hex(upload.scene_sha256())) {
     return InvalidArgumentError("the spec's scene_sha256 is not 64 lower-case hex digits");
   }

@@ -1,5 +1,7 @@
 #include "vc/server/voxelized_scenes.h"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cstring>
 
@@ -12,12 +14,21 @@ uint32_t SceneFingerprint(const VoxelScene& scene) {
   char resolution[sizeof(double)];
   std::memcpy(resolution, &scene.resolution_m, sizeof(double));
   crc.Update(std::string_view(resolution, sizeof(resolution)));
+  if (!scene.frame_origin_m.isZero()) {  // the local frame (SceneInput::frame_origin_m) is part of the scene
+    char origin[3 * sizeof(double)];
+    std::memcpy(origin, scene.frame_origin_m.data(), sizeof(origin));
+    crc.Update(std::string_view(origin, sizeof(origin)));
+  }
   for (const VoxelKey& k : scene.occupied) {
     const char key[6] = {char(k.x & 0xff), char(k.x >> 8),   char(k.y & 0xff),
                          char(k.y >> 8),   char(k.z & 0xff), char(k.z >> 8)};
     crc.Update(std::string_view(key, sizeof(key)));
   }
   return crc.value();
+}
+
+std::string VoxelizedSceneKey(const std::string& sha256, double resolution_m, const std::string& units) {
+  return fmt::format("{}@{:a}/{}", sha256, resolution_m, units.empty() ? "m" : units);
 }
 
 Result<VoxelizedScenes::Scene> VoxelizedScenes::Get(const std::string& key, const MakeFn& make) {

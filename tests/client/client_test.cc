@@ -7,7 +7,9 @@
 
 #include <thread>
 
+#include "testing/test_paths.h"
 #include "testing/test_server.h"
+#include "vc/report/plan_report.h"
 
 namespace vc {
 namespace {
@@ -28,6 +30,13 @@ PlanResult BigResult() {
   r.stations.push_back({{1, 0, 1.5}, 20, 20, 0.8, 0.3, 1});
   r.stations.push_back({{0, 0, 1.5}, 10, 5, 1.0, 0.2, 0});
   return r;
+}
+
+// stations.csv as vc::WritePlanOutputs writes it for `r`.
+std::string StationsCsvOf(const PlanResult& r) {
+  const std::string dir = testing::MakeTempDir();
+  EXPECT_TRUE(WritePlanOutputs(r, dir).ok());
+  return testing::ReadFileBytes(dir + "/stations.csv");
 }
 
 TEST(Client, PlanRebuildsAChunkedResultExactlyAndReportsEvents) {
@@ -73,6 +82,46 @@ TEST(Client, PlanRebuildsAChunkedResultExactlyAndReportsEvents) {
   EXPECT_EQ(station_indices, (std::vector<int>{0, 1}));
   EXPECT_EQ(final_lists, 1);
   EXPECT_EQ(final_stations, 2u);
+}
+
+TEST(Client, AGeoreferencedPlanComesBackLocalAndWritesTheServersFilesInTheInputsFrame) {
+  const WorldPoint origin(512000, 5612000, 0);
+  testing::BlockingBackend backend;
+  backend.block = false;
+  backend.plan_result = BigResult();
+  backend.plan_result.frame_origin_m = origin;
+  backend.plan_result.stations[0].position = WorldPoint(345.457, 330.123, 1.6);
+  server::Backend b = backend.Make();
+  double metres_per_unit = 0;
+  b.read_scene = [&](std::string_view, std::string_view, const ReadOptions& o) -> Result<SceneInput> {
+    metres_per_unit = o.metres_per_unit;
+    SceneInput in;
+    in.frame_origin_m = origin;  // as a reader sets it for survey coordinates
+    return in;
+  };
+  server::ServerOptions o;
+  o.workers = 1;
+  auto server = testing::StartServer(o, b);
+  ASSERT_TRUE(server);
+  client::ConnectionOptions conn;
+  conn.server = testing::Address(*server);
+  auto c = client::Client::Create(conn);
+  ASSERT_TRUE(c.ok());
+  std::vector<WorldPoint> picked;
+  client::JobObserver obs;
+  obs.on_station = [&](const PlannedStation& s, int) { picked.push_back(s.position); };
+  auto r = (*c)->Plan({"some scene bytes", "survey.xyz", "mm"}, PlanOptions{}, obs);
+  ASSERT_TRUE(r.ok()) << r.status().ToString();
+  EXPECT_EQ(metres_per_unit, 0.001);  // the spec's units reached the reader
+  EXPECT_EQ(r->frame_origin_m, origin);
+  ASSERT_EQ(picked.size(), 2u);  // streamed picks are for people: the input's frame
+  EXPECT_NEAR(picked[0].y(), 5612330.123, 1e-6);
+  const PlanResult& sent = backend.plan_result;
+  ASSERT_EQ(r->stations.size(), 2u);
+  EXPECT_LT((r->stations[0].position - sent.stations[0].position).norm(), 1e-9);  // local again
+  // What vc-client writes from the streamed result is what the server's own result gives.
+  EXPECT_EQ(StationsCsvOf(*r), StationsCsvOf(sent));
+  EXPECT_NE(StationsCsvOf(*r).find("512345.457000,5612330.123000"), std::string::npos) << StationsCsvOf(*r);
 }
 
 TEST(Client, UnavailableServerIsRetriedWithBackoffThenReported) {

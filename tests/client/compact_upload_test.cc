@@ -94,6 +94,25 @@ TEST(PrepareUploadTest, WhatMustNotShrinkGoesUpAsItIsWithTheReason) {
   ExpectRaw(compact.upload, false, "already a vc-voxels stream");
 }
 
+TEST(PrepareUploadTest, TheUnitsGoWithARawUploadAndIntoTheSummary) {
+  const std::string xyz = FloorXyz();
+  // Compact: read here in the file's units, sent as voxels in metres (no units on the wire).
+  const PreparedUpload compact = PrepareUpload({xyz, "floor.xyz", "mm"}, 0.0, false);
+  EXPECT_EQ(compact.summary.format, "vc-voxels");
+  EXPECT_EQ(compact.summary.units, "mm");
+  EXPECT_EQ(compact.upload.units, "");
+  // Raw: the server reads the file, so it needs the units.
+  const PreparedUpload raw = PrepareUpload({xyz, "floor.xyz", "us-ft"}, 0.0, true);
+  EXPECT_EQ(raw.summary.format, "raw");
+  EXPECT_EQ(raw.summary.units, "us-ft");
+  EXPECT_EQ(raw.upload.units, "us-ft");
+  // Units the client does not know: the server is left to say so.
+  const PreparedUpload unknown = PrepareUpload({xyz, "floor.xyz", "yd"}, 0.0, false);
+  EXPECT_EQ(unknown.summary.format, "raw");
+  EXPECT_THAT(unknown.summary.why_raw, HasSubstr("unknown length unit \"yd\""));
+  EXPECT_EQ(unknown.upload.units, "yd");
+}
+
 TEST(DescribeUploadTest, OneLineForEachKind) {
   UploadSummary s;
   s.format = "vc-voxels";

@@ -337,14 +337,14 @@ TEST(ListParametersTest, FixedStationsFromAPoseCsvWithAHeader) {
 TEST(ListParametersTest, StationsCarryFixedAndTheHeatMapItsFloorsOverTheWire) {
   PlannedStation s;
   s.fixed = true;
-  EXPECT_TRUE(wire::FromProto(wire::ToProto(s)).fixed);
+  EXPECT_TRUE(wire::FromProto(wire::ToProto(s, WorldPoint::Zero())).fixed);
   s.fixed = false;
-  EXPECT_FALSE(wire::FromProto(wire::ToProto(s)).fixed);
+  EXPECT_FALSE(wire::FromProto(wire::ToProto(s, WorldPoint::Zero())).fixed);
   HeatMap h;
   h.positions = {{0, 0, 1.5}, {1, 0, 1.9}};
   h.visible_voxels = {1, 2};
   h.floor_z_m = {0, 0.3};
-  const std::vector<v1::HeatMapChunk> chunks = wire::HeatMapChunks(h);
+  const std::vector<v1::HeatMapChunk> chunks = wire::HeatMapChunks(h, WorldPoint::Zero());
   ASSERT_EQ(chunks.size(), 1u);
   ASSERT_EQ(chunks[0].floor_z_m_size(), 2);
   EXPECT_EQ(chunks[0].floor_z_m(1), 0.3);

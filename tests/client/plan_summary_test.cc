@@ -54,6 +54,16 @@ TEST(PlanSummaryTest, StationsScanGraphRouteAndFieldTime) {
   EXPECT_NE(s.find("warning: w1\n"), std::string::npos);
 }
 
+TEST(PlanSummaryTest, StationsAndTheRouteStartAreInTheInputsFrame) {
+  PlanResult r = ThreeStations();
+  r.frame_origin_m = WorldPoint(512000, 5612000, 0);
+  r.stations[1].position = WorldPoint(345.457, 330.123, 1.6);
+  r.route.start = WorldPoint(1, 2, 0);
+  const std::string s = PlanSummary(r);
+  EXPECT_NE(s.find("512345.457 5612330.123      1.600"), std::string::npos) << s;
+  EXPECT_NE(s.find("route: start (512001.00, 5612002.00) -> 3"), std::string::npos) << s;
+}
+
 TEST(PlanSummaryTest, WithoutAScanTimeTheFieldTimeLineSaysSo) {
   PlanResult r = ThreeStations();
   r.field_time.scan_seconds_per_station = 0;

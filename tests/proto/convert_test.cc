@@ -128,7 +128,7 @@ PlanResult BigResult(size_t voxels, size_t candidates) {
 TEST(PlanResultChunks, ReassembleExactlyAndStayUnderOneMebibyte) {
   const PlanResult r = BigResult(3 * kVoxelsPerChunk + 5, kCandidatesPerHeatMapChunk + 1);
   PlanResultAssembler a;
-  for (const auto& c : HeatMapChunks(r.heat_map)) {
+  for (const auto& c : HeatMapChunks(r.heat_map, r.frame_origin_m)) {
     EXPECT_LE(c.ByteSizeLong(), size_t{1} << 20);
     ASSERT_TRUE(a.AddHeatMap(c).ok());
   }
@@ -216,7 +216,7 @@ TEST(PlanResultChunks, ARouteOrGraphNamingAMissingStationIsDataLoss) {
     if (bad == 1) p.mutable_scan_graph()->mutable_edges(0)->set_j(-1);
     if (bad == 2) p.mutable_route()->add_legs_m(1.0);  // one leg more than stations in the order
     PlanResultAssembler a;
-    for (const auto& c : HeatMapChunks(r.heat_map)) ASSERT_TRUE(a.AddHeatMap(c).ok());
+    for (const auto& c : HeatMapChunks(r.heat_map, r.frame_origin_m)) ASSERT_TRUE(a.AddHeatMap(c).ok());
     ForEachVoxelChunk(r, [&](v1::VoxelChunk&& c) { return a.AddVoxels(c).ok(); });
     auto back = std::move(a).Finish(p);
     ASSERT_FALSE(back.ok()) << bad;
@@ -228,7 +228,7 @@ TEST(PlanResultChunks, ASoleViewerNamingAMissingStationOrOnSomeChunksOnlyIsDataL
   for (int bad = 0; bad < 3; ++bad) {
     PlanResult r = BigResult(2 * kVoxelsPerChunk, 1);
     PlanResultAssembler a;
-    for (const auto& c : HeatMapChunks(r.heat_map)) ASSERT_TRUE(a.AddHeatMap(c).ok());
+    for (const auto& c : HeatMapChunks(r.heat_map, r.frame_origin_m)) ASSERT_TRUE(a.AddHeatMap(c).ok());
     if (bad == 0) r.evaluation.sole_viewer[5] = 2;  // there are 2 stations
     if (bad == 1) r.evaluation.sole_viewer[5] = -3;
     bool ok = true;
@@ -252,14 +252,87 @@ TEST(PlanResultChunks, ASoleViewerNamingAMissingStationOrOnSomeChunksOnlyIsDataL
 // (1440: Evaluation::per_viewpoint_sparse_values, which like per_viewpoint_face_values is the
 // reduction's working data and never part of a result on the wire.)
 TEST(PlanResultChunks, EveryCoreFieldIsCarried) {
-  EXPECT_EQ(sizeof(PlanResult), 1440u) << "PlanResult changed: update the vc.v1 PlanResult and vc::wire";
+  EXPECT_EQ(sizeof(PlanResult), 1464u) << "PlanResult changed: update the vc.v1 PlanResult and vc::wire";
   EXPECT_EQ(sizeof(PlanOptions), 408u) << "PlanOptions changed: update vc.v1 PlanParameters and vc::wire";
+}
+
+// A georeferenced plan: local positions, the frame's origin at UTM-like coordinates (and once
+// with a z offset, for the heights).
+TEST(PlanResultChunks, TheWireIsInTheInputsFrameAndTheResultComesBackLocal) {
+  for (const WorldPoint origin : {WorldPoint(512000, 5612000, 0), WorldPoint(512000, 5612000, 2000)}) {
+    PlanResult r = BigResult(kVoxelsPerChunk + 3, 5);
+    r.frame_origin_m = origin;
+    r.stations[0].position = WorldPoint(345.457, 330.123, 1.6);
+    std::vector<v1::HeatMapChunk> heat = HeatMapChunks(r.heat_map, r.frame_origin_m);
+    ASSERT_EQ(heat.size(), 1u);
+    EXPECT_EQ(heat[0].positions(3).x_m(), 512003.0);
+    EXPECT_EQ(heat[0].positions(3).z_m(), 1.5 + origin.z());
+    EXPECT_EQ(heat[0].floor_z_m(1), 0.25 + origin.z());
+    const v1::PlanResult summary = ToProto(r);
+    EXPECT_EQ(FromProto(summary.frame_origin()), origin);
+    EXPECT_NEAR(summary.stations(0).position().y_m(), 5612330.123, 1e-6);
+    EXPECT_EQ(summary.stations(1).position().x_m(), 512000.0);
+    EXPECT_EQ(summary.reduction().positions(0).y_m(), 5612002.0);
+    EXPECT_EQ(summary.floor_levels_m(1), 3.1 + origin.z());
+    EXPECT_EQ(summary.route().start().x_m(), 512000.5);
+    EXPECT_EQ(summary.route().polylines(0).points(1).x_m(), 512000.5);
+    EXPECT_EQ(summary.options().SerializeAsString(), ToProto(r.options).SerializeAsString());  // as given
+    PlanResultAssembler a;
+    ASSERT_TRUE(a.AddHeatMap(heat[0]).ok());
+    EXPECT_EQ(a.heat_map().positions[3].y(), 5612000.0);  // what a client shows while the plan runs
+    std::vector<v1::VoxelChunk> voxels;
+    ForEachVoxelChunk(r, [&](v1::VoxelChunk&& c) {
+      voxels.push_back(c);
+      return true;
+    });
+    ASSERT_EQ(voxels.size(), 2u);
+    EXPECT_EQ(voxels[0].centers_xyz_m(3 * 7), 512000.0 + 7 * 0.1);
+    EXPECT_EQ(voxels[0].centers_xyz_m(3 * 7 + 1), 5612000.0 - 7);
+    for (const v1::VoxelChunk& c : voxels) ASSERT_TRUE(a.AddVoxels(c).ok());
+    auto back = std::move(a).Finish(summary);
+    ASSERT_TRUE(back.ok()) << back.status().ToString();
+    EXPECT_EQ(back->frame_origin_m, origin);
+    // Local again, to a nanometre; and in the input's frame, which is what the writers use, exact.
+    auto same_place = [&](const WorldPoint& got, const WorldPoint& sent) {
+      EXPECT_LT((got - sent).norm(), 1e-9) << got.transpose() << " vs " << sent.transpose();
+      EXPECT_EQ(got + origin, sent + origin);
+    };
+    for (size_t k = 0; k < r.stations.size(); ++k) same_place(back->stations[k].position, r.stations[k].position);
+    for (size_t i = 0; i < r.heat_map.positions.size(); ++i)
+      same_place(back->heat_map.positions[i], r.heat_map.positions[i]);
+    for (size_t i = 0; i < r.voxel_centers.size(); ++i) same_place(back->voxel_centers[i], r.voxel_centers[i]);
+    same_place(back->reduction.positions[0], r.reduction.positions[0]);
+    same_place(back->route.polylines[0][1], r.route.polylines[0][1]);
+    same_place(*back->route.start, *r.route.start);
+    ASSERT_EQ(back->floor_levels_m.size(), r.floor_levels_m.size());
+    for (size_t i = 0; i < r.floor_levels_m.size(); ++i) {
+      EXPECT_EQ(back->floor_levels_m[i] + origin.z(), r.floor_levels_m[i] + origin.z());
+    }
+    EXPECT_EQ(back->heat_map.floor_z_m[1] + origin.z(), 0.25 + origin.z());
+    EXPECT_TRUE(std::isnan(back->heat_map.floor_z_m[0]));
+  }
+}
+
+TEST(PlanResultChunks, AZeroOriginCarriesEveryBitAsBefore) {
+  PlannedStation s;
+  s.position = WorldPoint(-0.0, 1, 2);
+  EXPECT_TRUE(std::signbit(ToProto(s, WorldPoint::Zero()).position().x_m()));
+}
+
+TEST(PlanResultChunks, ANonFiniteFrameOriginIsDataLoss) {
+  PlanResult r = BigResult(2, 1);
+  PlanResultAssembler a;
+  for (const auto& c : HeatMapChunks(r.heat_map, r.frame_origin_m)) ASSERT_TRUE(a.AddHeatMap(c).ok());
+  ForEachVoxelChunk(r, [&](v1::VoxelChunk&& c) { return a.AddVoxels(c).ok(); });
+  v1::PlanResult summary = ToProto(r);
+  summary.mutable_frame_origin()->set_x_m(std::nan(""));
+  EXPECT_EQ(std::move(a).Finish(summary).status().code(), StatusCode::kDataLoss);
 }
 
 TEST(PlanResultChunks, MissingChunkIsDataLoss) {
   const PlanResult r = BigResult(2 * kVoxelsPerChunk, 3);
   PlanResultAssembler a;
-  for (const auto& c : HeatMapChunks(r.heat_map)) ASSERT_TRUE(a.AddHeatMap(c).ok());
+  for (const auto& c : HeatMapChunks(r.heat_map, r.frame_origin_m)) ASSERT_TRUE(a.AddHeatMap(c).ok());
   bool first = true;
   ForEachVoxelChunk(r, [&](v1::VoxelChunk&& c) {
     if (!first) return true;  // drop the second chunk
@@ -274,8 +347,8 @@ TEST(PlanResultChunks, MissingChunkIsDataLoss) {
 TEST(PlanResultChunks, SecondHeatMapIsDataLoss) {
   const PlanResult r = BigResult(1, 3);
   PlanResultAssembler a;
-  for (const auto& c : HeatMapChunks(r.heat_map)) ASSERT_TRUE(a.AddHeatMap(c).ok());
-  EXPECT_EQ(a.AddHeatMap(HeatMapChunks(r.heat_map).front()).code(), StatusCode::kDataLoss);
+  for (const auto& c : HeatMapChunks(r.heat_map, r.frame_origin_m)) ASSERT_TRUE(a.AddHeatMap(c).ok());
+  EXPECT_EQ(a.AddHeatMap(HeatMapChunks(r.heat_map, r.frame_origin_m).front()).code(), StatusCode::kDataLoss);
 }
 
 TEST(PlanResultChunks, MissingHeatMapIsDataLoss) {

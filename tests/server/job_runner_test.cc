@@ -149,6 +149,24 @@ TEST(JobRunner, TheUploadIsReadWithinTheLimitsOfTheUploadAndTheJobsBudget) {
   EXPECT_EQ(want.max_decompressed_bytes, uint64_t{16} << 20) << "16 x the upload limit, under half the budget";
 }
 
+TEST(JobRunner, TheUploadIsReadInTheSpecsUnits) {
+  Fixture f;
+  JobRunner runner(&f.backend, uint64_t{1} << 20);
+  CancelToken token;
+  const auto nothing = [](const SceneInput&, const JobContext&, JobLog&) { return Status::Ok(); };
+  ASSERT_TRUE(runner.Run(f.MakeJob("1"), token, {}, nothing).ok());
+  EXPECT_EQ(f.read_options.metres_per_unit, 1.0);
+  Job job = f.MakeJob("1");
+  job.upload.set_units("mm");
+  ASSERT_TRUE(runner.Run(std::move(job), token, {}, nothing).ok());
+  EXPECT_EQ(f.read_options.metres_per_unit, 0.001);
+  job = f.MakeJob("1");
+  job.upload.set_units("yards");
+  const Status s = runner.Run(std::move(job), token, {}, nothing);
+  EXPECT_EQ(s.code(), StatusCode::kInvalidArgument);
+  EXPECT_THAT(s.message(), HasSubstr("units"));
+}
+
 TEST(JobRunner, OutOfMemoryIsResourceExhaustedNamingTheJob) {
   Fixture f;
   JobRunner runner(&f.backend, 1 << 20);

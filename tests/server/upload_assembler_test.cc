@@ -71,6 +71,34 @@ TEST_F(UploadAssemblerTest, UnknownFormatIsInvalidArgument) {
   EXPECT_EQ(assembler_.AcceptSpec(spec).code(), StatusCode::kInvalidArgument);
 }
 
+TEST_F(UploadAssemblerTest, UnknownUnitsAreInvalidArgumentNamingTheField) {
+  v1::UploadSpec spec = SpecFor("abc");
+  spec.set_units("furlong");
+  ASSERT_TRUE(assembler_.StartSpec().ok());
+  const Status s = assembler_.AcceptSpec(spec);
+  EXPECT_EQ(s.code(), StatusCode::kInvalidArgument);
+  EXPECT_THAT(s.message(), HasSubstr("the spec's units"));
+  EXPECT_THAT(s.message(), HasSubstr("furlong"));
+  EXPECT_THAT(s.message(), HasSubstr("us-ft"));
+  EXPECT_EQ(pool_.admitted(), 0) << "refused before admission";
+}
+
+TEST_F(UploadAssemblerTest, MillimetresAreAccepted) {
+  v1::UploadSpec spec = SpecFor("abc");
+  spec.set_units("mm");
+  ASSERT_TRUE(assembler_.StartSpec().ok());
+  EXPECT_TRUE(assembler_.AcceptSpec(spec).ok());
+}
+
+TEST(SpecMetresPerUnit, EmptyIsMetresAndTheNamesAreMetresPerUnits) {
+  EXPECT_EQ(*SpecMetresPerUnit("", "units"), 1.0);
+  EXPECT_EQ(*SpecMetresPerUnit("mm", "units"), 0.001);
+  EXPECT_EQ(*SpecMetresPerUnit("us-ft", "units"), 1200.0 / 3937.0);
+  const Result<double> bad = SpecMetresPerUnit("MM", "ComputeShard's units");
+  EXPECT_EQ(bad.status().code(), StatusCode::kInvalidArgument);
+  EXPECT_THAT(bad.status().message(), HasSubstr("ComputeShard's units"));
+}
+
 TEST(UploadAssembler, UploadOverTheLimitIsResourceExhaustedNamingTheFlag) {
   WorkerPool pool(1, 0);
   UploadAssembler a(/*max_upload_bytes=*/8, &pool);

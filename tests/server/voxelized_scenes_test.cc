@@ -104,6 +104,19 @@ TEST(SceneFingerprintTest, ChangesWithTheResolutionAndEveryKey) {
   EXPECT_NE(SceneFingerprint(Scene(0.1, {{4, 5, 6}, {1, 2, 3}})), f);  // order counts
   EXPECT_NE(SceneFingerprint(Scene(0.1, {{1, 2, 3}, {4, 5, 7}})), f);
   EXPECT_NE(SceneFingerprint(Scene(0.1, {{1, 2, 3}, {4 + 256, 5, 6}})), f);  // a key's high byte
+  VoxelScene shifted = Scene(0.1, {{1, 2, 3}, {4, 5, 6}});
+  shifted.frame_origin_m = WorldPoint(512000, 5612000, 0);
+  EXPECT_NE(SceneFingerprint(shifted), f);  // the same keys in another frame
+}
+
+TEST(VoxelizedSceneKeyTest, TellsUnitsAndResolutionsApart) {
+  const std::string sha(64, 'a');
+  const std::string metres = VoxelizedSceneKey(sha, 0.1, "");
+  EXPECT_EQ(VoxelizedSceneKey(sha, 0.1, "m"), metres);  // empty is metres
+  EXPECT_NE(VoxelizedSceneKey(sha, 0.1, "mm"), metres);
+  EXPECT_NE(VoxelizedSceneKey(sha, 0.1, "mm"), VoxelizedSceneKey(sha, 0.1, "cm"));
+  EXPECT_NE(VoxelizedSceneKey(sha, 0.2, ""), metres);
+  EXPECT_NE(VoxelizedSceneKey(std::string(64, 'b'), 0.1, ""), metres);
 }
 
 }  // namespace

@@ -1,6 +1,7 @@
 #include "vc/plan/evaluate_job.h"
 
 #include <string>
+#include <vector>
 
 namespace vc {
 
@@ -35,7 +36,9 @@ EvaluateOptions EvaluateJobOptions::evaluate_options() const {
 Result<Evaluation> RunEvaluation(const SceneInput& input, const EvaluateJobOptions& options, const JobContext& ctx) {
   VC_RETURN_IF_ERROR(options.Validate());
   VC_ASSIGN_OR_RETURN(VoxelScene scene, Voxelize(input, options.voxelize_options(), ctx));
-  return Evaluate(scene, options.viewpoints, options.evaluate_options(), ctx);
+  std::vector<WorldPoint> local_viewpoints = options.viewpoints;
+  for (WorldPoint& p : local_viewpoints) p -= input.frame_origin_m;
+  return Evaluate(scene, local_viewpoints, options.evaluate_options(), ctx);
 }
 
 }  // namespace vc

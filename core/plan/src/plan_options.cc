@@ -7,6 +7,7 @@
 
 namespace vc {
 
+using planner::Coordinate;
 using planner::Num;
 
 Status PlanOptions::Validate() const {
@@ -53,8 +54,8 @@ Status PlanOptions::Validate() const {
     const std::string name = "fixed_stations[" + std::to_string(i) + "]";
     if (!p.allFinite()) return InvalidArgumentError(name + " is not finite");
     if (const int z = KeepOutZoneContaining(keep_out, p); z >= 0) {
-      return InvalidArgumentError(name + " (" + Num(p.x()) + ", " + Num(p.y()) + ", " + Num(p.z()) +
-                                  ") lies inside keep_out[" + std::to_string(z) + "]");
+      return InvalidArgumentError(name + " (" + Coordinate(p.x()) + ", " + Coordinate(p.y()) + ", " +
+                                  Coordinate(p.z()) + ") lies inside keep_out[" + std::to_string(z) + "]");
     }
   }
   if (route_start &&
@@ -62,6 +63,19 @@ Status PlanOptions::Validate() const {
     return InvalidArgumentError("route_start needs finite x and y (and a finite z, or NaN for the lowest floor)");
   }
   return Status::Ok();
+}
+
+PlanOptions InLocalFrame(PlanOptions options, const WorldPoint& frame_origin_m) {
+  if (frame_origin_m.isZero()) return options;
+  for (WorldPoint& p : options.candidates) p -= frame_origin_m;
+  for (WorldPoint& p : options.fixed_stations) p -= frame_origin_m;
+  if (options.route_start) *options.route_start -= frame_origin_m;
+  for (KeepOutZone& zone : options.keep_out) {
+    zone.min -= frame_origin_m;
+    zone.max -= frame_origin_m;
+    for (size_t i = 0; i < zone.polygon_xy_m.size(); ++i) zone.polygon_xy_m[i] -= frame_origin_m[i % 2];
+  }
+  return options;
 }
 
 std::vector<double> PlanOptions::TripodHeights() const {

@@ -117,11 +117,15 @@ Result<PlanResult> Plan(const SceneInput& input, const PlanOptions& options, con
     return planner::RunVoxelizeStage({input}, options, c);
   }));
   const VoxelScene& scene = voxelized.scene;
+  // The stages work in the scene's local frame (SceneInput::frame_origin_m, which Voxelize copies into
+  // the scene); result.options stays as given, in the input's frame.
+  const PlanOptions local_options = InLocalFrame(options, input.frame_origin_m);
+  result.frame_origin_m = input.frame_origin_m;
   result.resolution_m = scene.resolution_m;
   result.occupied_voxels = scene.occupied.size();
 
   VC_ASSIGN_OR_RETURN(planner::CandidatesOutput candidates, runner.Run(Stage::kCandidates, [&](const JobContext& c) {
-    return planner::RunCandidatesStage({scene}, options, c);
+    return planner::RunCandidatesStage({scene}, local_options, c);
   }));
   result.candidate_count = candidates.positions.size();
   result.floor_levels_m = candidates.floor_levels_m;
@@ -130,25 +134,25 @@ Result<PlanResult> Plan(const SceneInput& input, const PlanOptions& options, con
   result.cells_failing_clearance = candidates.cells_failing_clearance;
   result.warnings = candidates.warnings;
 
-  if (options.sparse_set_gain <= 0) {  // sparse sets are checked as they are computed
-    VC_RETURN_IF_ERROR(planner::CheckVisibilitySetBudget(candidates.positions.size() + options.fixed_stations.size(),
-                                                         result.occupied_voxels, options.memory_budget_bytes,
-                                                         "visibility counts"));
+  if (local_options.sparse_set_gain <= 0) {  // sparse sets are checked as they are computed
+    VC_RETURN_IF_ERROR(planner::CheckVisibilitySetBudget(
+        candidates.positions.size() + local_options.fixed_stations.size(), result.occupied_voxels,
+        local_options.memory_budget_bytes, "visibility counts"));
   }
   VC_ASSIGN_OR_RETURN(planner::VisibilityOutput visibility, runner.Run(Stage::kVisibility, [&](const JobContext& c) {
     return planner::RunVisibilityStage(
-        {scene, candidates.positions, candidates.floor_z_m, options.fixed_stations, callbacks}, options, c);
+        {scene, candidates.positions, candidates.floor_z_m, local_options.fixed_stations, callbacks}, local_options, c);
   }));
   result.heat_map = std::move(visibility.heat_map);
   result.distribution = visibility.distribution;
   for (std::string& w : visibility.warnings) result.warnings.push_back(std::move(w));
 
-  const std::unique_ptr<planner::Selector> selector = planner::SelectorFor(options);
+  const std::unique_ptr<planner::Selector> selector = planner::SelectorFor(local_options);
   VC_ASSIGN_OR_RETURN(planner::SelectionOutput selected, runner.Run(Stage::kSelection, [&](const JobContext& c) {
     return planner::RunSelectionStage(
         {scene, *selector, std::move(visibility.sets), std::move(visibility.fixed_sets), candidates.positions,
          candidates.floor_z_m, result.heat_map.visible_voxels, callbacks},
-        options, c);
+        local_options, c);
   }));
   result.stop_reason = selected.selection.stop;
   result.greedy_stations = selected.selection.first_pass_picks;
@@ -160,9 +164,9 @@ Result<PlanResult> Plan(const SceneInput& input, const PlanOptions& options, con
   planner::Stations stations = std::move(selected.stations);
   VoxelSet coverable = std::move(selected.coverable);
 
-  if (options.refine && !stations.empty()) {
+  if (local_options.refine && !stations.empty()) {
     VC_ASSIGN_OR_RETURN(planner::RefineOutput refined, runner.Run(Stage::kRefine, [&](const JobContext& c) {
-      return planner::RunRefineStage({scene, std::move(stations), std::move(coverable)}, options, c);
+      return planner::RunRefineStage({scene, std::move(stations), std::move(coverable)}, local_options, c);
     }));
     stations = std::move(refined.stations);
     coverable = std::move(refined.coverable);
@@ -171,9 +175,9 @@ Result<PlanResult> Plan(const SceneInput& input, const PlanOptions& options, con
   if (auto w = UncoverableWarning(result.occupied_voxels, result.coverable_voxels)) result.warnings.push_back(*w);
 
   planner::ReductionOutput reduced = planner::KeepAllStations(stations.size());
-  if (options.reduce && !stations.empty()) {
+  if (local_options.reduce && !stations.empty()) {
     VC_ASSIGN_OR_RETURN(reduced, runner.Run(Stage::kReduction, [&](const JobContext& c) {
-      return planner::RunReductionStage({scene, stations, callbacks.face_values}, options, c);
+      return planner::RunReductionStage({scene, stations, callbacks.face_values}, local_options, c);
     }));
   }
   result.reduction = std::move(reduced.reduction);
@@ -188,16 +192,16 @@ Result<PlanResult> Plan(const SceneInput& input, const PlanOptions& options, con
   {
     std::vector<VoxelSet> final_sets;
     for (int k : reduced.keep) final_sets.push_back(std::move(stations.sets[k]));
-    result.scan_graph = planner::BuildScanGraph(planner::OverlapMatrix(final_sets), options.min_overlap);
+    result.scan_graph = planner::BuildScanGraph(planner::OverlapMatrix(final_sets), local_options.min_overlap);
   }
   if (auto w = ScanGraphWarning(result.scan_graph)) result.warnings.push_back(*w);
   if (callbacks.on_final_stations) callbacks.on_final_stations(result.stations);
-  if (auto w = StopWarning(selected.selection, options)) result.warnings.push_back(*w);
+  if (auto w = StopWarning(selected.selection, local_options)) result.warnings.push_back(*w);
 
   std::vector<WorldPoint> final_positions;
   for (const PlannedStation& ps : result.stations) final_positions.push_back(ps.position);
   VC_ASSIGN_OR_RETURN(planner::EvaluationOutput evaluated, runner.Run(Stage::kEvaluation, [&](const JobContext& c) {
-    return planner::RunEvaluationStage({scene, final_positions, std::move(reduced.evaluation)}, options, c);
+    return planner::RunEvaluationStage({scene, final_positions, std::move(reduced.evaluation)}, local_options, c);
   }));
   result.evaluation = std::move(evaluated.evaluation);
   for (std::string& w : evaluated.warnings) result.warnings.push_back(std::move(w));
@@ -207,16 +211,18 @@ Result<PlanResult> Plan(const SceneInput& input, const PlanOptions& options, con
   result.voxel_centers = std::move(evaluated.voxel_centers);
 
   VC_ASSIGN_OR_RETURN(planner::RouteOutput routed, runner.Run(Stage::kRoute, [&](const JobContext& c) {
-    return planner::RunRouteStage({input, scene, final_positions, final_floor_z, result.floor_levels_m}, options, c);
+    return planner::RunRouteStage({input, scene, final_positions, final_floor_z, result.floor_levels_m}, local_options,
+                                  c);
   }));
   std::optional<planner::Route>& route = routed.route;
   if (route) {
-    result.route = {route->order, route->legs_m, route->length_m, route->polylines, route->parts, options.route_start};
+    result.route = {route->order,     route->legs_m, route->length_m,
+                    route->polylines, route->parts,  local_options.route_start};
     for (std::string& w : route->warnings) result.warnings.push_back(std::move(w));
   } else {
     result.warnings.push_back("no walking route: " + routed.unrouted_reason);
   }
-  result.field_time = ComputeFieldTime(result.stations.size(), result.route.length_m, options);
+  result.field_time = ComputeFieldTime(result.stations.size(), result.route.length_m, local_options);
   result.timings = runner.timings();
   result.total_seconds = runner.elapsed_seconds();
   return result;

@@ -25,6 +25,23 @@ using raster::Rgb;
 
 Json Point(const WorldPoint& p) { return Json::array({p.x(), p.y(), p.z()}); }
 
+// A result's local position in the input's own frame (PlanResult::frame_origin_m added). A zero
+// origin leaves the bits as they are (-0.0 + 0.0 would print as 0), so such a plan writes as before.
+WorldPoint InputFrame(const PlanResult& r, const WorldPoint& local) {
+  return r.frame_origin_m.isZero() ? local : WorldPoint(local + r.frame_origin_m);
+}
+// A result's local height (a floor level) in the input's own frame; NaN stays NaN.
+double InputFrameZ(const PlanResult& r, double local_z) {
+  return r.frame_origin_m.z() == 0 ? local_z : local_z + r.frame_origin_m.z();
+}
+// Heights in the input's own frame.
+std::vector<double> InputFrameZ(const PlanResult& r, const std::vector<double>& local_z) {
+  std::vector<double> out;
+  out.reserve(local_z.size());
+  for (double z : local_z) out.push_back(InputFrameZ(r, z));
+  return out;
+}
+
 Json FiguresJson(const VisibilityFigures& f) {
   return Json{{"global_visibility", f.global_visibility},
               {"fully_visible_fraction", f.fully_visible_fraction},
@@ -156,7 +173,7 @@ std::string PlanStationsCsv(const PlanResult& r) {
   const std::vector<int> position = RoutePositions(r);
   std::string out = "x,y,z,route_order\n";
   for (size_t k = 0; k < r.stations.size(); ++k) {
-    const WorldPoint& p = r.stations[k].position;
+    const WorldPoint p = InputFrame(r, r.stations[k].position);
     out += Fixed(p.x(), 6) + "," + Fixed(p.y(), 6) + "," + Fixed(p.z(), 6) + "," + std::to_string(position[k]) + "\n";
   }
   return out;
@@ -164,18 +181,26 @@ std::string PlanStationsCsv(const PlanResult& r) {
 
 // ---------- visibility.ply ----------
 
+// Voxel centres in the input's own frame; double coordinates when that frame's origin is not zero
+// (float holds survey coordinates only to half a metre), float otherwise.
 std::string VisibilityPly(const PlanResult& r) {
   const size_t n = std::min(r.voxel_centers.size(), r.evaluation.best_face_values.size());
+  const bool shifted = !r.frame_origin_m.isZero();
   std::vector<ColouredPoint> points(n);
   for (size_t i = 0; i < n; ++i) {
     const auto& faces = r.evaluation.best_face_values[i];
     const float v = *std::max_element(faces.begin(), faces.end());
-    points[i] = {r.voxel_centers[i], v > 0 ? raster::Viridis(v) : Rgb{128, 128, 128}, v};
+    points[i] = {InputFrame(r, r.voxel_centers[i]), v > 0 ? raster::Viridis(v) : Rgb{128, 128, 128}, v};
   }
-  return ColouredPointsPly({"vc visibility: occupied voxel centres (m); visibility = best V over the voxel's 6 faces",
-                            "colour: viridis of visibility in [0, 1]; grey = seen by no station (V = 0)",
-                            "resolution_m " + Fixed(r.resolution_m, 6)},
-                           points, "visibility");
+  std::vector<std::string> comments = {
+      "vc visibility: occupied voxel centres (m); visibility = best V over the voxel's 6 faces",
+      "colour: viridis of visibility in [0, 1]; grey = seen by no station (V = 0)",
+      "resolution_m " + Fixed(r.resolution_m, 6)};
+  if (shifted) {
+    comments.push_back("frame_origin_m " + Fixed(r.frame_origin_m.x(), 3) + " " + Fixed(r.frame_origin_m.y(), 3) + " " +
+                       Fixed(r.frame_origin_m.z(), 3) + " (coordinates are in the input's frame)");
+  }
+  return ColouredPointsPly(comments, points, "visibility", shifted ? PlyCoordinates::kDouble : PlyCoordinates::kFloat);
 }
 
 // ---------- heatmap.png ----------
@@ -398,13 +423,13 @@ Image DrawHeatmap(const PlanResult& r) {
     for (double v = std::ceil(L.x0 / step) * step; v <= L.x1 + 1e-9; v += step) {
       const int x = px(pl, v);
       img.VLine(x, top + L.plot_h, top + L.plot_h + 4, raster::kBlack);
-      const std::string s = TickLabel(v, step);
+      const std::string s = TickLabel(v + r.frame_origin_m.x(), step);
       img.Text(x - raster::TextWidth(s) / 2, top + L.plot_h + 8, s, raster::kBlack);
     }
     for (double v = std::ceil(L.y0 / step) * step; v <= L.y1 + 1e-9; v += step) {
       const int y = py(v);
       img.HLine(left - 5, left - 1, y, raster::kBlack);
-      const std::string s = TickLabel(v, step);
+      const std::string s = TickLabel(v + r.frame_origin_m.y(), step);
       img.Text(left - 8 - raster::TextWidth(s), y - 3, s, raster::kBlack);
     }
     const std::string xl = "x (m)";
@@ -415,7 +440,8 @@ Image DrawHeatmap(const PlanResult& r) {
     if (r.options.tripod_heights_m.size() > 1) {
       title = "VISIBLE VOXELS, BEST OF " + std::to_string(r.options.tripod_heights_m.size()) + " HEIGHTS";
     }
-    if (L.panel_z.size() > 1 || !r.floor_levels_m.empty()) title += "  z = " + Fixed(L.panel_z[p], 2) + " m";
+    if (L.panel_z.size() > 1 || !r.floor_levels_m.empty())
+      title += "  z = " + Fixed(InputFrameZ(r, L.panel_z[p]), 2) + " m";
     img.Text(left, 10, title, raster::kBlack, 2);
   }
   // The panel a point at height z (m) is drawn on: the one of the nearest representative z.
@@ -592,10 +618,11 @@ std::string PlanToJson(const PlanResult& r, const UploadSummary* upload) {
   Json viewpoints = Json::array();
   for (size_t k = 0; k < r.stations.size(); ++k) {
     const PlannedStation& s = r.stations[k];
+    const WorldPoint p = InputFrame(r, s.position);
     Json v{{"index", k},
-           {"x", s.position.x()},
-           {"y", s.position.y()},
-           {"z", s.position.z()},
+           {"x", p.x()},
+           {"y", p.y()},
+           {"z", p.z()},
            {"compatible_voxels", s.visible_voxels},
            {"marginal_gain", s.marginal_gain},
            {"cumulative_coverage", s.cumulative_coverage},
@@ -633,7 +660,7 @@ std::string PlanToJson(const PlanResult& r, const UploadSummary* upload) {
     matrix.push_back(std::move(row));
   }
   Json reduction_positions = Json::array();
-  for (const WorldPoint& p : r.reduction.positions) reduction_positions.push_back(Point(p));
+  for (const WorldPoint& p : r.reduction.positions) reduction_positions.push_back(Point(InputFrame(r, p)));
   Json reduction{{"size", r.reduction.size},
                  {"stations", std::move(reduction_positions)},
                  {"matrix", std::move(matrix)},
@@ -642,12 +669,12 @@ std::string PlanToJson(const PlanResult& r, const UploadSummary* upload) {
                  {"global_visibility_after", r.reduction.global_visibility_after}};
   Json heat = Json::array();
   for (size_t i = 0; i < r.heat_map.positions.size(); ++i) {
-    const WorldPoint& p = r.heat_map.positions[i];
+    const WorldPoint p = InputFrame(r, r.heat_map.positions[i]);
     heat.push_back({p.x(), p.y(), p.z(), i < r.heat_map.visible_voxels.size() ? r.heat_map.visible_voxels[i] : 0});
   }
   Json candidates{{"count", r.candidate_count},
                   {"grid_spacing_m", r.heat_map.grid_spacing_m},
-                  {"floor_levels_m", r.floor_levels_m},
+                  {"floor_levels_m", InputFrameZ(r, r.floor_levels_m)},
                   {"grid_cells", r.grid_cells},
                   {"cells_without_floor", r.cells_without_floor},
                   {"cells_failing_clearance", r.cells_failing_clearance},
@@ -662,12 +689,15 @@ std::string PlanToJson(const PlanResult& r, const UploadSummary* upload) {
   Json polylines = Json::array();
   for (const std::vector<WorldPoint>& line : r.route.polylines) {
     Json points = Json::array();
-    for (const WorldPoint& p : line) points.push_back(Point(p));
+    for (const WorldPoint& p : line) points.push_back(Point(InputFrame(r, p)));
     polylines.push_back(std::move(points));
   }
-  Json route{{"order", r.route.order},           {"legs_m", r.route.legs_m},
-             {"length_m", r.route.length_m},     {"parts", r.route.parts},
-             {"polyline", std::move(polylines)}, {"start", r.route.start ? Point(*r.route.start) : Json(nullptr)}};
+  Json route{{"order", r.route.order},
+             {"legs_m", r.route.legs_m},
+             {"length_m", r.route.length_m},
+             {"parts", r.route.parts},
+             {"polyline", std::move(polylines)},
+             {"start", r.route.start ? Point(InputFrame(r, *r.route.start)) : Json(nullptr)}};
   Json field_time{{"setup", r.field_time.setup_s},
                   {"scan", r.field_time.scan_s},
                   {"walk", r.field_time.walk_s},
@@ -677,6 +707,9 @@ std::string PlanToJson(const PlanResult& r, const UploadSummary* upload) {
   for (const StageTiming& t : r.timings) timings[std::string(StageName(t.stage))] = t.seconds;
   timings["total"] = r.total_seconds;
   Json j{{"schema", "vc.plan/1"},
+         {"frame",
+          {{"origin_m", Point(r.frame_origin_m)},
+           {"units", upload == nullptr ? Json(nullptr) : Json(upload->units.empty() ? "m" : upload->units)}}},
          {"resolution_m", r.resolution_m},
          {"selection_test", std::string(SelectionTestName(r.selection_test))},
          {"stop_reason", std::string(StopReasonName(r.stop_reason))},
@@ -726,24 +759,30 @@ ImageSize ReductionImageSize(int stations) {
 }
 
 std::string ColouredPointsPly(const std::vector<std::string>& comments, const std::vector<ColouredPoint>& points,
-                              std::string_view value_name) {
+                              std::string_view value_name, PlyCoordinates coordinates) {
+  const bool doubles = coordinates == PlyCoordinates::kDouble;
+  const std::string type = doubles ? "double" : "float";
   std::string out = "ply\nformat binary_little_endian 1.0\n";
   for (const std::string& c : comments) out += "comment " + c + "\n";
-  out += "element vertex " + std::to_string(points.size()) +
-         "\nproperty float x\nproperty float y\nproperty float z\n"
+  out += "element vertex " + std::to_string(points.size()) + "\nproperty " + type + " x\nproperty " + type +
+         " y\nproperty " + type +
+         " z\n"
          "property uchar red\nproperty uchar green\nproperty uchar blue\n";
   if (!value_name.empty()) out += "property float " + std::string(value_name) + "\n";
   out += "end_header\n";
-  out.reserve(out.size() + points.size() * (value_name.empty() ? 15 : 19));
+  out.reserve(out.size() + points.size() * ((doubles ? 27 : 15) + (value_name.empty() ? 0 : 4)));
   auto put_float = [&out](float f) {
     char b[4];
     std::memcpy(b, &f, 4);  // x86-64 and ARM64 hosts are little-endian
     out.append(b, 4);
   };
+  auto put_double = [&out](double d) {
+    char b[8];
+    std::memcpy(b, &d, 8);
+    out.append(b, 8);
+  };
   for (const ColouredPoint& p : points) {
-    put_float(static_cast<float>(p.position_m.x()));
-    put_float(static_cast<float>(p.position_m.y()));
-    put_float(static_cast<float>(p.position_m.z()));
+    for (int a = 0; a < 3; ++a) doubles ? put_double(p.position_m[a]) : put_float(static_cast<float>(p.position_m[a]));
     out.append(reinterpret_cast<const char*>(p.rgb.data()), 3);
     if (!value_name.empty()) put_float(p.value);
   }

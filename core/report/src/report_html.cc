@@ -244,17 +244,12 @@ Json ReportData(const PlanResult& r, const ReportHtmlOptions& options) {
                {"route_parts", r.route.parts},
                {"min_overlap", r.scan_graph.min_overlap},
                {"scan_graph_connected", r.scan_graph.connected}};
-  return Json{{"schema", "vc.report/1"},
-              {"resolution_m", r.resolution_m},
-              {"selection_test", std::string(SelectionTestName(r.selection_test))},
-              {"figures", std::move(figures)},
-              {"stations", std::move(stations)},
-              {"edge_min_overlap", edge_min},
-              {"edges", std::move(edges)},
-              {"route", std::move(route)},
-              {"points", std::move(points)},
-              {"palette", PaletteBase64()},
-              {"warnings", r.warnings}};
+  return Json{{"schema", "vc.report/1"},        {"frame_origin_m", PointJson(r.frame_origin_m)},
+              {"resolution_m", r.resolution_m}, {"selection_test", std::string(SelectionTestName(r.selection_test))},
+              {"figures", std::move(figures)},  {"stations", std::move(stations)},
+              {"edge_min_overlap", edge_min},   {"edges", std::move(edges)},
+              {"route", std::move(route)},      {"points", std::move(points)},
+              {"palette", PaletteBase64()},     {"warnings", r.warnings}};
 }
 
 // `j` as a JavaScript expression safe inside an HTML <script> element: ASCII only (ensure_ascii;

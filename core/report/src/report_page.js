@@ -7,6 +7,8 @@
 (function () {
   'use strict';
   var D = window.VC_REPORT_DATA;
+  // Drawn in the plan's local frame; every coordinate shown adds the frame's origin (the input's frame).
+  var frame = D.frame_origin_m || [0, 0, 0];
   var R = window.vcReport;
   var body = document.body;
 
@@ -67,7 +69,8 @@
   var rows = [];
   stations.forEach(function (s, k) {
     var tr = el('tr');
-    [s.number, s.route_order || '\u2013', num(s.position[0], 2), num(s.position[1], 2), num(s.position[2], 2),
+    [s.number, s.route_order || '\u2013', num(s.position[0] + frame[0], 2), num(s.position[1] + frame[1], 2),
+     num(s.position[2] + frame[2], 2),
      num(s.global_visibility, 3), count(s.marginal_gain), s.sole_voxels === null ? '\u2013' : count(s.sole_voxels)]
         .forEach(function (v) { tr.appendChild(el('td', v)); });
     if (s.fixed) tr.title = 'fixed station';
@@ -282,8 +285,8 @@
   function applyCut() {
     cutZ = Number(slider.value);
     cut.constant = cutZ - origin[2];
-    cutText.textContent = cutZ >= zHigh ? 'voxels above z = ' + num(cutZ, 2) + ' m hidden (none)'
-                                        : 'voxels above z = ' + num(cutZ, 2) + ' m hidden (ceilings)';
+    cutText.textContent = cutZ >= zHigh ? 'voxels above z = ' + num(cutZ + frame[2], 2) + ' m hidden (none)'
+                                        : 'voxels above z = ' + num(cutZ + frame[2], 2) + ' m hidden (ceilings)';
     requestRender();
   }
   slider.addEventListener('input', applyCut);

@@ -70,6 +70,18 @@ TEST(CandidatesStageTest, AFixedStationOutsideTheBoundsIsRefusedNamingThem) {
   EXPECT_THAT(r.status().message(), HasSubstr("fixed_stations[0]"));
 }
 
+TEST(CandidatesStageTest, MessagesNameAGeoreferencedScenesPositionsInTheInputsFrame) {
+  VoxelScene scene = RoomWithAHoleAndAPit();
+  scene.frame_origin_m = WorldPoint(512000, 5612000, 0);
+  Result<CandidatesOutput> r = Candidates(scene, {WorldPoint(102.05, 0.35, 1.6)});  // local, as the stages see it
+  ASSERT_FALSE(r.ok());
+  EXPECT_THAT(r.status().message(), HasSubstr("at 512102.050, 5612000.350, 1.6)"));
+  EXPECT_THAT(r.status().message(), HasSubstr("(x 511998.000.."));
+  r = Candidates(scene, {WorldPoint(-1.95, 0.35, 1.0)});
+  ASSERT_FALSE(r.ok());
+  EXPECT_THAT(r.status().message(), HasSubstr("511998.050, 5612000.350, 1"));
+}
+
 TEST(CandidatesStageTest, AFixedStationInsideAWallIsRefused) {
   Result<CandidatesOutput> r = Candidates(RoomWithAHoleAndAPit(), {WorldPoint(-1.95, 0.35, 1.0)});
   ASSERT_FALSE(r.ok());

@@ -82,6 +82,23 @@ TEST(RunEvaluationTest, GivesEvaluateOnTheSceneAtTheJobsResolution) {
   }
 }
 
+TEST(RunEvaluationTest, ViewpointsInTheInputsFrameAreEvaluatedAtTheirLocalPlace) {
+  SceneInput georeferenced = testing::Synthetic("box");
+  const WorldPoint origin(512000, 5612000, 0);
+  georeferenced.frame_origin_m = origin;
+  EvaluateJobOptions given = InsideTheBox(georeferenced);
+  for (WorldPoint& p : given.viewpoints) p += origin;  // in the input's frame, as a user gives them
+  std::vector<WorldPoint> local = given.viewpoints;
+  for (WorldPoint& p : local) p -= origin;
+  const Result<Evaluation> direct =
+      Evaluate(*Voxelize(testing::Synthetic("box"), {0.2}), local, given.evaluate_options());
+  ASSERT_TRUE(direct.ok());
+  const Result<Evaluation> job = RunEvaluation(georeferenced, given);
+  ASSERT_TRUE(job.ok()) << job.status().ToString();
+  EXPECT_GT(job->overall.global_visibility, 0.0);
+  EXPECT_EQ(job->overall.global_visibility, direct->overall.global_visibility);
+}
+
 TEST(RunEvaluationTest, SamplesWhenAskedTo) {
   const SceneInput box = testing::Synthetic("box");
   EvaluateJobOptions o = InsideTheBox(box);

@@ -720,6 +720,51 @@ TEST(PlannerTest, NoStationOrCandidateLiesInAKeepOutZone) {
   EXPECT_EQ(r.status().code(), StatusCode::kFailedPrecondition);
 }
 
+TEST(PlannerTest, PositionsGivenInTheInputsFrameApplyAtTheirLocalPlace) {
+  // The same scene twice: at its frame's origin, and as a georeferenced scan whose local frame
+  // lies at a UTM-like origin. Fixed stations, keep-out zones and the route start given in the
+  // input's frame must plan exactly as their local equivalents do at the origin. (Input
+  // coordinates less a whole-kilometre origin are exact in double, so "exactly" holds.)
+  Result<SceneInfo> info = DescribeScene("comb:3");
+  ASSERT_TRUE(info.ok());
+  Result<PlanResult> free = Plan(Synthetic("comb:3"), TestOptions());
+  ASSERT_TRUE(free.ok()) << free.status().ToString();
+  ASSERT_GE(free->stations.size(), 3u);
+  const WorldPoint origin(512000, 5612000, 0);
+  PlanOptions around = TestOptions();
+  const WorldPoint a = free->stations[0].position, b = free->stations[1].position;
+  around.keep_out = {KeepOutBox(a - WorldPoint(0.75, 0.75, 10), a + WorldPoint(0.75, 0.75, 10)),
+                     KeepOutPolygon(-10, 10, {b.x() - 1, b.y() - 1, b.x() + 1, b.y() - 1, b.x(), b.y() + 1})};
+  around.fixed_stations = {free->stations[2].position + WorldPoint(0.13, 0.07, 0)};
+  around.route_start = free->stations[2].position;
+  const PlanOptions given = InLocalFrame(around, -origin);  // in the input's frame, as a user gives them
+  ASSERT_NEAR(given.fixed_stations[0].y() - around.fixed_stations[0].y(), 5612000, 1e-6);
+  const PlanOptions local = InLocalFrame(given, origin);
+  Result<PlanResult> at_origin = Plan(Synthetic("comb:3"), local);
+  ASSERT_TRUE(at_origin.ok()) << at_origin.status().ToString();
+  EXPECT_EQ(at_origin->frame_origin_m, WorldPoint::Zero());
+
+  SceneInput georeferenced = Synthetic("comb:3");
+  georeferenced.frame_origin_m = origin;
+  Result<PlanResult> shifted = Plan(georeferenced, given);
+  ASSERT_TRUE(shifted.ok()) << shifted.status().ToString();
+  EXPECT_EQ(shifted->frame_origin_m, origin);
+  EXPECT_EQ(shifted->options.fixed_stations, given.fixed_stations);  // options stay as given
+  ASSERT_EQ(shifted->stations.size(), at_origin->stations.size());
+  ASSERT_TRUE(shifted->stations[0].fixed);
+  EXPECT_EQ(shifted->stations[0].position, local.fixed_stations[0]);
+  for (size_t k = 0; k < shifted->stations.size(); ++k) {
+    EXPECT_EQ(shifted->stations[k].position, at_origin->stations[k].position) << k;
+    EXPECT_EQ(KeepOutZoneContaining(local.keep_out, shifted->stations[k].position), -1) << k;
+  }
+  EXPECT_EQ(shifted->candidate_count, at_origin->candidate_count);
+  EXPECT_LT(shifted->candidate_count, free->candidate_count);
+  EXPECT_EQ(shifted->heat_map.positions, at_origin->heat_map.positions);
+  ASSERT_TRUE(shifted->route.start.has_value());
+  EXPECT_EQ(*shifted->route.start, *local.route_start);
+  EXPECT_EQ(shifted->covered_voxels, at_origin->covered_voxels);
+}
+
 TEST(PlannerTest, FixedStationsArePlacedFirstKeptAndThePlanAddsToThem) {
   Result<SceneInfo> info = DescribeScene("comb:3");
   ASSERT_TRUE(info.ok());

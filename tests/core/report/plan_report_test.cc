@@ -311,6 +311,86 @@ TEST(PlanReportTest, VisibilityPlyHoldsOneColouredVertexPerVoxel) {
   EXPECT_FLOAT_EQ(x1, 0.15f);
 }
 
+// SamplePlan as a georeferenced scan's plan: the same local positions, the local frame at a
+// UTM-like origin, and a station 330.123 m north of it (5,612,330.123 in the input's frame).
+constexpr double kOriginX = 512000, kOriginY = 5612000;
+PlanResult GeoreferencedPlan() {
+  PlanResult r = SamplePlan();
+  r.frame_origin_m = WorldPoint(kOriginX, kOriginY, 0);
+  r.stations[1].position = WorldPoint(345.457, 330.123, 1.6);
+  r.route.start = WorldPoint(0.5, 0.5, 0.1);
+  return r;
+}
+
+TEST(PlanReportTest, PlanJsonWritesTheInputsFrameToTheMillimetre) {
+  const PlanResult plan = GeoreferencedPlan();
+  const json j = json::parse(PlanToJson(plan));
+  EXPECT_EQ(j["frame"]["origin_m"], json::parse("[512000.0, 5612000.0, 0.0]"));
+  EXPECT_TRUE(j["frame"]["units"].is_null());  // unknown without the upload's summary
+  UploadSummary upload;
+  upload.units = "mm";
+  EXPECT_EQ(json::parse(PlanToJson(plan, &upload))["frame"]["units"], "mm");
+  upload.units.clear();
+  EXPECT_EQ(json::parse(PlanToJson(plan, &upload))["frame"]["units"], "m");
+  EXPECT_NEAR(j["viewpoints"][1]["x"].get<double>(), 512345.457, 1e-4);
+  EXPECT_NEAR(j["viewpoints"][1]["y"].get<double>(), 5612330.123, 1e-4);
+  EXPECT_NEAR(j["viewpoints"][0]["y"].get<double>(), 5612000.5, 1e-4);
+  EXPECT_NEAR(j["reduction"]["stations"][2][1].get<double>(), 5612001.5, 1e-4);
+  EXPECT_NEAR(j["candidates"]["visible_voxels"][11][1].get<double>(), 5612002.5, 1e-4);
+  EXPECT_NEAR(j["route"]["polyline"][1][0][0].get<double>(), 512003.5, 1e-4);
+  EXPECT_NEAR(j["route"]["start"][1].get<double>(), 5612000.5, 1e-4);
+  EXPECT_NEAR(j["candidates"]["floor_levels_m"][0].get<double>(), 0.1, 1e-9);  // origin z = 0
+  // The text itself carries the millimetres (not 5.61233e+06).
+  EXPECT_NE(PlanToJson(plan).find("5612330.123"), std::string::npos);
+  // A plan near its origin says so.
+  EXPECT_EQ(json::parse(PlanToJson(SamplePlan()))["frame"]["origin_m"], json::parse("[0.0, 0.0, 0.0]"));
+}
+
+TEST(PlanReportTest, StationsCsvAndVisibilityPlyAreInTheInputsFrame) {
+  const PlanResult plan = GeoreferencedPlan();
+  const std::string dir = testing::MakeTempDir();
+  ASSERT_TRUE(WritePlanOutputs(plan, dir).ok());
+  const std::string csv = ReadAll(dir + "/stations.csv");
+  EXPECT_NE(csv.find("512345.457000,5612330.123000,1.600000,1\n"), std::string::npos) << csv;
+  Result<std::vector<WorldPoint>> parsed = ParseStationsCsv(csv, "stations.csv");
+  ASSERT_TRUE(parsed.ok()) << parsed.status().ToString();
+  ASSERT_EQ(parsed->size(), 2u);
+  EXPECT_LT(((*parsed)[0] - WorldPoint(512000.5, 5612000.5, 1.6)).norm(), 1e-6);
+
+  const std::string ply = ReadAll(dir + "/visibility.ply");
+  const size_t end = ply.find("end_header\n");
+  ASSERT_NE(end, std::string::npos);
+  const std::string header = ply.substr(0, end);
+  EXPECT_NE(header.find("property double x\nproperty double y\nproperty double z\n"), std::string::npos) << header;
+  EXPECT_NE(header.find("comment frame_origin_m 512000.000 5612000.000 0.000"), std::string::npos) << header;
+  const size_t body = end + std::strlen("end_header\n");
+  constexpr size_t kVertex = 3 * 8 + 3 + 4;
+  ASSERT_EQ(ply.size() - body, 5u * kVertex);
+  double xyz[3];
+  std::memcpy(xyz, ply.data() + body + kVertex, sizeof(xyz));  // vertex 1: (0.15, 0.05, 0.05) local
+  EXPECT_NEAR(xyz[0], 512000.15, 1e-6);
+  EXPECT_NEAR(xyz[1], 5612000.05, 1e-6);
+  EXPECT_NEAR(xyz[2], 0.05, 1e-9);
+  float v4;
+  std::memcpy(&v4, ply.data() + body + 4 * kVertex + 3 * 8 + 3, 4);
+  EXPECT_FLOAT_EQ(v4, 0.8f);
+}
+
+TEST(PlanReportTest, APlanNearItsOriginWritesFloatCoordinatesAsBefore) {
+  const std::string dir = testing::MakeTempDir();
+  ASSERT_TRUE(WritePlanOutputs(SamplePlan(), dir).ok());
+  const std::string ply = ReadAll(dir + "/visibility.ply");
+  EXPECT_EQ(ply.find("frame_origin_m"), std::string::npos);
+  EXPECT_EQ(ply.find("property double"), std::string::npos);
+  EXPECT_EQ(ReadAll(dir + "/stations.csv"),
+            "x,y,z,route_order\n0.500000,0.500000,1.600000,2\n"
+            "3.500000,2.500000,1.600000,1\n");
+  PlanResult negative_zero = SamplePlan();
+  negative_zero.stations[0].position.x() = -0.0;  // adding a zero origin would print it as 0.000000
+  ASSERT_TRUE(WritePlanOutputs(negative_zero, dir).ok());
+  EXPECT_EQ(ReadAll(dir + "/stations.csv").substr(18, 10), "-0.000000,");
+}
+
 TEST(PlanReportTest, ColouredPointsPlyWithoutAValueHoldsPositionAndColourOnly) {
   const std::string ply = ColouredPointsPly({"first line", "colour: red = missed"},
                                             {{{1.5, -2, 0.25}, {230, 40, 40}, 7.0f}, {{0, 0, 3}, {1, 2, 3}, 0.0f}});

@@ -160,6 +160,18 @@ TEST(ReportHtmlTest, DataHoldsTheStationsRouteOrderAndFigures) {
   EXPECT_EQ(d["route"][0].size(), 6u);
 }
 
+TEST(ReportHtmlTest, DrawsInTheLocalFrameAndGivesThePageTheFramesOrigin) {
+  PlanResult plan = BlockPlan();
+  const json near_origin = PageData(PlanToHtml(plan));
+  EXPECT_EQ(near_origin["frame_origin_m"], json::parse("[0.0, 0.0, 0.0]"));
+  plan.frame_origin_m = WorldPoint(512000, 5612000, 0);
+  const json d = PageData(PlanToHtml(plan));
+  EXPECT_EQ(d["frame_origin_m"], json::parse("[512000.0, 5612000.0, 0.0]"));
+  // Positions and voxels stay local (float32 in WebGL); the page adds the origin where it shows them.
+  EXPECT_EQ(d["stations"], near_origin["stations"]);
+  EXPECT_EQ(d["points"], near_origin["points"]);
+}
+
 TEST(ReportHtmlTest, VoxelsAreQuantisedWithVisibilityBytesAndSoleViewers) {
   const PlanResult plan = BlockPlan();
   const json p = PageData(PlanToHtml(plan))["points"];

@@ -108,10 +108,12 @@ struct JobObserver {
   std::function<void(const JobTicket&, const Status&, std::chrono::milliseconds)> on_reattach;
 };
 
-// A scene to upload: its bytes and a label for error messages (the file name).
+// A scene to upload: its bytes, a label for error messages (the file name), and the unit of its
+// coordinates (--units: "m", "cm", "mm", "ft", "us-ft"; empty = metres), sent as UploadSpec.units.
 struct Upload {
   std::string bytes;
   std::string source_name;
+  std::string units;
 };
 
 // Reads a file into an Upload. NOT_FOUND if it cannot be read.

@@ -24,7 +24,8 @@ struct PreparedUpload {
 // `raw` (--raw-upload), for octrees (already voxels, and their free space matters), for inputs
 // that carry scan origins (.graph, E57: a stream would drop them), when the compact stream is not
 // smaller, and when the file cannot be read or voxelised here (the server then reads it and says
-// what is wrong, with its own limits). Never fails.
+// what is wrong, with its own limits). A compact upload reads the file in file.units here and is
+// sent in metres (no units); a raw one keeps file.units for the server. Never fails.
 PreparedUpload PrepareUpload(Upload file, double resolution_m, bool raw, const JobContext& ctx = {});
 
 // One line for people: "compact upload: 131,705 voxels of 0.1 m, 212 KB instead of 4.6 MB" or

@@ -8,7 +8,7 @@
 
 namespace vc::client {
 
-// The summary lines, each ending in '\n'.
+// The summary lines, each ending in '\n'; positions in the input's frame (PlanResult::frame_origin_m added).
 std::string PlanSummary(const PlanResult& result);
 
 // How far the selection is from the optimum, one line ("optimal: 37 stations, proven", "37 stations,

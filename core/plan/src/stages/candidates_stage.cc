@@ -10,12 +10,17 @@
 namespace vc::planner {
 namespace {
 
+// A local position as the user gave it: in the input's frame (VoxelScene::frame_origin_m added).
+std::string InputFrame(const VoxelScene& scene, const WorldPoint& local) {
+  const WorldPoint p = scene.frame_origin_m.isZero() ? local : WorldPoint(local + scene.frame_origin_m);
+  return Coordinate(p.x()) + ", " + Coordinate(p.y()) + ", " + Coordinate(p.z());
+}
+
 // INVALID_ARGUMENT naming `what`[i] when a user position is out of range or inside an occupied voxel.
 Status CheckUserPositions(const VoxelScene& scene, const std::vector<WorldPoint>& user, const char* what) {
   for (size_t i = 0; i < user.size(); ++i) {
     const WorldPoint& p = user[i];
-    const std::string name =
-        std::string(what) + "[" + std::to_string(i) + "] (" + Num(p.x()) + ", " + Num(p.y()) + ", " + Num(p.z()) + ")";
+    const std::string name = std::string(what) + "[" + std::to_string(i) + "] (" + InputFrame(scene, p) + ")";
     if (!ViewpointInRange(p, scene.resolution_m)) {
       return InvalidArgumentError(name + " is more than " + Num(kMaxViewpointIndex * scene.resolution_m) +
                                   " m from the origin along an axis; use coordinates in the scene's frame");
@@ -33,9 +38,13 @@ constexpr double kFixedStationBoundsMargin_m = 2.0;
 // A fixed station whose nearest occupied voxel straight below is farther than this (m) gets a warning.
 constexpr double kFixedStationFloorWithin_m = 3.0;
 
-std::string Bounds(const WorldPoint& lo, const WorldPoint& hi) {
-  return "x " + Num(lo.x()) + ".." + Num(hi.x()) + ", y " + Num(lo.y()) + ".." + Num(hi.y()) + ", z " + Num(lo.z()) +
-         ".." + Num(hi.z()) + " m";
+// The box [lo, hi] (local) in the input's frame.
+std::string Bounds(const VoxelScene& scene, const WorldPoint& local_lo, const WorldPoint& local_hi) {
+  const bool zero = scene.frame_origin_m.isZero();
+  const WorldPoint lo = zero ? local_lo : WorldPoint(local_lo + scene.frame_origin_m);
+  const WorldPoint hi = zero ? local_hi : WorldPoint(local_hi + scene.frame_origin_m);
+  return "x " + Coordinate(lo.x()) + ".." + Coordinate(hi.x()) + ", y " + Coordinate(lo.y()) + ".." +
+         Coordinate(hi.y()) + ", z " + Coordinate(lo.z()) + ".." + Coordinate(hi.z()) + " m";
 }
 
 // Distance (m) from p down to the top of the nearest occupied voxel straight below it; NaN if none.
@@ -58,10 +67,10 @@ Result<std::vector<std::string>> CheckFixedStations(const VoxelScene& scene, con
   for (size_t i = 0; i < fixed.size(); ++i) {
     const WorldPoint& p = fixed[i];
     const std::string name = "fixed_stations[" + std::to_string(i) + "] (station " + std::to_string(i + 1) +
-                             " of the file, at " + Num(p.x()) + ", " + Num(p.y()) + ", " + Num(p.z()) + ")";
+                             " of the file, at " + InputFrame(scene, p) + ")";
     if ((p.array() < (lo - margin).array()).any() || (p.array() > (hi + margin).array()).any()) {
-      return InvalidArgumentError(name + " lies outside the scene's bounds (" + Bounds(lo, hi) + ", widened by " +
-                                  Num(kFixedStationBoundsMargin_m) +
+      return InvalidArgumentError(name + " lies outside the scene's bounds (" + Bounds(scene, lo, hi) +
+                                  ", widened by " + Num(kFixedStationBoundsMargin_m) +
                                   " m); is it in another frame or unit than the scene?");
     }
     const double below_m = DistanceToFloorBelow(scene, p);

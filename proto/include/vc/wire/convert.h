@@ -5,6 +5,11 @@
 // Bulk data (the heat map and the per-voxel results) is split into chunks of at most about
 // 0.8 MiB each (kCandidatesPerHeatMapChunk, kVoxelsPerChunk) and reassembled by
 // PlanResultAssembler, which checks that every chunk arrived exactly once and in order.
+// Positions on the wire are in the input's own frame (docs/PROTOCOL.md, "Frames"): a result's
+// local positions go out plus PlanResult::frame_origin_m and come back less it, so PlanResult is
+// local on both sides and its writers (vc/report) add the origin once more. Parameters
+// (PlanOptions, EvaluateJobOptions) are in the input's frame on both sides. Peers' ShardRequest
+// viewpoints are local (both replicas read the same bytes with the same units, so the same frame).
 // Functions are pure; PlanResultAssembler is not thread-safe.
 #pragma once
 
@@ -28,6 +33,7 @@ inline constexpr size_t kVoxelsPerChunk = 16384;
 // Candidates per HeatMapChunk (~40 bytes each on the wire).
 inline constexpr size_t kCandidatesPerHeatMapChunk = 16384;
 
+// A point as it is, in whatever frame the caller holds it.
 v1::Point ToProto(const WorldPoint& p);
 WorldPoint FromProto(const v1::Point& p);
 
@@ -59,19 +65,22 @@ Result<EvaluateJobOptions> FromProto(const v1::EvaluateParameters& p);
 v1::Progress ToProto(const ProgressEvent& e);
 ProgressEvent FromProto(const v1::Progress& p);
 
-v1::PlannedStation ToProto(const PlannedStation& s);
+// A station at a local position, sent in the input's frame (position + frame_origin_m).
+v1::PlannedStation ToProto(const PlannedStation& s, const WorldPoint& frame_origin_m);
+// A station as on the wire: its position in the input's frame (streamed picks, for people).
 PlannedStation FromProto(const v1::PlannedStation& s);
 
 // Without the per-face values (those travel in VoxelChunk); face_value_voxels is set from them.
 v1::Evaluation ToProto(const Evaluation& e);
 Evaluation FromProto(const v1::Evaluation& e);
 
-// The heat map in chunks, in order.
-std::vector<v1::HeatMapChunk> HeatMapChunks(const HeatMap& heat_map);
-// Calls fn with each VoxelChunk of result.voxel_centers and result.evaluation.best_face_values,
-// in order. Stops early and returns false when fn returns false.
+// The heat map (local) in chunks, in order, its positions and floor heights in the input's frame.
+std::vector<v1::HeatMapChunk> HeatMapChunks(const HeatMap& heat_map, const WorldPoint& frame_origin_m);
+// Calls fn with each VoxelChunk of result.voxel_centers (in the input's frame) and
+// result.evaluation.best_face_values, in order. Stops early and returns false when fn returns false.
 bool ForEachVoxelChunk(const PlanResult& result, const std::function<bool(v1::VoxelChunk&&)>& fn);
-// The summary that ends a Plan stream (everything but the chunked parts).
+// The summary that ends a Plan stream (everything but the chunked parts), in the input's frame
+// with result.frame_origin_m as frame_origin.
 v1::PlanResult ToProto(const PlanResult& result);
 
 // Rebuilds a vc::PlanResult from the chunks and the final summary of a Plan stream.
@@ -81,9 +90,10 @@ class PlanResultAssembler {
   // heat map (a stream carries exactly one).
   Status AddHeatMap(const v1::HeatMapChunk& chunk);
   Status AddVoxels(const v1::VoxelChunk& chunk);
-  // The heat map received so far (complete once all its chunks arrived).
+  // The heat map received so far (complete once all its chunks arrived), in the input's frame.
   const HeatMap& heat_map() const { return heat_map_; }
-  // DATA_LOSS if the chunks received do not add up to what `summary` declares (e.g. no heat map).
+  // The whole result, every position local (less summary.frame_origin). DATA_LOSS if the chunks
+  // received do not add up to what `summary` declares (e.g. no heat map), or the origin is not finite.
   Result<PlanResult> Finish(const v1::PlanResult& summary) &&;
 
  private:
@@ -96,6 +106,7 @@ class PlanResultAssembler {
   uint64_t voxel_total_ = 0;
 };
 
+// `viewpoints` as the job was given them (the input's frame).
 v1::EvaluateResult ToProto(const Evaluation& e, const std::vector<WorldPoint>& viewpoints);
 
 }  // namespace vc::wire

@@ -44,6 +44,7 @@ class PeerFanOut {
     std::string sha256;
     std::shared_ptr<const std::string> bytes;
     std::string source_name;
+    std::string units;  // UploadSpec.units: the peer reads the bytes in them (the same local frame)
   };
 
   // INVALID_ARGUMENT / NOT_FOUND for an unreadable TLS file. `self_id` is this replica's PeerHello id.

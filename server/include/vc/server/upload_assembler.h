@@ -25,6 +25,10 @@ namespace vc::server {
 // "12.3 MiB" style.
 std::string HumanBytes(uint64_t bytes);
 
+// Metres per unit of a spec's `units` field named `field` ("" = metres; MetresPerUnit otherwise).
+// INVALID_ARGUMENT naming the field and the accepted units.
+Result<double> SpecMetresPerUnit(std::string_view units, std::string_view field);
+
 class UploadAssembler {
  public:
   // `pool` admits the job and must outlive the assembler.
@@ -33,7 +37,7 @@ class UploadAssembler {
   // Notes that a spec message arrived, before its parameters are read: INVALID_ARGUMENT for a
   // second one.
   Status StartSpec();
-  // Checks the upload spec (format, non-empty, within --max-upload-bytes) and admits the job.
+  // Checks the upload spec (format, units, non-empty, within --max-upload-bytes) and admits the job.
   // INVALID_ARGUMENT, or RESOURCE_EXHAUSTED for a too-large upload or a busy server (busy() true).
   // INVALID_ARGUMENT once a spec was accepted. Until one is (it was refused, or the RPC refused its
   // parameters and never called this), AddChunk and Finish are INVALID_ARGUMENT: no data is taken

@@ -1,9 +1,9 @@
 // VoxelizedScenes: the scenes a replica has voxelized for its peers' shards (docs/DEPLOY.md,
 // "Scaling out"), so that the many shards of one plan read and voxelize the scene once.
 //
-// Keyed by the scene's SHA-256 and the working resolution; the few most recently used are kept (a
-// replica serves one or two plans' shards at a time). Two shards asking for the same scene at once
-// share one voxelization; a failed one is not kept. Thread-safe.
+// Keyed by the scene's SHA-256, the working resolution and the input's units (ShardRequest.units); the few most
+// recently used are kept (a replica serves one or two plans' shards at a time). Two shards asking for the same scene at
+// once share one voxelization; a failed one is not kept. Thread-safe.
 #pragma once
 
 #include <cstdint>
@@ -19,9 +19,13 @@
 
 namespace vc::server {
 
-// CRC32C of the scene's resolution and occupied keys, in order: a coordinator checks with it that a
-// peer's voxelization is its own (same build, same input).
+// CRC32C of the scene's resolution, its frame's origin (when not zero) and occupied keys, in order: a coordinator
+// checks with it that a peer's voxelization is its own (same build, same input).
 uint32_t SceneFingerprint(const VoxelScene& scene);
+
+// The key of a shared scene's voxelization: its SHA-256, the working resolution and the input's
+// units (UploadSpec.units), which change the scene's scale and local frame as the resolution does.
+std::string VoxelizedSceneKey(const std::string& sha256, double resolution_m, const std::string& units);
 
 class VoxelizedScenes {
  public:

@@ -33,7 +33,7 @@ struct EvaluateJobOptions {
   VC_EVALUATE_PARAMETERS(VC_DECLARE_PARAMETER)
   // The scanner (VC_SCANNER_PARAMETERS), nested as "scanner" in the proto.
   ScannerModel scanner;
-  // The viewpoints to evaluate, world frame (m); at least one.
+  // The viewpoints to evaluate, in the input's own frame (m); at least one.
   std::vector<WorldPoint> viewpoints;
 
   // INVALID_ARGUMENT naming the first bad parameter: no viewpoint, a non-finite viewpoint, a row's
@@ -44,7 +44,8 @@ struct EvaluateJobOptions {
   EvaluateOptions evaluate_options() const;
 };
 
-// Validates, voxelises `input` at options.resolution_m, then vc::Evaluate. Errors as those.
+// Validates, voxelises `input` at options.resolution_m, moves the viewpoints to the scene's local
+// frame (less VoxelScene::frame_origin_m), then vc::Evaluate. Errors as those.
 Result<Evaluation> RunEvaluation(const SceneInput& input, const EvaluateJobOptions& options,
                                  const JobContext& ctx = {});
 

@@ -1,8 +1,9 @@
 // Keep-out zones: places no station may stand in (a doorway, a machine, a road), as axis-aligned
-// boxes or as polygons in x, y extruded over a z range, world frame, metres. The planner drops
-// generated and user candidates and refinement's trial positions inside a zone, and refuses fixed
-// stations inside one (docs/PLANNING.md, "Keep-out zones"). ParseKeepOutCsv reads the CSV format
-// documented there. Zones are closed: a point on a zone's boundary is inside it.
+// boxes or as polygons in x, y extruded over a z range, in metres, in the frame the caller holds
+// (PlanOptions: the input's frame; Plan moves them to the local frame, InLocalFrame). The planner
+// drops generated and user candidates and refinement's trial positions inside a zone, and refuses
+// fixed stations inside one (docs/PLANNING.md, "Keep-out zones"). ParseKeepOutCsv reads the CSV
+// format documented there. Zones are closed: a point on a zone's boundary is inside it.
 // Thread-compatible: plain values and pure functions.
 #pragma once
 

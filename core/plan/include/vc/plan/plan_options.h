@@ -81,17 +81,18 @@ struct PlanOptions {
   VC_PLAN_PARAMETERS(VC_DECLARE_PARAMETER)
   // The scanner (VC_SCANNER_PARAMETERS); plan.json and the proto nest it as "scanner".
   ScannerModel scanner;
-  // User-supplied candidates (world frame, m). When non-empty, replaces the generated grid.
+  // Positions below are in the input's own frame (docs/PLANNING.md, "Outputs in the input's
+  // frame"); Plan moves them to the scene's local frame (InLocalFrame) once it has voxelised.
+  // User-supplied candidates (m). When non-empty, replaces the generated grid.
   std::vector<WorldPoint> candidates;
   // Several instrument heights above the floor (m): when non-empty, replaces tripod_height_m and
   // the grid gets a candidate at each height per cell.
   std::vector<double> tripod_heights_m;
-  // Places no station may stand in (world frame).
+  // Places no station may stand in.
   std::vector<KeepOutZone> keep_out;
-  // Stations already placed (world frame, m): picked first, never removed; the plan adds to them.
+  // Stations already placed (m): picked first, never removed; the plan adds to them.
   std::vector<WorldPoint> fixed_stations;
-  // Where the walking route starts (world frame, m; z picks the floor level nearest it, NaN = the
-  // lowest), if set.
+  // Where the walking route starts (m; z picks the floor level nearest it, NaN = the lowest), if set.
   std::optional<WorldPoint> route_start;
 
   // The instrument heights candidates stand at: tripod_heights_m, or {tripod_height_m}.
@@ -105,5 +106,10 @@ struct PlanOptions {
   // or an infinite z.
   Status Validate() const;
 };
+
+// `options` with every position (candidates, keep-out zones, fixed stations, route start) moved
+// from the input's frame to the local frame whose origin lies at `frame_origin_m` in the input's
+// frame (VoxelScene::frame_origin_m): each less that origin. A zero origin changes nothing.
+[[nodiscard]] PlanOptions InLocalFrame(PlanOptions options, const WorldPoint& frame_origin_m);
 
 }  // namespace vc

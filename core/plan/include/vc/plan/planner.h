@@ -52,7 +52,7 @@ struct Reduction {
   std::vector<int> removed;
   double global_visibility_before = 0;
   double global_visibility_after = 0;
-  // P: the stations the matrix is about (greedy order, after refinement), world frame (m).
+  // P: the stations the matrix is about (greedy order, after refinement), local frame (m).
   std::vector<WorldPoint> positions;
 };
 
@@ -123,8 +123,14 @@ using FaceValuesFn =
     std::function<Result<DistributedFaceValues>(const VoxelScene& scene, const std::vector<WorldPoint>& stations,
                                                 const EvaluateOptions& options, const JobContext& ctx)>;
 
+// Every position here (stations, heat map, reduction, voxel centres, route; floor levels and
+// floor_z_m as heights) is in the scene's local frame: add frame_origin_m for the input's own frame,
+// as every writer does (vc/report/plan_report.h, vc/wire/convert.h). `options` is as given, in the
+// input's frame.
 struct PlanResult {
   PlanOptions options;
+  // Where the local frame's origin lies in the input's frame, m (VoxelScene::frame_origin_m).
+  WorldPoint frame_origin_m = WorldPoint::Zero();
   double resolution_m = 0;
   SelectionTest selection_test = SelectionTest::kSurfaceVisibility;  // the test that ran
   std::vector<PlannedStation> stations;                              // final stations, in greedy order
@@ -151,7 +157,7 @@ struct PlanResult {
   // Greedy picks (fixed stations not counted), and how many of them consolidation saved.
   int greedy_stations = 0;
   int consolidated = 0;
-  // Occupied voxel centres (world, m) in id order, for visibility.ply.
+  // Occupied voxel centres (local frame, m) in id order, for visibility.ply.
   std::vector<WorldPoint> voxel_centers;
   // Registration: the final stations' scan graph (indices into stations) at options.min_overlap,
   // and how many stations selection picked only to link it.

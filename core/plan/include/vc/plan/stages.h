@@ -29,7 +29,7 @@ namespace vc::planner {
 
 // The stations between selection and the final evaluation, in greedy order, one entry each.
 struct Stations {
-  std::vector<WorldPoint> positions;  // optical centres, world frame (m)
+  std::vector<WorldPoint> positions;  // optical centres, local frame (m)
   std::vector<double> floor_z_m;      // top of the floor below (m); NaN for user candidates
   std::vector<int> candidate;         // index into the candidates; -1 once refined off-grid, or fixed
   std::vector<VoxelSet> sets;         // each station's visibility set (selection test)
@@ -56,7 +56,7 @@ struct CandidatesInput {
   const VoxelScene& scene;
 };
 struct CandidatesOutput {
-  std::vector<WorldPoint> positions;   // world frame (m)
+  std::vector<WorldPoint> positions;   // local frame (m)
   std::vector<double> floor_z_m;       // per candidate (m); NaN for user candidates
   std::vector<double> floor_levels_m;  // floor levels found (m), ascending; empty for user candidates
   uint64_t grid_cells = 0;             // grid cells x levels examined
@@ -178,7 +178,7 @@ inline constexpr int kReductionStationsPerBatch = 256;
 // --- Stage::kEvaluation: V of every face from the final stations, and G ---
 struct EvaluationInput {
   const VoxelScene& scene;
-  const std::vector<WorldPoint>& positions;  // the final stations, world frame (m)
+  const std::vector<WorldPoint>& positions;  // the final stations, local frame (m)
   std::optional<Evaluation> reusable;        // the same stations' evaluation, if one exists
 };
 struct EvaluationOutput {
@@ -194,7 +194,7 @@ struct EvaluationOutput {
 struct RouteInput {
   const SceneInput& input;  // an octree's free space tells where the scan saw
   const VoxelScene& scene;
-  const std::vector<WorldPoint>& stations;    // the final stations, world frame (m)
+  const std::vector<WorldPoint>& stations;    // the final stations, local frame (m)
   const std::vector<double>& floor_z_m;       // per station: its floor (m), NaN when unknown
   const std::vector<double>& floor_levels_m;  // the candidates' floor levels, ascending
 };

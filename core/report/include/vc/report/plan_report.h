@@ -27,14 +27,18 @@ struct UploadSummary {
   std::string why_raw;      // raw: why (e.g. "--raw-upload", "an octree is uploaded as it is")
   std::string scene_hash;   // SHA-256 of what was (or would have been) sent; empty without the cache
   bool from_cache = false;  // the server held the scene: bytes_sent is 0
+  std::string units;        // the input's units as given (vc-client --units; MetresPerUnit); empty = metres
 };
 
-// plan.json's content (documented schema). `upload` null when not given.
+// plan.json's content (documented schema). `upload` null when not given. Every position is in the
+// input's own frame (the result's local positions plus PlanResult::frame_origin_m), and "frame"
+// says where the local frame lies (docs/PLANNING.md, "Outputs in the input's frame").
 std::string PlanToJson(const PlanResult& result, const UploadSummary* upload = nullptr);
 
 // Writes plan.json, stations.csv, visibility.ply, heatmap.png, reduction.png and report.html into `out_dir`
-// (created if missing). visibility.ply needs result.voxel_centers and
-// result.evaluation.best_face_values. INTERNAL / FAILED_PRECONDITION with the path on I/O errors.
+// (created if missing), every coordinate in the input's own frame (stations.csv to the micrometre;
+// visibility.ply in double precision when the frame's origin is not zero). visibility.ply needs result.voxel_centers
+// and result.evaluation.best_face_values. INTERNAL / FAILED_PRECONDITION with the path on I/O errors.
 Status WritePlanOutputs(const PlanResult& result, const std::string& out_dir, const UploadSummary* upload = nullptr);
 
 // One point of a coloured PLY: its position (m), its colour and, when the PLY has one, its value.
@@ -43,13 +47,16 @@ struct ColouredPoint {
   std::array<uint8_t, 3> rgb{0, 0, 0};
   float value = 0;
 };
+// How a PLY stores x, y, z: float, or double for coordinates float cannot hold (survey coordinates).
+enum class PlyCoordinates { kFloat, kDouble };
 // A binary little-endian PLY of `points` (the writer of visibility.ply): one header comment line per
-// entry of `comments`, then float x y z (m), uchar red green blue and, when `value_name` is not
-// empty, a float property of that name holding each point's value.
+// entry of `comments`, then x y z (m) as `coordinates` say, uchar red green blue and, when
+// `value_name` is not empty, a float property of that name holding each point's value.
 std::string ColouredPointsPly(const std::vector<std::string>& comments, const std::vector<ColouredPoint>& points,
-                              std::string_view value_name = "");
+                              std::string_view value_name = "", PlyCoordinates coordinates = PlyCoordinates::kFloat);
 
-// evaluation.json's content: resolution_m, global_visibility, per_viewpoint[...] and more.
+// evaluation.json's content: resolution_m, global_visibility, per_viewpoint[...] and more;
+// `viewpoints` as the job was given them (the input's own frame).
 std::string EvaluationToJson(const Evaluation& evaluation, const std::vector<WorldPoint>& viewpoints);
 Status WriteEvaluationOutputs(const Evaluation& evaluation, const std::vector<WorldPoint>& viewpoints,
                               const std::string& out_dir);

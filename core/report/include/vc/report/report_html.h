@@ -9,7 +9,9 @@
 // table; clicking a station highlights the voxels only it sees (Evaluation::sole_viewer).
 //
 // Data is inlined as JSON with the bulk arrays in base64 (positions quantised to uint16 steps of
-// the resolution); every string from the plan (warnings, names) is JSON-escaped with '<', '>' and
+// the resolution), in the plan's local frame (WebGL's float32 cannot hold survey coordinates); the
+// page adds PlanResult::frame_origin_m wherever it shows a coordinate; every string from the plan (warnings, names) is
+// JSON-escaped with '<', '>' and
 // '&' as \u escapes, so it can neither end the <script> element nor inject markup, and the page
 // inserts it as text, never as HTML. Stateless; safe to call from several threads.
 #pragma once
