@@ -2,15 +2,16 @@
 // docs/VISIBILITY.md "Measured against captured points", docs/BENCHMARKS.md). Prints, for each
 // selection test, ValidateAgainstScans' recall and precision, with no slack and with one voxel of
 // slack, on: simulated planes tilted 0-60 deg to the lattice (with and without 1 cm range noise),
-// two simulated stations in RoomWithClutterScene, the real hall scan and the two real room scans.
+// two simulated stations in RoomWithClutterScene (all round, and 150 deg scans predicted with and
+// without their field of view), the real hall scan and the two real room scans.
 // Figures only, no assertions.
 //
 // Real scans: points nearer than the scanner's min_range_m to their own station are dropped (the
 // room scans hold returns from the scanning platform within ~0.3 m, which would put the station in
 // an occupied voxel); the room's second scan is moved into the first's frame by the estimated pose
 // of ../shared/data/README.md (yaw +40.8 deg, translation (1.974, 0.058, 0.016) m), whose direction
-// the tool checks by the overlap of the two scans. The prediction has no horizontal field of view:
-// the hall scan covers -91..+91 deg of azimuth only.
+// the tool checks by the overlap of the two scans. The hall scan covers -91..+91 deg of azimuth
+// only: it is measured both all round (hfov 360) and with hfov 182 centred on its heading 0 (+x).
 #include <CLI/CLI.hpp>
 #include <Eigen/Geometry>
 #include <chrono>
@@ -18,6 +19,7 @@
 #include <cstdio>
 #include <numbers>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "vc/scene/occupancy_grid.h"
@@ -45,10 +47,12 @@ void PrintHeader() {
               "both", "recall", "prec", "recall1", "prec1");
 }
 
-// Runs every selection test on `scans` and prints one line per test and scan.
-int Report(const std::string& label, const std::vector<vc::CapturedScan>& scans, const BenchOptions& bench) {
+// Runs every selection test on `scans` with `scanner`'s limits and prints one line per test and scan.
+int Report(const std::string& label, const std::vector<vc::CapturedScan>& scans, const BenchOptions& bench,
+           const vc::ScannerModel& scanner = {}) {
   for (const vc::SelectionTest test : kTests) {
     vc::ValidationOptions options;
+    options.scanner = scanner;
     options.resolution_m = bench.resolution_m;
     options.selection_test = test;
     options.threads = bench.threads;
@@ -120,6 +124,30 @@ int Room(const BenchOptions& bench) {
   return 0;
 }
 
+// Two simulated 150 deg scans of RoomWithClutterScene (headings 20 and -160 deg): predicted all
+// round, then with hfov 150 centred on each scan's heading.
+int PartialRoomScans(const BenchOptions& bench) {
+  const vc::AnalyticScene scene = vc::RoomWithClutterScene();
+  std::vector<vc::CapturedScan> scans;
+  const std::pair<vc::WorldPoint, double> stations[] = {{vc::kRoomWithClutterStationM, 20.0},
+                                                        {vc::WorldPoint(6.5, 3.0, 1.2), -160.0}};
+  for (const auto& [position, heading_deg] : stations) {
+    vc::SimulatedScanner scanner;
+    scanner.position_m = position;
+    scanner.heading_rad = heading_deg * std::numbers::pi / 180.0;
+    scanner.hfov_deg = 150.0;
+    scanner.horizontal_step_deg = scanner.vertical_step_deg = bench.step_deg;
+    auto scan = Simulate(scene, scanner, std::to_string(scans.size() + 1));
+    if (!scan.ok()) return std::fprintf(stderr, "%s\n", scan.status().ToString().c_str()), 1;
+    scan->heading_deg = heading_deg;
+    scans.push_back(std::move(*scan));
+  }
+  if (Report("room, 150 deg scans, hfov 360", scans, bench) != 0) return 1;
+  vc::ScannerModel sector;
+  sector.hfov_deg = 150.0;
+  return Report("room, 150 deg scans, hfov 150", scans, bench, sector);
+}
+
 // A real scan's points (its own frame), those nearer than min_range_m to the origin dropped.
 vc::Result<std::vector<Eigen::Vector3f>> ReadScan(const std::string& path, double min_range_m) {
   VC_ASSIGN_OR_RETURN(vc::SceneInput input, vc::ReadSceneFile(path));
@@ -167,8 +195,12 @@ int RealScans(const BenchOptions& bench) {
   const double min_range_m = vc::ScannerModel{}.min_range_m;
   auto hall = ReadScan(bench.data_dir + "/hall-scan/scan.dat.bz2", min_range_m);
   if (!hall.ok()) return std::fprintf(stderr, "%s\n", hall.status().ToString().c_str()), 1;
-  std::printf("# the hall scan covers -91..+91 deg of azimuth; the prediction has no horizontal field of view\n");
-  if (Report("hall (real, one station)", {{"1", {0, 0, 0}, std::move(*hall)}}, bench) != 0) return 1;
+  std::printf("# the hall scan covers -91..+91 deg of azimuth: predicted all round, then with hfov 182, heading 0\n");
+  if (Report("hall (real, one station)", {{"1", {0, 0, 0}, *hall}}, bench) != 0) return 1;
+  vc::ScannerModel hall_scanner;
+  hall_scanner.hfov_deg = 182.0;
+  if (Report("hall (real, one station), hfov 182", {{"1", {0, 0, 0}, std::move(*hall), 0.0}}, bench, hall_scanner) != 0)
+    return 1;
 
   auto room1 = ReadScan(bench.data_dir + "/room-2scans/room_scan1.pcd", min_range_m);
   auto room2 = ReadScan(bench.data_dir + "/room-2scans/room_scan2.pcd", min_range_m);
@@ -214,7 +246,7 @@ int main(int argc, char** argv) {
       "prec '-': one scan, so only recall is meaningful\n",
       bench.resolution_m, bench.step_deg);
   PrintHeader();
-  if (TiltedPlanes(bench) != 0 || Room(bench) != 0) return 1;
+  if (TiltedPlanes(bench) != 0 || Room(bench) != 0 || PartialRoomScans(bench) != 0) return 1;
   if (!simulated_only && RealScans(bench) != 0) return 1;
   std::printf("# %.1f s\n", Since(start));
   return 0;

@@ -7,6 +7,7 @@
 #include <fstream>
 #include <iostream>
 #include <nlohmann/json.hpp>
+#include <numbers>
 #include <optional>
 #include <string>
 #include <utility>
@@ -41,6 +42,12 @@ Result<std::string> ReadBytes(const std::string& path) {
   return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
 }
 
+// The station's heading in degrees, if it has one.
+Heading HeadingDeg(const KnownStation& station) {
+  if (!station.heading_rad) return std::nullopt;
+  return *station.heading_rad * 180.0 / std::numbers::pi;
+}
+
 // The scans of one E57 file, by the poses it carries. Its points arrive concatenated in scan order;
 // they are split by each scan's record count, which holds only when no record was dropped.
 Result<std::vector<CapturedScan>> E57Scans(const std::string& file, SceneInput input, size_t first_scan_number) {
@@ -54,10 +61,13 @@ Result<std::vector<CapturedScan>> E57Scans(const std::string& file, SceneInput i
                                 " are valid and finite; validate cannot tell which scan the dropped records "
                                 "belonged to (export the scans as one point file each, with --positions)");
   }
+  // The scans' headings, as the stations reader takes them from the poses.
+  VC_ASSIGN_OR_RETURN(const std::vector<KnownStation> stations, ParseStationFile(bytes, file));
   std::vector<CapturedScan> scans;
   size_t next = 0;
   for (size_t i = 0; i < listed.size(); ++i) {
     CapturedScan scan;
+    if (i < stations.size()) scan.heading_deg = HeadingDeg(stations[i]);
     scan.name = file + ", scan " + std::to_string(first_scan_number + i) +
                 (listed[i].name.empty() ? "" : " (" + listed[i].name + ")");
     scan.position_m = input.scan_origins[i];
@@ -192,7 +202,8 @@ Result<LoadedScans> LoadScans(const ValidateInputs& inputs, double min_range_m) 
     loaded.dropped_near_scanner.resize(loaded.scans.size() + 1);
     loaded.scans.push_back(
         {file, position_m,
-         PlacePoints(read[f], frame_origin_m, position_m, pose, min_range_m, &loaded.dropped_near_scanner.back())});
+         PlacePoints(read[f], frame_origin_m, position_m, pose, min_range_m, &loaded.dropped_near_scanner.back()),
+         HeadingDeg(station)});
   }
   for (size_t i = 0; i < loaded.scans.size(); ++i) {
     if (loaded.scans[i].points_m.empty()) {
@@ -243,7 +254,8 @@ std::string ValidationToJson(const ValidationReport& report, const ValidateInput
                   {"vfov_max_deg", scanner.vfov_max_deg},
                   {"max_incidence_deg", scanner.max_incidence_deg},
                   {"angular_step_deg", scanner.angular_step_deg},
-                  {"max_spacing_m", scanner.max_spacing_m}};
+                  {"max_spacing_m", scanner.max_spacing_m},
+                  {"hfov_deg", scanner.hfov_deg}};
   j["frame_origin_m"] = {loaded.frame_origin_m.x(), loaded.frame_origin_m.y(), loaded.frame_origin_m.z()};
   j["model_voxels"] = report.model_voxels;
   j["precision_meaningful"] = report.precision_meaningful;
@@ -255,6 +267,8 @@ std::string ValidationToJson(const ValidationReport& report, const ValidateInput
     scans.push_back({{"scan", i + 1},
                      {"name", a.name},
                      {"position_m", {p.x(), p.y(), p.z()}},
+                     {"heading_deg", loaded.scans[i].heading_deg ? nlohmann::ordered_json(*loaded.scans[i].heading_deg)
+                                                                 : nlohmann::ordered_json(nullptr)},
                      {"points", loaded.scans[i].points_m.size()},
                      {"points_dropped_near_scanner", loaded.dropped_near_scanner[i]},
                      {"captured", a.captured},
@@ -342,7 +356,8 @@ CLI::App* AddValidateCommand(CLI::App& app, ValidateCommand* command) {
       ->required();
   validate->add_option("--positions", command->inputs.positions_file,
                        "scanner positions of the point files, one per file in order (a stations CSV, a pose table "
-                       "x,y,z[,yaw], an E57, a .graph or a PCD); default: each PCD's VIEWPOINT");
+                       "x,y,z[,yaw], an E57, a .graph or a PCD); default: each PCD's VIEWPOINT. The yaw (degrees) is "
+                       "the scan's heading, which --hfov below 360 needs");
   validate->add_flag("--scanner-frame", command->inputs.scanner_frame,
                      "each point file is in its own scanner's frame: move it by its position and heading (yaw)");
   validate->add_option("--resolution", command->options.resolution_m, "voxel edge (m)")->capture_default_str();

@@ -31,6 +31,7 @@ double Other(double v, ParamCheck c) {
     case ParamCheck::kFraction:
     case ParamCheck::kElevationDeg:
     case ParamCheck::kIncidenceDeg:
+    case ParamCheck::kAzimuthSpanDeg:
       return v / 2;
     case ParamCheck::kUnitInterval:
       return v == 0 ? 0.375 : v / 2;
@@ -64,6 +65,7 @@ std::optional<double> Bad(double, ParamCheck c) {
     case ParamCheck::kElevationDeg:
       return -91.0;
     case ParamCheck::kIncidenceDeg:
+    case ParamCheck::kAzimuthSpanDeg:
       return 0.0;
   }
   return std::nullopt;

@@ -72,6 +72,7 @@ TEST_F(ValidateCommandTest, PointFilesTakeTheirPositionsInOrder) {
   EXPECT_EQ(loaded->scans[0].points_m.size(), first_.size());
   EXPECT_EQ(loaded->scans[1].points_m.size(), second_.size());
   EXPECT_EQ(loaded->dropped_near_scanner, (std::vector<uint64_t>{0, 0}));
+  EXPECT_FALSE(loaded->scans[0].heading_deg.has_value());  // positions.csv has no yaw column
 }
 
 TEST_F(ValidateCommandTest, SurveyCoordinatesGiveTheSameScansInALocalFrame) {
@@ -135,6 +136,10 @@ TEST_F(ValidateCommandTest, ScansInTheirOwnFramesAreMovedByPositionAndHeading) {
     EXPECT_LT((loaded->scans[1].points_m[i] - second_[i]).norm(), 1e-4f) << i;
   }
   EXPECT_LT((loaded->scans[0].points_m[0] - first_[0]).norm(), 1e-4f);
+  // The yaw column is each scan's heading, which --hfov below 360 needs.
+  ASSERT_TRUE(loaded->scans[0].heading_deg && loaded->scans[1].heading_deg);
+  EXPECT_DOUBLE_EQ(*loaded->scans[0].heading_deg, 0.0);
+  EXPECT_NEAR(*loaded->scans[1].heading_deg, heading_deg, 1e-9);
 }
 
 TEST_F(ValidateCommandTest, APcdTakesItsPositionFromItsViewpoint) {
@@ -152,7 +157,12 @@ TEST_F(ValidateCommandTest, AnE57GivesEachOfItsScansWithItsPose) {
   for (const auto& [points, position] : {std::pair{first_, kRoomWithClutterStationM}, {second_, kSecondStationM}}) {
     vc::testing::E57ScanSpec scan;
     scan.translation_m = position;
-    for (const Eigen::Vector3f& p : points) scan.points.push_back(p.cast<double>() - position);
+    // The second scan is turned by a yaw of 30 deg: its heading.
+    if (position == kSecondStationM) {
+      scan.rotation = Eigen::AngleAxisd(30 * std::numbers::pi / 180, Eigen::Vector3d::UnitZ());
+    }
+    for (const Eigen::Vector3f& p : points)
+      scan.points.push_back(scan.rotation.inverse() * (p.cast<double>() - position));
     scan.packets = int(points.size() / 1000) + 2;  // the writer's packets hold up to 64 KiB
     spec.scans.push_back(scan);
   }
@@ -164,6 +174,9 @@ TEST_F(ValidateCommandTest, AnE57GivesEachOfItsScansWithItsPose) {
   EXPECT_TRUE(loaded->scans[1].position_m.isApprox(kSecondStationM));
   ASSERT_EQ(loaded->scans[1].points_m.size(), second_.size());
   EXPECT_LT((loaded->scans[1].points_m.back() - second_.back()).norm(), 2e-3f);  // E57 scale 1 mm
+  ASSERT_TRUE(loaded->scans[0].heading_deg && loaded->scans[1].heading_deg);
+  EXPECT_NEAR(*loaded->scans[0].heading_deg, 0.0, 1e-9);
+  EXPECT_NEAR(*loaded->scans[1].heading_deg, 30.0, 1e-9);
 }
 
 TEST_F(ValidateCommandTest, AnE57WithDroppedRecordsIsRefusedNamingTheFile) {
@@ -317,6 +330,8 @@ TEST_F(ValidateCommandTest, OutputsCarryTheReportsFigures) {
   EXPECT_EQ(j["scans"][1]["captured"].get<uint64_t>(), report->scans[1].captured);
   EXPECT_EQ(j["scans"][1]["recall_slack"].get<double>(), report->scans[1].recall_slack);
   EXPECT_EQ(j["scans"][0]["position_m"][1].get<double>(), 3.0);
+  EXPECT_TRUE(j["scans"][0]["heading_deg"].is_null());  // positions.csv has no yaw
+  EXPECT_EQ(j["scanner"]["hfov_deg"].get<double>(), 360.0);
   EXPECT_EQ(vc::testing::ReadFileBytes(out + "/validation_2.ply"), *ValidationPly(*report, 1));
 
   const std::string table = ValidationTable(*report);
@@ -324,6 +339,29 @@ TEST_F(ValidateCommandTest, OutputsCarryTheReportsFigures) {
   std::snprintf(recall, sizeof recall, "%.3f", report->scans[0].recall);
   EXPECT_NE(table.find(recall), std::string::npos) << table;
   EXPECT_EQ(table.find("note:"), std::string::npos) << table;
+}
+
+// --hfov below 360 needs each scan's heading: positions without a yaw column are refused naming
+// the scan's file; with one the validation runs and predicts no more than all round.
+TEST_F(ValidateCommandTest, AFieldOfViewBelow360NeedsAYawPerScan) {
+  ValidationOptions options;
+  options.scanner.hfov_deg = 182;
+  Result<LoadedScans> loaded = LoadScans(TwoPointFiles(), 0.5);
+  ASSERT_TRUE(loaded.ok()) << loaded.status().ToString();
+  Result<ValidationReport> refused = ValidateAgainstScans(loaded->scans, options);
+  ASSERT_EQ(refused.status().code(), StatusCode::kInvalidArgument);
+  EXPECT_NE(refused.status().message().find(Path("a.xyz") + "\") has no heading"), std::string::npos)
+      << refused.status().ToString();
+  WriteText(Path("positions.csv"), "x,y,z,yaw\n2,3,1.5,0\n6,2.5,1.2,180\n");
+  loaded = LoadScans(TwoPointFiles(), 0.5);
+  ASSERT_TRUE(loaded.ok()) << loaded.status().ToString();
+  Result<ValidationReport> sector = ValidateAgainstScans(loaded->scans, options);
+  Result<ValidationReport> all_round = ValidateAgainstScans(loaded->scans, ValidationOptions{});
+  ASSERT_TRUE(sector.ok() && all_round.ok()) << sector.status().ToString();
+  for (size_t i = 0; i < 2; ++i) {
+    EXPECT_LT(sector->scans[i].predicted, all_round->scans[i].predicted) << i;
+    EXPECT_GT(sector->scans[i].predicted, 0u) << i;
+  }
 }
 
 TEST_F(ValidateCommandTest, ASingleScansTableSaysOnlyRecallIsMeaningful) {
@@ -341,8 +379,10 @@ TEST(ValidateCommandFlags, ParseTheTestTheScannerAndTheInputs) {
   CLI::App app;
   ValidateCommand command;
   AddValidateCommand(app, &command);
-  app.parse("validate a.xyz b.xyz --positions p.csv --test compatibility --max-range 30 --resolution 0.05 --out o",
-            false);
+  app.parse(
+      "validate a.xyz b.xyz --positions p.csv --test compatibility --max-range 30 --hfov 182 --resolution 0.05 --out o",
+      false);
+  EXPECT_EQ(command.options.scanner.hfov_deg, 182.0);
   EXPECT_EQ(command.inputs.positions_file, "p.csv");
   EXPECT_EQ(command.options.selection_test, SelectionTest::kCompatibility);
   EXPECT_EQ(command.options.scanner.max_range_m, 30.0);

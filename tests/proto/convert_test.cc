@@ -250,10 +250,11 @@ TEST(PlanResultChunks, ASoleViewerNamingAMissingStationOrOnSomeChunksOnlyIsDataL
 // A tripwire: when a field is added to PlanResult or PlanOptions, its size changes; carry the new
 // field in proto/vc/v1/planner.proto and proto/src/convert.cc (both ways), then update the sizes.
 // (1440: Evaluation::per_viewpoint_sparse_values, which like per_viewpoint_face_values is the
-// reduction's working data and never part of a result on the wire.)
+// reduction's working data and never part of a result on the wire. 1448 and 416: the scanner's
+// hfov_deg, a row carried as ScannerModel.hfov_deg.)
 TEST(PlanResultChunks, EveryCoreFieldIsCarried) {
-  EXPECT_EQ(sizeof(PlanResult), 1464u) << "PlanResult changed: update the vc.v1 PlanResult and vc::wire";
-  EXPECT_EQ(sizeof(PlanOptions), 408u) << "PlanOptions changed: update vc.v1 PlanParameters and vc::wire";
+  EXPECT_EQ(sizeof(PlanResult), 1472u) << "PlanResult changed: update the vc.v1 PlanResult and vc::wire";
+  EXPECT_EQ(sizeof(PlanOptions), 416u) << "PlanOptions changed: update vc.v1 PlanParameters and vc::wire";
 }
 
 // A georeferenced plan: local positions, the frame's origin at UTM-like coordinates (and once

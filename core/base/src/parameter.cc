@@ -45,6 +45,9 @@ Status CheckParameter(const ParamInfo& info, double v, std::string_view prefix) 
     case ParamCheck::kIncidenceDeg:
       if (!std::isfinite(v) || v <= 0 || v > 90) return Refuse(info, prefix, "in (0, 90]", Num(v));
       break;
+    case ParamCheck::kAzimuthSpanDeg:
+      if (!std::isfinite(v) || v <= 0 || v > 360) return Refuse(info, prefix, "in (0, 360]", Num(v));
+      break;
   }
   return Status::Ok();
 }
@@ -70,6 +73,9 @@ Status CheckParameter(const ParamInfo& info, int64_t v, std::string_view prefix)
       break;
     case ParamCheck::kIncidenceDeg:
       if (v <= 0 || v > 90) return Refuse(info, prefix, "in (0, 90]", std::to_string(v));
+      break;
+    case ParamCheck::kAzimuthSpanDeg:
+      if (v <= 0 || v > 360) return Refuse(info, prefix, "in (0, 360]", std::to_string(v));
       break;
   }
   return Status::Ok();

@@ -18,7 +18,12 @@ Status EvaluateJobOptions::Validate() const {
   VC_RETURN_IF_ERROR(CheckParameter(VC_PARAMETER_INFO(type, name, __VA_ARGS__), name));
   VC_EVALUATE_PARAMETERS(VC_CHECK_ROW)
 #undef VC_CHECK_ROW
-  return scanner.Validate();
+  VC_RETURN_IF_ERROR(scanner.Validate());
+  if (scanner.HasHorizontalFieldOfView()) {
+    return InvalidArgumentError("scanner.hfov_deg is " + std::to_string(scanner.hfov_deg) +
+                                " deg, but evaluated viewpoints carry no heading; leave hfov_deg at 360");
+  }
+  return Status::Ok();
 }
 
 VoxelizeOptions EvaluateJobOptions::voxelize_options() const { return {resolution_m, memory_budget_bytes}; }

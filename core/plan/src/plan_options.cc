@@ -16,6 +16,11 @@ Status PlanOptions::Validate() const {
   VC_PLAN_PARAMETERS(VC_CHECK_ROW)
 #undef VC_CHECK_ROW
   VC_RETURN_IF_ERROR(scanner.Validate());
+  if (scanner.HasHorizontalFieldOfView()) {
+    return InvalidArgumentError("scanner.hfov_deg is " + Num(scanner.hfov_deg) +
+                                " deg, but the planner's stations have no heading (it does not choose one), so it "
+                                "plans only with the full circle; leave hfov_deg at 360");
+  }
   for (size_t i = 0; i < tripod_heights_m.size(); ++i) {
     const double h = tripod_heights_m[i];
     const std::string name = "tripod_heights_m[" + std::to_string(i) + "]";

@@ -90,6 +90,7 @@ Json ScannerJson(const ScannerModel& o) {
   if (!o.HasVerticalFieldOfView()) j["vfov_min_deg"] = j["vfov_max_deg"] = nullptr;
   if (!o.HasIncidenceLimit()) j["max_incidence_deg"] = nullptr;
   if (!o.HasSpacingLimit()) j["max_spacing_m"] = nullptr;
+  if (!o.HasHorizontalFieldOfView()) j["hfov_deg"] = nullptr;
   if (!(o.angular_step_deg > 0)) j["angular_step_deg"] = nullptr;
   return j;
 }

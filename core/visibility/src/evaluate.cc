@@ -164,14 +164,16 @@ EvaluationJob Prepare(const VoxelScene& scene, const std::vector<WorldPoint>& vi
   for (size_t k = 0; k < viewpoints.size(); ++k) {
     job.uo[k] = g.WorldToIndexSpace(viewpoints[k]);
     job.shortcuts[k] = internal::ShortcutsHold(g, job.uo[k]);
-    job.limits[k] = ScannerLimits(options.scanner, job.r, job.uo[k]);
+    job.limits[k] = ScannerLimits(options.scanner, job.r, job.uo[k],
+                                  options.headings_deg.empty() ? Heading() : options.headings_deg[k]);
   }
   return job;
 }
 
 // Bounding boxes (index space) of consecutive blocks of kCullBlock points (corners or voxels, in
 // their sorted order: a block is a short run of rows), for skipping what no face centre in the
-// scanner's range needs (ScannerLimits::BoxVerdict): outside the range V is 0 whatever is seen.
+// scanner's range and horizontal field of view needs (ScannerLimits::BoxVerdict): outside them V
+// is 0 whatever is seen.
 constexpr uint64_t kCullBlock = 256;
 struct BlockBoxes {
   std::vector<Vector3d> lo, hi;
@@ -656,6 +658,7 @@ Result<Evaluation> Evaluate(const VoxelScene& scene, const std::vector<WorldPoin
                             const EvaluateOptions& options, const JobContext& ctx) {
   VC_RETURN_IF_ERROR(options.scanner.Validate());
   VC_RETURN_IF_ERROR(ValidateViewpoints(viewpoints, scene.resolution_m));
+  VC_RETURN_IF_ERROR(CheckViewpointHeadings(options.scanner, viewpoints.size(), options.headings_deg));
   const EvaluationJob job = Prepare(scene, viewpoints, options, ctx);
   Evaluation ev;
   ev.resolution_m = scene.resolution_m;

@@ -2,11 +2,14 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 
 namespace vc {
 
-ScannerLimits::ScannerLimits(const ScannerModel& s, double r, const Eigen::Vector3d& uo) : uo_(uo) {
+ScannerLimits::ScannerLimits(const ScannerModel& s, double r, const Eigen::Vector3d& uo,
+                             std::optional<double> heading_deg)
+    : uo_(uo) {
   min2_ = (s.min_range_m / r) * (s.min_range_m / r);
   max2_ = (s.max_range_m / r) * (s.max_range_m / r);
   // elevation >= vfov_min  <=>  dz >= tan(vfov_min) h, and likewise for the maximum (h the
@@ -20,7 +23,45 @@ ScannerLimits::ScannerLimits(const ScannerModel& s, double r, const Eigen::Vecto
   cos2_max_ = c * c;
   spacing_ = s.HasSpacingLimit();
   spacing_k_ = spacing_ ? r * (s.angular_step_deg * std::numbers::pi / 180.0) / s.max_spacing_m : 0.0;
+  azimuth_ = heading_deg.has_value() && s.hfov_deg < 360.0;
+  if (azimuth_) {
+    const double heading_rad = *heading_deg * std::numbers::pi / 180.0;
+    const double half_rad = s.hfov_deg / 2 * std::numbers::pi / 180.0;
+    right_edge_ = {std::cos(heading_rad - half_rad), std::sin(heading_rad - half_rad)};
+    left_edge_ = {std::cos(heading_rad + half_rad), std::sin(heading_rad + half_rad)};
+    wide_ = s.hfov_deg > 180.0;
+  }
   active_ = true;  // the range always is; BoxVerdict says where it matters
+}
+
+bool ScannerLimits::InAzimuth(double dx, double dy) const {
+  // Left of (counter-clockwise from) the right edge, and right of the left edge.
+  const bool after_right = right_edge_.x() * dy - right_edge_.y() * dx >= 0;
+  const bool before_left = dx * left_edge_.y() - dy * left_edge_.x() >= 0;
+  return wide_ ? (after_right || before_left) : (after_right && before_left);
+}
+
+ScannerLimits::Verdict ScannerLimits::AzimuthVerdict(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) const {
+  // Both sides are linear in (dx, dy), so over the rectangle their extremes are at its corners.
+  double right_min = std::numeric_limits<double>::infinity(), right_max = -right_min;
+  double left_min = right_min, left_max = right_max, far = 0;
+  for (int k = 0; k < 4; ++k) {
+    const double dx = ((k & 1) ? hi.x() : lo.x()) - uo_.x(), dy = ((k & 2) ? hi.y() : lo.y()) - uo_.y();
+    const double after_right = right_edge_.x() * dy - right_edge_.y() * dx;
+    const double before_left = dx * left_edge_.y() - dy * left_edge_.x();
+    right_min = std::min(right_min, after_right), right_max = std::max(right_max, after_right);
+    left_min = std::min(left_min, before_left), left_max = std::max(left_max, before_left);
+    far = std::max(far, std::abs(dx) + std::abs(dy));
+  }
+  const double margin = 1e-9 * (far + 1);
+  const bool all_right = right_min >= margin, all_left = left_min >= margin;
+  const bool none_right = right_max <= -margin, none_left = left_max <= -margin;
+  if (wide_) {
+    if (none_right && none_left) return Verdict::kNone;
+    return all_right || all_left ? Verdict::kAll : Verdict::kSome;
+  }
+  if (none_right || none_left) return Verdict::kNone;
+  return all_right && all_left ? Verdict::kAll : Verdict::kSome;
 }
 
 bool ScannerLimits::Passes(const Eigen::Vector3d& aim, int axis, int sign) const {
@@ -43,6 +84,7 @@ bool ScannerLimits::Passes(const Eigen::Vector3d& aim, int axis, int sign) const
       if (!below) return false;
     }
   }
+  if (azimuth_ && !InAzimuth(-d.x(), -d.y())) return false;
   // s = |d| cos(incidence): the component of d along the face's outward normal.
   const double s = sign > 0 ? d[axis] : -d[axis];
   if (incidence_ && !(s >= 0 && s * s >= cos2_max_ * d2)) return false;
@@ -64,6 +106,8 @@ ScannerLimits::Verdict ScannerLimits::BoxVerdict(const Eigen::Vector3d& lo, cons
   // decided point by point.
   const double slack = 1e-9 * (far2 + 1);
   if (near2 > max2_ + slack || far2 < min2_ - slack) return Verdict::kNone;
+  const Verdict azimuth = azimuth_ ? AzimuthVerdict(lo, hi) : Verdict::kAll;
+  if (azimuth == Verdict::kNone) return Verdict::kNone;
   if (!(near2 >= min2_ + slack && far2 <= max2_ - slack) || incidence_ || spacing_) return Verdict::kSome;
   if (vfov_lo_ || vfov_hi_) {
     // Every point must have dz >= tan_lo h (and dz <= tan_hi h), dz = z - station.z over
@@ -75,7 +119,7 @@ ScannerLimits::Verdict ScannerLimits::BoxVerdict(const Eigen::Vector3d& lo, cons
     if (vfov_lo_ && !(lo[2] - uo_[2] - tan_lo_ * (tan_lo_ <= 0 ? h_near : h_far) >= margin)) return Verdict::kSome;
     if (vfov_hi_ && !(tan_hi_ * (tan_hi_ >= 0 ? h_near : h_far) - (hi[2] - uo_[2]) >= margin)) return Verdict::kSome;
   }
-  return Verdict::kAll;
+  return azimuth;
 }
 
 void ScannerLimits::EntryFace(const VoxelIndex& v, int* axis, int* sign) const {

@@ -26,6 +26,15 @@ Status CheckInputs(const std::vector<CapturedScan>& scans, const ValidationOptio
     if (!scan.position_m.allFinite()) {
       return InvalidArgumentError(ScanLabel(scan, i) + " has a scanner position that is not finite");
     }
+    if (scan.heading_deg && !std::isfinite(*scan.heading_deg)) {
+      return InvalidArgumentError(ScanLabel(scan, i) + " has a heading that is not finite");
+    }
+    if (!scan.heading_deg && options.scanner.HasHorizontalFieldOfView()) {
+      return InvalidArgumentError(ScanLabel(scan, i) + " has no heading, but scanner.hfov_deg is " +
+                                  std::to_string(options.scanner.hfov_deg) +
+                                  " deg: give the scan's yaw (a pose with a rotation, or a yaw column in the "
+                                  "positions file), or leave hfov_deg at 360");
+    }
     bool any_finite = false;
     for (const auto& p : scan.points_m) {
       if (IsFinite(p)) {
@@ -131,8 +140,13 @@ Result<ValidationReport> ValidateAgainstScans(const std::vector<CapturedScan>& s
 
   std::vector<WorldPoint> positions;
   positions.reserve(scans.size());
-  for (const CapturedScan& scan : scans) positions.push_back(scan.position_m);
+  std::vector<Heading> headings;
+  for (const CapturedScan& scan : scans) {
+    positions.push_back(scan.position_m);
+    headings.push_back(scan.heading_deg);
+  }
   VisibilitySetsOptions sets_options;
+  sets_options.headings_deg = std::move(headings);
   sets_options.test = options.selection_test;
   sets_options.threads = options.threads;
   sets_options.scanner = options.scanner;

@@ -129,6 +129,26 @@ Status ScannerModel::Validate() const {
   return Status::Ok();
 }
 
+Status CheckViewpointHeadings(const ScannerModel& scanner, size_t viewpoints,
+                              const std::vector<Heading>& headings_deg) {
+  if (!headings_deg.empty() && headings_deg.size() != viewpoints) {
+    return InvalidArgumentError("got " + std::to_string(headings_deg.size()) + " headings for " +
+                                std::to_string(viewpoints) + " viewpoints; give one per viewpoint or none");
+  }
+  for (size_t k = 0; k < viewpoints; ++k) {
+    const Heading heading = headings_deg.empty() ? Heading() : headings_deg[k];
+    if (heading && !std::isfinite(*heading)) {
+      return InvalidArgumentError("viewpoint " + std::to_string(k + 1) + " has a heading that is not finite");
+    }
+    if (!heading && scanner.HasHorizontalFieldOfView()) {
+      return InvalidArgumentError("viewpoint " + std::to_string(k + 1) + " has no heading, but scanner.hfov_deg is " +
+                                  std::to_string(scanner.hfov_deg) +
+                                  " deg; a field of view below 360 deg needs the azimuth it is centred on");
+    }
+  }
+  return Status::Ok();
+}
+
 namespace {
 
 // One selection test for a single (viewpoint, voxel), with the limits of `scanner` or none.
@@ -199,6 +219,7 @@ struct SetsContext {
 
 // The dense sets of `viewpoints` (ComputeVisibilitySets without compaction).
 Result<std::vector<VoxelSet>> ComputeDenseSets(const SetsContext& sc, const std::vector<WorldPoint>& viewpoints,
+                                               const std::vector<Heading>& headings_deg,
                                                const VisibilitySetsOptions& options, const JobContext& ctx) {
   const OccupancyGrid& g = sc.g;
   const size_t n = sc.n;
@@ -210,7 +231,8 @@ Result<std::vector<VoxelSet>> ComputeDenseSets(const SetsContext& sc, const std:
   std::vector<char> valid(viewpoints.size()), shortcuts(viewpoints.size());
   for (size_t k = 0; k < viewpoints.size(); ++k) {
     uo[k] = g.WorldToIndexSpace(viewpoints[k]);
-    if (options.scanner) limits[k] = ScannerLimits(*options.scanner, g.resolution_m(), uo[k]);
+    const Heading heading = headings_deg.empty() ? Heading() : headings_deg[k];
+    if (options.scanner) limits[k] = ScannerLimits(*options.scanner, g.resolution_m(), uo[k], heading);
     valid[k] = ViewpointInRange(viewpoints[k], g.resolution_m()) && !InsideOccupied(g, uo[k]);
     shortcuts[k] = valid[k] && internal::ShortcutsHold(g, uo[k]);
   }
@@ -303,6 +325,8 @@ Status CheckSetBytes(uint64_t set_bytes, uint64_t positions, uint64_t voxels, ui
 
 Result<std::vector<VoxelSet>> ComputeVisibilitySets(const VoxelScene& scene, const std::vector<WorldPoint>& viewpoints,
                                                     const VisibilitySetsOptions& options, const JobContext& ctx) {
+  if (options.scanner)
+    VC_RETURN_IF_ERROR(CheckViewpointHeadings(*options.scanner, viewpoints.size(), options.headings_deg));
   SetsContext sc{scene.grid, scene.occupied.size(), std::vector<VoxelIndex>(scene.occupied.size()), {}, {}};
   for (size_t i = 0; i < sc.n; ++i) sc.index[i] = KeyToIndex(scene.occupied[i]);
   sc.candidates = NotEnclosed(sc.g, sc.index);
@@ -313,7 +337,8 @@ Result<std::vector<VoxelSet>> ComputeVisibilitySets(const VoxelScene& scene, con
     return CheckSetBytes(bytes, viewpoints.size(), sc.n, options.max_set_bytes);
   };
   if (options.compact_gain <= 0) {
-    VC_ASSIGN_OR_RETURN(std::vector<VoxelSet> sets, ComputeDenseSets(sc, viewpoints, options, ctx));
+    VC_ASSIGN_OR_RETURN(std::vector<VoxelSet> sets,
+                        ComputeDenseSets(sc, viewpoints, options.headings_deg, options, ctx));
     uint64_t bytes = 0;
     for (const VoxelSet& s : sets) bytes += s.MemoryBytes();
     VC_RETURN_IF_ERROR(check_bytes(bytes));
@@ -341,7 +366,11 @@ Result<std::vector<VoxelSet>> ComputeVisibilitySets(const VoxelScene& scene, con
     }
     const std::vector<WorldPoint> part(viewpoints.begin() + std::ptrdiff_t(b0),
                                        viewpoints.begin() + std::ptrdiff_t(b1));
-    VC_ASSIGN_OR_RETURN(std::vector<VoxelSet> sets, ComputeDenseSets(sc, part, options, sub));
+    const std::vector<Heading> part_headings =
+        options.headings_deg.empty() ? std::vector<Heading>()
+                                     : std::vector<Heading>(options.headings_deg.begin() + std::ptrdiff_t(b0),
+                                                            options.headings_deg.begin() + std::ptrdiff_t(b1));
+    VC_ASSIGN_OR_RETURN(std::vector<VoxelSet> sets, ComputeDenseSets(sc, part, part_headings, options, sub));
     for (VoxelSet& s : sets) {
       s.Compact(options.compact_gain);
       if (!s.sparse()) s.words().shrink_to_fit();

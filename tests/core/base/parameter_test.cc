@@ -29,6 +29,7 @@ TEST(CheckParameterTest, DoublesAtAndPastEachBound) {
       {ParamCheck::kUnitInterval, 0.0, 1.0, -1e-12, 1.0 + 1e-12},
       {ParamCheck::kElevationDeg, -90.0, 90.0, -90.001, 90.001},
       {ParamCheck::kIncidenceDeg, 1e-9, 90.0, 0.0, 90.001},
+      {ParamCheck::kAzimuthSpanDeg, 1e-9, 360.0, 0.0, 360.001},
   };
   for (const Case& c : cases) {
     const ParamInfo info = Info(c.check);
@@ -68,6 +69,8 @@ TEST(CheckParameterTest, SignedIntegersAtAndPastEachBound) {
   EXPECT_FALSE(CheckParameter(Info(ParamCheck::kElevationDeg), int64_t{91}).ok());
   EXPECT_TRUE(CheckParameter(Info(ParamCheck::kIncidenceDeg), int64_t{90}).ok());
   EXPECT_FALSE(CheckParameter(Info(ParamCheck::kIncidenceDeg), int64_t{0}).ok());
+  EXPECT_TRUE(CheckParameter(Info(ParamCheck::kAzimuthSpanDeg), int64_t{360}).ok());
+  EXPECT_FALSE(CheckParameter(Info(ParamCheck::kAzimuthSpanDeg), int64_t{361}).ok());
   // int32_t goes through the int64_t overload.
   EXPECT_FALSE(CheckParameter(Info(ParamCheck::kNonNegative), int32_t{-1}).ok());
   EXPECT_TRUE(CheckParameter(Info(ParamCheck::kNonNegative), int32_t{7}).ok());

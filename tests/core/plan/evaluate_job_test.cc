@@ -40,6 +40,9 @@ TEST(EvaluateJobOptionsTest, ValidateNamesWhatIsWrong) {
   o.threads = 0;
   o.scanner.max_range_m = -5;
   EXPECT_THAT(o.Validate().message(), HasSubstr("scanner.max_range_m"));
+  o.scanner = ScannerModel();
+  o.scanner.hfov_deg = 90;  // evaluated viewpoints carry no heading
+  EXPECT_THAT(o.Validate().message(), HasSubstr("scanner.hfov_deg"));
 }
 
 TEST(EvaluateJobOptionsTest, TheOptionsItRunsWithCarryEveryRow) {

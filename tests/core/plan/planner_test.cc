@@ -600,6 +600,9 @@ TEST(PlannerTest, ValidateRejectsBadParametersClearly) {
       {[](PlanOptions& o) { o.reduce_to = -1; }, "reduce_to"},
       {[](PlanOptions& o) { o.threads = -1; }, "threads"},
       {[](PlanOptions& o) { o.scanner.max_range_m = 0.1; }, "max_range_m"},
+      {[](PlanOptions& o) { o.scanner.hfov_deg = 0; }, "scanner.hfov_deg"},
+      // Stations have no heading, so a partial field of view cannot be planned.
+      {[](PlanOptions& o) { o.scanner.hfov_deg = 182; }, "scanner.hfov_deg is 182 deg"},
       {[](PlanOptions& o) { o.candidates = {WorldPoint(0, kNaN, 0)}; }, "candidates[0]"},
       {[](PlanOptions& o) { o.refine = true, o.refine_step_m = 1.0, o.refine_radius_m = 0.5; }, "refine_step_m"},
   };

@@ -44,6 +44,10 @@ TEST(ScannerPresetsTest, EveryPresetValidatesAndIsPhysicallySensible) {
     // The user's quality requirement is not the instrument's: off in every preset.
     EXPECT_FALSE(m.HasIncidenceLimit());
     EXPECT_FALSE(m.HasSpacingLimit());
+    // Every instrument listed turns all round (docs/SCANNERS.md), and a plan refuses less: a
+    // preset below 360 deg would make the preset unusable for planning.
+    EXPECT_EQ(m.hfov_deg, 360.0);
+    EXPECT_FALSE(m.HasHorizontalFieldOfView());
     // Seconds to an hour per station.
     EXPECT_GE(p.scan_time_s, 5.0);
     EXPECT_LE(p.scan_time_s, 3600.0);

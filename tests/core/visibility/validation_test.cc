@@ -4,7 +4,9 @@
 
 #include <cmath>
 #include <limits>
+#include <numbers>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "vc/synth/scanner_sim.h"
@@ -84,6 +86,46 @@ TEST(ValidateAgainstScansTest, SlackNeverLowersRecallOrPrecision) {
       EXPECT_FALSE(a.position_occupied);
     }
   }
+}
+
+// Two scans of the cluttered room that each cover 150 deg of azimuth: predicted all round, each
+// scan's position is credited with the half of the room it never scanned; with hfov_deg 150 and
+// each scan's heading the prediction keeps to its sector, so precision rises and recall stays.
+TEST(ValidateAgainstScansTest, AHeadingKeepsThePredictionToTheScansSector) {
+  const AnalyticScene scene = RoomWithClutterScene();
+  std::vector<CapturedScan> scans;
+  const std::pair<WorldPoint, double> stations[] = {{kRoomWithClutterStationM, 20.0}, {{6.5, 3.0, 1.2}, -160.0}};
+  for (const auto& [position, heading_deg] : stations) {
+    SimulatedScanner scanner;
+    scanner.position_m = position;
+    scanner.heading_rad = heading_deg * std::numbers::pi / 180;
+    scanner.hfov_deg = 150;
+    scanner.horizontal_step_deg = scanner.vertical_step_deg = 0.25;
+    auto scan = SimulateScan(scene, scanner);
+    ASSERT_TRUE(scan.ok()) << scan.status().ToString();
+    scans.push_back({std::to_string(scans.size() + 1), position, scan->points_m, heading_deg});
+  }
+  auto all_round = ValidateAgainstScans(scans, {});
+  ValidationOptions options;
+  options.scanner.hfov_deg = 150;
+  auto sector = ValidateAgainstScans(scans, options);
+  ASSERT_TRUE(all_round.ok() && sector.ok()) << sector.status().ToString();
+  for (size_t i = 0; i < scans.size(); ++i) {
+    SCOPED_TRACE(i);
+    const ScanAgreement& a = all_round->scans[i];
+    const ScanAgreement& b = sector->scans[i];
+    EXPECT_LT(b.predicted, a.predicted);
+    EXPECT_GT(b.precision, a.precision + 0.1);
+    EXPECT_GE(b.recall, a.recall - 0.01);
+  }
+  // Without a heading the sector has no centre: refused, naming the scan.
+  scans[1].heading_deg.reset();
+  auto refused = ValidateAgainstScans(scans, options);
+  ASSERT_EQ(refused.status().code(), StatusCode::kInvalidArgument);
+  EXPECT_NE(refused.status().message().find("scan 2 (\"2\") has no heading"), std::string::npos)
+      << refused.status().ToString();
+  scans[1].heading_deg = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_EQ(ValidateAgainstScans(scans, options).status().code(), StatusCode::kInvalidArgument);
 }
 
 TEST(ValidateAgainstScansTest, SingleScanSaysOnlyRecallIsMeaningful) {

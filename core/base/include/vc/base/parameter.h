@@ -28,13 +28,14 @@ namespace vc {
 
 // What values a parameter accepts (checked by CheckParameter). Numbers must also be finite.
 enum class ParamCheck : uint8_t {
-  kAny,           // any finite value
-  kNonNegative,   // >= 0
-  kPositive,      // > 0
-  kFraction,      // in (0, 1]
-  kUnitInterval,  // in [0, 1] (0 = off, for a fraction that can be switched off)
-  kElevationDeg,  // in [-90, 90] (degrees)
-  kIncidenceDeg,  // in (0, 90] (degrees)
+  kAny,             // any finite value
+  kNonNegative,     // >= 0
+  kPositive,        // > 0
+  kFraction,        // in (0, 1]
+  kUnitInterval,    // in [0, 1] (0 = off, for a fraction that can be switched off)
+  kElevationDeg,    // in [-90, 90] (degrees)
+  kIncidenceDeg,    // in (0, 90] (degrees)
+  kAzimuthSpanDeg,  // in (0, 360] (degrees)
 };
 
 // A parameter's metadata, from its table row.

@@ -37,7 +37,7 @@ struct EvaluateJobOptions {
   std::vector<WorldPoint> viewpoints;
 
   // INVALID_ARGUMENT naming the first bad parameter: no viewpoint, a non-finite viewpoint, a row's
-  // check or the scanner's.
+  // check or the scanner's, a scanner hfov_deg below 360 (viewpoints here carry no heading).
   Status Validate() const;
   // The voxelisation and evaluation options this job runs with (exact mode keeps no face values).
   VoxelizeOptions voxelize_options() const;

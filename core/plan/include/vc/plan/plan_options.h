@@ -99,7 +99,8 @@ struct PlanOptions {
   [[nodiscard]] std::vector<double> TripodHeights() const;
 
   // INVALID_ARGUMENT naming the first bad parameter: a row's check (non-finite, negative, zero,
-  // out of range), the scanner's, a non-finite candidate, clearance_m >= tripod_height_m (or a
+  // out of range), the scanner's, a scanner hfov_deg below 360 (stations have no heading), a
+  // non-finite candidate, clearance_m >= tripod_height_m (or a
   // tripod_heights_m entry), refine_step_m > refine_radius_m with refine on (local_candidates_step_m
   // > local_candidates_radius_m with local_candidates on), a bad keep-out zone, a
   // non-finite fixed station or one inside a keep-out zone, a route_start with a non-finite x or y

@@ -9,6 +9,13 @@
 // - incidence: the angle between the face's outward normal and the direction from the aim point
 //              to the station is at most max_incidence_deg;
 // - spacing:   d * step_rad / cos(incidence) <= max_spacing_m.
+// - horizontal field of view (hfov_deg < 360 and the station has a heading): the aim point's
+//              azimuth seen from the station (counter-clockwise from +x) within
+//              heading_deg +- hfov_deg / 2, both ends included. It is judged without angles, on the
+//              side of the sector's two edge directions the horizontal offset (dx, dy) lies:
+//              cross(right edge, d) >= 0 and (hfov <= 180) / or (hfov > 180) cross(d, left edge)
+//              >= 0; so an aim point straight above or below the station (dx = dy = 0) is in view
+//              whatever the heading.
 //
 // Every test is computed here, once, in index space (voxel units): the grouped engine, the per-ray
 // reference and the evaluation all call Passes, so they agree on every tie. Squared lengths are
@@ -17,6 +24,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <optional>
 
 #include "vc/scene/occupancy_grid.h"
 #include "vc/visibility/visibility.h"
@@ -26,8 +34,11 @@ namespace vc {
 class ScannerLimits {
  public:
   ScannerLimits() = default;  // no limit at all
-  // uo: the station in index space (OccupancyGrid::WorldToIndexSpace).
-  ScannerLimits(const ScannerModel& scanner, double resolution_m, const Eigen::Vector3d& uo);
+  // uo: the station in index space (OccupancyGrid::WorldToIndexSpace). heading_deg: the azimuth of
+  // the centre of the horizontal field of view (degrees, counter-clockwise from +x); without one,
+  // or with hfov_deg 360, no azimuth limit (callers refuse hfov < 360 without a heading).
+  ScannerLimits(const ScannerModel& scanner, double resolution_m, const Eigen::Vector3d& uo,
+                std::optional<double> heading_deg = std::nullopt);
 
   // Whether any limit can fail (with the defaults on a scene within 75 m: only near the station).
   bool active() const { return active_; }
@@ -38,11 +49,14 @@ class ScannerLimits {
   // normal is +axis (sign > 0) or -axis (sign < 0).
   bool Passes(const Eigen::Vector3d& aim, int axis, int sign) const;
 
+  // Whether the horizontal field of view limits this station.
+  bool LimitsAzimuth() const { return azimuth_; }
+
   // What the limits say for every aim point in the box [lo, hi] (index space): kNone when no point
-  // of the box is in range; kAll when every point is in range and in the vertical field of view,
-  // and no incidence or spacing limit is on (those depend on the face); kSome otherwise (decide
-  // point by point). Conservative: a margin far above rounding separates a decided box from the
-  // limits.
+  // of the box is in range, or none is in the horizontal field of view; kAll when every point is
+  // in range and in both fields of view, and no incidence or spacing limit is on (those depend on
+  // the face); kSome otherwise (decide point by point). Conservative: a margin far above rounding
+  // separates a decided box from the limits, so a box partly in view is never kNone.
   enum class Verdict { kNone, kSome, kAll };
   Verdict BoxVerdict(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) const;
 
@@ -62,6 +76,15 @@ class ScannerLimits {
   double cos2_max_ = 0;  // cos^2(max_incidence)
   bool spacing_ = false;
   double spacing_k_ = 0;  // resolution * step_rad / max_spacing: d^2 * k <= s passes
+  bool azimuth_ = false;  // a horizontal field of view below 360 deg with a heading
+  bool wide_ = false;     // that field of view is wider than 180 deg: either edge's side passes
+  Eigen::Vector2d right_edge_ = Eigen::Vector2d::Zero();  // direction of heading - hfov / 2
+  Eigen::Vector2d left_edge_ = Eigen::Vector2d::Zero();   // direction of heading + hfov / 2
+
+  // The horizontal offset (x, y) from the station to p passes the azimuth limit.
+  bool InAzimuth(double dx, double dy) const;
+  // The azimuth limit's verdict on the box's horizontal rectangle (kNone, kSome or kAll).
+  Verdict AzimuthVerdict(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) const;
 };
 
 }  // namespace vc

@@ -3,7 +3,8 @@
 // source and the quality setting it is for).
 //
 // A preset fixes what the instrument can do: the range, the vertical field of view and the angular
-// step (and the time of one scan) at one usual quality setting. It leaves the user's quality
+// step (and the time of one scan) at one usual quality setting; every instrument listed turns all
+// round, so each keeps hfov_deg 360. It leaves the user's quality
 // requirement off: max_incidence_deg 90 and max_spacing_m 0. Explicit values override a preset's
 // (vc-client `--scanner NAME --max-range 40`; the proto's ScannerModel.name, docs/SCANNERS.md).
 //

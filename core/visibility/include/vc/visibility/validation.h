@@ -11,8 +11,9 @@
 // versa). With a single scan the model is the scan itself, so every model voxel is captured and
 // precision says nothing about over-prediction: the report flags it.
 //
-// The prediction has no horizontal field of view: a scan that covers less than 360 deg is predicted
-// to see all round, so its precision is low by the share of the model outside its field of view.
+// A scan that covers less than 360 deg of azimuth is predicted with the scanner's hfov_deg centred
+// on the scan's heading (from its pose); with hfov_deg 360 (the default) it is predicted to see all
+// round, and its precision is then low by the share of the model outside its field of view.
 //
 // Thread-safety: a pure function; the visibility sets run on `threads` worker threads.
 #pragma once
@@ -39,6 +40,9 @@ struct CapturedScan {
   WorldPoint position_m{0, 0, 0};
   // The captured points (world, m); non-finite points are ignored.
   std::vector<Eigen::Vector3f> points_m;
+  // The azimuth the scanner's horizontal field of view is centred on (degrees, counter-clockwise
+  // from +x, world frame; the yaw of the scan's pose); needed when scanner.hfov_deg < 360.
+  Heading heading_deg{};
 };
 
 struct ValidationOptions {
@@ -97,11 +101,11 @@ struct ValidationReport {
 };
 
 // Measures the prediction of `options.selection_test` against `scans` (see the file comment).
-// INVALID_ARGUMENT naming the scan for a scan with no finite point, a non-finite position, or a
-// position farther than scanner.max_range_m from the model's bounding box; INVALID_ARGUMENT for no
-// scans, a bad resolution or scanner (ScannerModel::Validate); otherwise as Voxelize
-// (RESOURCE_EXHAUSTED over the memory budget) and ComputeVisibilitySets (CANCELLED /
-// DEADLINE_EXCEEDED from ctx).
+// INVALID_ARGUMENT naming the scan for a scan with no finite point, a non-finite position or
+// heading, no heading with scanner.hfov_deg < 360, or a position farther than scanner.max_range_m from the model's
+// bounding box; INVALID_ARGUMENT for no scans, a bad resolution or scanner (ScannerModel::Validate); otherwise as
+// Voxelize (RESOURCE_EXHAUSTED over the memory budget) and ComputeVisibilitySets (CANCELLED / DEADLINE_EXCEEDED from
+// ctx).
 Result<ValidationReport> ValidateAgainstScans(const std::vector<CapturedScan>& scans, const ValidationOptions& options,
                                               const JobContext& ctx = {});
 

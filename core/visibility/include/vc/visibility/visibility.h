@@ -40,20 +40,24 @@ std::string_view SelectionTestName(SelectionTest t);  // "surface", "compatibili
 // Each is a hard limit on what a station sees (docs/PLANNING.md "The scanner model"): selection
 // counts a voxel only through a face that passes every limit, and V (ALGORITHM.md s.5) is 0 for a
 // face that fails one. The defaults: the range [0.5, 75] m and no other limit (each at its "off"
-// end: vfov -90..90, incidence 90, spacing 0).
-#define VC_SCANNER_PARAMETERS(X)                                                              \
-  X(double, min_range_m, 0.5, "m", "min-range", kNonNegative, "scanner minimum range")        \
-  X(double, max_range_m, 75.0, "m", "max-range", kPositive, "scanner maximum range")          \
-  X(double, vfov_min_deg, -90.0, "deg", "vfov-min", kElevationDeg,                            \
-    "lowest elevation the scanner sees (-90 = straight down, no limit)")                      \
-  X(double, vfov_max_deg, 90.0, "deg", "vfov-max", kElevationDeg,                             \
-    "highest elevation the scanner sees (90 = straight up, no limit)")                        \
-  X(double, max_incidence_deg, 90.0, "deg", "max-incidence", kIncidenceDeg,                   \
-    "largest angle between a face's normal and the direction to the scanner (90 = no limit)") \
-  X(double, angular_step_deg, 0.0, "deg", "angular-step", kNonNegative,                       \
-    "the scanner's angular step between points (needed by --max-spacing)")                    \
-  X(double, max_spacing_m, 0.0, "m", "max-spacing", kNonNegative,                             \
-    "largest point spacing a face may get to count: distance x step / cos(incidence) (0 = no requirement)")
+// end: vfov -90..90, incidence 90, spacing 0, hfov 360). The horizontal field of view is centred on
+// each viewpoint's own heading (VisibilitySetsOptions::headings_deg), so an hfov below 360 needs a
+// heading for every viewpoint.
+#define VC_SCANNER_PARAMETERS(X)                                                                            \
+  X(double, min_range_m, 0.5, "m", "min-range", kNonNegative, "scanner minimum range")                      \
+  X(double, max_range_m, 75.0, "m", "max-range", kPositive, "scanner maximum range")                        \
+  X(double, vfov_min_deg, -90.0, "deg", "vfov-min", kElevationDeg,                                          \
+    "lowest elevation the scanner sees (-90 = straight down, no limit)")                                    \
+  X(double, vfov_max_deg, 90.0, "deg", "vfov-max", kElevationDeg,                                           \
+    "highest elevation the scanner sees (90 = straight up, no limit)")                                      \
+  X(double, max_incidence_deg, 90.0, "deg", "max-incidence", kIncidenceDeg,                                 \
+    "largest angle between a face's normal and the direction to the scanner (90 = no limit)")               \
+  X(double, angular_step_deg, 0.0, "deg", "angular-step", kNonNegative,                                     \
+    "the scanner's angular step between points (needed by --max-spacing)")                                  \
+  X(double, max_spacing_m, 0.0, "m", "max-spacing", kNonNegative,                                           \
+    "largest point spacing a face may get to count: distance x step / cos(incidence) (0 = no requirement)") \
+  X(double, hfov_deg, 360.0, "deg", "hfov", kAzimuthSpanDeg,                                                \
+    "horizontal field of view, centred on each station's heading (360 = all round, no heading needed)")
 
 // The scanner (ALGORITHM.md s.5, and the limits above).
 struct ScannerModel {
@@ -70,7 +74,18 @@ struct ScannerModel {
   bool HasVerticalFieldOfView() const { return vfov_min_deg > -90.0 || vfov_max_deg < 90.0; }
   bool HasIncidenceLimit() const { return max_incidence_deg < 90.0; }
   bool HasSpacingLimit() const { return max_spacing_m > 0.0; }
+  bool HasHorizontalFieldOfView() const { return hfov_deg < 360.0; }
 };
+
+// A viewpoint's heading: the azimuth of the centre of the scanner's horizontal field of view, in
+// degrees counter-clockwise from +x in the scene's frame; none = no azimuth limit.
+using Heading = std::optional<double>;
+
+// INVALID_ARGUMENT naming the viewpoint (1-based, as "viewpoint 3") when `headings_deg` is neither
+// empty (no viewpoint has a heading) nor one per viewpoint, a heading is not finite, or `scanner`
+// has hfov_deg < 360 and a viewpoint has no heading.
+[[nodiscard]] Status CheckViewpointHeadings(const ScannerModel& scanner, size_t viewpoints,
+                                            const std::vector<Heading>& headings_deg);
 
 // Faces of a voxel, by outward normal.
 enum class Face : uint8_t { kNegX = 0, kPosX, kNegY, kPosY, kNegZ, kPosZ };
@@ -81,7 +96,8 @@ enum class Perception : uint8_t { kNone = 0, kPartial, kFull };
 // --- Single queries (grid index space for voxels, world frame for viewpoints) ---
 
 // s.3. False if o is inside an occupied voxel. With a scanner: also false unless v's centre passes
-// its limits (incidence and spacing judged on the face the ray enters v through).
+// its limits (incidence and spacing judged on the face the ray enters v through). A single query
+// has no heading, so its scanner's hfov_deg is not applied.
 bool IsCompatible(const OccupancyGrid& grid, const WorldPoint& o, const VoxelIndex& v);
 bool IsCompatible(const OccupancyGrid& grid, const WorldPoint& o, const VoxelIndex& v, const ScannerModel& scanner);
 // s.3b. False if o is inside an occupied voxel. With a scanner: only faces that pass its limits
@@ -121,6 +137,9 @@ struct VisibilitySetsOptions {
   // None: no limit at all, not even the range (the paper's tests, as the planner used them
   // before the scanner model; the planner always passes its scanner).
   std::optional<ScannerModel> scanner;
+  // Per viewpoint, its heading (CheckViewpointHeadings); empty = none has one. Needed for every
+  // viewpoint when the scanner's hfov_deg < 360 (INVALID_ARGUMENT otherwise).
+  std::vector<Heading> headings_deg;
   // Sparse sets (voxel_set.h): each set is kept as a Roaring bitmap when that is at least this
   // many times smaller than its dense words; 0 = every set dense. With it the viewpoints are
   // computed in batches whose dense sets take at most batch_bytes, each compacted before the next.
@@ -131,7 +150,8 @@ struct VisibilitySetsOptions {
 };
 
 // For each viewpoint, the occupied voxels that pass the selection test. Viewpoints inside an
-// occupied voxel get an empty set. CANCELLED / DEADLINE_EXCEEDED from ctx.
+// occupied voxel get an empty set. INVALID_ARGUMENT from CheckViewpointHeadings (with a scanner);
+// CANCELLED / DEADLINE_EXCEEDED from ctx.
 Result<std::vector<VoxelSet>> ComputeVisibilitySets(const VoxelScene& scene, const std::vector<WorldPoint>& viewpoints,
                                                     const VisibilitySetsOptions& options, const JobContext& ctx = {});
 
@@ -156,6 +176,8 @@ enum class FaceSet {
 
 struct EvaluateOptions {
   ScannerModel scanner;
+  // Per viewpoint, its heading, as VisibilitySetsOptions::headings_deg.
+  std::vector<Heading> headings_deg;
   FaceSet faces = FaceSet::kAll;
   int threads = 0;
   // 0 = exact (every face). Otherwise an unbiased uniform random sample of this many faces (with
@@ -214,7 +236,8 @@ struct Evaluation {
 };
 
 // Evaluates a set of viewpoints on `scene` (s.6): G of the whole set and figures per viewpoint.
-// INVALID_ARGUMENT for a non-finite or out-of-range viewpoint, a bad scanner range, or (exact
+// INVALID_ARGUMENT for a non-finite or out-of-range viewpoint, a bad scanner range, headings that
+// CheckViewpointHeadings refuses, or (exact
 // mode) a scene whose voxels are not sorted and unique as VoxelScene requires.
 Result<Evaluation> Evaluate(const VoxelScene& scene, const std::vector<WorldPoint>& viewpoints,
                             const EvaluateOptions& options, const JobContext& ctx = {});
