@@ -42,8 +42,9 @@ grpc::StatusCode ToGrpcCode(StatusCode code) {
   return grpc::StatusCode::UNKNOWN;
 }
 
-StatusCode FromGrpcCode(grpc::StatusCode code) {
-  switch (code) {
+StatusCode FromGrpcCode(int code) {
+  if (code < grpc::StatusCode::OK || code > grpc::StatusCode::UNAUTHENTICATED) return StatusCode::kUnknown;
+  switch (static_cast<grpc::StatusCode>(code)) {
     case grpc::StatusCode::OK:
       return StatusCode::kOk;
     case grpc::StatusCode::CANCELLED:

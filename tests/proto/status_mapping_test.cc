@@ -26,7 +26,7 @@ TEST(StatusMapping, EveryCodeKeepsItsCanonicalNumberAndName) {
   const int expected[] = {0, 1, 3, 4, 5, 8, 9, 11, 12, 13, 15, 2, 6, 7, 10, 14, 16};  // google.rpc.Code
   for (size_t i = 0; i < std::size(codes); ++i) {
     EXPECT_EQ(int(ToGrpcCode(codes[i])), expected[i]) << StatusCodeName(codes[i]);
-    EXPECT_EQ(FromGrpcCode(grpc::StatusCode(expected[i])), codes[i]) << StatusCodeName(codes[i]);
+    EXPECT_EQ(FromGrpcCode(expected[i]), codes[i]) << StatusCodeName(codes[i]);
   }
 }
 
@@ -45,7 +45,8 @@ TEST(StatusMapping, GrpcStatusComesBackWithItsCodeAndMessage) {
 }
 
 TEST(StatusMapping, NumberOutsideGoogleRpcCodeIsUnknown) {
-  EXPECT_EQ(FromGrpcCode(grpc::StatusCode(99)), StatusCode::kUnknown);
+  EXPECT_EQ(FromGrpcCode(99), StatusCode::kUnknown);
+  EXPECT_EQ(FromGrpcCode(-1), StatusCode::kUnknown);
 }
 
 }  // namespace

@@ -13,8 +13,10 @@ namespace vc::wire {
 
 // The gRPC code with the same meaning as `code` (google.rpc.Code numbering).
 grpc::StatusCode ToGrpcCode(StatusCode code);
-// The vc code with the same meaning as `code`; kUnknown for a number outside google.rpc.Code.
-StatusCode FromGrpcCode(grpc::StatusCode code);
+// The vc code with the same meaning as the gRPC code numbered `code`; kUnknown for a number outside
+// google.rpc.Code (an int, not a grpc::StatusCode: 99 is no value of that enum, and making one is
+// undefined behaviour, which clang's UBSan reports).
+StatusCode FromGrpcCode(int code);
 
 // Same code, same message.
 grpc::Status ToGrpcStatus(const Status& status);
