@@ -118,12 +118,12 @@ std::vector<Eigen::Vector3f> PlacePoints(const SceneInput& input, const Eigen::V
   return out;
 }
 
-// The common local frame of scans whose points are in their scanners' frames: the first position's
-// whole kilometres per axis (the readers' rule, docs/PLANNING.md "Coordinates"), so posed points of
-// a georeferenced site stay small enough for floats.
+// The common local frame of scans whose points are in their scanners' frames: the readers' rule
+// (FrameOriginNear) applied to the first position, so posed points of a georeferenced site stay
+// small enough for floats.
 Eigen::Vector3d ScannerFrameOrigin(const std::vector<KnownStation>& positions) {
   if (positions.empty()) return Eigen::Vector3d::Zero();
-  return (positions.front().position_m / 1000.0).array().round() * 1000.0;
+  return FrameOriginNear(positions.front().position_m);
 }
 
 Result<std::vector<KnownStation>> ReadPositions(const ValidateInputs& inputs, size_t point_files) {

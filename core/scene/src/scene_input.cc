@@ -6,6 +6,7 @@
 #include "vc/scene/scene_input.h"
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -166,6 +167,10 @@ std::string_view CompressionName(Compression c) {
       return "bzip2";
   }
   return "unknown";
+}
+
+Eigen::Vector3d FrameOriginNear(const Eigen::Vector3d& point_m) {
+  return point_m.unaryExpr([](double c) { return 1000.0 * std::round(c / 1000.0); });
 }
 
 Result<double> MetresPerUnit(std::string_view unit_name) {

@@ -408,6 +408,11 @@ TEST(SceneInputRealDataTest, Geb079Octree) {
   EXPECT_EQ(CountOccupiedLeaves(*r->octree), 143'729u);
 }
 
+TEST(FrameOriginNearTest, EachAxisToItsNearestWholeKilometre) {
+  EXPECT_EQ(FrameOriginNear({512345.678, 5612330.123, 312.5}), Eigen::Vector3d(512000, 5612000, 0));
+  EXPECT_EQ(FrameOriginNear({-0.04, 499.9, -1500.1}), Eigen::Vector3d(0, 0, -2000));
+}
+
 TEST(MetresPerUnitTest, EachNamedUnitAndARefusal) {
   EXPECT_EQ(*MetresPerUnit("m"), 1.0);
   EXPECT_EQ(*MetresPerUnit("cm"), 0.01);

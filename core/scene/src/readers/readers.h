@@ -39,7 +39,7 @@ class LocalFrame {
     const Eigen::Vector3d m(x * metres_per_unit_, y * metres_per_unit_, z * metres_per_unit_);
     if (!origin_fixed_) {
       if (!m.cast<float>().allFinite()) return std::nullopt;
-      origin_m_ = m.unaryExpr([](double c) { return 1000.0 * std::round(c / 1000.0); });
+      origin_m_ = FrameOriginNear(m);
       origin_fixed_ = true;
     }
     const Eigen::Vector3f local = (m - origin_m_).cast<float>();

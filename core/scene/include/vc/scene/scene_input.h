@@ -68,6 +68,11 @@ struct ReadOptions {
   double metres_per_unit = 1.0;
 };
 
+// The local frame's origin for data whose first finite point is `point_m` (metres, the input's
+// frame): per axis the nearest whole number of kilometres (docs/PLANNING.md, "Coordinates"). The
+// readers' rule, and the one to use for any other data that needs a frame of its own.
+Eigen::Vector3d FrameOriginNear(const Eigen::Vector3d& point_m);
+
 // Metres per unit, by the unit's name: "m" 1, "cm" 0.01, "mm" 0.001, "ft" 0.3048 (international
 // foot), "us-ft" 1200/3937 (US survey foot). INVALID_ARGUMENT naming the accepted names otherwise.
 Result<double> MetresPerUnit(std::string_view unit_name);
