@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # Builds the libFuzzer targets (the `fuzz` preset: clang++, ASan + UBSan, no tests; or the `asan`
-# preset, which builds the same targets beside its tests) and runs each in turn, one process at a
-# time, from the checked-in seeds plus slices of ../shared/data.
-# Usage: scripts/fuzz.sh [--seconds N] [--only TARGET] [--preset fuzz|asan]
+# preset, which builds the same targets beside its tests) and runs them, --jobs targets at a time
+# (default: one per core; each target is one process), from the checked-in seeds plus slices of
+# ../shared/data.
+# Usage: scripts/fuzz.sh [--seconds N] [--only TARGET] [--preset fuzz|asan] [--jobs N]
 #        (default 180 s per target and the fuzz preset; CI: --seconds 10 --preset asan, whose build
 #        scripts/test.sh has just made, so the core is not compiled a third time)
 # Findings (crash-*, leak-*, timeout-*, oom-*) land in build/<preset>/findings/<target>/; the script
@@ -13,12 +14,14 @@ cd "$(dirname "$0")/.."
 seconds=180
 only=""
 preset=fuzz
+jobs=$(nproc)
 while (($#)); do
   case "$1" in
     --seconds) seconds="$2"; shift 2 ;;
     --only) only="$2"; shift 2 ;;
     --preset) preset="$2"; shift 2 ;;
-    *) echo "usage: scripts/fuzz.sh [--seconds N] [--only TARGET] [--preset fuzz|asan]" >&2; exit 2 ;;
+    --jobs) jobs="$2"; shift 2 ;;
+    *) echo "usage: scripts/fuzz.sh [--seconds N] [--only TARGET] [--preset fuzz|asan] [--jobs N]" >&2; exit 2 ;;
   esac
 done
 
@@ -60,22 +63,39 @@ slice_for() {  # the slices that suit a target
   esac 2>/dev/null || true
 }
 
-failed=0
-for t in "${targets[@]}"; do
-  corpus="$work/$t"
-  findings="$build/findings/$t"
+# fuzz_one TARGET: runs one target; its summary goes to $build/TARGET.summary, and it exits
+# non-zero on a finding.
+fuzz_one() {
+  local t="$1" corpus="$work/$1" findings="$build/findings/$1" rc=0
   mkdir -p "$corpus" "$findings"
   cp -n fuzz/corpus/"$t"/* "$corpus"/ 2>/dev/null || true
   for s in $(slice_for "$t"); do cp -n "$s" "$corpus"/; done
-  echo "== $t: ${seconds}s"
   # -malloc_limit_mb: the targets read with 1 MiB decompressed / 32 MiB result limits
   # (fuzz/fuzz_options.h); any single allocation above 256 MiB is a missing bound.
-  if ! "$build/fuzz/$t" "$corpus" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 \
-      -malloc_limit_mb=256 -max_len=65536 -artifact_prefix="$findings/" -print_final_stats=1 \
-      2>"$build/$t.log"; then
-    failed=1
-    echo "   FOUND: $(ls "$findings")"
-  fi
-  grep -E "^stat::number_of_executed_units|^#[0-9]+.*DONE" "$build/$t.log" | tail -2 | sed 's/^/   /'
+  "$build/fuzz/$t" "$corpus" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 \
+    -malloc_limit_mb=256 -max_len=65536 -artifact_prefix="$findings/" -print_final_stats=1 \
+    2>"$build/$t.log" || rc=1
+  {
+    echo "== $t: ${seconds}s"
+    if ((rc)); then echo "   FOUND: $(ls "$findings")"; fi
+    grep -E "^stat::number_of_executed_units|^#[0-9]+.*DONE" "$build/$t.log" | tail -2 | sed 's/^/   /'
+  } >"$build/$t.summary"
+  return "$rc"
+}
+
+# Up to $jobs targets at once; each summary is printed when its target ends.
+failed=0
+running=()
+finish_one() {  # waits for the oldest running target and prints its summary
+  local pid="${running[0]%%:*}" t="${running[0]#*:}"
+  wait "$pid" || failed=1
+  cat "$build/$t.summary"
+  running=("${running[@]:1}")
+}
+for t in "${targets[@]}"; do
+  while ((${#running[@]} >= jobs)); do finish_one; done
+  fuzz_one "$t" &
+  running+=("$!:$t")
 done
+while ((${#running[@]})); do finish_one; done
 exit "$failed"

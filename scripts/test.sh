@@ -1,16 +1,18 @@
 #!/usr/bin/env bash
 # Runs every test. Installs the dependencies, checks the layering, the code's health (functions at
 # most 150 lines, every path named exists, every public header tested) and the formatting, then:
-#   release  - build everything, run every test (including the `slow` ones) and vc-bench --quick
+#   release  - the binaries and the slow tests: the tests of the real binaries (labels smoke and
+#              slow: vc-server and vc-client end to end, the paper experiment) and vc-bench --quick
 #   asan     - AddressSanitizer + UndefinedBehaviorSanitizer (clang++): every test except the `slow`
-#              label; the same build holds the libFuzzer targets
-#   fuzz     - every libFuzzer target (fuzz/, from the asan build) for 10 s each
+#              label (every unit test runs here, once); the same build holds the libFuzzer targets
+#   fuzz     - every libFuzzer target (fuzz/, from the asan build) for 10 s each, two at a time
 #   tsan     - ThreadSanitizer on the tests whose concurrency is all ours (label `tsan`): the worker
 #              pool, upload assembler, outbox, job runner, shard board, status mapping, wire code,
 #              ParallelChunks and the multi-threaded visibility engine. The gRPC
 #              service tests are not run here: Debian's gRPC, absl and protobuf are not instrumented,
 #              so tsan cannot see the ordering gRPC provides between its threads (README, Testing).
-# Usage: scripts/test.sh [--quick]   (--quick: the release preset only)
+# Usage: scripts/test.sh [--quick]   (--quick: the release preset only, building and running every
+#                                     test, the `slow` ones included)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh --tests
@@ -38,17 +40,26 @@ for p in "${presets[@]}"; do
     fuzz)
       # Every libFuzzer target for 10 s from its seeds, built by the asan stage (scripts/fuzz.sh;
       # long runs: docs/RELIABILITY.md).
-      bash scripts/fuzz.sh --preset asan --seconds 10
+      bash scripts/fuzz.sh --preset asan --seconds 10 --jobs 2
       ;;
     asan)
       cmake --build --preset "$p"
       echo "=== preset $p: tests (except label slow)"
       ctest --preset "$p" -j2 -LE slow
       ;;
-    *)
-      cmake --build --preset "$p"
-      echo "=== preset $p: tests"
-      ctest --preset "$p" -j2
+    release)
+      if ((${#presets[@]} > 1)); then
+        # The unit tests run once, under asan (below). The release build makes what only it can
+        # test: the shipped binaries end to end (labels smoke and slow), the slow experiments, and
+        # the benchmarks.
+        cmake --build --preset "$p" --target vc-server vc-client vc-synth vc-bench paper_result_test
+        echo "=== preset $p: the tests of the binaries and the slow ones (labels smoke, slow)"
+        ctest --preset "$p" -j2 -L 'smoke|slow'
+      else
+        cmake --build --preset "$p"
+        echo "=== preset $p: tests"
+        ctest --preset "$p" -j2
+      fi
       echo "=== preset $p: vc-bench --quick, and --visibility-only (figures only, no timing assertions)"
       "build/$p/bench/vc-bench" --quick
       "build/$p/bench/vc-bench" --quick --visibility-only --repeat 1
