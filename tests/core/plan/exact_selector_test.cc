@@ -450,7 +450,7 @@ TEST(ExactSelectorTest, OverTheMemoryBudgetFallsBackToSwapLocalSearch) {
       EXPECT_EQ(got->optimality.status, OptimalityStatus::kFeasible);
       EXPECT_GT(got->optimality.lower_bound, 0);
       EXPECT_LE(got->optimality.lower_bound, static_cast<double>(got->picks.size()));
-      // No integer program, but the counting bound: valid (at most the optimum the ILP proves; on a
+      // No integer program, but the Lagrangian bound: valid (at most the optimum the ILP proves; on a
       // few instances, the ILP being slow under the sanitizers).
       if (fallbacks <= 4) {
         ExactSelectorOptions within = o;
