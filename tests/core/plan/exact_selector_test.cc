@@ -500,6 +500,10 @@ TEST(ExactSelectorTest, OverTheMemoryBudgetTheBoundIsLagrangian) {
   ASSERT_TRUE(got.ok()) << got.status().ToString();
   EXPECT_EQ(got->optimality.solver, "greedy");
   EXPECT_NE(got->optimality.note.find("Lagrangian"), std::string::npos) << got->optimality.note;
+  // Refused on the size probed before the reduction: 10 room-side classes and the hall, at least.
+  EXPECT_NE(got->optimality.note.find("at least"), std::string::npos) << got->optimality.note;
+  EXPECT_EQ(got->optimality.model.candidates, rooms + 1);
+  EXPECT_EQ(got->optimality.model.voxel_classes, 2 * rooms + 1);
   EXPECT_EQ(got->optimality.status, OptimalityStatus::kFeasible);
   const Best want = Exhaustive(sets, 0, Target(0.95, got->coverable), 0);
   EXPECT_EQ(want.stations, 6);
