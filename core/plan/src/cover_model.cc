@@ -67,8 +67,12 @@ uint64_t CoverModel::ClassNonZeros() const {
   return nnz;
 }
 
+uint64_t CoverModel::EstimatedBytes(uint64_t class_nonzeros, uint64_t rows, uint64_t columns) {
+  return class_nonzeros * 200 + (rows + columns) * 1000;
+}
+
 uint64_t CoverModel::EstimatedBytes() const {
-  return ClassNonZeros() * 200 + uint64_t(n_rows_ + station_cols_.count + cover_cols_.count) * 1000;
+  return EstimatedBytes(ClassNonZeros(), n_rows_, station_cols_.count + cover_cols_.count);
 }
 
 void CoverModel::AppendStationColumns(Columns& cols) const {

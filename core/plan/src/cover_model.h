@@ -99,6 +99,8 @@ class CoverModel {
   // The memory CBC would take for this model, in bytes (row and column copies, the LP
   // factorisation and cuts; an estimate from the non-zeros, rows and columns).
   uint64_t EstimatedBytes() const;
+  // The same estimate from the model's class non-zeros (the weight row's included), rows and columns.
+  static uint64_t EstimatedBytes(uint64_t class_nonzeros, uint64_t rows, uint64_t columns);
   // Loads the matrix, bounds and objective into `solver` and marks the x and r columns integer.
   void LoadInto(OsiClpSolverInterface& solver) const;
   // `picks` (candidate indices < n_candidates) as a solution: each dropped candidate replaced by

@@ -19,12 +19,14 @@
 #include <cmath>
 #include <cstdio>
 #include <map>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "cover_model.h"
 #include "vc/plan/greedy.h"
+#include "vc/plan/lagrangian_bound.h"
 #include "vc/plan/scan_graph.h"
 
 namespace vc::planner {
@@ -250,6 +252,111 @@ double CountingBound(const ReducedModel& m, uint64_t need) {
   }
   const uint64_t widest = std::max<uint64_t>(1, width.empty() ? 1 : *std::max_element(width.begin(), width.end()));
   return std::ceil(double(need) / double(widest) - 1e-9);
+}
+
+// What one pass over the candidates' voxels tells before any class is built: per voxel, how many
+// candidates see it and a hash of which. Voxels of one class hash alike (a collision only merges two
+// classes), so the distinct (hash, views) pairs count the classes and their non-zeros from below.
+// Voxels a fixed station sees are left out (`skip_fixed`: they are forced and leave the model).
+struct SizeProbe {
+  std::vector<uint32_t> views;  // per voxel: candidates that see it (0: outside the model)
+  uint64_t classes = 0;         // voxel classes of the model before the reduction, at least
+  uint64_t nonzeros = 0;        // their (class, candidate) pairs, at least
+  uint64_t voxels = 0;          // coverable voxels outside the fixed stations' sets
+  int first_column = 0;         // candidates before it are fixed stations outside the model
+};
+
+Result<SizeProbe> ProbeSize(const std::vector<VoxelSet>& sets, int fixed, bool skip_fixed, const JobContext& ctx) {
+  SizeProbe probe;
+  const size_t n_voxels = sets.empty() ? 0 : sets[0].size();
+  probe.first_column = skip_fixed ? fixed : 0;
+  probe.views.assign(n_voxels, 0);
+  std::vector<uint64_t> hash(n_voxels, 0);
+  std::vector<char> fixed_sees(skip_fixed ? n_voxels : 0, 0);
+  for (int c = 0; c < probe.first_column; ++c) sets[c].ForEach([&](size_t v) { fixed_sees[v] = 1; });
+  uint64_t key = 0x9e3779b97f4a7c15ull;
+  for (size_t c = probe.first_column; c < sets.size(); ++c) {
+    if (c % 64 == 0) VC_RETURN_IF_ERROR(ctx.CheckCancelled("exact selection (model size)"));
+    key = key * 6364136223846793005ull + 1442695040888963407ull;  // one odd key per candidate
+    const uint64_t k = key | 1;
+    sets[c].ForEach([&](size_t v) {
+      ++probe.views[v];
+      hash[v] += k;
+    });
+  }
+  std::vector<std::pair<uint64_t, uint32_t>> signatures;
+  for (size_t v = 0; v < n_voxels; ++v) {
+    if (!fixed_sees.empty() && fixed_sees[v]) probe.views[v] = 0;
+    if (probe.views[v] > 0) signatures.emplace_back(hash[v], probe.views[v]);
+  }
+  probe.voxels = signatures.size();
+  std::sort(signatures.begin(), signatures.end());
+  for (size_t i = 0; i < signatures.size(); ++i) {
+    if (i > 0 && signatures[i] == signatures[i - 1]) continue;
+    ++probe.classes;
+    probe.nonzeros += signatures[i].second;
+  }
+  return probe;
+}
+
+// A relaxation of the station problem small enough to bound in about a second: the voxels seen by
+// the fewest candidates (ascending views, then index) up to max_pairs (voxel, candidate) pairs,
+// grouped into classes, with every other voxel of the model counted as covered for free (need
+// shrinks by their number). Every plan of the full problem is a plan of this one, so a lower
+// bound of this one holds for it. Columns are the candidates from probe.first_column on.
+Result<CoverProblem> RareVoxelProblem(const std::vector<VoxelSet>& sets, const SizeProbe& probe, uint64_t need,
+                                      uint64_t max_pairs, const JobContext& ctx) {
+  CoverProblem p;
+  p.columns = static_cast<int>(sets.size()) - probe.first_column;
+  std::vector<uint32_t> order;
+  for (size_t v = 0; v < probe.views.size(); ++v) {
+    if (probe.views[v] > 0) order.push_back(static_cast<uint32_t>(v));
+  }
+  std::sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) {
+    return probe.views[a] != probe.views[b] ? probe.views[a] < probe.views[b] : a < b;
+  });
+  std::vector<int32_t> slot(probe.views.size(), -1);
+  uint64_t pairs = 0;
+  size_t kept = 0;
+  for (; kept < order.size() && pairs + probe.views[order[kept]] <= max_pairs; ++kept) {
+    pairs += probe.views[order[kept]];
+    slot[order[kept]] = static_cast<int32_t>(kept);
+  }
+  const uint64_t free_voxels = probe.voxels - kept;
+  if (need <= free_voxels) return p;  // nothing left to need: no bound beyond 0
+  p.need = need - free_voxels;
+  std::vector<std::vector<int>> lists(kept);
+  for (size_t c = probe.first_column; c < sets.size(); ++c) {
+    if (c % 64 == 0) VC_RETURN_IF_ERROR(ctx.CheckCancelled("exact selection (bound)"));
+    const int column = static_cast<int>(c) - probe.first_column;
+    sets[c].ForEach([&](size_t v) {
+      if (slot[v] >= 0) lists[slot[v]].push_back(column);
+    });
+  }
+  std::map<std::vector<int>, int> index;
+  for (std::vector<int>& cols : lists) {
+    auto [it, inserted] = index.emplace(std::move(cols), static_cast<int>(p.weight.size()));
+    if (inserted) {
+      p.weight.push_back(1);
+      p.seen_by.push_back(it->first);
+    } else {
+      ++p.weight[it->second];
+    }
+  }
+  return p;
+}
+
+// The Lagrangian bound's options in a plan: at most kBoundPairVisits pairs visited (about a second).
+constexpr uint64_t kBoundPairVisits = uint64_t{1} << 29;
+constexpr uint64_t kRareVoxelPairs = uint64_t{1} << 20;
+
+// The Lagrangian bound on the columns over the reduced model's classes.
+Result<int> ModelLagrangianBound(const ReducedModel& m, uint64_t need, int upper_bound, const JobContext& ctx) {
+  const CoverProblem p{m.weight, m.seen_by, static_cast<int>(m.columns.size()), need};
+  VC_ASSIGN_OR_RETURN(
+      LagrangianBound b,
+      ComputeLagrangianBound(p, {.upper_bound = upper_bound, .max_pair_visits = kBoundPairVisits}, ctx));
+  return b.bound;
 }
 
 // Voxels covered by the union of `picks`.
@@ -615,11 +722,12 @@ class ExactRun {
 
  private:
   Selection FinishForced(const ReducedModel& m, uint64_t need);
-  Result<Selection> SelectOverBudget(const Classes& cl, const ReducedModel& m, uint64_t need, uint64_t estimate);
+  Result<Selection> SelectOverBudget(const Classes* cl, const ReducedModel* m, uint64_t need, uint64_t estimate);
   Result<Selection> Read(const CoverModel& model, const CbcOutcome& outcome);
   void SetCoveredBound(const CoverModel& model, const CbcOutcome& outcome, bool proven, const std::vector<int>& picks);
   void SetStationBound(const CoverModel& model, const CbcOutcome& outcome, bool proven, size_t stations);
-  void SetCountingBound(const ReducedModel& m, uint64_t need);
+  Status SetRelaxedBound(const ReducedModel* m, uint64_t need, bool model_fits);
+  Result<int> RareVoxelBound();
   bool AtLeastAsGoodAsGreedy(const std::vector<int>& picks) const;
   bool StrictlyBetterThanGreedy(const std::vector<int>& picks) const;
   Selection Finish(std::vector<int> picks);
@@ -637,7 +745,8 @@ class ExactRun {
   const uint64_t greedy_covered_;
   const uint64_t greedy_pass_covered_;
   const StopReason greedy_stop_;
-  bool greedy_connected_ = true;  // set once the flow model has checked greedy's plan
+  bool greedy_connected_ = true;    // set once the flow model has checked greedy's plan
+  std::optional<SizeProbe> probe_;  // the model's size before the reduction, once probed
   Selection out_;
 };
 
@@ -665,8 +774,20 @@ ExactRun::ExactRun(const ExactSelectorOptions& options, const std::vector<VoxelS
 Result<Selection> ExactRun::Select() {
   const int n = static_cast<int>(sets_.size());
   Optimality& opt = out_.optimality;
-  VC_ASSIGN_OR_RETURN(Classes cl, BuildClasses(sets_, ctx_));
   const bool full = !max_mode_ && target_ == out_.coverable;
+  if (!full) {
+    // Below target coverage nothing but domination shrinks the model: its size before the reduction,
+    // from one pass over the sets, decides whether the classes are worth building at all.
+    VC_ASSIGN_OR_RETURN(probe_, ProbeSize(sets_, fixed_, !connect_, ctx_));
+    const uint64_t classes = probe_->classes;
+    const uint64_t at_least = CoverModel::EstimatedBytes(probe_->nonzeros + 2 * classes, classes + 1, classes);
+    const uint64_t fixed_cover = out_.coverable - probe_->voxels;
+    if (at_least > options_.memory_budget_bytes && target_ > fixed_cover) {
+      opt.model = {n - probe_->first_column, static_cast<int>(classes), static_cast<int>(classes) + 1};
+      return SelectOverBudget(nullptr, nullptr, target_ - fixed_cover, at_least);
+    }
+  }
+  VC_ASSIGN_OR_RETURN(Classes cl, BuildClasses(sets_, ctx_));
   VC_ASSIGN_OR_RETURN(ReducedModel m, Reduce(cl, n, fixed_, full && !connect_, connect_, ctx_));
   opt.forced = m.forced_sole_view;
   opt.dominated = m.dominated;
@@ -686,7 +807,7 @@ Result<Selection> ExactRun::Select() {
   // Nothing left to decide: the forced candidates reach the target (or there are no columns).
   if (model.station_cols().count == 0 || (!max_mode_ && need == 0)) return FinishForced(m, need);
   const uint64_t estimate = model.EstimatedBytes();
-  if (estimate > options_.memory_budget_bytes) return SelectOverBudget(cl, m, need, estimate);
+  if (estimate > options_.memory_budget_bytes) return SelectOverBudget(&cl, &m, need, estimate);
   VC_ASSIGN_OR_RETURN(CbcOutcome outcome, SolveWithCbc(model, greedy_picks_, n, start_, options_.time_limit_s, ctx_));
   return Read(model, outcome);
 }
@@ -702,37 +823,77 @@ Selection ExactRun::FinishForced(const ReducedModel& m, uint64_t need) {
 }
 
 // Over the budget no integer program is built: greedy's plan, or greedy plus the swap local search.
-Result<Selection> ExactRun::SelectOverBudget(const Classes& cl, const ReducedModel& m, uint64_t need,
+// Without `m` the model was refused before the reduction (`cl` is built here when the swaps need it).
+Result<Selection> ExactRun::SelectOverBudget(const Classes* cl, const ReducedModel* m, uint64_t need,
                                              uint64_t estimate) {
   Optimality& opt = out_.optimality;
-  const std::string too_large = "the integer program (about " + std::to_string(estimate >> 20) +
-                                " MiB) exceeds the memory budget (" +
+  const std::string too_large = "the integer program (" + std::string(m == nullptr ? "at least " : "") + "about " +
+                                std::to_string(estimate >> 20) + " MiB) exceeds the memory budget (" +
                                 std::to_string(options_.memory_budget_bytes >> 20) + " MiB); ";
+  const std::string bound_note = max_mode_ ? "" : ", with the Lagrangian bound";
   if (!options_.swap_search) {
     opt.solver = "greedy";
     opt.status = OptimalityStatus::kHeuristic;
-    opt.note = too_large + "greedy plan, with the counting bound";
-    SetCountingBound(m, need);
+    opt.note = too_large + "greedy plan" + bound_note;
+    VC_RETURN_IF_ERROR(SetRelaxedBound(m, need, false));
     return Finish(greedy_picks_);
+  }
+  std::optional<Classes> built;
+  if (cl == nullptr) {
+    VC_ASSIGN_OR_RETURN(built, BuildClasses(sets_, ctx_));
+    cl = &*built;
   }
   const Clock::time_point deadline =
       start_ + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(options_.time_limit_s));
-  VC_ASSIGN_OR_RETURN(std::vector<int> picks, SwapLocalSearch(cl, greedy_picks_, fixed_, static_cast<int>(sets_.size()),
-                                                              target_, max_mode_, deadline, ctx_));
+  VC_ASSIGN_OR_RETURN(
+      std::vector<int> picks,
+      SwapLocalSearch(*cl, greedy_picks_, fixed_, static_cast<int>(sets_.size()), target_, max_mode_, deadline, ctx_));
   opt.solver = "greedy+swap";
   opt.status = OptimalityStatus::kHeuristic;
-  opt.note = too_large + "greedy plus swap local search instead, with the counting bound";
-  SetCountingBound(m, need);
+  opt.note = too_large + "greedy plus swap local search instead" + bound_note;
+  VC_RETURN_IF_ERROR(SetRelaxedBound(m, need, false));
   return Finish(std::move(picks));
 }
 
-// At a station-count target the counting bound (the forced candidates plus what the widest
-// candidate would need) still says how far off the plan can be, at no cost.
-void ExactRun::SetCountingBound(const ReducedModel& m, uint64_t need) {
-  if (max_mode_) return;
+// Where no LP bound is at hand (over the budget, or the LP cut off), the best of the counting bound
+// (the forced candidates plus what the widest candidate would need; over the reduced model, when
+// built) and the Lagrangian bound: over the reduced classes when the model fits, else over the
+// rarest voxels (RareVoxelProblem). Nothing with max_stations (the objective is coverage).
+Status ExactRun::SetRelaxedBound(const ReducedModel* m, uint64_t need, bool model_fits) {
+  if (max_mode_) return Status::Ok();
   Optimality& opt = out_.optimality;
-  opt.lower_bound = static_cast<double>(m.forced.size()) + CountingBound(m, need);
+  const int upper_bound = static_cast<int>(greedy_picks_.size());
+  int bound = 0;
+  if (m != nullptr) {
+    const int forced = static_cast<int>(m->forced.size());
+    bound = forced + static_cast<int>(CountingBound(*m, need));
+    if (model_fits) {
+      VC_ASSIGN_OR_RETURN(int columns, ModelLagrangianBound(*m, need, std::max(1, upper_bound - forced), ctx_));
+      bound = std::max(bound, forced + columns);
+    }
+  }
+  if (m == nullptr || !model_fits) {
+    VC_ASSIGN_OR_RETURN(int rare, RareVoxelBound());
+    bound = std::max(bound, rare);
+  }
+  opt.lower_bound = bound;
   if (opt.lower_bound > 0) opt.status = OptimalityStatus::kFeasible;
+  return Status::Ok();
+}
+
+// The fixed stations outside the model plus the Lagrangian bound of RareVoxelProblem.
+Result<int> ExactRun::RareVoxelBound() {
+  if (!probe_) {
+    VC_ASSIGN_OR_RETURN(probe_, ProbeSize(sets_, fixed_, !connect_, ctx_));
+  }
+  const uint64_t fixed_cover = out_.coverable - probe_->voxels;
+  const uint64_t need = target_ - std::min(target_, fixed_cover);
+  VC_ASSIGN_OR_RETURN(CoverProblem p, RareVoxelProblem(sets_, *probe_, need, kRareVoxelPairs, ctx_));
+  const int upper_bound = std::max(1, static_cast<int>(greedy_picks_.size()) - probe_->first_column);
+  VC_ASSIGN_OR_RETURN(
+      LagrangianBound b,
+      ComputeLagrangianBound(p, {.upper_bound = upper_bound, .max_pair_visits = kBoundPairVisits}, ctx_));
+  return probe_->first_column + b.bound;
 }
 
 Result<Selection> ExactRun::Read(const CoverModel& model, const CbcOutcome& outcome) {
@@ -741,8 +902,8 @@ Result<Selection> ExactRun::Read(const CoverModel& model, const CbcOutcome& outc
   Optimality& opt = out_.optimality;
   if (outcome.root_lp_stopped) {
     opt.status = OptimalityStatus::kFeasible;
-    opt.lower_bound = static_cast<double>(m.forced.size()) + CountingBound(m, need);
-    opt.note = "the time limit cut off the LP relaxation; the bound is the counting bound";
+    VC_RETURN_IF_ERROR(SetRelaxedBound(&m, need, true));
+    opt.note = "the time limit cut off the LP relaxation; the bound is the Lagrangian or counting bound";
     return Finish(greedy_picks_);
   }
   greedy_connected_ = outcome.warm_connected;

@@ -371,7 +371,7 @@ TEST(ExactSelectorTest, TimeLimitReturnsAFeasiblePlanWithItsBound) {
 }
 
 // CBC checks its time limit only between nodes: the LP relaxation of a large partial-coverage model
-// is cut off at the deadline too, and the counting bound stands in for the LP's.
+// is cut off at the deadline too, and the Lagrangian bound over the reduced classes stands in for the LP's.
 TEST(ExactSelectorTest, TimeLimitCutsOffALongRootLp) {
   std::mt19937 rng(3);
   const std::vector<VoxelSet> sets = RandomSets(rng, 120, 40000, 0.03);
@@ -450,7 +450,7 @@ TEST(ExactSelectorTest, OverTheMemoryBudgetFallsBackToSwapLocalSearch) {
       EXPECT_EQ(got->optimality.status, OptimalityStatus::kFeasible);
       EXPECT_GT(got->optimality.lower_bound, 0);
       EXPECT_LE(got->optimality.lower_bound, static_cast<double>(got->picks.size()));
-      // No integer program, but the counting bound: valid (at most the optimum the ILP proves; on a
+      // No integer program, but the Lagrangian bound: valid (at most the optimum the ILP proves; on a
       // few instances, the ILP being slow under the sanitizers).
       if (fallbacks <= 4) {
         ExactSelectorOptions within = o;
@@ -472,6 +472,42 @@ TEST(ExactSelectorTest, OverTheMemoryBudgetFallsBackToSwapLocalSearch) {
   }
   EXPECT_GT(fallbacks, 10);
   EXPECT_GT(improved, 0) << "the swaps never saved a station over unconsolidated greedy";
+}
+
+// Rooms around a hall: one wide candidate sees the hall and every room's doorway side, each room's
+// own candidate its doorway and far side. Over the budget the model is refused before any class is
+// built, and the bound is the Lagrangian one (the LP's: the wide one and 5 rooms), not the counting
+// bound (2: the wide candidate's weight into the target).
+TEST(ExactSelectorTest, OverTheMemoryBudgetTheBoundIsLagrangian) {
+  const int rooms = 10;
+  const size_t hall = 5000, doorway = 40, far = 60;
+  std::vector<VoxelSet> sets(rooms + 1, VoxelSet(hall + rooms * (doorway + far)));
+  for (size_t v = 0; v < hall; ++v) sets[rooms].set(v);
+  for (int r = 0; r < rooms; ++r) {
+    const size_t first = hall + r * (doorway + far);
+    for (size_t v = first; v < first + doorway; ++v) {
+      sets[r].set(v);
+      sets[rooms].set(v);
+    }
+    for (size_t v = first + doorway; v < first + doorway + far; ++v) sets[r].set(v);
+  }
+  ExactSelectorOptions o;
+  o.greedy.target_coverage = 0.95;  // 5700 of 6000 voxels: the wide one (5400) and 5 far sides (300)
+  o.memory_budget_bytes = 1;
+  o.swap_search = false;
+  o.prefer_greedy = true;
+  Result<Selection> got = ExactSelector(o).Select(sets, 0, {});
+  ASSERT_TRUE(got.ok()) << got.status().ToString();
+  EXPECT_EQ(got->optimality.solver, "greedy");
+  EXPECT_NE(got->optimality.note.find("Lagrangian"), std::string::npos) << got->optimality.note;
+  // Refused on the size probed before the reduction: 10 room-side classes and the hall, at least.
+  EXPECT_NE(got->optimality.note.find("at least"), std::string::npos) << got->optimality.note;
+  EXPECT_EQ(got->optimality.model.candidates, rooms + 1);
+  EXPECT_EQ(got->optimality.model.voxel_classes, 2 * rooms + 1);
+  EXPECT_EQ(got->optimality.status, OptimalityStatus::kFeasible);
+  const Best want = Exhaustive(sets, 0, Target(0.95, got->coverable), 0);
+  EXPECT_EQ(want.stations, 6);
+  EXPECT_EQ(got->optimality.lower_bound, want.stations);
 }
 
 TEST(ExactSelectorTest, RejectsBadArguments) {

@@ -23,8 +23,14 @@
 // limit the best plan found comes back with its bound (status kFeasible). If the model's
 // estimated memory exceeds memory_budget_bytes, no ILP is built: greedy plus a swap local search
 // (drop a pick, 2-for-1 and 1-for-1 exchanges that keep the covered weight) runs instead, with a
-// note saying so (or, without swap_search, the greedy plan itself); its bound is the counting
-// bound (status kFeasible), or none with max_stations (kHeuristic).
+// note saying so (or, without swap_search, the greedy plan itself). Below full coverage the size
+// is first estimated before any class is built, from one pass over the sets (a hash per voxel of
+// the candidates that see it: the distinct hashes count the classes and non-zeros from below; the
+// reduction's domination is not foreseen), so a model that will be refused costs no reduction.
+// Where no LP bound is at hand (over the budget; the root LP cut off) the bound is the best of the
+// counting bound and the Lagrangian bound (lagrangian_bound.h) over the reduced classes or, over
+// the budget, over the voxels seen by the fewest candidates with the rest counted as covered
+// (status kFeasible); none with max_stations (kHeuristic).
 //
 // With min_overlap > 0 (registration, scan_graph.h) the plan must be connected: a single-commodity
 // flow over the candidates' scan-graph arcs (Dehbi et al. 2021) from one root station, which every
