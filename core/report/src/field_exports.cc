@@ -208,8 +208,10 @@ struct DxfLayer {
   const char* name;
   int colour;  // AutoCAD colour index
 };
-constexpr DxfLayer kDxfLayers[] = {{"STATIONS", 1}, {"LABELS", 7}, {"ROUTE", 30}, {"KEEP_OUT", 5}};
+// Layer 0 (every drawing's own), then one per kind of entity.
+constexpr DxfLayer kDxfLayers[] = {{"0", 7}, {"STATIONS", 1}, {"LABELS", 7}, {"ROUTE", 30}, {"KEEP_OUT", 5}};
 
+// The tables the entities name: the CONTINUOUS line type, the layers and the labels' STANDARD text style.
 void DxfTables(DxfWriter& w) {
   w.Pair(0, "SECTION");
   w.Pair(2, "TABLES");
@@ -234,6 +236,20 @@ void DxfTables(DxfWriter& w) {
     w.Pair(62, l.colour);
     w.Pair(6, "CONTINUOUS");
   }
+  w.Pair(0, "ENDTAB");
+  w.Pair(0, "TABLE");
+  w.Pair(2, "STYLE");
+  w.Pair(70, 1);
+  w.Pair(0, "STYLE");
+  w.Pair(2, "STANDARD");
+  w.Pair(70, 0);
+  w.Pair(40, "0.0");  // no fixed height: each TEXT gives its own
+  w.Pair(41, "1.0");
+  w.Pair(50, "0.0");
+  w.Pair(71, 0);
+  w.Pair(42, "0.2");
+  w.Pair(3, "txt");
+  w.Pair(4, "");
   w.Pair(0, "ENDTAB");
   w.Pair(0, "ENDSEC");
 }

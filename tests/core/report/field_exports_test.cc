@@ -205,6 +205,7 @@ TEST(StationsDxfTest, EzdxfReadsTheLayersStationsRouteAndKeepOutZones) {
   for (const char* layer : {"STATIONS", "LABELS", "ROUTE", "KEEP_OUT"}) {
     EXPECT_NE(std::find(d["layers"].begin(), d["layers"].end(), layer), d["layers"].end()) << layer;
   }
+  EXPECT_NE(std::find(d["styles"].begin(), d["styles"].end(), "STANDARD"), d["styles"].end()) << d["styles"].dump();
   EXPECT_FALSE(d.contains("other")) << d["other"].dump();
   ASSERT_EQ(d["points"].size(), f.size());
   ASSERT_EQ(d["texts"].size(), f.size());

@@ -15,6 +15,7 @@ out = {
     "dxfversion": doc.dxfversion,
     "extents": [list(doc.header.get("$EXTMIN", (0, 0, 0))), list(doc.header.get("$EXTMAX", (0, 0, 0)))],
     "layers": sorted(layer.dxf.name for layer in doc.layers),
+    "styles": sorted(style.dxf.name for style in doc.styles),
     "audit_errors": [str(e.message) for e in auditor.errors],
     "points": [],
     "texts": [],
