@@ -76,6 +76,12 @@ def graph():
 
 GRAPH = graph()
 STATIONS = b"x_m,y_m,z_m\n0,0,1.5\n2.5,1,1.5\n# comment\n3 4 1.6\n"
+# A plan's own stations.csv (vc/report/field_exports.h): x_m, y_m, z_m among named columns.
+PLAN_STATIONS = (b"# vc stations: lengths in metres\n"
+                 b"station,name,x_m,y_m,z_m,floor,floor_z_m,tripod_height_m,fixed,route_order,selection_order,"
+                 b"gain_voxels,cumulative_coverage\n"
+                 b"1,S01,3.500000,2.500000,1.600000,L0,0.100,1.500,new,1,2,25,1.000000\n"
+                 b"2,BM 7,0.500000,0.500000,1.600000,,,,existing,0,1,100,0.800000\n")
 
 KEEP_OUT = (b"# keep-out zones: boxes and polygons over a z range\n\nbox, -1, -1, -2, 1, 1, 4  # the tripod\n"
             b"POLYGON,0,3.5,10,10,12,10,12,12,10,12\npolygon,-1e3,1e3,0,0,1,0,0,1\n")
@@ -140,7 +146,7 @@ SEEDS = {
                      bz2.compress(CSV)},
     "lzf_fuzzer": {"literal.lzf": struct.pack("<H", len(_raw)) + _lzf,
                    "backref.lzf": struct.pack("<H", 12) + bytes([3]) + b"abcd" + bytes([0xc0, 3])},
-    "stations_csv_fuzzer": {"stations.csv": STATIONS},
+    "stations_csv_fuzzer": {"stations.csv": STATIONS, "plan_stations.csv": PLAN_STATIONS},
     "keep_out_csv_fuzzer": {"zones.csv": KEEP_OUT, "box.csv": b"box,0,0,0,1,1,1\n",
                             "polygon.csv": b"polygon,0,3,0,0,2,0,2,1,1,1,1,2,0,2\n"},
     "upload_assembler_fuzzer": UPLOADS,

@@ -4,7 +4,8 @@
 # Usage: scripts/install-deps.sh [--runtime | --tests]
 #   --runtime: only what the built binaries need to run
 #   --tests:   the build packages and what the tests need besides (headless chromium for
-#              report_html_browser_test); scripts/test.sh uses it, the demo does not
+#              report_html_browser_test, ezdxf for field_exports_test); scripts/test.sh uses it,
+#              the demo does not
 set -euo pipefail
 
 BUILD_PKGS=(
@@ -20,6 +21,7 @@ BUILD_PKGS=(
 )
 TEST_PKGS=(
   chromium  # report_html_browser_test opens report.html in headless chromium
+  python3-ezdxf  # field_exports_test reads stations.dxf with a real DXF reader
 )
 RUNTIME_PKGS=(
   libgrpc++1.51 libgrpc29 libprotobuf32 liboctomap1.9 libspdlog1.10 libfmt9 libhwy1

@@ -12,6 +12,7 @@
 #include <optional>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include "vc/client/client.h"
 #include "vc/client/compact_upload.h"
@@ -23,6 +24,7 @@
 #include "vc/scene/e57.h"
 #include "vc/scene/scene_input.h"
 #include "vc/scene/scene_summary.h"
+#include "vc/scene/station_file.h"
 #include "vc/wire/status_mapping.h"
 
 namespace {
@@ -138,13 +140,26 @@ vc::client::JobObserver Observe(vc::client::ProgressDisplay& display, InterruptC
   return o;
 }
 
+// The names in the --fixed-stations file, in its order (LoadPlanFiles keeps the positions only);
+// none without the file (attach: the names come from the file, which the job does not keep).
+std::vector<std::string> FixedStationNames(const std::string& path) {
+  std::vector<std::string> names;
+  if (path.empty()) return names;
+  auto stations = vc::ReadStationFile(path);
+  if (!stations.ok()) return names;
+  for (const vc::KnownStation& s : *stations) names.push_back(s.name);
+  return names;
+}
+
 // Writes the plan's reports and prints its stations.
-int WritePlan(const vc::PlanResult& r, const std::string& out_dir, const vc::UploadSummary* upload) {
-  vc::Status written = vc::WritePlanOutputs(r, out_dir, upload);
+int WritePlan(const vc::PlanResult& r, const std::string& out_dir, const vc::UploadSummary* upload,
+              const std::vector<std::string>& fixed_station_names = {}) {
+  vc::Status written = vc::WritePlanOutputs(r, out_dir, upload, fixed_station_names);
   if (!written.ok()) return Fail("cannot write the reports", written);
   PrintStations(r);
-  std::printf("wrote plan.json, stations.csv, visibility.ply, heatmap.png, reduction.png, report.html to %s\n",
-              out_dir.c_str());
+  std::printf(
+      "wrote plan.json, stations.csv, stations.dxf, visibility.ply, heatmap.png, reduction.png, report.html to %s\n",
+      out_dir.c_str());
   return 0;
 }
 
@@ -341,7 +356,7 @@ int RunSubmit(vc::client::Client& client, const CommandLine& cl, InterruptCancel
   display.Done();
   if (!r.ok()) return FailCall("plan", r.status(), cl.conn.server);
   NoteCache(client.last_upload(), &prepared.summary, display);
-  return WritePlan(*r, cl.out_dir, &prepared.summary);
+  return WritePlan(*r, cl.out_dir, &prepared.summary, FixedStationNames(cl.plan_files.fixed_stations));
 }
 
 int RunEvaluate(vc::client::Client& client, const CommandLine& cl, InterruptCancelsTheJob* interrupt) {

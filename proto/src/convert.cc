@@ -449,6 +449,7 @@ v1::PlannedStation ToProto(const PlannedStation& s, const WorldPoint& frame_orig
   p.set_global_visibility(s.global_visibility);
   p.set_candidate_index(s.candidate_index);
   p.set_fixed(s.fixed);
+  if (std::isfinite(s.floor_z_m)) p.set_floor_z_m(PlusOrigin(s.floor_z_m, frame_origin_m.z()));
   return p;
 }
 
@@ -461,6 +462,7 @@ PlannedStation FromProto(const v1::PlannedStation& p) {
   s.global_visibility = p.global_visibility();
   s.candidate_index = p.candidate_index();
   s.fixed = p.fixed();
+  if (p.has_floor_z_m()) s.floor_z_m = p.floor_z_m();
   return s;
 }
 
@@ -681,6 +683,7 @@ Result<PlanResult> PlanResultAssembler::Finish(const v1::PlanResult& p) && {
   for (const auto& s : p.stations()) {
     r.stations.push_back(FromProto(s));
     r.stations.back().position = LessOrigin(r.stations.back().position, origin);
+    r.stations.back().floor_z_m = LessOrigin(r.stations.back().floor_z_m, origin.z());
   }
   r.heat_map = std::move(heat_map_);
   for (WorldPoint& q : r.heat_map.positions) q = LessOrigin(q, origin);

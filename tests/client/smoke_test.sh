@@ -35,7 +35,7 @@ grep -q "heat map ready" "$work/client.err" || fail "no heat map line"
 grep -q "final stations:" "$work/client.err" || fail "no final stations line"
 grep -q "report.html to " "$work/client.out" || fail "vc-client does not name report.html among the files it wrote"
 
-for f in plan.json stations.csv visibility.ply heatmap.png reduction.png report.html; do
+for f in plan.json stations.csv stations.dxf visibility.ply heatmap.png reduction.png report.html; do
   [[ -s "$work/out/$f" ]] || fail "missing or empty $f"
 done
 python3 - "$work/out" <<'PY' || fail "output contents"
@@ -81,6 +81,16 @@ PY
 grep -q "in its cache: nothing uploaded" "$work/again.err" || { cat "$work/again.err" >&2; fail "no cache hit"; }
 python3 -c 'import json,sys; u=json.load(open(sys.argv[1]))["upload"]; assert u["from_cache"] and u["bytes_sent"] == 0 and len(u["scene_hash"]) == 64, u' \
   "$work/again/plan.json" || fail "plan.json upload after a cache hit"
+# A station already scanned, named in its file: stations.csv and stations.dxf call it by that name.
+python3 - "$work/out/stations.csv" "$work/fixed.csv" <<'PY' || fail "cannot write fixed.csv"
+import csv, sys
+first = next(csv.DictReader(l for l in open(sys.argv[1]) if not l.startswith("#")))
+open(sys.argv[2], "w").write(f"name,x,y,z\nBM-7,{first['x_m']},{first['y_m']},{first['z_m']}\n")
+PY
+"$client_bin" submit "$work/box.ply" --server "$addr" --out "$work/fixed" --fixed-stations "$work/fixed.csv" \
+  >/dev/null 2>"$work/fixed.err" || { cat "$work/fixed.err" >&2; fail "submit --fixed-stations failed"; }
+grep -q ",BM-7,.*,existing," "$work/fixed/stations.csv" || { cat "$work/fixed/stations.csv" >&2; fail "stations.csv does not name the fixed station"; }
+grep -q "^BM-7 h=" "$work/fixed/stations.dxf" || fail "stations.dxf does not label the fixed station by its name"
 grep -q "cache=hit" "$work/server.log" || fail "the server log has no cache=hit"
 grep -q "cache=miss" "$work/server.log" || fail "the server log has no cache=miss"
 

@@ -40,7 +40,8 @@ import csv, json, sys
 work = sys.argv[1]
 def stations(name):
     with open(f"{work}/{name}/stations.csv") as f:
-        return [(float(r["x"]), float(r["y"]), float(r["z"])) for r in csv.DictReader(f)]
+        rows = csv.DictReader(l for l in f if not l.startswith("#"))
+        return [(float(r["x_m"]), float(r["y_m"]), float(r["z_m"])) for r in rows]
 def plan(name):
     return json.load(open(f"{work}/{name}/plan.json"))
 base = stations("metres")

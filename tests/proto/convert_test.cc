@@ -81,8 +81,8 @@ PlanResult BigResult(size_t voxels, size_t candidates) {
     r.heat_map.floor_z_m.push_back(i % 2 ? 0.25 : std::nan(""));
   }
   r.heat_map.grid_spacing_m = 1;
-  r.stations.push_back({{1, 2, 3}, 10, 10, 0.5, 0.2, 4});
-  r.stations.push_back({{0, 0, 0}, 5, 5, 0.6, 0.1, -1, true});  // a fixed station
+  r.stations.push_back({{1, 2, 3}, 10, 10, 0.5, 0.2, 4, false, 1.5});
+  r.stations.push_back({{0, 0, 0}, 5, 5, 0.6, 0.1, -1, true});  // a fixed station, no floor below it
   r.reduction.size = 1;
   r.reduction.matrix = {0.25};
   r.occupied_voxels = voxels;
@@ -154,6 +154,8 @@ TEST(PlanResultChunks, ReassembleExactlyAndStayUnderOneMebibyte) {
   EXPECT_EQ(back->stations[0].candidate_index, 4);
   EXPECT_FALSE(back->stations[0].fixed);
   EXPECT_TRUE(back->stations[1].fixed);
+  EXPECT_EQ(back->stations[0].floor_z_m, 1.5);
+  EXPECT_TRUE(std::isnan(back->stations[1].floor_z_m));
   EXPECT_EQ(back->reduction.matrix, r.reduction.matrix);
   EXPECT_DOUBLE_EQ(back->evaluation.overall.global_visibility, 0.42);
   EXPECT_EQ(back->timings[0].stage, Stage::kSelection);
@@ -275,6 +277,8 @@ TEST(PlanResultChunks, TheWireIsInTheInputsFrameAndTheResultComesBackLocal) {
     EXPECT_EQ(summary.stations(1).position().x_m(), 512000.0);
     EXPECT_EQ(summary.reduction().positions(0).y_m(), 5612002.0);
     EXPECT_EQ(summary.floor_levels_m(1), 3.1 + origin.z());
+    EXPECT_EQ(summary.stations(0).floor_z_m(), 1.5 + origin.z());
+    EXPECT_FALSE(summary.stations(1).has_floor_z_m());  // NaN: absent
     EXPECT_EQ(summary.route().start().x_m(), 512000.5);
     EXPECT_EQ(summary.route().polylines(0).points(1).x_m(), 512000.5);
     EXPECT_EQ(summary.options().SerializeAsString(), ToProto(r.options).SerializeAsString());  // as given
@@ -310,6 +314,8 @@ TEST(PlanResultChunks, TheWireIsInTheInputsFrameAndTheResultComesBackLocal) {
       EXPECT_EQ(back->floor_levels_m[i] + origin.z(), r.floor_levels_m[i] + origin.z());
     }
     EXPECT_EQ(back->heat_map.floor_z_m[1] + origin.z(), 0.25 + origin.z());
+    EXPECT_EQ(back->stations[0].floor_z_m + origin.z(), 1.5 + origin.z());
+    EXPECT_TRUE(std::isnan(back->stations[1].floor_z_m));
     EXPECT_TRUE(std::isnan(back->heat_map.floor_z_m[0]));
   }
 }

@@ -188,6 +188,10 @@ Result<PlanResult> Plan(const SceneInput& input, const PlanOptions& options, con
   std::vector<double> final_floor_z;
   for (int k : reduced.keep) final_floor_z.push_back(stations.floor_z_m[k]);
   result.stations = std::move(final_stations.stations);
+  for (size_t k = 0; k < result.stations.size(); ++k) {
+    PlannedStation& s = result.stations[k];
+    s.floor_z_m = std::isnan(final_floor_z[k]) ? planner::FloorBelow(scene.grid, s.position) : final_floor_z[k];
+  }
   result.covered_voxels = final_stations.covered_voxels;
   {
     std::vector<VoxelSet> final_sets;

@@ -431,17 +431,6 @@ int SnapToFloor(const WalkGraph& g, const WorldPoint& floor_point, double tolera
   return best;
 }
 
-// The floor top (m) under an optical centre: the highest occupied run's top at or below it, or NaN.
-double FloorBelow(const OccupancyGrid& grid, const WorldPoint& p) {
-  const VoxelIndex v = grid.WorldToIndex(p);
-  std::vector<Surface> runs;
-  ColumnSurfaces(grid, v.x, v.y, 1, runs);
-  for (const Surface& s : runs) {
-    if ((s.z + 1) * grid.resolution_m() <= p.z() + 1e-9) return (s.z + 1) * grid.resolution_m();
-  }
-  return kNaN;
-}
-
 // Drops points equal to the previous one and points between two collinear segments of the same direction.
 std::vector<WorldPoint> Simplify(const std::vector<WorldPoint>& in) {
   std::vector<WorldPoint> out;
@@ -762,6 +751,16 @@ Status RoutePlanner::WalkPart(size_t pi) {
 }
 
 }  // namespace
+
+double FloorBelow(const OccupancyGrid& grid, const WorldPoint& p) {
+  const VoxelIndex v = grid.WorldToIndex(p);
+  std::vector<Surface> runs;
+  ColumnSurfaces(grid, v.x, v.y, 1, runs);
+  for (const Surface& s : runs) {
+    if ((s.z + 1) * grid.resolution_m() <= p.z() + 1e-9) return (s.z + 1) * grid.resolution_m();
+  }
+  return kNaN;
+}
 
 double OpenPathLength(const OpenPathProblem& p, const std::vector<int>& order) {
   double len = 0;

@@ -9,8 +9,10 @@
 #include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <optional>
 
 #include "raster.h"
+#include "vc/report/field_exports.h"
 #include "vc/report/report_html.h"
 
 namespace vc {
@@ -167,17 +169,6 @@ std::vector<int> RoutePositions(const PlanResult& r) {
     if (s >= 0 && static_cast<size_t>(s) < position.size()) position[s] = static_cast<int>(k) + 1;
   }
   return position;
-}
-
-// A plan's stations.csv: x,y,z and the station's place in the walking route.
-std::string PlanStationsCsv(const PlanResult& r) {
-  const std::vector<int> position = RoutePositions(r);
-  std::string out = "x,y,z,route_order\n";
-  for (size_t k = 0; k < r.stations.size(); ++k) {
-    const WorldPoint p = InputFrame(r, r.stations[k].position);
-    out += Fixed(p.x(), 6) + "," + Fixed(p.y(), 6) + "," + Fixed(p.z(), 6) + "," + std::to_string(position[k]) + "\n";
-  }
-  return out;
 }
 
 // ---------- visibility.ply ----------
@@ -612,10 +603,66 @@ std::vector<std::string_view> SplitFields(std::string_view line) {
   return fields;
 }
 
+// The columns a header names x, y and z ("x" or "x_m", any case), when it names all three.
+std::optional<std::array<size_t, 3>> XyzColumns(const std::vector<std::string_view>& fields) {
+  std::array<int, 3> at{-1, -1, -1};
+  for (size_t i = 0; i < fields.size(); ++i) {
+    std::string name(fields[i]);
+    for (char& c : name) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    if (name.size() == 3 && name.compare(1, 2, "_m") == 0) name.resize(1);
+    if (name.size() != 1 || name[0] < 'x' || name[0] > 'z') continue;
+    at[size_t(name[0] - 'x')] = static_cast<int>(i);
+  }
+  if (at[0] < 0 || at[1] < 0 || at[2] < 0) return std::nullopt;
+  return std::array<size_t, 3>{size_t(at[0]), size_t(at[1]), size_t(at[2])};
+}
+
+// A station from "x,y,z", or a plan's earlier "x,y,z,route_order" whose fourth column is read and ignored.
+Result<WorldPoint> PositionalRow(const std::vector<std::string_view>& fields, std::string_view line,
+                                 const std::string& where) {
+  double v[4];
+  const bool numeric = (fields.size() == 3 || fields.size() == 4) && ParseDouble(fields[0], &v[0]) &&
+                       ParseDouble(fields[1], &v[1]) && ParseDouble(fields[2], &v[2]) &&
+                       (fields.size() == 3 || ParseDouble(fields[3], &v[3]));
+  if (!numeric) {
+    return InvalidArgumentError(where +
+                                "expected 3 numbers \"x,y,z\" (metres), or a plan's \"x,y,z,route_order\", found \"" +
+                                std::string(line) + "\"");
+  }
+  if (!std::isfinite(v[0]) || !std::isfinite(v[1]) || !std::isfinite(v[2])) {
+    return InvalidArgumentError(where + "coordinates must be finite, found \"" + std::string(line) + "\"");
+  }
+  return WorldPoint(v[0], v[1], v[2]);
+}
+
+// A station from the columns a header named (a plan's stations.csv: x_m, y_m, z_m among others).
+Result<WorldPoint> NamedColumnsRow(const std::vector<std::string_view>& fields, const std::array<size_t, 3>& columns,
+                                   std::string_view line, const std::string& where) {
+  double v[3];
+  for (int a = 0; a < 3; ++a) {
+    const size_t c = columns[size_t(a)];
+    if (c >= fields.size() || !ParseDouble(fields[c], &v[a])) {
+      return InvalidArgumentError(where + "expected a number in column " + std::to_string(c + 1) + " (" +
+                                  std::string(1, char('x' + a)) + ", metres), found \"" + std::string(line) + "\"");
+    }
+    if (!std::isfinite(v[a])) {
+      return InvalidArgumentError(where + "coordinates must be finite, found \"" + std::string(line) + "\"");
+    }
+  }
+  return WorldPoint(v[0], v[1], v[2]);
+}
+
+// A height for plan.json: null when NaN.
+Json HeightJson(double v) { return std::isfinite(v) ? Json(v) : Json(nullptr); }
+
 }  // namespace
 
-std::string PlanToJson(const PlanResult& r, const UploadSummary* upload) {
+std::string PlanToJson(const PlanResult& r, const UploadSummary* upload,
+                       const std::vector<std::string>& fixed_station_names) {
   const std::vector<int> route_position = RoutePositions(r);
+  std::vector<const FieldStation*> field(r.stations.size(), nullptr);
+  const std::vector<FieldStation> field_stations = FieldStations(r, fixed_station_names);
+  for (const FieldStation& f : field_stations) field[f.index] = &f;
   Json viewpoints = Json::array();
   for (size_t k = 0; k < r.stations.size(); ++k) {
     const PlannedStation& s = r.stations[k];
@@ -635,6 +682,11 @@ std::string PlanToJson(const PlanResult& r, const UploadSummary* upload) {
       v["fully_visible_fraction"] = r.evaluation.per_viewpoint[k].fully_visible_fraction;
       v["partially_visible_fraction"] = r.evaluation.per_viewpoint[k].partially_visible_fraction;
     }
+    v["station"] = field[k]->number;
+    v["name"] = field[k]->name;
+    v["floor"] = field[k]->floor.empty() ? Json(nullptr) : Json(field[k]->floor);
+    v["floor_z_m"] = HeightJson(field[k]->floor_z_m);
+    v["tripod_height_m"] = HeightJson(field[k]->tripod_height_m);
     viewpoints.push_back(std::move(v));
   }
   const double coverable = static_cast<double>(r.coverable_voxels);
@@ -790,11 +842,14 @@ std::string ColouredPointsPly(const std::vector<std::string>& comments, const st
   return out;
 }
 
-Status WritePlanOutputs(const PlanResult& result, const std::string& out_dir, const UploadSummary* upload) {
+Status WritePlanOutputs(const PlanResult& result, const std::string& out_dir, const UploadSummary* upload,
+                        const std::vector<std::string>& fixed_station_names) {
   VC_RETURN_IF_ERROR(MakeDir(out_dir));
   const std::filesystem::path dir(out_dir);
-  VC_RETURN_IF_ERROR(WriteFile(dir / "plan.json", PlanToJson(result, upload)));
-  VC_RETURN_IF_ERROR(WriteFile(dir / "stations.csv", PlanStationsCsv(result)));
+  VC_RETURN_IF_ERROR(WriteFile(dir / "plan.json", PlanToJson(result, upload, fixed_station_names)));
+  const std::vector<FieldStation> field_stations = FieldStations(result, fixed_station_names);
+  VC_RETURN_IF_ERROR(WriteFile(dir / "stations.csv", FieldStationsCsv(field_stations)));
+  VC_RETURN_IF_ERROR(WriteFile(dir / "stations.dxf", StationsDxf(result, field_stations)));
   if (result.voxel_centers.size() != result.evaluation.best_face_values.size()) {
     return FailedPreconditionError("visibility.ply needs one best_face_values entry per voxel centre (" +
                                    std::to_string(result.voxel_centers.size()) + " centres, " +
@@ -825,6 +880,7 @@ Status WriteEvaluationOutputs(const Evaluation& evaluation, const std::vector<Wo
 Result<std::vector<WorldPoint>> ParseStationsCsv(std::string_view text, std::string_view source) {
   std::vector<WorldPoint> out;
   bool seen_data_line = false;
+  std::optional<std::array<size_t, 3>> named;  // the x, y, z columns a header names
   size_t line_no = 0;
   size_t pos = 0;
   while (pos <= text.size()) {
@@ -839,30 +895,20 @@ Result<std::vector<WorldPoint>> ParseStationsCsv(std::string_view text, std::str
       continue;
     }
     const std::vector<std::string_view> fields = SplitFields(line);
-    double v[4];
-    // x,y,z, and a plan's route_order column, which is read and ignored.
-    const bool numeric = (fields.size() == 3 || fields.size() == 4) && ParseDouble(fields[0], &v[0]) &&
-                         ParseDouble(fields[1], &v[1]) && ParseDouble(fields[2], &v[2]) &&
-                         (fields.size() == 3 || ParseDouble(fields[3], &v[3]));
     const std::string where = std::string(source) + ":" + std::to_string(line_no) + ": ";
-    if (!numeric) {
-      // One header line is allowed, before any station: fields without digits (e.g. "x,y,z").
-      const bool header = !seen_data_line && std::none_of(line.begin(), line.end(), [](char c) {
-        return std::isdigit(static_cast<unsigned char>(c));
-      });
-      if (header) {
-        seen_data_line = true;
-        continue;
-      }
-      return InvalidArgumentError(where +
-                                  "expected 3 numbers \"x,y,z\" (metres), or a plan's \"x,y,z,route_order\", found \"" +
-                                  std::string(line) + "\"");
+    // One header line is allowed, before any station: fields without digits (e.g. "x,y,z").
+    const bool header = !seen_data_line && std::none_of(line.begin(), line.end(), [](char c) {
+      return std::isdigit(static_cast<unsigned char>(c));
+    });
+    if (header) {
+      seen_data_line = true;
+      named = XyzColumns(fields);
+      continue;
     }
-    if (!std::isfinite(v[0]) || !std::isfinite(v[1]) || !std::isfinite(v[2])) {
-      return InvalidArgumentError(where + "coordinates must be finite, found \"" + std::string(line) + "\"");
-    }
+    VC_ASSIGN_OR_RETURN(const WorldPoint p,
+                        named ? NamedColumnsRow(fields, *named, line, where) : PositionalRow(fields, line, where));
     seen_data_line = true;
-    out.emplace_back(v[0], v[1], v[2]);
+    out.push_back(p);
     if (end == text.size()) break;
   }
   if (out.empty()) return InvalidArgumentError(std::string(source) + ": no station found (expected lines \"x,y,z\")");

@@ -63,6 +63,7 @@ Result<Columns> HeaderColumns(const std::vector<std::string_view>& fields, const
                               std::string_view line) {
   Columns c;
   c.x = c.y = c.z = -1;
+  int name_column = -1, id_column = -1;
   for (size_t i = 0; i < fields.size(); ++i) {
     std::string n = Lower(fields[i]);
     const int k = static_cast<int>(i);
@@ -82,8 +83,10 @@ Result<Columns> HeaderColumns(const std::vector<std::string_view>& fields, const
     if (n == "roll") c.roll = k;
     if (n == "pitch") c.pitch = k;
     if (n == "roll" || n == "pitch" || n == "yaw" || n == "heading") c.angles_in_rad = c.angles_in_rad || rad;
-    if (n == "name" || n == "id" || n == "station") c.name = k;
+    if (n == "name") name_column = k;
+    if ((n == "id" || n == "station") && id_column < 0) id_column = k;
   }
+  c.name = name_column >= 0 ? name_column : id_column;  // vc's stations.csv has both "station" and "name"
   if (c.x < 0 || c.y < 0 || c.z < 0) {
     return InvalidArgumentError(
         where + "the header " + Quote(line) +

@@ -341,6 +341,14 @@ TEST(PlannerTest, TwoFloorsGetCandidatesAndStationsOnBothStoreys) {
         std::any_of(r->stations.begin(), r->stations.end(), [&](const PlannedStation& s) { return near(s.position); }))
         << "no station on floor " << f;
   }
+  // Each station knows the floor it stands over: one of the two levels, 1.5 m below it.
+  for (const PlannedStation& s : r->stations) {
+    EXPECT_NEAR(s.position.z() - s.floor_z_m, 1.5, 1e-9);
+    const double level = std::fabs(s.floor_z_m - r->floor_levels_m[0]) < std::fabs(s.floor_z_m - r->floor_levels_m[1])
+                             ? r->floor_levels_m[0]
+                             : r->floor_levels_m[1];
+    EXPECT_NEAR(s.floor_z_m, level, 0.1);
+  }
   EXPECT_EQ(r->covered_voxels, r->coverable_voxels);
 }
 
@@ -669,6 +677,11 @@ TEST(PlannerTest, SeveralTripodHeightsGiveCandidatesAtEachHeightAndOneHeatMapPan
   }
   EXPECT_EQ(heights, (std::set<long>{12, 16, 20}));
   EXPECT_GE(static_cast<double>(r->covered_voxels), 0.99 * static_cast<double>(r->coverable_voxels));
+  // Each station's floor lies one of the tripod heights below it.
+  for (const PlannedStation& s : r->stations) {
+    const long height = std::lround(10 * (s.position.z() - s.floor_z_m));
+    EXPECT_TRUE(height == 12 || height == 16 || height == 20) << s.position.transpose() << " floor " << s.floor_z_m;
+  }
   // The heat map keeps one panel for the one floor.
   const ImageSize one_panel = HeatmapImageSize(*single);
   EXPECT_EQ(HeatmapImageSize(*r).width, one_panel.width);
@@ -793,6 +806,8 @@ TEST(PlannerTest, FixedStationsArePlacedFirstKeptAndThePlanAddsToThem) {
     EXPECT_TRUE(r->stations[k].fixed);
     EXPECT_EQ(r->stations[k].position, fixed);  // not refined
     EXPECT_EQ(r->stations[k].candidate_index, -1);
+    // A fixed station has no candidate's floor: the floor below it in the scene, 1.5 m down.
+    EXPECT_NEAR(r->stations[k].floor_z_m, info->floor_heights_m[0], r->resolution_m) << k;
   }
   EXPECT_GT(r->stations[0].marginal_gain, 0u);  // its coverage counts first
   EXPECT_EQ(r->stations[1].marginal_gain, 0u);

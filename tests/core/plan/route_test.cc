@@ -178,6 +178,14 @@ TEST(RouteTest, StoreysWithoutStairsAreTwoPartsWithAWarning) {
   EXPECT_NEAR(r.length_m, r.legs_m[1] + r.legs_m[3], 1e-9);
 }
 
+TEST(RouteTest, FloorBelowIsTheHighestSurfaceUnderTheOpticalCentre) {
+  const VoxelScene s = TwoStoreys(false);
+  EXPECT_NEAR(FloorBelow(s.grid, At(80, 10, 3.1)), 3.1, 1e-9);  // on the upper slab
+  EXPECT_NEAR(FloorBelow(s.grid, At(80, 10)), 0.1, 1e-9);       // under it: the lower one
+  EXPECT_NEAR(FloorBelow(s.grid, At(10, 10)), 0.1, 1e-9);
+  EXPECT_TRUE(std::isnan(FloorBelow(s.grid, At(10, 10, -2.0))));  // below the lowest slab
+}
+
 TEST(RouteTest, StairsLinkTheStoreysAndThePathClimbsThem) {
   const VoxelScene s = TwoStoreys(true);
   const std::vector<WorldPoint> st{At(80, 10, 3.1), At(10, 10), At(90, 30, 3.1)};

@@ -274,15 +274,15 @@ TEST(PlanReportTest, StationsCsvRoundTrips) {
   const std::string dir = testing::MakeTempDir();
   ASSERT_TRUE(WritePlanOutputs(plan, dir).ok());
   const std::string csv = ReadAll(dir + "/stations.csv");
-  EXPECT_EQ(csv.substr(0, 18), "x,y,z,route_order\n");
-  // The route visits station 1 first, then station 0.
-  EXPECT_NE(csv.find(",2\n"), std::string::npos) << csv;
-  EXPECT_NE(csv.find(",1\n"), std::string::npos) << csv;
+  EXPECT_EQ(csv.substr(0, 16), "# vc stations: l");
+  EXPECT_NE(csv.find("\nstation,name,x_m,y_m,z_m,"), std::string::npos) << csv;
+  // The route visits station 1 first, then station 0: rows in that order.
+  EXPECT_LT(csv.find("\n1,S01,3.500000,2.500000,1.600000,"), csv.find("\n2,S02,0.500000,0.500000,1.600000,")) << csv;
   Result<std::vector<WorldPoint>> parsed = ParseStationsCsv(csv, "stations.csv");
   ASSERT_TRUE(parsed.ok()) << parsed.status().ToString();
   ASSERT_EQ(parsed->size(), plan.stations.size());
   for (size_t i = 0; i < parsed->size(); ++i) {
-    EXPECT_NEAR(((*parsed)[i] - plan.stations[i].position).norm(), 0.0, 1e-6);
+    EXPECT_NEAR(((*parsed)[i] - plan.stations[plan.route.order[i]].position).norm(), 0.0, 1e-6);
   }
 }
 
@@ -351,11 +351,11 @@ TEST(PlanReportTest, StationsCsvAndVisibilityPlyAreInTheInputsFrame) {
   const std::string dir = testing::MakeTempDir();
   ASSERT_TRUE(WritePlanOutputs(plan, dir).ok());
   const std::string csv = ReadAll(dir + "/stations.csv");
-  EXPECT_NE(csv.find("512345.457000,5612330.123000,1.600000,1\n"), std::string::npos) << csv;
+  EXPECT_NE(csv.find("\n1,S01,512345.457000,5612330.123000,1.600000,"), std::string::npos) << csv;
   Result<std::vector<WorldPoint>> parsed = ParseStationsCsv(csv, "stations.csv");
   ASSERT_TRUE(parsed.ok()) << parsed.status().ToString();
   ASSERT_EQ(parsed->size(), 2u);
-  EXPECT_LT(((*parsed)[0] - WorldPoint(512000.5, 5612000.5, 1.6)).norm(), 1e-6);
+  EXPECT_LT(((*parsed)[1] - WorldPoint(512000.5, 5612000.5, 1.6)).norm(), 1e-6);
 
   const std::string ply = ReadAll(dir + "/visibility.ply");
   const size_t end = ply.find("end_header\n");
@@ -382,13 +382,15 @@ TEST(PlanReportTest, APlanNearItsOriginWritesFloatCoordinatesAsBefore) {
   const std::string ply = ReadAll(dir + "/visibility.ply");
   EXPECT_EQ(ply.find("frame_origin_m"), std::string::npos);
   EXPECT_EQ(ply.find("property double"), std::string::npos);
-  EXPECT_EQ(ReadAll(dir + "/stations.csv"),
-            "x,y,z,route_order\n0.500000,0.500000,1.600000,2\n"
-            "3.500000,2.500000,1.600000,1\n");
+  const std::string csv = ReadAll(dir + "/stations.csv");
+  const std::string rows = csv.substr(csv.find("\n1,"));
+  EXPECT_EQ(rows,
+            "\n1,S01,3.500000,2.500000,1.600000,,,,new,1,2,25,1.000000\n"
+            "2,S02,0.500000,0.500000,1.600000,,,,new,2,1,100,0.800000\n");
   PlanResult negative_zero = SamplePlan();
   negative_zero.stations[0].position.x() = -0.0;  // adding a zero origin would print it as 0.000000
   ASSERT_TRUE(WritePlanOutputs(negative_zero, dir).ok());
-  EXPECT_EQ(ReadAll(dir + "/stations.csv").substr(18, 10), "-0.000000,");
+  EXPECT_NE(ReadAll(dir + "/stations.csv").find("\n2,S02,-0.000000,"), std::string::npos);
 }
 
 TEST(PlanReportTest, ColouredPointsPlyWithoutAValueHoldsPositionAndColourOnly) {

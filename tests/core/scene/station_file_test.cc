@@ -72,6 +72,23 @@ TEST(StationFileTest, HeaderlessRowsAreXyzAndMore) {
   EXPECT_EQ((*r)[0].position_m, WorldPoint(1, 2, 3));
 }
 
+TEST(StationFileTest, ANameColumnWinsOverStationAndIdColumns) {
+  // A plan's stations.csv: a comment, "station" (its number) before "name", empty cells.
+  Result<std::vector<KnownStation>> r = ParseStationFile(
+      "# vc stations\nstation,name,x_m,y_m,z_m,floor,tripod_height_m\n1,S01,1,2,3,L0,1.5\n2,BM 7,4,5,6,,\n",
+      "stations.csv");
+  ASSERT_TRUE(r.ok()) << r.status().ToString();
+  ASSERT_EQ(r->size(), 2u);
+  EXPECT_EQ((*r)[1].name, "BM 7");
+  EXPECT_EQ((*r)[1].position_m, WorldPoint(4, 5, 6));
+  r = ParseStationFile("name,station,x,y,z\nA,1,1,2,3\n", "swapped.csv");
+  ASSERT_TRUE(r.ok()) << r.status().ToString();
+  EXPECT_EQ((*r)[0].name, "A");
+  r = ParseStationFile("station,x,y,z\n7,1,2,3\n", "numbered.csv");
+  ASSERT_TRUE(r.ok()) << r.status().ToString();
+  EXPECT_EQ((*r)[0].name, "7");
+}
+
 TEST(StationFileTest, E57ScansPosesWithHeadings) {
   testing::E57Spec spec;
   const double yaws[] = {0.7, -2.0, 3.0};

@@ -32,6 +32,9 @@ struct PlannedStation {
   double global_visibility = 0;    // G of this station alone
   int candidate_index = -1;        // index into PlanResult::candidates, or -1 if refined off-grid or fixed
   bool fixed = false;              // one of PlanOptions::fixed_stations (placed first, never removed)
+  // Top of the floor the station stands over (m, local frame): its candidate's floor, else the
+  // highest standing surface below it (planner::FloorBelow); NaN when nothing lies below it.
+  double floor_z_m = std::numeric_limits<double>::quiet_NaN();
 };
 
 struct HeatMap {

@@ -113,6 +113,10 @@ struct Route {
 Result<Route> PlanRoute(const VoxelScene& scene, const std::vector<WorldPoint>& stations,
                         const std::vector<double>& floor_z_m, const RouteOptions& options, const JobContext& ctx = {});
 
+// The top (m, the grid's frame) of the highest standing surface at or below `p` in p's voxel column
+// (the floor under an optical centre), or NaN when the column holds none below it.
+double FloorBelow(const OccupancyGrid& grid, const WorldPoint& p);
+
 // An open-path ordering problem: n points, symmetric distances, an optional fixed start.
 struct OpenPathProblem {
   int n = 0;

@@ -1,5 +1,5 @@
 // The files a user gets from a plan or an evaluation (written by vc-client from the streamed
-// result, and usable directly from core): plan.json, stations.csv, visibility.ply, heatmap.png,
+// result, and usable directly from core): plan.json, stations.csv, stations.dxf, visibility.ply, heatmap.png,
 // reduction.png, report.html (vc/report/report_html.h), evaluation.json. Schemas are documented
 // in docs/PLANNING.md and docs/PROTOCOL.md.
 #pragma once
@@ -33,13 +33,18 @@ struct UploadSummary {
 // plan.json's content (documented schema). `upload` null when not given. Every position is in the
 // input's own frame (the result's local positions plus PlanResult::frame_origin_m), and "frame"
 // says where the local frame lies (docs/PLANNING.md, "Outputs in the input's frame").
-std::string PlanToJson(const PlanResult& result, const UploadSummary* upload = nullptr);
+// `fixed_station_names` name the fixed stations as FieldStations (vc/report/field_exports.h) does.
+std::string PlanToJson(const PlanResult& result, const UploadSummary* upload = nullptr,
+                       const std::vector<std::string>& fixed_station_names = {});
 
-// Writes plan.json, stations.csv, visibility.ply, heatmap.png, reduction.png and report.html into `out_dir`
-// (created if missing), every coordinate in the input's own frame (stations.csv to the micrometre;
-// visibility.ply in double precision when the frame's origin is not zero). visibility.ply needs result.voxel_centers
-// and result.evaluation.best_face_values. INTERNAL / FAILED_PRECONDITION with the path on I/O errors.
-Status WritePlanOutputs(const PlanResult& result, const std::string& out_dir, const UploadSummary* upload = nullptr);
+// Writes plan.json, stations.csv, stations.dxf, visibility.ply, heatmap.png, reduction.png and report.html into
+// `out_dir` (created if missing), every coordinate in the input's own frame (stations.csv and stations.dxf to the
+// micrometre; visibility.ply in double precision when the frame's origin is not zero). `fixed_station_names`: the
+// fixed stations' names from their file, in PlanOptions::fixed_stations order (may be empty). visibility.ply needs
+// result.voxel_centers and result.evaluation.best_face_values. INTERNAL / FAILED_PRECONDITION with the path on I/O
+// errors.
+Status WritePlanOutputs(const PlanResult& result, const std::string& out_dir, const UploadSummary* upload = nullptr,
+                        const std::vector<std::string>& fixed_station_names = {});
 
 // One point of a coloured PLY: its position (m), its colour and, when the PLY has one, its value.
 struct ColouredPoint {
@@ -74,9 +79,11 @@ ImageSize HeatmapImageSize(const PlanResult& result);
 // Size of reduction.png for a |P| x |P| matrix.
 ImageSize ReductionImageSize(int stations);
 
-// Parses a stations CSV ("x,y,z" per line, or a plan's stations.csv "x,y,z,route_order" whose
-// fourth column is ignored; optional header line, '#' comments). INVALID_ARGUMENT
-// naming `source` and the line on a malformed or non-finite row, or when there is no station.
+// Parses a stations CSV: "x,y,z" per line (an earlier plan's "x,y,z,route_order": the fourth column
+// ignored), or, after a header naming x, y and z columns ("x" or "x_m", any order, as a plan's
+// stations.csv does), those columns of each row, the others ignored; '#' comments; one optional
+// header line. INVALID_ARGUMENT naming `source` and the line on a malformed or non-finite row, or
+// when there is no station.
 Result<std::vector<WorldPoint>> ParseStationsCsv(std::string_view text, std::string_view source);
 
 }  // namespace vc

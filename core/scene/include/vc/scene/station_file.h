@@ -29,8 +29,9 @@ struct KnownStation {
 // The stations of `bytes`, in file order. `source` (the file name) labels messages and each
 // station's `source`. CSV and whitespace text: an optional header line whose columns name x, y, z
 // (any order, case-insensitive; a "_m" suffix allowed), and optionally yaw or heading (degrees;
-// "yaw_rad"/"heading_rad" for radians), roll and pitch (read, checked, not kept), name or id; other
-// columns are ignored. Without a header each line is "x y z [more...]". Fields split at ';', else
+// "yaw_rad"/"heading_rad" for radians), roll and pitch (read, checked, not kept), and a name (a
+// "name" column, else "id" or "station"); other columns are ignored, so a plan's own stations.csv
+// reads back with its names. Without a header each line is "x y z [more...]". Fields split at ';', else
 // ',', else whitespace; '#' starts a comment; a UTF-8 byte-order mark is skipped.
 // INVALID_ARGUMENT naming file:line (text) or file and scan (binary) for a malformed or non-finite
 // value, a file without stations, or binary content that is none of the formats above.
