@@ -1,6 +1,6 @@
-// Keep-out zones: the CSV parser (a good file; every kind of bad line named by file:line and what
-// is wrong), the checks, containment of boxes and polygons (boundary included), and the CSV line
-// read back exactly.
+// Keep-out zones: the CSV parser (a good file; a header and boxes without their kind; every kind
+// of bad line named by file:line and what is wrong), the checks, containment of boxes and polygons (boundary included),
+// and the CSV line read back exactly.
 #include "vc/plan/keep_out.h"
 
 #include <gtest/gtest.h>
