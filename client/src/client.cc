@@ -2,7 +2,11 @@
 
 #include <grpcpp/grpcpp.h>
 
+#include <cerrno>
+#include <cstring>
+#include <filesystem>
 #include <fstream>
+#include <optional>
 #include <sstream>
 #include <thread>
 
@@ -57,10 +61,63 @@ Status Local(const Status& s) {
 
 }  // namespace
 
+namespace {
+
+bool Contains(const std::string& text, std::string_view part) { return text.find(part) != std::string::npos; }
+
+// The host of "host:port", "[v6]:port" or "dns:///host:port".
+std::string HostOf(std::string server) {
+  if (const size_t scheme = server.find(":///"); scheme != std::string::npos) server.erase(0, scheme + 4);
+  if (server.starts_with("[")) return server.substr(1, server.find(']') - 1);
+  const size_t colon = server.rfind(':');
+  return colon == std::string::npos ? server : server.substr(0, colon);
+}
+
+bool UsesTls(const ConnectionOptions& o) { return o.tls || !o.tls_ca_file.empty() || !o.tls_cert_file.empty(); }
+
+}  // namespace
+
+std::optional<Status> PermanentConnectionError(const Status& s, const ConnectionOptions& options) {
+  if (s.code() != StatusCode::kUnavailable) return std::nullopt;
+  const std::string& m = s.message();
+  if (Contains(m, "DNS resolution failed")) {
+    return UnavailableError("cannot resolve host " + HostOf(options.server) +
+                            ": check the name in --server (or VC_SERVER) [" + m + "]");
+  }
+  if (!UsesTls(options)) return std::nullopt;
+  if (Contains(m, "WRONG_VERSION_NUMBER") || Contains(m, "wrong version number")) {
+    return UnavailableError("the server does not speak TLS: drop --tls (and --tls-ca, --tls-cert) [" + m + "]");
+  }
+  if (Contains(m, "CERTIFICATE_VERIFY_FAILED") || Contains(m, "certificate verify failed")) {
+    return UnavailableError(
+        "the server's TLS certificate is not trusted: give its CA with --tls-ca, or the name in it with "
+        "--tls-server-name [" +
+        m + "]");
+  }
+  return std::nullopt;
+}
+
 Result<Upload> ReadUpload(const std::string& path) {
-  VC_ASSIGN_OR_RETURN(std::string bytes, ReadFile(path, "the scene file"));
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) {
+    return InvalidArgumentError("the scene file " + path + " is a directory; give the file in it");
+  }
+  errno = 0;
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    const std::string why = errno != 0 ? std::strerror(errno) : "cannot open it";
+    return NotFoundError("cannot read the scene file " + path + ": " + why);
+  }
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  if (in.bad()) return NotFoundError("cannot read the scene file " + path + ": read error");
+  std::string bytes = std::move(ss).str();
+  if (bytes.empty()) {
+    return InvalidArgumentError("the scene file " + path +
+                                " is empty (0 bytes): nothing to upload; export the scene again");
+  }
   const auto slash = path.find_last_of('/');
-  return Upload{std::move(bytes), slash == std::string::npos ? path : path.substr(slash + 1)};
+  return Upload{std::move(bytes), slash == std::string::npos ? path : path.substr(slash + 1), ""};
 }
 
 Result<std::unique_ptr<Client>> Client::Create(const ConnectionOptions& options) {
@@ -104,7 +161,9 @@ Status Client::WithRetries(const JobObserver& observer, Fn&& attempt) {
   for (int i = 1;; ++i) {
     bool accepted = false;
     Status s = attempt(&accepted);
-    if (s.code() != StatusCode::kUnavailable || accepted || i >= options_.max_attempts) return s;
+    if (s.code() != StatusCode::kUnavailable || accepted) return s;
+    if (std::optional<Status> permanent = PermanentConnectionError(s, options_)) return *permanent;
+    if (i >= options_.max_attempts) return s;
     if (observer.on_retry) observer.on_retry(s, backoff);
     std::this_thread::sleep_for(backoff);
     backoff *= 2;

@@ -16,6 +16,7 @@
 
 #include "vc/client/client.h"
 #include "vc/client/compact_upload.h"
+#include "vc/client/did_you_mean.h"
 #include "vc/client/parameter_flags.h"
 #include "vc/client/plan_summary.h"
 #include "vc/client/progress_display.h"
@@ -32,6 +33,13 @@ namespace {
 // A local failure; the exit status is its gRPC code number.
 int Fail(const std::string& what, const vc::Status& s) {
   std::cerr << "vc-client: " << what << ": " << s.message() << "\n";
+  return int(vc::wire::ToGrpcCode(s.code()));
+}
+
+// A local failure whose message says it all (it names the flag or the file), found before any
+// connection; the exit status is its gRPC code number.
+int Fail(const vc::Status& s) {
+  std::cerr << "vc-client: " << s.message() << " (nothing was sent)\n";
   return int(vc::wire::ToGrpcCode(s.code()));
 }
 
@@ -333,48 +341,95 @@ int RunAttach(vc::client::Client& client, const CommandLine& cl) {
   return WritePlan(job->plan, cl.out_dir, nullptr);
 }
 
-// The scene's upload at `resolution_m`, announced on `display`.
-vc::client::PreparedUpload StartUpload(vc::client::Upload file_bytes, double resolution_m, const CommandLine& cl,
-                                       vc::client::ProgressDisplay& display) {
+// The scene file, read and checked here before any connection: refused when the server's reader
+// would refuse it too (compact_upload.h); the upload for it at `resolution_m` otherwise.
+vc::Result<vc::client::PreparedUpload> PrepareScene(const CommandLine& cl, double resolution_m) {
+  VC_ASSIGN_OR_RETURN(vc::client::Upload file_bytes, vc::client::ReadUpload(cl.file));
   file_bytes.units = cl.units;
-  vc::client::PreparedUpload prepared = vc::client::PrepareUpload(std::move(file_bytes), resolution_m, cl.raw_upload);
-  display.Note(vc::client::DescribeUpload(prepared.summary));
-  display.Uploading(prepared.upload.source_name, prepared.upload.bytes.size(), cl.conn.server);
-  return prepared;
+  return vc::client::PrepareUpload(std::move(file_bytes), resolution_m, cl.raw_upload);
 }
 
-int RunSubmit(vc::client::Client& client, const CommandLine& cl, InterruptCancelsTheJob* interrupt) {
-  auto file_bytes = vc::client::ReadUpload(cl.file);
-  if (!file_bytes.ok()) return Fail("cannot read the scene", file_bytes.status());
-  vc::PlanOptions plan = cl.plan;
-  if (vc::Status loaded = vc::client::LoadPlanFiles(cl.plan_files, &plan); !loaded.ok()) {
-    return Fail("bad input file", loaded);
-  }
+// Announces `prepared` on `display`.
+void AnnounceUpload(const vc::client::PreparedUpload& prepared, const CommandLine& cl,
+                    vc::client::ProgressDisplay& display) {
+  if (!prepared.format_note.empty()) display.Note(prepared.format_note);
+  display.Note(vc::client::DescribeUpload(prepared.summary));
+  display.Uploading(prepared.upload.source_name, prepared.upload.bytes.size(), cl.conn.server);
+}
+
+// Everything submit checks before it connects: the parameters and the files they name (by the
+// server's rules, named by flag), then the scene file.
+struct CheckedSubmit {
+  vc::PlanOptions plan;
+  vc::client::PreparedUpload prepared;
+};
+
+vc::Result<CheckedSubmit> CheckSubmit(const CommandLine& cl) {
+  CheckedSubmit checked{cl.plan, {}};
+  VC_ASSIGN_OR_RETURN(const vc::client::PlanFileLines lines, vc::client::LoadPlanFiles(cl.plan_files, &checked.plan));
+  VC_RETURN_IF_ERROR(checked.plan.Validate(vc::client::PlanFlagNamer(lines)));
+  VC_ASSIGN_OR_RETURN(checked.prepared, PrepareScene(cl, checked.plan.resolution_m));
+  return checked;
+}
+
+int RunSubmit(const CommandLine& cl, InterruptCancelsTheJob* interrupt) {
+  vc::Result<CheckedSubmit> checked = CheckSubmit(cl);
+  if (!checked.ok()) return Fail(checked.status());
+  auto client = vc::client::Client::Create(cl.conn);
+  if (!client.ok()) return Fail("cannot set up the connection", client.status());
   vc::client::ProgressDisplay display(stderr, isatty(fileno(stderr)) != 0);
-  vc::client::PreparedUpload prepared = StartUpload(std::move(file_bytes).value(), plan.resolution_m, cl, display);
-  auto r = client.Plan(prepared.upload, plan, Observe(display, interrupt));
+  vc::client::PreparedUpload& prepared = checked->prepared;
+  AnnounceUpload(prepared, cl, display);
+  auto r = (*client)->Plan(prepared.upload, checked->plan, Observe(display, interrupt));
   display.Done();
   if (!r.ok()) return FailCall("plan", r.status(), cl.conn.server);
-  NoteCache(client.last_upload(), &prepared.summary, display);
+  NoteCache((*client)->last_upload(), &prepared.summary, display);
   return WritePlan(*r, cl.out_dir, &prepared.summary, FixedStationNames(cl.plan_files.fixed_stations));
 }
 
-int RunEvaluate(vc::client::Client& client, const CommandLine& cl, InterruptCancelsTheJob* interrupt) {
-  auto file_bytes = vc::client::ReadUpload(cl.file);
-  if (!file_bytes.ok()) return Fail("cannot read the scene", file_bytes.status());
+// evaluate's counterpart of CheckSubmit.
+struct CheckedEvaluate {
+  vc::EvaluateJobOptions eval;
+  vc::client::PreparedUpload prepared;
+};
+
+vc::Result<CheckedEvaluate> CheckEvaluate(const CommandLine& cl) {
+  CheckedEvaluate checked{cl.eval, {}};
+  VC_ASSIGN_OR_RETURN(checked.eval.viewpoints, vc::client::LoadViewpoints(cl.viewpoints_csv));
+  VC_RETURN_IF_ERROR(checked.eval.Validate(vc::client::EvaluateFlagNamer()));
+  VC_ASSIGN_OR_RETURN(checked.prepared, PrepareScene(cl, checked.eval.resolution_m));
+  return checked;
+}
+
+int RunEvaluate(const CommandLine& cl, InterruptCancelsTheJob* interrupt) {
+  vc::Result<CheckedEvaluate> checked = CheckEvaluate(cl);
+  if (!checked.ok()) return Fail(checked.status());
+  auto client = vc::client::Client::Create(cl.conn);
+  if (!client.ok()) return Fail("cannot set up the connection", client.status());
   vc::client::ProgressDisplay display(stderr, isatty(fileno(stderr)) != 0);
-  vc::client::PreparedUpload prepared = StartUpload(std::move(file_bytes).value(), cl.eval.resolution_m, cl, display);
-  auto text = vc::client::ReadUpload(cl.viewpoints_csv);
-  if (!text.ok()) return Fail("cannot read the viewpoints", text.status());
-  auto points = vc::ParseStationsCsv(text->bytes, cl.viewpoints_csv);
-  if (!points.ok()) return Fail("bad viewpoints file", points.status());
-  vc::EvaluateJobOptions eval = cl.eval;
-  eval.viewpoints = std::move(points).value();
-  auto r = client.Evaluate(prepared.upload, eval, Observe(display, interrupt));
+  vc::client::PreparedUpload& prepared = checked->prepared;
+  AnnounceUpload(prepared, cl, display);
+  auto r = (*client)->Evaluate(prepared.upload, checked->eval, Observe(display, interrupt));
   display.Done();
   if (!r.ok()) return FailCall("evaluate", r.status(), cl.conn.server);
-  NoteCache(client.last_upload(), &prepared.summary, display);
-  return WriteEvaluation(*r, eval.viewpoints, cl.out_dir);
+  NoteCache((*client)->last_upload(), &prepared.summary, display);
+  return WriteEvaluation(*r, checked->eval.viewpoints, cl.out_dir);
+}
+
+// Parses the command line; on a mistake prints CLI11's message and, for a misspelt flag or
+// subcommand, the nearest known one. The exit status when the parse failed (or --help).
+std::optional<int> Parse(CLI::App& app, int argc, char** argv) {
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int code = app.exit(e);
+    if (code != 0) {
+      const std::string hint = vc::client::CommandLineHint(app, std::vector<std::string>(argv + 1, argv + argc));
+      if (!hint.empty()) std::cerr << "vc-client: " << hint << "\n";
+    }
+    return code;
+  }
+  return std::nullopt;
 }
 
 }  // namespace
@@ -387,7 +442,7 @@ int main(int argc, char** argv) {
   const Subcommands sub = AddCommands(app, &cl);
   vc::client::ValidateCommand validate;
   const CLI::App* validate_command = vc::client::AddValidateCommand(app, &validate);
-  CLI11_PARSE(app, argc, argv);
+  if (const std::optional<int> refused = Parse(app, argc, argv)) return *refused;
   cl.conn.timeout = std::chrono::milliseconds(int64_t(cl.timeout_s * 1000));
 
   if (*sub.scanners) return RunScanners();
@@ -398,12 +453,11 @@ int main(int argc, char** argv) {
   InterruptCancelsTheJob* interrupt = nullptr;  // never freed: its watcher thread lives as long as the process
   // (attach leaves SIGINT as it is: interrupting it stops following, and the job runs on.)
   if (*sub.submit || *sub.evaluate) interrupt = new InterruptCancelsTheJob(cl.conn);
+  if (*sub.submit) return RunSubmit(cl, interrupt);
+  if (*sub.evaluate) return RunEvaluate(cl, interrupt);
   auto client = vc::client::Client::Create(cl.conn);
   if (!client.ok()) return Fail("cannot set up the connection", client.status());
-
   if (*sub.health) return RunHealth(**client, cl);
   if (*sub.cancel) return RunCancel(**client, cl);
-  if (*sub.attach) return RunAttach(**client, cl);
-  if (*sub.submit) return RunSubmit(**client, cl, interrupt);
-  return RunEvaluate(**client, cl, interrupt);
+  return RunAttach(**client, cl);
 }

@@ -144,7 +144,8 @@ void AddPlanFileFlags(CLI::App* command, PlanFileFlags* files) {
                       "x,y,z (e.g. stations.csv, or a pose table x,y,z,roll,pitch,yaw), an E57 file or an "
                       "OctoMap .graph (its scans' origins), or a PCD file (its VIEWPOINT)");
   command->add_option("--keep-out", files->keep_out,
-                      "CSV of keep-out zones: box,xmin,ymin,zmin,xmax,ymax,zmax or polygon,zmin,zmax,x1,y1,...");
+                      "CSV of keep-out zones, one per line: xmin,ymin,zmin,xmax,ymax,zmax (a box; or box,xmin,...) or "
+                      "polygon,zmin,zmax,x1,y1,...; an optional header line");
   command->add_option("--start", files->start,
                       "where the walking route starts: x,y (m; the lowest floor) or x,y,z (the floor nearest z)");
 }
@@ -182,7 +183,8 @@ Result<WorldPoint> ParseStart(const std::string& text) {
 
 }  // namespace
 
-Status LoadPlanFiles(const PlanFileFlags& files, PlanOptions* o) {
+Result<PlanFileLines> LoadPlanFiles(const PlanFileFlags& files, PlanOptions* o) {
+  PlanFileLines lines;
   if (!files.candidates.empty()) {
     VC_ASSIGN_OR_RETURN(std::string text, ReadText(files.candidates, "candidates"));
     VC_ASSIGN_OR_RETURN(o->candidates, ParseStationsCsv(text, files.candidates));
@@ -194,12 +196,78 @@ Status LoadPlanFiles(const PlanFileFlags& files, PlanOptions* o) {
   }
   if (!files.keep_out.empty()) {
     VC_ASSIGN_OR_RETURN(std::string text, ReadText(files.keep_out, "keep-out"));
-    VC_ASSIGN_OR_RETURN(o->keep_out, ParseKeepOutCsv(text, files.keep_out));
+    VC_ASSIGN_OR_RETURN(KeepOutFile zones, ParseKeepOutFile(text, files.keep_out));
+    o->keep_out = std::move(zones.zones);
+    lines.keep_out = std::move(zones.lines);
   }
   if (!files.start.empty()) {
     VC_ASSIGN_OR_RETURN(o->route_start, ParseStart(files.start));
   }
-  return Status::Ok();
+  return lines;
 }
+
+Result<std::vector<WorldPoint>> LoadViewpoints(const std::string& path) {
+  VC_ASSIGN_OR_RETURN(const std::string text, ReadText(path, "viewpoints"));
+  return ParseStationsCsv(text, path);
+}
+
+namespace {
+
+// Each row's field path ("grid_spacing_m", "scanner.max_range_m") and its flag ("--grid-spacing").
+using FlagTable = std::map<std::string, std::string, std::less<>>;
+
+FlagTable ScannerFlags() {
+  FlagTable flags;
+#define VC_SCANNER_ROW_NAME(type, name, default_value, unit, flag, ...) flags.emplace("scanner." #name, "--" flag);
+  VC_SCANNER_PARAMETERS(VC_SCANNER_ROW_NAME)
+#undef VC_SCANNER_ROW_NAME
+  return flags;
+}
+
+// "keep_out[2]" as {"keep_out", 2}; {path, npos} when it has no index.
+std::pair<std::string_view, size_t> SplitIndex(std::string_view path) {
+  const size_t open = path.find('[');
+  if (open == std::string_view::npos || path.back() != ']') return {path, std::string_view::npos};
+  size_t index = 0;
+  for (char c : path.substr(open + 1, path.size() - open - 2)) {
+    if (c < '0' || c > '9') return {path, std::string_view::npos};
+    index = index * 10 + size_t(c - '0');
+  }
+  return {path.substr(0, open), index};
+}
+
+FieldNamer FlagNamer(FlagTable flags, PlanFileLines lines) {
+  return [flags = std::move(flags), lines = std::move(lines)](std::string_view path) -> std::string {
+    if (const auto row = flags.find(path); row != flags.end()) return row->second;
+    const auto [list, i] = SplitIndex(path);
+    if (i == std::string_view::npos) return path == "route_start" ? "--start" : std::string(path);
+    const std::string n = std::to_string(i + 1);
+    if (list == "keep_out") {
+      return "--keep-out " + (i < lines.keep_out.size() ? "line " + std::to_string(lines.keep_out[i]) : "zone " + n);
+    }
+    if (list == "fixed_stations") return "--fixed-stations station " + n;
+    if (list == "candidates") return "--candidates point " + n;
+    if (list == "tripod_heights_m") return "--tripod-heights value " + n;
+    return std::string(path);
+  };
+}
+
+}  // namespace
+
+#define VC_ROW_NAME(type, name, default_value, unit, flag, ...) flags.emplace(#name, "--" flag);
+
+FieldNamer PlanFlagNamer(PlanFileLines lines) {
+  FlagTable flags = ScannerFlags();
+  VC_PLAN_PARAMETERS(VC_ROW_NAME)
+  return FlagNamer(std::move(flags), std::move(lines));
+}
+
+FieldNamer EvaluateFlagNamer() {
+  FlagTable flags = ScannerFlags();
+  VC_EVALUATE_PARAMETERS(VC_ROW_NAME)
+  return FlagNamer(std::move(flags), {});
+}
+
+#undef VC_ROW_NAME
 
 }  // namespace vc::client

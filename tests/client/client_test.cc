@@ -1,10 +1,12 @@
 // vc::client::Client against an in-process server with a fake backend: the streamed result is
-// rebuilt exactly, events arrive, UNAVAILABLE is retried, Attach finds a job of either kind, and
-// CancelDetachedJob reaches the replica running the job.
+// rebuilt exactly, events arrive, UNAVAILABLE is retried (but not an unknown host or TLS against a
+// plain server), Attach finds a job of either kind, and CancelDetachedJob reaches the replica
+// running the job. ReadUpload refuses an empty or unreadable scene file.
 #include "vc/client/client.h"
 
 #include <gtest/gtest.h>
 
+#include <fstream>
 #include <thread>
 
 #include "testing/test_paths.h"
@@ -150,6 +152,90 @@ TEST(Client, UnavailableServerIsRetriedWithBackoffThenReported) {
   EXPECT_EQ(r.status().code(), StatusCode::kUnavailable);
   EXPECT_EQ(waits,
             (std::vector<std::chrono::milliseconds>{std::chrono::milliseconds(10), std::chrono::milliseconds(20)}));
+}
+
+// A server that is not there at that name, or does not speak TLS, will not be there on a retry:
+// both are reported at once, explained, with nothing uploaded.
+TEST(Client, TlsAgainstAPlainServerIsNotRetriedAndSaysDropTls) {
+  testing::BlockingBackend backend;
+  server::ServerOptions o;
+  o.workers = 1;
+  auto server = testing::StartServer(o, backend.Make());
+  ASSERT_TRUE(server);
+  client::ConnectionOptions conn;
+  conn.server = testing::Address(*server);
+  conn.tls = true;
+  conn.initial_backoff = std::chrono::milliseconds(10);
+  auto c = client::Client::Create(conn);
+  ASSERT_TRUE(c.ok());
+  int retries = 0;
+  client::JobObserver obs;
+  obs.on_retry = [&](const Status&, std::chrono::milliseconds) { ++retries; };
+  auto r = (*c)->Plan({"x", "x.ply", ""}, PlanOptions{}, obs);
+  EXPECT_EQ(r.status().code(), StatusCode::kUnavailable);
+  EXPECT_EQ(r.status().message().rfind("the server does not speak TLS: drop --tls", 0), 0u) << r.status().message();
+  EXPECT_EQ(retries, 0);
+  EXPECT_FALSE(backend.started.WaitFor(std::chrono::milliseconds(0)));
+  EXPECT_EQ((*c)->last_job().job_id, "");
+  // The same server without TLS is reached.
+  conn.tls = false;
+  EXPECT_TRUE(client::Client::Create(conn).value()->Health().ok());
+}
+
+TEST(Client, AnUnknownHostIsNotRetried) {
+  client::ConnectionOptions conn;
+  conn.server = "no-such-host.invalid:50051";
+  conn.initial_backoff = std::chrono::milliseconds(10);
+  auto c = client::Client::Create(conn);
+  ASSERT_TRUE(c.ok());
+  int retries = 0;
+  client::JobObserver obs;
+  obs.on_retry = [&](const Status&, std::chrono::milliseconds) { ++retries; };
+  auto r = (*c)->Plan({"x", "x.ply", ""}, PlanOptions{}, obs);
+  EXPECT_EQ(r.status().code(), StatusCode::kUnavailable);
+  EXPECT_EQ(r.status().message().rfind("cannot resolve host no-such-host.invalid: check the name in --server", 0), 0u)
+      << r.status().message();
+  EXPECT_EQ(retries, 0);
+}
+
+TEST(Client, OnlyPermanentConnectionErrorsAreExplained) {
+  client::ConnectionOptions plain;
+  plain.server = "dns:///scanner-hq.example:443";
+  client::ConnectionOptions tls = plain;
+  tls.tls = true;
+  const Status dns =
+      UnavailableError("DNS resolution failed for scanner-hq.example:443: C-ares status is not ARES_SUCCESS");
+  EXPECT_EQ(client::PermanentConnectionError(dns, plain)->message().rfind("cannot resolve host scanner-hq.example:", 0),
+            0u);
+  const Status version =
+      UnavailableError("failed to connect to all addresses; Ssl handshake failed: wrong version number");
+  EXPECT_EQ(client::PermanentConnectionError(version, tls)->message().rfind("the server does not speak TLS", 0), 0u);
+  EXPECT_FALSE(client::PermanentConnectionError(version, plain).has_value());
+  const Status trust = UnavailableError("Handshake failed: CERTIFICATE_VERIFY_FAILED");
+  EXPECT_NE(client::PermanentConnectionError(trust, tls)->message().find("--tls-ca"), std::string::npos);
+  // Transient: retried as before.
+  const Status refused = UnavailableError("failed to connect to all addresses; Connection refused");
+  EXPECT_FALSE(client::PermanentConnectionError(refused, tls).has_value());
+  EXPECT_FALSE(client::PermanentConnectionError(InvalidArgumentError("DNS resolution failed"), plain).has_value());
+}
+
+TEST(ReadUploadTest, EmptyAndUnreadableFilesAreRefusedPlainly) {
+  const std::string dir = testing::MakeTempDir();
+  const std::string empty = dir + "/empty.ply";
+  { std::ofstream(empty, std::ios::binary); }
+  Result<client::Upload> r = client::ReadUpload(empty);
+  EXPECT_EQ(r.status(), InvalidArgumentError("the scene file " + empty +
+                                             " is empty (0 bytes): nothing to upload; export the scene again"));
+  r = client::ReadUpload(dir + "/missing.ply");
+  EXPECT_EQ(r.status(), NotFoundError("cannot read the scene file " + dir + "/missing.ply: No such file or directory"));
+  r = client::ReadUpload(dir);
+  EXPECT_EQ(r.status(), InvalidArgumentError("the scene file " + dir + " is a directory; give the file in it"));
+  const std::string one = dir + "/one.xyz";
+  { std::ofstream(one, std::ios::binary) << "1 2 3\n"; }
+  r = client::ReadUpload(one);
+  ASSERT_TRUE(r.ok()) << r.status().ToString();
+  EXPECT_EQ(r->bytes, "1 2 3\n");
+  EXPECT_EQ(r->source_name, "one.xyz");
 }
 
 TEST(Client, MissingTlsFileIsNotFound) {

@@ -120,31 +120,33 @@ std::set<std::string> FieldNames(const google::protobuf::Descriptor* d) {
 
 TEST(ParameterTablesTest, EveryPlanRowIsAFlagAProtoFieldAPlanJsonKeyAndChecked) {
   const PlanOptions defaults;
-#define VC_PLAN_ROW(type, name, default_value, unit, flag, check, help)           \
-  {                                                                               \
-    SCOPED_TRACE(#name);                                                          \
-    const type other = Other(defaults.name, ParamCheck::check);                   \
-    ASSERT_NE(other, defaults.name);                                              \
-    PlanOptions parsed;                                                           \
-    CLI::App app;                                                                 \
-    client::AddPlanFlags(&app, &parsed);                                          \
-    app.parse(Args(flag, other), false);                                          \
-    EXPECT_EQ(parsed.name, other) << "flag --" << flag;                           \
-    PlanOptions o;                                                                \
-    o.name = other;                                                               \
-    Result<PlanOptions> back = wire::FromProto(wire::ToProto(o));                 \
-    ASSERT_TRUE(back.ok()) << back.status().ToString();                           \
-    EXPECT_EQ(back->name, other) << "proto field " #name;                         \
-    PlanResult r;                                                                 \
-    r.options = o;                                                                \
-    EXPECT_EQ(json::parse(PlanToJson(r))["parameters"][#name], JsonValue(other)); \
-    if (const auto bad = Bad(defaults.name, ParamCheck::check)) {                 \
-      PlanOptions b;                                                              \
-      b.name = *bad;                                                              \
-      const Status s = b.Validate();                                              \
-      EXPECT_EQ(s.code(), StatusCode::kInvalidArgument);                          \
-      EXPECT_NE(s.message().find(#name), std::string::npos) << s.message();       \
-    }                                                                             \
+#define VC_PLAN_ROW(type, name, default_value, unit, flag, check, help)                  \
+  {                                                                                      \
+    SCOPED_TRACE(#name);                                                                 \
+    const type other = Other(defaults.name, ParamCheck::check);                          \
+    ASSERT_NE(other, defaults.name);                                                     \
+    PlanOptions parsed;                                                                  \
+    CLI::App app;                                                                        \
+    client::AddPlanFlags(&app, &parsed);                                                 \
+    app.parse(Args(flag, other), false);                                                 \
+    EXPECT_EQ(parsed.name, other) << "flag --" << flag;                                  \
+    PlanOptions o;                                                                       \
+    o.name = other;                                                                      \
+    Result<PlanOptions> back = wire::FromProto(wire::ToProto(o));                        \
+    ASSERT_TRUE(back.ok()) << back.status().ToString();                                  \
+    EXPECT_EQ(back->name, other) << "proto field " #name;                                \
+    PlanResult r;                                                                        \
+    r.options = o;                                                                       \
+    EXPECT_EQ(json::parse(PlanToJson(r))["parameters"][#name], JsonValue(other));        \
+    if (const auto bad = Bad(defaults.name, ParamCheck::check)) {                        \
+      PlanOptions b;                                                                     \
+      b.name = *bad;                                                                     \
+      const Status s = b.Validate();                                                     \
+      EXPECT_EQ(s.code(), StatusCode::kInvalidArgument);                                 \
+      EXPECT_NE(s.message().find(#name), std::string::npos) << s.message();              \
+      const Status named = b.Validate(client::PlanFlagNamer());                          \
+      EXPECT_EQ(named.message().rfind("--" flag " must be ", 0), 0u) << named.message(); \
+    }                                                                                    \
   }
   VC_PLAN_PARAMETERS(VC_PLAN_ROW)
 #undef VC_PLAN_ROW
@@ -175,6 +177,14 @@ TEST(ParameterTablesTest, EveryScannerRowIsAFlagOfBothCommandsAProtoFieldAndChec
       ScannerModel b;                                                                        \
       b.name = *bad;                                                                         \
       EXPECT_NE(b.Validate().message().find("scanner." #name), std::string::npos);           \
+      PlanOptions p;                                                                         \
+      p.scanner.name = *bad;                                                                 \
+      const Status named = p.Validate(client::PlanFlagNamer());                              \
+      EXPECT_EQ(named.message().rfind("--" flag " must be ", 0), 0u) << named.message();     \
+      EvaluateJobOptions e;                                                                  \
+      e.viewpoints = {{0, 0, 0}};                                                            \
+      e.scanner.name = *bad;                                                                 \
+      EXPECT_EQ(e.Validate(client::EvaluateFlagNamer()).message().rfind("--" flag, 0), 0u);  \
     }                                                                                        \
   }
   VC_SCANNER_PARAMETERS(VC_SCANNER_ROW)
@@ -184,25 +194,27 @@ TEST(ParameterTablesTest, EveryScannerRowIsAFlagOfBothCommandsAProtoFieldAndChec
 TEST(ParameterTablesTest, EveryEvaluateRowIsAFlagAProtoFieldAndChecked) {
   EvaluateJobOptions defaults;
   defaults.viewpoints = {{0, 0, 0}};
-#define VC_EVALUATE_ROW(type, name, default_value, unit, flag, check, help)            \
-  {                                                                                    \
-    SCOPED_TRACE(#name);                                                               \
-    const type other = Other(defaults.name, ParamCheck::check);                        \
-    EvaluateJobOptions parsed;                                                         \
-    CLI::App app;                                                                      \
-    client::AddEvaluateFlags(&app, &parsed);                                           \
-    app.parse(Args(flag, other), false);                                               \
-    EXPECT_EQ(parsed.name, other) << "flag --" << flag;                                \
-    EvaluateJobOptions o = defaults;                                                   \
-    o.name = other;                                                                    \
-    EXPECT_EQ(wire::FromProto(wire::ToProto(o))->name, other) << "proto field " #name; \
-    if (const auto bad = Bad(defaults.name, ParamCheck::check)) {                      \
-      EvaluateJobOptions b = defaults;                                                 \
-      b.name = *bad;                                                                   \
-      const Status s = b.Validate();                                                   \
-      EXPECT_EQ(s.code(), StatusCode::kInvalidArgument);                               \
-      EXPECT_NE(s.message().find(#name), std::string::npos) << s.message();            \
-    }                                                                                  \
+#define VC_EVALUATE_ROW(type, name, default_value, unit, flag, check, help)              \
+  {                                                                                      \
+    SCOPED_TRACE(#name);                                                                 \
+    const type other = Other(defaults.name, ParamCheck::check);                          \
+    EvaluateJobOptions parsed;                                                           \
+    CLI::App app;                                                                        \
+    client::AddEvaluateFlags(&app, &parsed);                                             \
+    app.parse(Args(flag, other), false);                                                 \
+    EXPECT_EQ(parsed.name, other) << "flag --" << flag;                                  \
+    EvaluateJobOptions o = defaults;                                                     \
+    o.name = other;                                                                      \
+    EXPECT_EQ(wire::FromProto(wire::ToProto(o))->name, other) << "proto field " #name;   \
+    if (const auto bad = Bad(defaults.name, ParamCheck::check)) {                        \
+      EvaluateJobOptions b = defaults;                                                   \
+      b.name = *bad;                                                                     \
+      const Status s = b.Validate();                                                     \
+      EXPECT_EQ(s.code(), StatusCode::kInvalidArgument);                                 \
+      EXPECT_NE(s.message().find(#name), std::string::npos) << s.message();              \
+      const Status named = b.Validate(client::EvaluateFlagNamer());                      \
+      EXPECT_EQ(named.message().rfind("--" flag " must be ", 0), 0u) << named.message(); \
+    }                                                                                    \
   }
   VC_EVALUATE_PARAMETERS(VC_EVALUATE_ROW)
 #undef VC_EVALUATE_ROW
@@ -318,7 +330,7 @@ TEST(ListParametersTest, FixedStationsFromAnE57FilesScanOrigins) {
 
   e57[1500] ^= 1;
   files.fixed_stations = WriteTemp("damaged.e57", e57);
-  const Status s = client::LoadPlanFiles(files, &o);
+  const Status s = client::LoadPlanFiles(files, &o).status();
   EXPECT_EQ(s.code(), StatusCode::kInvalidArgument);
   EXPECT_NE(s.message().find("damaged.e57: E57 page 1"), std::string::npos) << s.message();
 }
@@ -329,7 +341,7 @@ TEST(ListParametersTest, FixedStationsFromAPoseCsvWithAHeader) {
   client::PlanFileFlags files;
   files.fixed_stations = WriteTemp("poses.csv", "name,x,y,z,roll,pitch,yaw\ns1,1,2,1.5,0,0,90\ns2,-4,0.5,1.7,1,2,3\n");
   PlanOptions o;
-  const Status s = client::LoadPlanFiles(files, &o);
+  const Status s = client::LoadPlanFiles(files, &o).status();
   ASSERT_TRUE(s.ok()) << s.ToString();
   ASSERT_EQ(o.fixed_stations.size(), 2u);
   EXPECT_EQ(o.fixed_stations[0], WorldPoint(1, 2, 1.5));
@@ -356,14 +368,14 @@ TEST(ListParametersTest, BadFilesAndZonesAreRefusedNamingWhere) {
   PlanOptions o;
   client::PlanFileFlags files;
   files.keep_out = WriteTemp("bad_keep_out.csv", "box,0,0,0,1,1,1\nbox,0,0,0,1,1\n");
-  Status s = client::LoadPlanFiles(files, &o);
+  Status s = client::LoadPlanFiles(files, &o).status();
   EXPECT_EQ(s.code(), StatusCode::kInvalidArgument);
   EXPECT_NE(s.message().find("bad_keep_out.csv:2"), std::string::npos) << s.message();
   files.keep_out = ::testing::TempDir() + "/no_such_file.csv";
-  EXPECT_EQ(client::LoadPlanFiles(files, &o).code(), StatusCode::kNotFound);
+  EXPECT_EQ(client::LoadPlanFiles(files, &o).status().code(), StatusCode::kNotFound);
   files = {};
   files.fixed_stations = WriteTemp("bad_fixed.csv", "1,2,3\n1,2\n");
-  s = client::LoadPlanFiles(files, &o);
+  s = client::LoadPlanFiles(files, &o).status();
   EXPECT_EQ(s.code(), StatusCode::kInvalidArgument);
   EXPECT_NE(s.message().find("bad_fixed.csv:2"), std::string::npos) << s.message();
   // A zone without a shape on the wire, and bad values the server's Validate refuses.
@@ -390,13 +402,60 @@ TEST(ListParametersTest, BadFilesAndZonesAreRefusedNamingWhere) {
   EXPECT_NE(s.message().find("tripod_heights_m[1]"), std::string::npos) << s.message();
 }
 
+// What vc-client checks before it uploads, with the server's rules (PlanOptions::Validate), in
+// the words of its command line: flags, units, the keep-out file's lines, a list's entries.
+TEST(PlanFlagNamerTest, TheServersRulesInTheUsersWords) {
+  PlanOptions o;
+  CLI::App app;
+  client::AddPlanFlags(&app, &o);
+  app.parse("--max-range -5", false);
+  EXPECT_EQ(o.Validate(client::PlanFlagNamer()), InvalidArgumentError("--max-range must be > 0 m, got -5"));
+  EXPECT_EQ(o.Validate(), InvalidArgumentError("scanner.max_range_m must be > 0 m, got -5"));  // the server's
+
+  PlanOptions c;
+  c.clearance_m = 2;
+  EXPECT_EQ(c.Validate(client::PlanFlagNamer()).message(),
+            "--clearance (2 m) must be smaller than --tripod-height (1.5 m): the scanner would touch the floor");
+  c = PlanOptions{};
+  c.tripod_heights_m = {1.5, 0.1};
+  EXPECT_EQ(c.Validate(client::PlanFlagNamer())
+                .message()
+                .rfind("--tripod-heights value 2 (0.1 m) must be larger than "
+                       "--clearance (0.2 m)",
+                       0),
+            0u);
+  c = PlanOptions{};
+  c.scanner.min_range_m = 9;
+  c.scanner.max_range_m = 8;
+  EXPECT_EQ(c.Validate(client::PlanFlagNamer()).message(), "--max-range (8 m) must be greater than --min-range (9 m)");
+  c = PlanOptions{};
+  c.route_start = WorldPoint(std::nan(""), 0, 0);
+  EXPECT_EQ(c.Validate(client::PlanFlagNamer()).message().rfind("--start needs finite x and y", 0), 0u);
+}
+
+TEST(PlanFlagNamerTest, AKeepOutConflictIsNamedByFlagAndLine) {
+  client::PlanFileFlags files;
+  files.keep_out =
+      WriteTemp("conflict_zones.csv", "xmin,ymin,zmin,xmax,ymax,zmax\n# the crane\n0,0,0,1,1,3\n5,5,0,6,6,3\n");
+  files.fixed_stations = WriteTemp("conflict_fixed.csv", "x,y,z\n10,10,1.5\n5.5,5.5,1.5\n");
+  PlanOptions o;
+  Result<client::PlanFileLines> lines = client::LoadPlanFiles(files, &o);
+  ASSERT_TRUE(lines.ok()) << lines.status().ToString();
+  EXPECT_EQ(lines->keep_out, (std::vector<size_t>{3, 4}));
+  EXPECT_EQ(o.Validate(client::PlanFlagNamer(*lines)).message(),
+            "--keep-out line 4: --fixed-stations station 2 (5.5, 5.5, 1.5) lies inside this zone");
+  EXPECT_EQ(o.Validate().message(), "keep_out[1]: fixed_stations[1] (5.5, 5.5, 1.5) lies inside this zone");
+  o.keep_out[0].min.x() = 2;  // a zone the wire could carry: min above max
+  EXPECT_EQ(o.Validate(client::PlanFlagNamer(*lines)).message(), "--keep-out line 3: box xmin (2) exceeds xmax (1)");
+}
+
 TEST(ListParametersTest, StartIsXYOrXYZAndAnythingElseIsRefused) {
   auto load = [](const std::string& start, PlanOptions* o) {
     client::PlanFileFlags files;
     CLI::App app;
     client::AddPlanFileFlags(&app, &files);
     app.parse("--start " + start, false);
-    return client::LoadPlanFiles(files, o);
+    return client::LoadPlanFiles(files, o).status();
   };
   PlanOptions o;
   ASSERT_TRUE(load("1.5,-2", &o).ok());

@@ -131,6 +131,15 @@ assert s["name"] == "leica-rtc360", s
 assert s["max_range_m"] == 40 and s["min_range_m"] == 0.5 and s["vfov_min_deg"] == -60, s
 PY
 
+# --tls against this plain server: no retry (it cannot mend), and the message says what to do.
+set +e
+"$client_bin" --tls --retries 4 submit "$work/box.ply" --server "$addr" --out "$work/out5" >/dev/null 2>"$work/err5"
+rc=$?
+set -e
+[[ $rc -eq 14 ]] || fail "--tls against a plain server exited $rc, expected 14 ($(cat "$work/err5"))"
+grep -q "the server does not speak TLS: drop --tls" "$work/err5" || fail "--tls message: $(cat "$work/err5")"
+if grep -q "retrying" "$work/err5"; then fail "--tls against a plain server was retried: $(cat "$work/err5")"; fi
+
 # SIGTERM: the server drains and exits 0.
 stop_server
 

@@ -13,14 +13,20 @@ std::string Num(double v) {
   return buf;
 }
 
-// "must be a finite number > 0 (m)" for the row's check and unit.
+// Units a bound reads well with ("> 0 m", ">= 0 stations"); a fraction's interval and a ratio's
+// "x" say what they are without one.
+bool UnitFollowsBound(std::string_view unit) { return !unit.empty() && unit != "fraction" && unit != "x"; }
+
+// "must be > 0 m, got -5" for the row's check and unit.
 Status Refuse(const ParamInfo& info, std::string_view prefix, const char* requirement, const std::string& got) {
   std::string m = std::string(prefix) + std::string(info.name) + " must be " + requirement;
-  if (!info.unit.empty()) m += " (" + std::string(info.unit) + ")";
+  if (info.check != ParamCheck::kAny && UnitFollowsBound(info.unit)) m += " " + std::string(info.unit);
   return InvalidArgumentError(m + ", got " + got);
 }
 
 }  // namespace
+
+std::string NameOf(const FieldNamer& namer, std::string_view path) { return namer ? namer(path) : std::string(path); }
 
 Status CheckParameter(const ParamInfo& info, double v, std::string_view prefix) {
   switch (info.check) {
@@ -28,10 +34,10 @@ Status CheckParameter(const ParamInfo& info, double v, std::string_view prefix) 
       if (!std::isfinite(v)) return Refuse(info, prefix, "a finite number", Num(v));
       break;
     case ParamCheck::kNonNegative:
-      if (!std::isfinite(v) || v < 0) return Refuse(info, prefix, "a finite number >= 0", Num(v));
+      if (!std::isfinite(v) || v < 0) return Refuse(info, prefix, ">= 0", Num(v));
       break;
     case ParamCheck::kPositive:
-      if (!std::isfinite(v) || v <= 0) return Refuse(info, prefix, "a finite number > 0", Num(v));
+      if (!std::isfinite(v) || v <= 0) return Refuse(info, prefix, "> 0", Num(v));
       break;
     case ParamCheck::kFraction:
       if (!std::isfinite(v) || v <= 0 || v > 1) return Refuse(info, prefix, "in (0, 1]", Num(v));

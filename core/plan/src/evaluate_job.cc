@@ -5,7 +5,7 @@
 
 namespace vc {
 
-Status EvaluateJobOptions::Validate() const {
+Status EvaluateJobOptions::Validate(const FieldNamer& namer) const {
   if (viewpoints.empty()) {
     return InvalidArgumentError("no viewpoint to evaluate; give at least one (e.g. --viewpoints stations.csv)");
   }
@@ -14,13 +14,13 @@ Status EvaluateJobOptions::Validate() const {
       return InvalidArgumentError("viewpoint " + std::to_string(i) + " has a non-finite coordinate");
     }
   }
-#define VC_CHECK_ROW(type, name, ...) \
-  VC_RETURN_IF_ERROR(CheckParameter(VC_PARAMETER_INFO(type, name, __VA_ARGS__), name));
+#define VC_CHECK_ROW(type, row, ...) \
+  VC_RETURN_IF_ERROR(CheckNamedParameter(VC_PARAMETER_INFO(type, row, __VA_ARGS__), row, namer));
   VC_EVALUATE_PARAMETERS(VC_CHECK_ROW)
 #undef VC_CHECK_ROW
-  VC_RETURN_IF_ERROR(scanner.Validate());
+  VC_RETURN_IF_ERROR(scanner.Validate(namer));
   if (scanner.HasHorizontalFieldOfView()) {
-    return InvalidArgumentError("scanner.hfov_deg is " + std::to_string(scanner.hfov_deg) +
+    return InvalidArgumentError(NameOf(namer, "scanner.hfov_deg") + " is " + std::to_string(scanner.hfov_deg) +
                                 " deg, but evaluated viewpoints carry no heading; leave hfov_deg at 360");
   }
   return Status::Ok();

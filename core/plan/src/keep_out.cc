@@ -130,9 +130,69 @@ int KeepOutZoneContaining(const std::vector<KeepOutZone>& zones, const WorldPoin
   return -1;
 }
 
-Result<std::vector<KeepOutZone>> ParseKeepOutCsv(std::string_view text, std::string_view source) {
-  std::vector<KeepOutZone> zones;
+namespace {
+
+// fields[first...] as numbers; INVALID_ARGUMENT naming `where` and the first that is not one,
+// counted from 1 in the line.
+Result<std::vector<double>> Numbers(const std::vector<std::string_view>& fields, size_t first,
+                                    const std::string& where) {
+  std::vector<double> values(fields.size() - first);
+  for (size_t i = first; i < fields.size(); ++i) {
+    std::string_view f = fields[i];
+    if (!f.empty() && f.front() == '+') f.remove_prefix(1);
+    const auto result = std::from_chars(f.data(), f.data() + f.size(), values[i - first]);
+    if (f.empty() || result.ec != std::errc() || result.ptr != f.data() + f.size()) {
+      return InvalidArgumentError(where + ": field " + std::to_string(i + 1) + " " + Quoted(fields[i]) +
+                                  " is not a number");
+    }
+  }
+  return values;
+}
+
+bool IsNumber(std::string_view f) {
+  if (!f.empty() && f.front() == '+') f.remove_prefix(1);
+  double v = 0;
+  const auto result = std::from_chars(f.data(), f.data() + f.size(), v);
+  return !f.empty() && result.ec == std::errc() && result.ptr == f.data() + f.size();
+}
+
+// One zone from a line's fields: `box,...`, `polygon,...` or six numbers (a box without its kind).
+Result<KeepOutZone> ParseZone(const std::vector<std::string_view>& fields, const std::string& where) {
+  std::string kind(fields[0]);
+  for (char& c : kind) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  if (IsNumber(fields[0])) {
+    if (fields.size() != 6) {
+      return InvalidArgumentError(where + ": a box without its kind has 6 numbers (xmin,ymin,zmin,xmax,ymax,zmax); " +
+                                  "this line has " + std::to_string(fields.size()) + " fields");
+    }
+    VC_ASSIGN_OR_RETURN(const std::vector<double> v, Numbers(fields, 0, where));
+    return KeepOutBox(WorldPoint(v[0], v[1], v[2]), WorldPoint(v[3], v[4], v[5]));
+  }
+  if (kind != "box" && kind != "polygon") {
+    return InvalidArgumentError(where + ": unknown zone kind " + Quoted(fields[0]) +
+                                "; use box, polygon, or six numbers for a box");
+  }
+  VC_ASSIGN_OR_RETURN(const std::vector<double> values, Numbers(fields, 1, where));
+  if (kind == "box") {
+    if (values.size() != 6) {
+      return InvalidArgumentError(where + ": a box has 7 fields (box,xmin,ymin,zmin,xmax,ymax,zmax); this line has " +
+                                  std::to_string(fields.size()));
+    }
+    return KeepOutBox(WorldPoint(values[0], values[1], values[2]), WorldPoint(values[3], values[4], values[5]));
+  }
+  if (values.size() < 2) {
+    return InvalidArgumentError(where + ": a polygon needs zmin,zmax and at least 3 vertices " +
+                                "(polygon,zmin,zmax,x1,y1,x2,y2,x3,y3,...)");
+  }
+  return KeepOutPolygon(values[0], values[1], std::vector<double>(values.begin() + 2, values.end()));
+}
+
+}  // namespace
+
+Result<KeepOutFile> ParseKeepOutFile(std::string_view text, std::string_view source) {
+  KeepOutFile file;
   size_t line_no = 0;
+  bool first = true;
   while (!text.empty()) {
     const size_t eol = text.find('\n');
     std::string_view line = text.substr(0, eol);
@@ -141,6 +201,7 @@ Result<std::vector<KeepOutZone>> ParseKeepOutCsv(std::string_view text, std::str
     const std::string where = std::string(source) + ":" + std::to_string(line_no);
     if (const size_t hash = line.find('#'); hash != std::string_view::npos) line = line.substr(0, hash);
     line = Trim(line);
+    if (line_no == 1 && line.substr(0, 3) == "\xEF\xBB\xBF") line = Trim(line.substr(3));  // a UTF-8 byte-order mark
     if (line.empty()) continue;
     std::vector<std::string_view> fields;
     for (size_t start = 0;;) {
@@ -149,38 +210,25 @@ Result<std::vector<KeepOutZone>> ParseKeepOutCsv(std::string_view text, std::str
       if (comma == std::string_view::npos) break;
       start = comma + 1;
     }
-    std::string kind(fields[0]);
-    for (char& c : kind) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-    std::vector<double> values(fields.size() - 1);
-    for (size_t i = 1; i < fields.size(); ++i) {
-      std::string_view f = fields[i];
-      if (!f.empty() && f.front() == '+') f.remove_prefix(1);
-      const auto result = std::from_chars(f.data(), f.data() + f.size(), values[i - 1]);
-      if (f.empty() || result.ec != std::errc() || result.ptr != f.data() + f.size()) {
-        return InvalidArgumentError(where + ": field " + std::to_string(i + 1) + " " + Quoted(fields[i]) +
-                                    " is not a number");
-      }
-    }
-    KeepOutZone zone;
-    if (kind == "box") {
-      if (values.size() != 6) {
-        return InvalidArgumentError(where + ": a box has 7 fields (box,xmin,ymin,zmin,xmax,ymax,zmax); this line has " +
-                                    std::to_string(fields.size()));
-      }
-      zone = KeepOutBox(WorldPoint(values[0], values[1], values[2]), WorldPoint(values[3], values[4], values[5]));
-    } else if (kind == "polygon") {
-      if (values.size() < 2) {
-        return InvalidArgumentError(where + ": a polygon needs zmin,zmax and at least 3 vertices " +
-                                    "(polygon,zmin,zmax,x1,y1,x2,y2,x3,y3,...)");
-      }
-      zone = KeepOutPolygon(values[0], values[1], std::vector<double>(values.begin() + 2, values.end()));
-    } else {
-      return InvalidArgumentError(where + ": unknown zone kind " + Quoted(fields[0]) + "; use box or polygon");
-    }
+    // A header: the first line, when none of its fields is a number or a zone kind.
+    const bool header = first && std::none_of(fields.begin(), fields.end(), [](std::string_view f) {
+                          std::string lower(f);
+                          for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+                          return IsNumber(f) || lower == "box" || lower == "polygon";
+                        });
+    first = false;
+    if (header) continue;
+    VC_ASSIGN_OR_RETURN(KeepOutZone zone, ParseZone(fields, where));
     VC_RETURN_IF_ERROR(ValidateKeepOutZone(zone, where));
-    zones.push_back(std::move(zone));
+    file.zones.push_back(std::move(zone));
+    file.lines.push_back(line_no);
   }
-  return zones;
+  return file;
+}
+
+Result<std::vector<KeepOutZone>> ParseKeepOutCsv(std::string_view text, std::string_view source) {
+  VC_ASSIGN_OR_RETURN(KeepOutFile file, ParseKeepOutFile(text, source));
+  return std::move(file.zones);
 }
 
 std::string KeepOutCsvLine(const KeepOutZone& zone) {

@@ -65,43 +65,23 @@ Result<SceneInput> FromOctree(Result<std::shared_ptr<octomap::OcTree>> read, Inp
   return in;
 }
 
-Result<SceneInput> ReadDecompressed(std::string_view bytes, std::string_view source, const ReadOptions& options) {
-  if (bytes.empty()) return readers::InvalidInput(source, "input is empty (0 bytes)");
-  if (StartsWith(bytes, "# Octomap OcTree binary file")) {
-    VC_RETURN_IF_ERROR(CheckOctreeUnits(source, options));
-    return FromOctree(ReadOctreeBinary(bytes, source, options.max_result_bytes), InputFormat::kOctomapBinary);
+Result<SceneInput> ReadE57Input(std::string_view bytes, std::string_view source, const ReadOptions& options) {
+  Result<readers::E57Cloud> e57 = readers::ReadE57(bytes, source, options);
+  if (!e57.ok()) return e57.status();
+  std::vector<Eigen::Vector3d> origins;
+  for (const E57Scan& scan : e57->scans) origins.push_back(e57->cloud.frame.ToLocal(scan.translation_m));
+  if (e57->cloud.points.empty()) {
+    return readers::InvalidInput(source, e57->cloud.detail + ": no valid, finite point (" +
+                                             std::to_string(e57->cloud.dropped_nonfinite) +
+                                             " non-finite); the cloud is empty");
   }
-  if (StartsWith(bytes, "# Octomap OcTree file")) {
-    VC_RETURN_IF_ERROR(CheckOctreeUnits(source, options));
-    return FromOctree(ReadOctreeText(bytes, source, options.max_result_bytes), InputFormat::kOctomapText);
-  }
-  if (readers::LooksLikeVoxelStream(bytes)) return readers::ReadVoxelStream(bytes, source, options);
-  if (readers::LooksLikePly(bytes)) {
-    return FromCloud(readers::ReadPly(bytes, source, options), InputFormat::kPly, source);
-  }
-  if (readers::LooksLikeLas(bytes)) {
-    return FromCloud(readers::ReadLas(bytes, source, options), InputFormat::kLas, source);
-  }
-  if (LooksLikeE57(bytes)) {
-    Result<readers::E57Cloud> e57 = readers::ReadE57(bytes, source, options);
-    if (!e57.ok()) return e57.status();
-    std::vector<Eigen::Vector3d> origins;
-    for (const E57Scan& scan : e57->scans) origins.push_back(e57->cloud.frame.ToLocal(scan.translation_m));
-    if (e57->cloud.points.empty()) {
-      return readers::InvalidInput(source, e57->cloud.detail + ": no valid, finite point (" +
-                                               std::to_string(e57->cloud.dropped_nonfinite) +
-                                               " non-finite); the cloud is empty");
-    }
-    VC_ASSIGN_OR_RETURN(SceneInput in, FromCloud(std::move(e57->cloud), InputFormat::kE57, source));
-    in.scan_origins = std::move(origins);
-    return in;
-  }
-  if (readers::LooksLikePcd(bytes)) {
-    return FromCloud(readers::ReadPcd(bytes, source, options), InputFormat::kPcd, source);
-  }
-  if (readers::LooksLikeText(bytes)) {
-    return FromCloud(readers::ReadXyz(bytes, source, options), InputFormat::kXyz, source);
-  }
+  VC_ASSIGN_OR_RETURN(SceneInput in, FromCloud(std::move(e57->cloud), InputFormat::kE57, source));
+  in.scan_origins = std::move(origins);
+  return in;
+}
+
+// Binary content with no magic of its own, read as an OctoMap ScanGraph.
+Result<SceneInput> ReadGraphInput(std::string_view bytes, std::string_view source, const ReadOptions& options) {
   Result<ScanGraphData> graph = ReadScanGraph(bytes, source, options.metres_per_unit);
   if (!graph.ok()) {
     std::string why = graph.status().message();
@@ -131,7 +111,48 @@ Result<SceneInput> ReadDecompressed(std::string_view bytes, std::string_view sou
   return in;
 }
 
+Result<SceneInput> ReadDecompressed(std::string_view bytes, std::string_view source, const ReadOptions& options) {
+  if (bytes.empty()) return readers::InvalidInput(source, "input is empty (0 bytes)");
+  switch (DetectInputFormat(bytes)) {
+    case InputFormat::kOctomapBinary:
+      VC_RETURN_IF_ERROR(CheckOctreeUnits(source, options));
+      return FromOctree(ReadOctreeBinary(bytes, source, options.max_result_bytes), InputFormat::kOctomapBinary);
+    case InputFormat::kOctomapText:
+      VC_RETURN_IF_ERROR(CheckOctreeUnits(source, options));
+      return FromOctree(ReadOctreeText(bytes, source, options.max_result_bytes), InputFormat::kOctomapText);
+    case InputFormat::kVoxelStream:
+      return readers::ReadVoxelStream(bytes, source, options);
+    case InputFormat::kPly:
+      return FromCloud(readers::ReadPly(bytes, source, options), InputFormat::kPly, source);
+    case InputFormat::kLas:
+      return FromCloud(readers::ReadLas(bytes, source, options), InputFormat::kLas, source);
+    case InputFormat::kE57:
+      return ReadE57Input(bytes, source, options);
+    case InputFormat::kPcd:
+      return FromCloud(readers::ReadPcd(bytes, source, options), InputFormat::kPcd, source);
+    case InputFormat::kXyz:
+      return FromCloud(readers::ReadXyz(bytes, source, options), InputFormat::kXyz, source);
+    case InputFormat::kOctomapGraph:
+      break;
+  }
+  return ReadGraphInput(bytes, source, options);
+}
+
 }  // namespace
+
+InputFormat DetectInputFormat(std::string_view bytes) {
+  if (StartsWith(bytes, "# Octomap OcTree binary file")) return InputFormat::kOctomapBinary;
+  if (StartsWith(bytes, "# Octomap OcTree file")) return InputFormat::kOctomapText;
+  if (readers::LooksLikeVoxelStream(bytes)) return InputFormat::kVoxelStream;
+  if (readers::LooksLikePly(bytes)) return InputFormat::kPly;
+  if (readers::LooksLikeLas(bytes)) return InputFormat::kLas;
+  if (LooksLikeE57(bytes)) return InputFormat::kE57;
+  if (readers::LooksLikePcd(bytes)) return InputFormat::kPcd;
+  if (readers::LooksLikeText(bytes)) return InputFormat::kXyz;
+  return InputFormat::kOctomapGraph;
+}
+
+Compression DetectCompression(std::string_view bytes) { return readers::DetectCompression(bytes); }
 
 std::string_view InputFormatName(InputFormat format) {
   switch (format) {

@@ -14,7 +14,9 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <cstdio>
 #include <optional>
+#include <string>
 
 #include "vc/base/parallel.h"
 #include "vc/base/popcount.h"
@@ -107,24 +109,29 @@ std::string_view SelectionTestName(SelectionTest t) {
   return t == SelectionTest::kCompatibility ? "compatibility" : "surface";
 }
 
-Status ScannerModel::Validate() const {
-#define VC_CHECK_ROW(type, name, ...) \
-  VC_RETURN_IF_ERROR(CheckParameter(VC_PARAMETER_INFO(type, name, __VA_ARGS__), name, "scanner."));
+Status ScannerModel::Validate(const FieldNamer& namer) const {
+  const auto name = [&namer](std::string_view path) { return NameOf(namer, path); };
+  const auto num = [](double v) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%g", v);
+    return std::string(text);
+  };
+#define VC_CHECK_ROW(type, row, ...) \
+  VC_RETURN_IF_ERROR(CheckNamedParameter(VC_PARAMETER_INFO(type, row, __VA_ARGS__), row, namer, "scanner."));
   VC_SCANNER_PARAMETERS(VC_CHECK_ROW)
 #undef VC_CHECK_ROW
   if (max_range_m <= min_range_m) {
-    return InvalidArgumentError("scanner.max_range_m (" + std::to_string(max_range_m) +
-                                " m) must be greater than scanner.min_range_m (" + std::to_string(min_range_m) + " m)");
+    return InvalidArgumentError(name("scanner.max_range_m") + " (" + num(max_range_m) + " m) must be greater than " +
+                                name("scanner.min_range_m") + " (" + num(min_range_m) + " m)");
   }
   if (vfov_max_deg <= vfov_min_deg) {
-    return InvalidArgumentError("scanner.vfov_max_deg (" + std::to_string(vfov_max_deg) +
-                                " deg) must be greater than scanner.vfov_min_deg (" + std::to_string(vfov_min_deg) +
-                                " deg)");
+    return InvalidArgumentError(name("scanner.vfov_max_deg") + " (" + num(vfov_max_deg) +
+                                " deg) must be greater than " + name("scanner.vfov_min_deg") + " (" +
+                                num(vfov_min_deg) + " deg)");
   }
   if (max_spacing_m > 0 && !(angular_step_deg > 0)) {
-    return InvalidArgumentError(
-        "scanner.max_spacing_m is set but scanner.angular_step_deg is 0; give the instrument's angular step "
-        "(--angular-step) or a preset (--scanner)");
+    return InvalidArgumentError(name("scanner.max_spacing_m") + " is set but " + name("scanner.angular_step_deg") +
+                                " is 0; give the instrument's angular step (--angular-step) or a preset (--scanner)");
   }
   return Status::Ok();
 }

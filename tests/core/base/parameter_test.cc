@@ -46,13 +46,36 @@ TEST(CheckParameterTest, DoublesAtAndPastEachBound) {
 
 TEST(CheckParameterTest, TheMessageNamesPrefixParameterRequirementUnitAndValue) {
   Status s = CheckParameter(Info(ParamCheck::kPositive), -2.5, "scanner.");
-  EXPECT_EQ(s.message(), "scanner.spacing_m must be a finite number > 0 (m), got -2.5");
+  EXPECT_EQ(s.message(), "scanner.spacing_m must be > 0 m, got -2.5");
+  s = CheckParameter(Info(ParamCheck::kPositive), std::nan(""));
+  EXPECT_EQ(s.message(), "spacing_m must be > 0 m, got nan");
   s = CheckParameter(Info(ParamCheck::kFraction, ""), 1.5);
   EXPECT_EQ(s.message(), "spacing_m must be in (0, 1], got 1.5");
+  s = CheckParameter(Info(ParamCheck::kFraction, "fraction"), 1.5);
+  EXPECT_EQ(s.message(), "spacing_m must be in (0, 1], got 1.5");
+  s = CheckParameter(Info(ParamCheck::kElevationDeg, "deg"), 91.0);
+  EXPECT_EQ(s.message(), "spacing_m must be in [-90, 90] deg, got 91");
+  s = CheckParameter(Info(ParamCheck::kAny), kInf);
+  EXPECT_EQ(s.message(), "spacing_m must be a finite number, got inf");
   s = CheckParameter(Info(ParamCheck::kNonNegative, "voxels"), int64_t{-3});
-  EXPECT_EQ(s.message(), "spacing_m must be >= 0 (voxels), got -3");
+  EXPECT_EQ(s.message(), "spacing_m must be >= 0 voxels, got -3");
   s = CheckParameter(Info(ParamCheck::kPositive, "bytes"), uint64_t{0});
-  EXPECT_EQ(s.message(), "spacing_m must be > 0 (bytes), got 0");
+  EXPECT_EQ(s.message(), "spacing_m must be > 0 bytes, got 0");
+}
+
+// The client's names: the same check, the field shown as the namer says (a flag), the path
+// (prefix + name) as it is without a namer.
+TEST(CheckNamedParameterTest, TheNamerChoosesTheName) {
+  const FieldNamer flags = [](std::string_view path) {
+    return path == "scanner.spacing_m" ? std::string("--spacing") : "?" + std::string(path);
+  };
+  EXPECT_EQ(CheckNamedParameter(Info(ParamCheck::kPositive), -5.0, flags, "scanner.").message(),
+            "--spacing must be > 0 m, got -5");
+  EXPECT_EQ(CheckNamedParameter(Info(ParamCheck::kPositive), -5.0, FieldNamer(), "scanner.").message(),
+            "scanner.spacing_m must be > 0 m, got -5");
+  EXPECT_TRUE(CheckNamedParameter(Info(ParamCheck::kPositive), 5.0, flags).ok());
+  EXPECT_EQ(NameOf(flags, "x"), "?x");
+  EXPECT_EQ(NameOf(FieldNamer(), "keep_out[2]"), "keep_out[2]");
 }
 
 TEST(CheckParameterTest, SignedIntegersAtAndPastEachBound) {

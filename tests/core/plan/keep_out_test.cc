@@ -1,6 +1,6 @@
-// Keep-out zones: the CSV parser (a good file; every kind of bad line named by file:line and what
-// is wrong), the checks, containment of boxes and polygons (boundary included), and the CSV line
-// read back exactly.
+// Keep-out zones: the CSV parser (a good file; a header and boxes without their kind; every kind
+// of bad line named by file:line and what is wrong), the checks, containment of boxes and polygons (boundary included),
+// and the CSV line read back exactly.
 #include "vc/plan/keep_out.h"
 
 #include <gtest/gtest.h>
@@ -35,6 +35,45 @@ TEST(KeepOutCsvTest, ParsesBoxesPolygonsCommentsAndBlankLines) {
   EXPECT_TRUE(ParseKeepOutCsv("# nothing\n\n", "empty.csv")->empty());
 }
 
+// A header line (only the first line that is not blank or a comment) and boxes as six plain
+// numbers, as a spreadsheet exports them, beside the kinds; each zone knows its line.
+TEST(KeepOutCsvTest, TakesAHeaderAndBoxesWithoutTheirKind) {
+  const std::string text =
+      "\xEF\xBB\xBF# exported\n"
+      "xmin,ymin,zmin,xmax,ymax,zmax\n"
+      "0,0,-1,2,3,4\n"
+      "\n"
+      " 5 , 5 , 0 , 6 , 6 , 1 \n"
+      "box,7,7,0,8,8,1\n"
+      "polygon,0,1,0,0,1,0,0,1\n";
+  Result<KeepOutFile> file = ParseKeepOutFile(text, "zones.csv");
+  ASSERT_TRUE(file.ok()) << file.status().ToString();
+  ASSERT_EQ(file->zones.size(), 4u);
+  EXPECT_EQ(file->lines, (std::vector<size_t>{3, 5, 6, 7}));
+  EXPECT_EQ(file->zones[0].shape, KeepOutShape::kBox);
+  EXPECT_EQ(file->zones[0].min, WorldPoint(0, 0, -1));
+  EXPECT_EQ(file->zones[0].max, WorldPoint(2, 3, 4));
+  EXPECT_EQ(file->zones[1].min, WorldPoint(5, 5, 0));
+  EXPECT_EQ(file->zones[1].max, WorldPoint(6, 6, 1));
+  EXPECT_EQ(file->zones[3].shape, KeepOutShape::kPolygon);
+
+  Result<std::vector<KeepOutZone>> with_kind =
+      ParseKeepOutCsv("kind,xmin,ymin,zmin,xmax,ymax,zmax\nbox,0,0,0,1,1,1\n", "k.csv");
+  ASSERT_TRUE(with_kind.ok()) << with_kind.status().ToString();
+  EXPECT_EQ(with_kind->size(), 1u);
+  EXPECT_TRUE(ParseKeepOutCsv("xmin,ymin,zmin,xmax,ymax,zmax\n", "header-only.csv")->empty());
+}
+
+TEST(KeepOutCsvTest, OnlyTheFirstLineMayBeAHeader) {
+  Result<std::vector<KeepOutZone>> zones = ParseKeepOutCsv("box,0,0,0,1,1,1\nxmin,ymin,zmin,xmax,ymax,zmax\n", "z.csv");
+  ASSERT_FALSE(zones.ok());
+  EXPECT_EQ(zones.status().message(), "z.csv:2: unknown zone kind 'xmin'; use box, polygon, or six numbers for a box");
+  // A typo in the kind is not a header: the line has numbers.
+  zones = ParseKeepOutCsv("boks,0,0,0,1,1,1\n", "z.csv");
+  ASSERT_FALSE(zones.ok());
+  EXPECT_EQ(zones.status().message(), "z.csv:1: unknown zone kind 'boks'; use box, polygon, or six numbers for a box");
+}
+
 struct BadLine {
   const char* line;
   const char* what;  // a part of the message
@@ -58,6 +97,10 @@ TEST(KeepOutCsvTest, EveryBadLineIsNamedByFileLineAndWhatIsWrong) {
       {"polygon,0,2,0,0,nan,0,1,1", "vertex 2 x is not finite"},
       {"circle,0,0,1", "unknown zone kind 'circle'"},
       {",0,0,0,1,1,1", "unknown zone kind ''"},
+      {"0,0,0,1,1", "a box without its kind has 6 numbers (xmin,ymin,zmin,xmax,ymax,zmax); this line has 5 fields"},
+      {"0,0,0,1,1,1,1", "a box without its kind has 6 numbers"},
+      {"0,0,0,1,x,1", "field 5 'x' is not a number"},
+      {"0,0,3,1,1,1", "zmin (3) exceeds zmax (1)"},
   };
   for (const BadLine& c : cases) {
     SCOPED_TRACE(c.line);

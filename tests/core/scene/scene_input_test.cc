@@ -64,6 +64,22 @@ TEST(SceneInputTest, Names) {
   EXPECT_EQ(CompressionName(Compression::kBzip2), "bzip2");
 }
 
+// The format comes from the content, whatever the name: DetectInputFormat is ReadScene's own
+// dispatch, so what it says is what ReadScene reads.
+TEST(SceneInputTest, DetectInputFormatIsWhatReadSceneReads) {
+  EXPECT_EQ(DetectInputFormat(kPly), InputFormat::kPly);
+  EXPECT_EQ(DetectInputFormat(kXyz), InputFormat::kXyz);
+  EXPECT_EQ(DetectInputFormat("# Octomap OcTree binary file\n"), InputFormat::kOctomapBinary);
+  EXPECT_EQ(DetectInputFormat("# Octomap OcTree file\n"), InputFormat::kOctomapText);
+  EXPECT_EQ(DetectInputFormat(std::string("\x01\x00\x00\x00\xff", 5)), InputFormat::kOctomapGraph);
+  Result<SceneInput> renamed = ReadScene(kXyz, "cloud.ply");
+  ASSERT_TRUE(renamed.ok()) << renamed.status().ToString();
+  EXPECT_EQ(renamed->format, DetectInputFormat(kXyz));
+  EXPECT_EQ(DetectCompression(Gzip(kXyz)), Compression::kGzip);
+  EXPECT_EQ(DetectCompression(Bzip2(kPly)), Compression::kBzip2);
+  EXPECT_EQ(DetectCompression(kPly), Compression::kNone);
+}
+
 TEST(SceneInputTest, EmptyInput) {
   Result<SceneInput> r = ReadScene("", "upload");
   ASSERT_FALSE(r.ok());

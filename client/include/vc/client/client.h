@@ -5,12 +5,15 @@
 // Failures are vc::Status values: the call's gRPC status mapped by vc::wire::FromGrpcStatus (same
 // google.rpc.Code, same message), or DATA_LOSS / INTERNAL for a stream that does not add up.
 // Transient UNAVAILABLE failures before the server accepted the job are retried with exponential
-// backoff; every other status is returned as it came. Not thread-safe; use one per thread.
+// backoff; permanent ones (PermanentConnectionError: an unknown host, TLS against a server that
+// does not speak it) are returned at once, explained; every other status is returned as it came. Not thread-safe; use
+// one per thread.
 #pragma once
 
 #include <chrono>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -116,7 +119,16 @@ struct Upload {
   std::string units;
 };
 
-// Reads a file into an Upload. NOT_FOUND if it cannot be read.
+// A connection failure that retrying cannot mend, explained, still UNAVAILABLE: a host name that
+// does not resolve ("cannot resolve host nosuch.example: check the name in --server ..."), and,
+// with TLS on, a server that does not speak TLS ("the server does not speak TLS: drop --tls ...")
+// or a certificate the client does not trust; gRPC's own words follow in [...]. nullopt for any
+// other status (connection refused, a server restarting: transient, retried).
+[[nodiscard]] std::optional<Status> PermanentConnectionError(const Status& s, const ConnectionOptions& options);
+
+// Reads a scene file into an Upload, before any connection. NOT_FOUND when it cannot be read
+// ("cannot read the scene file x.ply: Permission denied"); INVALID_ARGUMENT when it is empty or a
+// directory.
 Result<Upload> ReadUpload(const std::string& path);
 
 // Cancels `ticket`'s job the way a client about to exit does: on the replica running it (its

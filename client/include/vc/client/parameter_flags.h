@@ -11,6 +11,7 @@
 
 #include <CLI/CLI.hpp>
 #include <string>
+#include <vector>
 
 #include "vc/base/status.h"
 #include "vc/plan/evaluate_job.h"
@@ -46,9 +47,26 @@ struct PlanFileFlags {
 // Binds --candidates, --fixed-stations, --keep-out and --start to `files` (which must outlive the
 // parse).
 void AddPlanFileFlags(CLI::App* command, PlanFileFlags* files);
+// Where LoadPlanFiles found the zones, for messages that name them by line.
+struct PlanFileLines {
+  std::vector<size_t> keep_out;  // keep_out[i]: the line of zone i in the --keep-out file
+};
 // Reads the files named in `files` into options->candidates, fixed_stations and keep_out, and the
 // start into options->route_start (z NaN when only x,y is given). NOT_FOUND / INVALID_ARGUMENT
 // (naming file:line, or --start) from reading and parsing.
-[[nodiscard]] Status LoadPlanFiles(const PlanFileFlags& files, PlanOptions* options);
+[[nodiscard]] Result<PlanFileLines> LoadPlanFiles(const PlanFileFlags& files, PlanOptions* options);
+
+// evaluate's --viewpoints file (stations.csv format). NOT_FOUND / INVALID_ARGUMENT (naming
+// file:line) from reading and parsing.
+[[nodiscard]] Result<std::vector<WorldPoint>> LoadViewpoints(const std::string& path);
+
+// The names vc-client's messages give the fields PlanOptions::Validate and
+// EvaluateJobOptions::Validate check (vc/base/parameter.h, FieldNamer): each row by its flag
+// ("scanner.max_range_m" -> "--max-range"), a keep-out zone by its line ("keep_out[0]" ->
+// "--keep-out line 2"), a list entry by its place ("fixed_stations[0]" -> "--fixed-stations
+// station 1", "tripod_heights_m[1]" -> "--tripod-heights value 2"), route_start as --start. So
+// the client checks before it uploads, with the server's own rules, in the user's words.
+[[nodiscard]] FieldNamer PlanFlagNamer(PlanFileLines lines = {});
+[[nodiscard]] FieldNamer EvaluateFlagNamer();
 
 }  // namespace vc::client

@@ -19,6 +19,8 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
+#include <string>
 #include <string_view>
 #include <type_traits>
 
@@ -47,7 +49,9 @@ struct ParamInfo {
   std::string_view help;  // one line for --help and docs
 };
 
-// INVALID_ARGUMENT "<prefix><name> must be ..., got <value>" when `value` fails info.check.
+// INVALID_ARGUMENT "<prefix><name> must be <requirement> <unit>, got <value>" when `value` fails
+// info.check ("scanner.max_range_m must be > 0 m, got -5"); the unit is left out where the
+// requirement says it ("fraction", "x") and for kAny ("must be a finite number").
 Status CheckParameter(const ParamInfo& info, double value, std::string_view prefix = "");
 Status CheckParameter(const ParamInfo& info, int64_t value, std::string_view prefix = "");
 Status CheckParameter(const ParamInfo& info, uint64_t value, std::string_view prefix = "");
@@ -60,6 +64,24 @@ concept UncheckedParameter = std::is_enum_v<T> || std::is_same_v<T, bool>;
 template <UncheckedParameter T>
 Status CheckParameter(const ParamInfo&, T, std::string_view = "") {
   return Status::Ok();
+}
+
+// How validation messages name a field: given its path as the proto and plan.json name it
+// ("grid_spacing_m", "scanner.max_range_m", "keep_out[2]", "tripod_heights_m[0]"), the name to
+// show. Empty shows the path (the server). vc-client shows its flags ("--max-range", "--keep-out
+// line 4"; PlanFlagNamer in client/src/parameter_flags.cc), so the client and the server apply the
+// same rules and only the names differ.
+using FieldNamer = std::function<std::string(std::string_view path)>;
+
+// `path` as `namer` shows it.
+[[nodiscard]] std::string NameOf(const FieldNamer& namer, std::string_view path);
+
+// CheckParameter naming the field `prefix` + info.name as `namer` shows it.
+template <typename T>
+Status CheckNamedParameter(ParamInfo info, T value, const FieldNamer& namer, std::string_view prefix = "") {
+  const std::string shown = NameOf(namer, std::string(prefix) + std::string(info.name));
+  info.name = shown;
+  return CheckParameter(info, value);
 }
 
 }  // namespace vc

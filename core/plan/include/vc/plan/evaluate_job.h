@@ -38,7 +38,8 @@ struct EvaluateJobOptions {
 
   // INVALID_ARGUMENT naming the first bad parameter: no viewpoint, a non-finite viewpoint, a row's
   // check or the scanner's, a scanner hfov_deg below 360 (viewpoints here carry no heading).
-  Status Validate() const;
+  // Fields are named as `namer` shows them (vc/base/parameter.h).
+  Status Validate(const FieldNamer& namer = {}) const;
   // The voxelisation and evaluation options this job runs with (exact mode keeps no face values).
   VoxelizeOptions voxelize_options() const;
   EvaluateOptions evaluate_options() const;

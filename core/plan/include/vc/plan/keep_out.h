@@ -46,11 +46,21 @@ struct KeepOutZone {
 // Index of the first zone containing p, or -1.
 [[nodiscard]] int KeepOutZoneContaining(const std::vector<KeepOutZone>& zones, const WorldPoint& p);
 
-// Parses the keep-out CSV (docs/PLANNING.md): one zone per line, `box,xmin,ymin,zmin,xmax,ymax,zmax`
-// or `polygon,zmin,zmax,x1,y1,x2,y2,x3,y3,...`; `#` starts a comment; blank lines are skipped;
-// fields may carry spaces. INVALID_ARGUMENT naming `source:line` and what is wrong (an unknown
-// kind, a wrong number of fields, a field that is not a number, NaN or infinity, min > max, fewer
-// than 3 polygon vertices).
+// A keep-out CSV's zones, each with the line (from 1) it was read from.
+struct KeepOutFile {
+  std::vector<KeepOutZone> zones;
+  std::vector<size_t> lines;  // lines[i]: the line of zones[i]
+};
+
+// Parses the keep-out CSV (docs/PLANNING.md): one zone per line, `box,xmin,ymin,zmin,xmax,ymax,zmax`,
+// `xmin,ymin,zmin,xmax,ymax,zmax` (a box without its kind) or `polygon,zmin,zmax,x1,y1,x2,y2,x3,
+// y3,...`; the first line is a header, and skipped, when none of its fields is a number or a kind
+// (`kind,xmin,ymin,...`); `#` starts a comment; blank lines are skipped; fields may carry spaces; a
+// UTF-8 byte-order mark is skipped. INVALID_ARGUMENT naming `source:line` and what is wrong (an
+// unknown kind, a wrong number of fields, a field that is not a number, NaN or infinity,
+// min > max, fewer than 3 polygon vertices).
+[[nodiscard]] Result<KeepOutFile> ParseKeepOutFile(std::string_view text, std::string_view source);
+// ParseKeepOutFile's zones.
 [[nodiscard]] Result<std::vector<KeepOutZone>> ParseKeepOutCsv(std::string_view text, std::string_view source);
 
 // One line of that CSV for `zone` (no newline); ParseKeepOutCsv reads it back exactly (%.17g).

@@ -104,8 +104,10 @@ struct PlanOptions {
   // tripod_heights_m entry), refine_step_m > refine_radius_m with refine on (local_candidates_step_m
   // > local_candidates_radius_m with local_candidates on), a bad keep-out zone, a
   // non-finite fixed station or one inside a keep-out zone, a route_start with a non-finite x or y
-  // or an infinite z.
-  Status Validate() const;
+  // or an infinite z. A fixed station inside a zone is named after the zone ("keep_out[1]:
+  // fixed_stations[0] (x, y, z) lies inside this zone"). Fields are named as `namer` shows them
+  // (vc/base/parameter.h; empty: by their paths, "scanner.max_range_m", "keep_out[0]").
+  Status Validate(const FieldNamer& namer = {}) const;
 };
 
 // `options` with every position (candidates, keep-out zones, fixed stations, route start) moved

@@ -119,6 +119,12 @@ struct SceneInput {
 // (never an exception).
 Result<SceneInput> ReadScene(std::string_view bytes, std::string_view source_name, const ReadOptions& options = {});
 
+// The format ReadScene reads uncompressed `bytes` as, from their first bytes (its own dispatch):
+// binary content with no magic of its own is tried as an OctoMap ScanGraph (kOctomapGraph).
+[[nodiscard]] InputFormat DetectInputFormat(std::string_view bytes);
+// The compression ReadScene finds around `bytes` (gzip, bzip2 magic; kNone otherwise).
+[[nodiscard]] Compression DetectCompression(std::string_view bytes);
+
 // Reads a whole file and calls ReadScene. NOT_FOUND if it cannot be opened.
 Result<SceneInput> ReadSceneFile(const std::string& path, const ReadOptions& options = {});
 

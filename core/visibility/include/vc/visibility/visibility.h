@@ -68,8 +68,8 @@ struct ScannerModel {
   std::string name{};
   // INVALID_ARGUMENT naming the field ("scanner.max_range_m ..."): a row's check,
   // min_range_m >= max_range_m, vfov_min_deg >= vfov_max_deg, or max_spacing_m without
-  // angular_step_deg.
-  Status Validate() const;
+  // angular_step_deg. Fields are named as `namer` shows them (vc/base/parameter.h).
+  Status Validate(const FieldNamer& namer = {}) const;
   // Whether a limit other than the range is on.
   bool HasVerticalFieldOfView() const { return vfov_min_deg > -90.0 || vfov_max_deg < 90.0; }
   bool HasIncidenceLimit() const { return max_incidence_deg < 90.0; }
