@@ -25,9 +25,11 @@
 #include <vector>
 
 #include "cover_model.h"
+#include "progress_pacer.h"
 #include "vc/plan/greedy.h"
 #include "vc/plan/lagrangian_bound.h"
 #include "vc/plan/scan_graph.h"
+#include "vc/plan/stage_runner.h"
 
 namespace vc::planner {
 namespace {
@@ -37,6 +39,10 @@ using internal::ReducedModel;
 using internal::ScanArc;
 using internal::WarmStart;
 using Clock = std::chrono::steady_clock;
+
+// The selection stage's progress fraction at the end of greedy (with consolidation), of the voxel
+// classes and of the model reduction; CBC's time limit fills the rest.
+constexpr double kGreedyShare = 0.3, kClassesEnd = 0.4, kReductionEnd = 0.5;
 
 double SecondsSince(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
@@ -69,8 +75,20 @@ Result<Classes> BuildClasses(const std::vector<VoxelSet>& sets, const JobContext
   std::vector<int32_t> cls(n_voxels, 0);
   std::vector<int32_t> remap(1, -1), stamp(1, -1);
   int32_t next = 1;
+  // Two passes over the candidates, counted as one.
+  const uint64_t steps = 2 * sets.size();
+  internal::ProgressPacer pacer;
+  auto report = [&](uint64_t done) {
+    if (!pacer.Due()) return;
+    std::string note = "exact: voxel classes";
+    if (const std::string left = pacer.TimeLeft(done, steps); !left.empty()) note += ", " + left;
+    ctx.ReportCount(Stage::kSelection, done, steps, "candidate passes", std::move(note));
+  };
   for (size_t c = 0; c < sets.size(); ++c) {
-    if (c % 64 == 0) VC_RETURN_IF_ERROR(ctx.CheckCancelled("exact selection (voxel classes)"));
+    if (c % 64 == 0) {
+      VC_RETURN_IF_ERROR(ctx.CheckCancelled("exact selection (voxel classes)"));
+      report(c);
+    }
     ForEachBit(sets[c], [&](size_t v) {
       const int32_t old = cls[v];
       if (stamp[old] != static_cast<int32_t>(c)) {
@@ -98,6 +116,10 @@ Result<Classes> BuildClasses(const std::vector<VoxelSet>& sets, const JobContext
   out.sees.resize(sets.size());
   std::vector<int32_t> last(out.weight.size(), -1);
   for (size_t c = 0; c < sets.size(); ++c) {
+    if (c % 64 == 0) {
+      VC_RETURN_IF_ERROR(ctx.CheckCancelled("exact selection (voxel classes)"));
+      report(sets.size() + c);
+    }
     ForEachBit(sets[c], [&](size_t v) {
       const int32_t k = compact[cls[v]];
       if (last[k] == static_cast<int32_t>(c)) return;
@@ -170,9 +192,24 @@ Result<ReducedModel> Reduce(const Classes& cl, int n_candidates, int fixed, bool
   }
   std::vector<int> active_sees(n_candidates, 0);
   std::vector<int32_t> mark(n_classes, -1);
+  // Rounds run until nothing changes: each advances through what the rounds before it left, so the
+  // fraction never falls although the number of rounds is not known.
+  internal::ProgressPacer pacer;
+  int round = 0;
+  double done_before = 0;
+  auto report = [&](uint64_t checked, uint64_t total) {
+    if (!ctx.progress || !pacer.Due()) return;
+    std::string note =
+        "exact: model reduction round " + std::to_string(round) + " (" + std::to_string(m.dominated) + " dominated)";
+    if (const std::string left = pacer.TimeLeft(checked, total); !left.empty()) note += ", " + left + " in this round";
+    const double fraction = done_before + (1.0 - done_before) * (total ? double(checked) / double(total) : 0.0);
+    ctx.progress(ProgressEvent{Stage::kSelection, fraction, std::move(note), checked, total, "candidates"});
+  };
   bool changed = true;
   while (changed) {
     changed = false;
+    ++round;
+    pacer.Restart();
     VC_RETURN_IF_ERROR(ctx.CheckCancelled("exact selection (model reduction)"));
     // Candidates that see no class still to cover add nothing.
     for (int c = 0; c < n_candidates; ++c) {
@@ -211,7 +248,10 @@ Result<ReducedModel> Reduce(const Classes& cl, int n_candidates, int fixed, bool
     std::sort(order.begin(), order.end(),
               [&](int a, int b) { return active_sees[a] != active_sees[b] ? active_sees[a] < active_sees[b] : a > b; });
     for (size_t i = 0; i < order.size(); ++i) {
-      if (i % 256 == 0) VC_RETURN_IF_ERROR(ctx.CheckCancelled("exact selection (model reduction)"));
+      if (i % 256 == 0) {
+        VC_RETURN_IF_ERROR(ctx.CheckCancelled("exact selection (model reduction)"));
+        report(i, order.size());
+      }
       const int a = order[i];
       // The class of a with the fewest candidates still active bounds who can dominate a.
       int rarest = -1;
@@ -239,6 +279,7 @@ Result<ReducedModel> Reduce(const Classes& cl, int n_candidates, int fixed, bool
         }
       }
     }
+    done_before += (1.0 - done_before) / 2;  // a full round done, another may follow
   }
   AssembleColumns(cl, active_class, active, m);
   return m;
@@ -787,8 +828,9 @@ Result<Selection> ExactRun::Select() {
       return SelectOverBudget(nullptr, nullptr, target_ - fixed_cover, at_least);
     }
   }
-  VC_ASSIGN_OR_RETURN(Classes cl, BuildClasses(sets_, ctx_));
-  VC_ASSIGN_OR_RETURN(ReducedModel m, Reduce(cl, n, fixed_, full && !connect_, connect_, ctx_));
+  VC_ASSIGN_OR_RETURN(Classes cl, BuildClasses(sets_, ProgressRange(ctx_, kGreedyShare, kClassesEnd)));
+  VC_ASSIGN_OR_RETURN(ReducedModel m, Reduce(cl, n, fixed_, full && !connect_, connect_,
+                                             ProgressRange(ctx_, kClassesEnd, kReductionEnd)));
   opt.forced = m.forced_sole_view;
   opt.dominated = m.dominated;
   const uint64_t need = target_ - std::min(target_, m.forced_covered);  // voxels the columns must add
@@ -808,7 +850,8 @@ Result<Selection> ExactRun::Select() {
   if (model.station_cols().count == 0 || (!max_mode_ && need == 0)) return FinishForced(m, need);
   const uint64_t estimate = model.EstimatedBytes();
   if (estimate > options_.memory_budget_bytes) return SelectOverBudget(&cl, &m, need, estimate);
-  VC_ASSIGN_OR_RETURN(CbcOutcome outcome, SolveWithCbc(model, greedy_picks_, n, start_, options_.time_limit_s, ctx_));
+  VC_ASSIGN_OR_RETURN(CbcOutcome outcome, SolveWithCbc(model, greedy_picks_, n, start_, options_.time_limit_s,
+                                                       ProgressRange(ctx_, kReductionEnd, 1.0)));
   return Read(model, outcome);
 }
 
@@ -1040,7 +1083,8 @@ Result<Selection> ExactSelector::Select(const std::vector<VoxelSet>& sets, int f
                                 std::to_string(options_.time_limit_s));
   }
   // The greedy plan: the warm start, the floor, and the argument checks.
-  VC_ASSIGN_OR_RETURN(Selection greedy, GreedySelector(options_.greedy).Select(sets, fixed, ctx));
+  VC_ASSIGN_OR_RETURN(Selection greedy,
+                      GreedySelector(options_.greedy).Select(sets, fixed, ProgressRange(ctx, 0.0, kGreedyShare)));
   return ExactRun(options_, sets, fixed, ctx, start, std::move(greedy)).Select();
 }
 

@@ -9,6 +9,7 @@
 #include <string>
 #include <unordered_map>
 
+#include "progress_pacer.h"
 #include "vc/plan/scan_graph.h"
 
 namespace vc::planner {
@@ -447,17 +448,46 @@ class Consolidation {
   Result<ConsolidateResult> Run() {
     while (true) {
       VC_RETURN_IF_ERROR(ctx_.CheckCancelled("consolidation"));
+      ++pass_;
+      pairs_ = picks_.size() * (picks_.size() - 1) / 2;
+      pacer_.Restart();
+      ReportPass(0);
       CountCoverage();
-      if (DropOne()) continue;
+      if (DropOne()) {
+        EndPass(0);
+        continue;
+      }
       VC_ASSIGN_OR_RETURN(const bool merged, MergeOne());
       if (!merged) break;
     }
+    ctx_.Report(Stage::kSelection, 1.0, PassNote() + ", done");
     out_.picks = std::move(picks_);
     return std::move(out_);
   }
 
  private:
   bool IsFixed(int candidate) const { return candidate < fixed_; }
+
+  // "consolidation pass 2 (1 dropped, 0 merged)".
+  std::string PassNote() const {
+    return "consolidation pass " + std::to_string(pass_) + " (" + std::to_string(out_.dropped) + " dropped, " +
+           std::to_string(out_.merged) + " merged)";
+  }
+  // The fraction after `checked` of this pass's pairs: each pass advances through what the passes
+  // before it left, so the fraction never falls although the number of passes is not known.
+  double Fraction(uint64_t checked) const {
+    return pairs_ == 0 ? done_before_ : done_before_ + (1.0 - done_before_) * double(checked) / double(pairs_);
+  }
+  // `checked` of this pass's pairs of picks, and the time left in this pass at the rate so far.
+  void ReportPass(uint64_t checked) const {
+    if (!ctx_.progress) return;
+    std::string note = PassNote();
+    if (const std::string left = pacer_.TimeLeft(checked, pairs_); !left.empty()) note += ", " + left + " in this pass";
+    ctx_.progress(
+        ProgressEvent{Stage::kSelection, Fraction(checked), std::move(note), checked, pairs_, "pairs of picks"});
+  }
+  // A pass that changed the picks after `checked` pairs: the next one starts where it stopped.
+  void EndPass(uint64_t checked) { done_before_ = Fraction(checked); }
 
   // A pick's words (a sparse pick is made dense once).
   const std::vector<uint64_t>& Words(int pick) {
@@ -543,12 +573,16 @@ class Consolidation {
   }
 
   // Replaces the first pair of picks (in pick order) one candidate can stand in for.
+  // Checks cancellation after every pair and reports at most once per pacer interval.
   Result<bool> MergeOne() {
+    uint64_t checked = 0;
     for (size_t a = 0; a < picks_.size(); ++a) {
-      VC_RETURN_IF_ERROR(ctx_.CheckCancelled("consolidation"));
-      if (IsFixed(picks_[a])) continue;
-      for (size_t b = a + 1; b < picks_.size(); ++b) {
-        if (!IsFixed(picks_[b]) && MergePair(a, b)) return true;
+      for (size_t b = a + 1; b < picks_.size(); ++b, ++checked) {
+        VC_RETURN_IF_ERROR(ctx_.CheckCancelled("consolidation"));
+        if (pacer_.Due()) ReportPass(checked);
+        if (IsFixed(picks_[a]) || IsFixed(picks_[b]) || !MergePair(a, b)) continue;
+        EndPass(checked + 1);
+        return true;
       }
     }
     return false;
@@ -636,6 +670,10 @@ class Consolidation {
   std::vector<uint64_t> c1_, c2_, c3_, rest_;
   std::vector<size_t> nonzero_;  // the words where rest_ has a voxel
   ConsolidateResult out_;
+  int pass_ = 0;                   // 1-based number of the pass running
+  uint64_t pairs_ = 0;             // pairs of picks in this pass
+  double done_before_ = 0;         // the progress fraction this pass started at
+  internal::ProgressPacer pacer_;  // within a pass
 };
 
 }  // namespace

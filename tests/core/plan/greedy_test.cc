@@ -5,7 +5,10 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <numeric>
 #include <random>
+#include <string>
+#include <vector>
 
 namespace vc::planner {
 namespace {
@@ -309,6 +312,75 @@ TEST(ConsolidateTest, NeverLosesCoverageNorAddsPicks) {
     saved += static_cast<int>(greedy.size() - merged.size());
   }
   EXPECT_GT(saved, 0);  // the instances exercised it
+}
+
+// `pairs` pairs of half-rooms, each pair seen whole by one more candidate: consolidation merges one
+// pair per pass, so it takes pairs + 1 passes. The picks are the half-rooms (0 .. 2 pairs - 1).
+std::vector<VoxelSet> HalfRoomPairs(int pairs) {
+  const size_t n = size_t(pairs) * 8;
+  std::vector<VoxelSet> sets;
+  for (int p = 0; p < pairs; ++p) {
+    VoxelSet left(n), right(n);
+    for (size_t v = 0; v < 4; ++v) left.set(size_t(p) * 8 + v);
+    for (size_t v = 4; v < 8; ++v) right.set(size_t(p) * 8 + v);
+    sets.push_back(left);
+    sets.push_back(right);
+  }
+  for (int p = 0; p < pairs; ++p) {
+    VoxelSet whole(n);
+    for (size_t v = 0; v < 8; ++v) whole.set(size_t(p) * 8 + v);
+    sets.push_back(whole);
+  }
+  return sets;
+}
+
+std::vector<int> FirstPicks(int count) {
+  std::vector<int> picks(size_t(count), 0);
+  std::iota(picks.begin(), picks.end(), 0);
+  return picks;
+}
+
+TEST(ConsolidateTest, ReportsEveryPassWithCountsAndRisingFractions) {
+  const std::vector<VoxelSet> sets = HalfRoomPairs(6);
+  std::vector<ProgressEvent> events;
+  JobContext ctx;
+  ctx.progress = [&](const ProgressEvent& e) { events.push_back(e); };
+  Result<ConsolidateResult> r = ConsolidatePicks(sets, FirstPicks(12), {}, ctx);
+  ASSERT_TRUE(r.ok());
+  EXPECT_EQ(r->merged, 6);
+  std::vector<std::string> passes_seen;
+  for (size_t i = 0; i < events.size(); ++i) {
+    const ProgressEvent& e = events[i];
+    EXPECT_EQ(e.stage, Stage::kSelection);
+    EXPECT_NE(e.message.find("consolidation pass "), std::string::npos) << e.message;
+    if (i > 0) EXPECT_GE(e.fraction, events[i - 1].fraction) << "event " << i << ": " << e.message;
+    if (e.unit.empty()) continue;
+    EXPECT_EQ(e.unit, "pairs of picks");
+    EXPECT_LE(e.done, e.total);
+    if (e.done == 0) passes_seen.push_back(e.message.substr(0, e.message.find(" (")));
+  }
+  // 12 picks (66 pairs) in the first pass, one fewer per merge, and a last pass that changes nothing.
+  EXPECT_EQ(events.front().total, 66u);
+  ASSERT_FALSE(passes_seen.empty());
+  EXPECT_EQ(passes_seen.back(), "consolidation pass 7");
+  EXPECT_EQ(events.back().fraction, 1.0);
+  EXPECT_NE(events.back().message.find("6 merged"), std::string::npos) << events.back().message;
+}
+
+TEST(ConsolidateTest, CancelledDuringAPassReturnsCancelledAtOnce) {
+  const std::vector<VoxelSet> sets = HalfRoomPairs(6);
+  CancelToken cancel;
+  int events_after_cancel = 0;
+  JobContext ctx;
+  ctx.cancel = &cancel;
+  ctx.progress = [&](const ProgressEvent& e) {
+    if (cancel.cancelled()) ++events_after_cancel;
+    if (e.message.rfind("consolidation pass 2", 0) == 0) cancel.Cancel();
+  };
+  Result<ConsolidateResult> r = ConsolidatePicks(sets, FirstPicks(12), {}, ctx);
+  ASSERT_FALSE(r.ok());
+  EXPECT_EQ(r.status().code(), StatusCode::kCancelled);
+  EXPECT_EQ(events_after_cancel, 0);  // stopped before the next report, let alone the next pass
 }
 
 TEST(GreedyTest, RejectsSetsOfDifferentSizes) {
