@@ -314,6 +314,71 @@ TEST(ConsolidateTest, NeverLosesCoverageNorAddsPicks) {
   EXPECT_GT(saved, 0);  // the instances exercised it
 }
 
+// Consolidation as its header states it, written plainly (no neighbour filters, no coverage
+// counts): drop the latest pick the others cover, else replace the first pair (in pick order) by
+// the first candidate (by decreasing |set|, then index) that sees what only those two cover.
+std::vector<int> ReferenceConsolidation(const std::vector<VoxelSet>& sets, std::vector<int> picks) {
+  std::vector<int> order(sets.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return CountBits(sets[a]) > CountBits(sets[b]); });
+  auto others = [&](size_t a, size_t b) {
+    VoxelSet u(sets[0].size());
+    for (size_t k = 0; k < picks.size(); ++k) {
+      if (k != a && k != b) UnionInto(u, sets[picks[k]]);
+    }
+    return u;
+  };
+  auto covers = [](const VoxelSet& big, const VoxelSet& small) { return CountAnd(big, small) == CountBits(small); };
+  while (true) {
+    bool changed = false;
+    for (size_t i = picks.size(); picks.size() > 1 && i-- > 0 && !changed;) {
+      if (covers(others(i, i), sets[picks[i]])) {
+        picks.erase(picks.begin() + static_cast<std::ptrdiff_t>(i));
+        changed = true;
+      }
+    }
+    for (size_t a = 0; a < picks.size() && !changed; ++a) {
+      for (size_t b = a + 1; b < picks.size() && !changed; ++b) {
+        const VoxelSet rest_of = others(a, b);
+        VoxelSet rest(sets[0].size());
+        for (size_t v = 0; v < rest.size(); ++v) {
+          if ((sets[picks[a]].test(v) || sets[picks[b]].test(v)) && !rest_of.test(v)) rest.set(v);
+        }
+        for (int c : order) {
+          if (!covers(sets[c], rest)) continue;
+          picks[a] = c;
+          picks.erase(picks.begin() + static_cast<std::ptrdiff_t>(b));
+          changed = true;
+          break;
+        }
+      }
+    }
+    if (!changed) return picks;
+  }
+}
+
+TEST(ConsolidateTest, SameAsThePlainReferenceOnSitesWithFarApartPicks) {
+  std::mt19937 rng(2026);
+  int changed = 0;
+  for (int trial = 0; trial < 150; ++trial) {
+    const size_t n = 200 + rng() % 800;
+    std::vector<VoxelSet> sets;
+    for (size_t i = 0; i < 20 + rng() % 60; ++i) {
+      VoxelSet s(n);
+      const size_t start = rng() % n, len = 5 + rng() % 40;
+      for (size_t v = 0; v < len; ++v) {
+        if (rng() % 5 != 0) s.set((start + v) % n);
+      }
+      sets.push_back(s);
+    }
+    const std::vector<int> greedy = Picks(Greedy(sets));
+    const std::vector<int> want = ReferenceConsolidation(sets, greedy);
+    EXPECT_EQ(Consolidated(sets, greedy), want) << "trial " << trial;
+    changed += want != greedy;
+  }
+  EXPECT_GT(changed, 10);  // the instances exercised drops and merges
+}
+
 // `pairs` pairs of half-rooms, each pair seen whole by one more candidate: consolidation merges one
 // pair per pass, so it takes pairs + 1 passes. The picks are the half-rooms (0 .. 2 pairs - 1).
 std::vector<VoxelSet> HalfRoomPairs(int pairs) {
