@@ -1,9 +1,11 @@
 // Micro-benchmarks of the hot kernels on a fixed synthetic scene (Google Benchmark).
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
 #include <random>
 #include <string>
 
+#include "vc/plan/greedy.h"
 #include "vc/raycast/ray_traversal.h"
 #include "vc/scene/voxel_scene.h"
 #include "vc/synth/synth.h"
@@ -83,5 +85,45 @@ void BM_EvaluateExact(benchmark::State& state) {
   state.SetItemsProcessed(state.iterations() * int64_t(s.occupied.size()) * 6);
 }
 BENCHMARK(BM_EvaluateExact)->Unit(benchmark::kMillisecond);
+
+// A campus-like site for consolidation: a 400 x 200 voxel plane, a candidate every 4 voxels (5,000),
+// each seeing the voxels within 20 voxels of it but a pseudo-random quarter (occlusion), so that
+// greedy's many picks are mostly far apart and consolidation has many pairs to rule out.
+std::vector<vc::VoxelSet> CampusSets() {
+  constexpr int kWidth = 400, kHeight = 200, kStep = 4, kRadius = 20;
+  std::vector<vc::VoxelSet> sets;
+  for (int cy = 0; cy < kHeight; cy += kStep) {
+    for (int cx = 0; cx < kWidth; cx += kStep) {
+      vc::VoxelSet s(size_t(kWidth) * kHeight);
+      for (int y = std::max(0, cy - kRadius); y < std::min(kHeight, cy + kRadius + 1); ++y) {
+        for (int x = std::max(0, cx - kRadius); x < std::min(kWidth, cx + kRadius + 1); ++x) {
+          const uint32_t hash = uint32_t(x * 73856093) ^ uint32_t(y * 19349663) ^ uint32_t(sets.size() * 83492791);
+          if ((x - cx) * (x - cx) + (y - cy) * (y - cy) <= kRadius * kRadius && hash % 4 != 0) {
+            s.set(size_t(y) * kWidth + size_t(x));
+          }
+        }
+      }
+      sets.push_back(std::move(s));
+    }
+  }
+  return sets;
+}
+
+void BM_ConsolidatePicks(benchmark::State& state) {
+  const std::vector<vc::VoxelSet> sets = CampusSets();
+  vc::planner::GreedyOptions options;
+  options.target_coverage = 0.99;
+  const auto greedy = vc::planner::SelectGreedy(sets, options);
+  std::vector<int> picks;
+  for (const vc::planner::GreedyPick& p : greedy->picks) picks.push_back(p.candidate);
+  size_t after = 0;
+  for (auto _ : state) {
+    const auto r = vc::planner::ConsolidatePicks(sets, picks, options);
+    after = r->picks.size();
+  }
+  state.counters["greedy_picks"] = double(picks.size());
+  state.counters["consolidated_picks"] = double(after);
+}
+BENCHMARK(BM_ConsolidatePicks)->Unit(benchmark::kMillisecond)->Iterations(1);
 
 }  // namespace

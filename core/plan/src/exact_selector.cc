@@ -25,9 +25,11 @@
 #include <vector>
 
 #include "cover_model.h"
+#include "progress_pacer.h"
 #include "vc/plan/greedy.h"
 #include "vc/plan/lagrangian_bound.h"
 #include "vc/plan/scan_graph.h"
+#include "vc/plan/stage_runner.h"
 
 namespace vc::planner {
 namespace {
@@ -37,6 +39,10 @@ using internal::ReducedModel;
 using internal::ScanArc;
 using internal::WarmStart;
 using Clock = std::chrono::steady_clock;
+
+// The selection stage's progress fraction at the end of greedy (with consolidation), of the size
+// probe, the voxel classes, the model reduction and the scan graph; CBC's time limit fills the rest.
+constexpr double kGreedyShare = 0.3, kProbeEnd = 0.33, kClassesEnd = 0.4, kReductionEnd = 0.47, kArcsEnd = 0.5;
 
 double SecondsSince(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
@@ -69,8 +75,20 @@ Result<Classes> BuildClasses(const std::vector<VoxelSet>& sets, const JobContext
   std::vector<int32_t> cls(n_voxels, 0);
   std::vector<int32_t> remap(1, -1), stamp(1, -1);
   int32_t next = 1;
+  // Two passes over the candidates, counted as one.
+  const uint64_t steps = 2 * sets.size();
+  internal::ProgressPacer pacer;
+  auto report = [&](uint64_t done) {
+    if (!pacer.Due()) return;
+    std::string note = "exact: voxel classes";
+    if (const std::string left = pacer.TimeLeft(done, steps); !left.empty()) note += ", " + left;
+    ctx.ReportCount(Stage::kSelection, done, steps, "candidate passes", std::move(note));
+  };
   for (size_t c = 0; c < sets.size(); ++c) {
-    if (c % 64 == 0) VC_RETURN_IF_ERROR(ctx.CheckCancelled("exact selection (voxel classes)"));
+    if (c % 64 == 0) {
+      VC_RETURN_IF_ERROR(ctx.CheckCancelled("exact selection (voxel classes)"));
+      report(c);
+    }
     ForEachBit(sets[c], [&](size_t v) {
       const int32_t old = cls[v];
       if (stamp[old] != static_cast<int32_t>(c)) {
@@ -98,6 +116,10 @@ Result<Classes> BuildClasses(const std::vector<VoxelSet>& sets, const JobContext
   out.sees.resize(sets.size());
   std::vector<int32_t> last(out.weight.size(), -1);
   for (size_t c = 0; c < sets.size(); ++c) {
+    if (c % 64 == 0) {
+      VC_RETURN_IF_ERROR(ctx.CheckCancelled("exact selection (voxel classes)"));
+      report(sets.size() + c);
+    }
     ForEachBit(sets[c], [&](size_t v) {
       const int32_t k = compact[cls[v]];
       if (last[k] == static_cast<int32_t>(c)) return;
@@ -170,9 +192,24 @@ Result<ReducedModel> Reduce(const Classes& cl, int n_candidates, int fixed, bool
   }
   std::vector<int> active_sees(n_candidates, 0);
   std::vector<int32_t> mark(n_classes, -1);
+  // Rounds run until nothing changes: each advances through what the rounds before it left, so the
+  // fraction never falls although the number of rounds is not known.
+  internal::ProgressPacer pacer;
+  int round = 0;
+  double done_before = 0;
+  auto report = [&](uint64_t checked, uint64_t total) {
+    if (!ctx.progress || !pacer.Due()) return;
+    std::string note =
+        "exact: model reduction round " + std::to_string(round) + " (" + std::to_string(m.dominated) + " dominated)";
+    if (const std::string left = pacer.TimeLeft(checked, total); !left.empty()) note += ", " + left + " in this round";
+    const double fraction = done_before + (1.0 - done_before) * (total ? double(checked) / double(total) : 0.0);
+    ctx.progress(ProgressEvent{Stage::kSelection, fraction, std::move(note), checked, total, "candidates"});
+  };
   bool changed = true;
   while (changed) {
     changed = false;
+    ++round;
+    pacer.Restart();
     VC_RETURN_IF_ERROR(ctx.CheckCancelled("exact selection (model reduction)"));
     // Candidates that see no class still to cover add nothing.
     for (int c = 0; c < n_candidates; ++c) {
@@ -211,7 +248,10 @@ Result<ReducedModel> Reduce(const Classes& cl, int n_candidates, int fixed, bool
     std::sort(order.begin(), order.end(),
               [&](int a, int b) { return active_sees[a] != active_sees[b] ? active_sees[a] < active_sees[b] : a > b; });
     for (size_t i = 0; i < order.size(); ++i) {
-      if (i % 256 == 0) VC_RETURN_IF_ERROR(ctx.CheckCancelled("exact selection (model reduction)"));
+      if (i % 256 == 0) {
+        VC_RETURN_IF_ERROR(ctx.CheckCancelled("exact selection (model reduction)"));
+        report(i, order.size());
+      }
       const int a = order[i];
       // The class of a with the fewest candidates still active bounds who can dominate a.
       int rarest = -1;
@@ -239,6 +279,7 @@ Result<ReducedModel> Reduce(const Classes& cl, int n_candidates, int fixed, bool
         }
       }
     }
+    done_before += (1.0 - done_before) / 2;  // a full round done, another may follow
   }
   AssembleColumns(cl, active_class, active, m);
   return m;
@@ -275,8 +316,16 @@ Result<SizeProbe> ProbeSize(const std::vector<VoxelSet>& sets, int fixed, bool s
   std::vector<char> fixed_sees(skip_fixed ? n_voxels : 0, 0);
   for (int c = 0; c < probe.first_column; ++c) sets[c].ForEach([&](size_t v) { fixed_sees[v] = 1; });
   uint64_t key = 0x9e3779b97f4a7c15ull;
+  internal::ProgressPacer pacer;
   for (size_t c = probe.first_column; c < sets.size(); ++c) {
-    if (c % 64 == 0) VC_RETURN_IF_ERROR(ctx.CheckCancelled("exact selection (model size)"));
+    if (c % 64 == 0) {
+      VC_RETURN_IF_ERROR(ctx.CheckCancelled("exact selection (model size)"));
+      if (pacer.Due()) {
+        std::string note = "exact: model size";
+        if (const std::string left = pacer.TimeLeft(c, sets.size()); !left.empty()) note += ", " + left;
+        ctx.ReportCount(Stage::kSelection, c, sets.size(), "candidates", std::move(note));
+      }
+    }
     key = key * 6364136223846793005ull + 1442695040888963407ull;  // one odd key per candidate
     const uint64_t k = key | 1;
     sets[c].ForEach([&](size_t v) {
@@ -592,8 +641,16 @@ Result<std::vector<ScanArc>> ScanGraphArcs(const std::vector<VoxelSet>& sets, co
                                            double min_overlap, const JobContext& ctx) {
   std::vector<ScanArc> arcs;
   const int n_cols = static_cast<int>(columns.size());
-  for (int a = 0; a < n_cols; ++a) {
-    if (a % 32 == 0) VC_RETURN_IF_ERROR(ctx.CheckCancelled("exact selection (scan graph)"));
+  const uint64_t pairs = uint64_t(n_cols) * uint64_t(std::max(n_cols - 1, 0)) / 2;
+  uint64_t checked = 0;  // pairs before row a
+  internal::ProgressPacer pacer;
+  for (int a = 0; a < n_cols; checked += uint64_t(n_cols - 1 - a), ++a) {
+    VC_RETURN_IF_ERROR(ctx.CheckCancelled("exact selection (scan graph)"));
+    if (pacer.Due()) {
+      std::string note = "exact: scan graph";
+      if (const std::string left = pacer.TimeLeft(checked, pairs); !left.empty()) note += ", " + left;
+      ctx.ReportCount(Stage::kSelection, checked, pairs, "pairs of columns", std::move(note));
+    }
     for (int b = a + 1; b < n_cols; ++b) {
       if (IsEdge(Overlap(sets[columns[a]], sets[columns[b]]), min_overlap)) {
         arcs.push_back({a, b});
@@ -778,7 +835,7 @@ Result<Selection> ExactRun::Select() {
   if (!full) {
     // Below target coverage nothing but domination shrinks the model: its size before the reduction,
     // from one pass over the sets, decides whether the classes are worth building at all.
-    VC_ASSIGN_OR_RETURN(probe_, ProbeSize(sets_, fixed_, !connect_, ctx_));
+    VC_ASSIGN_OR_RETURN(probe_, ProbeSize(sets_, fixed_, !connect_, ProgressRange(ctx_, kGreedyShare, kProbeEnd)));
     const uint64_t classes = probe_->classes;
     const uint64_t at_least = CoverModel::EstimatedBytes(probe_->nonzeros + 2 * classes, classes + 1, classes);
     const uint64_t fixed_cover = out_.coverable - probe_->voxels;
@@ -787,14 +844,16 @@ Result<Selection> ExactRun::Select() {
       return SelectOverBudget(nullptr, nullptr, target_ - fixed_cover, at_least);
     }
   }
-  VC_ASSIGN_OR_RETURN(Classes cl, BuildClasses(sets_, ctx_));
-  VC_ASSIGN_OR_RETURN(ReducedModel m, Reduce(cl, n, fixed_, full && !connect_, connect_, ctx_));
+  VC_ASSIGN_OR_RETURN(Classes cl, BuildClasses(sets_, ProgressRange(ctx_, kProbeEnd, kClassesEnd)));
+  VC_ASSIGN_OR_RETURN(ReducedModel m, Reduce(cl, n, fixed_, full && !connect_, connect_,
+                                             ProgressRange(ctx_, kClassesEnd, kReductionEnd)));
   opt.forced = m.forced_sole_view;
   opt.dominated = m.dominated;
   const uint64_t need = target_ - std::min(target_, m.forced_covered);  // voxels the columns must add
   std::vector<ScanArc> arcs;
   if (connect_) {
-    VC_ASSIGN_OR_RETURN(arcs, ScanGraphArcs(sets_, m.columns, options_.greedy.min_overlap, ctx_));
+    VC_ASSIGN_OR_RETURN(arcs, ScanGraphArcs(sets_, m.columns, options_.greedy.min_overlap,
+                                            ProgressRange(ctx_, kReductionEnd, kArcsEnd)));
   }
   const CoverModel model(m, std::move(arcs),
                          {.max_mode = max_mode_,
@@ -808,7 +867,8 @@ Result<Selection> ExactRun::Select() {
   if (model.station_cols().count == 0 || (!max_mode_ && need == 0)) return FinishForced(m, need);
   const uint64_t estimate = model.EstimatedBytes();
   if (estimate > options_.memory_budget_bytes) return SelectOverBudget(&cl, &m, need, estimate);
-  VC_ASSIGN_OR_RETURN(CbcOutcome outcome, SolveWithCbc(model, greedy_picks_, n, start_, options_.time_limit_s, ctx_));
+  VC_ASSIGN_OR_RETURN(CbcOutcome outcome, SolveWithCbc(model, greedy_picks_, n, start_, options_.time_limit_s,
+                                                       ProgressRange(ctx_, kArcsEnd, 1.0)));
   return Read(model, outcome);
 }
 
@@ -840,7 +900,7 @@ Result<Selection> ExactRun::SelectOverBudget(const Classes* cl, const ReducedMod
   }
   std::optional<Classes> built;
   if (cl == nullptr) {
-    VC_ASSIGN_OR_RETURN(built, BuildClasses(sets_, ctx_));
+    VC_ASSIGN_OR_RETURN(built, BuildClasses(sets_, ProgressRange(ctx_, kProbeEnd, kClassesEnd)));
     cl = &*built;
   }
   const Clock::time_point deadline =
@@ -883,8 +943,8 @@ Status ExactRun::SetRelaxedBound(const ReducedModel* m, uint64_t need, bool mode
 
 // The fixed stations outside the model plus the Lagrangian bound of RareVoxelProblem.
 Result<int> ExactRun::RareVoxelBound() {
-  if (!probe_) {
-    VC_ASSIGN_OR_RETURN(probe_, ProbeSize(sets_, fixed_, !connect_, ctx_));
+  if (!probe_) {  // after the model was built: the counts move, the fraction stays
+    VC_ASSIGN_OR_RETURN(probe_, ProbeSize(sets_, fixed_, !connect_, ProgressRange(ctx_, kArcsEnd, kArcsEnd)));
   }
   const uint64_t fixed_cover = out_.coverable - probe_->voxels;
   const uint64_t need = target_ - std::min(target_, fixed_cover);
@@ -1040,7 +1100,8 @@ Result<Selection> ExactSelector::Select(const std::vector<VoxelSet>& sets, int f
                                 std::to_string(options_.time_limit_s));
   }
   // The greedy plan: the warm start, the floor, and the argument checks.
-  VC_ASSIGN_OR_RETURN(Selection greedy, GreedySelector(options_.greedy).Select(sets, fixed, ctx));
+  VC_ASSIGN_OR_RETURN(Selection greedy,
+                      GreedySelector(options_.greedy).Select(sets, fixed, ProgressRange(ctx, 0.0, kGreedyShare)));
   return ExactRun(options_, sets, fixed, ctx, start, std::move(greedy)).Select();
 }
 

@@ -9,6 +9,7 @@
 #include <string>
 #include <unordered_map>
 
+#include "progress_pacer.h"
 #include "vc/plan/scan_graph.h"
 
 namespace vc::planner {
@@ -440,6 +441,8 @@ class Consolidation {
     std::vector<uint64_t> sizes(sets.size());
     for (size_t i = 0; i < sets.size(); ++i) sizes[i] = CountBits(sets[i]);
     std::stable_sort(order_.begin(), order_.end(), [&](int a, int b) { return sizes[a] > sizes[b]; });
+    rank_.assign(sets.size(), -1);
+    for (size_t r = 0; r < order_.size(); ++r) rank_[order_[r]] = static_cast<int>(r);
     if (min_overlap_ > 0) overlaps_.emplace(sets);
     groups_ = overlaps_ ? overlaps_->Components(picks_, min_overlap_) : 1;
   }
@@ -447,17 +450,46 @@ class Consolidation {
   Result<ConsolidateResult> Run() {
     while (true) {
       VC_RETURN_IF_ERROR(ctx_.CheckCancelled("consolidation"));
+      ++pass_;
+      pairs_ = picks_.size() * (picks_.size() - 1) / 2;
+      pacer_.Restart();
+      ReportPass(0);
       CountCoverage();
-      if (DropOne()) continue;
+      if (DropOne()) {
+        EndPass(0);
+        continue;
+      }
       VC_ASSIGN_OR_RETURN(const bool merged, MergeOne());
       if (!merged) break;
     }
+    ctx_.Report(Stage::kSelection, 1.0, PassNote() + ", done");
     out_.picks = std::move(picks_);
     return std::move(out_);
   }
 
  private:
   bool IsFixed(int candidate) const { return candidate < fixed_; }
+
+  // "consolidation pass 2 (1 dropped, 0 merged)".
+  std::string PassNote() const {
+    return "consolidation pass " + std::to_string(pass_) + " (" + std::to_string(out_.dropped) + " dropped, " +
+           std::to_string(out_.merged) + " merged)";
+  }
+  // The fraction after `checked` of this pass's pairs: each pass advances through what the passes
+  // before it left, so the fraction never falls although the number of passes is not known.
+  double Fraction(uint64_t checked) const {
+    return pairs_ == 0 ? done_before_ : done_before_ + (1.0 - done_before_) * double(checked) / double(pairs_);
+  }
+  // `checked` of this pass's pairs of picks, and the time left in this pass at the rate so far.
+  void ReportPass(uint64_t checked) const {
+    if (!ctx_.progress) return;
+    std::string note = PassNote();
+    if (const std::string left = pacer_.TimeLeft(checked, pairs_); !left.empty()) note += ", " + left + " in this pass";
+    ctx_.progress(
+        ProgressEvent{Stage::kSelection, Fraction(checked), std::move(note), checked, pairs_, "pairs of picks"});
+  }
+  // A pass that changed the picks after `checked` pairs: the next one starts where it stopped.
+  void EndPass(uint64_t checked) { done_before_ = Fraction(checked); }
 
   // A pick's words (a sparse pick is made dense once).
   const std::vector<uint64_t>& Words(int pick) {
@@ -485,12 +517,23 @@ class Consolidation {
 
   // The candidates that see any voxel of a pick, as bits: one standing in for picks a and b must
   // see the voxels only they cover, so it is a neighbour of a (of b) when some of those lie in a
-  // (in b). Far-apart picks have no common neighbour and are passed over at once.
+  // (in b). Far-apart picks have no common neighbour and are passed over at once. A dense
+  // candidate is tested on the pick's nonzero words only: on a large site that is a small share of
+  // the scene, and this was most of consolidation's time (every pick against every candidate).
   const std::vector<uint64_t>& Neighbours(int pick) {
     return neighbours_.Get(pick, [&] {
+      const std::vector<uint64_t>& words = Words(pick);
+      const std::vector<size_t>& nonzero = NonzeroWords(pick);
       std::vector<uint64_t> bits(candidate_words_, 0);
       for (size_t c = 0; c < sets_.size(); ++c) {
-        if (sets_[c].Intersects(sets_[pick])) bits[c >> 6] |= uint64_t{1} << (c & 63);
+        bool meets = false;
+        if (sets_[c].sparse()) {
+          meets = sets_[c].Intersects(sets_[pick]);
+        } else {
+          const std::vector<uint64_t>& other = sets_[c].words();
+          for (size_t i = 0; i < nonzero.size() && !meets; ++i) meets = (other[nonzero[i]] & words[nonzero[i]]) != 0;
+        }
+        if (meets) bits[c >> 6] |= uint64_t{1} << (c & 63);
       }
       return bits;
     });
@@ -524,13 +567,18 @@ class Consolidation {
   }
 
   // Drops a pick nobody needs (all its voxels covered twice), the latest such pick first.
+  // Notes which picks cover a voxel alone (sole_) on the way.
   bool DropOne() {
+    sole_.assign(picks_.size(), 0);
     if (picks_.size() <= 1) return false;
     for (size_t i = picks_.size(); i-- > 0;) {
       if (IsFixed(picks_[i])) continue;
       const std::vector<uint64_t>& w = Words(picks_[i]);
       bool needed = false;
-      for (size_t k = 0; k < words_ && !needed; ++k) needed = (w[k] & ~c2_[k]) != 0;
+      for (size_t k : NonzeroWords(picks_[i])) {
+        if ((needed = (w[k] & ~c2_[k]) != 0)) break;
+      }
+      sole_[i] = needed;
       if (needed) continue;
       std::vector<int> after = picks_;
       after.erase(after.begin() + static_cast<std::ptrdiff_t>(i));
@@ -543,12 +591,16 @@ class Consolidation {
   }
 
   // Replaces the first pair of picks (in pick order) one candidate can stand in for.
+  // Checks cancellation after every pair and reports at most once per pacer interval.
   Result<bool> MergeOne() {
+    uint64_t checked = 0;
     for (size_t a = 0; a < picks_.size(); ++a) {
-      VC_RETURN_IF_ERROR(ctx_.CheckCancelled("consolidation"));
-      if (IsFixed(picks_[a])) continue;
-      for (size_t b = a + 1; b < picks_.size(); ++b) {
-        if (!IsFixed(picks_[b]) && MergePair(a, b)) return true;
+      for (size_t b = a + 1; b < picks_.size(); ++b, ++checked) {
+        VC_RETURN_IF_ERROR(ctx_.CheckCancelled("consolidation"));
+        if (pacer_.Due()) ReportPass(checked);
+        if (IsFixed(picks_[a]) || IsFixed(picks_[b]) || !MergePair(a, b)) continue;
+        EndPass(checked + 1);
+        return true;
       }
     }
     return false;
@@ -593,31 +645,64 @@ class Consolidation {
 
   // Replaces picks a < b by the first candidate (in order_) that covers what only they cover and
   // keeps the scan graph's groups.
+  //
+  // Picks that each cover a voxel alone (sole_) need a stand-in among the neighbours of both: where
+  // there is none, the pair is passed over before rest_ is computed (most pairs on a large site);
+  // otherwise only the common neighbours are tried, in order_.
   bool MergePair(size_t a, size_t b) {
+    if (sole_[a] && sole_[b] && !Meet(Neighbours(picks_[a]), Neighbours(picks_[b]))) return false;
     const auto [in_a, in_b] = FindRest(picks_[a], picks_[b]);
     const std::vector<uint64_t>* need_a = in_a ? &Neighbours(picks_[a]) : nullptr;
     const std::vector<uint64_t>* need_b = in_b ? &Neighbours(picks_[b]) : nullptr;
+    if (need_a && need_b && !Meet(*need_a, *need_b)) return false;  // no candidate sees into both
     if (need_a && need_b) {
-      bool any = false;
-      for (size_t k = 0; k < candidate_words_ && !any; ++k) any = ((*need_a)[k] & (*need_b)[k]) != 0;
-      if (!any) return false;  // no candidate sees into both
+      CommonNeighboursInOrder(*need_a, *need_b);
+      for (int c : common_) {
+        if (TryStandIn(a, b, c)) return true;
+      }
+      return false;
     }
-    // A voxel of rest_ every candidate standing in must see: one test rules most out.
-    const bool has_probe = !nonzero_.empty();
-    const size_t probe = has_probe ? nonzero_[0] * 64 + static_cast<size_t>(std::countr_zero(rest_[nonzero_[0]])) : 0;
     for (int c : order_) {
-      if (!Has(need_a, c) || !Has(need_b, c)) continue;
-      if (has_probe && !sets_[c].test(probe)) continue;
-      if (!CoversRest(sets_[c])) continue;
-      std::vector<int> after = picks_;
-      after[a] = c;
-      after.erase(after.begin() + static_cast<std::ptrdiff_t>(b));
-      if (!KeepsLinked(after)) continue;
-      picks_ = std::move(after);
-      ++out_.merged;
-      return true;
+      if (Has(need_a, c) && Has(need_b, c) && TryStandIn(a, b, c)) return true;
     }
     return false;
+  }
+
+  // Whether two candidate bitsets share a candidate.
+  bool Meet(const std::vector<uint64_t>& x, const std::vector<uint64_t>& y) const {
+    for (size_t k = 0; k < candidate_words_; ++k) {
+      if (x[k] & y[k]) return true;
+    }
+    return false;
+  }
+
+  // common_: the non-fixed candidates in both x and y, in order_.
+  void CommonNeighboursInOrder(const std::vector<uint64_t>& x, const std::vector<uint64_t>& y) {
+    common_.clear();
+    for (size_t k = 0; k < candidate_words_; ++k) {
+      for (uint64_t bits = x[k] & y[k]; bits != 0; bits &= bits - 1) {
+        const size_t c = k * 64 + static_cast<size_t>(std::countr_zero(bits));
+        if (rank_[c] >= 0) common_.push_back(static_cast<int>(c));
+      }
+    }
+    std::sort(common_.begin(), common_.end(), [&](int p, int q) { return rank_[p] < rank_[q]; });
+  }
+
+  // Replaces picks a < b by candidate c if c sees all of rest_ and the scan graph keeps its groups.
+  bool TryStandIn(size_t a, size_t b, int c) {
+    // A voxel of rest_ every candidate standing in must see: one test rules most out.
+    if (!nonzero_.empty()) {
+      const size_t probe = nonzero_[0] * 64 + static_cast<size_t>(std::countr_zero(rest_[nonzero_[0]]));
+      if (!sets_[c].test(probe)) return false;
+    }
+    if (!CoversRest(sets_[c])) return false;
+    std::vector<int> after = picks_;
+    after[a] = c;
+    after.erase(after.begin() + static_cast<std::ptrdiff_t>(b));
+    if (!KeepsLinked(after)) return false;
+    picks_ = std::move(after);
+    ++out_.merged;
+    return true;
   }
 
   const std::vector<VoxelSet>& sets_;
@@ -628,6 +713,9 @@ class Consolidation {
   const size_t candidate_words_;  // per candidate bitset (Neighbours)
   std::vector<int> picks_;
   std::vector<int> order_;            // the non-fixed candidates by decreasing |set|, then index
+  std::vector<int> rank_;             // per candidate: its place in order_, -1 for a fixed one
+  std::vector<int> common_;           // CommonNeighboursInOrder's output
+  std::vector<char> sole_;            // per pick this pass: covers a voxel no other pick covers
   std::optional<Overlaps> overlaps_;  // with registration
   int groups_ = 1;                    // components of the picks' scan graph
   PerPick<VoxelSet> dense_copies_;    // sparse picks, made dense
@@ -636,6 +724,10 @@ class Consolidation {
   std::vector<uint64_t> c1_, c2_, c3_, rest_;
   std::vector<size_t> nonzero_;  // the words where rest_ has a voxel
   ConsolidateResult out_;
+  int pass_ = 0;                   // 1-based number of the pass running
+  uint64_t pairs_ = 0;             // pairs of picks in this pass
+  double done_before_ = 0;         // the progress fraction this pass started at
+  internal::ProgressPacer pacer_;  // within a pass
 };
 
 }  // namespace

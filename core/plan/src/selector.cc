@@ -1,9 +1,11 @@
 #include "vc/plan/selector.h"
 
+#include <algorithm>
 #include <chrono>
 #include <utility>
 
 #include "vc/plan/greedy.h"
+#include "vc/plan/stage_runner.h"
 
 namespace vc {
 
@@ -51,7 +53,10 @@ Result<Selection> GreedySelector::Select(const std::vector<VoxelSet>& sets, int 
   for (const GreedyPick& pick : greedy.picks) out.picks.push_back(pick.candidate);
   out.first_pass_picks = static_cast<int>(out.picks.size()) - fixed;
   if (options.consolidate) {
-    VC_ASSIGN_OR_RETURN(ConsolidateResult merged, ConsolidatePicks(sets, std::move(out.picks), options, ctx));
+    // Consolidation's progress continues from the coverage greedy's last report showed.
+    const double reached = out.coverable > 0 ? std::min(1.0, double(out.covered) / double(out.coverable)) : 1.0;
+    VC_ASSIGN_OR_RETURN(ConsolidateResult merged,
+                        ConsolidatePicks(sets, std::move(out.picks), options, ProgressRange(ctx, reached, 1.0)));
     out.picks = std::move(merged.picks);
     out.saved_by_improvement = merged.dropped + merged.merged;
   }

@@ -428,6 +428,71 @@ TEST(ExactSelectorTest, ReportsIncumbentAndBoundAsSelectionProgress) {
   EXPECT_TRUE(seen);
 }
 
+TEST(ExactSelectorTest, ReportsClassesAndReductionWithCountsAndNeverFallingFractions) {
+  const std::vector<VoxelSet> sets = HardSets();
+  ExactSelectorOptions o;
+  o.greedy.target_coverage = 1.0;
+  o.greedy.consolidate = true;
+  o.time_limit_s = 1.0;
+  std::vector<ProgressEvent> events;
+  JobContext ctx;
+  ctx.progress = [&](const ProgressEvent& e) { events.push_back(e); };
+  Result<Selection> got = ExactSelector(o).Select(sets, 0, ctx);
+  ASSERT_TRUE(got.ok()) << got.status().ToString();
+  bool consolidation = false, classes = false, reduction = false;
+  for (size_t i = 0; i < events.size(); ++i) {
+    const ProgressEvent& e = events[i];
+    if (i > 0) EXPECT_GE(e.fraction, events[i - 1].fraction) << "event " << i << ": " << e.message;
+    consolidation = consolidation || e.message.rfind("consolidation pass 1", 0) == 0;
+    if (e.message.rfind("exact: voxel classes", 0) == 0) {
+      classes = true;
+      EXPECT_EQ(e.unit, "candidate passes");
+      EXPECT_EQ(e.total, 2 * sets.size());
+    }
+    if (e.message.rfind("exact: model reduction round ", 0) == 0) {
+      reduction = true;
+      EXPECT_EQ(e.unit, "candidates");
+      EXPECT_GT(e.total, 0u);
+      EXPECT_LE(e.done, e.total);
+    }
+  }
+  EXPECT_TRUE(consolidation);
+  EXPECT_TRUE(classes);
+  EXPECT_TRUE(reduction);
+}
+
+TEST(ExactSelectorTest, SelectionFractionsNeverFallOnAnyPath) {
+  std::mt19937 rng(37);
+  const std::vector<VoxelSet> sets = RandomSets(rng, 60, 800, 0.04);
+  struct Path {
+    std::string name;
+    double target;
+    double min_overlap;
+    uint64_t budget_bytes;
+  };
+  const std::vector<Path> paths = {{"full cover", 1.0, 0.0, uint64_t{1} << 30},
+                                   {"below full cover (size probe)", 0.9, 0.0, uint64_t{1} << 30},
+                                   {"connected (scan graph)", 0.95, 0.02, uint64_t{1} << 30},
+                                   {"over the memory budget", 0.95, 0.0, 1}};
+  for (const Path& path : paths) {
+    ExactSelectorOptions o;
+    o.greedy.target_coverage = path.target;
+    o.greedy.min_overlap = path.min_overlap;
+    o.memory_budget_bytes = path.budget_bytes;
+    o.time_limit_s = 1.0;
+    std::vector<ProgressEvent> events;
+    JobContext ctx;
+    ctx.progress = [&](const ProgressEvent& e) { events.push_back(e); };
+    Result<Selection> got = ExactSelector(o).Select(sets, 0, ctx);
+    ASSERT_TRUE(got.ok()) << path.name << ": " << got.status().ToString();
+    ASSERT_FALSE(events.empty()) << path.name;
+    for (size_t i = 1; i < events.size(); ++i) {
+      EXPECT_GE(events[i].fraction, events[i - 1].fraction)
+          << path.name << ", event " << i << ": " << events[i].message << " after " << events[i - 1].message;
+    }
+  }
+}
+
 TEST(ExactSelectorTest, OverTheMemoryBudgetFallsBackToSwapLocalSearch) {
   std::mt19937 rng(5);
   int fallbacks = 0, improved = 0;

@@ -5,7 +5,10 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <numeric>
 #include <random>
+#include <string>
+#include <vector>
 
 namespace vc::planner {
 namespace {
@@ -309,6 +312,140 @@ TEST(ConsolidateTest, NeverLosesCoverageNorAddsPicks) {
     saved += static_cast<int>(greedy.size() - merged.size());
   }
   EXPECT_GT(saved, 0);  // the instances exercised it
+}
+
+// Consolidation as its header states it, written plainly (no neighbour filters, no coverage
+// counts): drop the latest pick the others cover, else replace the first pair (in pick order) by
+// the first candidate (by decreasing |set|, then index) that sees what only those two cover.
+std::vector<int> ReferenceConsolidation(const std::vector<VoxelSet>& sets, std::vector<int> picks) {
+  std::vector<int> order(sets.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return CountBits(sets[a]) > CountBits(sets[b]); });
+  auto others = [&](size_t a, size_t b) {
+    VoxelSet u(sets[0].size());
+    for (size_t k = 0; k < picks.size(); ++k) {
+      if (k != a && k != b) UnionInto(u, sets[picks[k]]);
+    }
+    return u;
+  };
+  auto covers = [](const VoxelSet& big, const VoxelSet& small) { return CountAnd(big, small) == CountBits(small); };
+  while (true) {
+    bool changed = false;
+    for (size_t i = picks.size(); picks.size() > 1 && i-- > 0 && !changed;) {
+      if (covers(others(i, i), sets[picks[i]])) {
+        picks.erase(picks.begin() + static_cast<std::ptrdiff_t>(i));
+        changed = true;
+      }
+    }
+    for (size_t a = 0; a < picks.size() && !changed; ++a) {
+      for (size_t b = a + 1; b < picks.size() && !changed; ++b) {
+        const VoxelSet rest_of = others(a, b);
+        VoxelSet rest(sets[0].size());
+        for (size_t v = 0; v < rest.size(); ++v) {
+          if ((sets[picks[a]].test(v) || sets[picks[b]].test(v)) && !rest_of.test(v)) rest.set(v);
+        }
+        for (int c : order) {
+          if (!covers(sets[c], rest)) continue;
+          picks[a] = c;
+          picks.erase(picks.begin() + static_cast<std::ptrdiff_t>(b));
+          changed = true;
+          break;
+        }
+      }
+    }
+    if (!changed) return picks;
+  }
+}
+
+TEST(ConsolidateTest, SameAsThePlainReferenceOnSitesWithFarApartPicks) {
+  std::mt19937 rng(2026);
+  int changed = 0;
+  for (int trial = 0; trial < 150; ++trial) {
+    const size_t n = 200 + rng() % 800;
+    std::vector<VoxelSet> sets;
+    for (size_t i = 0; i < 20 + rng() % 60; ++i) {
+      VoxelSet s(n);
+      const size_t start = rng() % n, len = 5 + rng() % 40;
+      for (size_t v = 0; v < len; ++v) {
+        if (rng() % 5 != 0) s.set((start + v) % n);
+      }
+      sets.push_back(s);
+    }
+    const std::vector<int> greedy = Picks(Greedy(sets));
+    const std::vector<int> want = ReferenceConsolidation(sets, greedy);
+    EXPECT_EQ(Consolidated(sets, greedy), want) << "trial " << trial;
+    changed += want != greedy;
+  }
+  EXPECT_GT(changed, 10);  // the instances exercised drops and merges
+}
+
+// `pairs` pairs of half-rooms, each pair seen whole by one more candidate: consolidation merges one
+// pair per pass, so it takes pairs + 1 passes. The picks are the half-rooms (0 .. 2 pairs - 1).
+std::vector<VoxelSet> HalfRoomPairs(int pairs) {
+  const size_t n = size_t(pairs) * 8;
+  std::vector<VoxelSet> sets;
+  for (int p = 0; p < pairs; ++p) {
+    VoxelSet left(n), right(n);
+    for (size_t v = 0; v < 4; ++v) left.set(size_t(p) * 8 + v);
+    for (size_t v = 4; v < 8; ++v) right.set(size_t(p) * 8 + v);
+    sets.push_back(left);
+    sets.push_back(right);
+  }
+  for (int p = 0; p < pairs; ++p) {
+    VoxelSet whole(n);
+    for (size_t v = 0; v < 8; ++v) whole.set(size_t(p) * 8 + v);
+    sets.push_back(whole);
+  }
+  return sets;
+}
+
+std::vector<int> FirstPicks(int count) {
+  std::vector<int> picks(size_t(count), 0);
+  std::iota(picks.begin(), picks.end(), 0);
+  return picks;
+}
+
+TEST(ConsolidateTest, ReportsEveryPassWithCountsAndRisingFractions) {
+  const std::vector<VoxelSet> sets = HalfRoomPairs(6);
+  std::vector<ProgressEvent> events;
+  JobContext ctx;
+  ctx.progress = [&](const ProgressEvent& e) { events.push_back(e); };
+  Result<ConsolidateResult> r = ConsolidatePicks(sets, FirstPicks(12), {}, ctx);
+  ASSERT_TRUE(r.ok());
+  EXPECT_EQ(r->merged, 6);
+  std::vector<std::string> passes_seen;
+  for (size_t i = 0; i < events.size(); ++i) {
+    const ProgressEvent& e = events[i];
+    EXPECT_EQ(e.stage, Stage::kSelection);
+    EXPECT_NE(e.message.find("consolidation pass "), std::string::npos) << e.message;
+    if (i > 0) EXPECT_GE(e.fraction, events[i - 1].fraction) << "event " << i << ": " << e.message;
+    if (e.unit.empty()) continue;
+    EXPECT_EQ(e.unit, "pairs of picks");
+    EXPECT_LE(e.done, e.total);
+    if (e.done == 0) passes_seen.push_back(e.message.substr(0, e.message.find(" (")));
+  }
+  // 12 picks (66 pairs) in the first pass, one fewer per merge, and a last pass that changes nothing.
+  EXPECT_EQ(events.front().total, 66u);
+  ASSERT_FALSE(passes_seen.empty());
+  EXPECT_EQ(passes_seen.back(), "consolidation pass 7");
+  EXPECT_EQ(events.back().fraction, 1.0);
+  EXPECT_NE(events.back().message.find("6 merged"), std::string::npos) << events.back().message;
+}
+
+TEST(ConsolidateTest, CancelledDuringAPassReturnsCancelledAtOnce) {
+  const std::vector<VoxelSet> sets = HalfRoomPairs(6);
+  CancelToken cancel;
+  int events_after_cancel = 0;
+  JobContext ctx;
+  ctx.cancel = &cancel;
+  ctx.progress = [&](const ProgressEvent& e) {
+    if (cancel.cancelled()) ++events_after_cancel;
+    if (e.message.rfind("consolidation pass 2", 0) == 0) cancel.Cancel();
+  };
+  Result<ConsolidateResult> r = ConsolidatePicks(sets, FirstPicks(12), {}, ctx);
+  ASSERT_FALSE(r.ok());
+  EXPECT_EQ(r.status().code(), StatusCode::kCancelled);
+  EXPECT_EQ(events_after_cancel, 0);  // stopped before the next report, let alone the next pass
 }
 
 TEST(GreedyTest, RejectsSetsOfDifferentSizes) {
