@@ -1,6 +1,8 @@
 #include "vc/client/plan_summary.h"
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 
 namespace vc::client {
@@ -126,6 +128,35 @@ std::string FormatDuration(double seconds) {
   return Format("%ld h %02ld min", minutes / 60, minutes % 60);
 }
 
+namespace {
+
+// The plan's first lines: the share of the whole scene covered first (what a crew reads first),
+// then the share of what any candidate can see, and what no candidate sees. Older servers send no
+// occupied count (0): then only the coverable share is known.
+std::string HeadlineLines(const PlanResult& r) {
+  const auto percent = [](uint64_t part, uint64_t whole) { return whole ? 100.0 * double(part) / double(whole) : 0.0; };
+  const auto count = [](uint64_t n) { return static_cast<unsigned long long>(n); };
+  if (r.occupied_voxels == 0) {
+    return Format("%zu station(s), coverage %.1f%% of %llu coverable voxels, global visibility G = %.3f\n",
+                  r.stations.size(), percent(r.covered_voxels, r.coverable_voxels), count(r.coverable_voxels),
+                  r.evaluation.overall.global_visibility);
+  }
+  std::string out =
+      Format("%zu station(s) see %.1f%% of the scene (%llu of %llu occupied voxels), global visibility G = %.3f\n",
+             r.stations.size(), percent(r.covered_voxels, r.occupied_voxels), count(r.covered_voxels),
+             count(r.occupied_voxels), r.evaluation.overall.global_visibility);
+  out += Format("  %.1f%% of the %llu voxels some candidate can see", percent(r.covered_voxels, r.coverable_voxels),
+                count(r.coverable_voxels));
+  const uint64_t unseen = r.occupied_voxels - std::min(r.occupied_voxels, r.coverable_voxels);
+  if (unseen > 0) {
+    out += Format("; %llu (%.1f%% of the scene) no candidate sees at all (plan.json \"coverage\")", count(unseen),
+                  percent(unseen, r.occupied_voxels));
+  }
+  return out + "\n";
+}
+
+}  // namespace
+
 std::string PlanSummary(const PlanResult& r) {
   std::vector<int> route_position(r.stations.size(), 0);
   for (size_t k = 0; k < r.route.order.size(); ++k) {
@@ -133,10 +164,7 @@ std::string PlanSummary(const PlanResult& r) {
       route_position[r.route.order[k]] = static_cast<int>(k) + 1;
     }
   }
-  std::string out = Format("%zu station(s), coverage %.1f%% of %llu coverable voxels, global visibility G = %.3f\n",
-                           r.stations.size(),
-                           r.coverable_voxels ? 100.0 * double(r.covered_voxels) / double(r.coverable_voxels) : 0.0,
-                           static_cast<unsigned long long>(r.coverable_voxels), r.evaluation.overall.global_visibility);
+  std::string out = HeadlineLines(r);
   out += Format("  %3s %10s %10s %10s %12s %9s %6s\n", "#", "x_m", "y_m", "z_m", "gain_voxels", "coverage", "walk");
   for (size_t i = 0; i < r.stations.size(); ++i) {
     const PlannedStation& s = r.stations[i];

@@ -54,6 +54,25 @@ TEST(PlanSummaryTest, StationsScanGraphRouteAndFieldTime) {
   EXPECT_NE(s.find("warning: w1\n"), std::string::npos);
 }
 
+// A crew reads the first figure: the share of the whole scene, then that of what any candidate can
+// see, and how much no candidate sees.
+TEST(PlanSummaryTest, TheHeadlineIsTheShareOfTheWholeScene) {
+  PlanResult r = ThreeStations();
+  r.occupied_voxels = 80;
+  r.coverable_voxels = 20;
+  r.covered_voxels = 19;
+  const std::string s = PlanSummary(r);
+  EXPECT_EQ(s.substr(0, s.find('\n')),
+            "3 station(s) see 23.8% of the scene (19 of 80 occupied voxels), global visibility G = 0.000")
+      << s;
+  EXPECT_NE(
+      s.find("\n  95.0% of the 20 voxels some candidate can see; 60 (75.0% of the scene) no candidate sees at all"),
+      std::string::npos)
+      << s;
+  r.occupied_voxels = 20;  // everything occupied is coverable: no third figure
+  EXPECT_EQ(PlanSummary(r).find("no candidate sees"), std::string::npos);
+}
+
 TEST(PlanSummaryTest, StationsAndTheRouteStartAreInTheInputsFrame) {
   PlanResult r = ThreeStations();
   r.frame_origin_m = WorldPoint(512000, 5612000, 0);
