@@ -402,7 +402,11 @@ std::string JoinHostPort(const sockaddr* sa, const std::string& port) {
     return std::string(host) + ":" + port;
   }
   inet_ntop(AF_INET6, &reinterpret_cast<const sockaddr_in6*>(sa)->sin6_addr, host, sizeof(host));
-  return "[" + std::string(host) + "]:" + port;
+  std::string joined = "[";
+  joined += host;
+  joined += "]:";
+  joined += port;
+  return joined;
 }
 
 }  // namespace

@@ -20,7 +20,10 @@ bool UnitFollowsBound(std::string_view unit) { return !unit.empty() && unit != "
 // "must be > 0 m, got -5" for the row's check and unit.
 Status Refuse(const ParamInfo& info, std::string_view prefix, const char* requirement, const std::string& got) {
   std::string m = std::string(prefix) + std::string(info.name) + " must be " + requirement;
-  if (info.check != ParamCheck::kAny && UnitFollowsBound(info.unit)) m += " " + std::string(info.unit);
+  if (info.check != ParamCheck::kAny && UnitFollowsBound(info.unit)) {
+    m += ' ';
+    m += info.unit;
+  }
   return InvalidArgumentError(m + ", got " + got);
 }
 

@@ -79,7 +79,10 @@ std::optional<std::string> ScanGraphWarning(const ScanGraph& graph) {
   std::string groups;
   for (const std::vector<int>& g : graph.components) {
     groups += groups.empty() ? "[" : ", [";
-    for (size_t k = 0; k < g.size(); ++k) groups += (k ? " " : "") + std::to_string(g[k] + 1);
+    for (size_t k = 0; k < g.size(); ++k) {
+      if (k > 0) groups += ' ';
+      groups += std::to_string(g[k] + 1);
+    }
     groups += "]";
   }
   return "the stations form " + std::to_string(graph.components.size()) + " groups (" + groups +

@@ -69,7 +69,7 @@ std::string FloorLabel(const std::vector<double>& levels, double floor_z_m) {
   for (size_t i = 1; i < levels.size(); ++i) {
     if (std::fabs(levels[i] - floor_z_m) < std::fabs(levels[best] - floor_z_m)) best = i;
   }
-  return "L" + std::to_string(best);
+  return std::string("L").append(std::to_string(best));
 }
 
 // Station indices in walking order: the route's, then those it leaves out in selection order.
