@@ -15,6 +15,8 @@ find_package(PkgConfig REQUIRED)
 pkg_check_modules(HWY REQUIRED IMPORTED_TARGET libhwy)
 # COIN-OR CBC (coinor-libcbc-dev): the exact station selector (vc::plan only).
 pkg_check_modules(CBC REQUIRED IMPORTED_TARGET cbc)
+# PROJ (libproj-dev): the CRS of vc-client --crs, stations.geojson and true north (vc::report only).
+pkg_check_modules(PROJ REQUIRED IMPORTED_TARGET proj)
 
 # three.js r111 and its OrbitControls from Debian's libjs-three: report.html inlines them
 # (core/report). Needed at build time only; the binaries carry the text.

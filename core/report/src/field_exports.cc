@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <iterator>
 #include <limits>
+#include <nlohmann/json.hpp>
 #include <set>
 #include <string>
 #include <utility>
@@ -145,9 +146,27 @@ std::vector<FieldStation> FieldStations(const PlanResult& r, const std::vector<s
   return rows;
 }
 
-std::string FieldStationsCsv(const std::vector<FieldStation>& stations) {
+namespace {
+
+// The stations.csv units line's words for the input's frame.
+std::string FrameWords(const CrsInfo* crs) {
+  if (crs == nullptr) return "the input's frame";
+  std::string words = "the input's frame, CRS " + (crs->epsg ? "EPSG:" + std::to_string(*crs->epsg) : crs->definition) +
+                      " (" + crs->name + ")";
+  if (crs->metres_per_unit != 1) {
+    char factor[64];
+    std::snprintf(factor, sizeof(factor), "%.10g", crs->metres_per_unit);
+    words += " whose " + crs->axis_unit + " are given here in metres (1 " + crs->axis_unit + " = " + factor + " m)";
+  }
+  return words;
+}
+
+}  // namespace
+
+std::string FieldStationsCsv(const std::vector<FieldStation>& stations, const CrsInfo* crs) {
   std::string out =
-      "# vc stations: lengths in metres in the input's frame (x_m, y_m, z_m = the instrument's optical centre); "
+      "# vc stations: lengths in metres in " + FrameWords(crs) +
+      " (x_m, y_m, z_m = the instrument's optical centre); "
       "rows in walking order; tripod_height_m above floor_z_m; gain_voxels and cumulative_coverage (0..1 of the "
       "coverable voxels) in selection order\n"
       "station,name,x_m,y_m,z_m,floor,floor_z_m,tripod_height_m,fixed,route_order,selection_order,gain_voxels,"
@@ -285,7 +304,74 @@ std::vector<WorldPoint> ZoneOutline(const KeepOutZone& z) {
   return out;
 }
 
+// RFC 7946's position of the input-frame point `p`: [longitude, latitude], rounded to 1e-9 degrees
+// (0.1 mm).
+Result<nlohmann::json> Position(const Crs& crs, const WorldPoint& p) {
+  VC_ASSIGN_OR_RETURN(const LonLat ll, crs.ToLonLat(p.x(), p.y()));
+  const auto round9 = [](double deg) { return std::round(deg * 1e9) / 1e9; };
+  return nlohmann::json::array({round9(ll.lon_deg), round9(ll.lat_deg)});
+}
+
+nlohmann::json Feature(nlohmann::json geometry, nlohmann::json properties) {
+  return {{"type", "Feature"}, {"geometry", std::move(geometry)}, {"properties", std::move(properties)}};
+}
+
+// A keep-out zone's footprint as a GeoJSON Polygon: one ring, closed, counter-clockwise (RFC 7946 §3.1.6).
+Result<nlohmann::json> FootprintPolygon(const Crs& crs, const KeepOutZone& zone) {
+  nlohmann::json ring = nlohmann::json::array();
+  for (const WorldPoint& p : ZoneOutline(zone)) {
+    VC_ASSIGN_OR_RETURN(nlohmann::json position, Position(crs, p));
+    ring.push_back(std::move(position));
+  }
+  double twice_area = 0;
+  for (size_t i = 0; i < ring.size(); ++i) {
+    const nlohmann::json& a = ring[i];
+    const nlohmann::json& b = ring[(i + 1) % ring.size()];
+    twice_area += a[0].get<double>() * b[1].get<double>() - b[0].get<double>() * a[1].get<double>();
+  }
+  if (twice_area < 0) std::reverse(ring.begin(), ring.end());
+  ring.push_back(ring.front());
+  return nlohmann::json{{"type", "Polygon"}, {"coordinates", nlohmann::json::array({std::move(ring)})}};
+}
+
 }  // namespace
+
+Result<std::string> StationsGeoJson(const PlanResult& r, const std::vector<FieldStation>& stations, const Crs& crs) {
+  nlohmann::json features = nlohmann::json::array();
+  for (const FieldStation& f : stations) {
+    VC_ASSIGN_OR_RETURN(nlohmann::json position, Position(crs, f.position_m));
+    const bool floor = std::isfinite(f.floor_z_m);
+    features.push_back(Feature({{"type", "Point"}, {"coordinates", std::move(position)}},
+                               {{"kind", "station"},
+                                {"station", f.number},
+                                {"name", f.name},
+                                {"tripod_height_m", floor ? nlohmann::json(std::round(f.tripod_height_m * 1e3) / 1e3)
+                                                          : nlohmann::json(nullptr)},
+                                {"floor", floor ? nlohmann::json(f.floor) : nlohmann::json(nullptr)},
+                                {"fixed", f.fixed},
+                                {"route_order", f.route_order},
+                                {"z_m", std::round(f.position_m.z() * 1e6) / 1e6}}));
+  }
+  const std::vector<std::vector<WorldPoint>> parts = RouteParts(r);
+  for (size_t k = 0; k < parts.size(); ++k) {
+    nlohmann::json line = nlohmann::json::array();
+    for (const WorldPoint& p : parts[k]) {
+      VC_ASSIGN_OR_RETURN(nlohmann::json position, Position(crs, p));
+      line.push_back(std::move(position));
+    }
+    features.push_back(
+        Feature({{"type", "LineString"}, {"coordinates", std::move(line)}}, {{"kind", "route"}, {"part", k + 1}}));
+  }
+  for (size_t k = 0; k < r.options.keep_out.size(); ++k) {
+    const KeepOutZone& zone = r.options.keep_out[k];
+    VC_ASSIGN_OR_RETURN(nlohmann::json polygon, FootprintPolygon(crs, zone));
+    features.push_back(
+        Feature(std::move(polygon),
+                {{"kind", "keep_out"}, {"zone", k + 1}, {"z_min_m", zone.min.z()}, {"z_max_m", zone.max.z()}}));
+  }
+  const nlohmann::json collection = {{"type", "FeatureCollection"}, {"features", std::move(features)}};
+  return collection.dump(1) + "\n";
+}
 
 std::string StationsDxf(const PlanResult& r, const std::vector<FieldStation>& stations) {
   const std::vector<std::vector<WorldPoint>> route = RouteParts(r);

@@ -655,10 +655,20 @@ Result<WorldPoint> NamedColumnsRow(const std::vector<std::string_view>& fields, 
 // A height for plan.json: null when NaN.
 Json HeightJson(double v) { return std::isfinite(v) ? Json(v) : Json(nullptr); }
 
+// plan.json's and evaluation.json's `crs`: null without one.
+Json CrsJson(const CrsInfo* crs) {
+  if (crs == nullptr) return nullptr;
+  return Json{{"definition", crs->definition},
+              {"name", crs->name},
+              {"epsg", crs->epsg ? Json(*crs->epsg) : Json(nullptr)},
+              {"axis_unit", crs->axis_unit},
+              {"metres_per_unit", crs->metres_per_unit}};
+}
+
 }  // namespace
 
 std::string PlanToJson(const PlanResult& r, const UploadSummary* upload,
-                       const std::vector<std::string>& fixed_station_names) {
+                       const std::vector<std::string>& fixed_station_names, const CrsInfo* crs) {
   const std::vector<int> route_position = RoutePositions(r);
   std::vector<const FieldStation*> field(r.stations.size(), nullptr);
   const std::vector<FieldStation> field_stations = FieldStations(r, fixed_station_names);
@@ -763,6 +773,7 @@ std::string PlanToJson(const PlanResult& r, const UploadSummary* upload,
          {"frame",
           {{"origin_m", Point(r.frame_origin_m)},
            {"units", upload == nullptr ? Json(nullptr) : Json(upload->units.empty() ? "m" : upload->units)}}},
+         {"crs", CrsJson(crs)},
          {"resolution_m", r.resolution_m},
          {"selection_test", std::string(SelectionTestName(r.selection_test))},
          {"stop_reason", std::string(StopReasonName(r.stop_reason))},
@@ -843,13 +854,18 @@ std::string ColouredPointsPly(const std::vector<std::string>& comments, const st
 }
 
 Status WritePlanOutputs(const PlanResult& result, const std::string& out_dir, const UploadSummary* upload,
-                        const std::vector<std::string>& fixed_station_names) {
+                        const std::vector<std::string>& fixed_station_names, const Crs* crs) {
   VC_RETURN_IF_ERROR(MakeDir(out_dir));
   const std::filesystem::path dir(out_dir);
-  VC_RETURN_IF_ERROR(WriteFile(dir / "plan.json", PlanToJson(result, upload, fixed_station_names)));
+  const CrsInfo* crs_info = crs == nullptr ? nullptr : &crs->info();
+  VC_RETURN_IF_ERROR(WriteFile(dir / "plan.json", PlanToJson(result, upload, fixed_station_names, crs_info)));
   const std::vector<FieldStation> field_stations = FieldStations(result, fixed_station_names);
-  VC_RETURN_IF_ERROR(WriteFile(dir / "stations.csv", FieldStationsCsv(field_stations)));
+  VC_RETURN_IF_ERROR(WriteFile(dir / "stations.csv", FieldStationsCsv(field_stations, crs_info)));
   VC_RETURN_IF_ERROR(WriteFile(dir / "stations.dxf", StationsDxf(result, field_stations)));
+  if (crs != nullptr) {
+    VC_ASSIGN_OR_RETURN(const std::string geojson, StationsGeoJson(result, field_stations, *crs));
+    VC_RETURN_IF_ERROR(WriteFile(dir / "stations.geojson", geojson));
+  }
   if (result.voxel_centers.size() != result.evaluation.best_face_values.size()) {
     return FailedPreconditionError("visibility.ply needs one best_face_values entry per voxel centre (" +
                                    std::to_string(result.voxel_centers.size()) + " centres, " +
@@ -864,15 +880,18 @@ Status WritePlanOutputs(const PlanResult& result, const std::string& out_dir, co
   return Status::Ok();
 }
 
-std::string EvaluationToJson(const Evaluation& evaluation, const std::vector<WorldPoint>& viewpoints) {
-  return EvaluationJson(evaluation, viewpoints).dump(2) + "\n";
+std::string EvaluationToJson(const Evaluation& evaluation, const std::vector<WorldPoint>& viewpoints,
+                             const CrsInfo* crs) {
+  Json j = EvaluationJson(evaluation, viewpoints);
+  j["crs"] = CrsJson(crs);
+  return j.dump(2) + "\n";
 }
 
 Status WriteEvaluationOutputs(const Evaluation& evaluation, const std::vector<WorldPoint>& viewpoints,
-                              const std::string& out_dir) {
+                              const std::string& out_dir, const CrsInfo* crs) {
   VC_RETURN_IF_ERROR(MakeDir(out_dir));
   const std::filesystem::path dir(out_dir);
-  VC_RETURN_IF_ERROR(WriteFile(dir / "evaluation.json", EvaluationToJson(evaluation, viewpoints)));
+  VC_RETURN_IF_ERROR(WriteFile(dir / "evaluation.json", EvaluationToJson(evaluation, viewpoints, crs)));
   VC_RETURN_IF_ERROR(WriteFile(dir / "stations.csv", StationsCsv(viewpoints)));
   return Status::Ok();
 }

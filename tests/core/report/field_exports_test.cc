@@ -1,7 +1,9 @@
 // The crew's files: the station table (walking order, names, floors, tripod heights), stations.csv
 // read back by both station readers, plan.json's station fields, and stations.dxf opened by a real
-// DXF reader (Debian's python3-ezdxf through tests/core/report/read_dxf.py; the test fails, never
-// skips, when it is missing: scripts/install-deps.sh --tests installs it).
+// DXF reader (Debian's python3-ezdxf through tests/core/report/read_dxf.py), and stations.geojson
+// checked by python's json and pyproj (Debian's python3-pyproj through
+// tests/core/report/check_geojson.py). The tests fail, never skip, when a reader is missing:
+// scripts/install-deps.sh --tests installs them.
 #include "vc/report/field_exports.h"
 
 #include <gtest/gtest.h>
@@ -12,6 +14,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "testing/test_paths.h"
@@ -243,6 +246,119 @@ TEST(StationsDxfTest, WritePlanOutputsWritesItNextToStationsCsv) {
   const std::string dxf = testing::ReadFileBytes(dir + "/stations.dxf");
   EXPECT_EQ(dxf, StationsDxf(plan, FieldStations(plan, {"BM 7"})));
   EXPECT_NE(testing::ReadFileBytes(dir + "/stations.csv").find("\n2,BM 7,"), std::string::npos);
+  EXPECT_FALSE(std::ifstream(dir + "/stations.geojson").good()) << "no CRS, no GeoJSON";
+  EXPECT_TRUE(json::parse(testing::ReadFileBytes(dir + "/plan.json"))["crs"].is_null());
+}
+
+// What check_geojson.py says of `geojson` against the input-frame points of `expected`; fails the
+// test when pyproj disagrees with a coordinate or the structure is wrong.
+json CheckWithPyproj(const std::string& geojson, const json& expected) {
+  const std::string dir = testing::MakeTempDir();
+  std::ofstream(dir + "/stations.geojson", std::ios::binary) << geojson;
+  std::ofstream(dir + "/expected.json", std::ios::binary) << expected.dump();
+  // Appended piece by piece: GCC 12's -Wstringop-overflow misreads "literal" + std::string (GCC PR 105651).
+  std::string command;
+  for (const std::string_view part : {"'", VC_DXF_PYTHON, "' '", VC_CHECK_GEOJSON_SCRIPT, "' '"}) command += part;
+  command += dir;
+  command += "/stations.geojson' '";
+  command += dir;
+  command += "/expected.json' >'";
+  command += dir;
+  command += "/out.json' 2>'";
+  command += dir;
+  command += "/err.txt'";
+  const int rc = std::system(command.c_str());
+  EXPECT_EQ(rc, 0) << "check_geojson.py (python3-pyproj: scripts/install-deps.sh --tests): "
+                   << testing::ReadFileBytes(dir + "/err.txt");
+  if (rc != 0) return json();
+  return json::parse(testing::ReadFileBytes(dir + "/out.json"));
+}
+
+json Xy(const WorldPoint& p) { return json::array({p.x(), p.y()}); }
+
+TEST(StationsGeoJsonTest, PyprojAgreesWithEveryCoordinateAndRingsAreClosedCounterClockwise) {
+  const PlanResult plan = TwoFloorPlan();  // at 512 km east, 5,612 km north: EPSG:25832 in Germany
+  const Result<Crs> crs = Crs::Create("EPSG:25832");
+  ASSERT_TRUE(crs.ok()) << crs.status().message();
+  const std::vector<FieldStation> stations = FieldStations(plan, {"BM 7"});
+  const Result<std::string> geojson = StationsGeoJson(plan, stations, *crs);
+  ASSERT_TRUE(geojson.ok()) << geojson.status().message();
+
+  json expected{{"crs", "EPSG:25832"}, {"stations", json::array()}};
+  for (const FieldStation& f : stations) expected["stations"].push_back(Xy(f.position_m));
+  // The route's paths joined in walking order: start (5, 0), (4, 0), station 1 at (4, 1), station 0 at (1, 1).
+  expected["route"] = json::array({json::array()});
+  for (const WorldPoint& local : {WorldPoint(5, 0, 0), WorldPoint(4, 0, 0), WorldPoint(4, 1, 0), WorldPoint(1, 1, 0)}) {
+    expected["route"][0].push_back(Xy(local + kOrigin));
+  }
+  expected["zones"] = json::array(
+      {json::array({json::array({512002, 5612002}), json::array({512003, 5612002}), json::array({512003, 5612003}),
+                    json::array({512002, 5612003})}),
+       json::array({json::array({512000, 5612000}), json::array({512001, 5612000}), json::array({512000, 5612001})})});
+  const json summary = CheckWithPyproj(*geojson, expected);
+  EXPECT_EQ(summary["Point"], 4);
+  EXPECT_EQ(summary["LineString"], 1);
+  EXPECT_EQ(summary["Polygon"], 2);
+
+  const json doc = json::parse(*geojson);
+  const json& first = doc["features"][0]["properties"];  // walking order: S01 first, then the fixed BM 7
+  EXPECT_EQ(first["kind"], "station");
+  EXPECT_EQ(first["station"], 1);
+  EXPECT_EQ(first["name"], "S01");
+  EXPECT_EQ(first["fixed"], false);
+  EXPECT_EQ(first["route_order"], 1);
+  EXPECT_EQ(first["floor"], "L0");
+  EXPECT_NEAR(first["tripod_height_m"].get<double>(), 1.2, 1e-9);
+  EXPECT_EQ(doc["features"][1]["properties"]["name"], "BM 7");
+  EXPECT_EQ(doc["features"][1]["properties"]["fixed"], true);
+  EXPECT_TRUE(doc["features"][3]["properties"]["tripod_height_m"].is_null());  // no floor below it
+  EXPECT_EQ(doc["features"][4]["properties"]["kind"], "route");
+  EXPECT_EQ(doc["features"][5]["properties"]["kind"], "keep_out");
+  EXPECT_EQ(doc["features"][5]["properties"]["z_max_m"], 102);
+  // Nine decimals of a degree (0.1 mm): "9.1234567..,"
+  const std::string lon = doc["features"][0]["geometry"]["coordinates"][0].dump();
+  EXPECT_GE(lon.size() - lon.find('.') - 1, 7u) << lon;
+}
+
+TEST(StationsGeoJsonTest, AFootCrsTakesTheMetresOfTheOutputs) {
+  PlanResult plan = TwoFloorPlan();
+  plan.frame_origin_m = WorldPoint(300000, 60000, 10);  // NAD83 / New York Long Island, in metres
+  plan.options.keep_out.clear();
+  const Result<Crs> crs = Crs::Create("EPSG:2263");
+  ASSERT_TRUE(crs.ok()) << crs.status().message();
+  const std::vector<FieldStation> stations = FieldStations(plan);
+  const Result<std::string> geojson = StationsGeoJson(plan, stations, *crs);
+  ASSERT_TRUE(geojson.ok()) << geojson.status().message();
+  json expected{{"crs", "EPSG:2263"},
+                {"metres_per_unit", 1200.0 / 3937.0},
+                {"stations", json::array()},
+                {"route", json::array({json::array()})},
+                {"zones", json::array()}};
+  for (const FieldStation& f : stations) expected["stations"].push_back(Xy(f.position_m));
+  for (const WorldPoint& local : {WorldPoint(5, 0, 0), WorldPoint(4, 0, 0), WorldPoint(4, 1, 0), WorldPoint(1, 1, 0)}) {
+    expected["route"][0].push_back(Xy(local + plan.frame_origin_m));
+  }
+  EXPECT_EQ(CheckWithPyproj(*geojson, expected)["Point"], 4);
+}
+
+TEST(StationsGeoJsonTest, WithACrsWritePlanOutputsWritesItAndNamesTheCrs) {
+  const PlanResult plan = TwoFloorPlan();
+  const Result<Crs> crs = Crs::Create("EPSG:25832");
+  ASSERT_TRUE(crs.ok());
+  const std::string dir = testing::MakeTempDir();
+  ASSERT_TRUE(WritePlanOutputs(plan, dir, nullptr, {"BM 7"}, &*crs).ok());
+  EXPECT_EQ(testing::ReadFileBytes(dir + "/stations.geojson"),
+            *StationsGeoJson(plan, FieldStations(plan, {"BM 7"}), *crs));
+  const json j = json::parse(testing::ReadFileBytes(dir + "/plan.json"));
+  EXPECT_EQ(j["crs"]["definition"], "EPSG:25832");
+  EXPECT_EQ(j["crs"]["name"], "ETRS89 / UTM zone 32N");
+  EXPECT_EQ(j["crs"]["epsg"], 25832);
+  EXPECT_EQ(j["crs"]["axis_unit"], "metre");
+  EXPECT_EQ(testing::ReadFileBytes(dir + "/stations.csv")
+                .rfind("# vc stations: lengths in metres in the input's frame, CRS EPSG:25832 (ETRS89 / UTM zone 32N) "
+                       "(x_m",
+                       0),
+            0u);
 }
 
 }  // namespace

@@ -7,7 +7,8 @@
 // (or a commercial licence), which would bind vc-client and vc-server, which link this layer, and
 // the four entity kinds needed (POINT, TEXT, POLYLINE/VERTEX, the LAYER table) are a few dozen
 // lines of group codes. R12 is the one DXF every CAD program and field controller still imports.
-// Pure functions of their arguments: thread-safe.
+// Pure functions of their arguments: thread-safe (StationsGeoJson as far as its Crs is: one thread
+// at a time per Crs).
 #pragma once
 
 #include <cstdint>
@@ -15,7 +16,9 @@
 #include <vector>
 
 #include "vc/base/geometry.h"
+#include "vc/base/status.h"
 #include "vc/plan/planner.h"
+#include "vc/report/crs.h"
 
 namespace vc {
 
@@ -45,12 +48,22 @@ std::vector<FieldStation> FieldStations(const PlanResult& result,
 // order: station,name,x_m,y_m,z_m,floor,floor_z_m,tripod_height_m,fixed,route_order,
 // selection_order,gain_voxels,cumulative_coverage (x, y, z to the micrometre; fixed "existing" or
 // "new"; empty cells where a station has no floor). ParseStationsCsv and ParseStationFile read it.
-std::string FieldStationsCsv(const std::vector<FieldStation>& stations);
+// With `crs`, the '#' line names the CRS the input's frame is in.
+std::string FieldStationsCsv(const std::vector<FieldStation>& stations, const CrsInfo* crs = nullptr);
 
 // stations.dxf (DXF R12, metres, the input's frame): layer STATIONS a POINT per optical centre,
 // LABELS a TEXT "name h=1.60" beside each, ROUTE one 3D polyline per walkable part of the route
 // (its paths over the floors, as plan.json's route.polyline), KEEP_OUT each zone's outline as a
 // closed 3D polyline at the zone's lowest z.
 std::string StationsDxf(const PlanResult& result, const std::vector<FieldStation>& stations);
+
+// stations.geojson (RFC 7946: WGS 84 longitude, latitude in degrees, 9 decimals): a FeatureCollection
+// of a Point per station in walking order (properties kind "station", station, name, tripod_height_m,
+// floor, fixed, route_order, z_m), a LineString per walkable part of the route (kind "route", part),
+// and a Polygon per keep-out zone's footprint (kind "keep_out", zone, z_min_m, z_max_m; closed ring,
+// counter-clockwise), the input's frame being in `crs`. INVALID_ARGUMENT when PROJ cannot place a
+// point.
+Result<std::string> StationsGeoJson(const PlanResult& result, const std::vector<FieldStation>& stations,
+                                    const Crs& crs);
 
 }  // namespace vc

@@ -1,7 +1,7 @@
 // The files a user gets from a plan or an evaluation (written by vc-client from the streamed
-// result, and usable directly from core): plan.json, stations.csv, stations.dxf, visibility.ply, heatmap.png,
-// reduction.png, report.html (vc/report/report_html.h), evaluation.json. Schemas are documented
-// in docs/PLANNING.md and docs/PROTOCOL.md.
+// result, and usable directly from core): plan.json, stations.csv, stations.dxf, stations.geojson (with a CRS),
+// visibility.ply, heatmap.png, reduction.png, report.html (vc/report/report_html.h), evaluation.json. Schemas are
+// documented in docs/PLANNING.md and docs/PROTOCOL.md.
 #pragma once
 
 #include <array>
@@ -13,6 +13,7 @@
 #include "vc/base/geometry.h"
 #include "vc/base/status.h"
 #include "vc/plan/planner.h"
+#include "vc/report/crs.h"
 #include "vc/visibility/visibility.h"
 
 namespace vc {
@@ -34,17 +35,19 @@ struct UploadSummary {
 // input's own frame (the result's local positions plus PlanResult::frame_origin_m), and "frame"
 // says where the local frame lies (docs/PLANNING.md, "Outputs in the input's frame").
 // `fixed_station_names` name the fixed stations as FieldStations (vc/report/field_exports.h) does.
+// `crs`: the CRS the input's frame is in, for plan.json's `crs` (null when not given).
 std::string PlanToJson(const PlanResult& result, const UploadSummary* upload = nullptr,
-                       const std::vector<std::string>& fixed_station_names = {});
+                       const std::vector<std::string>& fixed_station_names = {}, const CrsInfo* crs = nullptr);
 
 // Writes plan.json, stations.csv, stations.dxf, visibility.ply, heatmap.png, reduction.png and report.html into
 // `out_dir` (created if missing), every coordinate in the input's own frame (stations.csv and stations.dxf to the
 // micrometre; visibility.ply in double precision when the frame's origin is not zero). `fixed_station_names`: the
 // fixed stations' names from their file, in PlanOptions::fixed_stations order (may be empty). visibility.ply needs
-// result.voxel_centers and result.evaluation.best_face_values. INTERNAL / FAILED_PRECONDITION with the path on I/O
-// errors.
+// result.voxel_centers and result.evaluation.best_face_values. With `crs` (the CRS of the input's frame), also
+// stations.geojson, and plan.json and stations.csv name the CRS. INTERNAL / FAILED_PRECONDITION with the path on
+// I/O errors; INVALID_ARGUMENT when PROJ cannot place a station on the earth.
 Status WritePlanOutputs(const PlanResult& result, const std::string& out_dir, const UploadSummary* upload = nullptr,
-                        const std::vector<std::string>& fixed_station_names = {});
+                        const std::vector<std::string>& fixed_station_names = {}, const Crs* crs = nullptr);
 
 // One point of a coloured PLY: its position (m), its colour and, when the PLY has one, its value.
 struct ColouredPoint {
@@ -61,10 +64,12 @@ std::string ColouredPointsPly(const std::vector<std::string>& comments, const st
                               std::string_view value_name = "", PlyCoordinates coordinates = PlyCoordinates::kFloat);
 
 // evaluation.json's content: resolution_m, global_visibility, per_viewpoint[...] and more;
-// `viewpoints` as the job was given them (the input's own frame).
-std::string EvaluationToJson(const Evaluation& evaluation, const std::vector<WorldPoint>& viewpoints);
+// `viewpoints` as the job was given them (the input's own frame); `crs` (null when not given) the CRS
+// of that frame, as plan.json's `crs`.
+std::string EvaluationToJson(const Evaluation& evaluation, const std::vector<WorldPoint>& viewpoints,
+                             const CrsInfo* crs = nullptr);
 Status WriteEvaluationOutputs(const Evaluation& evaluation, const std::vector<WorldPoint>& viewpoints,
-                              const std::string& out_dir);
+                              const std::string& out_dir, const CrsInfo* crs = nullptr);
 
 // Pixel size of a picture.
 struct ImageSize {
