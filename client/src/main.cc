@@ -16,6 +16,7 @@
 
 #include "vc/client/client.h"
 #include "vc/client/compact_upload.h"
+#include "vc/client/crs_flag.h"
 #include "vc/client/did_you_mean.h"
 #include "vc/client/parameter_flags.h"
 #include "vc/client/plan_summary.h"
@@ -110,10 +111,10 @@ class InterruptCancelsTheJob {
   vc::client::JobTicket job_;
 };
 
-// Writes evaluation.json and prints G.
-int WriteEvaluation(const vc::Evaluation& r, const std::vector<vc::WorldPoint>& viewpoints,
-                    const std::string& out_dir) {
-  vc::Status written = vc::WriteEvaluationOutputs(r, viewpoints, out_dir);
+// Writes evaluation.json (naming `crs` when given) and prints G.
+int WriteEvaluation(const vc::Evaluation& r, const std::vector<vc::WorldPoint>& viewpoints, const std::string& out_dir,
+                    const vc::Crs* crs = nullptr) {
+  vc::Status written = vc::WriteEvaluationOutputs(r, viewpoints, out_dir, crs == nullptr ? nullptr : &crs->info());
   if (!written.ok()) return Fail("cannot write evaluation.json", written);
   std::printf("global visibility G = %.4f%s over %llu faces; wrote %s/evaluation.json\n", r.overall.global_visibility,
               r.sampled ? (" (+/- " + std::to_string(r.global_visibility_ci95) + ", sampled)").c_str() : "",
@@ -159,15 +160,19 @@ std::vector<std::string> FixedStationNames(const std::string& path) {
   return names;
 }
 
-// Writes the plan's reports and prints its stations.
+// Writes the plan's reports (stations.geojson with a CRS) and prints its stations.
 int WritePlan(const vc::PlanResult& r, const std::string& out_dir, const vc::UploadSummary* upload,
-              const std::vector<std::string>& fixed_station_names = {}) {
-  vc::Status written = vc::WritePlanOutputs(r, out_dir, upload, fixed_station_names);
+              const std::vector<std::string>& fixed_station_names = {}, const vc::Crs* crs = nullptr) {
+  vc::Status written = vc::WritePlanOutputs(r, out_dir, upload, fixed_station_names, crs);
   if (!written.ok()) return Fail("cannot write the reports", written);
   PrintStations(r);
   std::printf(
-      "wrote plan.json, stations.csv, stations.dxf, visibility.ply, heatmap.png, reduction.png, report.html to %s\n",
-      out_dir.c_str());
+      "wrote plan.json, stations.csv, stations.dxf, %svisibility.ply, heatmap.png, reduction.png, "
+      "report.html to %s\n",
+      crs != nullptr ? "stations.geojson, " : "", out_dir.c_str());
+  if (crs == nullptr) {
+    std::printf("no stations.geojson: name the scene's CRS (--crs EPSG:25832, say) for a map in longitude/latitude\n");
+  }
   return 0;
 }
 
@@ -180,6 +185,10 @@ constexpr const char* kDetachHelp =
 constexpr const char* kUnitsHelp =
     "unit of the file's coordinates when the file does not say: m, cm, mm, ft (international foot), us-ft "
     "(US survey foot); default m";
+
+constexpr const char* kCrsHelp =
+    "CRS of the file's coordinates (EPSG:25832, WKT or a PROJ string; a projected CRS): labels plan.json and "
+    "stations.csv and writes stations.geojson; without --units the file is read in the CRS's unit";
 
 // --units on `command`, checked here with the server's own list (MetresPerUnit).
 void AddUnitsFlag(CLI::App* command, std::string* units) {
@@ -197,6 +206,7 @@ struct CommandLine {
   std::string out_dir = "./vc-out";
   bool raw_upload = false;
   std::string units;                     // submit, evaluate, inspect (--units; empty = metres)
+  std::string crs;                       // submit, evaluate (--crs; empty = none)
   vc::PlanOptions plan;                  // submit
   vc::client::PlanFileFlags plan_files;  // submit
   vc::EvaluateJobOptions eval;           // evaluate
@@ -244,6 +254,7 @@ CLI::App* AddSubmitCommand(CLI::App& app, CommandLine* cl) {
   submit->add_option("--out", cl->out_dir, "output directory")->capture_default_str();
   submit->add_flag("--raw-upload", cl->raw_upload, kRawUploadHelp);
   AddUnitsFlag(submit, &cl->units);
+  submit->add_option("--crs", cl->crs, kCrsHelp);
   cl->conn.detach_grace_s = 600;
   submit->add_option("--detach-grace", cl->conn.detach_grace_s, kDetachHelp)->capture_default_str();
   vc::client::AddPlanFileFlags(submit, &cl->plan_files);
@@ -259,6 +270,7 @@ CLI::App* AddEvaluateCommand(CLI::App& app, CommandLine* cl) {
   evaluate->add_option("--out", cl->out_dir, "output directory")->capture_default_str();
   evaluate->add_flag("--raw-upload", cl->raw_upload, kRawUploadHelp);
   AddUnitsFlag(evaluate, &cl->units);
+  evaluate->add_option("--crs", cl->crs, kCrsHelp);
   evaluate->add_option("--detach-grace", cl->conn.detach_grace_s, kDetachHelp)->capture_default_str();
   vc::client::AddEvaluateFlags(evaluate, &cl->eval);
   return evaluate;
@@ -342,10 +354,11 @@ int RunAttach(vc::client::Client& client, const CommandLine& cl) {
 }
 
 // The scene file, read and checked here before any connection: refused when the server's reader
-// would refuse it too (compact_upload.h); the upload for it at `resolution_m` otherwise.
-vc::Result<vc::client::PreparedUpload> PrepareScene(const CommandLine& cl, double resolution_m) {
+// would refuse it too (compact_upload.h); the upload for it in `units` at `resolution_m` otherwise.
+vc::Result<vc::client::PreparedUpload> PrepareScene(const CommandLine& cl, const std::string& units,
+                                                    double resolution_m) {
   VC_ASSIGN_OR_RETURN(vc::client::Upload file_bytes, vc::client::ReadUpload(cl.file));
-  file_bytes.units = cl.units;
+  file_bytes.units = units;
   return vc::client::PrepareUpload(std::move(file_bytes), resolution_m, cl.raw_upload);
 }
 
@@ -361,14 +374,16 @@ void AnnounceUpload(const vc::client::PreparedUpload& prepared, const CommandLin
 // server's rules, named by flag), then the scene file.
 struct CheckedSubmit {
   vc::PlanOptions plan;
+  vc::client::CrsChoice crs;
   vc::client::PreparedUpload prepared;
 };
 
 vc::Result<CheckedSubmit> CheckSubmit(const CommandLine& cl) {
-  CheckedSubmit checked{cl.plan, {}};
+  CheckedSubmit checked{cl.plan, {}, {}};
+  VC_ASSIGN_OR_RETURN(checked.crs, vc::client::CheckCrsFlag(cl.crs, cl.units));
   VC_ASSIGN_OR_RETURN(const vc::client::PlanFileLines lines, vc::client::LoadPlanFiles(cl.plan_files, &checked.plan));
   VC_RETURN_IF_ERROR(checked.plan.Validate(vc::client::PlanFlagNamer(lines)));
-  VC_ASSIGN_OR_RETURN(checked.prepared, PrepareScene(cl, checked.plan.resolution_m));
+  VC_ASSIGN_OR_RETURN(checked.prepared, PrepareScene(cl, checked.crs.units, checked.plan.resolution_m));
   return checked;
 }
 
@@ -384,20 +399,24 @@ int RunSubmit(const CommandLine& cl, InterruptCancelsTheJob* interrupt) {
   display.Done();
   if (!r.ok()) return FailCall("plan", r.status(), cl.conn.server);
   NoteCache((*client)->last_upload(), &prepared.summary, display);
-  return WritePlan(*r, cl.out_dir, &prepared.summary, FixedStationNames(cl.plan_files.fixed_stations));
+  const std::optional<vc::Crs>& crs = checked->crs.crs;
+  return WritePlan(*r, cl.out_dir, &prepared.summary, FixedStationNames(cl.plan_files.fixed_stations),
+                   crs ? &*crs : nullptr);
 }
 
 // evaluate's counterpart of CheckSubmit.
 struct CheckedEvaluate {
   vc::EvaluateJobOptions eval;
+  vc::client::CrsChoice crs;
   vc::client::PreparedUpload prepared;
 };
 
 vc::Result<CheckedEvaluate> CheckEvaluate(const CommandLine& cl) {
-  CheckedEvaluate checked{cl.eval, {}};
+  CheckedEvaluate checked{cl.eval, {}, {}};
+  VC_ASSIGN_OR_RETURN(checked.crs, vc::client::CheckCrsFlag(cl.crs, cl.units));
   VC_ASSIGN_OR_RETURN(checked.eval.viewpoints, vc::client::LoadViewpoints(cl.viewpoints_csv));
   VC_RETURN_IF_ERROR(checked.eval.Validate(vc::client::EvaluateFlagNamer()));
-  VC_ASSIGN_OR_RETURN(checked.prepared, PrepareScene(cl, checked.eval.resolution_m));
+  VC_ASSIGN_OR_RETURN(checked.prepared, PrepareScene(cl, checked.crs.units, checked.eval.resolution_m));
   return checked;
 }
 
@@ -413,7 +432,8 @@ int RunEvaluate(const CommandLine& cl, InterruptCancelsTheJob* interrupt) {
   display.Done();
   if (!r.ok()) return FailCall("evaluate", r.status(), cl.conn.server);
   NoteCache((*client)->last_upload(), &prepared.summary, display);
-  return WriteEvaluation(*r, checked->eval.viewpoints, cl.out_dir);
+  const std::optional<vc::Crs>& crs = checked->crs.crs;
+  return WriteEvaluation(*r, checked->eval.viewpoints, cl.out_dir, crs ? &*crs : nullptr);
 }
 
 // Parses the command line; on a mistake prints CLI11's message and, for a misspelt flag or

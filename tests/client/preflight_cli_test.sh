@@ -71,6 +71,15 @@ expect 5 "vc-client: cannot read the scene file missing.ply: No such file or dir
   submit missing.ply
 expect 3 "vc-client: text.ply is not a PLY file (it looks like XYZ text; rename it .xyz, or export it again as PLY): text.ply: line 2: expected a number for y (column 2), found \"x\" (nothing was sent)" \
   submit text.ply
+# --crs is checked with PROJ before anything is sent (vc/client/crs_flag.h).
+expect 3 "vc-client: --crs: \"EPSG:99999\" is not a CRS PROJ knows (proj_create: crs not found) (nothing was sent)" \
+  submit cloud.xyz --crs EPSG:99999
+expect 3 "vc-client: --crs: \"EPSG:4326\" (WGS 84) is a geographic CRS: its coordinates are degrees of longitude and latitude, not a site frame in metres or feet. Give the projected CRS the scan is in (e.g. the UTM zone, EPSG:25832 for ETRS89 / UTM zone 32N, or the national grid) (nothing was sent)" \
+  submit cloud.xyz --crs EPSG:4326
+expect 3 "vc-client: --crs EPSG:25832 (ETRS89 / UTM zone 32N) has its axes in metre (--units m) but --units says mm: a file in the CRS's coordinates is in its unit. Drop --units (the CRS's unit is used), or give the CRS the file is in (nothing was sent)" \
+  submit cloud.xyz --crs EPSG:25832 --units mm
+expect 3 "vc-client: --crs EPSG:2263 (NAD83 / New York Long Island (ftUS)) has its axes in US survey foot (--units us-ft) but --units says m: a file in the CRS's coordinates is in its unit. Drop --units (the CRS's unit is used), or give the CRS the file is in (nothing was sent)" \
+  evaluate cloud.xyz --viewpoints fixed.csv --crs EPSG:2263 --units m
 expect 109 "vc-client: unknown flag --grid-spaceing; did you mean --grid-spacing?" submit cloud.xyz --grid-spaceing 2
 expect 106 "vc-client: unknown command 'sumbit'; did you mean submit?" sumbit cloud.xyz
 
