@@ -88,9 +88,9 @@ PlanResult SamplePlan() {
 
 TEST(PlanReportTest, PlanJsonHasEveryDocumentedKey) {
   const json j = json::parse(PlanToJson(SamplePlan()));
-  for (const char* key :
-       {"schema", "resolution_m", "selection_test", "stop_reason", "viewpoints", "coverage", "reduction", "candidates",
-        "timings_s", "parameters", "warnings", "scan_graph", "route", "field_time_s", "optimality", "distribution"}) {
+  for (const char* key : {"schema", "resolution_m", "selection_test", "stop_reason", "viewpoints", "coverage",
+                          "reduction", "candidates", "timings_s", "parameters", "warnings", "scan_graph", "route",
+                          "field_time_s", "optimality", "distribution", "frame", "crs"}) {
     EXPECT_TRUE(j.contains(key)) << key;
   }
   EXPECT_EQ(j["scan_graph"]["min_overlap"].get<double>(), 0.3);
@@ -445,6 +445,26 @@ TEST(PlanReportTest, EvaluationJsonHasItsKeys) {
   const std::string dir = testing::MakeTempDir();
   ASSERT_TRUE(WriteEvaluationOutputs(plan.evaluation, vps, dir).ok());
   EXPECT_EQ(json::parse(ReadAll(dir + "/evaluation.json"))["faces_total"].get<int>(), 30);
+}
+
+TEST(PlanReportTest, EvaluationJsonNamesTheCrsOfItsFrameWhenGivenOne) {
+  const PlanResult plan = SamplePlan();
+  const std::vector<WorldPoint> vps = {plan.stations[0].position};
+  EXPECT_TRUE(json::parse(EvaluationToJson(plan.evaluation, vps))["crs"].is_null());
+  CrsInfo crs;
+  crs.definition = "EPSG:2263";
+  crs.name = "NAD83 / New York Long Island (ftUS)";
+  crs.epsg = 2263;
+  crs.axis_unit = "US survey foot";
+  crs.metres_per_unit = 1200.0 / 3937.0;
+  const std::string dir = testing::MakeTempDir();
+  ASSERT_TRUE(WriteEvaluationOutputs(plan.evaluation, vps, dir, &crs).ok());
+  const json j = json::parse(ReadAll(dir + "/evaluation.json"))["crs"];
+  EXPECT_EQ(j["definition"], "EPSG:2263");
+  EXPECT_EQ(j["name"], "NAD83 / New York Long Island (ftUS)");
+  EXPECT_EQ(j["epsg"], 2263);
+  EXPECT_EQ(j["axis_unit"], "US survey foot");
+  EXPECT_DOUBLE_EQ(j["metres_per_unit"].get<double>(), 1200.0 / 3937.0);
 }
 
 TEST(ParseStationsCsvTest, AcceptsHeaderCommentsBlankLinesAndSpaces) {
