@@ -206,7 +206,7 @@ struct CommandLine {
   std::string out_dir = "./vc-out";
   bool raw_upload = false;
   std::string units;                     // submit, evaluate, inspect (--units; empty = metres)
-  std::string crs;                       // submit, evaluate (--crs; empty = none)
+  std::string crs;                       // submit, evaluate, attach (--crs; empty = none)
   vc::PlanOptions plan;                  // submit
   vc::client::PlanFileFlags plan_files;  // submit
   vc::EvaluateJobOptions eval;           // evaluate
@@ -286,6 +286,8 @@ Subcommands AddCommands(CLI::App& app, CommandLine* cl) {
       "attach", "re-attach to a detached job (plan or evaluation) by its id; write its reports like submit/evaluate");
   sub.attach->add_option("JOB_ID", cl->job_id, "the id submit printed (j-...)")->required();
   sub.attach->add_option("--out", cl->out_dir, "output directory")->capture_default_str();
+  sub.attach->add_option("--crs", cl->crs,
+                         "CRS the job's scene was submitted in (as submit --crs): labels the outputs");
   sub.cancel = app.add_subcommand("cancel", "cancel a detached job, or discard its kept result");
   sub.cancel->add_option("JOB_ID", cl->job_id, "the id submit printed (j-...)")->required();
 
@@ -343,14 +345,18 @@ int RunCancel(vc::client::Client& client, const CommandLine& cl) {
 }
 
 int RunAttach(vc::client::Client& client, const CommandLine& cl) {
+  // The job's units are the server's to know: only the CRS itself is checked here.
+  vc::Result<vc::client::CrsChoice> crs = vc::client::CheckCrsFlag(cl.crs, "");
+  if (!crs.ok()) return Fail(crs.status());
+  const vc::Crs* crs_ptr = crs->crs ? &*crs->crs : nullptr;
   vc::client::ProgressDisplay display(stderr, isatty(fileno(stderr)) != 0);
   auto job = client.Attach(cl.job_id, Observe(display));
   display.Done();
   if (!job.ok()) return FailCall("attach", job.status(), cl.conn.server);
   if (job->kind == vc::client::AttachedJob::Kind::kEvaluation) {
-    return WriteEvaluation(job->evaluation.evaluation, job->evaluation.viewpoints, cl.out_dir);
+    return WriteEvaluation(job->evaluation.evaluation, job->evaluation.viewpoints, cl.out_dir, crs_ptr);
   }
-  return WritePlan(job->plan, cl.out_dir, nullptr);
+  return WritePlan(job->plan, cl.out_dir, nullptr, {}, crs_ptr);
 }
 
 // The scene file, read and checked here before any connection: refused when the server's reader

@@ -80,6 +80,8 @@ expect 3 "vc-client: --crs EPSG:25832 (ETRS89 / UTM zone 32N) has its axes in me
   submit cloud.xyz --crs EPSG:25832 --units mm
 expect 3 "vc-client: --crs EPSG:2263 (NAD83 / New York Long Island (ftUS)) has its axes in US survey foot (--units us-ft) but --units says m: a file in the CRS's coordinates is in its unit. Drop --units (the CRS's unit is used), or give the CRS the file is in (nothing was sent)" \
   evaluate cloud.xyz --viewpoints fixed.csv --crs EPSG:2263 --units m
+expect 3 "vc-client: --crs: \"EPSG:99999\" is not a CRS PROJ knows (proj_create: crs not found) (nothing was sent)" \
+  attach j-0123456789abcdef --crs EPSG:99999
 expect 109 "vc-client: unknown flag --grid-spaceing; did you mean --grid-spacing?" submit cloud.xyz --grid-spaceing 2
 expect 106 "vc-client: unknown command 'sumbit'; did you mean submit?" sumbit cloud.xyz
 
