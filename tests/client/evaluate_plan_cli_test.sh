@@ -2,7 +2,8 @@
 # evaluate --plan (#38): a plan.json from a real submit is evaluated with the plan's stations and
 # scanner, so a plan made with --max-range 2 evaluates without the flag as with it, and not as the
 # default scanner would; a flag given overrides the plan and is named on stderr; the files written
-# are listed. Usage: evaluate_plan_cli_test.sh VC_SERVER VC_CLIENT VC_SYNTH
+# are listed; the plan's CRS labels evaluation.json.
+# Usage: evaluate_plan_cli_test.sh VC_SERVER VC_CLIENT VC_SYNTH
 set -euo pipefail
 server_bin="$1" client_bin="$2" synth_bin="$3"
 test_name=evaluate_plan_cli_test
@@ -22,6 +23,18 @@ evaluate() {
     2>"$work/$name.err" || { cat "$work/$name.err" >&2; fail "evaluate $name ($*) failed"; }
 }
 evaluate from-plan --plan "$work/plan/plan.json"
+# The plan's CRS labels evaluation.json (a plan submitted with --crs names it in plan.json's crs).
+python3 -c '
+import json, sys
+plan = json.load(open(sys.argv[1]))
+plan["crs"] = {"definition": "EPSG:25832"}
+json.dump(plan, open(sys.argv[2], "w"))' "$work/plan/plan.json" "$work/plan-crs.json"
+evaluate with-crs --plan "$work/plan-crs.json"
+python3 -c '
+import json, sys
+crs = json.load(open(sys.argv[1]))["crs"]
+assert crs is not None and crs["definition"] == "EPSG:25832", crs' "$work/with-crs/evaluation.json" \
+  || fail "evaluation.json does not name the plan's CRS"
 evaluate with-flags --plan "$work/plan/plan.json" --max-range 2 --max-incidence 80
 evaluate csv-default --viewpoints "$work/plan/stations.csv"
 evaluate overridden --plan "$work/plan/plan.json" --max-range 30
