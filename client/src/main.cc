@@ -19,6 +19,7 @@
 #include "vc/client/crs_flag.h"
 #include "vc/client/did_you_mean.h"
 #include "vc/client/parameter_flags.h"
+#include "vc/client/plan_file.h"
 #include "vc/client/plan_summary.h"
 #include "vc/client/progress_display.h"
 #include "vc/client/validate_command.h"
@@ -111,12 +112,13 @@ class InterruptCancelsTheJob {
   vc::client::JobTicket job_;
 };
 
-// Writes evaluation.json (naming `crs` when given) and prints G.
+// Writes evaluation.json (naming `crs` when given) and stations.csv, prints G and the files written.
 int WriteEvaluation(const vc::Evaluation& r, const std::vector<vc::WorldPoint>& viewpoints, const std::string& out_dir,
                     const vc::Crs* crs = nullptr) {
   vc::Status written = vc::WriteEvaluationOutputs(r, viewpoints, out_dir, crs == nullptr ? nullptr : &crs->info());
   if (!written.ok()) return Fail("cannot write evaluation.json", written);
-  std::printf("global visibility G = %.4f%s over %llu faces; wrote %s/evaluation.json\n", r.overall.global_visibility,
+  std::printf("global visibility G = %.4f%s over %llu faces; wrote evaluation.json, stations.csv to %s\n",
+              r.overall.global_visibility,
               r.sampled ? (" (+/- " + std::to_string(r.global_visibility_ci95) + ", sampled)").c_str() : "",
               static_cast<unsigned long long>(r.faces_evaluated), out_dir.c_str());
   return 0;
@@ -211,6 +213,7 @@ struct CommandLine {
   vc::client::PlanFileFlags plan_files;  // submit
   vc::EvaluateJobOptions eval;           // evaluate
   std::string viewpoints_csv;            // evaluate
+  std::string plan_json;                 // evaluate (--plan: stations, scanner and CRS from a plan.json)
   std::string job_id;                    // attach, cancel
   std::string health_service;            // health
   double inspect_resolution = 0;         // inspect
@@ -263,10 +266,16 @@ CLI::App* AddSubmitCommand(CLI::App& app, CommandLine* cl) {
 }
 
 CLI::App* AddEvaluateCommand(CLI::App& app, CommandLine* cl) {
-  auto* evaluate =
-      app.add_subcommand("evaluate", "evaluate viewpoints on a scene on the server; write evaluation.json");
+  auto* evaluate = app.add_subcommand(
+      "evaluate", "evaluate viewpoints or a plan on a scene on the server; write evaluation.json and stations.csv");
   evaluate->add_option("FILE", cl->file, "scene file")->required();
-  evaluate->add_option("--viewpoints", cl->viewpoints_csv, "CSV of viewpoints x,y,z (e.g. stations.csv)")->required();
+  auto* viewpoints =
+      evaluate->add_option("--viewpoints", cl->viewpoints_csv, "CSV of viewpoints x,y,z (e.g. stations.csv)");
+  evaluate
+      ->add_option("--plan", cl->plan_json,
+                   "a plan.json from submit: its stations, its scanner (each scanner flag given overrides it) and "
+                   "its CRS (unless --crs)")
+      ->excludes(viewpoints);
   evaluate->add_option("--out", cl->out_dir, "output directory")->capture_default_str();
   evaluate->add_flag("--raw-upload", cl->raw_upload, kRawUploadHelp);
   AddUnitsFlag(evaluate, &cl->units);
@@ -417,17 +426,45 @@ struct CheckedEvaluate {
   vc::client::PreparedUpload prepared;
 };
 
-vc::Result<CheckedEvaluate> CheckEvaluate(const CommandLine& cl) {
+// --plan's stations and CRS into `checked`, and its scanner for the rows whose flags are not given
+// (each given flag that differs from the plan is noted on stderr).
+vc::Status TakePlan(const CommandLine& cl, const CLI::App& evaluate, CheckedEvaluate* checked, std::string* crs) {
+  VC_ASSIGN_OR_RETURN(vc::client::PlanForEvaluation plan, vc::client::LoadPlanForEvaluation(cl.plan_json));
+  checked->eval.viewpoints = std::move(plan.stations);
+  for (const std::string& flag : vc::client::TakeScannerFromPlan(evaluate, plan.scanner, &checked->eval.scanner)) {
+    std::cerr << "vc-client: " << flag << " overrides " << cl.plan_json << "\n";
+  }
+  if (checked->eval.scanner.HasHorizontalFieldOfView()) {
+    return vc::InvalidArgumentError(cl.plan_json + "'s scanner sees " + std::to_string(int(plan.scanner.hfov_deg)) +
+                                    " deg around its heading, and evaluate takes no headings: add --hfov 360 to "
+                                    "evaluate its stations all round");
+  }
+  if (crs->empty()) {
+    *crs = plan.crs_definition;
+  } else if (!plan.crs_definition.empty() && *crs != plan.crs_definition) {
+    std::cerr << "vc-client: --crs " << *crs << " overrides " << cl.plan_json << "'s " << plan.crs_definition << "\n";
+  }
+  return vc::Status::Ok();
+}
+
+vc::Result<CheckedEvaluate> CheckEvaluate(const CommandLine& cl, const CLI::App& evaluate) {
   CheckedEvaluate checked{cl.eval, {}, {}};
-  VC_ASSIGN_OR_RETURN(checked.crs, vc::client::CheckCrsFlag(cl.crs, cl.units));
-  VC_ASSIGN_OR_RETURN(checked.eval.viewpoints, vc::client::LoadViewpoints(cl.viewpoints_csv));
+  std::string crs = cl.crs;
+  if (!cl.plan_json.empty()) {
+    VC_RETURN_IF_ERROR(TakePlan(cl, evaluate, &checked, &crs));
+  } else if (cl.viewpoints_csv.empty()) {
+    return vc::InvalidArgumentError("evaluate needs the stations: --viewpoints stations.csv or --plan plan.json");
+  } else {
+    VC_ASSIGN_OR_RETURN(checked.eval.viewpoints, vc::client::LoadViewpoints(cl.viewpoints_csv));
+  }
+  VC_ASSIGN_OR_RETURN(checked.crs, vc::client::CheckCrsFlag(crs, cl.units));
   VC_RETURN_IF_ERROR(checked.eval.Validate(vc::client::EvaluateFlagNamer()));
   VC_ASSIGN_OR_RETURN(checked.prepared, PrepareScene(cl, checked.crs.units, checked.eval.resolution_m));
   return checked;
 }
 
-int RunEvaluate(const CommandLine& cl, InterruptCancelsTheJob* interrupt) {
-  vc::Result<CheckedEvaluate> checked = CheckEvaluate(cl);
+int RunEvaluate(const CommandLine& cl, const CLI::App& evaluate, InterruptCancelsTheJob* interrupt) {
+  vc::Result<CheckedEvaluate> checked = CheckEvaluate(cl, evaluate);
   if (!checked.ok()) return Fail(checked.status());
   auto client = vc::client::Client::Create(cl.conn);
   if (!client.ok()) return Fail("cannot set up the connection", client.status());
@@ -480,7 +517,7 @@ int main(int argc, char** argv) {
   // (attach leaves SIGINT as it is: interrupting it stops following, and the job runs on.)
   if (*sub.submit || *sub.evaluate) interrupt = new InterruptCancelsTheJob(cl.conn);
   if (*sub.submit) return RunSubmit(cl, interrupt);
-  if (*sub.evaluate) return RunEvaluate(cl, interrupt);
+  if (*sub.evaluate) return RunEvaluate(cl, *sub.evaluate, interrupt);
   auto client = vc::client::Client::Create(cl.conn);
   if (!client.ok()) return Fail("cannot set up the connection", client.status());
   if (*sub.health) return RunHealth(**client, cl);

@@ -65,6 +65,18 @@ expect 3 "vc-client: --keep-out line 3: --fixed-stations station 1 (1, 1, 1.5) l
   submit cloud.xyz --keep-out zones.csv --fixed-stations fixed.csv
 expect 3 "vc-client: --max-range must be > 0 m, got -5 (nothing was sent)" \
   evaluate cloud.xyz --viewpoints fixed.csv --max-range -5
+# evaluate --plan: a file that is not a plan is refused naming it and the field.
+printf 'x,y,z\n1,1,1.5\n' >notjson.json
+printf '{"schema": "vc.plan/1", "viewpoints": [{"x": 1, "y": 1}]}' >noz.json
+expect 3 "vc-client: notjson.json: not JSON (expected a plan.json written by vc-client submit) (nothing was sent)" \
+  evaluate cloud.xyz --plan notjson.json
+expect 3 "vc-client: noz.json: no viewpoints[0].z (expected a plan.json written by vc-client submit) (nothing was sent)" \
+  evaluate cloud.xyz --plan noz.json
+printf '{"schema": "vc.plan/1", "viewpoints": [{"x": 1, "y": 1, "z": 1.5}], "parameters": {"scanner": {"min_range_m": 0.5, "max_range_m": 75, "vfov_min_deg": null, "vfov_max_deg": null, "max_incidence_deg": null, "angular_step_deg": null, "max_spacing_m": null, "hfov_deg": 180}}}' >hfov.json
+expect 3 "vc-client: hfov.json's scanner sees 180 deg around its heading, and evaluate takes no headings: add --hfov 360 to evaluate its stations all round (nothing was sent)" \
+  evaluate cloud.xyz --plan hfov.json
+expect 3 "vc-client: evaluate needs the stations: --viewpoints stations.csv or --plan plan.json (nothing was sent)" \
+  evaluate cloud.xyz
 expect 3 "vc-client: the scene file empty.ply is empty (0 bytes): nothing to upload; export the scene again (nothing was sent)" \
   submit empty.ply
 expect 5 "vc-client: cannot read the scene file missing.ply: No such file or directory (nothing was sent)" \
