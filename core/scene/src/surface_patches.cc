@@ -54,19 +54,58 @@ SurfacePatch PatchOf(double n, const Eigen::Vector3d& sum, const Eigen::Matrix3d
   const Eigen::Vector3d lambda = eig.eigenvalues().cwiseMax(0.0);  // ascending
   patch.normal = eig.eigenvectors().col(0).normalized().cast<float>();
   patch.thickness_m = float(std::sqrt(lambda[0]));
-  patch.flat = std::sqrt(lambda[0]) <= kFlatMaxThickness * r && std::sqrt(lambda[1]) >= kFlatMinSpread * r;
+  const double thickness = std::sqrt(lambda[0]), spread = std::sqrt(lambda[1]);
+  patch.flat = thickness <= kFlatMaxThickness * r && spread >= kFlatMinSpreadPerThickness * thickness &&
+               spread >= kFlatMinSpread * r;
   return patch;
 }
 
 }  // namespace
 
+Eigen::Matrix3d SurfacePatchBuilder::Outer(const Sums& s) {
+  Eigen::Matrix3d outer;
+  outer << s.xx, s.xy, s.xz, s.xy, s.yy, s.yz, s.xz, s.yz, s.zz;
+  return outer;
+}
+
+void SurfacePatchBuilder::BorrowPlane(size_t id, const std::vector<SurfacePatch>& own, SurfacePatch& patch) const {
+  const Sums& s = sums_[id];
+  const double r = scene_.resolution_m;
+  const WorldPoint center = scene_.Center(id);
+  const VoxelIndex v = KeyToIndex(scene_.occupied[id]);
+  double best = kFlatMaxThickness * r;
+  int64_t from = -1;
+  for (int dz = -1; dz <= 1; ++dz) {
+    for (int dy = -1; dy <= 1; ++dy) {
+      for (int dx = -1; dx <= 1; ++dx) {
+        const int64_t w = (dx | dy | dz) == 0 ? -1 : scene_.IdOf(IndexToKey({v.x + dx, v.y + dy, v.z + dz}));
+        if (w < 0 || !own[size_t(w)].flat) continue;
+        // RMS distance of this voxel's points to w's plane, from the sums: n'Sn / count with S the
+        // sum of outer products of the offsets from w's centroid.
+        const Eigen::Vector3d n = own[size_t(w)].normal.cast<double>();
+        const double offset = n.dot(center - own[size_t(w)].centroid_m.cast<double>());
+        const double mean_sq = (n.dot(Outer(s) * n) + 2 * offset * n.dot(s.sum)) / s.n + offset * offset;
+        const double rms = std::sqrt(std::max(mean_sq, 0.0));
+        if (rms <= best) best = rms, from = w;
+      }
+    }
+  }
+  if (from < 0) return;
+  patch.normal = own[size_t(from)].normal;
+  patch.thickness_m = float(best);
+  patch.flat = true;
+  patch.borrowed = true;
+}
+
 std::vector<SurfacePatch> SurfacePatchBuilder::Finish() const {
   std::vector<SurfacePatch> patches(sums_.size());
   for (size_t id = 0; id < sums_.size(); ++id) {
     const Sums& s = sums_[id];
-    Eigen::Matrix3d outer;
-    outer << s.xx, s.xy, s.xz, s.xy, s.yy, s.yz, s.xz, s.yz, s.zz;
-    patches[id] = PatchOf(s.n, s.sum, outer, scene_.Center(id), scene_.resolution_m);
+    patches[id] = PatchOf(s.n, s.sum, Outer(s), scene_.Center(id), scene_.resolution_m);
+  }
+  const std::vector<SurfacePatch> own = patches;  // planes fitted to each voxel's own points
+  for (size_t id = 0; id < sums_.size(); ++id) {
+    if (!own[id].flat && sums_[id].n > 0) BorrowPlane(id, own, patches[id]);
   }
   return patches;
 }

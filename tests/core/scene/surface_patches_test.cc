@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 #include <vector>
@@ -121,6 +122,36 @@ TEST(SurfacePatchesTest, PassesPerScanGiveTheSamePatchesAsOne) {
     EXPECT_EQ(once[id].flat, twice[id].flat);
     EXPECT_LT((once[id].centroid_m - twice[id].centroid_m).norm(), 1e-6f);
   }
+}
+
+TEST(SurfacePatchesTest, ASliverTakesTheFlatNeighboursPlaneItsPointsLieOn) {
+  // The plane z = 0.05 + 0.2 (x - 0.01) over one voxel, and two more of its points in the next one.
+  std::vector<Eigen::Vector3f> points = PlanePoints(0.01f, 0.01f, 0.05f, 0.2f, 0.08f, 9);
+  points.emplace_back(0.12f, 0.03f, 0.05f + 0.2f * 0.11f);
+  points.emplace_back(0.12f, 0.06f, 0.05f + 0.2f * 0.11f);
+  const VoxelScene scene = SceneOf(points);
+  ASSERT_EQ(scene.occupied.size(), 2u);
+  const std::vector<SurfacePatch> patches = ComputeSurfacePatches(scene, points);
+  const size_t plane = patches[0].points > patches[1].points ? 0 : 1, sliver = 1 - plane;
+  EXPECT_LE(patches[sliver].points, 2);
+  EXPECT_TRUE(patches[plane].flat);
+  EXPECT_FALSE(patches[plane].borrowed);
+  EXPECT_TRUE(patches[sliver].flat);
+  EXPECT_TRUE(patches[sliver].borrowed);
+  EXPECT_EQ(patches[sliver].normal, patches[plane].normal);
+  EXPECT_LT(patches[sliver].thickness_m, 1e-5f);
+}
+
+TEST(SurfacePatchesTest, PointsOffTheNeighboursPlaneBorrowNothing) {
+  std::vector<Eigen::Vector3f> points = PlanePoints(0.01f, 0.01f, 0.05f, 0.0f, 0.08f, 9);
+  points.emplace_back(0.15f, 0.05f, 0.01f);  // 4 cm below the plane's level, in the next voxel
+  points.emplace_back(0.16f, 0.05f, 0.09f);  // and 4 cm above it
+  const VoxelScene scene = SceneOf(points);
+  ASSERT_EQ(scene.occupied.size(), 2u);
+  const std::vector<SurfacePatch> patches = ComputeSurfacePatches(scene, points);
+  const size_t odd = patches[0].points == 2 ? 0 : 1;
+  EXPECT_FALSE(patches[odd].flat);
+  EXPECT_FALSE(patches[odd].borrowed);
 }
 
 }  // namespace

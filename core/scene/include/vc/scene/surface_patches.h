@@ -9,6 +9,8 @@
 // the points' offsets from the voxel's centre (80 bytes per voxel while it builds, in double), then
 // keeps 32 bytes per voxel (SurfacePatch). Points are added in any order and in any number of
 // passes (one per scan), each with VoxelScene::IdOf, so the cost is O(points x log voxels).
+// A voxel whose own points do not determine a plane (a sliver of a surface at its edge, one or two
+// points, a noisy strip) takes a flat neighbour's plane when its points lie on it (borrowed).
 // A builder is not thread-safe; the patches it returns are immutable.
 #pragma once
 
@@ -21,12 +23,15 @@
 namespace vc {
 
 // A patch is flat (SurfacePatch::flat) when it has at least kFlatMinPoints points, their RMS
-// distance to the fitted plane is at most kFlatMaxThickness voxel edges, and they spread at least
-// kFlatMinSpread voxel edges (RMS along the middle principal axis) across the plane, so a line of
-// points (a rail, a cable) is not taken for a plane.
+// distance to the fitted plane is at most kFlatMaxThickness voxel edges, and they spread across
+// the plane (RMS along the middle principal axis) at least kFlatMinSpreadPerThickness times that
+// distance and at least kFlatMinSpread voxel edges, so that the plane is well determined: a line
+// of points (a rail, a cable, a noisy sliver of a surface) is not taken for a plane, while a
+// noise-free sliver (two rows of points on one plane) is.
 inline constexpr int kFlatMinPoints = 3;
 inline constexpr double kFlatMaxThickness = 0.15;
-inline constexpr double kFlatMinSpread = 0.1;
+inline constexpr double kFlatMinSpreadPerThickness = 2.0;
+inline constexpr double kFlatMinSpread = 0.001;
 
 // What the points inside one occupied voxel say about its surface. 32 bytes.
 struct SurfacePatch {
@@ -39,8 +44,12 @@ struct SurfacePatch {
   float thickness_m = 0;
   // Points inside the voxel, saturating at 65535.
   uint16_t points = 0;
-  // By the rule above (kFlatMinPoints, kFlatMaxThickness, kFlatMinSpread).
+  // By the rule above, or borrowed (below).
   bool flat = false;
+  // The voxel's own points do not give a flat plane, but they lie on a flat 26-neighbour's plane
+  // (RMS distance at most kFlatMaxThickness voxel edges; the nearest such plane): its normal is
+  // that neighbour's, through this voxel's own centroid, and thickness_m that RMS distance.
+  bool borrowed = false;
 };
 static_assert(sizeof(SurfacePatch) == 32, "SurfacePatch is documented as 32 bytes");
 
@@ -63,6 +72,10 @@ class SurfacePatchBuilder {
     Eigen::Vector3d sum = Eigen::Vector3d::Zero();
     double xx = 0, xy = 0, xz = 0, yy = 0, yz = 0, zz = 0;
   };
+  static Eigen::Matrix3d Outer(const Sums& s);
+  // Gives `patch` (voxel id's, not flat) the plane of a flat neighbour in `own` (the patches from
+  // each voxel's own points) when its points lie on it, as SurfacePatch::borrowed says.
+  void BorrowPlane(size_t id, const std::vector<SurfacePatch>& own, SurfacePatch& patch) const;
   const VoxelScene& scene_;
   std::vector<Sums> sums_;
   uint64_t ignored_ = 0;
