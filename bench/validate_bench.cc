@@ -1,10 +1,9 @@
 // vc-validate-bench: how well today's selection tests predict what a scanner captures (issue 34;
 // docs/VISIBILITY.md "Measured against captured points", docs/BENCHMARKS.md). Prints, for each
-// selection test, ValidateAgainstScans' recall and precision, with no slack and with one voxel of
-// slack, on: simulated planes tilted 0-60 deg to the lattice (with and without 1 cm range noise),
-// two simulated stations in RoomWithClutterScene (all round, and 150 deg scans predicted with and
-// without their field of view), the real hall scan and the two real room scans.
-// Figures only, no assertions.
+// selection test (surface, compatibility, subvoxel), ValidateAgainstScans' recall and precision, with no slack and with
+// one voxel of slack, on: simulated planes tilted 0-60 deg to the lattice (with and without 1 cm range noise), two
+// simulated stations in RoomWithClutterScene (all round, and 150 deg scans predicted with and without their field of
+// view), the real hall scan and the two real room scans. Figures only, no assertions.
 //
 // Real scans: points nearer than the scanner's min_range_m to their own station are dropped (the
 // room scans hold returns from the scanning platform within ~0.3 m, which would put the station in
@@ -32,7 +31,8 @@ namespace {
 using Clock = std::chrono::steady_clock;
 double Since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
-constexpr vc::SelectionTest kTests[] = {vc::SelectionTest::kSurfaceVisibility, vc::SelectionTest::kCompatibility};
+constexpr vc::SelectionTest kTests[] = {vc::SelectionTest::kSurfaceVisibility, vc::SelectionTest::kCompatibility,
+                                        vc::SelectionTest::kSubvoxel};
 
 struct BenchOptions {
   double resolution_m = vc::kDefaultResolutionM;

@@ -150,6 +150,15 @@ Result<ValidationReport> ValidateAgainstScans(const std::vector<CapturedScan>& s
   sets_options.test = options.selection_test;
   sets_options.threads = options.threads;
   sets_options.scanner = options.scanner;
+  std::vector<SurfacePatch> patches;
+  if (options.selection_test == SelectionTest::kSubvoxel) {
+    SurfacePatchBuilder builder(model);
+    for (const CapturedScan& scan : scans) {
+      for (const auto& p : scan.points_m) builder.Add(p);
+    }
+    patches = builder.Finish();
+    sets_options.surface_patches = patches;
+  }
   VC_ASSIGN_OR_RETURN(std::vector<VoxelSet> predicted, ComputeVisibilitySets(model, positions, sets_options, ctx));
 
   ValidationReport report;

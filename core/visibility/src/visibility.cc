@@ -18,6 +18,7 @@
 #include <optional>
 #include <string>
 
+#include "subvoxel_internal.h"
 #include "vc/base/parallel.h"
 #include "vc/base/popcount.h"
 #include "vc/raycast/occluders.h"
@@ -106,7 +107,15 @@ bool ViewpointInRange(const WorldPoint& o, double resolution_m) {
 }
 
 std::string_view SelectionTestName(SelectionTest t) {
-  return t == SelectionTest::kCompatibility ? "compatibility" : "surface";
+  switch (t) {
+    case SelectionTest::kCompatibility:
+      return "compatibility";
+    case SelectionTest::kSubvoxel:
+      return "subvoxel";
+    case SelectionTest::kSurfaceVisibility:
+      break;
+  }
+  return "surface";
 }
 
 Status ScannerModel::Validate(const FieldNamer& namer) const {
@@ -217,6 +226,7 @@ namespace {
 // What every batch of viewpoints shares: the voxels' indices, those that can pass either test, and
 // (grouped surface test) the targets.
 struct SetsContext {
+  const VoxelScene& scene;
   const OccupancyGrid& g;
   size_t n;
   std::vector<VoxelIndex> index;
@@ -300,9 +310,15 @@ Result<std::vector<VoxelSet>> ComputeDenseSets(const SetsContext& sc, const std:
   const uint64_t tasks = viewpoints.size() * id_chunks;
   StageProgress progress(ctx, Stage::kVisibility, tasks, viewpoints.size(), "candidates");
   const bool compat = options.test == SelectionTest::kCompatibility;
+  const bool subvoxel = options.test == SelectionTest::kSubvoxel;
   Status st = ParallelChunks(tasks, 1, options.threads, ctx, [&](uint64_t task, uint64_t, uint64_t) {
     const size_t k = task / id_chunks, c = task % id_chunks;
-    if (valid[k] && !(grouped && shortcuts[k])) {
+    if (valid[k] && subvoxel) {
+      for (size_t j = chunk_start[c]; j < chunk_start[c + 1]; ++j) {
+        const uint32_t id = candidates[j];
+        if (internal::SubvoxelVisibleFrom(sc.scene, options.surface_patches, uo[k], id, limits[k])) sets[k].set(id);
+      }
+    } else if (valid[k] && !(grouped && shortcuts[k])) {
       VoxelSet& set = sets[k];
       OccluderCache cache(shortcuts[k]);
       for (size_t j = chunk_start[c]; j < chunk_start[c + 1]; ++j) {
@@ -331,12 +347,26 @@ Status CheckSetBytes(uint64_t set_bytes, uint64_t positions, uint64_t voxels, ui
 }
 
 Result<std::vector<VoxelSet>> ComputeVisibilitySets(const VoxelScene& scene, const std::vector<WorldPoint>& viewpoints,
-                                                    const VisibilitySetsOptions& options, const JobContext& ctx) {
-  if (options.scanner)
-    VC_RETURN_IF_ERROR(CheckViewpointHeadings(*options.scanner, viewpoints.size(), options.headings_deg));
-  SetsContext sc{scene.grid, scene.occupied.size(), std::vector<VoxelIndex>(scene.occupied.size()), {}, {}};
+                                                    const VisibilitySetsOptions& requested, const JobContext& ctx) {
+  if (requested.scanner)
+    VC_RETURN_IF_ERROR(CheckViewpointHeadings(*requested.scanner, viewpoints.size(), requested.headings_deg));
+  if (!requested.surface_patches.empty() && requested.surface_patches.size() != scene.occupied.size()) {
+    return InvalidArgumentError("got " + std::to_string(requested.surface_patches.size()) + " surface patches for " +
+                                std::to_string(scene.occupied.size()) + " occupied voxels; give one per voxel or none");
+  }
+  VisibilitySetsOptions options = requested;
+  if (options.test == SelectionTest::kSubvoxel && options.surface_patches.empty()) {
+    options.test = SelectionTest::kSurfaceVisibility;  // no points, no patches (subvoxel.h)
+  }
+  SetsContext sc{scene, scene.grid, scene.occupied.size(), std::vector<VoxelIndex>(scene.occupied.size()), {}, {}};
   for (size_t i = 0; i < sc.n; ++i) sc.index[i] = KeyToIndex(scene.occupied[i]);
-  sc.candidates = NotEnclosed(sc.g, sc.index);
+  if (options.test == SelectionTest::kSubvoxel) {
+    // Every voxel: a voxel enclosed by occupied cubes can still be reached past flat patches.
+    sc.candidates.resize(sc.n);
+    for (size_t i = 0; i < sc.n; ++i) sc.candidates[i] = uint32_t(i);
+  } else {
+    sc.candidates = NotEnclosed(sc.g, sc.index);
+  }
   if (options.test == SelectionTest::kSurfaceVisibility && !options.per_voxel) {
     sc.targets.emplace(sc.g, sc.index, sc.candidates);
   }

@@ -48,7 +48,8 @@ struct CapturedScan {
 struct ValidationOptions {
   // Edge of the model's voxels (m), > 0.
   double resolution_m = kDefaultResolutionM;
-  // The test whose prediction is measured (the planner's default: surface visibility).
+  // The test whose prediction is measured (the planner's default: surface visibility); subvoxel
+  // builds the model's surface patches from all scans' points.
   SelectionTest selection_test = SelectionTest::kSurfaceVisibility;
   // The scanner's limits applied to the prediction (default: range [0.5, 75] m, no other limit).
   ScannerModel scanner;

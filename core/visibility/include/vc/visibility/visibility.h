@@ -8,6 +8,8 @@
 // - Face perception (s.4): each face's 4 corner rays, the face's own voxel transparent; a corner is
 //   visible iff the first occupied voxel on its ray is one of the 8 voxels sharing the corner (or
 //   none). 4 visible corners: full; 1-3: partial; 0: none.
+// - Sub-voxel visibility (docs/VISIBILITY.md "Sub-voxel surfaces"; vc/visibility/subvoxel.h): aimed
+//   at the surface the points give each voxel, blocked only where a beam meets a voxel's surface.
 // - Visibility value V (s.5) and global visibility G (s.6).
 //
 // All functions are deterministic (the traversal's tie rule) and thread-safe on a const scene.
@@ -18,6 +20,7 @@
 #include <array>
 #include <cstdint>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -25,6 +28,7 @@
 #include "vc/base/parameter.h"
 #include "vc/base/progress.h"
 #include "vc/base/status.h"
+#include "vc/scene/surface_patches.h"
 #include "vc/scene/voxel_scene.h"
 #include "vc/visibility/voxel_set.h"
 
@@ -33,8 +37,9 @@ namespace vc {
 enum class SelectionTest {
   kSurfaceVisibility,  // ALGORITHM.md 3b (default)
   kCompatibility,      // ALGORITHM.md 3, the paper's test
+  kSubvoxel,           // vc/visibility/subvoxel.h (needs surface patches; surface visibility without)
 };
-std::string_view SelectionTestName(SelectionTest t);  // "surface", "compatibility"
+std::string_view SelectionTestName(SelectionTest t);  // "surface", "compatibility", "subvoxel"
 
 // The scanner model's parameters (vc/base/parameter.h): X(type, name, default, unit, flag, check, help).
 // Each is a hard limit on what a station sees (docs/PLANNING.md "The scanner model"): selection
@@ -140,6 +145,9 @@ struct VisibilitySetsOptions {
   // Per viewpoint, its heading (CheckViewpointHeadings); empty = none has one. Needed for every
   // viewpoint when the scanner's hfov_deg < 360 (INVALID_ARGUMENT otherwise).
   std::vector<Heading> headings_deg;
+  // Sub-voxel test only: one patch per voxel id of the scene (ComputeSurfacePatches); must outlive
+  // the call. Empty (an octree's scene has no points): the surface test runs instead.
+  std::span<const SurfacePatch> surface_patches;
   // Sparse sets (voxel_set.h): each set is kept as a Roaring bitmap when that is at least this
   // many times smaller than its dense words; 0 = every set dense. With it the viewpoints are
   // computed in batches whose dense sets take at most batch_bytes, each compacted before the next.
@@ -150,7 +158,8 @@ struct VisibilitySetsOptions {
 };
 
 // For each viewpoint, the occupied voxels that pass the selection test. Viewpoints inside an
-// occupied voxel get an empty set. INVALID_ARGUMENT from CheckViewpointHeadings (with a scanner);
+// occupied voxel get an empty set. INVALID_ARGUMENT from CheckViewpointHeadings (with a scanner),
+// or for surface_patches that are neither empty nor one per occupied voxel;
 // CANCELLED / DEADLINE_EXCEEDED from ctx.
 Result<std::vector<VoxelSet>> ComputeVisibilitySets(const VoxelScene& scene, const std::vector<WorldPoint>& viewpoints,
                                                     const VisibilitySetsOptions& options, const JobContext& ctx = {});
