@@ -14,6 +14,7 @@
 #include "floor_plan.h"
 #include "raster.h"
 #include "vc/report/field_exports.h"
+#include "vc/report/field_sheet.h"
 #include "vc/report/report_html.h"
 
 namespace vc {
@@ -763,13 +764,15 @@ std::string ColouredPointsPly(const std::vector<std::string>& comments, const st
 }
 
 Status WritePlanOutputs(const PlanResult& result, const std::string& out_dir, const UploadSummary* upload,
-                        const std::vector<std::string>& fixed_station_names) {
+                        const std::vector<std::string>& fixed_station_names, const FieldSheetOptions& field_sheet) {
   VC_RETURN_IF_ERROR(MakeDir(out_dir));
   const std::filesystem::path dir(out_dir);
   VC_RETURN_IF_ERROR(WriteFile(dir / "plan.json", PlanToJson(result, upload, fixed_station_names)));
   const std::vector<FieldStation> field_stations = FieldStations(result, fixed_station_names);
   VC_RETURN_IF_ERROR(WriteFile(dir / "stations.csv", FieldStationsCsv(field_stations)));
   VC_RETURN_IF_ERROR(WriteFile(dir / "stations.dxf", StationsDxf(result, field_stations)));
+  VC_ASSIGN_OR_RETURN(std::string sheet, FieldSheetPdf(result, field_stations, field_sheet));
+  VC_RETURN_IF_ERROR(WriteFile(dir / "fieldsheet.pdf", sheet));
   if (result.voxel_centers.size() != result.evaluation.best_face_values.size()) {
     return FailedPreconditionError("visibility.ply needs one best_face_values entry per voxel centre (" +
                                    std::to_string(result.voxel_centers.size()) + " centres, " +
