@@ -160,13 +160,16 @@ std::vector<std::string> FixedStationNames(const std::string& path) {
 }
 
 // Writes the plan's reports and prints its stations.
-int WritePlan(const vc::PlanResult& r, const std::string& out_dir, const vc::UploadSummary* upload,
-              const std::vector<std::string>& fixed_station_names = {}) {
-  vc::Status written = vc::WritePlanOutputs(r, out_dir, upload, fixed_station_names);
+int WritePlan(const vc::PlanResult& r, const std::string& out_dir, const std::string& paper,
+              const vc::UploadSummary* upload, const std::vector<std::string>& fixed_station_names = {}) {
+  vc::FieldSheetOptions sheet;
+  sheet.paper = paper == "a4" ? vc::PaperSize::kA4 : vc::PaperSize::kA3;
+  vc::Status written = vc::WritePlanOutputs(r, out_dir, upload, fixed_station_names, sheet);
   if (!written.ok()) return Fail("cannot write the reports", written);
   PrintStations(r);
   std::printf(
-      "wrote plan.json, stations.csv, stations.dxf, visibility.ply, heatmap.png, reduction.png, report.html to %s\n",
+      "wrote plan.json, stations.csv, stations.dxf, fieldsheet.pdf, visibility.ply, heatmap.png, reduction.png, "
+      "report.html to %s\n",
       out_dir.c_str());
   return 0;
 }
@@ -189,6 +192,13 @@ void AddUnitsFlag(CLI::App* command, std::string* units) {
   });
 }
 
+// --paper: the paper fieldsheet.pdf is laid out for (landscape).
+void AddPaperFlag(CLI::App* command, std::string* paper) {
+  command->add_option("--paper", *paper, "paper of fieldsheet.pdf, landscape: a3 or a4")
+      ->check(CLI::IsMember({"a3", "a4"}))
+      ->capture_default_str();
+}
+
 // What the command line says; each subcommand reads its own fields.
 struct CommandLine {
   vc::client::ConnectionOptions conn;
@@ -197,6 +207,7 @@ struct CommandLine {
   std::string out_dir = "./vc-out";
   bool raw_upload = false;
   std::string units;                     // submit, evaluate, inspect (--units; empty = metres)
+  std::string paper = "a3";              // submit, attach: fieldsheet.pdf's paper (--paper)
   vc::PlanOptions plan;                  // submit
   vc::client::PlanFileFlags plan_files;  // submit
   vc::EvaluateJobOptions eval;           // evaluate
@@ -242,6 +253,7 @@ CLI::App* AddSubmitCommand(CLI::App& app, CommandLine* cl) {
   auto* submit = app.add_subcommand("submit", "plan stations for a scene on the server; write the reports");
   submit->add_option("FILE", cl->file, "scene: PLY, PCD, XYZ, LAS, or OctoMap .bt/.ot/.graph")->required();
   submit->add_option("--out", cl->out_dir, "output directory")->capture_default_str();
+  AddPaperFlag(submit, &cl->paper);
   submit->add_flag("--raw-upload", cl->raw_upload, kRawUploadHelp);
   AddUnitsFlag(submit, &cl->units);
   cl->conn.detach_grace_s = 600;
@@ -274,6 +286,7 @@ Subcommands AddCommands(CLI::App& app, CommandLine* cl) {
       "attach", "re-attach to a detached job (plan or evaluation) by its id; write its reports like submit/evaluate");
   sub.attach->add_option("JOB_ID", cl->job_id, "the id submit printed (j-...)")->required();
   sub.attach->add_option("--out", cl->out_dir, "output directory")->capture_default_str();
+  AddPaperFlag(sub.attach, &cl->paper);
   sub.cancel = app.add_subcommand("cancel", "cancel a detached job, or discard its kept result");
   sub.cancel->add_option("JOB_ID", cl->job_id, "the id submit printed (j-...)")->required();
 
@@ -338,7 +351,7 @@ int RunAttach(vc::client::Client& client, const CommandLine& cl) {
   if (job->kind == vc::client::AttachedJob::Kind::kEvaluation) {
     return WriteEvaluation(job->evaluation.evaluation, job->evaluation.viewpoints, cl.out_dir);
   }
-  return WritePlan(job->plan, cl.out_dir, nullptr);
+  return WritePlan(job->plan, cl.out_dir, cl.paper, nullptr);
 }
 
 // The scene file, read and checked here before any connection: refused when the server's reader
@@ -384,7 +397,7 @@ int RunSubmit(const CommandLine& cl, InterruptCancelsTheJob* interrupt) {
   display.Done();
   if (!r.ok()) return FailCall("plan", r.status(), cl.conn.server);
   NoteCache((*client)->last_upload(), &prepared.summary, display);
-  return WritePlan(*r, cl.out_dir, &prepared.summary, FixedStationNames(cl.plan_files.fixed_stations));
+  return WritePlan(*r, cl.out_dir, cl.paper, &prepared.summary, FixedStationNames(cl.plan_files.fixed_stations));
 }
 
 // evaluate's counterpart of CheckSubmit.
