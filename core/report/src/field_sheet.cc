@@ -63,7 +63,8 @@ double RoundScale(double extent_m, double room_pt) {
   return needed;
 }
 
-// Table rows of one floor page: stations in walking order; those beyond `capacity` overflow.
+// The station table's rows: each floor page lists its stations in walking order, up to
+// `table_capacity`; the rest continue on table pages of `table_page_capacity` rows.
 void AssignRows(Sheet& s, size_t stations, int table_capacity, int table_page_capacity) {
   s.floor_rows.assign(s.floors.panel_z.size(), {});
   std::vector<size_t> overflow;

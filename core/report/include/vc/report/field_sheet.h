@@ -6,7 +6,7 @@
 // station table; rows that do not fit continue on table pages after the floors. Drawn with cairo
 // (Debian libcairo2-dev) in shapes and hatching that read in black and white, text in DejaVu Sans.
 // The layout is computed apart from the drawing so tests can find a station's marker on its page.
-// Pure functions of their arguments: thread-safe (cairo's toy font API is thread-safe).
+// Pure functions of their arguments, each call drawing on its own cairo surface: thread-safe.
 #pragma once
 
 #include <cmath>
