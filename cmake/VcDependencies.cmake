@@ -15,8 +15,8 @@ find_package(PkgConfig REQUIRED)
 pkg_check_modules(HWY REQUIRED IMPORTED_TARGET libhwy)
 # COIN-OR CBC (coinor-libcbc-dev): the exact station selector (vc::plan only).
 pkg_check_modules(CBC REQUIRED IMPORTED_TARGET cbc)
-# cairo (libcairo2-dev): fieldsheet.pdf (vc::report only).
-pkg_check_modules(CAIRO REQUIRED IMPORTED_TARGET cairo)
+# cairo (libcairo2-dev, which brings FreeType's libfreetype-dev): fieldsheet.pdf (vc::report only).
+pkg_check_modules(CAIRO REQUIRED IMPORTED_TARGET cairo cairo-pdf cairo-ft freetype2)
 
 # three.js r111 and its OrbitControls from Debian's libjs-three: report.html inlines them
 # (core/report). Needed at build time only; the binaries carry the text.
