@@ -237,6 +237,43 @@ TEST(FieldSheetTest, A4SheetContinuesALongTableOnExtraPages) {
   EXPECT_NE(text.find(stations.back().name), std::string::npos) << "every station is in a table";
 }
 
+// A plan in survey coordinates (frame origin far from zero) draws the same plan as one near its
+// origin, keep-out zones given in the input's frame included, and its table lists the input's frame.
+TEST(FieldSheetTest, APlanInSurveyCoordinatesDrawsTheSamePlanAndListsTheInputsFrame) {
+  if (!HavePoppler()) GTEST_SKIP() << "pdftoppm/pdfinfo (poppler-utils) not found";
+  PlanResult near = TwoFloorPlan();
+  near.options.keep_out = {KeepOutBox(WorldPoint(2.4, 0.9, 0.0), WorldPoint(3.4, 1.9, 2.5))};
+  PlanResult survey = near;
+  const WorldPoint origin(500000, 5400000, 300);
+  survey.frame_origin_m = origin;
+  survey.options.keep_out = {KeepOutBox(WorldPoint(2.4, 0.9, 0.0) + origin, WorldPoint(3.4, 1.9, 2.5) + origin)};
+  const FieldSheetLayout a = ComputeFieldSheetLayout(near, FieldStations(near));
+  const FieldSheetLayout b = ComputeFieldSheetLayout(survey, FieldStations(survey));
+  ASSERT_EQ(a.markers.size(), b.markers.size());
+  for (size_t k = 0; k < a.markers.size(); ++k) {
+    EXPECT_EQ(a.markers[k].page, b.markers[k].page);
+    EXPECT_DOUBLE_EQ(a.markers[k].x_pt, b.markers[k].x_pt);
+    EXPECT_DOUBLE_EQ(a.markers[k].y_pt, b.markers[k].y_pt);
+  }
+  const ReadBack pa = Rasterise(*FieldSheetPdf(near, FieldStations(near)));
+  const ReadBack pb = Rasterise(*FieldSheetPdf(survey, FieldStations(survey)));
+  ASSERT_EQ(pb.pages, 2);
+  const double pt_per_m = (a.markers[1].x_pt - a.markers[0].x_pt) / 3.0;
+  int zone_a = 0, zone_b = 0;
+  for (double x = 2.5; x < 3.35; x += 0.05)
+    for (double y = 1.0; y < 1.85; y += 0.05) {
+      const int u = Px(a.markers[0].x_pt + (x - 0.5) * pt_per_m), v = Px(a.markers[0].y_pt - (y - 0.5) * pt_per_m);
+      zone_a += pa.rasters[0].at(u, v) < 160 ? 1 : 0;
+      zone_b += pb.rasters[0].at(u, v) < 160 ? 1 : 0;
+    }
+  EXPECT_GT(zone_a, 10) << "the zone is hatched";
+  EXPECT_EQ(zone_b, zone_a) << "and in the same place";
+  const std::string text = PdfText(pb.path);
+  for (const char* words : {"500000.500", "5400000.500", "z = 300.10 m"}) {
+    EXPECT_NE(text.find(words), std::string::npos) << words << " in:\n" << text;
+  }
+}
+
 TEST(FieldSheetTest, WritePlanOutputsWritesTheFieldSheet) {
   const PlanResult plan = TwoFloorPlan();
   const std::string dir = testing::MakeTempDir() + "/out";
