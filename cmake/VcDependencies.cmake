@@ -17,6 +17,8 @@ pkg_check_modules(HWY REQUIRED IMPORTED_TARGET libhwy)
 pkg_check_modules(CBC REQUIRED IMPORTED_TARGET cbc)
 # PROJ (libproj-dev): the CRS of vc-client --crs, stations.geojson and true north (vc::report only).
 pkg_check_modules(PROJ REQUIRED IMPORTED_TARGET proj)
+# cairo (libcairo2-dev, which brings FreeType's libfreetype-dev): fieldsheet.pdf (vc::report only).
+pkg_check_modules(CAIRO REQUIRED IMPORTED_TARGET cairo cairo-pdf cairo-ft freetype2)
 
 # three.js r111 and its OrbitControls from Debian's libjs-three: report.html inlines them
 # (core/report). Needed at build time only; the binaries carry the text.

@@ -4,7 +4,7 @@
 # benchmarks, no vc-synth; README records the first run's time), starts vc-server on a free loopback port,
 # inspects the scene locally, submits it with vc-client (live progress) with the Leica RTC360 preset
 # and --min-overlap 0.3, prints the stations, the scan graph, the walking route and the field time,
-# leaves plan.json, stations.csv, stations.dxf, visibility.ply, heatmap.png, reduction.png and report.html in
+# leaves plan.json, stations.csv, stations.dxf, fieldsheet.pdf, visibility.ply, heatmap.png, reduction.png and report.html in
 # vc-out/, and stops the server.
 # Usage: scripts/demo.sh [extra vc-client submit flags...]
 set -euo pipefail

@@ -162,14 +162,18 @@ std::vector<std::string> FixedStationNames(const std::string& path) {
   return names;
 }
 
-// Writes the plan's reports (stations.geojson with a CRS) and prints its stations.
-int WritePlan(const vc::PlanResult& r, const std::string& out_dir, const vc::UploadSummary* upload,
-              const std::vector<std::string>& fixed_station_names = {}, const vc::Crs* crs = nullptr) {
-  vc::Status written = vc::WritePlanOutputs(r, out_dir, upload, fixed_station_names, crs);
+// Writes the plan's reports (stations.geojson and true north on the field sheet with a CRS) and
+// prints its stations.
+int WritePlan(const vc::PlanResult& r, const std::string& out_dir, const std::string& paper,
+              const vc::UploadSummary* upload, const std::vector<std::string>& fixed_station_names = {},
+              const vc::Crs* crs = nullptr) {
+  vc::FieldSheetOptions sheet;
+  sheet.paper = paper == "a4" ? vc::PaperSize::kA4 : vc::PaperSize::kA3;
+  vc::Status written = vc::WritePlanOutputs(r, out_dir, upload, fixed_station_names, crs, sheet);
   if (!written.ok()) return Fail("cannot write the reports", written);
   PrintStations(r);
   std::printf(
-      "wrote plan.json, stations.csv, stations.dxf, %svisibility.ply, heatmap.png, reduction.png, "
+      "wrote plan.json, stations.csv, stations.dxf, %sfieldsheet.pdf, visibility.ply, heatmap.png, reduction.png, "
       "report.html to %s\n",
       crs != nullptr ? "stations.geojson, " : "", out_dir.c_str());
   if (crs == nullptr) {
@@ -200,6 +204,13 @@ void AddUnitsFlag(CLI::App* command, std::string* units) {
   });
 }
 
+// --paper: the paper fieldsheet.pdf is laid out for (landscape).
+void AddPaperFlag(CLI::App* command, std::string* paper) {
+  command->add_option("--paper", *paper, "paper of fieldsheet.pdf, landscape: a3 or a4")
+      ->check(CLI::IsMember({"a3", "a4"}))
+      ->capture_default_str();
+}
+
 // What the command line says; each subcommand reads its own fields.
 struct CommandLine {
   vc::client::ConnectionOptions conn;
@@ -209,6 +220,7 @@ struct CommandLine {
   bool raw_upload = false;
   std::string units;                     // submit, evaluate, inspect (--units; empty = metres)
   std::string crs;                       // submit, evaluate, attach (--crs; empty = none)
+  std::string paper = "a3";              // submit, attach: fieldsheet.pdf's paper (--paper)
   vc::PlanOptions plan;                  // submit
   vc::client::PlanFileFlags plan_files;  // submit
   vc::EvaluateJobOptions eval;           // evaluate
@@ -255,6 +267,7 @@ CLI::App* AddSubmitCommand(CLI::App& app, CommandLine* cl) {
   auto* submit = app.add_subcommand("submit", "plan stations for a scene on the server; write the reports");
   submit->add_option("FILE", cl->file, "scene: PLY, PCD, XYZ, LAS, or OctoMap .bt/.ot/.graph")->required();
   submit->add_option("--out", cl->out_dir, "output directory")->capture_default_str();
+  AddPaperFlag(submit, &cl->paper);
   submit->add_flag("--raw-upload", cl->raw_upload, kRawUploadHelp);
   AddUnitsFlag(submit, &cl->units);
   submit->add_option("--crs", cl->crs, kCrsHelp);
@@ -297,6 +310,7 @@ Subcommands AddCommands(CLI::App& app, CommandLine* cl) {
   sub.attach->add_option("--out", cl->out_dir, "output directory")->capture_default_str();
   sub.attach->add_option("--crs", cl->crs,
                          "CRS the job's scene was submitted in (as submit --crs): labels the outputs");
+  AddPaperFlag(sub.attach, &cl->paper);
   sub.cancel = app.add_subcommand("cancel", "cancel a detached job, or discard its kept result");
   sub.cancel->add_option("JOB_ID", cl->job_id, "the id submit printed (j-...)")->required();
 
@@ -365,7 +379,7 @@ int RunAttach(vc::client::Client& client, const CommandLine& cl) {
   if (job->kind == vc::client::AttachedJob::Kind::kEvaluation) {
     return WriteEvaluation(job->evaluation.evaluation, job->evaluation.viewpoints, cl.out_dir, crs_ptr);
   }
-  return WritePlan(job->plan, cl.out_dir, nullptr, {}, crs_ptr);
+  return WritePlan(job->plan, cl.out_dir, cl.paper, nullptr, {}, crs_ptr);
 }
 
 // The scene file, read and checked here before any connection: refused when the server's reader
@@ -415,7 +429,7 @@ int RunSubmit(const CommandLine& cl, InterruptCancelsTheJob* interrupt) {
   if (!r.ok()) return FailCall("plan", r.status(), cl.conn.server);
   NoteCache((*client)->last_upload(), &prepared.summary, display);
   const std::optional<vc::Crs>& crs = checked->crs.crs;
-  return WritePlan(*r, cl.out_dir, &prepared.summary, FixedStationNames(cl.plan_files.fixed_stations),
+  return WritePlan(*r, cl.out_dir, cl.paper, &prepared.summary, FixedStationNames(cl.plan_files.fixed_stations),
                    crs ? &*crs : nullptr);
 }
 

@@ -35,7 +35,7 @@ grep -q "heat map ready" "$work/client.err" || fail "no heat map line"
 grep -q "final stations:" "$work/client.err" || fail "no final stations line"
 grep -q "report.html to " "$work/client.out" || fail "vc-client does not name report.html among the files it wrote"
 
-for f in plan.json stations.csv stations.dxf visibility.ply heatmap.png reduction.png report.html; do
+for f in plan.json stations.csv stations.dxf fieldsheet.pdf visibility.ply heatmap.png reduction.png report.html; do
   [[ -s "$work/out/$f" ]] || fail "missing or empty $f"
 done
 python3 - "$work/out" <<'PY' || fail "output contents"

@@ -11,8 +11,10 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 
+#include "floor_plan.h"
 #include "raster.h"
 #include "vc/report/field_exports.h"
+#include "vc/report/field_sheet.h"
 #include "vc/report/report_html.h"
 
 namespace vc {
@@ -201,102 +203,28 @@ std::string VisibilityPly(const PlanResult& r) {
 constexpr int kMarginLeft = 64, kMarginTop = 40, kMarginBottom = 60, kPanelRight = 24, kLegendWidth = 110;
 constexpr int kMinPlotHeight = 180, kTargetPlot = 720;
 
-struct HeatLayout {
+struct HeatLayout : floor_plan::Floors {
   double cell_m = 1;
-  double x0 = 0, y0 = 0, x1 = 1, y1 = 1;  // footprint (m)
-  double ppm = 10;                        // pixels per metre
+  double ppm = 10;  // pixels per metre
   int plot_w = 0, plot_h = 0;
-  std::vector<double> panel_z;       // representative z of each panel
-  std::vector<int> candidate_panel;  // per heat-map position
-  std::vector<double> floor_m;       // the floor (top, m) under each panel: its z less the lowest height
   int width = 0, height = 0;
 };
 
-double LowestTripodHeight(const PlanResult& r) {
-  const std::vector<double> heights = r.options.TripodHeights();
-  return *std::min_element(heights.begin(), heights.end());
-}
-double HighestTripodHeight(const PlanResult& r) {
-  const std::vector<double> heights = r.options.TripodHeights();
-  return *std::max_element(heights.begin(), heights.end());
-}
-
-// The floor plan of a panel: the occupied voxels standing on its floor and reaching no higher than
-// the highest tripod height above it (walls, furniture, columns: what a crew walks around and what
-// a scanner on a tripod sees past), projected. A voxel belongs to a panel when its centre lies at
-// least a quarter of a voxel above the floor's top (the floor's own voxels lie below it) and at
-// most the highest tripod height above it. Bit p of the result: the voxel is on panel p (at most
-// 4 panels, see ComputeHeatLayout).
-unsigned FloorPlanPanels(const HeatLayout& L, const PlanResult& r, double z) {
-  unsigned panels = 0;
-  const double top = HighestTripodHeight(r);
-  for (size_t p = 0; p < L.floor_m.size(); ++p) {
-    const double above = z - L.floor_m[p];
-    if (above >= 0.25 * r.resolution_m && above <= top) panels |= 1u << p;
-  }
-  return panels;
-}
+using floor_plan::HighestTripodHeight;
 
 // The floor plan's shade of a column whose highest voxel in the band stands `above` metres over
 // the floor: light grey for low objects, near black for what reaches the tripod (walls).
 Rgb FloorPlanShade(double above, double top) {
-  const double t = std::clamp(above / std::max(top, 1e-6), 0.0, 1.0);
-  const auto g = static_cast<uint8_t>(std::lround(175 - 135 * t));
+  const uint8_t g = floor_plan::SliceGrey(above, top);
   return Rgb{g, g, g};
 }
 
-// The z a candidate's panel is chosen by: its floor plus the lowest tripod height when the floor is
-// known (so a cell's candidates at several heights share one panel), else its own z. With one
-// height that is the candidate's z.
-std::vector<double> PanelKeys(const PlanResult& r) {
-  const auto& pos = r.heat_map.positions;
-  const std::vector<double> heights = r.options.TripodHeights();
-  const double lowest = *std::min_element(heights.begin(), heights.end());
-  const bool floors = r.heat_map.floor_z_m.size() == pos.size();
-  std::vector<double> keys;
-  for (size_t i = 0; i < pos.size(); ++i) {
-    keys.push_back(floors && std::isfinite(r.heat_map.floor_z_m[i]) ? r.heat_map.floor_z_m[i] + lowest : pos[i].z());
-  }
-  return keys;
-}
-
-// Panels: positions grouped by PanelKeys (a gap over 0.5 m starts a new group); at most 4, else one.
+// Panels and footprint as floor_plan::ComputeFloors finds them, drawn at a whole number of pixels
+// per metre.
 HeatLayout ComputeHeatLayout(const PlanResult& r) {
   HeatLayout L;
-  const auto& pos = r.heat_map.positions;
   L.cell_m = r.heat_map.grid_spacing_m > 0 ? r.heat_map.grid_spacing_m : 1.0;
-  const std::vector<double> keys = PanelKeys(r);
-  std::vector<double> zs = keys;
-  std::sort(zs.begin(), zs.end());
-  std::vector<std::pair<double, double>> groups;  // [lo, hi]
-  for (double z : zs) {
-    if (groups.empty() || z - groups.back().second > 0.5) groups.push_back({z, z});
-    groups.back().second = z;
-  }
-  if (groups.size() > 4) groups = {{zs.front(), zs.back()}};
-  for (const auto& g : groups) L.panel_z.push_back(0.5 * (g.first + g.second));
-  if (L.panel_z.empty()) L.panel_z.push_back(0.0);
-  for (double key : keys) {
-    int k = 0;
-    while (k + 1 < static_cast<int>(groups.size()) && key > groups[k].second + 1e-9) ++k;
-    L.candidate_panel.push_back(k);
-  }
-  bool any = false;
-  auto grow = [&](const WorldPoint& p, double pad) {
-    if (!any) L.x0 = p.x() - pad, L.x1 = p.x() + pad, L.y0 = p.y() - pad, L.y1 = p.y() + pad, any = true;
-    L.x0 = std::min(L.x0, p.x() - pad), L.x1 = std::max(L.x1, p.x() + pad);
-    L.y0 = std::min(L.y0, p.y() - pad), L.y1 = std::max(L.y1, p.y() + pad);
-  };
-  for (const WorldPoint& p : pos) grow(p, L.cell_m / 2);
-  for (const PlannedStation& s : r.stations) grow(s.position, L.cell_m / 2);
-  // The walls around the candidates belong to the floor plan: the footprint takes in the voxels
-  // drawn on some panel.
-  L.floor_m.clear();
-  for (double z : L.panel_z) L.floor_m.push_back(z - LowestTripodHeight(r));
-  for (const WorldPoint& v : r.voxel_centers) {
-    if (FloorPlanPanels(L, r, v.z()) != 0) grow(v, r.resolution_m / 2);
-  }
-  if (!any) L.x0 = 0, L.x1 = 1, L.y0 = 0, L.y1 = 1;
+  static_cast<floor_plan::Floors&>(L) = floor_plan::ComputeFloors(r, L.cell_m / 2);
   const double extent = std::max({L.x1 - L.x0, L.y1 - L.y0, 1e-3});
   L.ppm = std::clamp(std::floor(kTargetPlot / extent), 4.0, 200.0);
   L.plot_w = static_cast<int>(std::ceil((L.x1 - L.x0) * L.ppm));
@@ -358,7 +286,7 @@ void DrawFloorPlan(Image& img, const HeatLayout& L, const PlanResult& r, int pan
   std::vector<float> above(size_t(L.plot_w) * size_t(L.plot_h), -1.f);  // per plot pixel, the highest
   const double half = r.resolution_m / 2;
   for (const WorldPoint& v : r.voxel_centers) {
-    if (!((FloorPlanPanels(L, r, v.z()) >> panel) & 1)) continue;
+    if (!((floor_plan::SlicePanels(L, r, v.z()) >> panel) & 1)) continue;
     const auto h = static_cast<float>(v.z() - L.floor_m[size_t(panel)]);
     const int x0 = static_cast<int>(std::floor((v.x() - half - L.x0) * L.ppm));
     const int y0 = static_cast<int>(std::floor((L.y1 - v.y() - half) * L.ppm));
@@ -437,14 +365,7 @@ Image DrawHeatmap(const PlanResult& r) {
     img.Text(left, 10, title, raster::kBlack, 2);
   }
   // The panel a point at height z (m) is drawn on: the one of the nearest representative z.
-  auto panel_of = [&](double z) {
-    int panel = 0;
-    double best = 1e300;
-    for (size_t p = 0; p < L.panel_z.size(); ++p) {
-      if (std::fabs(L.panel_z[p] - z) < best) best = std::fabs(L.panel_z[p] - z), panel = static_cast<int>(p);
-    }
-    return panel;
-  };
+  auto panel_of = [&](double z) { return floor_plan::NearestPanel(L, z); };
   const std::vector<double> heights = r.options.TripodHeights();
   const double lowest_height = *std::min_element(heights.begin(), heights.end());
   // The scan graph's edges at its threshold (0.3 when registration is off), white, between stations
@@ -853,8 +774,24 @@ std::string ColouredPointsPly(const std::vector<std::string>& comments, const st
   return out;
 }
 
+namespace {
+
+// The angle from grid north to true north, degrees clockwise (FieldSheetOptions'), at the mean of
+// the plan's stations in the input's frame (the scene's origin when it has none).
+Result<double> TrueNorthAtSiteDeg(const PlanResult& result, const Crs& crs) {
+  WorldPoint site = WorldPoint::Zero();
+  for (const PlannedStation& s : result.stations) site += s.position;
+  if (!result.stations.empty()) site /= static_cast<double>(result.stations.size());
+  site += result.frame_origin_m;
+  VC_ASSIGN_OR_RETURN(const double ccw_rad, crs.TrueNorthFromGridNorthRad(site.x(), site.y()));
+  return -ccw_rad * 180.0 / M_PI;
+}
+
+}  // namespace
+
 Status WritePlanOutputs(const PlanResult& result, const std::string& out_dir, const UploadSummary* upload,
-                        const std::vector<std::string>& fixed_station_names, const Crs* crs) {
+                        const std::vector<std::string>& fixed_station_names, const Crs* crs,
+                        const FieldSheetOptions& field_sheet) {
   VC_RETURN_IF_ERROR(MakeDir(out_dir));
   const std::filesystem::path dir(out_dir);
   const CrsInfo* crs_info = crs == nullptr ? nullptr : &crs->info();
@@ -866,6 +803,12 @@ Status WritePlanOutputs(const PlanResult& result, const std::string& out_dir, co
     VC_ASSIGN_OR_RETURN(const std::string geojson, StationsGeoJson(result, field_stations, *crs));
     VC_RETURN_IF_ERROR(WriteFile(dir / "stations.geojson", geojson));
   }
+  FieldSheetOptions sheet_options = field_sheet;
+  if (crs != nullptr && std::isnan(sheet_options.true_north_from_grid_deg)) {
+    VC_ASSIGN_OR_RETURN(sheet_options.true_north_from_grid_deg, TrueNorthAtSiteDeg(result, *crs));
+  }
+  VC_ASSIGN_OR_RETURN(std::string sheet, FieldSheetPdf(result, field_stations, sheet_options));
+  VC_RETURN_IF_ERROR(WriteFile(dir / "fieldsheet.pdf", sheet));
   if (result.voxel_centers.size() != result.evaluation.best_face_values.size()) {
     return FailedPreconditionError("visibility.ply needs one best_face_values entry per voxel centre (" +
                                    std::to_string(result.voxel_centers.size()) + " centres, " +

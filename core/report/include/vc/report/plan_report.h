@@ -1,7 +1,7 @@
 // The files a user gets from a plan or an evaluation (written by vc-client from the streamed
 // result, and usable directly from core): plan.json, stations.csv, stations.dxf, stations.geojson (with a CRS),
-// visibility.ply, heatmap.png, reduction.png, report.html (vc/report/report_html.h), evaluation.json. Schemas are
-// documented in docs/PLANNING.md and docs/PROTOCOL.md.
+// fieldsheet.pdf (vc/report/field_sheet.h), visibility.ply, heatmap.png, reduction.png, report.html
+// (vc/report/report_html.h), evaluation.json. Schemas are documented in docs/PLANNING.md and docs/PROTOCOL.md.
 #pragma once
 
 #include <array>
@@ -14,6 +14,7 @@
 #include "vc/base/status.h"
 #include "vc/plan/planner.h"
 #include "vc/report/crs.h"
+#include "vc/report/field_sheet.h"
 #include "vc/visibility/visibility.h"
 
 namespace vc {
@@ -39,7 +40,8 @@ struct UploadSummary {
 std::string PlanToJson(const PlanResult& result, const UploadSummary* upload = nullptr,
                        const std::vector<std::string>& fixed_station_names = {}, const CrsInfo* crs = nullptr);
 
-// Writes plan.json, stations.csv, stations.dxf, visibility.ply, heatmap.png, reduction.png and report.html into
+// Writes plan.json, stations.csv, stations.dxf, fieldsheet.pdf (laid out as `field_sheet` says), visibility.ply,
+// heatmap.png, reduction.png and report.html into
 // `out_dir` (created if missing), every coordinate in the input's own frame (stations.csv and stations.dxf to the
 // micrometre; visibility.ply in double precision when the frame's origin is not zero). `fixed_station_names`: the
 // fixed stations' names from their file, in PlanOptions::fixed_stations order (may be empty). visibility.ply needs
@@ -47,7 +49,8 @@ std::string PlanToJson(const PlanResult& result, const UploadSummary* upload = n
 // stations.geojson, and plan.json and stations.csv name the CRS. INTERNAL / FAILED_PRECONDITION with the path on
 // I/O errors; INVALID_ARGUMENT when PROJ cannot place a station on the earth.
 Status WritePlanOutputs(const PlanResult& result, const std::string& out_dir, const UploadSummary* upload = nullptr,
-                        const std::vector<std::string>& fixed_station_names = {}, const Crs* crs = nullptr);
+                        const std::vector<std::string>& fixed_station_names = {}, const Crs* crs = nullptr,
+                        const FieldSheetOptions& field_sheet = {});
 
 // One point of a coloured PLY: its position (m), its colour and, when the PLY has one, its value.
 struct ColouredPoint {

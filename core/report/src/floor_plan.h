@@ -1,0 +1,42 @@
+// The floors of a plan as heatmap.png and fieldsheet.pdf draw them (docs/PLANNING.md, "heatmap.png"):
+// the candidates grouped into floor panels by height, the footprint that takes in the walls around
+// them, and the slice of occupied voxels that is a floor's plan view (walls and objects between the
+// floor and the highest tripod height). One place, so both pictures show the same floors. Everything
+// here is in the result's local frame. Internal to vc_core; pure functions, thread-safe.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "vc/plan/planner.h"
+
+namespace vc::floor_plan {
+
+// A plan's floors: at most 4 panels, else one; every height and bound in the local frame (m).
+struct Floors {
+  std::vector<double> panel_z;            // representative z of each panel (a floor plus the lowest tripod height)
+  std::vector<int> candidate_panel;       // per heat-map position, its panel
+  std::vector<double> floor_m;            // the floor (top, m) under each panel: its z less the lowest tripod height
+  double x0 = 0, y0 = 0, x1 = 1, y1 = 1;  // footprint: candidates, stations and every panel's slice
+};
+
+// The lowest and highest of the plan's tripod heights (m).
+double LowestTripodHeight(const PlanResult& r);
+double HighestTripodHeight(const PlanResult& r);
+
+// Panels: positions grouped by height (a gap over 0.5 m starts a new group), and the footprint;
+// `pad_m` is the margin around each candidate and station (half a heat-map cell).
+Floors ComputeFloors(const PlanResult& r, double pad_m);
+
+// Bit p set: a voxel centred at height `z` belongs to panel p's slice (at least a quarter of a voxel
+// above its floor's top and at most the highest tripod height above it).
+unsigned SlicePanels(const Floors& floors, const PlanResult& r, double z);
+
+// The panel whose representative z lies nearest to `z` (m).
+int NearestPanel(const Floors& floors, double z);
+
+// Grey level of a slice column whose highest voxel stands `above` m over the floor, `top` the
+// highest tripod height: 175 for low objects down to 40 for what reaches the tripod (walls).
+uint8_t SliceGrey(double above, double top);
+
+}  // namespace vc::floor_plan
