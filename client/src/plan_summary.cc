@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <iterator>
 
 namespace vc::client {
 namespace {
@@ -19,7 +20,10 @@ std::string Format(const char* format, Args... args) {
 // "[1 2 5]" from 0-based station indices.
 std::string Group(const std::vector<int>& stations) {
   std::string out = "[";
-  for (size_t k = 0; k < stations.size(); ++k) out += (k ? " " : "") + std::to_string(stations[k] + 1);
+  for (size_t k = 0; k < stations.size(); ++k) {
+    if (k > 0) out += ' ';
+    out += std::to_string(stations[k] + 1);
+  }
   return out + "]";
 }
 
@@ -35,7 +39,10 @@ std::string ScanGraphLine(const PlanResult& r) {
       line += ", connected";
     } else {
       line += Format(", %zu groups no chain links:", g.components.size());
-      for (const std::vector<int>& c : g.components) line += " " + Group(c);
+      for (const std::vector<int>& c : g.components) {
+        line += ' ';
+        line += Group(c);
+      }
     }
     if (r.connecting_stations > 0) line += Format(" (%d connecting station(s))", r.connecting_stations);
   } else {
@@ -59,7 +66,8 @@ std::string RouteLines(const PlanResult& r) {
   }
   for (size_t k = 0; k < route.order.size(); ++k) {
     if (k > 0) line += k < route.legs_m.size() && std::isnan(route.legs_m[k]) ? " //" : " ->";
-    line += " " + std::to_string(route.order[k] + 1);
+    line += ' ';
+    line += std::to_string(route.order[k] + 1);
   }
   line += Format("\n  walking %.1f m", route.length_m);
   if (route.parts > 1) line += Format(" in %d parts no walkable path links (// above)", route.parts);
@@ -99,6 +107,44 @@ std::string OptimalityBoundLine(const PlanResult& r) {
 }
 
 }  // namespace
+
+std::string CoverageTable(const PlanResult& r) {
+  if (r.coverage_curve.empty()) return "";
+  std::string out = Format("  %8s %7s %9s  %s\n", "coverage", "scene", "stations", "field time (set-up and scans)");
+  const std::vector<double> levels(std::begin(kCoverageMilestones), std::end(kCoverageMilestones));
+  for (const CoverageMilestone& m : CoverageMilestones(r.coverage_curve, r.coverable_voxels, levels)) {
+    if (!m.reached) {
+      out += Format("  %6.0f %% %7s %9s  not reached by this plan\n", 100.0 * m.coverable_fraction, "-", "-");
+      continue;
+    }
+    out += Format("  %6.0f %% %6.1f%% %9d  %s\n", 100.0 * m.coverable_fraction, 100.0 * m.reached->scene_fraction,
+                  m.reached->stations, FormatDuration(m.reached->setup_scan_s).c_str());
+  }
+  return out;
+}
+
+std::string StopLine(const PlanResult& r) {
+  const PlanOptions& o = r.options;
+  switch (r.stop_reason) {
+    case StopReason::kExhausted:
+      return "stopped: every voxel some candidate sees is covered\n";
+    case StopReason::kTargetReached:
+      return Format("stopped: target coverage %g %% reached (--target-coverage)\n", 100.0 * o.target_coverage);
+    case StopReason::kMaxStations:
+      return Format("stopped: %d stations (--max-stations)\n", o.max_stations);
+    case StopReason::kMinGain:
+      return Format("stopped: no candidate adds %llu voxels or more (--min-gain; candidates exhausted)\n",
+                    static_cast<unsigned long long>(o.min_marginal_gain_voxels));
+    case StopReason::kGainRule: {
+      const double minutes = (o.setup_seconds + r.field_time.scan_seconds_per_station) / 60.0;
+      return Format(
+          "stopped: gain rule, the next station adds under %.0f voxels for its %s of set-up and scan "
+          "(--min-gain-voxels-per-minute %g)\n",
+          o.min_gain_voxels_per_minute * minutes, FormatDuration(60.0 * minutes).c_str(), o.min_gain_voxels_per_minute);
+    }
+  }
+  return "";
+}
 
 std::string OptimalityLine(const PlanResult& r) {
   const planner::Optimality& o = r.optimality;
@@ -173,6 +219,8 @@ std::string PlanSummary(const PlanResult& r) {
                   static_cast<unsigned long long>(s.marginal_gain), 100.0 * s.cumulative_coverage,
                   route_position[i] ? std::to_string(route_position[i]).c_str() : "-", s.fixed ? "  fixed" : "");
   }
+  out += CoverageTable(r);
+  out += StopLine(r);
   out += OptimalityLine(r);
   out += DistributionLine(r);
   out += ScanGraphLine(r);

@@ -381,6 +381,20 @@ Stage FromProto(v1::Stage s) {
   return s > v1::STAGE_UNSPECIFIED && s <= v1::STAGE_ROUTE ? static_cast<Stage>(s) : Stage::kUnspecified;
 }
 
+v1::CoveragePoint ToProto(const CoveragePoint& c) {
+  v1::CoveragePoint p;
+  p.set_stations(c.stations);
+  p.set_covered_voxels(c.covered_voxels);
+  p.set_coverable_fraction(c.coverable_fraction);
+  p.set_scene_fraction(c.scene_fraction);
+  p.set_setup_scan_s(c.setup_scan_s);
+  return p;
+}
+
+CoveragePoint FromProto(const v1::CoveragePoint& p) {
+  return {p.stations(), p.covered_voxels(), p.coverable_fraction(), p.scene_fraction(), p.setup_scan_s()};
+}
+
 v1::StopReason ToProto(StopReason r) {
   switch (r) {
     case StopReason::kExhausted:
@@ -391,6 +405,8 @@ v1::StopReason ToProto(StopReason r) {
       return v1::STOP_REASON_MAX_STATIONS;
     case StopReason::kMinGain:
       return v1::STOP_REASON_MIN_GAIN;
+    case StopReason::kGainRule:
+      return v1::STOP_REASON_GAIN_RULE;
   }
   return v1::STOP_REASON_UNSPECIFIED;
 }
@@ -405,6 +421,8 @@ Result<StopReason> FromProto(v1::StopReason r) {
       return StopReason::kMaxStations;
     case v1::STOP_REASON_MIN_GAIN:
       return StopReason::kMinGain;
+    case v1::STOP_REASON_GAIN_RULE:
+      return StopReason::kGainRule;
     default:
       break;
   }
@@ -607,6 +625,7 @@ v1::PlanResult ToProto(const PlanResult& r) {
   t->set_walk_s(r.field_time.walk_s);
   t->set_total_s(r.field_time.total_s);
   t->set_scan_seconds_per_station(r.field_time.scan_seconds_per_station);
+  for (const CoveragePoint& c : r.coverage_curve) *p.add_coverage_curve() = ToProto(c);
   return p;
 }
 
@@ -753,6 +772,7 @@ Result<PlanResult> PlanResultAssembler::Finish(const v1::PlanResult& p) && {
   if (route.has_start()) r.route.start = LessOrigin(FromProto(route.start()), origin);
   r.field_time = {p.field_time().setup_s(), p.field_time().scan_s(), p.field_time().walk_s(), p.field_time().total_s(),
                   p.field_time().scan_seconds_per_station()};
+  for (const v1::CoveragePoint& c : p.coverage_curve()) r.coverage_curve.push_back(FromProto(c));
   r.voxel_centers = std::move(centers_);
   for (WorldPoint& q : r.voxel_centers) q = LessOrigin(q, origin);
   return r;

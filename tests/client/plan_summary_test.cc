@@ -92,6 +92,53 @@ TEST(PlanSummaryTest, WithoutAScanTimeTheFieldTimeLineSaysSo) {
   EXPECT_NE(s.find("route: start (1.00, 1.00) -> 3"), std::string::npos) << s;
 }
 
+// A known plan: gains 50, 30, 12, 4, 3 of 100 coverable voxels in a scene of 200, 150 s of set-up
+// and scan a station.
+PlanResult KnownCurve() {
+  PlanResult r = ThreeStations();
+  r.occupied_voxels = 200;
+  r.coverable_voxels = 100;
+  r.covered_voxels = 99;
+  r.coverage_curve = CoverageCurve({50, 30, 12, 4, 3}, 200, 100, 150);
+  return r;
+}
+
+TEST(CoverageTableTest, StationsSceneShareAndFieldTimeAtEachLevel) {
+  EXPECT_EQ(CoverageTable(KnownCurve()),
+            "  coverage   scene  stations  field time (set-up and scans)\n"
+            "      80 %   40.0%         2  5 min\n"
+            "      90 %   46.0%         3  8 min\n"
+            "      95 %   48.0%         4  10 min\n"
+            "      99 %   49.5%         5  13 min\n");
+  PlanResult shorter = KnownCurve();
+  shorter.coverage_curve.resize(2);
+  const std::string s = CoverageTable(shorter);
+  EXPECT_NE(s.find("      90 %       -         -  not reached by this plan\n"), std::string::npos) << s;
+  EXPECT_EQ(CoverageTable(ThreeStations()), "");  // an older server sends no curve
+  EXPECT_NE(PlanSummary(KnownCurve()).find("      99 %   49.5%         5  13 min\n"), std::string::npos);
+}
+
+TEST(StopLineTest, NamesTheRuleThatStoppedTheSelection) {
+  PlanResult r = ThreeStations();
+  r.stop_reason = StopReason::kTargetReached;
+  EXPECT_EQ(StopLine(r), "stopped: target coverage 99 % reached (--target-coverage)\n");
+  r.stop_reason = StopReason::kGainRule;
+  r.options.min_gain_voxels_per_minute = 10;
+  r.options.setup_seconds = 120;
+  r.field_time.scan_seconds_per_station = 60;
+  EXPECT_EQ(StopLine(r),
+            "stopped: gain rule, the next station adds under 30 voxels for its 3 min of set-up and scan "
+            "(--min-gain-voxels-per-minute 10)\n");
+  r.stop_reason = StopReason::kMinGain;
+  EXPECT_NE(StopLine(r).find("candidates exhausted"), std::string::npos);
+  r.stop_reason = StopReason::kExhausted;
+  EXPECT_NE(StopLine(r).find("every voxel some candidate sees is covered"), std::string::npos);
+  r.stop_reason = StopReason::kMaxStations;
+  r.options.max_stations = 4;
+  EXPECT_EQ(StopLine(r), "stopped: 4 stations (--max-stations)\n");
+  EXPECT_NE(PlanSummary(r).find("stopped: 4 stations"), std::string::npos);
+}
+
 TEST(OptimalityLineTest, SaysProvenOptimalOrHowFarFromTheBound) {
   PlanResult r;
   EXPECT_EQ(OptimalityLine(r), "") << "a greedy plan without a bound prints no line";

@@ -23,6 +23,7 @@ TEST(PlanParameters, RoundTripKeepsEveryField) {
   o.max_stations = 9;
   o.min_marginal_gain_voxels = 17;
   o.target_coverage = 0.9;
+  o.min_gain_voxels_per_minute = 12.5;
   o.refine = !PlanOptions{}.refine;
   o.refine_radius_m = 0.8;
   o.refine_step_m = 0.1;
@@ -48,6 +49,7 @@ TEST(PlanParameters, RoundTripKeepsEveryField) {
   EXPECT_EQ(back->selection_test, SelectionTest::kCompatibility);
   EXPECT_EQ(back->solver, SelectionSolver::kExact);
   EXPECT_EQ(back->solve_seconds, 7.5);
+  EXPECT_EQ(back->min_gain_voxels_per_minute, 12.5);
   EXPECT_TRUE(back->local_candidates);
   EXPECT_EQ(back->local_candidates_radius_m, 0.75);
   EXPECT_EQ(back->local_candidates_step_m, 0.3);
@@ -122,6 +124,7 @@ PlanResult BigResult(size_t voxels, size_t candidates) {
   r.optimality.note = "n";
   r.optimality.local_candidates = {2, 90, {4, 3, 3}, {26912, 26912, 26912}};
   r.distribution = {3, 31, 2, 5000000000};
+  r.coverage_curve = {{1, 5, 0.5, 0.25, 165}, {2, 9, 0.9, 0.45, 330}};
   return r;
 }
 
@@ -208,6 +211,21 @@ TEST(PlanResultChunks, ReassembleExactlyAndStayUnderOneMebibyte) {
   EXPECT_EQ(back->distribution.shards, 31);
   EXPECT_EQ(back->distribution.retried, 2);
   EXPECT_EQ(back->distribution.bytes_exchanged, 5000000000u);
+  ASSERT_EQ(back->coverage_curve.size(), 2u);
+  EXPECT_EQ(back->coverage_curve[1].stations, 2);
+  EXPECT_EQ(back->coverage_curve[1].covered_voxels, 9u);
+  EXPECT_EQ(back->coverage_curve[1].coverable_fraction, 0.9);
+  EXPECT_EQ(back->coverage_curve[1].scene_fraction, 0.45);
+  EXPECT_EQ(back->coverage_curve[1].setup_scan_s, 330);
+}
+
+TEST(PlanResultChunks, EveryStopReasonRoundTrips) {
+  for (StopReason s : {StopReason::kExhausted, StopReason::kTargetReached, StopReason::kMaxStations,
+                       StopReason::kMinGain, StopReason::kGainRule}) {
+    Result<StopReason> back = FromProto(ToProto(s));
+    ASSERT_TRUE(back.ok()) << StopReasonName(s);
+    EXPECT_EQ(*back, s) << StopReasonName(s);
+  }
 }
 
 TEST(PlanResultChunks, ARouteOrGraphNamingAMissingStationIsDataLoss) {
@@ -255,8 +273,8 @@ TEST(PlanResultChunks, ASoleViewerNamingAMissingStationOrOnSomeChunksOnlyIsDataL
 // reduction's working data and never part of a result on the wire. 1448 and 416: the scanner's
 // hfov_deg, a row carried as ScannerModel.hfov_deg.)
 TEST(PlanResultChunks, EveryCoreFieldIsCarried) {
-  EXPECT_EQ(sizeof(PlanResult), 1472u) << "PlanResult changed: update the vc.v1 PlanResult and vc::wire";
-  EXPECT_EQ(sizeof(PlanOptions), 416u) << "PlanOptions changed: update vc.v1 PlanParameters and vc::wire";
+  EXPECT_EQ(sizeof(PlanResult), 1504u) << "PlanResult changed: update the vc.v1 PlanResult and vc::wire";
+  EXPECT_EQ(sizeof(PlanOptions), 424u) << "PlanOptions changed: update vc.v1 PlanParameters and vc::wire";
 }
 
 // A georeferenced plan: local positions, the frame's origin at UTM-like coordinates (and once

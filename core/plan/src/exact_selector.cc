@@ -796,7 +796,8 @@ class ExactRun {
   const Clock::time_point start_;
   const bool max_mode_;
   const bool connect_;
-  const uint64_t target_;  // voxels to cover (TargetVoxels)
+  // Voxels to cover: TargetVoxels, or what greedy covered when the gain rule stopped it, if less.
+  const uint64_t target_;
   // Greedy's plan: its picks, the voxels they cover, its first pass's covered count and stop reason.
   const std::vector<int> greedy_picks_;
   const uint64_t greedy_covered_;
@@ -816,7 +817,9 @@ ExactRun::ExactRun(const ExactSelectorOptions& options, const std::vector<VoxelS
       start_(start),
       max_mode_(options.greedy.max_stations > 0),
       connect_(options.greedy.min_overlap > 0),
-      target_(TargetVoxels(options.greedy.target_coverage, greedy.coverable)),
+      target_(greedy.stop == StopReason::kGainRule
+                  ? std::min(greedy.covered, TargetVoxels(options.greedy.target_coverage, greedy.coverable))
+                  : TargetVoxels(options.greedy.target_coverage, greedy.coverable)),
       greedy_picks_(greedy.picks),
       greedy_covered_(Covered(sets, greedy.picks)),
       greedy_pass_covered_(greedy.covered),
@@ -1058,9 +1061,12 @@ Selection ExactRun::Finish(std::vector<int> picks) {
     const bool greedys = SameSet(picks, greedy_picks_);
     out_.picks = SortByMarginalGain(sets_, std::move(picks), fixed_);
     out_.covered = Covered(sets_, out_.picks);
+    // The gain rule set the target: reaching it is the gain rule's stop.
+    const StopReason reached =
+        greedy_stop_ == StopReason::kGainRule ? StopReason::kGainRule : StopReason::kTargetReached;
     out_.stop = greedys                          ? greedy_stop_  // e.g. kMinGain, which no recount can tell
                 : out_.covered >= out_.coverable ? StopReason::kExhausted
-                : out_.covered >= target_        ? StopReason::kTargetReached
+                : out_.covered >= target_        ? reached
                                                  : StopReason::kMaxStations;
   }
   opt.stations = static_cast<int>(out_.picks.size());

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <bit>
+#include <cmath>
 #include <cstdio>
 #include <numeric>
 #include <optional>
@@ -162,6 +163,12 @@ Status CheckOptions(const GreedyOptions& options, size_t candidates) {
   if (!(options.target_coverage > 0.0 && options.target_coverage <= 1.0)) {
     return InvalidArgumentError("target_coverage must be in (0, 1]");
   }
+  if (!(options.min_gain_voxels_per_minute >= 0.0 && std::isfinite(options.min_gain_voxels_per_minute))) {
+    return InvalidArgumentError("min_gain_voxels_per_minute must be finite and >= 0");
+  }
+  if (!(options.station_seconds >= 0.0 && std::isfinite(options.station_seconds))) {
+    return InvalidArgumentError("station_seconds must be finite and >= 0");
+  }
   if (!(options.min_overlap >= 0.0 && options.min_overlap <= 1.0)) {
     return InvalidArgumentError("min_overlap must be in [0, 1]");
   }
@@ -190,6 +197,7 @@ class GreedyRun {
         ctx_(ctx),
         fixed_(static_cast<size_t>(options.fixed)),
         min_gain_(std::max<uint64_t>(options.min_marginal_gain_voxels, 1)),
+        gain_rule_voxels_(options.min_gain_voxels_per_minute * options.station_seconds / 60.0),
         registration_(options.min_overlap > 0),
         uncovered_(sets[0].size()),
         picked_(sets.size(), 0),
@@ -226,6 +234,10 @@ class GreedyRun {
       }
       if (!gains_enough) {
         result_.stop = StopReason::kMinGain;
+        break;
+      }
+      if (!picked_list_.empty() && static_cast<double>(best.gain) < gain_rule_voxels_) {
+        result_.stop = StopReason::kGainRule;
         break;
       }
       Pick(best.candidate, best.gain, false);
@@ -391,6 +403,9 @@ class GreedyRun {
   const JobContext& ctx_;
   const size_t fixed_;
   const uint64_t min_gain_;  // min_marginal_gain_voxels, at least 1: a 0 gain always stops
+  // The gain rule's threshold: min_gain_voxels_per_minute x station_seconds / 60 (0 = off); it
+  // stops no plan before its first station.
+  const double gain_rule_voxels_;
   const bool registration_;
   VoxelSet uncovered_;
   double coverable_ = 0;  // result_.coverable

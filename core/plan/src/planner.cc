@@ -230,6 +230,10 @@ Result<PlanResult> Plan(const SceneInput& input, const PlanOptions& options, con
     result.warnings.push_back("no walking route: " + routed.unrouted_reason);
   }
   result.field_time = ComputeFieldTime(result.stations.size(), result.route.length_m, local_options);
+  std::vector<uint64_t> gains;
+  for (const PlannedStation& s : result.stations) gains.push_back(s.marginal_gain);
+  result.coverage_curve = CoverageCurve(gains, result.occupied_voxels, result.coverable_voxels,
+                                        local_options.setup_seconds + result.field_time.scan_seconds_per_station);
   result.timings = runner.timings();
   result.total_seconds = runner.elapsed_seconds();
   return result;

@@ -19,6 +19,8 @@ std::string_view StopReasonName(StopReason reason) {
       return "max_stations";
     case StopReason::kMinGain:
       return "min_gain";
+    case StopReason::kGainRule:
+      return "gain_rule";
   }
   return "unknown";
 }

@@ -573,6 +573,33 @@ Result<WorldPoint> NamedColumnsRow(const std::vector<std::string_view>& fields, 
   return WorldPoint(v[0], v[1], v[2]);
 }
 
+// plan.json's `coverage_curve`: one point per station (vc/plan/coverage_curve.h).
+Json CoverageCurveJson(const std::vector<CoveragePoint>& curve) {
+  Json out = Json::array();
+  for (const CoveragePoint& c : curve) {
+    out.push_back({{"stations", c.stations},
+                   {"covered_voxels", c.covered_voxels},
+                   {"coverable_fraction", c.coverable_fraction},
+                   {"scene_fraction", c.scene_fraction},
+                   {"setup_scan_s", c.setup_scan_s}});
+  }
+  return out;
+}
+
+// plan.json's `coverage_milestones`: the stations needed for 80, 90, 95 and 99 % of the coverable
+// voxels, with the scene's share and the set-up and scan time there (stations null: never reached).
+Json CoverageMilestonesJson(const PlanResult& r) {
+  Json out = Json::array();
+  const std::vector<double> levels(std::begin(kCoverageMilestones), std::end(kCoverageMilestones));
+  for (const CoverageMilestone& m : CoverageMilestones(r.coverage_curve, r.coverable_voxels, levels)) {
+    out.push_back({{"coverable_fraction", m.coverable_fraction},
+                   {"stations", m.reached ? Json(m.reached->stations) : Json(nullptr)},
+                   {"scene_fraction", m.reached ? Json(m.reached->scene_fraction) : Json(nullptr)},
+                   {"setup_scan_s", m.reached ? Json(m.reached->setup_scan_s) : Json(nullptr)}});
+  }
+  return out;
+}
+
 // A height for plan.json: null when NaN.
 Json HeightJson(double v) { return std::isfinite(v) ? Json(v) : Json(nullptr); }
 
@@ -707,6 +734,8 @@ std::string PlanToJson(const PlanResult& r, const UploadSummary* upload,
          {"scan_graph", std::move(scan_graph)},
          {"route", std::move(route)},
          {"field_time_s", std::move(field_time)},
+         {"coverage_curve", CoverageCurveJson(r.coverage_curve)},
+         {"coverage_milestones", CoverageMilestonesJson(r)},
          {"optimality", OptimalityJson(r.optimality)},
          {"distribution", r.distribution.shards == 0 ? Json(nullptr)
                                                      : Json{{"replicas", r.distribution.replicas},

@@ -165,6 +165,38 @@ TEST(ExactSelectorTest, PreferGreedyKeepsGreedysPlanUnlessStrictlyBetter) {
   EXPECT_GT(kept_although_exact_differs, 0) << "exact never reordered greedy's plan: the test proves little";
 }
 
+// The gain rule (min_gain_voxels_per_minute): greedy stops where a station is worth less than its
+// minutes; the integer program then seeks the fewest stations covering what greedy covered there,
+// not the target coverage, and the plan says the gain rule stopped it.
+TEST(ExactSelectorTest, GainRuleMinimisesStationsForWhatGreedyCoveredWhenItStopped) {
+  std::mt19937 rng(47);
+  int stopped_by_rule = 0;
+  for (int trial = 0; trial < 80; ++trial) {
+    const int n = 4 + static_cast<int>(rng() % 9);
+    const size_t voxels = 40 + rng() % 120;
+    std::vector<VoxelSet> sets = RandomSets(rng, n, voxels, 0.08 + 0.3 * (rng() % 100) / 100.0);
+    const int fixed = static_cast<int>(rng() % 2);
+    ExactSelectorOptions o;
+    o.greedy.target_coverage = 1.0;
+    o.greedy.station_seconds = 60;
+    o.greedy.min_gain_voxels_per_minute = 2 + static_cast<double>(rng() % 8);
+    o.prefer_greedy = trial % 2 == 0;
+    Result<Selection> greedy = GreedySelector(o.greedy).Select(sets, fixed, {});
+    Result<Selection> got = ExactSelector(o).Select(sets, fixed, {});
+    ASSERT_TRUE(greedy.ok() && got.ok()) << got.status().ToString();
+    if (greedy->stop != StopReason::kGainRule) continue;
+    ++stopped_by_rule;
+    const std::string what = "trial " + std::to_string(trial);
+    const Best want = Exhaustive(sets, fixed, greedy->covered, 0);
+    EXPECT_EQ(static_cast<int>(got->picks.size()), want.stations) << what;
+    EXPECT_GE(got->covered, greedy->covered) << what;
+    // Fewer stations may happen to cover every coverable voxel: then that is why it stopped.
+    const StopReason want_stop = got->covered == got->coverable ? StopReason::kExhausted : StopReason::kGainRule;
+    EXPECT_EQ(got->stop, want_stop) << what;
+  }
+  EXPECT_GT(stopped_by_rule, 10) << "the gain rule rarely stopped greedy: the test proves little";
+}
+
 // With max_stations the covered voxels are maximised (capped at the target); when no plan of that
 // size reaches the target, the plan covers the most any can and stops on kMaxStations.
 TEST(ExactSelectorTest, MaximumCoverageEqualsExhaustiveSearchIncludingUnreachableTargets) {

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <limits>
 #include <numeric>
 #include <random>
 #include <string>
@@ -239,6 +240,39 @@ TEST(GreedyTest, StopsAtMinimumMarginalGain) {
   EXPECT_EQ(r.stop, StopReason::kMinGain);
 }
 
+TEST(GreedyTest, GainRuleStopsWhereAStationIsWorthLessThanItsMinutes) {
+  // Gains 6, 3, 1 at 2 minutes a station.
+  std::vector<VoxelSet> sets = {MakeSet(10, {0, 1, 2, 3, 4, 5}), MakeSet(10, {6, 7, 8}), MakeSet(10, {9})};
+  GreedyOptions o = FullCoverage();
+  o.station_seconds = 120;
+  o.min_gain_voxels_per_minute = 2;  // a station must add 4 voxels
+  GreedyResult r = Greedy(sets, o);
+  EXPECT_EQ(Picks(r), std::vector<int>({0}));
+  EXPECT_EQ(r.stop, StopReason::kGainRule);
+  o.min_gain_voxels_per_minute = 1.5;  // 3 voxels: a gain of exactly 3 is worth its time
+  r = Greedy(sets, o);
+  EXPECT_EQ(Picks(r), std::vector<int>({0, 1}));
+  EXPECT_EQ(r.stop, StopReason::kGainRule);
+  EXPECT_EQ(r.covered, 9u);
+  o.min_gain_voxels_per_minute = 0;  // off
+  r = Greedy(sets, o);
+  EXPECT_EQ(Picks(r), std::vector<int>({0, 1, 2}));
+  EXPECT_EQ(r.stop, StopReason::kExhausted);
+  o.min_gain_voxels_per_minute = 1000;
+  o.station_seconds = 0;  // a station that costs nothing is always worth it
+  EXPECT_EQ(Greedy(sets, o).picks.size(), 3u);
+}
+
+TEST(GreedyTest, GainRuleAlwaysPlacesTheFirstStation) {
+  std::vector<VoxelSet> sets = {MakeSet(10, {0, 1, 2, 3, 4, 5}), MakeSet(10, {6, 7, 8})};
+  GreedyOptions o = FullCoverage();
+  o.station_seconds = 60;
+  o.min_gain_voxels_per_minute = 1e6;
+  const GreedyResult r = Greedy(sets, o);
+  EXPECT_EQ(Picks(r), std::vector<int>({0}));
+  EXPECT_EQ(r.stop, StopReason::kGainRule);
+}
+
 TEST(GreedyTest, StopsAtTargetCoverage) {
   std::vector<VoxelSet> sets = {MakeSet(10, {0, 1, 2, 3, 4, 5}), MakeSet(10, {6, 7, 8}), MakeSet(10, {9})};
   GreedyOptions o;
@@ -461,6 +495,12 @@ TEST(GreedyTest, RejectsBadOptions) {
   EXPECT_EQ(SelectGreedy(ThreeRooms(), o).status().code(), StatusCode::kInvalidArgument);
   o = {};
   o.max_stations = -1;
+  EXPECT_EQ(SelectGreedy(ThreeRooms(), o).status().code(), StatusCode::kInvalidArgument);
+  o = {};
+  o.min_gain_voxels_per_minute = -1;
+  EXPECT_EQ(SelectGreedy(ThreeRooms(), o).status().code(), StatusCode::kInvalidArgument);
+  o = {};
+  o.station_seconds = std::numeric_limits<double>::infinity();
   EXPECT_EQ(SelectGreedy(ThreeRooms(), o).status().code(), StatusCode::kInvalidArgument);
 }
 

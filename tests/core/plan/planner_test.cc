@@ -9,7 +9,9 @@
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <iostream>
+#include <iterator>
 #include <limits>
 #include <map>
 #include <set>
@@ -880,6 +882,119 @@ TEST(PlannerTest, MaxStationsStopsEarlyWithAWarning) {
   EXPECT_LT(r->covered_voxels, r->coverable_voxels);
   EXPECT_TRUE(std::any_of(r->warnings.begin(), r->warnings.end(),
                           [](const std::string& w) { return w.find("max_stations") != std::string::npos; }));
+}
+
+// One row of stations.csv by its header's column names.
+std::map<std::string, std::string> CsvRow(const std::vector<std::string>& header, const std::string& line) {
+  std::map<std::string, std::string> row;
+  size_t start = 0;
+  for (const std::string& name : header) {
+    const size_t end = std::min(line.find(',', start), line.size());
+    row[name] = line.substr(start, end - start);
+    start = end + 1;
+  }
+  return row;
+}
+
+std::vector<std::string> SplitCsv(const std::string& line) {
+  std::vector<std::string> out;
+  size_t start = 0;
+  while (start <= line.size()) {
+    const size_t end = std::min(line.find(',', start), line.size());
+    out.push_back(line.substr(start, end - start));
+    start = end + 1;
+  }
+  return out;
+}
+
+// The coverage curve: each step is a station's gain as PlanResult and stations.csv give it, the
+// curve never falls, its last point is the plan's coverage (of the coverable voxels and of the
+// whole scene) and plan.json carries it with the 80 / 90 / 95 / 99 % milestones.
+TEST(PlannerTest, CoverageCurveAgreesWithTheStationsAndStationsCsv) {
+  PlanOptions o = TestOptions();
+  o.scan_seconds = 30;
+  Result<PlanResult> r = Plan(Synthetic("rooms:3"), o);
+  ASSERT_TRUE(r.ok()) << r.status().ToString();
+  const std::vector<CoveragePoint>& curve = r->coverage_curve;
+  ASSERT_EQ(curve.size(), r->stations.size());
+  ASSERT_GE(curve.size(), 3u);
+  uint64_t before = 0;
+  for (size_t k = 0; k < curve.size(); ++k) {
+    EXPECT_EQ(curve[k].stations, static_cast<int>(k) + 1);
+    EXPECT_GE(curve[k].covered_voxels, before) << "the curve falls at " << k;
+    EXPECT_EQ(curve[k].covered_voxels - before, r->stations[k].marginal_gain) << k;
+    EXPECT_DOUBLE_EQ(curve[k].coverable_fraction, r->stations[k].cumulative_coverage) << k;
+    EXPECT_DOUBLE_EQ(curve[k].setup_scan_s, (k + 1) * (o.setup_seconds + 30.0)) << k;
+    before = curve[k].covered_voxels;
+  }
+  EXPECT_EQ(curve.back().covered_voxels, r->covered_voxels);
+  EXPECT_DOUBLE_EQ(curve.back().coverable_fraction, double(r->covered_voxels) / double(r->coverable_voxels));
+  EXPECT_DOUBLE_EQ(curve.back().scene_fraction, double(r->covered_voxels) / double(r->occupied_voxels));
+  EXPECT_DOUBLE_EQ(curve.back().setup_scan_s, r->field_time.setup_s + r->field_time.scan_s);
+
+  const std::string dir = testing::MakeTempDir();
+  ASSERT_TRUE(WritePlanOutputs(*r, dir).ok());
+  std::ifstream csv(dir + "/stations.csv");
+  std::string line;
+  std::vector<std::string> header;
+  size_t rows = 0;
+  while (std::getline(csv, line)) {
+    if (line.empty() || line[0] == '#') continue;
+    if (header.empty()) {
+      header = SplitCsv(line);
+      continue;
+    }
+    std::map<std::string, std::string> row = CsvRow(header, line);
+    const size_t k = std::stoul(row.at("selection_order")) - 1;
+    ASSERT_LT(k, curve.size()) << line;
+    const uint64_t step = curve[k].covered_voxels - (k ? curve[k - 1].covered_voxels : 0);
+    EXPECT_EQ(std::stoull(row.at("gain_voxels")), step) << line;
+    EXPECT_NEAR(std::stod(row.at("cumulative_coverage")), curve[k].coverable_fraction, 1e-6) << line;
+    ++rows;
+  }
+  EXPECT_EQ(rows, curve.size());
+  std::ifstream plan_json(dir + "/plan.json");
+  const std::string text((std::istreambuf_iterator<char>(plan_json)), std::istreambuf_iterator<char>());
+  for (const std::string key : {"\"coverage_curve\"", "\"coverage_milestones\"", "\"setup_scan_s\""}) {
+    EXPECT_NE(text.find(key), std::string::npos) << key;
+  }
+}
+
+// The gain rule: with greedy's own gains (no consolidation, no reduction) the plan keeps exactly
+// the stations whose gain is worth their minutes; the exact solver (auto) then needs no more
+// stations for at least as much; the default (0) leaves the plan as it was.
+TEST(PlannerTest, GainRuleKeepsTheStationsWorthTheirMinutes) {
+  PlanOptions o = TestOptions();
+  o.solver = SelectionSolver::kGreedy;
+  o.consolidate = false;
+  o.reduce = false;
+  o.target_coverage = 1.0;
+  o.setup_seconds = 120;
+  o.scan_seconds = 60;  // 3 minutes a station
+  const SceneInput scene = Synthetic("rooms:3");
+  Result<PlanResult> all = Plan(scene, o);
+  ASSERT_TRUE(all.ok()) << all.status().ToString();
+  ASSERT_GE(all->stations.size(), 4u);
+  const double threshold = static_cast<double>(all->stations[all->stations.size() / 2].marginal_gain) + 0.5;
+  const size_t worth =
+      static_cast<size_t>(std::count_if(all->stations.begin(), all->stations.end(), [&](const auto& s) {
+        return static_cast<double>(s.marginal_gain) >= threshold;
+      }));
+  ASSERT_GE(worth, 1u);
+  ASSERT_LT(worth, all->stations.size());
+  o.min_gain_voxels_per_minute = threshold / 3.0;
+  Result<PlanResult> ruled = Plan(scene, o);
+  ASSERT_TRUE(ruled.ok()) << ruled.status().ToString();
+  EXPECT_EQ(ruled->stations.size(), worth);
+  EXPECT_EQ(ruled->stop_reason, StopReason::kGainRule);
+  EXPECT_EQ(ruled->covered_voxels, all->coverage_curve[worth - 1].covered_voxels);
+  o.solver = SelectionSolver::kAuto;
+  Result<PlanResult> exact = Plan(scene, o);
+  ASSERT_TRUE(exact.ok()) << exact.status().ToString();
+  EXPECT_LE(exact->stations.size(), worth);
+  EXPECT_GE(exact->covered_voxels, ruled->covered_voxels);
+  EXPECT_EQ(exact->stop_reason, StopReason::kGainRule);
+  EXPECT_EQ(PlanOptions{}.min_gain_voxels_per_minute, 0.0);
 }
 
 TEST(PlannerTest, RealScanGeb079) {

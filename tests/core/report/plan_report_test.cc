@@ -83,14 +83,17 @@ PlanResult SamplePlan() {
   r.route.parts = 1;
   r.field_time = {240, 52, 3.6, 295.6, 26};
   r.warnings = {"20.0 % of occupied voxels (1) are visible from no candidate"};
+  r.coverage_curve = CoverageCurve({3, 1}, 5, 4, 146);
   return r;
 }
 
 TEST(PlanReportTest, PlanJsonHasEveryDocumentedKey) {
   const json j = json::parse(PlanToJson(SamplePlan()));
-  for (const char* key : {"schema", "resolution_m", "selection_test", "stop_reason", "viewpoints", "coverage",
-                          "reduction", "candidates", "timings_s", "parameters", "warnings", "scan_graph", "route",
-                          "field_time_s", "optimality", "distribution", "frame", "crs"}) {
+  for (const char* key :
+       {"schema",         "resolution_m",       "selection_test", "stop_reason",  "viewpoints", "coverage",
+        "reduction",      "candidates",         "timings_s",      "parameters",   "warnings",   "scan_graph",
+        "route",          "field_time_s",       "optimality",     "distribution", "frame",      "crs",
+        "coverage_curve", "coverage_milestones"}) {
     EXPECT_TRUE(j.contains(key)) << key;
   }
   EXPECT_EQ(j["scan_graph"]["min_overlap"].get<double>(), 0.3);
@@ -168,6 +171,25 @@ TEST(PlanReportTest, PlanJsonHasEveryDocumentedKey) {
   EXPECT_EQ(j["parameters"]["selection_test"], "surface");
   EXPECT_EQ(j["warnings"].size(), 1u);
   EXPECT_DOUBLE_EQ(j["resolution_m"].get<double>(), 0.1);
+}
+
+// The coverage curve, one point per station, and the stations needed for 80 / 90 / 95 / 99 % of
+// the coverable voxels with the scene's share there (null where the plan never gets there).
+TEST(PlanReportTest, PlanJsonHasTheCoverageCurveAndItsMilestones) {
+  PlanResult r = SamplePlan();
+  r.coverage_curve = CoverageCurve({3, 1}, 5, 4, 146);
+  json j = json::parse(PlanToJson(r));
+  EXPECT_EQ(j["coverage_curve"], json::parse(R"([
+      {"stations": 1, "covered_voxels": 3, "coverable_fraction": 0.75, "scene_fraction": 0.6, "setup_scan_s": 146.0},
+      {"stations": 2, "covered_voxels": 4, "coverable_fraction": 1.0, "scene_fraction": 0.8, "setup_scan_s": 292.0}])"));
+  ASSERT_EQ(j["coverage_milestones"].size(), 4u);
+  for (const json& m : j["coverage_milestones"]) EXPECT_EQ(m["stations"].get<int>(), 2) << m;
+  EXPECT_DOUBLE_EQ(j["coverage_milestones"][0]["coverable_fraction"].get<double>(), 0.8);
+  EXPECT_DOUBLE_EQ(j["coverage_milestones"][3]["scene_fraction"].get<double>(), 0.8);
+  r.coverage_curve.resize(1);  // 75 %: no level reached
+  j = json::parse(PlanToJson(r));
+  EXPECT_TRUE(j["coverage_milestones"][0]["stations"].is_null());
+  EXPECT_TRUE(j["coverage_milestones"][0]["scene_fraction"].is_null());
 }
 
 TEST(PlanReportTest, WritesAllFilesWithPngsOfTheExpectedSize) {

@@ -11,6 +11,13 @@ namespace vc::client {
 // The summary lines, each ending in '\n'; positions in the input's frame (PlanResult::frame_origin_m added).
 std::string PlanSummary(const PlanResult& result);
 
+// The coverage table: for 80, 90, 95 and 99 % of the coverable voxels, the scene's share, the
+// stations (the plan's first k) and their set-up and scan time ("not reached by this plan" where
+// the plan stops short); "" without a coverage curve (an older server).
+std::string CoverageTable(const PlanResult& result);
+// Which rule stopped station selection, one line ("stopped: target coverage 99 % reached ...").
+std::string StopLine(const PlanResult& result);
+
 // How far the selection is from the optimum, one line ("optimal: 37 stations, proven", "37 stations,
 // at most 4 more than the optimum (bound 33)"; empty for a greedy selection without a bound),
 // after a line on the local-candidates loop when it ran.

@@ -11,6 +11,7 @@
 #include "vc/plan/greedy.h"
 #include "vc/plan/keep_out.h"
 #include "vc/plan/local_refinement.h"
+#include "vc/plan/planner.h"
 #include "vc/plan/stages.h"
 
 namespace vc::planner {
@@ -108,6 +109,7 @@ GreedyOptions SelectorOptionsFor(const PlanOptions& options) {
   GreedyOptions out;
   VC_GREEDY_PARAMETERS(VC_COPY_ROW)
   out.min_overlap = options.min_overlap;
+  out.station_seconds = options.setup_seconds + ComputeFieldTime(1, 0.0, options).scan_seconds_per_station;
   return out;
 }
 

@@ -51,6 +51,9 @@ v1::StopReason ToProto(StopReason r);
 // DATA_LOSS for UNSPECIFIED or an unknown value.
 Result<StopReason> FromProto(v1::StopReason r);
 v1::FaceSet ToProto(FaceSet f);
+// One point of the coverage curve, field for field.
+v1::CoveragePoint ToProto(const CoveragePoint& c);
+CoveragePoint FromProto(const v1::CoveragePoint& p);
 // SelectionSolver <-> its enum (UNSPECIFIED in PlanParameters keeps the default).
 v1::SelectionSolver ToProto(SelectionSolver s);
 

@@ -15,6 +15,7 @@
 #include "vc/base/geometry.h"
 #include "vc/base/progress.h"
 #include "vc/base/status.h"
+#include "vc/plan/coverage_curve.h"
 #include "vc/plan/plan_options.h"
 #include "vc/plan/scan_graph.h"
 #include "vc/plan/selector.h"
@@ -155,7 +156,8 @@ struct PlanResult {
   // Floor levels found for the operating plane (top of the floor, m), ascending; empty with
   // user-supplied candidates.
   std::vector<double> floor_levels_m;
-  // Why selection stopped (StopReasonName: "exhausted", "target_reached", "max_stations", "min_gain").
+  // Why selection stopped (StopReasonName: "exhausted", "target_reached", "max_stations", "min_gain",
+  // "gain_rule").
   StopReason stop_reason = StopReason::kExhausted;
   // Greedy picks (fixed stations not counted), and how many of them consolidation saved.
   int greedy_stations = 0;
@@ -168,6 +170,9 @@ struct PlanResult {
   int connecting_stations = 0;
   WalkingRoute route;
   FieldTime field_time;
+  // The coverage curve of the final stations (vc/plan/coverage_curve.h): one point per station, in
+  // the order of stations; the last point is the plan's own coverage.
+  std::vector<CoveragePoint> coverage_curve;
   // How the selection's station count relates to the optimum over the candidates (docs/PLANNING.md,
   // "Exact selection"): the selection stage's, before refinement and reduction.
   planner::Optimality optimality;

@@ -25,8 +25,9 @@ enum class StopReason : uint8_t {
   kTargetReached,  // target_coverage reached
   kMaxStations,    // max_stations picks made
   kMinGain,        // best marginal gain below min_marginal_gain_voxels
+  kGainRule,       // best marginal gain below min_gain_voxels_per_minute x the station's set-up and scan minutes
 };
-// "exhausted", "target_reached", "max_stations", "min_gain".
+// "exhausted", "target_reached", "max_stations", "min_gain", "gain_rule".
 std::string_view StopReasonName(StopReason reason);
 
 // Which selector a plan uses (PlanOptions::solver; docs/PLANNING.md, "Exact selection").
@@ -120,6 +121,12 @@ class Selector {
 // reaches PlanOptions, its flag, its proto field's conversion, plan.json and GreedyOptions. Notes:
 // - target_coverage: the default 0.99 stops chasing the last voxels of scan noise: on geb079, 1.0
 //   puts a station on every one of the 123 candidates, 0.99 needs 69 and 0.95 needs 37.
+// - min_gain_voxels_per_minute: the gain rule (docs/PLANNING.md, "The gain rule"): stop before a
+//   station whose gain is below this many voxels per minute of its set-up and scan time
+//   (GreedyOptions::station_seconds); walking is not counted (the route is planned afterwards).
+//   The first station is always placed. With min_overlap, the rule reads the linked candidates'
+//   gains; the chains of connecting stations are picked as before.
+//   The exact solver then seeks the fewest stations covering what greedy covered when it stopped.
 // - consolidate: after greedy selection, drop picks the others cover and replace two picks by one
 //   candidate that sees all they alone covered (coverage never shrinks; docs/PLANNING.md).
 #define VC_GREEDY_PARAMETERS(X)                                                                                        \
@@ -127,6 +134,8 @@ class Selector {
   X(uint64_t, min_marginal_gain_voxels, 1, "voxels", "min-gain", kAny, "stop when the best station adds fewer voxels") \
   X(double, target_coverage, 0.99, "fraction", "target-coverage", kFraction,                                           \
     "stop at this covered fraction of the coverable voxels")                                                           \
+  X(double, min_gain_voxels_per_minute, 0.0, "voxels/min", "min-gain-voxels-per-minute", kNonNegative,                 \
+    "stop when the best station adds fewer voxels per minute of its set-up and scan (0 = off)")                        \
   X(bool, consolidate, true, "", "consolidate", kAny, "drop covered picks and merge pairs after greedy")
 
 // The options of greedy selection: of GreedySelector, SelectGreedy and ConsolidatePicks (greedy.h).
@@ -147,6 +156,9 @@ struct GreedyOptions {
   // stations left apart are joined the same way when a chain exists (unless max_stations stopped
   // the picks). Consolidation keeps the number of groups. 0 = off: the plain greedy.
   double min_overlap = 0;
+  // Set-up and scan time of one station, s: the gain rule's cost (PlanOptions::setup_seconds plus
+  // the scan time, FieldTime::scan_seconds_per_station). 0: the gain rule never stops.
+  double station_seconds = 0;
   // CELF lazy evaluation (true) or the plain recount of every candidate per round (false).
   bool lazy = true;
   // The first `fixed` sets are stations already placed: picked first, in order (whatever their
