@@ -452,7 +452,9 @@ TEST(ConsolidateTest, ReportsEveryPassWithCountsAndRisingFractions) {
     const ProgressEvent& e = events[i];
     EXPECT_EQ(e.stage, Stage::kSelection);
     EXPECT_NE(e.message.find("consolidation pass "), std::string::npos) << e.message;
-    if (i > 0) EXPECT_GE(e.fraction, events[i - 1].fraction) << "event " << i << ": " << e.message;
+    if (i > 0) {
+      EXPECT_GE(e.fraction, events[i - 1].fraction) << "event " << i << ": " << e.message;
+    }
     if (e.unit.empty()) continue;
     EXPECT_EQ(e.unit, "pairs of picks");
     EXPECT_LE(e.done, e.total);

@@ -264,7 +264,9 @@ TEST(SubvoxelTest, APlaneFullyInViewIsFullyPredictedAtEveryTilt) {
       // Measured (docs/VISIBILITY.md): 1.000 without noise; 0.944-1.000 with 1 cm of noise.
       EXPECT_GE(subvoxel, noise_m == 0 ? 0.99 : 0.93);
       EXPECT_GE(subvoxel, surface);
-      if (tilt_deg >= 30) EXPECT_GT(subvoxel, surface + 0.2);  // the second layer counts
+      if (tilt_deg >= 30) {  // the second layer counts
+        EXPECT_GT(subvoxel, surface + 0.2);
+      }
     }
   }
 }
