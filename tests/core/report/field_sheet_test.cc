@@ -12,6 +12,7 @@
 #include <string>
 
 #include "testing/test_paths.h"
+#include "vc/report/crs.h"
 #include "vc/report/field_exports.h"
 #include "vc/report/plan_report.h"
 
@@ -279,6 +280,34 @@ TEST(FieldSheetTest, WritePlanOutputsWritesTheFieldSheet) {
   const std::string dir = testing::MakeTempDir() + "/out";
   ASSERT_TRUE(WritePlanOutputs(plan, dir).ok());
   EXPECT_EQ(testing::ReadFileBytes(dir + "/fieldsheet.pdf").substr(0, 5), "%PDF-");
+}
+
+// With a CRS, WritePlanOutputs draws true north where PROJ puts it at the stations' mean: in UTM
+// zone 32N 200 km east of the central meridian it lies west of grid north (a negative clockwise
+// angle, about 2.2 degrees at 50.6 N); without a CRS the sheet shows grid north only.
+TEST(FieldSheetTest, WithACrsTheSheetShowsTrueNorthFromProj) {
+  if (!HavePoppler()) GTEST_SKIP() << "pdftoppm/pdfinfo (poppler-utils) not found";
+  PlanResult plan = TwoFloorPlan();
+  plan.frame_origin_m = WorldPoint(700000, 5607000, 0);
+  Result<Crs> crs = Crs::Create("EPSG:25832");
+  ASSERT_TRUE(crs.ok()) << crs.status().ToString();
+  WorldPoint mean = WorldPoint::Zero();
+  for (const PlannedStation& s : plan.stations) mean += s.position;
+  mean = mean / static_cast<double>(plan.stations.size()) + plan.frame_origin_m;
+  Result<double> ccw_rad = crs->TrueNorthFromGridNorthRad(mean.x(), mean.y());
+  ASSERT_TRUE(ccw_rad.ok());
+  const double clockwise_deg = -*ccw_rad * 180 / M_PI;
+  EXPECT_LT(clockwise_deg, -2.0);
+  EXPECT_GT(clockwise_deg, -2.4);
+  char expected[64];
+  std::snprintf(expected, sizeof(expected), "true north (%.1f", clockwise_deg);
+
+  const std::string dir = testing::MakeTempDir() + "/out";
+  ASSERT_TRUE(WritePlanOutputs(plan, dir, nullptr, {}, &*crs).ok());
+  EXPECT_NE(PdfText(dir + "/fieldsheet.pdf").find(expected), std::string::npos) << expected;
+  const std::string plain = testing::MakeTempDir() + "/out";
+  ASSERT_TRUE(WritePlanOutputs(plan, plain).ok());
+  EXPECT_EQ(PdfText(plain + "/fieldsheet.pdf").find("true north"), std::string::npos);
 }
 
 }  // namespace
