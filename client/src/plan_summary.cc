@@ -5,6 +5,9 @@
 #include <cstdint>
 #include <cstdio>
 #include <iterator>
+#include <string>
+#include <utility>
+#include <vector>
 
 namespace vc::client {
 namespace {
@@ -176,6 +179,31 @@ std::string FormatDuration(double seconds) {
 
 namespace {
 
+// Why no candidate sees what it does not, the largest cause first, each with what would help; empty
+// when nothing is unseen (or an older server sent no breakdown).
+std::string UnseenCausesLine(const UnseenCauses& u) {
+  const std::pair<uint64_t, const char*> causes[] = {
+      {u.hidden, "hidden behind other surfaces from every candidate (a finer grid or your own candidates)"},
+      {u.faces_away, "facing away from every candidate (undersides, outer walls: a station on that side)"},
+      {u.interior, "inside solid matter, seen from nowhere"},
+      {u.out_of_range, "out of every candidate's range"},
+      {u.outside_field_of_view, "outside the vertical field of view (another tripod height)"},
+      {u.no_candidate_on_floor, "on floors without candidates"},
+      {u.in_keep_out, "in keep-out zones"},
+  };
+  std::vector<std::pair<uint64_t, const char*>> present;
+  for (const auto& c : causes) {
+    if (c.first > 0) present.push_back(c);
+  }
+  if (present.empty()) return "";
+  std::stable_sort(present.begin(), present.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
+  std::string out = "  unseen:";
+  for (size_t i = 0; i < present.size(); ++i) {
+    out += Format("%s %llu %s", i ? ";" : "", static_cast<unsigned long long>(present[i].first), present[i].second);
+  }
+  return out + "\n";
+}
+
 // The plan's first lines: the share of the whole scene covered first (what a crew reads first),
 // then the share of what any candidate can see, and what no candidate sees. Older servers send no
 // occupied count (0): then only the coverable share is known.
@@ -198,7 +226,7 @@ std::string HeadlineLines(const PlanResult& r) {
     out += Format("; %llu (%.1f%% of the scene) no candidate sees at all (plan.json \"coverage\")", count(unseen),
                   percent(unseen, r.occupied_voxels));
   }
-  return out + "\n";
+  return out + "\n" + UnseenCausesLine(r.unseen_causes);
 }
 
 }  // namespace

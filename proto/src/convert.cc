@@ -626,6 +626,14 @@ v1::PlanResult ToProto(const PlanResult& r) {
   t->set_total_s(r.field_time.total_s);
   t->set_scan_seconds_per_station(r.field_time.scan_seconds_per_station);
   for (const CoveragePoint& c : r.coverage_curve) *p.add_coverage_curve() = ToProto(c);
+  v1::UnseenCauses* u = p.mutable_unseen_causes();
+  u->set_interior(r.unseen_causes.interior);
+  u->set_in_keep_out(r.unseen_causes.in_keep_out);
+  u->set_no_candidate_on_floor(r.unseen_causes.no_candidate_on_floor);
+  u->set_out_of_range(r.unseen_causes.out_of_range);
+  u->set_outside_field_of_view(r.unseen_causes.outside_field_of_view);
+  u->set_faces_away(r.unseen_causes.faces_away);
+  u->set_hidden(r.unseen_causes.hidden);
   return p;
 }
 
@@ -773,6 +781,10 @@ Result<PlanResult> PlanResultAssembler::Finish(const v1::PlanResult& p) && {
   r.field_time = {p.field_time().setup_s(), p.field_time().scan_s(), p.field_time().walk_s(), p.field_time().total_s(),
                   p.field_time().scan_seconds_per_station()};
   for (const v1::CoveragePoint& c : p.coverage_curve()) r.coverage_curve.push_back(FromProto(c));
+  const v1::UnseenCauses& u = p.unseen_causes();
+  r.unseen_causes = {u.interior(),     u.in_keep_out(),           u.no_candidate_on_floor(),
+                     u.out_of_range(), u.outside_field_of_view(), u.faces_away(),
+                     u.hidden()};
   r.voxel_centers = std::move(centers_);
   for (WorldPoint& q : r.voxel_centers) q = LessOrigin(q, origin);
   return r;

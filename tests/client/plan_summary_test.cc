@@ -69,7 +69,19 @@ TEST(PlanSummaryTest, TheHeadlineIsTheShareOfTheWholeScene) {
       s.find("\n  95.0% of the 20 voxels some candidate can see; 60 (75.0% of the scene) no candidate sees at all"),
       std::string::npos)
       << s;
+  EXPECT_EQ(s.find("unseen:"), std::string::npos) << s;  // no breakdown sent
+  r.unseen_causes.hidden = 40;
+  r.unseen_causes.interior = 15;
+  r.unseen_causes.outside_field_of_view = 5;
+  r.unseen_causes.faces_away = 15;
+  EXPECT_NE(PlanSummary(r).find("\n  unseen: 40 hidden behind other surfaces from every candidate (a finer grid or "
+                                "your own candidates); 15 facing away from every candidate (undersides, outer walls: "
+                                "a station on that side); 15 inside solid matter, seen from nowhere; 5 outside the "
+                                "vertical field of view (another tripod height)\n"),
+            std::string::npos)
+      << PlanSummary(r);
   r.occupied_voxels = 20;  // everything occupied is coverable: no third figure
+  r.unseen_causes = {};
   EXPECT_EQ(PlanSummary(r).find("no candidate sees"), std::string::npos);
 }
 

@@ -125,6 +125,7 @@ PlanResult BigResult(size_t voxels, size_t candidates) {
   r.optimality.local_candidates = {2, 90, {4, 3, 3}, {26912, 26912, 26912}};
   r.distribution = {3, 31, 2, 5000000000};
   r.coverage_curve = {{1, 5, 0.5, 0.25, 165}, {2, 9, 0.9, 0.45, 330}};
+  r.unseen_causes = {1, 2, 3, 4, 5, 6, 7};
   return r;
 }
 
@@ -217,6 +218,13 @@ TEST(PlanResultChunks, ReassembleExactlyAndStayUnderOneMebibyte) {
   EXPECT_EQ(back->coverage_curve[1].coverable_fraction, 0.9);
   EXPECT_EQ(back->coverage_curve[1].scene_fraction, 0.45);
   EXPECT_EQ(back->coverage_curve[1].setup_scan_s, 330);
+  EXPECT_EQ(back->unseen_causes.interior, 1u);
+  EXPECT_EQ(back->unseen_causes.in_keep_out, 2u);
+  EXPECT_EQ(back->unseen_causes.no_candidate_on_floor, 3u);
+  EXPECT_EQ(back->unseen_causes.out_of_range, 4u);
+  EXPECT_EQ(back->unseen_causes.outside_field_of_view, 5u);
+  EXPECT_EQ(back->unseen_causes.faces_away, 6u);
+  EXPECT_EQ(back->unseen_causes.hidden, 7u);
 }
 
 TEST(PlanResultChunks, EveryStopReasonRoundTrips) {
@@ -271,9 +279,9 @@ TEST(PlanResultChunks, ASoleViewerNamingAMissingStationOrOnSomeChunksOnlyIsDataL
 // field in proto/vc/v1/planner.proto and proto/src/convert.cc (both ways), then update the sizes.
 // (1440: Evaluation::per_viewpoint_sparse_values, which like per_viewpoint_face_values is the
 // reduction's working data and never part of a result on the wire. 1448 and 416: the scanner's
-// hfov_deg, a row carried as ScannerModel.hfov_deg.)
+// hfov_deg, a row carried as ScannerModel.hfov_deg. 1560: unseen_causes.)
 TEST(PlanResultChunks, EveryCoreFieldIsCarried) {
-  EXPECT_EQ(sizeof(PlanResult), 1504u) << "PlanResult changed: update the vc.v1 PlanResult and vc::wire";
+  EXPECT_EQ(sizeof(PlanResult), 1560u) << "PlanResult changed: update the vc.v1 PlanResult and vc::wire";
   EXPECT_EQ(sizeof(PlanOptions), 424u) << "PlanOptions changed: update vc.v1 PlanParameters and vc::wire";
 }
 

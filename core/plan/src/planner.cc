@@ -176,6 +176,13 @@ Result<PlanResult> Plan(const SceneInput& input, const PlanOptions& options, con
   }
   result.coverable_voxels = coverable.count();
   if (auto w = UncoverableWarning(result.occupied_voxels, result.coverable_voxels)) result.warnings.push_back(*w);
+  {
+    std::vector<WorldPoint> seeing = candidates.positions;
+    seeing.insert(seeing.end(), stations.positions.begin(), stations.positions.end());
+    VC_ASSIGN_OR_RETURN(result.unseen_causes, CountUnseenCauses({scene, coverable, seeing, result.floor_levels_m,
+                                                                 local_options.keep_out, local_options.scanner},
+                                                                local_options.threads, ctx));
+  }
 
   planner::ReductionOutput reduced = planner::KeepAllStations(stations.size());
   if (local_options.reduce && !stations.empty()) {

@@ -573,6 +573,17 @@ Result<WorldPoint> NamedColumnsRow(const std::vector<std::string_view>& fields, 
   return WorldPoint(v[0], v[1], v[2]);
 }
 
+// plan.json's `coverage.uncoverable_by_cause` (vc/plan/unseen_causes.h): voxel counts per cause.
+Json UnseenCausesJson(const UnseenCauses& u) {
+  return Json{{"interior", u.interior},
+              {"in_keep_out", u.in_keep_out},
+              {"no_candidate_on_floor", u.no_candidate_on_floor},
+              {"out_of_range", u.out_of_range},
+              {"outside_field_of_view", u.outside_field_of_view},
+              {"faces_away", u.faces_away},
+              {"hidden", u.hidden}};
+}
+
 // plan.json's `coverage_curve`: one point per station (vc/plan/coverage_curve.h).
 Json CoverageCurveJson(const std::vector<CoveragePoint>& curve) {
   Json out = Json::array();
@@ -660,7 +671,8 @@ std::string PlanToJson(const PlanResult& r, const UploadSummary* upload,
                 {"fully_visible_fraction", r.evaluation.overall.fully_visible_fraction},
                 {"mean_full_visibility", r.evaluation.overall.mean_full_visibility},
                 {"partially_visible_fraction", r.evaluation.overall.partially_visible_fraction},
-                {"faces_total", r.evaluation.faces_total}};
+                {"faces_total", r.evaluation.faces_total},
+                {"uncoverable_by_cause", UnseenCausesJson(r.unseen_causes)}};
   Json matrix = Json::array();
   for (int i = 0; i < r.reduction.size; ++i) {
     Json row = Json::array();

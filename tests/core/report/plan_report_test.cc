@@ -84,6 +84,7 @@ PlanResult SamplePlan() {
   r.field_time = {240, 52, 3.6, 295.6, 26};
   r.warnings = {"20.0 % of occupied voxels (1) are visible from no candidate"};
   r.coverage_curve = CoverageCurve({3, 1}, 5, 4, 146);
+  r.unseen_causes.hidden = 1;
   return r;
 }
 
@@ -95,6 +96,12 @@ TEST(PlanReportTest, PlanJsonHasEveryDocumentedKey) {
         "route",          "field_time_s",       "optimality",     "distribution", "frame",      "crs",
         "coverage_curve", "coverage_milestones"}) {
     EXPECT_TRUE(j.contains(key)) << key;
+  }
+  const json& by_cause = j["coverage"]["uncoverable_by_cause"];
+  EXPECT_EQ(by_cause["hidden"].get<int>(), 1);
+  for (const char* cause :
+       {"interior", "in_keep_out", "no_candidate_on_floor", "out_of_range", "outside_field_of_view", "faces_away"}) {
+    EXPECT_EQ(by_cause[cause].get<int>(), 0) << cause;
   }
   EXPECT_EQ(j["scan_graph"]["min_overlap"].get<double>(), 0.3);
   EXPECT_TRUE(j["scan_graph"]["connected"].get<bool>());

@@ -20,6 +20,7 @@
 #include "vc/plan/scan_graph.h"
 #include "vc/plan/selector.h"
 #include "vc/plan/stage_runner.h"
+#include "vc/plan/unseen_causes.h"
 #include "vc/scene/voxel_scene.h"
 #include "vc/visibility/visibility.h"
 
@@ -149,6 +150,8 @@ struct PlanResult {
   uint64_t occupied_voxels = 0;
   uint64_t coverable_voxels = 0;
   uint64_t covered_voxels = 0;
+  // Why the occupied voxels outside the coverable ones are seen by no candidate (unseen_causes.h).
+  UnseenCauses unseen_causes;
   Evaluation evaluation;             // of the final stations at the working resolution (with face values)
   std::vector<StageTiming> timings;  // the stages that ran, in order
   double total_seconds = 0;          // the whole plan, from validation to the evaluation
