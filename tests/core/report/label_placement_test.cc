@@ -60,8 +60,9 @@ TEST(LabelPlacementTest, NoTwoLabelsOverlapOnADenseSetAndEveryLeaderEndsAtItsAnc
     EXPECT_FALSE(placed[i].overlaps) << "label " << i;
     EXPECT_TRUE(options.bounds.Contains(placed[i].box)) << "label " << i;
     for (size_t j = 0; j < placed.size(); ++j) {
-      if (j > i) EXPECT_FALSE(placed[i].box.Overlaps(placed[j].box)) << i << " and " << j;
-      if (j != i) EXPECT_FALSE(placed[i].box.Overlaps(AnchorSquare(labels[j]))) << i << " over anchor " << j;
+      if (j == i) continue;
+      EXPECT_FALSE(placed[i].box.Overlaps(placed[j].box)) << i << " and " << j;
+      EXPECT_FALSE(placed[i].box.Overlaps(AnchorSquare(labels[j]))) << i << " over anchor " << j;
     }
     EXPECT_EQ(placed[i].leader, !placed[i].centred) << "label " << i;
     if (!placed[i].leader) continue;
