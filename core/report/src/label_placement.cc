@@ -83,18 +83,31 @@ std::vector<PlacedLabel> PlaceLabels(const std::vector<LabelRequest>& labels, co
   std::vector<PlacedLabel> placed;
   placed.reserve(labels.size());
   for (size_t k = 0; k < labels.size(); ++k) {
-    // How much `box` covers the anchors, obstacles and labels placed so far (0: nothing).
-    auto covered = [&](const LabelBox& box, bool own_anchor_allowed) {
-      double area = 0;
-      for (size_t a = 0; a < anchors.size(); ++a) {
-        if (a == k && own_anchor_allowed) continue;
-        area += Cover(box, anchors[a]);
-      }
-      for (const LabelBox& b : obstacles) area += Cover(box, b);
-      for (const PlacedLabel& p : placed) area += Cover(box, p.box);
+    const std::vector<Candidate> candidates = Candidates(labels[k], options);
+    // What some candidate could cover (its own anchor apart): a filter, so that a plan of
+    // thousands of stations compares each label with its neighbours only.
+    LabelBox reach = candidates.front().box;
+    for (const Candidate& c : candidates) {
+      reach = {std::min(reach.x0, c.box.x0), std::min(reach.y0, c.box.y0), std::max(reach.x1, c.box.x1),
+               std::max(reach.y1, c.box.y1)};
+    }
+    std::vector<LabelBox> near;
+    for (size_t a = 0; a < anchors.size(); ++a) {
+      if (a != k && reach.Overlaps(anchors[a])) near.push_back(anchors[a]);
+    }
+    for (const LabelBox& b : obstacles) {
+      if (reach.Overlaps(b)) near.push_back(b);
+    }
+    for (const PlacedLabel& p : placed) {
+      if (reach.Overlaps(p.box)) near.push_back(p.box);
+    }
+    // How much `box` covers the other anchors, the obstacles and the labels placed so far (0:
+    // nothing), and its own anchor unless it is centred on it.
+    auto covered = [&](const LabelBox& box, bool centred) {
+      double area = centred ? 0.0 : Cover(box, anchors[k]);
+      for (const LabelBox& b : near) area += Cover(box, b);
       return area;
     };
-    const std::vector<Candidate> candidates = Candidates(labels[k], options);
     const Candidate* best = nullptr;
     double best_area = std::numeric_limits<double>::infinity();
     for (const Candidate& c : candidates) {
