@@ -561,8 +561,8 @@ Image DrawHeatmap(const PlanResult& r) {
   if (!r.scan_graph.edges.empty()) legend += "   WHITE: OVERLAP \u2265 " + Short(ScanGraphDrawThreshold(r));
   img.Text(kMarginLeft, legend_y, legend, raster::kBlack);
   std::string marks;
-  if (zones) marks += "HATCHED: KEEP-OUT ZONE (NO STATION THERE)";
-  if (moved) marks += std::string(marks.empty() ? "" : "   ") + "DOT AND LINE: STATION WHOSE NUMBER IS SET ASIDE";
+  if (zones) marks += "HATCHED: KEEP-OUT ZONE";
+  if (moved) marks += std::string(marks.empty() ? "" : "   ") + "LINE TO DOT: STATION OF A MOVED NUMBER";
   img.Text(kMarginLeft, legend_y + 10, marks, raster::kBlack);
   HeatColourBar(img, L, r, max_count);
   return img;
