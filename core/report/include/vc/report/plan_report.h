@@ -80,8 +80,9 @@ struct ImageSize {
   int width = 0;
   int height = 0;
 };
-// heatmap.png's bytes: the candidates' cells over the floor plan of each level, the scan graph's
-// edges, the walking route and the stations (docs/PLANNING.md, "heatmap.png").
+// heatmap.png's bytes: the candidates' cells under the floor plan and keep-out zones of each
+// level, the scan graph's edges, the walking route, the stations and a colour bar in per cent of
+// the scene (docs/PLANNING.md, "heatmap.png").
 Result<std::string> HeatmapPng(const PlanResult& result);
 // Where heatmap.png draws a station, in pixels from the picture's top-left corner: its panel, the
 // station's own pixel, and the box of its numbered disc (centred on the station, or moved aside
