@@ -12,6 +12,7 @@
 
 #include "floor_plan.h"
 #include "vc/plan/keep_out.h"
+#include "vc/report/label_placement.h"
 
 namespace vc {
 
@@ -28,6 +29,9 @@ constexpr int kLegendRows = 7;
 constexpr double kRowHeight = 12;    // station table
 constexpr double kTableHeader = 30;  // the table's heading and column titles
 constexpr double kMarkerRadius = 7;
+constexpr double kDotRadius = 1.6;   // the dot at a station whose numbered marker is moved aside
+constexpr double kNameHeight = 9;    // a name label's white ground
+constexpr double kNameFontSize = 7;  // and its text
 constexpr const char* kFont = "DejaVu Sans";
 constexpr const char* kFontFile = "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf";  // Debian fonts-dejavu-core
 constexpr const char* kBoldFontFile = "/usr/share/fonts/truetype/dejavu/DejaVuSans-Bold.ttf";
@@ -58,6 +62,18 @@ const FontFaces& DejaVuFaces() {
   return faces;
 }
 
+// Selects DejaVu Sans (bold or regular) at `size_pt` on `cr`.
+void SetFont(cairo_t* cr, double size_pt, bool bold = false) {
+  const FontFaces& faces = DejaVuFaces();
+  if (faces.regular != nullptr && faces.bold != nullptr) {
+    cairo_set_font_face(cr, bold ? faces.bold : faces.regular);
+  } else {
+    cairo_select_font_face(cr, kFont, CAIRO_FONT_SLANT_NORMAL,
+                           bold ? CAIRO_FONT_WEIGHT_BOLD : CAIRO_FONT_WEIGHT_NORMAL);
+  }
+  cairo_set_font_size(cr, size_pt);
+}
+
 struct Column {
   const char* title;
   double width_pt;
@@ -74,6 +90,9 @@ struct Sheet {
   double centre_x = 0, centre_y = 0;            // footprint centre (local, m), drawn at the plan area's centre
   double table_top = 0;                         // top of the station table in the side column
   std::vector<int> station_panel;               // per FieldStation given
+  std::vector<std::string> names;               // per FieldStation: its label, name and tripod height
+  std::vector<PlacedLabel> numbers;             // per FieldStation: its numbered marker's place
+  std::vector<PlacedLabel> name_places;         // per FieldStation: its name label's place
   std::vector<std::vector<size_t>> floor_rows;  // per floor page, the stations in its table
   std::vector<std::vector<size_t>> table_page_rows;
 
@@ -113,6 +132,65 @@ void AssignRows(Sheet& s, size_t stations, int table_capacity, int table_page_ca
   }
 }
 
+std::string Fixed(double v, int decimals) {
+  char buf[64];
+  std::snprintf(buf, sizeof(buf), "%.*f", decimals, v);
+  return buf;
+}
+
+// A station's label beside its marker: "S03  h 1.60 m", or the name alone without a floor.
+std::string NameLabel(const FieldStation& f) {
+  return std::isfinite(f.tripod_height_m) ? f.name + "  h " + Fixed(f.tripod_height_m, 2) + " m" : f.name;
+}
+
+// Where each floor page draws its stations' numbered markers and names (PlaceLabels, in walking
+// order): a marker centred on its station unless that covers another station or marker, else moved
+// aside with a leader line back to a dot at the station; then each name beside its marker, or
+// further out with a leader line. Text is measured on a PDF surface that writes nothing, with the
+// fonts the sheet draws with.
+void PlaceStationLabels(Sheet& s, const PlanResult& r, const std::vector<FieldStation>& stations) {
+  cairo_surface_t* surface = cairo_pdf_surface_create_for_stream(nullptr, nullptr, s.width, s.height);
+  cairo_t* cr = cairo_create(surface);
+  SetFont(cr, kNameFontSize);
+  s.names.resize(stations.size());
+  s.numbers.resize(stations.size());
+  s.name_places.resize(stations.size());
+  LabelPlacementOptions options;
+  options.bounds = {s.plan_left, s.plan_top, s.plan_left + s.plan_width, s.plan_top + s.plan_height};
+  for (size_t panel = 0; panel < s.floors.panel_z.size(); ++panel) {
+    std::vector<size_t> here;
+    std::vector<LabelRequest> markers, names;
+    for (size_t k = 0; k < stations.size(); ++k) {
+      if (s.station_panel[k] != static_cast<int>(panel) || stations[k].index >= r.stations.size()) continue;
+      const WorldPoint& p = r.stations[stations[k].index].position;
+      // A circle of radius 7 or a square of half-side 9, and half their 1.3 pt ring.
+      const double side = 2 * ((stations[k].fixed ? kMarkerRadius + 2 : kMarkerRadius) + 0.65);
+      markers.push_back({{s.PageX(p.x()), s.PageY(p.y())}, kDotRadius + 0.5, side, side});
+      here.push_back(k);
+    }
+    options.centred_first = true;
+    const std::vector<PlacedLabel> placed = PlaceLabels(markers, {}, options);
+    std::vector<LabelBox> taken;
+    for (size_t i = 0; i < here.size(); ++i) {
+      taken.push_back(placed[i].box);
+      const LabelPoint& a = markers[i].anchor;
+      taken.push_back({a.x - markers[i].anchor_radius, a.y - markers[i].anchor_radius, a.x + markers[i].anchor_radius,
+                       a.y + markers[i].anchor_radius});
+      s.numbers[here[i]] = placed[i];
+      s.names[here[i]] = NameLabel(stations[here[i]]);
+      cairo_text_extents_t e;
+      cairo_text_extents(cr, s.names[here[i]].c_str(), &e);
+      const LabelBox& b = placed[i].box;
+      names.push_back({{0.5 * (b.x0 + b.x1), 0.5 * (b.y0 + b.y1)}, kMarkerRadius + 2, e.x_advance + 2, kNameHeight});
+    }
+    options.centred_first = false;
+    const std::vector<PlacedLabel> named = PlaceLabels(names, taken, options);
+    for (size_t i = 0; i < here.size(); ++i) s.name_places[here[i]] = named[i];
+  }
+  cairo_destroy(cr);
+  cairo_surface_destroy(surface);
+}
+
 Sheet ComputeSheet(const PlanResult& r, const std::vector<FieldStation>& stations, const FieldSheetOptions& o) {
   Sheet s;
   const bool a3 = o.paper == PaperSize::kA3;
@@ -140,13 +218,8 @@ Sheet ComputeSheet(const PlanResult& r, const std::vector<FieldStation>& station
   const int capacity = static_cast<int>((s.height - kMargin - s.table_top - kTableHeader) / kRowHeight);
   const int page_capacity = static_cast<int>((s.height - 2 * kMargin - kTitleBand - kTableHeader) / kRowHeight);
   AssignRows(s, stations.size(), std::max(capacity, 0), std::max(page_capacity, 1));
+  PlaceStationLabels(s, r, stations);
   return s;
-}
-
-std::string Fixed(double v, int decimals) {
-  char buf[64];
-  std::snprintf(buf, sizeof(buf), "%.*f", decimals, v);
-  return buf;
 }
 
 // A tripod height for the table; "-" for a station with no floor below it.
@@ -160,16 +233,6 @@ std::string Duration(double seconds) {
   char buf[32];
   std::snprintf(buf, sizeof(buf), "%ld h %02ld min", total_min / 60, total_min % 60);
   return buf;
-}
-
-// A keep-out zone's outline in the local frame (m): x1, y1, x2, y2, ...
-std::vector<double> ZoneOutlineLocal(const PlanResult& r, const KeepOutZone& z) {
-  std::vector<double> xy =
-      z.shape == KeepOutShape::kPolygon
-          ? z.polygon_xy_m
-          : std::vector<double>{z.min.x(), z.min.y(), z.max.x(), z.min.y(), z.max.x(), z.max.y(), z.min.x(), z.max.y()};
-  for (size_t i = 0; i + 1 < xy.size(); i += 2) xy[i] -= r.frame_origin_m.x(), xy[i + 1] -= r.frame_origin_m.y();
-  return xy;
 }
 
 // Draws the pages of one sheet onto a cairo context.
@@ -194,16 +257,7 @@ class FieldSheetPainter {
   }
 
  private:
-  void Font(double size_pt, bool bold = false) {
-    const FontFaces& faces = DejaVuFaces();
-    if (faces.regular != nullptr && faces.bold != nullptr) {
-      cairo_set_font_face(cr_, bold ? faces.bold : faces.regular);
-    } else {
-      cairo_select_font_face(cr_, kFont, CAIRO_FONT_SLANT_NORMAL,
-                             bold ? CAIRO_FONT_WEIGHT_BOLD : CAIRO_FONT_WEIGHT_NORMAL);
-    }
-    cairo_set_font_size(cr_, size_pt);
-  }
+  void Font(double size_pt, bool bold = false) { SetFont(cr_, size_pt, bold); }
   // Text with its baseline at y; `align` 0 left, 0.5 centred, 1 right.
   void Text(double x, double y, const std::string& text, double align = 0) {
     cairo_text_extents_t e;
@@ -342,12 +396,9 @@ void FieldSheetPainter::HatchPath(double spacing_pt) {
 // Keep-out zones whose z range meets the panel's band (floor to the highest tripod height):
 // outlined and hatched.
 void FieldSheetPainter::DrawZones(int panel) {
-  const double floor = s_.floors.floor_m[size_t(panel)];
-  const double band_top = floor + floor_plan::HighestTripodHeight(r_);
   for (const KeepOutZone& z : r_.options.keep_out) {
-    const double zmin = z.min.z() - r_.frame_origin_m.z(), zmax = z.max.z() - r_.frame_origin_m.z();
-    if (zmax < floor || zmin > band_top) continue;
-    const std::vector<double> xy = ZoneOutlineLocal(r_, z);
+    if (!floor_plan::ZoneOnPanel(s_.floors, r_, z, panel)) continue;
+    const std::vector<double> xy = floor_plan::ZoneOutlineLocal(r_, z);
     auto outline = [&] {
       cairo_new_path(cr_);
       for (size_t i = 0; i + 1 < xy.size(); i += 2) cairo_line_to(cr_, s_.PageX(xy[i]), s_.PageY(xy[i + 1]));
@@ -434,52 +485,46 @@ void FieldSheetPainter::StationMarker(double x, double y, const FieldStation& f)
   Text(x, y + 2.5, number, 0.5);
 }
 
-// A rectangle on the page (pt).
-struct Box {
-  double x0, y0, x1, y1;
-  bool Overlaps(const Box& o) const { return x0 < o.x1 && o.x0 < x1 && y0 < o.y1 && o.y0 < y1; }
-};
-
-// Markers first, then each label ("S03  h 1.60 m") on a white ground beside its marker: right,
-// left, below or above it, the first place that covers no other label or marker.
+// The floor's stations where PlaceStationLabels put them: first the leader lines (thin, black) of
+// markers and names moved aside and the dots at their stations, then the markers, then each label
+// ("S03  h 1.60 m") on a white ground.
 void FieldSheetPainter::DrawStations(int panel) {
   std::vector<size_t> here;
-  std::vector<Box> taken;
-  const double r = kMarkerRadius + 2;
   for (size_t k = 0; k < stations_.size(); ++k) {
-    if (s_.station_panel[k] != panel || stations_[k].index >= r_.stations.size()) continue;
-    const WorldPoint& p = r_.stations[stations_[k].index].position;
-    StationMarker(s_.PageX(p.x()), s_.PageY(p.y()), stations_[k]);
-    here.push_back(k);
-    taken.push_back({s_.PageX(p.x()) - r, s_.PageY(p.y()) - r, s_.PageX(p.x()) + r, s_.PageY(p.y()) + r});
+    if (s_.station_panel[k] == panel && stations_[k].index < r_.stations.size()) here.push_back(k);
   }
-  Font(7);
+  auto centre = [](const LabelBox& b) { return LabelPoint{0.5 * (b.x0 + b.x1), 0.5 * (b.y0 + b.y1)}; };
+  Grey(0);
+  cairo_new_path(cr_);
+  cairo_set_line_width(cr_, 0.8);
   for (size_t k : here) {
-    const FieldStation& f = stations_[k];
-    const WorldPoint& p = r_.stations[f.index].position;
-    const double x = s_.PageX(p.x()), y = s_.PageY(p.y());
-    const std::string label =
-        std::isfinite(f.tripod_height_m) ? f.name + "  h " + Fixed(f.tripod_height_m, 2) + " m" : f.name;
-    cairo_text_extents_t e;
-    cairo_text_extents(cr_, label.c_str(), &e);
-    const double w = e.x_advance + 2, h = 9;
-    const Box places[] = {{x + r + 1, y - h / 2, x + r + 1 + w, y + h / 2},
-                          {x - r - 1 - w, y - h / 2, x - r - 1, y + h / 2},
-                          {x - w / 2, y + r + 1, x + w / 2, y + r + 1 + h},
-                          {x - w / 2, y - r - 1 - h, x + w / 2, y - r - 1}};
-    Box chosen = places[0];
-    for (const Box& b : places) {
-      if (std::none_of(taken.begin(), taken.end(), [&](const Box& t) { return t.Overlaps(b); })) {
-        chosen = b;
-        break;
-      }
+    const WorldPoint& p = r_.stations[stations_[k].index].position;
+    if (s_.numbers[k].leader) {
+      cairo_move_to(cr_, s_.PageX(p.x()), s_.PageY(p.y()));
+      cairo_line_to(cr_, centre(s_.numbers[k].box).x, centre(s_.numbers[k].box).y);
     }
-    taken.push_back(chosen);
+    if (s_.name_places[k].leader) {
+      cairo_move_to(cr_, s_.name_places[k].leader_start.x, s_.name_places[k].leader_start.y);
+      cairo_line_to(cr_, s_.name_places[k].leader_end.x, s_.name_places[k].leader_end.y);
+    }
+  }
+  cairo_stroke(cr_);
+  for (size_t k : here) {
+    if (!s_.numbers[k].leader) continue;
+    const WorldPoint& p = r_.stations[stations_[k].index].position;
+    cairo_new_path(cr_);
+    cairo_arc(cr_, s_.PageX(p.x()), s_.PageY(p.y()), kDotRadius, 0, 2 * M_PI);
+    cairo_fill(cr_);
+  }
+  for (size_t k : here) StationMarker(centre(s_.numbers[k].box).x, centre(s_.numbers[k].box).y, stations_[k]);
+  Font(kNameFontSize);
+  for (size_t k : here) {
+    const LabelBox& b = s_.name_places[k].box;
     Grey(1);
-    cairo_rectangle(cr_, chosen.x0, chosen.y0, w, h);
+    cairo_rectangle(cr_, b.x0, b.y0, b.x1 - b.x0, b.y1 - b.y0);
     cairo_fill(cr_);
     Grey(0);
-    Text(chosen.x0 + 1, chosen.y1 - 2, label);
+    Text(b.x0 + 1, b.y1 - 2, s_.names[k]);
   }
 }
 
@@ -662,7 +707,7 @@ FieldSheetLayout ComputeFieldSheetLayout(const PlanResult& result, const std::ve
   for (size_t k = 0; k < stations.size(); ++k) {
     const WorldPoint p =
         stations[k].index < result.stations.size() ? result.stations[stations[k].index].position : WorldPoint(0, 0, 0);
-    layout.markers.push_back({s.station_panel[k], s.PageX(p.x()), s.PageY(p.y())});
+    layout.markers.push_back({s.station_panel[k], s.PageX(p.x()), s.PageY(p.y()), s.numbers[k], s.name_places[k]});
   }
   return layout;
 }

@@ -40,6 +40,22 @@ int NearestPanel(const Floors& floors, double z) {
   return panel;
 }
 
+std::vector<double> ZoneOutlineLocal(const PlanResult& r, const KeepOutZone& z) {
+  std::vector<double> xy =
+      z.shape == KeepOutShape::kPolygon
+          ? z.polygon_xy_m
+          : std::vector<double>{z.min.x(), z.min.y(), z.max.x(), z.min.y(), z.max.x(), z.max.y(), z.min.x(), z.max.y()};
+  for (size_t i = 0; i + 1 < xy.size(); i += 2) xy[i] -= r.frame_origin_m.x(), xy[i + 1] -= r.frame_origin_m.y();
+  return xy;
+}
+
+bool ZoneOnPanel(const Floors& floors, const PlanResult& r, const KeepOutZone& zone, int panel) {
+  const double floor = floors.floor_m[size_t(panel)];
+  const double band_top = floor + HighestTripodHeight(r);
+  const double zmin = zone.min.z() - r.frame_origin_m.z(), zmax = zone.max.z() - r.frame_origin_m.z();
+  return zmax >= floor && zmin <= band_top;
+}
+
 namespace {
 
 // The z a candidate's panel is chosen by: its floor plus the lowest tripod height when the floor is

@@ -1,13 +1,15 @@
 // The floors of a plan as heatmap.png and fieldsheet.pdf draw them (docs/PLANNING.md, "heatmap.png"):
 // the candidates grouped into floor panels by height, the footprint that takes in the walls around
 // them, and the slice of occupied voxels that is a floor's plan view (walls and objects between the
-// floor and the highest tripod height). One place, so both pictures show the same floors. Everything
-// here is in the result's local frame. Internal to vc_core; pure functions, thread-safe.
+// floor and the highest tripod height), with the keep-out zones each floor shows. One place, so both
+// pictures show the same floors. Everything here is in the result's local frame. Internal to
+// vc_core; pure functions, thread-safe.
 #pragma once
 
 #include <cstdint>
 #include <vector>
 
+#include "vc/plan/keep_out.h"
 #include "vc/plan/planner.h"
 
 namespace vc::floor_plan {
@@ -34,6 +36,13 @@ unsigned SlicePanels(const Floors& floors, const PlanResult& r, double z);
 
 // The panel whose representative z lies nearest to `z` (m).
 int NearestPanel(const Floors& floors, double z);
+
+// A keep-out zone's outline in the local frame (m): x1, y1, x2, y2, ... (a box's four corners).
+std::vector<double> ZoneOutlineLocal(const PlanResult& r, const KeepOutZone& zone);
+
+// True when the zone's z range meets panel p's slice (its floor up to the highest tripod height),
+// so the panel draws it.
+bool ZoneOnPanel(const Floors& floors, const PlanResult& r, const KeepOutZone& zone, int panel);
 
 // Grey level of a slice column whose highest voxel stands `above` m over the floor, `top` the
 // highest tripod height: 175 for low objects down to 40 for what reaches the tripod (walls).

@@ -13,6 +13,7 @@
 
 #include "floor_plan.h"
 #include "raster.h"
+#include "vc/plan/keep_out.h"
 #include "vc/report/field_exports.h"
 #include "vc/report/field_sheet.h"
 #include "vc/report/report_html.h"
@@ -202,6 +203,8 @@ std::string VisibilityPly(const PlanResult& r) {
 // Layout constants (pixels), documented in docs/PLANNING.md.
 constexpr int kMarginLeft = 64, kMarginTop = 40, kMarginBottom = 60, kPanelRight = 24, kLegendWidth = 110;
 constexpr int kMinPlotHeight = 180, kTargetPlot = 720;
+constexpr int kDotRadius = 3;   // the dot at a station whose numbered disc is moved aside
+constexpr int kHatchPitch = 6;  // pixels between a keep-out zone's hatch lines, along a row
 
 struct HeatLayout : floor_plan::Floors {
   double cell_m = 1;
@@ -211,6 +214,17 @@ struct HeatLayout : floor_plan::Floors {
 };
 
 using floor_plan::HighestTripodHeight;
+
+// Pixel positions on heatmap.png: a panel's plot, and a local (x, y) in metres on it.
+struct HeatPixels {
+  const HeatLayout& L;
+  int PanelLeft(int panel) const { return panel * (kMarginLeft + L.plot_w + kPanelRight) + kMarginLeft; }
+  int X(int panel, double x) const { return PanelLeft(panel) + static_cast<int>(std::lround((x - L.x0) * L.ppm)); }
+  int Y(double y) const { return kMarginTop + static_cast<int>(std::lround((L.y1 - y) * L.ppm)); }
+  // The local (x, y) in metres at the centre of pixel (x, y) of `panel`.
+  double LocalX(int panel, int x) const { return L.x0 + (x - PanelLeft(panel)) / L.ppm; }
+  double LocalY(int y) const { return L.y1 - (y - kMarginTop) / L.ppm; }
+};
 
 // The floor plan's shade of a column whose highest voxel in the band stands `above` metres over
 // the floor: light grey for low objects, near black for what reaches the tripod (walls).
@@ -250,26 +264,80 @@ std::string TickLabel(double v, double step) {
   return step >= 1 ? Fixed(v, 0) : Fixed(v, step >= 0.1 ? 1 : 2);
 }
 
-// A numbered station marker: white disc, black ring, black number.
-void StationMarker(Image& img, int cx, int cy, int number, Rgb ring) {
+// The radius (pixels) of station `number`'s disc: room for the number.
+int DiscRadius(int number) { return std::max(10, raster::TextWidth(std::to_string(number)) / 2 + 5); }
+
+// A numbered station disc: white, ringed in `ring`, black number.
+void StationDisc(Image& img, int cx, int cy, int number, Rgb ring) {
   const std::string label = std::to_string(number);
-  const int radius = std::max(10, raster::TextWidth(label) / 2 + 5);
+  const int radius = DiscRadius(number);
   img.FillCircle(cx, cy, radius + 1, ring);
   img.FillCircle(cx, cy, radius - 1, raster::kWhite);
   img.Text(cx - raster::TextWidth(label) / 2, cy - raster::kGlyphH / 2, label, raster::kBlack);
 }
 
-// A vertical colour bar at (x, y) of size 16 x h from 0 (bottom) to max (top), with labels.
-void ColourBar(Image& img, int x, int y, int h, double max_value, const std::string& title, bool integer) {
+// A colour bar's tick: its height as a fraction of the bar (0 bottom, 1 top) and its label.
+struct BarTick {
+  double fraction = 0;
+  std::string label;
+};
+
+// A vertical colour bar at (x, y) of size 16 x h, viridis from 0 (bottom) to 1 (top), with its
+// ticks and, above it, its title lines (the last one 14 pixels over the bar).
+void ColourBar(Image& img, int x, int y, int h, const std::vector<BarTick>& ticks,
+               const std::vector<std::string>& title) {
   for (int k = 0; k < h; ++k) img.HLine(x, x + 15, y + h - 1 - k, raster::Viridis(h > 1 ? double(k) / (h - 1) : 0));
   img.StrokeRect(x, y, x + 16, y + h, raster::kBlack);
+  for (const BarTick& t : ticks) {
+    const int ty = y + h - 1 - static_cast<int>(std::lround((h - 1) * t.fraction));
+    img.HLine(x + 16, x + 19, ty, raster::kBlack);
+    img.Text(x + 22, ty - 3, t.label, raster::kBlack);
+  }
+  for (size_t i = 0; i < title.size(); ++i) {
+    img.Text(x - 2, y - 14 - 12 * static_cast<int>(title.size() - 1 - i), title[i], raster::kBlack);
+  }
+}
+
+// Ticks at a quarter, a half, ... of `max_value`, labelled with the value.
+std::vector<BarTick> QuarterTicks(double max_value, bool integer) {
+  std::vector<BarTick> ticks;
   for (int i = 0; i <= 4; ++i) {
     const double v = max_value * i / 4.0;
-    const int ty = y + h - 1 - static_cast<int>(std::lround((h - 1) * i / 4.0));
-    img.HLine(x + 16, x + 19, ty, raster::kBlack);
-    img.Text(x + 22, ty - 3, integer ? Fixed(std::round(v), 0) : Short(v), raster::kBlack);
+    ticks.push_back({i / 4.0, integer ? Fixed(std::round(v), 0) : Short(v)});
   }
-  img.Text(x - 2, y - 14, title, raster::kBlack);
+  return ticks;
+}
+
+// The smallest step of 1, 2 or 5 x 10^k that divides `span` into at most `max_steps` steps.
+double RoundStep(double span, int max_steps) {
+  for (double decade = 1e-3; decade < 1e6; decade *= 10) {
+    for (double m : {1.0, 2.0, 5.0}) {
+      if (span / (m * decade) <= max_steps) return m * decade;
+    }
+  }
+  return 1e6;
+}
+
+// heatmap.png's colour bar in plain words: the share of the scene's occupied voxels a tripod at
+// the cell sees, in per cent at round steps (1, 2, 5 x 10^k, at most 5 steps), with the top's
+// value and its voxel count under the bar; in voxels when the plan does not give the scene's size
+// (or its counts exceed it).
+void HeatColourBar(Image& img, const HeatLayout& L, const PlanResult& r, uint64_t max_count) {
+  const int x = L.width - kLegendWidth + 20, y = kMarginTop + 14;
+  const int h = std::max(L.plot_h, kMinPlotHeight) - 14;
+  if (max_count == 0 || r.occupied_voxels < max_count) {
+    ColourBar(img, x, y, h, QuarterTicks(static_cast<double>(max_count), true), {"VOXELS SEEN", "FROM HERE"});
+    return;
+  }
+  const double top_pct = 100.0 * static_cast<double>(max_count) / static_cast<double>(r.occupied_voxels);
+  const double step = RoundStep(top_pct, 5);
+  const int decimals = step >= 1 ? 0 : step >= 0.1 ? 1 : step >= 0.01 ? 2 : 3;
+  std::vector<BarTick> ticks;
+  for (int i = 0; i * step <= top_pct * (1 + 1e-9); ++i)
+    ticks.push_back({i * step / top_pct, Fixed(i * step, decimals) + " %"});
+  ColourBar(img, x, y, h, ticks, {"SEEN FROM HERE", "% OF THE SCENE"});
+  img.Text(x - 2, y + h + 8, "TOP: " + Fixed(top_pct, 1) + " % =", raster::kBlack);
+  img.Text(x - 2, y + h + 20, std::to_string(max_count) + " VOXELS", raster::kBlack);
 }
 
 // The overlap from which heatmap.png draws a scan graph edge: min_overlap, or 0.3 (the usual
@@ -306,70 +374,151 @@ void DrawFloorPlan(Image& img, const HeatLayout& L, const PlanResult& r, int pan
     }
 }
 
-Image DrawHeatmap(const PlanResult& r) {
-  const HeatLayout L = ComputeHeatLayout(r);
-  Image img(L.width, L.height);
-  uint64_t max_count = 0;
-  for (uint64_t c : r.heat_map.visible_voxels) max_count = std::max(max_count, c);
-  const double denom = max_count > 0 ? static_cast<double>(max_count) : 1.0;
-  const int top = kMarginTop;
-  auto count_of = [&](size_t i) { return i < r.heat_map.visible_voxels.size() ? r.heat_map.visible_voxels[i] : 0; };
-  std::vector<size_t> order(r.heat_map.positions.size());
-  for (size_t i = 0; i < order.size(); ++i) order[i] = i;
-  if (r.options.tripod_heights_m.size() > 1) {
-    std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return count_of(a) < count_of(b); });
+// Panel `panel`'s keep-out zones (those whose z range meets its slice), over the floor plan and
+// clipped to the plot: hatched with black diagonals and outlined in black 2 pixels inside the
+// zone's edge. True when it drew one.
+bool DrawKeepOutZones(Image& img, const HeatLayout& L, const PlanResult& r, int panel) {
+  const HeatPixels P{L};
+  const int left = P.PanelLeft(panel), top = kMarginTop;
+  bool drawn = false;
+  for (const KeepOutZone& z : r.options.keep_out) {
+    if (!floor_plan::ZoneOnPanel(L, r, z, panel)) continue;
+    const WorldPoint lo = z.min - r.frame_origin_m, hi = z.max - r.frame_origin_m;
+    // The zone's pixels, with 2 pixels around them to find its edge; clipped to the plot.
+    const int x0 = std::max(left, P.X(panel, lo.x()) - 3), x1 = std::min(left + L.plot_w - 1, P.X(panel, hi.x()) + 3);
+    const int y0 = std::max(top, P.Y(hi.y()) - 3), y1 = std::min(top + L.plot_h - 1, P.Y(lo.y()) + 3);
+    if (x0 > x1 || y0 > y1) continue;
+    const int w = x1 - x0 + 5, h = y1 - y0 + 5;  // the clipped box and 2 pixels each side
+    std::vector<char> inside(size_t(w) * size_t(h));
+    for (int v = 0; v < h; ++v)
+      for (int u = 0; u < w; ++u) {
+        const WorldPoint p(P.LocalX(panel, x0 - 2 + u) + r.frame_origin_m.x(),
+                           P.LocalY(y0 - 2 + v) + r.frame_origin_m.y(), z.min.z());
+        inside[size_t(v) * size_t(w) + size_t(u)] = KeepOutContains(z, p) ? 1 : 0;
+      }
+    auto in = [&](int u, int v) { return inside[size_t(v) * size_t(w) + size_t(u)] != 0; };
+    for (int v = 2; v < h - 2; ++v)
+      for (int u = 2; u < w - 2; ++u) {
+        if (!in(u, v)) continue;
+        const bool edge = !in(u - 1, v) || !in(u + 1, v) || !in(u, v - 1) || !in(u, v + 1) || !in(u - 2, v) ||
+                          !in(u + 2, v) || !in(u, v - 2) || !in(u, v + 2);
+        const int x = x0 - 2 + u, y = y0 - 2 + v;
+        if (edge || (x + y) % kHatchPitch == 0) img.Set(x, y, raster::kBlack);
+      }
+    drawn = true;
   }
-  auto px = [&](int panel, double x) {
-    return panel * (kMarginLeft + L.plot_w + kPanelRight) + kMarginLeft +
-           static_cast<int>(std::lround((x - L.x0) * L.ppm));
-  };
-  auto py = [&](double y) { return top + static_cast<int>(std::lround((L.y1 - y) * L.ppm)); };
-  const double step = TickStep(L.ppm, 48);
+  return drawn;
+}
+
+// Where each station's numbered disc goes, panel by panel (PlaceLabels): centred on the station
+// where that covers no other station and no other disc, else moved aside within the plot.
+std::vector<HeatmapStationPlace> StationPlaces(const HeatLayout& L, const PlanResult& r) {
+  const HeatPixels P{L};
+  std::vector<HeatmapStationPlace> places(r.stations.size());
   for (size_t p = 0; p < L.panel_z.size(); ++p) {
-    const int pl = static_cast<int>(p);
-    const int left = px(pl, L.x0);
-    img.FillRect(left, top, left + L.plot_w, top + L.plot_h, Rgb{235, 235, 235});
-    // With several heights in ascending count, so a cell shows the best of its heights.
-    for (size_t i : order) {
-      if (L.candidate_panel[i] != pl) continue;
-      const WorldPoint& c = r.heat_map.positions[i];
-      const double h = L.cell_m / 2;
-      const uint64_t count = i < r.heat_map.visible_voxels.size() ? r.heat_map.visible_voxels[i] : 0;
-      img.FillRect(px(pl, c.x() - h), py(c.y() + h), px(pl, c.x() + h), py(c.y() - h), raster::Viridis(count / denom));
+    const int panel = static_cast<int>(p);
+    std::vector<size_t> here;
+    std::vector<LabelRequest> requests;
+    for (size_t k = 0; k < r.stations.size(); ++k) {
+      const WorldPoint& s = r.stations[k].position;
+      if (floor_plan::NearestPanel(L, s.z()) != panel) continue;
+      // The disc is 2 r + 3 pixels wide; half a pixel more each side keeps a rounded one inside.
+      const double side = 2 * DiscRadius(static_cast<int>(k) + 1) + 4;
+      requests.push_back({{double(P.X(panel, s.x())), double(P.Y(s.y()))}, kDotRadius + 1.5, side, side});
+      here.push_back(k);
     }
-    DrawFloorPlan(img, L, r, pl, left, top);
-    img.StrokeRect(left, top, left + L.plot_w, top + L.plot_h, raster::kBlack);
-    // Axes in metres.
-    for (double v = std::ceil(L.x0 / step) * step; v <= L.x1 + 1e-9; v += step) {
-      const int x = px(pl, v);
-      img.VLine(x, top + L.plot_h, top + L.plot_h + 4, raster::kBlack);
-      const std::string s = TickLabel(v + r.frame_origin_m.x(), step);
-      img.Text(x - raster::TextWidth(s) / 2, top + L.plot_h + 8, s, raster::kBlack);
-    }
-    for (double v = std::ceil(L.y0 / step) * step; v <= L.y1 + 1e-9; v += step) {
-      const int y = py(v);
-      img.HLine(left - 5, left - 1, y, raster::kBlack);
-      const std::string s = TickLabel(v + r.frame_origin_m.y(), step);
-      img.Text(left - 8 - raster::TextWidth(s), y - 3, s, raster::kBlack);
-    }
-    const std::string xl = "x (m)";
-    img.Text(left + L.plot_w / 2 - raster::TextWidth(xl) / 2, top + L.plot_h + 24, xl, raster::kBlack);
-    img.TextVertical(left - kMarginLeft + 4, top + L.plot_h / 2 - raster::TextWidth("y (m)") / 2, "y (m)",
-                     raster::kBlack);
-    std::string title = "VISIBLE VOXELS PER CANDIDATE";
-    if (r.options.tripod_heights_m.size() > 1) {
-      title = "VISIBLE VOXELS, BEST OF " + std::to_string(r.options.tripod_heights_m.size()) + " HEIGHTS";
-    }
-    if (L.panel_z.size() > 1 || !r.floor_levels_m.empty())
-      title += "  z = " + Fixed(InputFrameZ(r, L.panel_z[p]), 2) + " m";
-    img.Text(left, 10, title, raster::kBlack, 2);
+    LabelPlacementOptions options;
+    options.centred_first = true;
+    const double left = P.PanelLeft(panel) - 0.5, top = kMarginTop - 0.5;
+    options.bounds = {left, top, left + L.plot_w, top + L.plot_h};
+    const std::vector<PlacedLabel> placed = PlaceLabels(requests, {}, options);
+    for (size_t i = 0; i < here.size(); ++i) places[here[i]] = {panel, requests[i].anchor, placed[i]};
   }
-  // The panel a point at height z (m) is drawn on: the one of the nearest representative z.
+  return places;
+}
+
+// The stations, numbered in plan order, on the panel of their height; fixed stations ringed in
+// black, the others in red. A disc moved aside has a black leader line to a dot at the station.
+// True when a disc was moved.
+bool DrawStations(Image& img, const PlanResult& r, const std::vector<HeatmapStationPlace>& places) {
+  auto ring = [&](size_t k) { return r.stations[k].fixed ? raster::kBlack : raster::kRed; };
+  auto centre = [&](size_t k) {
+    const LabelBox& b = places[k].disc.box;
+    return std::pair{static_cast<int>(std::lround(0.5 * (b.x0 + b.x1))),
+                     static_cast<int>(std::lround(0.5 * (b.y0 + b.y1)))};
+  };
+  bool moved = false;
+  for (size_t k = 0; k < places.size(); ++k) {
+    if (!places[k].disc.leader) continue;
+    const auto [cx, cy] = centre(k);
+    const int sx = static_cast<int>(places[k].station_px.x), sy = static_cast<int>(places[k].station_px.y);
+    img.Line(sx, sy, cx, cy, raster::kBlack, 1);
+    moved = true;
+  }
+  for (size_t k = 0; k < places.size(); ++k) {
+    if (!places[k].disc.leader) continue;
+    const int sx = static_cast<int>(places[k].station_px.x), sy = static_cast<int>(places[k].station_px.y);
+    img.FillCircle(sx, sy, kDotRadius + 1, raster::kWhite);
+    img.FillCircle(sx, sy, kDotRadius, ring(k));
+  }
+  for (size_t k = 0; k < places.size(); ++k) {
+    const auto [cx, cy] = centre(k);
+    StationDisc(img, cx, cy, static_cast<int>(k) + 1, ring(k));
+  }
+  return moved;
+}
+
+// One panel: its cells, floor plan, keep-out zones, frame, axes in metres and title. True when it
+// drew a keep-out zone.
+bool DrawPanel(Image& img, const HeatLayout& L, const PlanResult& r, int panel, const std::vector<size_t>& order,
+               double denom) {
+  const HeatPixels P{L};
+  const int left = P.PanelLeft(panel), top = kMarginTop;
+  img.FillRect(left, top, left + L.plot_w, top + L.plot_h, Rgb{235, 235, 235});
+  // With several heights in ascending count, so a cell shows the best of its heights.
+  for (size_t i : order) {
+    if (L.candidate_panel[i] != panel) continue;
+    const WorldPoint& c = r.heat_map.positions[i];
+    const double h = L.cell_m / 2;
+    const uint64_t count = i < r.heat_map.visible_voxels.size() ? r.heat_map.visible_voxels[i] : 0;
+    img.FillRect(P.X(panel, c.x() - h), P.Y(c.y() + h), P.X(panel, c.x() + h), P.Y(c.y() - h),
+                 raster::Viridis(count / denom));
+  }
+  DrawFloorPlan(img, L, r, panel, left, top);
+  const bool zones = DrawKeepOutZones(img, L, r, panel);
+  img.StrokeRect(left, top, left + L.plot_w, top + L.plot_h, raster::kBlack);
+  const double step = TickStep(L.ppm, 48);
+  for (double v = std::ceil(L.x0 / step) * step; v <= L.x1 + 1e-9; v += step) {
+    const int x = P.X(panel, v);
+    img.VLine(x, top + L.plot_h, top + L.plot_h + 4, raster::kBlack);
+    const std::string s = TickLabel(v + r.frame_origin_m.x(), step);
+    img.Text(x - raster::TextWidth(s) / 2, top + L.plot_h + 8, s, raster::kBlack);
+  }
+  for (double v = std::ceil(L.y0 / step) * step; v <= L.y1 + 1e-9; v += step) {
+    const int y = P.Y(v);
+    img.HLine(left - 5, left - 1, y, raster::kBlack);
+    const std::string s = TickLabel(v + r.frame_origin_m.y(), step);
+    img.Text(left - 8 - raster::TextWidth(s), y - 3, s, raster::kBlack);
+  }
+  const std::string xl = "x (m)";
+  img.Text(left + L.plot_w / 2 - raster::TextWidth(xl) / 2, top + L.plot_h + 24, xl, raster::kBlack);
+  img.TextVertical(left - kMarginLeft + 4, top + L.plot_h / 2 - raster::TextWidth("y (m)") / 2, "y (m)",
+                   raster::kBlack);
+  std::string title = "VISIBLE VOXELS PER CANDIDATE";
+  if (r.options.tripod_heights_m.size() > 1) {
+    title = "VISIBLE VOXELS, BEST OF " + std::to_string(r.options.tripod_heights_m.size()) + " HEIGHTS";
+  }
+  if (L.panel_z.size() > 1 || !r.floor_levels_m.empty())
+    title += "  z = " + Fixed(InputFrameZ(r, L.panel_z[size_t(panel)]), 2) + " m";
+  img.Text(left, 10, title, raster::kBlack, 2);
+  return zones;
+}
+
+// The scan graph's edges at its threshold (0.3 when registration is off), white, between stations
+// on one panel; and the walking route, orange, each polyline point on the panel of its floor.
+void DrawEdgesAndRoute(Image& img, const HeatLayout& L, const PlanResult& r) {
+  const HeatPixels P{L};
   auto panel_of = [&](double z) { return floor_plan::NearestPanel(L, z); };
-  const std::vector<double> heights = r.options.TripodHeights();
-  const double lowest_height = *std::min_element(heights.begin(), heights.end());
-  // The scan graph's edges at its threshold (0.3 when registration is off), white, between stations
-  // on one panel.
   const double edge_min = ScanGraphDrawThreshold(r);
   for (const ScanGraph::Edge& e : r.scan_graph.edges) {
     if (e.overlap < edge_min || static_cast<size_t>(std::max(e.i, e.j)) >= r.stations.size()) continue;
@@ -377,29 +526,45 @@ Image DrawHeatmap(const PlanResult& r) {
     const WorldPoint& b = r.stations[e.j].position;
     const int pa = panel_of(a.z()), pb = panel_of(b.z());
     if (pa != pb) continue;
-    img.Line(px(pa, a.x()), py(a.y()), px(pb, b.x()), py(b.y()), raster::kWhite, 1);
+    img.Line(P.X(pa, a.x()), P.Y(a.y()), P.X(pb, b.x()), P.Y(b.y()), raster::kWhite, 1);
   }
-  // The walking route, orange, each polyline point on the panel of its floor.
+  const double lowest_height = floor_plan::LowestTripodHeight(r);
   for (const std::vector<WorldPoint>& line : r.route.polylines) {
     for (size_t k = 1; k < line.size(); ++k) {
       const int pa = panel_of(line[k - 1].z() + lowest_height), pb = panel_of(line[k].z() + lowest_height);
       if (pa != pb) continue;  // the step between two panels (stairs) is not drawn
-      img.Line(px(pa, line[k - 1].x()), py(line[k - 1].y()), px(pb, line[k].x()), py(line[k].y()), raster::kOrange, 3);
+      img.Line(P.X(pa, line[k - 1].x()), P.Y(line[k - 1].y()), P.X(pb, line[k].x()), P.Y(line[k].y()), raster::kOrange,
+               3);
     }
   }
-  // Stations, numbered in plan order, on the panel of their height; fixed stations ringed in black.
-  for (size_t k = 0; k < r.stations.size(); ++k) {
-    const WorldPoint& s = r.stations[k].position;
-    StationMarker(img, px(panel_of(s.z()), s.x()), py(s.y()), static_cast<int>(k) + 1,
-                  r.stations[k].fixed ? raster::kBlack : raster::kRed);
+}
+
+Image DrawHeatmap(const PlanResult& r) {
+  const HeatLayout L = ComputeHeatLayout(r);
+  Image img(L.width, L.height);
+  uint64_t max_count = 0;
+  for (uint64_t c : r.heat_map.visible_voxels) max_count = std::max(max_count, c);
+  const double denom = max_count > 0 ? static_cast<double>(max_count) : 1.0;
+  auto count_of = [&](size_t i) { return i < r.heat_map.visible_voxels.size() ? r.heat_map.visible_voxels[i] : 0; };
+  std::vector<size_t> order(r.heat_map.positions.size());
+  for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+  if (r.options.tripod_heights_m.size() > 1) {
+    std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return count_of(a) < count_of(b); });
   }
-  // What the lines mean, under the first panel's axis label.
+  bool zones = false;
+  for (size_t p = 0; p < L.panel_z.size(); ++p) zones |= DrawPanel(img, L, r, static_cast<int>(p), order, denom);
+  DrawEdgesAndRoute(img, L, r);
+  const bool moved = DrawStations(img, r, StationPlaces(L, r));
+  // What the lines and marks mean, under the first panel's axis label.
+  const int legend_y = kMarginTop + std::max(L.plot_h, kMinPlotHeight) + 42;
   std::string legend = "GREY: WALLS AND OBJECTS (DARKER = TALLER)   ORANGE: WALKING ROUTE";
-  if (!r.scan_graph.edges.empty()) legend += "   WHITE: OVERLAP >= " + Short(edge_min);
-  img.Text(kMarginLeft, top + std::max(L.plot_h, kMinPlotHeight) + 42, legend, raster::kBlack);
-  const int bar_x = L.width - kLegendWidth + 20;
-  ColourBar(img, bar_x, top + 14, std::max(L.plot_h, kMinPlotHeight) - 14, static_cast<double>(max_count), "VOXELS",
-            true);
+  if (!r.scan_graph.edges.empty()) legend += "   WHITE: OVERLAP \u2265 " + Short(ScanGraphDrawThreshold(r));
+  img.Text(kMarginLeft, legend_y, legend, raster::kBlack);
+  std::string marks;
+  if (zones) marks += "HATCHED: KEEP-OUT ZONE";
+  if (moved) marks += std::string(marks.empty() ? "" : "   ") + "LINE TO DOT: STATION OF A MOVED NUMBER";
+  img.Text(kMarginLeft, legend_y + 10, marks, raster::kBlack);
+  HeatColourBar(img, L, r, max_count);
   return img;
 }
 
@@ -461,7 +626,7 @@ Image DrawReduction(const PlanResult& r) {
   }
   img.Text(kRedLeft, kRedTop + n * cell + 22, "STATION (GREEDY ORDER)", raster::kBlack);
   const int bar_h = std::max(n * cell, kRedMinH) - 14;
-  ColourBar(img, kRedLeft + n * cell + 24, kRedTop + 14, bar_h, max_loss, "G LOST", false);
+  ColourBar(img, kRedLeft + n * cell + 24, kRedTop + 14, bar_h, QuarterTicks(max_loss, false), {"G LOST"});
   return img;
 }
 
@@ -771,6 +936,10 @@ std::string PlanToJson(const PlanResult& r, const UploadSummary* upload,
 }
 
 Result<std::string> HeatmapPng(const PlanResult& result) { return raster::EncodePng(DrawHeatmap(result)); }
+
+std::vector<HeatmapStationPlace> HeatmapStationPlaces(const PlanResult& result) {
+  return StationPlaces(ComputeHeatLayout(result), result);
+}
 
 ImageSize HeatmapImageSize(const PlanResult& result) {
   const HeatLayout L = ComputeHeatLayout(result);

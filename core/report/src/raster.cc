@@ -3,7 +3,6 @@
 #include <png.h>
 
 #include <algorithm>
-#include <cctype>
 #include <cmath>
 #include <csetjmp>
 #include <cstdlib>
@@ -13,7 +12,7 @@ namespace vc::raster {
 namespace {
 
 struct Glyph {
-  char c;
+  char32_t c;
   const char* rows[kGlyphH];  // '#' = ink
 };
 
@@ -72,20 +71,44 @@ constexpr Glyph kFont[] = {
     {'[', {" ### ", " #   ", " #   ", " #   ", " #   ", " #   ", " ### "}},
     {']', {" ### ", "   # ", "   # ", "   # ", "   # ", "   # ", " ### "}},
     {'\'', {"  #  ", "  #  ", "     ", "     ", "     ", "     ", "     "}},
+    {'>', {" #   ", "  #  ", "   # ", "    #", "   # ", "  #  ", " #   "}},
+    {'<', {"   # ", "  #  ", " #   ", "#    ", " #   ", "  #  ", "   # "}},
+    {U'\u2265', {"#    ", " ##  ", "   ##", " ##  ", "#    ", "     ", "#####"}},  // greater than or equal
+    {U'\u2264', {"    #", "  ## ", "##   ", "  ## ", "    #", "     ", "#####"}},  // less than or equal
     {' ', {"     ", "     ", "     ", "     ", "     ", "     ", "     "}},
 };
 
 constexpr Glyph kUnknown = {'?', {"#####", "#   #", "#   #", "#   #", "#   #", "#   #", "#####"}};
 
-const Glyph& FindGlyph(char c) {
+const Glyph& FindGlyph(char32_t c) {
   for (const Glyph& g : kFont) {
     if (g.c == c) return g;
   }
-  const char upper = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+  const char32_t upper = c >= 'a' && c <= 'z' ? c - 'a' + 'A' : c;
   for (const Glyph& g : kFont) {
     if (g.c == upper) return g;
   }
   return kUnknown;
+}
+
+// The characters of UTF-8 `text`, one per glyph; a byte that starts no valid sequence of up to
+// three bytes stands for itself (and is drawn as the unknown box).
+std::u32string CodePoints(std::string_view text) {
+  std::u32string out;
+  for (size_t i = 0; i < text.size();) {
+    const auto b = static_cast<unsigned char>(text[i]);
+    const int extra = (b & 0xE0) == 0xC0 ? 1 : (b & 0xF0) == 0xE0 ? 2 : 0;
+    char32_t c = extra == 1 ? b & 0x1F : extra == 2 ? b & 0x0F : b;
+    bool valid = i + extra < text.size();
+    for (int k = 1; valid && k <= extra; ++k) {
+      const auto next = static_cast<unsigned char>(text[i + k]);
+      valid = (next & 0xC0) == 0x80;
+      c = (c << 6) | (next & 0x3F);
+    }
+    out.push_back(valid ? c : b);
+    i += valid ? 1 + extra : 1;
+  }
+  return out;
 }
 
 // Matplotlib's viridis at 10 evenly spaced stops.
@@ -161,8 +184,9 @@ void Image::FillCircle(int cx, int cy, int radius, Rgb c) {
 }
 
 void Image::Text(int x, int y, std::string_view text, Rgb c, int scale) {
-  for (size_t k = 0; k < text.size(); ++k) {
-    const Glyph& g = FindGlyph(text[k]);
+  const std::u32string chars = CodePoints(text);
+  for (size_t k = 0; k < chars.size(); ++k) {
+    const Glyph& g = FindGlyph(chars[k]);
     const int gx = x + static_cast<int>(k) * kAdvance * scale;
     for (int r = 0; r < kGlyphH; ++r) {
       for (int col = 0; col < kGlyphW; ++col) {
@@ -176,8 +200,9 @@ void Image::Text(int x, int y, std::string_view text, Rgb c, int scale) {
 void Image::TextVertical(int x, int y, std::string_view text, Rgb c, int scale) {
   // Glyph row r becomes column x + r; glyph column col runs upwards from the bottom.
   const int len = TextWidth(text, scale);
-  for (size_t k = 0; k < text.size(); ++k) {
-    const Glyph& g = FindGlyph(text[k]);
+  const std::u32string chars = CodePoints(text);
+  for (size_t k = 0; k < chars.size(); ++k) {
+    const Glyph& g = FindGlyph(chars[k]);
     const int base = y + len - static_cast<int>(k) * kAdvance * scale;
     for (int r = 0; r < kGlyphH; ++r) {
       for (int col = 0; col < kGlyphW; ++col) {
@@ -191,7 +216,7 @@ void Image::TextVertical(int x, int y, std::string_view text, Rgb c, int scale) 
 
 int TextWidth(std::string_view text, int scale) {
   if (text.empty()) return 0;
-  return (static_cast<int>(text.size()) * kAdvance - (kAdvance - kGlyphW)) * scale;
+  return (static_cast<int>(CodePoints(text).size()) * kAdvance - (kAdvance - kGlyphW)) * scale;
 }
 
 Rgb Viridis(double t) {

@@ -43,8 +43,9 @@ class Image {
   void VLine(int x, int y0, int y1, Rgb c);
   // A straight segment from (x0, y0) to (x1, y1), `width` pixels wide (discs along it), clipped.
   void Line(int x0, int y0, int x1, int y1, Rgb c, int width = 1);
-  // Text with its top-left corner at (x, y). Digits, A-Z, lower-case m x y z, and . - , : ( ) %
-  // = / + [ ] ' space; other lower-case letters are drawn as capitals, anything else as a box.
+  // UTF-8 text with its top-left corner at (x, y). Digits, A-Z, lower-case m x y z, and
+  // . - , : ( ) % = / + [ ] ' < > ≤ ≥ space; other lower-case letters are drawn as
+  // capitals, anything else as a box.
   void Text(int x, int y, std::string_view text, Rgb c, int scale = 1);
   // The same text rotated 90 degrees counter-clockwise (reading bottom to top), top-left at (x, y).
   void TextVertical(int x, int y, std::string_view text, Rgb c, int scale = 1);
@@ -54,7 +55,7 @@ class Image {
   std::vector<uint8_t> px_;
 };
 
-// Pixel width of `text` at `scale`.
+// Pixel width of UTF-8 `text` at `scale`.
 int TextWidth(std::string_view text, int scale = 1);
 
 // Viridis colour of t in [0, 1] (clamped; NaN gives 0).

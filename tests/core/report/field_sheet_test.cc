@@ -1,6 +1,7 @@
 // fieldsheet.pdf read by real consumers (poppler's pdfinfo, pdftoppm and pdftotext): one page per
-// floor, station markers drawn where the layout puts them, existing stations as squares, keep-out
-// zones hatched, the station table continued on extra pages, the words a crew reads.
+// floor, station markers drawn where the layout puts them (moved aside with leader lines where
+// stations stand close), existing stations as squares, keep-out zones hatched, the station table
+// continued on extra pages, the words a crew reads.
 #include "vc/report/field_sheet.h"
 
 #include <gtest/gtest.h>
@@ -43,6 +44,13 @@ struct Page {
   int width = 0, height = 0;
   std::vector<uint8_t> grey;
   int at(int x, int y) const { return grey[size_t(y) * size_t(width) + size_t(x)]; }
+  // The darkest grey in the 3 x 3 pixels around (x, y): thin lines and small dots are grey at 50 dpi.
+  int Darkest(int x, int y) const {
+    int g = 255;
+    for (int v = std::max(0, y - 1); v <= std::min(height - 1, y + 1); ++v)
+      for (int u = std::max(0, x - 1); u <= std::min(width - 1, x + 1); ++u) g = std::min(g, at(u, v));
+    return g;
+  }
   // Pixels darker than 128 in the square of half-size `half` around (x, y) (pixels).
   int DarkAround(int x, int y, int half) const {
     int n = 0;
@@ -211,6 +219,55 @@ TEST(FieldSheetTest, ExistingStationsAreSquaresAndKeepOutZonesHatched) {
     EXPECT_NE(text.find(words), std::string::npos) << words << " in:\n" << text;
   }
   EXPECT_EQ(text.find("true north"), std::string::npos) << "no true north without an angle";
+}
+
+// Twelve stations 0.08 m apart (11 pt at 1:20) beside station 1: their markers would cover each
+// other. No two markers or name labels overlap, none leaves the plan, every number is drawn where
+// its marker went, a moved marker has a dot at its station and a leader line to it, and every
+// name is on the page.
+TEST(FieldSheetTest, CloseStationsGetMarkersAndNamesThatDoNotOverlap) {
+  if (!HavePoppler()) GTEST_SKIP() << "pdftoppm/pdfinfo (poppler-utils) not found";
+  PlanResult plan = TwoFloorPlan();
+  for (int i = 0; i < 12; ++i) {
+    PlannedStation s = plan.stations[0];
+    s.position = WorldPoint(0.7 + 0.08 * i, 1.0, 1.6);
+    plan.stations.push_back(s);
+  }
+  const std::vector<FieldStation> stations = FieldStations(plan);
+  const FieldSheetLayout layout = ComputeFieldSheetLayout(plan, stations);
+  EXPECT_EQ(layout.scale_denominator, 20);
+  std::vector<LabelBox> boxes;
+  int moved = 0;
+  for (const StationMarkerPlace& m : layout.markers) {
+    if (m.page != 0) continue;
+    EXPECT_FALSE(m.number.overlaps);
+    EXPECT_FALSE(m.name.overlaps);
+    boxes.push_back(m.number.box);
+    boxes.push_back(m.name.box);
+    moved += m.number.leader ? 1 : 0;
+  }
+  EXPECT_GE(moved, 6) << "at most every other marker fits on its station";
+  for (size_t i = 0; i < boxes.size(); ++i)
+    for (size_t j = i + 1; j < boxes.size(); ++j) EXPECT_FALSE(boxes[i].Overlaps(boxes[j])) << i << " and " << j;
+  const ReadBack b = Rasterise(*FieldSheetPdf(plan, stations));
+  ASSERT_EQ(b.pages, 2);
+  const Page& page = b.rasters[0];
+  for (size_t k = 0; k < stations.size(); ++k) {
+    const StationMarkerPlace& m = layout.markers[k];
+    if (m.page != 0) continue;
+    const double cx = 0.5 * (m.number.box.x0 + m.number.box.x1), cy = 0.5 * (m.number.box.y0 + m.number.box.y1);
+    EXPECT_GE(page.DarkAround(Px(cx), Px(cy), 2), 3) << stations[k].name << ": its number";
+    if (!m.number.leader) continue;
+    EXPECT_LT(page.Darkest(Px(m.x_pt), Px(m.y_pt)), 160) << stations[k].name << ": the dot at the station";
+    // Halfway from the dot to the marker's ring: the leader line (thin: grey at 50 dpi).
+    const double r = std::hypot(cx - m.x_pt, cy - m.y_pt), along = 0.5 * (r - 8 + 2);
+    const int u = Px(m.x_pt + along * (cx - m.x_pt) / r), v = Px(m.y_pt + along * (cy - m.y_pt) / r);
+    EXPECT_LT(page.Darkest(u, v), 200) << stations[k].name << ": the leader at " << u << "," << v;
+  }
+  const std::string text = PdfText(b.path);
+  int heights = 0;
+  for (size_t at = text.find("h 1.50 m"); at != std::string::npos; at = text.find("h 1.50 m", at + 1)) ++heights;
+  EXPECT_EQ(heights, 15) << "every label, 14 on the ground floor and 1 upstairs:\n" << text;
 }
 
 // On A4 a long station table continues on extra pages; a true-north angle is shown.

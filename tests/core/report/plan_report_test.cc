@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include "testing/test_paths.h"
+#include "vc/plan/keep_out.h"
 
 namespace vc {
 namespace {
@@ -288,6 +289,147 @@ TEST(PlanReportTest, HeatmapFootprintTakesInTheWallsAroundTheCandidates) {
   EXPECT_EQ(after.width, before.width);
   EXPECT_EQ(before.height, 40 + 540 + 60);
   EXPECT_EQ(after.height, 40 + 720 + 60);  // 4 x 4 m now, still 180 px/m
+}
+
+// A keep-out zone whose height range meets the floor's slice is hatched and outlined on the
+// floor's panel, and said in the legend; one above the tripod is not drawn at all. The zone
+// (1.2..1.8 m in x and y) lies at pixels 280..388 x 256..364.
+TEST(PlanReportTest, HeatmapHatchesAndOutlinesTheKeepOutZonesOfTheFloor) {
+  PlanResult bare = SamplePlan();
+  bare.scan_graph.edges.clear();  // its white line would cross the zone
+  PlanResult zoned = bare, above = bare;
+  zoned.options.keep_out = {KeepOutBox(WorldPoint(1.2, 1.2, 0.0), WorldPoint(1.8, 1.8, 2.5))};
+  above.options.keep_out = {KeepOutBox(WorldPoint(1.2, 1.2, 5.0), WorldPoint(1.8, 1.8, 6.0))};
+  const Picture a = DecodePng(*HeatmapPng(zoned)), b = DecodePng(*HeatmapPng(bare)), c = DecodePng(*HeatmapPng(above));
+  const std::array<int, 3> black{0, 0, 0};
+  int hatched = 0, between = 0;
+  for (int y = 266; y < 355; ++y)
+    for (int x = 290; x < 379; ++x) (a.at(x, y) == black ? hatched : between) += 1;
+  EXPECT_GT(hatched, 89 * 89 / 8) << "diagonals every 6 pixels";
+  EXPECT_GT(between, 89 * 89 / 2) << "the cells show between them";
+  for (int y = 262; y < 358; y += 5) {
+    EXPECT_EQ(a.at(281, y), black) << "the west edge at row " << y;
+    EXPECT_EQ(a.at(387, y), black) << "the east edge at row " << y;
+  }
+  for (const auto& [x, y] : {std::pair{275, 310}, std::pair{393, 310}, std::pair{330, 251}, std::pair{330, 369}}) {
+    EXPECT_EQ(a.at(x, y), b.at(x, y)) << "outside the zone at " << x << "," << y;
+  }
+  int legend_ink = 0;
+  for (int y = 40 + 540 + 52; y < 40 + 540 + 59; ++y)
+    for (int x = 64; x < 400; ++x) legend_ink += a.at(x, y) != b.at(x, y) ? 1 : 0;
+  EXPECT_GT(legend_ink, 50) << "the legend names the hatching";
+  EXPECT_EQ(c.rgb, b.rgb) << "a zone above the tripod is not on this floor";
+}
+
+// The colour bar reads in per cent of the scene: with 1,000 occupied voxels and 132 seen at best
+// the bar's top is 13.2 % and its ticks 0, 5 and 10 %; with 2,000, 6.6 % and 0, 2, 4, 6 %. Bar:
+// x 828..843, y 54..579 (h = 526); a tick mark is 4 pixels right of it, its label beyond.
+TEST(PlanReportTest, HeatmapColourBarIsInPerCentOfTheScene) {
+  PlanResult plan = SamplePlan();
+  const int bar_x = 64 + 720 + 24 + 110 - 110 + 20, bar_y = 54, h = 540 - 14;
+  for (const auto& [occupied, ticks] :
+       {std::pair{1000, std::vector<double>{0, 5, 10}}, std::pair{2000, std::vector<double>{0, 2, 4, 6}}}) {
+    plan.occupied_voxels = static_cast<uint64_t>(occupied);
+    const double top_pct = 100.0 * 132 / occupied;
+    const Picture p = DecodePng(*HeatmapPng(plan));
+    std::vector<int> marks;
+    for (int y = bar_y - 2; y < bar_y + h + 2; ++y) {
+      if (p.at(bar_x + 18, y) == std::array<int, 3>{0, 0, 0}) marks.push_back(y);
+    }
+    std::vector<int> expected;
+    for (double t : ticks) expected.push_back(bar_y + h - 1 - static_cast<int>(std::lround((h - 1) * t / top_pct)));
+    std::sort(expected.begin(), expected.end());
+    EXPECT_EQ(marks, expected) << occupied << " occupied voxels";
+    for (int y : expected) {
+      int ink = 0;
+      for (int v = y - 3; v <= y + 3; ++v)
+        for (int u = bar_x + 22; u < bar_x + 22 + 30; ++u) ink += p.at(u, v)[0] < 128 ? 1 : 0;
+      EXPECT_GT(ink, 15) << "a label beside the tick at row " << y;
+    }
+    int under = 0, over = 0;
+    for (int u = bar_x - 2; u < bar_x + 80; ++u) {
+      for (int v = bar_y + h + 8; v < bar_y + h + 27; ++v) under += p.at(u, v)[0] < 128 ? 1 : 0;
+      for (int v = bar_y - 26; v < bar_y - 7; ++v) over += p.at(u, v)[0] < 128 ? 1 : 0;
+    }
+    EXPECT_GT(under, 100) << "the top's value and its voxel count under the bar";
+    EXPECT_GT(over, 100) << "two title lines over the bar";
+  }
+}
+
+// Every character heatmap.png and reduction.png draw has a glyph: nowhere is the font's unknown
+// box (a 5 x 7 outline, hollow) drawn, with zones, moved numbers and the scan graph's "≥" in the
+// legend.
+TEST(PlanReportTest, HeatmapAndReductionDrawNoCharacterAsTheUnknownBox) {
+  PlanResult plan = SamplePlan();
+  plan.occupied_voxels = 1000;
+  plan.options.keep_out = {KeepOutBox(WorldPoint(1.2, 1.2, 0.0), WorldPoint(1.8, 1.8, 2.5))};
+  plan.stations.push_back({WorldPoint(0.55, 0.55, 1.6), 10, 10, 0.9, 0.4, 1});
+  const std::string dir = testing::MakeTempDir() + "/out";
+  ASSERT_TRUE(WritePlanOutputs(plan, dir).ok());
+  for (const char* name : {"heatmap.png", "reduction.png"}) {
+    const Picture p = DecodePng(ReadAll(dir + "/" + name));
+    const std::array<int, 3> black{0, 0, 0}, white{255, 255, 255};
+    int boxes = 0;
+    for (int y = 0; y + 7 <= p.height; ++y)
+      for (int x = 0; x + 5 <= p.width; ++x) {
+        bool box = true;
+        for (int v = 0; v < 7 && box; ++v)
+          for (int u = 0; u < 5 && box; ++u) {
+            const bool rim = u == 0 || u == 4 || v == 0 || v == 6;
+            box = p.at(x + u, y + v) == (rim ? black : white);
+          }
+        boxes += box ? 1 : 0;
+      }
+    EXPECT_EQ(boxes, 0) << name;
+  }
+}
+
+// 30 stations 0.1 m (18 pixels) apart in a row at y = 1.5 m: centred, their 23-pixel discs would
+// cover each other. Each disc is drawn whole (its red ring on all four sides), none covers
+// another or another station's pixel, and a moved one has a red dot at its station and a black
+// leader line from the dot towards the disc.
+TEST(PlanReportTest, HeatmapMovesNumbersAsideOnADensePlanWithoutOverlaps) {
+  PlanResult plan = SamplePlan();
+  plan.scan_graph.edges.clear();
+  plan.route.polylines.clear();
+  for (int i = 0; i < 30; ++i) plan.stations.push_back({WorldPoint(0.3 + 0.1 * i, 1.5, 1.6), 10, 10, 0.9, 0.4, 1});
+  const std::vector<HeatmapStationPlace> places = HeatmapStationPlaces(plan);
+  ASSERT_EQ(places.size(), plan.stations.size());
+  const Picture p = DecodePng(*HeatmapPng(plan));
+  const std::array<int, 3> red{215, 40, 40}, black{0, 0, 0};
+  int moved = 0;
+  for (size_t i = 0; i < places.size(); ++i) {
+    const LabelBox& d = places[i].disc.box;
+    EXPECT_FALSE(places[i].disc.overlaps) << "station " << i + 1;
+    for (size_t j = 0; j < places.size(); ++j) {
+      if (j == i) continue;
+      EXPECT_FALSE(d.Overlaps(places[j].disc.box)) << "discs " << i + 1 << " and " << j + 1;
+      const LabelPoint s = places[j].station_px;
+      EXPECT_FALSE(s.x > d.x0 && s.x < d.x1 && s.y > d.y0 && s.y < d.y1) << i + 1 << " covers station " << j + 1;
+    }
+    const int cx = static_cast<int>(std::lround(0.5 * (d.x0 + d.x1)));
+    const int cy = static_cast<int>(std::lround(0.5 * (d.y0 + d.y1)));
+    for (const auto& [dx, dy] : {std::pair{10, 0}, std::pair{-10, 0}, std::pair{0, 10}, std::pair{0, -10}}) {
+      EXPECT_EQ(p.at(cx + dx, cy + dy), red) << "station " << i + 1 << "'s ring at " << dx << "," << dy;
+    }
+    if (!places[i].disc.leader) continue;
+    ++moved;
+    const int sx = static_cast<int>(places[i].station_px.x), sy = static_cast<int>(places[i].station_px.y);
+    EXPECT_EQ(p.at(sx, sy), red) << "station " << i + 1 << "'s dot";
+    // Just beyond the dot's white rim on the way to the disc: the leader line.
+    const double len = std::hypot(cx - sx, cy - sy);
+    const int lx = static_cast<int>(std::lround(sx + 6 * (cx - sx) / len));
+    const int ly = static_cast<int>(std::lround(sy + 6 * (cy - sy) / len));
+    const bool under_a_disc = std::any_of(places.begin(), places.end(), [&](const HeatmapStationPlace& q) {
+      return lx + 1 >= q.disc.box.x0 && lx - 1 <= q.disc.box.x1 && ly + 1 >= q.disc.box.y0 && ly - 1 <= q.disc.box.y1;
+    });
+    int ink = 0;
+    for (int v = ly - 1; v <= ly + 1; ++v)
+      for (int u = lx - 1; u <= lx + 1; ++u) ink += p.at(u, v) == black ? 1 : 0;
+    EXPECT_TRUE(under_a_disc || ink > 0) << "station " << i + 1 << "'s leader near " << lx << "," << ly;
+  }
+  EXPECT_GE(moved, 15) << "at most every other one fits centred";
+  EXPECT_FALSE(places[0].disc.leader) << "station 1 stands alone and keeps its disc";
 }
 
 TEST(PlanReportTest, ReductionImageGrowsWithTheMatrix) {

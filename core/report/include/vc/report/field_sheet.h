@@ -3,9 +3,11 @@
 // slice heatmap.png draws), the numbered stations with their names and tripod heights (existing
 // stations as squares, new ones as circles), the walking route with arrows, hatched keep-out zones,
 // a scale bar, a north arrow, a legend in plain words, the plan's headline figures and the floor's
-// station table; rows that do not fit continue on table pages after the floors. Drawn with cairo
-// (Debian libcairo2-dev) in shapes and hatching that read in black and white, text in DejaVu Sans.
-// The layout is computed apart from the drawing so tests can find a station's marker on its page.
+// station table; rows that do not fit continue on table pages after the floors. Where stations
+// stand close, markers and names move aside with leader lines rather than cover each other. Drawn
+// with cairo (Debian libcairo2-dev) in shapes and hatching that read in black and white, text in
+// DejaVu Sans. The layout is computed apart from the drawing so tests can find a station's marker
+// and label on its page.
 // Pure functions of their arguments, each call drawing on its own cairo surface: thread-safe.
 #pragma once
 
@@ -16,6 +18,7 @@
 #include "vc/base/status.h"
 #include "vc/plan/planner.h"
 #include "vc/report/field_exports.h"
+#include "vc/report/label_placement.h"
 
 namespace vc {
 
@@ -29,12 +32,14 @@ struct FieldSheetOptions {
   double true_north_from_grid_deg = std::nan("");
 };
 
-// Where a station's marker lies: its page (0-based) and the marker's centre in points (1/72 inch)
-// from the page's top-left corner.
+// Where a station is drawn: its page (0-based) and the station's place in points (1/72 inch) from
+// the page's top-left corner, and where its numbered marker and its name label went (PlaceLabels).
 struct StationMarkerPlace {
   int page = 0;
   double x_pt = 0;
   double y_pt = 0;
+  PlacedLabel number;  // the marker: centred on the station, or moved aside with a leader line to a dot there
+  PlacedLabel name;    // "S03  h 1.60 m": beside the marker, or further out with a leader line to it
 };
 
 // The sheet's pages and where each station is drawn.

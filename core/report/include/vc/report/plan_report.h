@@ -15,6 +15,7 @@
 #include "vc/plan/planner.h"
 #include "vc/report/crs.h"
 #include "vc/report/field_sheet.h"
+#include "vc/report/label_placement.h"
 #include "vc/visibility/visibility.h"
 
 namespace vc {
@@ -79,9 +80,20 @@ struct ImageSize {
   int width = 0;
   int height = 0;
 };
-// heatmap.png's bytes: the candidates' cells over the floor plan of each level, the scan graph's
-// edges, the walking route and the stations (docs/PLANNING.md, "heatmap.png").
+// heatmap.png's bytes: the candidates' cells under the floor plan and keep-out zones of each
+// level, the scan graph's edges, the walking route, the stations and a colour bar in per cent of
+// the scene (docs/PLANNING.md, "heatmap.png").
 Result<std::string> HeatmapPng(const PlanResult& result);
+// Where heatmap.png draws a station, in pixels from the picture's top-left corner: its panel, the
+// station's own pixel, and the box of its numbered disc (centred on the station, or moved aside
+// with a leader line back to it, PlaceLabels).
+struct HeatmapStationPlace {
+  int panel = 0;
+  LabelPoint station_px;
+  PlacedLabel disc;
+};
+// One place per station of `result`, in plan order.
+std::vector<HeatmapStationPlace> HeatmapStationPlaces(const PlanResult& result);
 // Size of heatmap.png for `result` (layout in docs/PLANNING.md: one panel per floor level).
 ImageSize HeatmapImageSize(const PlanResult& result);
 // Size of reduction.png for a |P| x |P| matrix.
