@@ -6,9 +6,11 @@
 #pragma once
 
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "vc/plan/planner.h"
+#include "vc/report/field_exports.h"
 
 namespace vc::floor_plan {
 
@@ -34,6 +36,15 @@ unsigned SlicePanels(const Floors& floors, const PlanResult& r, double z);
 
 // The panel whose representative z lies nearest to `z` (m).
 int NearestPanel(const Floors& floors, double z);
+
+// Each of `stations`' panel, in their order: the panel nearest to its height (fieldsheet.pdf's page
+// and report.html's floor).
+std::vector<int> StationPanels(const Floors& floors, const PlanResult& r, const std::vector<FieldStation>& stations);
+
+// Each panel's name as fieldsheet.pdf titles its page: the floor label (FieldStation::floor, "L0", ...)
+// of its first station in `stations` that has one, else the panel's number from 1 ("2").
+std::vector<std::string> PanelNames(const Floors& floors, const std::vector<FieldStation>& stations,
+                                    const std::vector<int>& station_panel);
 
 // Grey level of a slice column whose highest voxel stands `above` m over the floor, `top` the
 // highest tripod height: 175 for low objects down to 40 for what reaches the tripod (walls).
