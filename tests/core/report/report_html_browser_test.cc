@@ -3,7 +3,10 @@
 // through ANGLE). Checks the page's own state after its first frame (no script errors, one marker
 // per station, every voxel drawn, a station selected from the URL with its sole voxels, a click on
 // a marker selecting its station), and that a screenshot shows the scene: many distinct colours,
-// red station markers and the selected station's sole voxels in magenta. Fails, never skips, when
+// red station markers and the selected station's sole voxels in magenta. On a two-storey scene
+// with a keep-out zone: the floor selector shows one floor's stations and voxels (from the URL
+// and by choosing it in the <select>), a screenshot changes with the floor, and the zone is
+// drawn (a screenshot redder where it stands than the same page without it). Fails, never skips, when
 // chromium is missing (scripts/install-deps.sh installs it); VC_CHROMIUM overrides its path.
 #include <gtest/gtest.h>
 #include <png.h>
@@ -19,6 +22,7 @@
 
 #include "testing/scenes.h"
 #include "testing/test_paths.h"
+#include "vc/plan/keep_out.h"
 #include "vc/plan/planner.h"
 #include "vc/report/plan_report.h"
 #include "vc/report/report_html.h"
@@ -27,11 +31,16 @@ namespace vc {
 namespace {
 
 constexpr int kWidth = 1280, kHeight = 800;
-constexpr int kPanelWidth = 400;  // report_page.css: #panel's width (px)
+constexpr int kPanelWidth = 460;  // report_page.css: #panel's width (px)
 
 std::string Chromium() {
   if (const char* env = std::getenv("VC_CHROMIUM"); env != nullptr && *env != '\0') return env;
   return VC_CHROMIUM;
+}
+
+std::string ChromiumMissing() {
+  return "chromium not found at '" + Chromium() +
+         "': install it with scripts/install-deps.sh (Debian package chromium) or set VC_CHROMIUM";
 }
 
 // Runs headless chromium on `url` with `action` (--dump-dom or --screenshot=...), stdout to
@@ -98,9 +107,7 @@ class ReportHtmlBrowserTest : public ::testing::Test {
     delete dir_;
   }
   void SetUp() override {
-    ASSERT_TRUE(std::filesystem::exists(Chromium()))
-        << "chromium not found at '" << Chromium()
-        << "': install it with scripts/install-deps.sh (Debian package chromium) or set VC_CHROMIUM";
+    ASSERT_TRUE(std::filesystem::exists(Chromium())) << ChromiumMissing();
     ASSERT_NE(plan_, nullptr);
   }
   static std::string Url(const std::string& fragment = "") { return "file://" + *dir_ + "/report.html" + fragment; }
@@ -140,7 +147,7 @@ TEST_F(ReportHtmlBrowserTest, StationFromTheUrlIsSelected) {
   const std::string dom = testing::ReadFileBytes(dom_path);
   EXPECT_EQ(BodyAttributes(dom)["data-errors"], "0");
   EXPECT_EQ(BodyAttributes(dom)["data-ready"], "true");
-  EXPECT_NE(dom.find("<tr class=\"selected\">"), std::string::npos);
+  EXPECT_NE(dom.find("class=\"selected\">"), std::string::npos);
   // The plan carries sole viewers, so the page offers the highlight.
   ASSERT_EQ(plan_->evaluation.sole_viewer.size(), plan_->voxel_centers.size());
   EXPECT_NE(dom.find("Station 2: "), std::string::npos);
@@ -225,6 +232,161 @@ TEST_F(ReportHtmlBrowserTest, ScreenshotShowsTheSceneAndASelectedStationsSoleVox
   EXPECT_GT(colours.size(), 100u) << "distinct colours (5 bits per channel)";
   EXPECT_GT(red_pixels, 50u) << "no red station marker rings";
   EXPECT_GT(magenta_pixels, 1000u) << "station " << best + 1 << "'s " << sole[best] << " sole voxels are not magenta";
+}
+
+// The two-storey scene (storeys 3 m high on a 0.3 m slab, the upper floor's top at z = 3.3) with a
+// keep-out box on the lower floor, planned; its report.html written.
+class ReportHtmlTwoFloorTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    PlanOptions o;
+    o.resolution_m = 0.1;
+    o.solver = SelectionSolver::kGreedy;
+    o.keep_out = {KeepOutBox(WorldPoint(0.5, 3.5, 0), WorldPoint(2.5, 5.5, 2))};
+    Result<PlanResult> r = Plan(testing::Synthetic("twofloor"), o);
+    ASSERT_TRUE(r.ok()) << r.status().ToString();
+    two_floor_ = new PlanResult(std::move(*r));
+    two_floor_dir_ = new std::string(testing::MakeTempDir());
+    ASSERT_TRUE(WritePlanOutputs(*two_floor_, *two_floor_dir_).ok());
+  }
+  static void TearDownTestSuite() {
+    delete two_floor_;
+    delete two_floor_dir_;
+  }
+  void SetUp() override {
+    ASSERT_TRUE(std::filesystem::exists(Chromium())) << ChromiumMissing();
+    ASSERT_NE(two_floor_, nullptr);
+  }
+  // The DOM of `page` (a file in the test's directory) opened with `fragment`, after its first frame.
+  static std::string Dom(const std::string& page, const std::string& fragment, const std::string& out) {
+    const std::string path = *two_floor_dir_ + "/" + out;
+    if (RunChromium(*two_floor_dir_, "file://" + *two_floor_dir_ + "/" + page + fragment, "--dump-dom", path) != 0) {
+      return "";
+    }
+    return testing::ReadFileBytes(path);
+  }
+  static Picture Screenshot(const std::string& page, const std::string& fragment, const std::string& out) {
+    const std::string png = *two_floor_dir_ + "/" + out;
+    if (RunChromium(*two_floor_dir_, "file://" + *two_floor_dir_ + "/" + page + fragment, "--screenshot='" + png + "'",
+                    png + ".out") != 0) {
+      return Picture{};
+    }
+    return ReadPng(png);
+  }
+  static std::string TwoFloorLog() { return testing::ReadFileBytes(*two_floor_dir_ + "/chromium.log"); }
+  // Stations standing on the lower floor (under the slab at z = 3.0).
+  static size_t LowerStations() {
+    size_t n = 0;
+    for (const PlannedStation& s : two_floor_->stations) n += s.position.z() < 3.0 ? 1 : 0;
+    return n;
+  }
+
+  static PlanResult* two_floor_;
+  static std::string* two_floor_dir_;
+};
+PlanResult* ReportHtmlTwoFloorTest::two_floor_ = nullptr;
+std::string* ReportHtmlTwoFloorTest::two_floor_dir_ = nullptr;
+
+TEST_F(ReportHtmlTwoFloorTest, FloorFromTheUrlShowsOnlyThatFloorsStationsAndVoxels) {
+  const size_t lower = LowerStations(), total = two_floor_->stations.size();
+  ASSERT_GE(lower, 1u);
+  ASSERT_GE(total - lower, 1u) << "no station upstairs";
+  size_t points_on_floors = 0;
+  for (const auto& [floor, stations] : {std::pair{"L0", lower}, std::pair{"L1", total - lower}}) {
+    const std::string dom = Dom("report.html", std::string("#floor=") + floor, std::string("dom-") + floor + ".html");
+    std::map<std::string, std::string> body = BodyAttributes(dom);
+    ASSERT_EQ(body["data-ready"], "true") << TwoFloorLog();
+    EXPECT_EQ(body["data-errors"], "0");
+    EXPECT_EQ(body["data-floor"], floor);
+    EXPECT_EQ(body["data-station-markers"], std::to_string(total));
+    EXPECT_EQ(body["data-visible-station-markers"], std::to_string(stations)) << floor;
+    // The other floor's rows are hidden.
+    const std::string table = dom.substr(dom.find("<tbody>"), dom.find("</tbody>") - dom.find("<tbody>"));
+    size_t hidden = 0;
+    for (size_t at = table.find(" hidden=\"\""); at != std::string::npos; at = table.find(" hidden=\"\"", at + 1)) {
+      ++hidden;
+    }
+    EXPECT_EQ(hidden, total - stations) << floor;
+    const size_t points = std::stoul(body["data-points-on-floor"]);
+    EXPECT_GT(points, two_floor_->voxel_centers.size() / 4) << floor;
+    EXPECT_LT(points, two_floor_->voxel_centers.size() * 3 / 4) << floor;
+    points_on_floors += points;
+    EXPECT_NE(dom.find("on floor " + std::string(floor)), std::string::npos) << "the scale note names the floor";
+  }
+  EXPECT_EQ(points_on_floors, two_floor_->voxel_centers.size()) << "the floors' bands share no voxel and miss none";
+}
+
+TEST_F(ReportHtmlTwoFloorTest, ChoosingAFloorInTheSelectorSwitchesFloors) {
+  // A copy of the page that, once ready, chooses the upper floor in the <select> as a user would.
+  std::string html = testing::ReadFileBytes(*two_floor_dir_ + "/report.html");
+  const size_t end = html.rfind("</body>");
+  ASSERT_NE(end, std::string::npos);
+  html.insert(end, R"js(<script>
+(function choose() {
+  if (!window.vcReport.ready) { setTimeout(choose, 20); return; }
+  var select = document.getElementById('floor');
+  document.body.setAttribute('data-options', Array.prototype.map.call(select.options, function (o) {
+    return o.textContent.split(' (')[0];
+  }).join('|'));
+  select.value = '1';
+  select.dispatchEvent(new Event('change'));
+})();
+</script>
+)js");
+  std::ofstream(*two_floor_dir_ + "/choose.html", std::ios::binary) << html;
+  std::map<std::string, std::string> body = BodyAttributes(Dom("choose.html", "", "dom-choose.html"));
+  EXPECT_EQ(body["data-errors"], "0");
+  EXPECT_EQ(body["data-options"], "All floors|floor L0|floor L1");
+  EXPECT_EQ(body["data-floor"], "L1");
+  EXPECT_EQ(body["data-visible-station-markers"], std::to_string(two_floor_->stations.size() - LowerStations()));
+}
+
+// The view's pixels (left of the panel) that differ between two screenshots by more than 40 in
+// some channel, and those of them redder in `b` than in `a` (red up, green and blue down).
+struct PixelChange {
+  size_t changed = 0;
+  size_t redder = 0;
+};
+PixelChange CompareViews(const Picture& a, const Picture& b) {
+  PixelChange c;
+  for (int y = 0; y < a.height; ++y) {
+    for (int x = 0; x < kWidth - kPanelWidth; ++x) {
+      const uint8_t* p = &a.rgb[3 * (static_cast<size_t>(y) * a.width + x)];
+      const uint8_t* q = &b.rgb[3 * (static_cast<size_t>(y) * b.width + x)];
+      const int dr = q[0] - p[0], dg = q[1] - p[1], db = q[2] - p[2];
+      if (std::max({std::abs(dr), std::abs(dg), std::abs(db)}) > 40) ++c.changed;
+      if (dr - std::max(dg, db) > 40) ++c.redder;
+    }
+  }
+  return c;
+}
+
+TEST_F(ReportHtmlTwoFloorTest, ScreenshotChangesWithTheFloorShown) {
+  const Picture lower = Screenshot("report.html", "#floor=L0", "floor-L0.png");
+  const Picture upper = Screenshot("report.html", "#floor=L1", "floor-L1.png");
+  ASSERT_EQ(lower.width, kWidth) << TwoFloorLog();
+  ASSERT_EQ(upper.width, kWidth);
+  const size_t view_pixels = static_cast<size_t>(kWidth - kPanelWidth) * kHeight;
+  EXPECT_GT(CompareViews(lower, upper).changed, view_pixels / 20) << "the two floors look alike";
+}
+
+TEST_F(ReportHtmlTwoFloorTest, KeepOutZonesAreDrawnAndListed) {
+  const std::string dom = Dom("report.html", "#floor=L0", "dom-zones.html");
+  std::map<std::string, std::string> body = BodyAttributes(dom);
+  EXPECT_EQ(body["data-errors"], "0");
+  EXPECT_EQ(body["data-keep-out-zones"], "1");
+  EXPECT_NE(dom.find("<li>zone 1, box x 0.50 to 2.50, y 3.50 to 5.50, z 0.00 to 2.00 m</li>"), std::string::npos);
+  // The same page without the zone: the zone's screenshot is redder where it stands.
+  PlanResult without = *two_floor_;
+  without.options.keep_out.clear();
+  std::ofstream(*two_floor_dir_ + "/no-zones.html", std::ios::binary) << PlanToHtml(without);
+  const Picture zoned = Screenshot("report.html", "#floor=L0", "zones.png");
+  const Picture bare = Screenshot("no-zones.html", "#floor=L0", "no-zones.png");
+  ASSERT_EQ(zoned.width, kWidth) << TwoFloorLog();
+  ASSERT_EQ(bare.width, kWidth);
+  const PixelChange c = CompareViews(bare, zoned);
+  EXPECT_GT(c.redder, 2000u) << "the keep-out zone is not drawn";
+  EXPECT_GT(c.redder, c.changed * 8 / 10) << "the zone changes the view in other ways than a red tint";
 }
 
 }  // namespace
