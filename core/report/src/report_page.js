@@ -92,14 +92,14 @@
   D.warnings.forEach(function (w) { warnings.appendChild(el('li', w)); });
   if (!D.warnings.length) warnings.appendChild(el('li', 'none'));
   var zoneList = document.getElementById('zones');
-  function range(axis, lo, hi) {
-    return axis + ' ' + num(lo + frame[axis === 'x' ? 0 : axis === 'y' ? 1 : 2], 2) + ' to ' +
-        num(hi + frame[axis === 'x' ? 0 : axis === 'y' ? 1 : 2], 2);
+  // "x 1.00 to 2.00": a zone's extent along axis a (0, 1, 2) in the input's frame.
+  function range(z, a) {
+    return 'xyz'.charAt(a) + ' ' + num(z.min[a] + frame[a], 2) + ' to ' + num(z.max[a] + frame[a], 2);
   }
   D.keep_out.forEach(function (z) {
     var shape = z.shape === 'box' ? 'box' : 'polygon of ' + z.outline.length / 2 + ' corners within';
-    zoneList.appendChild(el('li', 'zone ' + z.number + ', ' + shape + ' ' + range('x', z.min[0], z.max[0]) + ', ' +
-                                  range('y', z.min[1], z.max[1]) + ', ' + range('z', z.min[2], z.max[2]) + ' m'));
+    zoneList.appendChild(el('li', 'zone ' + z.number + ', ' + shape + ' ' + range(z, 0) + ', ' + range(z, 1) + ', ' +
+                                  range(z, 2) + ' m'));
   });
   if (!D.keep_out.length) zoneList.appendChild(el('li', 'none'));
   var shown = P.drawn === P.total ? 'all ' + count(P.total) + ' occupied voxels are drawn.'
@@ -315,7 +315,6 @@
     var edges = new THREE.LineSegments(new THREE.EdgesGeometry(prism),
                                        new THREE.LineBasicMaterial({color: 0xff2828, clippingPlanes: floorClipping}));
     fill.position.z = edges.position.z = bottom;
-    fill.userData.zone = z.number;
     zoneGroup.add(fill);
     zoneGroup.add(edges);
   });
@@ -461,12 +460,13 @@
   controls.update();
   var pending = false;
   // For print, a picture of the view (#snapshot) taken half a second after the view last changed
-  // and again just before printing.
+  // and again just before printing. While printing, the hidden view keeps its size and picture.
   var snapshot = document.getElementById('snapshot');
   var snapshotTimer = null;
+  var printing = false;
   function takeSnapshot() {
     snapshotTimer = null;
-    snapshot.src = renderer.domElement.toDataURL('image/png');
+    if (!printing) snapshot.src = renderer.domElement.toDataURL('image/png');
   }
   function render() {
     pending = false;
@@ -477,6 +477,11 @@
   window.addEventListener('beforeprint', function () {
     render();
     takeSnapshot();
+    printing = true;
+  });
+  window.addEventListener('afterprint', function () {
+    printing = false;
+    resize();
   });
   function requestRender() {
     if (!pending) {
@@ -486,6 +491,7 @@
   }
   controls.addEventListener('change', requestRender);
   function resize() {
+    if (printing) return;
     var w = Math.max(view.clientWidth, 1), h = Math.max(view.clientHeight, 1);
     renderer.setSize(w, h);
     camera.aspect = w / h;

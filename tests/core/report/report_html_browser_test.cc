@@ -4,9 +4,12 @@
 // per station, every voxel drawn, a station selected from the URL with its sole voxels, a click on
 // a marker selecting its station), and that a screenshot shows the scene: many distinct colours,
 // red station markers and the selected station's sole voxels in magenta. On a two-storey scene
-// with a keep-out zone: the floor selector shows one floor's stations and voxels (from the URL
+// with keep-out zones: the floor selector shows one floor's stations and voxels (from the URL
 // and by choosing it in the <select>), a screenshot changes with the floor, and the zone is
-// drawn (a screenshot redder where it stands than the same page without it). Fails, never skips, when
+// drawn (a screenshot redder where it stands than the same page without it). Printed to PDF, the
+// page holds the view's snapshot, the tables, the coverage curve and the glossary, and none of its
+// controls (read with poppler's pdftotext and pdfimages; skipped without them, as the field sheet's
+// tests). Fails, never skips, when
 // chromium is missing (scripts/install-deps.sh installs it); VC_CHROMIUM overrides its path.
 #include <gtest/gtest.h>
 #include <png.h>
@@ -17,6 +20,7 @@
 #include <fstream>
 #include <map>
 #include <set>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -24,6 +28,7 @@
 #include "testing/test_paths.h"
 #include "vc/plan/keep_out.h"
 #include "vc/plan/planner.h"
+#include "vc/report/field_exports.h"
 #include "vc/report/plan_report.h"
 #include "vc/report/report_html.h"
 
@@ -54,6 +59,22 @@ int RunChromium(const std::string& dir, const std::string& url, const std::strin
                               std::to_string(kHeight) + " --virtual-time-budget=15000 " + action + " '" + url + "' >'" +
                               out + "' 2>'" + dir + "/chromium.log'";
   return std::system(command.c_str());
+}
+
+// The standard output of `command`.
+std::string CommandOutput(const std::string& command) {
+  std::string out;
+  FILE* pipe = popen(command.c_str(), "r");
+  if (pipe == nullptr) return out;
+  char buf[4096];
+  for (size_t n; (n = fread(buf, 1, sizeof(buf), pipe)) > 0;) out.append(buf, n);
+  pclose(pipe);
+  return out;
+}
+
+// A poppler-utils tool beside pdftoppm (tests/core/CMakeLists.txt finds pdftoppm).
+std::string Poppler(const std::string& tool) {
+  return (std::filesystem::path(VC_PDFTOPPM).parent_path() / tool).string();
 }
 
 // The attributes of the dumped DOM's <body> tag.
@@ -234,15 +255,47 @@ TEST_F(ReportHtmlBrowserTest, ScreenshotShowsTheSceneAndASelectedStationsSoleVox
   EXPECT_GT(magenta_pixels, 1000u) << "station " << best + 1 << "'s " << sole[best] << " sole voxels are not magenta";
 }
 
+TEST_F(ReportHtmlBrowserTest, PrintedPageHoldsTheViewTablesCurveAndGlossaryWithoutControls) {
+  if (!std::filesystem::exists(Poppler("pdftotext")) || !std::filesystem::exists(Poppler("pdfimages"))) {
+    GTEST_SKIP() << "pdftotext/pdfimages (poppler-utils) not found";
+  }
+  const std::string pdf = *dir_ + "/printed.pdf";
+  ASSERT_EQ(RunChromium(*dir_, Url(), "--no-pdf-header-footer --print-to-pdf='" + pdf + "'", *dir_ + "/print.out"), 0)
+      << Log();
+  const std::string text = CommandOutput(Poppler("pdftotext") + " '" + pdf + "' - 2>&1");
+  for (const std::string words : {"GLOSSARY", "Visibility score", "COVERAGE CURVE", "80 % of what can be covered",
+                                  "tripod height", "walking order", "Grid squares of"}) {
+    EXPECT_NE(text.find(words), std::string::npos) << words << " is not on paper";
+  }
+  for (const FieldStation& f : FieldStations(*plan_)) EXPECT_NE(text.find(f.name), std::string::npos) << f.name;
+  // No controls: neither the checkboxes' labels nor the mouse hint.
+  EXPECT_EQ(text.find("(score 0) in red"), std::string::npos);
+  EXPECT_EQ(text.find("drag: rotate"), std::string::npos);
+  // The view's snapshot: an image as wide as the view (the legend's colour bar is 255 x 1).
+  const std::string images = CommandOutput(Poppler("pdfimages") + " -list '" + pdf + "' 2>&1");
+  bool snapshot = false;
+  std::istringstream lines(images);
+  for (std::string line; std::getline(lines, line);) {
+    std::istringstream fields(line);
+    int page = 0, num = 0, width = 0, height = 0;
+    std::string type;
+    if (fields >> page >> num >> type >> width >> height && type == "image") {
+      snapshot = snapshot || (width == kWidth - kPanelWidth && height >= kHeight / 2);
+    }
+  }
+  EXPECT_TRUE(snapshot) << "no snapshot of the view:\n" << images;
+}
+
 // The two-storey scene (storeys 3 m high on a 0.3 m slab, the upper floor's top at z = 3.3) with a
-// keep-out box on the lower floor, planned; its report.html written.
-class ReportHtmlTwoFloorTest : public ::testing::Test {
+// keep-out box on the lower floor and a triangle on the upper, planned; its report.html written.
+class ReportHtmlBrowserTwoFloorTest : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
     PlanOptions o;
     o.resolution_m = 0.1;
     o.solver = SelectionSolver::kGreedy;
-    o.keep_out = {KeepOutBox(WorldPoint(0.5, 3.5, 0), WorldPoint(2.5, 5.5, 2))};
+    o.keep_out = {KeepOutBox(WorldPoint(0.5, 3.5, 0), WorldPoint(2.5, 5.5, 2)),
+                  KeepOutPolygon(3.3, 5.3, {5, 3.5, 7, 3.5, 6, 5.5})};
     Result<PlanResult> r = Plan(testing::Synthetic("twofloor"), o);
     ASSERT_TRUE(r.ok()) << r.status().ToString();
     two_floor_ = new PlanResult(std::move(*r));
@@ -284,10 +337,10 @@ class ReportHtmlTwoFloorTest : public ::testing::Test {
   static PlanResult* two_floor_;
   static std::string* two_floor_dir_;
 };
-PlanResult* ReportHtmlTwoFloorTest::two_floor_ = nullptr;
-std::string* ReportHtmlTwoFloorTest::two_floor_dir_ = nullptr;
+PlanResult* ReportHtmlBrowserTwoFloorTest::two_floor_ = nullptr;
+std::string* ReportHtmlBrowserTwoFloorTest::two_floor_dir_ = nullptr;
 
-TEST_F(ReportHtmlTwoFloorTest, FloorFromTheUrlShowsOnlyThatFloorsStationsAndVoxels) {
+TEST_F(ReportHtmlBrowserTwoFloorTest, FloorFromTheUrlShowsOnlyThatFloorsStationsAndVoxels) {
   const size_t lower = LowerStations(), total = two_floor_->stations.size();
   ASSERT_GE(lower, 1u);
   ASSERT_GE(total - lower, 1u) << "no station upstairs";
@@ -316,7 +369,7 @@ TEST_F(ReportHtmlTwoFloorTest, FloorFromTheUrlShowsOnlyThatFloorsStationsAndVoxe
   EXPECT_EQ(points_on_floors, two_floor_->voxel_centers.size()) << "the floors' bands share no voxel and miss none";
 }
 
-TEST_F(ReportHtmlTwoFloorTest, ChoosingAFloorInTheSelectorSwitchesFloors) {
+TEST_F(ReportHtmlBrowserTwoFloorTest, ChoosingAFloorInTheSelectorSwitchesFloors) {
   // A copy of the page that, once ready, chooses the upper floor in the <select> as a user would.
   std::string html = testing::ReadFileBytes(*two_floor_dir_ + "/report.html");
   const size_t end = html.rfind("</body>");
@@ -361,7 +414,7 @@ PixelChange CompareViews(const Picture& a, const Picture& b) {
   return c;
 }
 
-TEST_F(ReportHtmlTwoFloorTest, ScreenshotChangesWithTheFloorShown) {
+TEST_F(ReportHtmlBrowserTwoFloorTest, ScreenshotChangesWithTheFloorShown) {
   const Picture lower = Screenshot("report.html", "#floor=L0", "floor-L0.png");
   const Picture upper = Screenshot("report.html", "#floor=L1", "floor-L1.png");
   ASSERT_EQ(lower.width, kWidth) << TwoFloorLog();
@@ -370,13 +423,16 @@ TEST_F(ReportHtmlTwoFloorTest, ScreenshotChangesWithTheFloorShown) {
   EXPECT_GT(CompareViews(lower, upper).changed, view_pixels / 20) << "the two floors look alike";
 }
 
-TEST_F(ReportHtmlTwoFloorTest, KeepOutZonesAreDrawnAndListed) {
+TEST_F(ReportHtmlBrowserTwoFloorTest, KeepOutZonesAreDrawnAndListed) {
   const std::string dom = Dom("report.html", "#floor=L0", "dom-zones.html");
   std::map<std::string, std::string> body = BodyAttributes(dom);
   EXPECT_EQ(body["data-errors"], "0");
-  EXPECT_EQ(body["data-keep-out-zones"], "1");
+  EXPECT_EQ(body["data-keep-out-zones"], "2");
   EXPECT_NE(dom.find("<li>zone 1, box x 0.50 to 2.50, y 3.50 to 5.50, z 0.00 to 2.00 m</li>"), std::string::npos);
-  // The same page without the zone: the zone's screenshot is redder where it stands.
+  EXPECT_NE(dom.find("<li>zone 2, polygon of 3 corners within x 5.00 to 7.00, y 3.50 to 5.50, z 3.30 to 5.30 m</li>"),
+            std::string::npos);
+  // The same page without the zones: the lower floor's screenshot is redder where its zone stands
+  // (the upper floor's polygon lies above the floor's band).
   PlanResult without = *two_floor_;
   without.options.keep_out.clear();
   std::ofstream(*two_floor_dir_ + "/no-zones.html", std::ios::binary) << PlanToHtml(without);
