@@ -294,7 +294,7 @@
   checkbox('walking route (orange)', true, function (on) { routeGroup.visible = on; requestRender(); });
   // Hundreds of links hide the scene: then they start hidden.
   edgeGroup.visible = D.edges.length <= 200;
-  checkbox('scan graph links, overlap \u2265 ' + num(D.edge_min_overlap, 2) + ' (blue): ' + D.edges.length,
+  checkbox('overlap links (blue): ' + D.edges.length + ' pairs of stations overlapping \u2265 ' + num(D.edge_min_overlap, 2),
            edgeGroup.visible, function (on) { edgeGroup.visible = on; requestRender(); });
 
   // Keep-out zones: translucent red prisms with solid edges, their heights clamped to 1 m around
