@@ -210,10 +210,7 @@ Sheet ComputeSheet(const PlanResult& r, const std::vector<FieldStation>& station
   s.pt_per_m = kPointsPerMetre / s.scale_denominator;
   s.centre_x = 0.5 * (s.floors.x0 + s.floors.x1);
   s.centre_y = 0.5 * (s.floors.y0 + s.floors.y1);
-  for (const FieldStation& f : stations) {
-    const double z = f.index < r.stations.size() ? r.stations[f.index].position.z() : 0.0;
-    s.station_panel.push_back(floor_plan::NearestPanel(s.floors, z));
-  }
+  s.station_panel = floor_plan::StationPanels(s.floors, r, stations);
   s.table_top = s.plan_top + kSideBlock + kLegendRows * kLegendRow + 24;
   const int capacity = static_cast<int>((s.height - kMargin - s.table_top - kTableHeader) / kRowHeight);
   const int page_capacity = static_cast<int>((s.height - 2 * kMargin - kTitleBand - kTableHeader) / kRowHeight);
@@ -268,10 +265,7 @@ class FieldSheetPainter {
   void Grey(double g) { cairo_set_source_rgb(cr_, g, g, g); }
 
   std::string FloorName(int panel) const {
-    for (size_t k = 0; k < stations_.size(); ++k) {
-      if (s_.station_panel[k] == panel && !stations_[k].floor.empty()) return stations_[k].floor;
-    }
-    return "";
+    return floor_plan::PanelNames(s_.floors, stations_, s_.station_panel)[size_t(panel)];
   }
 
   void DrawTitle(const std::string& title, int page, int pages) {
@@ -298,7 +292,7 @@ class FieldSheetPainter {
   void DrawFloorPage(int panel, int pages) {
     const std::string label = FloorName(panel);
     const double floor_z = s_.floors.floor_m[size_t(panel)] + r_.frame_origin_m.z();
-    std::string title = "Field sheet: floor " + (label.empty() ? std::to_string(panel + 1) : label);
+    std::string title = "Field sheet: floor " + label;
     title += " (floor at z = " + Fixed(floor_z, 2) + " m)";
     DrawTitle(title, panel, pages);
     cairo_save(cr_);

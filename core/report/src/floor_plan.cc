@@ -56,6 +56,29 @@ bool ZoneOnPanel(const Floors& floors, const PlanResult& r, const KeepOutZone& z
   return zmax >= floor && zmin <= band_top;
 }
 
+std::vector<int> StationPanels(const Floors& floors, const PlanResult& r, const std::vector<FieldStation>& stations) {
+  std::vector<int> panels;
+  panels.reserve(stations.size());
+  for (const FieldStation& f : stations) {
+    const double z = f.index < r.stations.size() ? r.stations[f.index].position.z() : 0.0;
+    panels.push_back(NearestPanel(floors, z));
+  }
+  return panels;
+}
+
+std::vector<std::string> PanelNames(const Floors& floors, const std::vector<FieldStation>& stations,
+                                    const std::vector<int>& station_panel) {
+  std::vector<std::string> names(floors.panel_z.size());
+  for (size_t k = 0; k < stations.size() && k < station_panel.size(); ++k) {
+    const auto p = static_cast<size_t>(station_panel[k]);
+    if (p < names.size() && names[p].empty()) names[p] = stations[k].floor;
+  }
+  for (size_t p = 0; p < names.size(); ++p) {
+    if (names[p].empty()) names[p] = std::to_string(p + 1);
+  }
+  return names;
+}
+
 namespace {
 
 // The z a candidate's panel is chosen by: its floor plus the lowest tripod height when the floor is

@@ -7,10 +7,12 @@
 #pragma once
 
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "vc/plan/keep_out.h"
 #include "vc/plan/planner.h"
+#include "vc/report/field_exports.h"
 
 namespace vc::floor_plan {
 
@@ -43,6 +45,15 @@ std::vector<double> ZoneOutlineLocal(const PlanResult& r, const KeepOutZone& zon
 // True when the zone's z range meets panel p's slice (its floor up to the highest tripod height),
 // so the panel draws it.
 bool ZoneOnPanel(const Floors& floors, const PlanResult& r, const KeepOutZone& zone, int panel);
+
+// Each of `stations`' panel, in their order: the panel nearest to its height (fieldsheet.pdf's page
+// and report.html's floor).
+std::vector<int> StationPanels(const Floors& floors, const PlanResult& r, const std::vector<FieldStation>& stations);
+
+// Each panel's name as fieldsheet.pdf titles its page: the floor label (FieldStation::floor, "L0", ...)
+// of its first station in `stations` that has one, else the panel's number from 1 ("2").
+std::vector<std::string> PanelNames(const Floors& floors, const std::vector<FieldStation>& stations,
+                                    const std::vector<int>& station_panel);
 
 // Grey level of a slice column whose highest voxel stands `above` m over the floor, `top` the
 // highest tripod height: 175 for low objects down to 40 for what reaches the tripod (walls).

@@ -1029,7 +1029,9 @@ Status WritePlanOutputs(const PlanResult& result, const std::string& out_dir, co
   VC_RETURN_IF_ERROR(WriteFile(dir / "heatmap.png", heat));
   VC_ASSIGN_OR_RETURN(std::string red, raster::EncodePng(DrawReduction(result)));
   VC_RETURN_IF_ERROR(WriteFile(dir / "reduction.png", red));
-  VC_RETURN_IF_ERROR(WriteFile(dir / "report.html", PlanToHtml(result)));
+  ReportHtmlOptions report_options;
+  report_options.fixed_station_names = fixed_station_names;
+  VC_RETURN_IF_ERROR(WriteFile(dir / "report.html", PlanToHtml(result, report_options)));
   return Status::Ok();
 }
 

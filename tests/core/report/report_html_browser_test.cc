@@ -3,7 +3,13 @@
 // through ANGLE). Checks the page's own state after its first frame (no script errors, one marker
 // per station, every voxel drawn, a station selected from the URL with its sole voxels, a click on
 // a marker selecting its station), and that a screenshot shows the scene: many distinct colours,
-// red station markers and the selected station's sole voxels in magenta. Fails, never skips, when
+// red station markers and the selected station's sole voxels in magenta. On a two-storey scene
+// with keep-out zones: the floor selector shows one floor's stations and voxels (from the URL
+// and by choosing it in the <select>), a screenshot changes with the floor, and the zone is
+// drawn (a screenshot redder where it stands than the same page without it). Printed to PDF, the
+// page holds the view's snapshot, the tables, the coverage curve and the glossary, and none of its
+// controls (read with poppler's pdftotext and pdfimages; skipped without them, as the field sheet's
+// tests). Fails, never skips, when
 // chromium is missing (scripts/install-deps.sh installs it); VC_CHROMIUM overrides its path.
 #include <gtest/gtest.h>
 #include <png.h>
@@ -14,12 +20,15 @@
 #include <fstream>
 #include <map>
 #include <set>
+#include <sstream>
 #include <string>
 #include <vector>
 
 #include "testing/scenes.h"
 #include "testing/test_paths.h"
+#include "vc/plan/keep_out.h"
 #include "vc/plan/planner.h"
+#include "vc/report/field_exports.h"
 #include "vc/report/plan_report.h"
 #include "vc/report/report_html.h"
 
@@ -27,11 +36,16 @@ namespace vc {
 namespace {
 
 constexpr int kWidth = 1280, kHeight = 800;
-constexpr int kPanelWidth = 400;  // report_page.css: #panel's width (px)
+constexpr int kPanelWidth = 460;  // report_page.css: #panel's width (px)
 
 std::string Chromium() {
   if (const char* env = std::getenv("VC_CHROMIUM"); env != nullptr && *env != '\0') return env;
   return VC_CHROMIUM;
+}
+
+std::string ChromiumMissing() {
+  return "chromium not found at '" + Chromium() +
+         "': install it with scripts/install-deps.sh (Debian package chromium) or set VC_CHROMIUM";
 }
 
 // Runs headless chromium on `url` with `action` (--dump-dom or --screenshot=...), stdout to
@@ -45,6 +59,22 @@ int RunChromium(const std::string& dir, const std::string& url, const std::strin
                               std::to_string(kHeight) + " --virtual-time-budget=15000 " + action + " '" + url + "' >'" +
                               out + "' 2>'" + dir + "/chromium.log'";
   return std::system(command.c_str());
+}
+
+// The standard output of `command`.
+std::string CommandOutput(const std::string& command) {
+  std::string out;
+  FILE* pipe = popen(command.c_str(), "r");
+  if (pipe == nullptr) return out;
+  char buf[4096];
+  for (size_t n; (n = fread(buf, 1, sizeof(buf), pipe)) > 0;) out.append(buf, n);
+  pclose(pipe);
+  return out;
+}
+
+// A poppler-utils tool beside pdftoppm (tests/core/CMakeLists.txt finds pdftoppm).
+std::string Poppler(const std::string& tool) {
+  return (std::filesystem::path(VC_PDFTOPPM).parent_path() / tool).string();
 }
 
 // The attributes of the dumped DOM's <body> tag.
@@ -98,9 +128,7 @@ class ReportHtmlBrowserTest : public ::testing::Test {
     delete dir_;
   }
   void SetUp() override {
-    ASSERT_TRUE(std::filesystem::exists(Chromium()))
-        << "chromium not found at '" << Chromium()
-        << "': install it with scripts/install-deps.sh (Debian package chromium) or set VC_CHROMIUM";
+    ASSERT_TRUE(std::filesystem::exists(Chromium())) << ChromiumMissing();
     ASSERT_NE(plan_, nullptr);
   }
   static std::string Url(const std::string& fragment = "") { return "file://" + *dir_ + "/report.html" + fragment; }
@@ -140,7 +168,7 @@ TEST_F(ReportHtmlBrowserTest, StationFromTheUrlIsSelected) {
   const std::string dom = testing::ReadFileBytes(dom_path);
   EXPECT_EQ(BodyAttributes(dom)["data-errors"], "0");
   EXPECT_EQ(BodyAttributes(dom)["data-ready"], "true");
-  EXPECT_NE(dom.find("<tr class=\"selected\">"), std::string::npos);
+  EXPECT_NE(dom.find("class=\"selected\">"), std::string::npos);
   // The plan carries sole viewers, so the page offers the highlight.
   ASSERT_EQ(plan_->evaluation.sole_viewer.size(), plan_->voxel_centers.size());
   EXPECT_NE(dom.find("Station 2: "), std::string::npos);
@@ -225,6 +253,196 @@ TEST_F(ReportHtmlBrowserTest, ScreenshotShowsTheSceneAndASelectedStationsSoleVox
   EXPECT_GT(colours.size(), 100u) << "distinct colours (5 bits per channel)";
   EXPECT_GT(red_pixels, 50u) << "no red station marker rings";
   EXPECT_GT(magenta_pixels, 1000u) << "station " << best + 1 << "'s " << sole[best] << " sole voxels are not magenta";
+}
+
+TEST_F(ReportHtmlBrowserTest, PrintedPageHoldsTheViewTablesCurveAndGlossaryWithoutControls) {
+  if (!std::filesystem::exists(Poppler("pdftotext")) || !std::filesystem::exists(Poppler("pdfimages"))) {
+    GTEST_SKIP() << "pdftotext/pdfimages (poppler-utils) not found";
+  }
+  const std::string pdf = *dir_ + "/printed.pdf";
+  ASSERT_EQ(RunChromium(*dir_, Url(), "--no-pdf-header-footer --print-to-pdf='" + pdf + "'", *dir_ + "/print.out"), 0)
+      << Log();
+  const std::string text = CommandOutput(Poppler("pdftotext") + " '" + pdf + "' - 2>&1");
+  for (const std::string words : {"GLOSSARY", "Visibility score", "COVERAGE CURVE", "80 % of what can be covered",
+                                  "tripod height", "walking order", "Grid squares of"}) {
+    EXPECT_NE(text.find(words), std::string::npos) << words << " is not on paper";
+  }
+  for (const FieldStation& f : FieldStations(*plan_)) EXPECT_NE(text.find(f.name), std::string::npos) << f.name;
+  // No controls: neither the checkboxes' labels nor the mouse hint.
+  EXPECT_EQ(text.find("(score 0) in red"), std::string::npos);
+  EXPECT_EQ(text.find("drag: rotate"), std::string::npos);
+  // The view's snapshot: an image as wide as the view (the legend's colour bar is 255 x 1).
+  const std::string images = CommandOutput(Poppler("pdfimages") + " -list '" + pdf + "' 2>&1");
+  bool snapshot = false;
+  std::istringstream lines(images);
+  for (std::string line; std::getline(lines, line);) {
+    std::istringstream fields(line);
+    int page = 0, num = 0, width = 0, height = 0;
+    std::string type;
+    if (fields >> page >> num >> type >> width >> height && type == "image") {
+      snapshot = snapshot || (width == kWidth - kPanelWidth && height >= kHeight / 2);
+    }
+  }
+  EXPECT_TRUE(snapshot) << "no snapshot of the view:\n" << images;
+}
+
+// The two-storey scene (storeys 3 m high on a 0.3 m slab, the upper floor's top at z = 3.3) with a
+// keep-out box on the lower floor and a triangle on the upper, planned; its report.html written.
+class ReportHtmlBrowserTwoFloorTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    PlanOptions o;
+    o.resolution_m = 0.1;
+    o.solver = SelectionSolver::kGreedy;
+    o.keep_out = {KeepOutBox(WorldPoint(0.5, 3.5, 0), WorldPoint(2.5, 5.5, 2)),
+                  KeepOutPolygon(3.3, 5.3, {5, 3.5, 7, 3.5, 6, 5.5})};
+    Result<PlanResult> r = Plan(testing::Synthetic("twofloor"), o);
+    ASSERT_TRUE(r.ok()) << r.status().ToString();
+    two_floor_ = new PlanResult(std::move(*r));
+    two_floor_dir_ = new std::string(testing::MakeTempDir());
+    ASSERT_TRUE(WritePlanOutputs(*two_floor_, *two_floor_dir_).ok());
+  }
+  static void TearDownTestSuite() {
+    delete two_floor_;
+    delete two_floor_dir_;
+  }
+  void SetUp() override {
+    ASSERT_TRUE(std::filesystem::exists(Chromium())) << ChromiumMissing();
+    ASSERT_NE(two_floor_, nullptr);
+  }
+  // The DOM of `page` (a file in the test's directory) opened with `fragment`, after its first frame.
+  static std::string Dom(const std::string& page, const std::string& fragment, const std::string& out) {
+    const std::string path = *two_floor_dir_ + "/" + out;
+    if (RunChromium(*two_floor_dir_, "file://" + *two_floor_dir_ + "/" + page + fragment, "--dump-dom", path) != 0) {
+      return "";
+    }
+    return testing::ReadFileBytes(path);
+  }
+  static Picture Screenshot(const std::string& page, const std::string& fragment, const std::string& out) {
+    const std::string png = *two_floor_dir_ + "/" + out;
+    if (RunChromium(*two_floor_dir_, "file://" + *two_floor_dir_ + "/" + page + fragment, "--screenshot='" + png + "'",
+                    png + ".out") != 0) {
+      return Picture{};
+    }
+    return ReadPng(png);
+  }
+  static std::string TwoFloorLog() { return testing::ReadFileBytes(*two_floor_dir_ + "/chromium.log"); }
+  // Stations standing on the lower floor (under the slab at z = 3.0).
+  static size_t LowerStations() {
+    size_t n = 0;
+    for (const PlannedStation& s : two_floor_->stations) n += s.position.z() < 3.0 ? 1 : 0;
+    return n;
+  }
+
+  static PlanResult* two_floor_;
+  static std::string* two_floor_dir_;
+};
+PlanResult* ReportHtmlBrowserTwoFloorTest::two_floor_ = nullptr;
+std::string* ReportHtmlBrowserTwoFloorTest::two_floor_dir_ = nullptr;
+
+TEST_F(ReportHtmlBrowserTwoFloorTest, FloorFromTheUrlShowsOnlyThatFloorsStationsAndVoxels) {
+  const size_t lower = LowerStations(), total = two_floor_->stations.size();
+  ASSERT_GE(lower, 1u);
+  ASSERT_GE(total - lower, 1u) << "no station upstairs";
+  size_t points_on_floors = 0;
+  for (const auto& [floor, stations] : {std::pair{"L0", lower}, std::pair{"L1", total - lower}}) {
+    const std::string dom = Dom("report.html", std::string("#floor=") + floor, std::string("dom-") + floor + ".html");
+    std::map<std::string, std::string> body = BodyAttributes(dom);
+    ASSERT_EQ(body["data-ready"], "true") << TwoFloorLog();
+    EXPECT_EQ(body["data-errors"], "0");
+    EXPECT_EQ(body["data-floor"], floor);
+    EXPECT_EQ(body["data-station-markers"], std::to_string(total));
+    EXPECT_EQ(body["data-visible-station-markers"], std::to_string(stations)) << floor;
+    // The other floor's rows are hidden.
+    const std::string table = dom.substr(dom.find("<tbody>"), dom.find("</tbody>") - dom.find("<tbody>"));
+    size_t hidden = 0;
+    for (size_t at = table.find(" hidden=\"\""); at != std::string::npos; at = table.find(" hidden=\"\"", at + 1)) {
+      ++hidden;
+    }
+    EXPECT_EQ(hidden, total - stations) << floor;
+    const size_t points = std::stoul(body["data-points-on-floor"]);
+    EXPECT_GT(points, two_floor_->voxel_centers.size() / 4) << floor;
+    EXPECT_LT(points, two_floor_->voxel_centers.size() * 3 / 4) << floor;
+    points_on_floors += points;
+    EXPECT_NE(dom.find("on floor " + std::string(floor)), std::string::npos) << "the scale note names the floor";
+  }
+  EXPECT_EQ(points_on_floors, two_floor_->voxel_centers.size()) << "the floors' bands share no voxel and miss none";
+}
+
+TEST_F(ReportHtmlBrowserTwoFloorTest, ChoosingAFloorInTheSelectorSwitchesFloors) {
+  // A copy of the page that, once ready, chooses the upper floor in the <select> as a user would.
+  std::string html = testing::ReadFileBytes(*two_floor_dir_ + "/report.html");
+  const size_t end = html.rfind("</body>");
+  ASSERT_NE(end, std::string::npos);
+  html.insert(end, R"js(<script>
+(function choose() {
+  if (!window.vcReport.ready) { setTimeout(choose, 20); return; }
+  var select = document.getElementById('floor');
+  document.body.setAttribute('data-options', Array.prototype.map.call(select.options, function (o) {
+    return o.textContent.split(' (')[0];
+  }).join('|'));
+  select.value = '1';
+  select.dispatchEvent(new Event('change'));
+})();
+</script>
+)js");
+  std::ofstream(*two_floor_dir_ + "/choose.html", std::ios::binary) << html;
+  std::map<std::string, std::string> body = BodyAttributes(Dom("choose.html", "", "dom-choose.html"));
+  EXPECT_EQ(body["data-errors"], "0");
+  EXPECT_EQ(body["data-options"], "All floors|floor L0|floor L1");
+  EXPECT_EQ(body["data-floor"], "L1");
+  EXPECT_EQ(body["data-visible-station-markers"], std::to_string(two_floor_->stations.size() - LowerStations()));
+}
+
+// The view's pixels (left of the panel) that differ between two screenshots by more than 40 in
+// some channel, and those of them redder in `b` than in `a` (red up, green and blue down).
+struct PixelChange {
+  size_t changed = 0;
+  size_t redder = 0;
+};
+PixelChange CompareViews(const Picture& a, const Picture& b) {
+  PixelChange c;
+  for (int y = 0; y < a.height; ++y) {
+    for (int x = 0; x < kWidth - kPanelWidth; ++x) {
+      const uint8_t* p = &a.rgb[3 * (static_cast<size_t>(y) * a.width + x)];
+      const uint8_t* q = &b.rgb[3 * (static_cast<size_t>(y) * b.width + x)];
+      const int dr = q[0] - p[0], dg = q[1] - p[1], db = q[2] - p[2];
+      if (std::max({std::abs(dr), std::abs(dg), std::abs(db)}) > 40) ++c.changed;
+      if (dr - std::max(dg, db) > 40) ++c.redder;
+    }
+  }
+  return c;
+}
+
+TEST_F(ReportHtmlBrowserTwoFloorTest, ScreenshotChangesWithTheFloorShown) {
+  const Picture lower = Screenshot("report.html", "#floor=L0", "floor-L0.png");
+  const Picture upper = Screenshot("report.html", "#floor=L1", "floor-L1.png");
+  ASSERT_EQ(lower.width, kWidth) << TwoFloorLog();
+  ASSERT_EQ(upper.width, kWidth);
+  const size_t view_pixels = static_cast<size_t>(kWidth - kPanelWidth) * kHeight;
+  EXPECT_GT(CompareViews(lower, upper).changed, view_pixels / 20) << "the two floors look alike";
+}
+
+TEST_F(ReportHtmlBrowserTwoFloorTest, KeepOutZonesAreDrawnAndListed) {
+  const std::string dom = Dom("report.html", "#floor=L0", "dom-zones.html");
+  std::map<std::string, std::string> body = BodyAttributes(dom);
+  EXPECT_EQ(body["data-errors"], "0");
+  EXPECT_EQ(body["data-keep-out-zones"], "2");
+  EXPECT_NE(dom.find("<li>zone 1, box x 0.50 to 2.50, y 3.50 to 5.50, z 0.00 to 2.00 m</li>"), std::string::npos);
+  EXPECT_NE(dom.find("<li>zone 2, polygon of 3 corners within x 5.00 to 7.00, y 3.50 to 5.50, z 3.30 to 5.30 m</li>"),
+            std::string::npos);
+  // The same page without the zones: the lower floor's screenshot is redder where its zone stands
+  // (the upper floor's polygon lies above the floor's band).
+  PlanResult without = *two_floor_;
+  without.options.keep_out.clear();
+  std::ofstream(*two_floor_dir_ + "/no-zones.html", std::ios::binary) << PlanToHtml(without);
+  const Picture zoned = Screenshot("report.html", "#floor=L0", "zones.png");
+  const Picture bare = Screenshot("no-zones.html", "#floor=L0", "no-zones.png");
+  ASSERT_EQ(zoned.width, kWidth) << TwoFloorLog();
+  ASSERT_EQ(bare.width, kWidth);
+  const PixelChange c = CompareViews(bare, zoned);
+  EXPECT_GT(c.redder, 2000u) << "the keep-out zone is not drawn";
+  EXPECT_GT(c.redder, c.changed * 8 / 10) << "the zone changes the view in other ways than a red tint";
 }
 
 }  // namespace

@@ -1,16 +1,24 @@
 // report.html's writer: a self-contained page (no network references, three.js inlined), the
-// plan's data as the page reads it (stations, route order, sole voxels, the quantised voxels and
-// their colours), decimation, escaping of hostile strings, and WritePlanOutputs writing it.
+// plan's data as the page reads it (stations with their field-sheet names, floors and tripod
+// heights, route order, sole voxels, the quantised voxels and their colours, floors, keep-out
+// zones), the static parts (station table columns, coverage curve, glossary, print style),
+// decimation, escaping of hostile strings, and WritePlanOutputs writing it.
 // report_html_browser_test opens the page in a real browser.
 #include "vc/report/report_html.h"
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cctype>
 #include <nlohmann/json.hpp>
 #include <set>
+#include <string>
+#include <vector>
 
 #include "testing/test_paths.h"
+#include "vc/plan/coverage_curve.h"
+#include "vc/plan/keep_out.h"
+#include "vc/report/field_exports.h"
 #include "vc/report/plan_report.h"
 
 namespace vc {
@@ -53,6 +61,26 @@ PlanResult BlockPlan() {
   }
   r.warnings = {"a plain warning"};
   return r;
+}
+
+// The text between the first `begin` and the next `end` after it; "" if either is missing.
+std::string Between(const std::string& text, const std::string& begin, const std::string& end) {
+  const size_t at = text.find(begin);
+  if (at == std::string::npos) return "";
+  const size_t stop = text.find(end, at + begin.size());
+  return stop == std::string::npos ? "" : text.substr(at + begin.size(), stop - at - begin.size());
+}
+
+// Every `<tag ...>text</tag>`'s text in `html`, in order (no nesting).
+std::vector<std::string> Texts(const std::string& html, const std::string& tag) {
+  std::vector<std::string> out;
+  for (size_t at = html.find("<" + tag); at != std::string::npos; at = html.find("<" + tag, at + 1)) {
+    const size_t open_end = html.find('>', at);
+    const size_t close = html.find("</" + tag + ">", open_end);
+    if (open_end == std::string::npos || close == std::string::npos) break;
+    out.push_back(html.substr(open_end + 1, close - open_end - 1));
+  }
+  return out;
 }
 
 // The page's data object (window.VC_REPORT_DATA = {...};).
@@ -253,6 +281,139 @@ TEST(ReportHtmlTest, NoVoxelsGiveAnEmptyButValidPage) {
   EXPECT_EQ(d["points"]["drawn"].get<int>(), 0);
   EXPECT_TRUE(d["points"]["sole"].is_null());
   EXPECT_EQ(d["stations"].size(), 3u);
+}
+
+TEST(ReportHtmlTest, StationTableNamesTheFieldSheetsColumns) {
+  const std::string head = Between(PlanToHtml(BlockPlan()), "<table id=\"stations\"><thead>", "</thead>");
+  EXPECT_EQ(Texts(head, "th"),
+            (std::vector<std::string>{"#", "name", "floor", "tripod height (m)", "walking order", "x (m)", "y (m)",
+                                      "z (m)", "score alone", "new voxels", "seen only here"}));
+}
+
+TEST(ReportHtmlTest, StationsCarryTheirFieldSheetNameFloorAndTripodHeight) {
+  PlanResult plan = BlockPlan();
+  plan.stations[0].floor_z_m = 0.0;  // 1.5 m above it
+  plan.stations[1].floor_z_m = 0.1;  // 1.4 m
+  ReportHtmlOptions options;
+  options.fixed_station_names = {"PILLAR 7"};  // station 2, the only fixed one
+  const json d = PageData(PlanToHtml(plan, options));
+  const std::vector<FieldStation> field = FieldStations(plan, options.fixed_station_names);
+  ASSERT_EQ(field.size(), 3u);
+  for (const FieldStation& f : field) {
+    const json& s = d["stations"][f.index];
+    EXPECT_EQ(s["name"].get<std::string>(), f.name);
+    EXPECT_EQ(s["walk_number"].get<int>(), f.number);
+    EXPECT_EQ(s["page_floor"].get<int>(), 0);
+  }
+  EXPECT_EQ(d["stations"][2]["name"], "PILLAR 7");
+  EXPECT_EQ(d["stations"][2]["walk_number"], 1);  // the route starts there
+  EXPECT_EQ(d["stations"][0]["floor"], "L0");
+  EXPECT_NEAR(d["stations"][0]["tripod_height_m"].get<double>(), 1.5, 1e-12);
+  EXPECT_NEAR(d["stations"][1]["tripod_height_m"].get<double>(), 1.4, 1e-12);
+  EXPECT_TRUE(d["stations"][2]["floor"].is_null()) << "no floor below it";
+  EXPECT_TRUE(d["stations"][2]["tripod_height_m"].is_null());
+}
+
+TEST(ReportHtmlTest, FloorsAreTheFieldSheetsWithTheirBandsOfVoxels) {
+  PlanResult plan = BlockPlan();
+  // Candidates on two floors (tops at z 0 and 3.3) under 1.5 m tripods; station 1 upstairs.
+  plan.heat_map.grid_spacing_m = 1.0;
+  plan.heat_map.positions = {WorldPoint(0, 0, 1.5), WorldPoint(1, 0, 1.5), WorldPoint(0, 0, 4.8)};
+  plan.heat_map.floor_z_m = {0.0, 0.0, 3.3};
+  plan.heat_map.visible_voxels = {5, 5, 5};
+  plan.stations[0].floor_z_m = plan.stations[2].floor_z_m = 0.0;
+  plan.stations[1].position.z() = 4.8;
+  plan.stations[1].floor_z_m = 3.3;
+  plan.floor_levels_m = {0.0, 3.3};
+  const json d = PageData(PlanToHtml(plan));
+  ASSERT_EQ(d["floors"].size(), 2u);
+  EXPECT_EQ(d["floors"][0]["name"], "L0");
+  EXPECT_EQ(d["floors"][1]["name"], "L1");
+  EXPECT_NEAR(d["floors"][0]["floor_z"].get<double>(), 0.0, 1e-9);
+  EXPECT_NEAR(d["floors"][1]["floor_z"].get<double>(), 3.3, 1e-9);
+  // The lower floor ends, and the upper begins, half a metre below the upper floor's top.
+  EXPECT_TRUE(d["floors"][0]["from_z"].is_null());
+  EXPECT_NEAR(d["floors"][0]["to_z"].get<double>(), 2.8, 1e-9);
+  EXPECT_NEAR(d["floors"][1]["from_z"].get<double>(), 2.8, 1e-9);
+  EXPECT_TRUE(d["floors"][1]["to_z"].is_null());
+  EXPECT_EQ(d["stations"][0]["page_floor"], 0);
+  EXPECT_EQ(d["stations"][1]["page_floor"], 1);
+  EXPECT_EQ(d["stations"][1]["floor"], "L1");
+  EXPECT_EQ(d["stations"][2]["page_floor"], 0);
+}
+
+TEST(ReportHtmlTest, KeepOutZonesAreGivenInTheLocalFrame) {
+  PlanResult plan = BlockPlan();
+  plan.frame_origin_m = WorldPoint(512000, 5612000, 100);
+  plan.options.keep_out = {KeepOutBox(WorldPoint(512001, 5612002, 100), WorldPoint(512003, 5612004, 102)),
+                           KeepOutPolygon(99, 101, {512000, 5612000, 512002, 5612000, 512001, 5612001})};
+  const json z = PageData(PlanToHtml(plan))["keep_out"];
+  ASSERT_EQ(z.size(), 2u);
+  EXPECT_EQ(z[0]["number"], 1);
+  EXPECT_EQ(z[0]["shape"], "box");
+  EXPECT_EQ(z[0]["outline"], json::parse("[1.0, 2.0, 3.0, 2.0, 3.0, 4.0, 1.0, 4.0]"));
+  EXPECT_EQ(z[0]["min"], json::parse("[1.0, 2.0, 0.0]"));
+  EXPECT_EQ(z[0]["max"], json::parse("[3.0, 4.0, 2.0]"));
+  EXPECT_EQ(z[1]["shape"], "polygon");
+  EXPECT_EQ(z[1]["outline"], json::parse("[0.0, 0.0, 2.0, 0.0, 1.0, 1.0]"));
+  EXPECT_EQ(z[1]["min"], json::parse("[0.0, 0.0, -1.0]"));
+  EXPECT_EQ(z[1]["max"], json::parse("[2.0, 1.0, 1.0]"));
+  EXPECT_EQ(PageData(PlanToHtml(BlockPlan()))["keep_out"], json::array());
+}
+
+TEST(ReportHtmlTest, CoverageCurveHoldsEveryPointAndMarksTheMilestones) {
+  PlanResult plan = BlockPlan();
+  plan.coverage_curve = CoverageCurve({10, 6, 2}, 24, 20, 30);  // 50, 80, 90 % of the coverable voxels
+  const std::string html = PlanToHtml(plan);
+  const std::string svg = Between(html, "<svg id=\"coverage-curve\"", "</svg>");
+  ASSERT_FALSE(svg.empty());
+  EXPECT_EQ(Between(svg, "<polyline id=\"coverage-points\" vector-effect=\"non-scaling-stroke\" points=\"", "\""),
+            "0,0 1,50.000 2,80.000 3,90.000");
+  // 80 % after 2 stations, 90 % after 3; 95 and 99 % never.
+  EXPECT_NE(svg.find("<g class=\"milestone\" data-levels=\"80\" data-stations=\"2\">"), std::string::npos);
+  EXPECT_NE(svg.find("<g class=\"milestone\" data-levels=\"90\" data-stations=\"3\">"), std::string::npos);
+  EXPECT_EQ(Count(svg, "class=\"milestone\""), 2u);
+  // Levels reached by the same station share its mark: 80 and 90 % both after 2 stations here.
+  plan.coverage_curve = CoverageCurve({10, 8, 2}, 24, 20, 30);  // 50, 90, 100 %
+  const std::string shared = Between(PlanToHtml(plan), "<svg id=\"coverage-curve\"", "</svg>");
+  EXPECT_NE(shared.find("<g class=\"milestone\" data-levels=\"80 90\" data-stations=\"2\">"), std::string::npos);
+  EXPECT_NE(shared.find(">80, 90 %</text>"), std::string::npos);
+  EXPECT_NE(shared.find("<g class=\"milestone\" data-levels=\"95 99\" data-stations=\"3\">"), std::string::npos);
+  const std::vector<std::string> items = Texts(Between(html, "<ul id=\"milestones\">", "</ul>"), "li");
+  ASSERT_EQ(items.size(), 4u);
+  EXPECT_EQ(items[0],
+            "80 % of what can be covered: 2 stations (66.7 % of the whole scene; setting up and scanning "
+            "them about 1 min)");
+  EXPECT_EQ(items[2], "95 % of what can be covered: not reached by this plan");
+  EXPECT_EQ(items[3], "99 % of what can be covered: not reached by this plan");
+}
+
+TEST(ReportHtmlTest, WithoutACoverageCurveThePageSaysSo) {
+  const std::string html = PlanToHtml(BlockPlan());
+  EXPECT_EQ(html.find("<svg"), std::string::npos);
+  EXPECT_NE(html.find("This plan carries no coverage curve."), std::string::npos);
+}
+
+TEST(ReportHtmlTest, GlossaryExplainsTheWordsAndColoursInPlainLanguage) {
+  const std::vector<std::string> terms = Texts(Between(PlanToHtml(BlockPlan()), "<dl id=\"glossary\">", "</dl>"), "dt");
+  for (const std::string term : {"Visibility score", "Coverable", "Coverage", "Field time", "Tripod height", "Floor",
+                                 "Walking order", "Colours"}) {
+    EXPECT_NE(std::find(terms.begin(), terms.end(), term), terms.end()) << term;
+  }
+  const std::string colours = Between(PlanToHtml(BlockPlan()), "<dt>Colours</dt><dd>", "</dd>");
+  for (const std::string colour : {"dark purple to yellow", "grey", "magenta", "orange", "light blue", "red ring",
+                                   "black ring", "translucent red: keep-out zones", "metre grid"}) {
+    EXPECT_NE(colours.find(colour), std::string::npos) << colour;
+  }
+}
+
+TEST(ReportHtmlTest, PrintStyleDropsTheControlsAndShowsASnapshot) {
+  const std::string html = PlanToHtml(BlockPlan());
+  const std::string print = Between(html, "@media print {", "\n}\n");
+  ASSERT_FALSE(print.empty());
+  EXPECT_NE(print.find("#controls"), std::string::npos);
+  EXPECT_NE(print.find("#snapshot { display: block;"), std::string::npos);
+  EXPECT_NE(html.find("<img id=\"snapshot\""), std::string::npos);
 }
 
 TEST(ReportHtmlTest, WritePlanOutputsWritesReportHtml) {

@@ -4,9 +4,15 @@
 //
 // The page draws the occupied voxels coloured by their best V (visibility.ply's colours; at most
 // ReportHtmlOptions::max_points of them, a deterministic pseudo-random subset when there are more),
-// the stations as numbered markers (plan order, 1-based, as heatmap.png and stations.csv), the scan
-// graph's edges, the walking route, and a side panel with plan.json's figures and the station
-// table; clicking a station highlights the voxels only it sees (Evaluation::sole_viewer).
+// the stations as numbered markers (plan order, 1-based, as heatmap.png), the scan graph's edges,
+// the walking route, the keep-out zones as translucent boxes and a metre grid on the floor; a
+// floor selector (fieldsheet.pdf's floors and names) shows one floor's voxels, stations and table
+// rows; the side panel holds plan.json's figures, the station table (name, floor, tripod height
+// and walking order as fieldsheet.pdf and stations.csv give them), the keep-out zones, the
+// coverage curve (an inline SVG with the 80/90/95/99 % milestones) and a glossary in plain
+// words. Clicking a station highlights the voxels only it sees (Evaluation::sole_viewer). Printed,
+// the page drops its controls and keeps a snapshot of the view, the tables, the curve and the
+// glossary.
 //
 // Data is inlined as JSON with the bulk arrays in base64 (positions quantised to uint16 steps of
 // the resolution), in the plan's local frame (WebGL's float32 cannot hold survey coordinates); the
@@ -18,6 +24,7 @@
 
 #include <cstddef>
 #include <string>
+#include <vector>
 
 #include "vc/plan/planner.h"
 
@@ -27,6 +34,8 @@ struct ReportHtmlOptions {
   // Most voxels drawn: 300,000 points stay smooth on a laptop's integrated GPU (and keep the file
   // a few MB); a larger scene shows a deterministic pseudo-random subset of this size.
   size_t max_points = 300000;
+  // The fixed stations' names, in PlanOptions::fixed_stations order, as FieldStations takes them.
+  std::vector<std::string> fixed_station_names;
 };
 
 // report.html's content for `result`. Uses result.voxel_centers with
