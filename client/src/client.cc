@@ -253,8 +253,10 @@ Status FollowPlan(Stream& stream, const JobObserver& observer, JobTicket* ticket
 // Reads an Evaluate event stream (Evaluate's or AttachEvaluate's) to its end and its status.
 template <typename Stream>
 Status FollowEvaluate(Stream& stream, const JobObserver& observer, JobTicket* ticket, bool* accepted,
-                      EvaluateOutcome* out) {
-  std::optional<v1::EvaluateResult> result;
+                      EvaluateJobResult* out) {
+  wire::EvaluateResultAssembler assembler;
+  std::optional<v1::EvaluateResult> summary;
+  Status broken;
   v1::EvaluateResponse r;
   while (stream.Read(&r)) {
     switch (r.event_case()) {
@@ -265,18 +267,22 @@ Status FollowEvaluate(Stream& stream, const JobObserver& observer, JobTicket* ti
       case v1::EvaluateResponse::kProgress:
         if (observer.on_progress) observer.on_progress(wire::FromProto(r.progress()));
         break;
+      case v1::EvaluateResponse::kVoxels:
+        if (broken.ok()) broken = assembler.AddVoxels(r.voxels());
+        break;
       case v1::EvaluateResponse::kResult:
-        result = r.result();
+        summary = r.result();
         break;
       default:
         break;
     }
   }
   VC_RETURN_IF_ERROR(wire::FromGrpcStatus(stream.Finish()));
-  if (!result) return InternalError("the server ended the evaluation without a result");
-  out->evaluation = wire::FromProto(result->evaluation());
-  out->viewpoints.clear();
-  for (const auto& p : result->viewpoints()) out->viewpoints.push_back(wire::FromProto(p));
+  if (!broken.ok()) return Local(broken);
+  if (!summary) return InternalError("the server ended the evaluation without a result");
+  auto result = std::move(assembler).Finish(*summary);
+  if (!result.ok()) return Local(result.status());
+  *out = std::move(result).value();
   return Status::Ok();
 }
 
@@ -338,15 +344,15 @@ Result<PlanResult> Client::Plan(const Upload& upload, const PlanOptions& options
   return out;
 }
 
-Result<Evaluation> Client::Evaluate(const Upload& upload, const EvaluateJobOptions& options,
-                                    const JobObserver& observer) {
+Result<EvaluateJobResult> Client::Evaluate(const Upload& upload, const EvaluateJobOptions& options,
+                                           const JobObserver& observer) {
   auto stub = v1::StationPlanner::NewStub(channel_);
   v1::EvaluateRequest spec;
   *spec.mutable_spec()->mutable_upload() = MakeUploadSpec(upload);
   *spec.mutable_spec()->mutable_parameters() = wire::ToProto(options);
   spec.mutable_spec()->mutable_control()->set_detach_grace_s(options_.detach_grace_s);
   last_job_ = {};
-  EvaluateOutcome out;
+  EvaluateJobResult out;
   const Status status = WithSceneCache(upload, spec.mutable_spec()->mutable_upload(), [&](bool from_cache) {
     return WithRetries(observer, [&](bool* accepted) -> Status {
       grpc::ClientContext ctx;
@@ -358,7 +364,7 @@ Result<Evaluation> Client::Evaluate(const Upload& upload, const EvaluateJobOptio
     });
   });
   if (!status.ok()) return status;
-  return std::move(out.evaluation);
+  return out;
 }
 
 Status Client::AttachPlanOnce(const JobObserver& observer, PlanResult* out, bool* followed) {
@@ -371,7 +377,7 @@ Status Client::AttachPlanOnce(const JobObserver& observer, PlanResult* out, bool
   return FollowPlan(*stream, observer, &last_job_, followed, out);
 }
 
-Status Client::AttachEvaluateOnce(const JobObserver& observer, EvaluateOutcome* out, bool* followed) {
+Status Client::AttachEvaluateOnce(const JobObserver& observer, EvaluateJobResult* out, bool* followed) {
   auto stub = v1::StationPlanner::NewStub(AttachChannel(last_job_));
   grpc::ClientContext ctx;
   Prepare(&ctx);
@@ -399,9 +405,9 @@ Result<PlanResult> Client::AttachPlan(const std::string& job_id, const JobObserv
   return out;
 }
 
-Result<EvaluateOutcome> Client::AttachEvaluate(const std::string& job_id, const JobObserver& observer) {
+Result<EvaluateJobResult> Client::AttachEvaluate(const std::string& job_id, const JobObserver& observer) {
   last_job_ = {job_id, "", 0};
-  EvaluateOutcome out;
+  EvaluateJobResult out;
   const auto once = [&](bool* followed) { return AttachEvaluateOnce(observer, &out, followed); };
   const Status s = Reattach(WithRetries(observer, once), observer, once);
   if (!s.ok()) return s;

@@ -112,15 +112,29 @@ class InterruptCancelsTheJob {
   vc::client::JobTicket job_;
 };
 
-// Writes evaluation.json (naming `crs` when given) and stations.csv, prints G and the files written.
-int WriteEvaluation(const vc::Evaluation& r, const std::vector<vc::WorldPoint>& viewpoints, const std::string& out_dir,
+// Writes the evaluation's reports (stations.geojson and true north on the field sheet with a CRS),
+// prints G and the files written.
+int WriteEvaluation(const vc::EvaluateJobResult& result, const std::string& out_dir, const std::string& paper,
                     const vc::Crs* crs = nullptr) {
-  vc::Status written = vc::WriteEvaluationOutputs(r, viewpoints, out_dir, crs == nullptr ? nullptr : &crs->info());
-  if (!written.ok()) return Fail("cannot write evaluation.json", written);
-  std::printf("global visibility G = %.4f%s over %llu faces; wrote evaluation.json, stations.csv to %s\n",
-              r.overall.global_visibility,
-              r.sampled ? (" (+/- " + std::to_string(r.global_visibility_ci95) + ", sampled)").c_str() : "",
-              static_cast<unsigned long long>(r.faces_evaluated), out_dir.c_str());
+  vc::FieldSheetOptions sheet;
+  sheet.paper = paper == "a4" ? vc::PaperSize::kA4 : vc::PaperSize::kA3;
+  vc::Status written = vc::WriteEvaluationOutputs(result, out_dir, crs, sheet);
+  if (!written.ok()) return Fail("cannot write the reports", written);
+  const vc::Evaluation& r = result.evaluation;
+  const bool per_voxel = !r.best_face_values.empty();
+  std::printf(
+      "global visibility G = %.4f%s over %llu faces; wrote evaluation.json, stations.csv, stations.dxf, "
+      "%sfieldsheet.pdf%s to %s\n",
+      r.overall.global_visibility,
+      r.sampled ? (" (+/- " + std::to_string(r.global_visibility_ci95) + ", sampled)").c_str() : "",
+      static_cast<unsigned long long>(r.faces_evaluated), crs != nullptr ? "stations.geojson, " : "",
+      per_voxel ? ", visibility.ply, heatmap.png (what the stations miss), report.html" : "", out_dir.c_str());
+  if (!per_voxel) {
+    std::printf("no visibility.ply, heatmap.png, report.html: a sampled evaluation has no per-voxel values\n");
+  }
+  if (crs == nullptr) {
+    std::printf("no stations.geojson: name the scene's CRS (--crs EPSG:25832, say) for a map in longitude/latitude\n");
+  }
   return 0;
 }
 
@@ -220,7 +234,7 @@ struct CommandLine {
   bool raw_upload = false;
   std::string units;                     // submit, evaluate, inspect (--units; empty = metres)
   std::string crs;                       // submit, evaluate, attach (--crs; empty = none)
-  std::string paper = "a3";              // submit, attach: fieldsheet.pdf's paper (--paper)
+  std::string paper = "a3";              // submit, evaluate, attach: fieldsheet.pdf's paper (--paper)
   vc::PlanOptions plan;                  // submit
   vc::client::PlanFileFlags plan_files;  // submit
   vc::EvaluateJobOptions eval;           // evaluate
@@ -280,7 +294,9 @@ CLI::App* AddSubmitCommand(CLI::App& app, CommandLine* cl) {
 
 CLI::App* AddEvaluateCommand(CLI::App& app, CommandLine* cl) {
   auto* evaluate = app.add_subcommand(
-      "evaluate", "evaluate viewpoints or a plan on a scene on the server; write evaluation.json and stations.csv");
+      "evaluate",
+      "evaluate viewpoints or a plan on a scene on the server; write evaluation.json and submit's files for them "
+      "(stations.csv, stations.dxf, fieldsheet.pdf, visibility.ply, heatmap.png of what they miss, report.html)");
   evaluate->add_option("FILE", cl->file, "scene file")->required();
   auto* viewpoints =
       evaluate->add_option("--viewpoints", cl->viewpoints_csv, "CSV of viewpoints x,y,z (e.g. stations.csv)");
@@ -294,6 +310,7 @@ CLI::App* AddEvaluateCommand(CLI::App& app, CommandLine* cl) {
   AddUnitsFlag(evaluate, &cl->units);
   evaluate->add_option("--crs", cl->crs, kCrsHelp);
   evaluate->add_option("--detach-grace", cl->conn.detach_grace_s, kDetachHelp)->capture_default_str();
+  AddPaperFlag(evaluate, &cl->paper);
   vc::client::AddEvaluateFlags(evaluate, &cl->eval);
   return evaluate;
 }
@@ -377,7 +394,7 @@ int RunAttach(vc::client::Client& client, const CommandLine& cl) {
   display.Done();
   if (!job.ok()) return FailCall("attach", job.status(), cl.conn.server);
   if (job->kind == vc::client::AttachedJob::Kind::kEvaluation) {
-    return WriteEvaluation(job->evaluation.evaluation, job->evaluation.viewpoints, cl.out_dir, crs_ptr);
+    return WriteEvaluation(job->evaluation, cl.out_dir, cl.paper, crs_ptr);
   }
   return WritePlan(job->plan, cl.out_dir, cl.paper, nullptr, {}, crs_ptr);
 }
@@ -440,12 +457,16 @@ struct CheckedEvaluate {
   vc::client::PreparedUpload prepared;
 };
 
-// --plan's stations and CRS into `checked`, and its scanner for the rows whose flags are not given
+// --plan's stations and CRS into `checked`, and its scanner and resolution for the flags not given
 // (each given flag that differs from the plan is noted on stderr).
 vc::Status TakePlan(const CommandLine& cl, const CLI::App& evaluate, CheckedEvaluate* checked, std::string* crs) {
   VC_ASSIGN_OR_RETURN(vc::client::PlanForEvaluation plan, vc::client::LoadPlanForEvaluation(cl.plan_json));
   checked->eval.viewpoints = std::move(plan.stations);
   for (const std::string& flag : vc::client::TakeScannerFromPlan(evaluate, plan.scanner, &checked->eval.scanner)) {
+    std::cerr << "vc-client: " << flag << " overrides " << cl.plan_json << "\n";
+  }
+  for (const std::string& flag :
+       vc::client::TakeResolutionFromPlan(evaluate, plan.resolution_m, &checked->eval.resolution_m)) {
     std::cerr << "vc-client: " << flag << " overrides " << cl.plan_json << "\n";
   }
   if (checked->eval.scanner.HasHorizontalFieldOfView()) {
@@ -490,7 +511,7 @@ int RunEvaluate(const CommandLine& cl, const CLI::App& evaluate, InterruptCancel
   if (!r.ok()) return FailCall("evaluate", r.status(), cl.conn.server);
   NoteCache((*client)->last_upload(), &prepared.summary, display);
   const std::optional<vc::Crs>& crs = checked->crs.crs;
-  return WriteEvaluation(*r, checked->eval.viewpoints, cl.out_dir, crs ? &*crs : nullptr);
+  return WriteEvaluation(*r, cl.out_dir, cl.paper, crs ? &*crs : nullptr);
 }
 
 // Parses the command line; on a mistake prints CLI11's message and, for a misspelt flag or

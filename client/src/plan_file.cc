@@ -76,6 +76,8 @@ Result<PlanForEvaluation> ParsePlanForEvaluation(std::string_view text, const st
   PlanForEvaluation out;
   VC_ASSIGN_OR_RETURN(out.stations, Stations(plan, source));
   VC_ASSIGN_OR_RETURN(out.scanner, Scanner(plan, source));
+  VC_ASSIGN_OR_RETURN(out.resolution_m, Number(plan, "resolution_m", "resolution_m", source));
+  if (out.resolution_m <= 0) return Refuse(source, "resolution_m is not positive");
   if (plan.contains("crs") && plan["crs"].is_object()) {
     const Json& crs = plan["crs"];
     if (!crs.contains("definition") || !crs["definition"].is_string())
@@ -109,6 +111,16 @@ std::vector<std::string> TakeScannerFromPlan(const CLI::App& command, const Scan
 #undef VC_ROW_TAKE
   if (!preset) scanner->name = plan_scanner.name;
   return differ;
+}
+
+std::vector<std::string> TakeResolutionFromPlan(const CLI::App& command, double plan_resolution_m,
+                                                double* resolution_m) {
+  if (command.get_option("--resolution")->count() == 0) {
+    *resolution_m = plan_resolution_m;
+    return {};
+  }
+  if (*resolution_m == plan_resolution_m) return {};
+  return {"--resolution " + Metres(*resolution_m, "m") + " (the plan: " + Metres(plan_resolution_m, "m") + ")"};
 }
 
 }  // namespace vc::client

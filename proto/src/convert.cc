@@ -528,10 +528,10 @@ std::vector<v1::HeatMapChunk> HeatMapChunks(const HeatMap& h, const WorldPoint& 
   return chunks;
 }
 
-bool ForEachVoxelChunk(const PlanResult& result, const std::function<bool(v1::VoxelChunk&&)>& fn) {
-  const auto& centers = result.voxel_centers;
-  const auto& values = result.evaluation.best_face_values;
-  const auto& viewers = result.evaluation.sole_viewer;
+bool ForEachVoxelChunk(const std::vector<WorldPoint>& centers, const Evaluation& evaluation,
+                       const WorldPoint& frame_origin_m, const std::function<bool(v1::VoxelChunk&&)>& fn) {
+  const auto& values = evaluation.best_face_values;
+  const auto& viewers = evaluation.sole_viewer;
   const bool with_values = values.size() == centers.size();
   const size_t n = centers.size();
   for (size_t first = 0; first < n; first += kVoxelsPerChunk) {
@@ -541,7 +541,7 @@ bool ForEachVoxelChunk(const PlanResult& result, const std::function<bool(v1::Vo
     c.set_total_voxels(n);
     c.mutable_centers_xyz_m()->Reserve(int((end - first) * 3));
     for (size_t i = first; i < end; ++i) {
-      for (int a = 0; a < 3; ++a) c.add_centers_xyz_m(PlusOrigin(centers[i][a], result.frame_origin_m[a]));
+      for (int a = 0; a < 3; ++a) c.add_centers_xyz_m(PlusOrigin(centers[i][a], frame_origin_m[a]));
     }
     if (with_values) {
       c.mutable_best_face_values()->Reserve(int((end - first) * kFacesPerVoxel));
@@ -555,6 +555,14 @@ bool ForEachVoxelChunk(const PlanResult& result, const std::function<bool(v1::Vo
     if (!fn(std::move(c))) return false;
   }
   return true;
+}
+
+bool ForEachVoxelChunk(const PlanResult& result, const std::function<bool(v1::VoxelChunk&&)>& fn) {
+  return ForEachVoxelChunk(result.voxel_centers, result.evaluation, result.frame_origin_m, fn);
+}
+
+bool ForEachVoxelChunk(const EvaluateJobResult& result, const std::function<bool(v1::VoxelChunk&&)>& fn) {
+  return ForEachVoxelChunk(result.voxel_centers, result.evaluation, result.frame_origin_m, fn);
 }
 
 v1::PlanResult ToProto(const PlanResult& r) {
@@ -653,58 +661,82 @@ Status PlanResultAssembler::AddHeatMap(const v1::HeatMapChunk& c) {
   return Status::Ok();
 }
 
-Status PlanResultAssembler::AddVoxels(const v1::VoxelChunk& c) {
-  if (c.first_voxel_id() != centers_.size()) return ChunkError("voxel chunk out of order");
+Status VoxelChunkAssembler::Add(const v1::VoxelChunk& c) {
+  std::vector<WorldPoint>& centers = voxels_.centers;
+  auto& face_values = voxels_.best_face_values;
+  auto& sole_viewers = voxels_.sole_viewer;
+  if (c.first_voxel_id() != centers.size()) return ChunkError("voxel chunk out of order");
   if (c.centers_xyz_m_size() % 3 != 0) return ChunkError("voxel chunk with a partial centre");
   const int n = c.centers_xyz_m_size() / 3;
   const bool with_values = c.best_face_values_size() > 0;
   if (with_values && c.best_face_values_size() != n * kFacesPerVoxel) {
     return ChunkError("voxel chunk with face values for a different number of voxels");
   }
-  if (with_values != (face_values_.size() == centers_.size()) && !centers_.empty()) {
+  if (with_values != (face_values.size() == centers.size()) && !centers.empty()) {
     return ChunkError("face values present in some voxel chunks only");
   }
   const bool with_viewers = c.sole_viewer_size() > 0;
   if (with_viewers && (!with_values || c.sole_viewer_size() != n)) {
     return ChunkError("voxel chunk with sole viewers for a different number of voxels");
   }
-  if (with_viewers != (sole_viewers_.size() == centers_.size()) && !centers_.empty()) {
+  if (with_viewers != (sole_viewers.size() == centers.size()) && !centers.empty()) {
     return ChunkError("sole viewers present in some voxel chunks only");
   }
   for (int32_t v : c.sole_viewer()) {
     if (v < kSeveralViewers) return ChunkError("voxel chunk with a sole viewer below -2");
   }
-  sole_viewers_.insert(sole_viewers_.end(), c.sole_viewer().begin(), c.sole_viewer().end());
-  voxel_total_ = c.total_voxels();
+  sole_viewers.insert(sole_viewers.end(), c.sole_viewer().begin(), c.sole_viewer().end());
+  total_ = c.total_voxels();
   for (int i = 0; i < n; ++i) {
-    centers_.emplace_back(c.centers_xyz_m(3 * i), c.centers_xyz_m(3 * i + 1), c.centers_xyz_m(3 * i + 2));
+    centers.emplace_back(c.centers_xyz_m(3 * i), c.centers_xyz_m(3 * i + 1), c.centers_xyz_m(3 * i + 2));
     if (with_values) {
       std::array<float, kFacesPerVoxel> v{};
       for (int f = 0; f < kFacesPerVoxel; ++f) v[f] = c.best_face_values(kFacesPerVoxel * i + f);
-      face_values_.push_back(v);
+      face_values.push_back(v);
     }
   }
-  if (centers_.size() > voxel_total_) return ChunkError("more voxels than declared");
+  if (centers.size() > total_) return ChunkError("more voxels than declared");
   return Status::Ok();
 }
+
+Result<AssembledVoxels> VoxelChunkAssembler::Finish(uint64_t voxel_count, uint64_t face_value_voxels, int stations,
+                                                    const WorldPoint& frame_origin_m) && {
+  AssembledVoxels& v = voxels_;
+  if (v.centers.size() != voxel_count) {
+    return ChunkError("received " + std::to_string(v.centers.size()) + " voxels of " + std::to_string(voxel_count));
+  }
+  if (face_value_voxels != 0 && v.best_face_values.size() != face_value_voxels) {
+    return ChunkError("received face values for " + std::to_string(v.best_face_values.size()) + " voxels of " +
+                      std::to_string(face_value_voxels));
+  }
+  if (!v.sole_viewer.empty() && v.sole_viewer.size() != v.best_face_values.size()) {
+    return ChunkError("received sole viewers for " + std::to_string(v.sole_viewer.size()) + " voxels of " +
+                      std::to_string(v.best_face_values.size()));
+  }
+  for (int32_t viewer : v.sole_viewer) {
+    if (viewer >= stations) {
+      return ChunkError("a sole viewer names station " + std::to_string(viewer) + " of " + std::to_string(stations));
+    }
+  }
+  for (WorldPoint& q : v.centers) q = LessOrigin(q, frame_origin_m);
+  return std::move(v);
+}
+
+Status PlanResultAssembler::AddVoxels(const v1::VoxelChunk& c) { return voxels_.Add(c); }
 
 Result<PlanResult> PlanResultAssembler::Finish(const v1::PlanResult& p) && {
   if (heat_map_.positions.size() != p.heat_map_candidates()) {
     return ChunkError("received " + std::to_string(heat_map_.positions.size()) + " heat map candidates of " +
                       std::to_string(p.heat_map_candidates()));
   }
-  if (centers_.size() != p.voxel_count()) {
-    return ChunkError("received " + std::to_string(centers_.size()) + " voxels of " + std::to_string(p.voxel_count()));
-  }
-  if (p.evaluation().face_value_voxels() != 0 && face_values_.size() != p.evaluation().face_value_voxels()) {
-    return ChunkError("received face values for " + std::to_string(face_values_.size()) + " voxels of " +
-                      std::to_string(p.evaluation().face_value_voxels()));
-  }
   PlanResult r;
-  VC_ASSIGN_OR_RETURN(r.options, FromProto(p.options()));
   r.frame_origin_m = FromProto(p.frame_origin());
   const WorldPoint& origin = r.frame_origin_m;
   if (!origin.allFinite()) return ChunkError("the frame's origin is not finite");
+  VC_ASSIGN_OR_RETURN(
+      AssembledVoxels voxels,
+      std::move(voxels_).Finish(p.voxel_count(), p.evaluation().face_value_voxels(), p.stations_size(), origin));
+  VC_ASSIGN_OR_RETURN(r.options, FromProto(p.options()));
   r.resolution_m = p.resolution_m();
   VC_ASSIGN_OR_RETURN(r.selection_test, FromProto(p.selection_test()));
   for (const auto& s : p.stations()) {
@@ -721,19 +753,8 @@ Result<PlanResult> PlanResultAssembler::Finish(const v1::PlanResult& p) && {
   r.coverable_voxels = p.coverable_voxels();
   r.covered_voxels = p.covered_voxels();
   r.evaluation = FromProto(p.evaluation());
-  r.evaluation.best_face_values = std::move(face_values_);
-  if (!sole_viewers_.empty()) {
-    if (sole_viewers_.size() != r.evaluation.best_face_values.size()) {
-      return ChunkError("received sole viewers for " + std::to_string(sole_viewers_.size()) + " voxels of " +
-                        std::to_string(r.evaluation.best_face_values.size()));
-    }
-    for (int32_t v : sole_viewers_) {
-      if (v >= p.stations_size())
-        return ChunkError("a sole viewer names station " + std::to_string(v) + " of " +
-                          std::to_string(p.stations_size()));
-    }
-  }
-  r.evaluation.sole_viewer = std::move(sole_viewers_);
+  r.evaluation.best_face_values = std::move(voxels.best_face_values);
+  r.evaluation.sole_viewer = std::move(voxels.sole_viewer);
   for (const auto& t : p.timings()) r.timings.push_back({FromProto(t.stage()), t.seconds()});
   r.total_seconds = p.total_seconds();
   r.warnings.assign(p.warnings().begin(), p.warnings().end());
@@ -785,15 +806,36 @@ Result<PlanResult> PlanResultAssembler::Finish(const v1::PlanResult& p) && {
   r.unseen_causes = {u.interior(),     u.in_keep_out(),           u.no_candidate_on_floor(),
                      u.out_of_range(), u.outside_field_of_view(), u.faces_away(),
                      u.hidden()};
-  r.voxel_centers = std::move(centers_);
-  for (WorldPoint& q : r.voxel_centers) q = LessOrigin(q, origin);
+  r.voxel_centers = std::move(voxels.centers);
   return r;
 }
 
-v1::EvaluateResult ToProto(const Evaluation& e, const std::vector<WorldPoint>& viewpoints) {
+v1::EvaluateResult ToProto(const EvaluateJobResult& result) {
   v1::EvaluateResult r;
-  *r.mutable_evaluation() = ToProto(e);
-  for (const auto& v : viewpoints) *r.add_viewpoints() = ToProto(v);
+  *r.mutable_evaluation() = ToProto(result.evaluation);
+  if (result.evaluation.best_face_values.size() != result.voxel_centers.size()) {
+    r.mutable_evaluation()->set_face_value_voxels(0);  // not streamed (see ForEachVoxelChunk)
+  }
+  for (const auto& v : result.viewpoints) *r.add_viewpoints() = ToProto(v);
+  r.set_voxel_count(result.voxel_centers.size());
+  *r.mutable_frame_origin() = ToProto(result.frame_origin_m);
+  return r;
+}
+
+Status EvaluateResultAssembler::AddVoxels(const v1::VoxelChunk& chunk) { return voxels_.Add(chunk); }
+
+Result<EvaluateJobResult> EvaluateResultAssembler::Finish(const v1::EvaluateResult& p) && {
+  EvaluateJobResult r;
+  r.frame_origin_m = FromProto(p.frame_origin());
+  if (!r.frame_origin_m.allFinite()) return ChunkError("the frame's origin is not finite");
+  VC_ASSIGN_OR_RETURN(AssembledVoxels voxels,
+                      std::move(voxels_).Finish(p.voxel_count(), p.evaluation().face_value_voxels(),
+                                                p.viewpoints_size(), r.frame_origin_m));
+  r.evaluation = FromProto(p.evaluation());
+  r.evaluation.best_face_values = std::move(voxels.best_face_values);
+  r.evaluation.sole_viewer = std::move(voxels.sole_viewer);
+  r.voxel_centers = std::move(voxels.centers);
+  for (const auto& v : p.viewpoints()) r.viewpoints.push_back(FromProto(v));
   return r;
 }
 

@@ -125,10 +125,16 @@ class EvaluateReactor final : public JobReactor<v1::EvaluateRequest, v1::Evaluat
 
   Status Run(const SceneInput& input, const JobContext& ctx, JobLog& log) override {
     log.set_details(fmt::format(" viewpoints={}", options_.viewpoints.size()));
-    VC_ASSIGN_OR_RETURN(const Evaluation evaluation, backend().evaluate(input, options_, ctx));
+    VC_ASSIGN_OR_RETURN(const EvaluateJobResult result, backend().evaluate(input, options_, ctx));
+    // The voxels, then the summary: together the whole EvaluateJobResult, as a plan's result.
+    wire::ForEachVoxelChunk(result, [this](v1::VoxelChunk&& c) {
+      v1::EvaluateResponse r;
+      *r.mutable_voxels() = std::move(c);
+      return channel().Post(std::move(r), /*bulk=*/true);
+    });
     v1::EvaluateResponse r;
-    *r.mutable_result() = wire::ToProto(evaluation, options_.viewpoints);
-    channel().Post(std::move(r));
+    *r.mutable_result() = wire::ToProto(result);
+    channel().Post(std::move(r), /*bulk=*/true);
     return ctx.CheckCancelled("the evaluation (while sending the result)");
   }
 

@@ -126,6 +126,55 @@ TEST(Client, AGeoreferencedPlanComesBackLocalAndWritesTheServersFilesInTheInputs
   EXPECT_NE(StationsCsvOf(*r).find("512345.457000,5612330.123000"), std::string::npos) << StationsCsvOf(*r);
 }
 
+// An Evaluate's voxels come in VoxelChunk messages as a plan's do: Client::Evaluate rebuilds the
+// server's EvaluateJobResult exactly (voxels local again), and vc-client's files from it are the
+// server's result's.
+TEST(Client, EvaluateRebuildsAChunkedEvaluationExactly) {
+  const WorldPoint origin(512000, 5612000, 0);
+  EvaluateJobResult sent;
+  const PlanResult plan = BigResult();
+  sent.voxel_centers = plan.voxel_centers;  // three voxel chunks
+  sent.evaluation = plan.evaluation;
+  sent.evaluation.resolution_m = plan.resolution_m;
+  sent.evaluation.sole_viewer.assign(sent.voxel_centers.size(), kNoViewer);
+  sent.evaluation.sole_viewer[7] = 1;
+  sent.evaluation.per_viewpoint.resize(2);
+  sent.frame_origin_m = origin;
+  sent.viewpoints = {origin + WorldPoint(1, 0, 1.5), origin + WorldPoint(2, 1, 1.5)};
+  testing::BlockingBackend backend;
+  server::Backend b = backend.Make();
+  b.evaluate = [&](const SceneInput&, const EvaluateJobOptions&, const JobContext&) -> Result<EvaluateJobResult> {
+    return sent;
+  };
+  server::ServerOptions o;
+  o.workers = 1;
+  auto server = testing::StartServer(o, b);
+  ASSERT_TRUE(server);
+  client::ConnectionOptions conn;
+  conn.server = testing::Address(*server);
+  auto c = client::Client::Create(conn);
+  ASSERT_TRUE(c.ok());
+  EvaluateJobOptions options;
+  options.viewpoints = sent.viewpoints;
+  auto r = (*c)->Evaluate({"some scene bytes", "x.ply"}, options);
+  ASSERT_TRUE(r.ok()) << r.status().ToString();
+  EXPECT_EQ(r->frame_origin_m, origin);
+  EXPECT_EQ(r->viewpoints, sent.viewpoints);
+  ASSERT_EQ(r->voxel_centers.size(), sent.voxel_centers.size());
+  for (size_t i = 0; i < sent.voxel_centers.size(); i += 1001) {
+    EXPECT_LT((r->voxel_centers[i] - sent.voxel_centers[i]).norm(), 1e-9) << i;
+  }
+  EXPECT_EQ(r->evaluation.best_face_values, sent.evaluation.best_face_values);
+  EXPECT_EQ(r->evaluation.sole_viewer, sent.evaluation.sole_viewer);
+  const std::string from_client = testing::MakeTempDir(), from_server = testing::MakeTempDir();
+  ASSERT_TRUE(WriteEvaluationOutputs(*r, from_client).ok());
+  ASSERT_TRUE(WriteEvaluationOutputs(sent, from_server).ok());
+  EXPECT_EQ(testing::ReadFileBytes(from_client + "/stations.csv"),
+            testing::ReadFileBytes(from_server + "/stations.csv"));
+  EXPECT_EQ(testing::ReadFileBytes(from_client + "/visibility.ply"),
+            testing::ReadFileBytes(from_server + "/visibility.ply"));
+}
+
 TEST(Client, UnavailableServerIsRetriedWithBackoffThenReported) {
   // Reserve a free port, then shut the server down so nothing listens there.
   int port = 0;
@@ -269,10 +318,12 @@ struct GatedBackend {
       if (!plan_failure.ok()) return plan_failure;
       return plan_result;
     };
-    b.evaluate = [wait](const SceneInput&, const EvaluateJobOptions&, const JobContext& ctx) -> Result<Evaluation> {
+    b.evaluate = [wait](const SceneInput&, const EvaluateJobOptions& o,
+                        const JobContext& ctx) -> Result<EvaluateJobResult> {
       VC_RETURN_IF_ERROR(wait(ctx));
-      Evaluation e;
-      e.overall.global_visibility = kEvaluationG;
+      EvaluateJobResult e;
+      e.evaluation.overall.global_visibility = kEvaluationG;
+      e.viewpoints = o.viewpoints;  // as vc::RunEvaluation gives them back
       return e;
     };
     return b;

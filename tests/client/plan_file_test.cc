@@ -1,4 +1,5 @@
-// evaluate --plan: plan.json read for its stations, scanner and CRS; each malformed file refused naming the field.
+// evaluate --plan: plan.json read for its stations, scanner, resolution and CRS; each malformed file refused
+// naming the field.
 #include "vc/client/plan_file.h"
 
 #include <gtest/gtest.h>
@@ -15,6 +16,7 @@ namespace {
 constexpr const char* kPlan = R"({
   "schema": "vc.plan/1",
   "crs": {"definition": "EPSG:25832", "name": "ETRS89 / UTM zone 32N"},
+  "resolution_m": 0.1,
   "viewpoints": [{"x": 1.5, "y": 2.0, "z": 1.6}, {"x": -3.0, "y": 4.25, "z": 2.1}],
   "parameters": {"scanner": {"min_range_m": 0.6, "max_range_m": 10.0, "vfov_min_deg": null, "vfov_max_deg": null,
     "max_incidence_deg": 80.0, "angular_step_deg": null, "max_spacing_m": null, "hfov_deg": null, "name": null}}
@@ -34,6 +36,22 @@ TEST(PlanFile, ReadsStationsScannerAndCrs) {
   EXPECT_EQ(plan->scanner.hfov_deg, 360.0);
   EXPECT_EQ(plan->scanner.name, "");
   EXPECT_EQ(plan->crs_definition, "EPSG:25832");
+  EXPECT_EQ(plan->resolution_m, 0.1);
+}
+
+TEST(PlanFile, MissingOrNonPositiveResolutionIsNamed) {
+  std::string text = kPlan;
+  const std::string row = "\"resolution_m\": 0.1,";
+  const size_t at = text.find(row);
+  ASSERT_NE(at, std::string::npos);
+  std::string without = text;
+  without.erase(at, row.size());
+  EXPECT_NE(ParseError(without).message().find("p/plan.json: no resolution_m"), std::string::npos)
+      << ParseError(without).message();
+  std::string zero = text;
+  zero.replace(at, row.size(), "\"resolution_m\": 0,");
+  EXPECT_NE(ParseError(zero).message().find("resolution_m is not positive"), std::string::npos)
+      << ParseError(zero).message();
 }
 
 TEST(PlanFile, NotJsonIsRefusedNamingTheFile) {
@@ -91,7 +109,11 @@ Taken TakeWith(std::vector<std::string> args) {
   AddEvaluateFlags(&app, &t.options);
   std::reverse(args.begin(), args.end());
   app.parse(args);
-  t.differ = TakeScannerFromPlan(app, ParsePlanForEvaluation(kPlan, "plan.json")->scanner, &t.options.scanner);
+  const PlanForEvaluation plan = *ParsePlanForEvaluation(kPlan, "plan.json");
+  t.differ = TakeScannerFromPlan(app, plan.scanner, &t.options.scanner);
+  for (std::string& line : TakeResolutionFromPlan(app, plan.resolution_m, &t.options.resolution_m)) {
+    t.differ.push_back(std::move(line));
+  }
   return t;
 }
 
@@ -109,6 +131,17 @@ TEST(PlanFile, GivenFlagOverridesThePlanAndIsNoted) {
   EXPECT_EQ(t.options.scanner.max_incidence_deg, 80.0);
   ASSERT_EQ(t.differ.size(), 1u);  // --min-range equals the plan's
   EXPECT_EQ(t.differ[0], "--max-range 30 m (the plan: 10 m)");
+}
+
+TEST(PlanFile, ResolutionComesFromThePlanUnlessTheFlagOverridesIt) {
+  EXPECT_EQ(TakeWith({}).options.resolution_m, 0.1);
+  const Taken same = TakeWith({"--resolution", "0.1"});
+  EXPECT_EQ(same.options.resolution_m, 0.1);
+  EXPECT_TRUE(same.differ.empty());
+  const Taken t = TakeWith({"--resolution", "0.25"});
+  EXPECT_EQ(t.options.resolution_m, 0.25);
+  ASSERT_EQ(t.differ.size(), 1u);
+  EXPECT_EQ(t.differ[0], "--resolution 0.25 m (the plan: 0.1 m)");
 }
 
 }  // namespace

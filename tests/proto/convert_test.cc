@@ -1,5 +1,6 @@
-// The proto <-> core conversions of vc/wire/convert.h: plan parameters both ways, and a result
-// cut into chunks and reassembled (the scanner model's conversion: scanner_convert_test.cc).
+// The proto <-> core conversions of vc/wire/convert.h: plan parameters both ways, and a plan's or
+// an evaluation's result cut into chunks and reassembled (the scanner model's conversion:
+// scanner_convert_test.cc).
 #include "vc/wire/convert.h"
 
 #include <gtest/gtest.h>
@@ -403,6 +404,111 @@ TEST(PlanResultChunks, OutOfOrderChunkIsDataLoss) {
   ASSERT_EQ(chunks.size(), 2u);
   PlanResultAssembler a;
   EXPECT_EQ(a.AddVoxels(chunks[1]).code(), StatusCode::kDataLoss);
+}
+
+// An evaluation of two viewpoints with `voxels` voxels (BigResult's), its frame at `origin`.
+EvaluateJobResult BigEvaluation(size_t voxels, const WorldPoint& origin = WorldPoint::Zero()) {
+  const PlanResult plan = BigResult(voxels, 0);
+  EvaluateJobResult r;
+  r.evaluation = plan.evaluation;
+  r.evaluation.per_viewpoint.resize(2);
+  r.evaluation.per_viewpoint[1].global_visibility = 0.37;
+  r.voxel_centers = plan.voxel_centers;
+  r.frame_origin_m = origin;
+  r.viewpoints = {origin + WorldPoint(1, 2, 1.5), origin + WorldPoint(3, 2, 1.5)};
+  return r;
+}
+
+std::vector<v1::VoxelChunk> EvaluationChunks(const EvaluateJobResult& r) {
+  std::vector<v1::VoxelChunk> chunks;
+  ForEachVoxelChunk(r, [&](v1::VoxelChunk&& c) {
+    chunks.push_back(std::move(c));
+    return true;
+  });
+  return chunks;
+}
+
+TEST(EvaluateResultChunks, ReassembleExactlyWithTheVoxelsLocalAndTheViewpointsAsGiven) {
+  for (const WorldPoint origin : {WorldPoint(0, 0, 0), WorldPoint(512000, 5612000, 100)}) {
+    const EvaluateJobResult r = BigEvaluation(2 * kVoxelsPerChunk + 5, origin);
+    const std::vector<v1::VoxelChunk> chunks = EvaluationChunks(r);
+    ASSERT_EQ(chunks.size(), 3u);
+    EXPECT_EQ(chunks[0].centers_xyz_m(3 * 7), origin.x() + 7 * 0.1);  // the input's frame on the wire
+    const v1::EvaluateResult summary = ToProto(r);
+    EXPECT_EQ(summary.voxel_count(), r.voxel_centers.size());
+    EXPECT_EQ(summary.evaluation().face_value_voxels(), r.voxel_centers.size());
+    EXPECT_EQ(FromProto(summary.frame_origin()), origin);
+    EvaluateResultAssembler a;
+    for (const v1::VoxelChunk& c : chunks) {
+      EXPECT_LE(c.ByteSizeLong(), size_t{1} << 20);
+      ASSERT_TRUE(a.AddVoxels(c).ok());
+    }
+    auto back = std::move(a).Finish(summary);
+    ASSERT_TRUE(back.ok()) << back.status().ToString();
+    EXPECT_EQ(back->viewpoints, r.viewpoints);
+    EXPECT_EQ(back->frame_origin_m, origin);
+    ASSERT_EQ(back->voxel_centers.size(), r.voxel_centers.size());
+    for (size_t i = 0; i < r.voxel_centers.size(); i += 997) {
+      EXPECT_LT((back->voxel_centers[i] - r.voxel_centers[i]).norm(), 1e-9) << i;
+    }
+    EXPECT_EQ(back->evaluation.best_face_values, r.evaluation.best_face_values);
+    EXPECT_EQ(back->evaluation.sole_viewer, r.evaluation.sole_viewer);
+    EXPECT_EQ(back->evaluation.per_viewpoint[1].global_visibility, 0.37);
+  }
+}
+
+TEST(EvaluateResultChunks, WithoutFaceValuesOnlyTheCentresTravel) {
+  EvaluateJobResult r = BigEvaluation(kVoxelsPerChunk + 1);
+  r.evaluation.best_face_values.clear();  // a sampled evaluation
+  r.evaluation.sole_viewer.clear();
+  EvaluateResultAssembler a;
+  for (const v1::VoxelChunk& c : EvaluationChunks(r)) {
+    EXPECT_EQ(c.best_face_values_size(), 0);
+    ASSERT_TRUE(a.AddVoxels(c).ok());
+  }
+  const v1::EvaluateResult summary = ToProto(r);
+  EXPECT_EQ(summary.evaluation().face_value_voxels(), 0u);
+  auto back = std::move(a).Finish(summary);
+  ASSERT_TRUE(back.ok()) << back.status().ToString();
+  EXPECT_EQ(back->voxel_centers.size(), r.voxel_centers.size());
+  EXPECT_TRUE(back->evaluation.best_face_values.empty());
+}
+
+TEST(EvaluateResultChunks, MissingOrOutOfOrderChunkIsDataLoss) {
+  const EvaluateJobResult r = BigEvaluation(2 * kVoxelsPerChunk + 5);
+  const std::vector<v1::VoxelChunk> chunks = EvaluationChunks(r);
+  ASSERT_EQ(chunks.size(), 3u);
+  {
+    EvaluateResultAssembler a;
+    EXPECT_EQ(a.AddVoxels(chunks[1]).code(), StatusCode::kDataLoss);
+  }
+  {
+    EvaluateResultAssembler a;
+    ASSERT_TRUE(a.AddVoxels(chunks[0]).ok());
+    EXPECT_EQ(a.AddVoxels(chunks[2]).code(), StatusCode::kDataLoss);
+  }
+  {
+    EvaluateResultAssembler a;  // the last chunk never came
+    ASSERT_TRUE(a.AddVoxels(chunks[0]).ok());
+    ASSERT_TRUE(a.AddVoxels(chunks[1]).ok());
+    auto back = std::move(a).Finish(ToProto(r));
+    EXPECT_EQ(back.status().code(), StatusCode::kDataLoss);
+    EXPECT_NE(back.status().message().find("received 32768 voxels of 32773"), std::string::npos)
+        << back.status().message();
+  }
+}
+
+TEST(EvaluateResultChunks, ASoleViewerNamingAMissingViewpointOrANonFiniteOriginIsDataLoss) {
+  for (int bad = 0; bad < 2; ++bad) {
+    EvaluateJobResult r = BigEvaluation(100);
+    v1::EvaluateResult summary = ToProto(r);
+    if (bad == 0) summary.mutable_viewpoints()->RemoveLast();  // sole viewers name viewpoint 1
+    if (bad == 1) summary.mutable_frame_origin()->set_y_m(std::nan(""));
+    EvaluateResultAssembler a;
+    for (const v1::VoxelChunk& c : EvaluationChunks(r)) ASSERT_TRUE(a.AddVoxels(c).ok());
+    auto back = std::move(a).Finish(summary);
+    EXPECT_EQ(back.status().code(), StatusCode::kDataLoss) << bad;
+  }
 }
 
 }  // namespace

@@ -49,7 +49,7 @@ struct GatedBackend {
       return r;
     };
     b.evaluate = [this, wait, real = b.evaluate](const SceneInput& in, const EvaluateJobOptions& o,
-                                                 const JobContext& ctx) -> Result<Evaluation> {
+                                                 const JobContext& ctx) -> Result<EvaluateJobResult> {
       VC_RETURN_IF_ERROR(wait(ctx));
       auto r = real(in, o, ctx);
       Returned(r.ok() ? Status::Ok() : r.status());
@@ -475,7 +475,7 @@ TEST_F(Detach, AnEvaluationIsDetachableToo) {
   eval.viewpoints = {{2, 1.5, 1.2}};
   const auto r = (*with_grace)->Evaluate({scene_, "box.ply"}, eval);
   ASSERT_TRUE(r.ok()) << r.status().ToString();
-  EXPECT_GT(r->overall.global_visibility, 0.5);
+  EXPECT_GT(r->evaluation.overall.global_visibility, 0.5);
   const client::JobTicket& ticket = (*with_grace)->last_job();
   EXPECT_EQ(ticket.detach_grace_s, 30u);
   EXPECT_EQ(EventuallyNotFound([&] { return (*c)->AttachEvaluate(ticket.job_id).status(); }).code(),

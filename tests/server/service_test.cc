@@ -135,9 +135,50 @@ TEST(EvaluateRpc, ViewpointInsideTheBoxSeesItsWalls) {
   o.viewpoints = {{2.0, 1.5, 1.2}};
   auto r = (*c)->Evaluate({testing::BoxRoomPly(), "box.ply"}, o);
   ASSERT_TRUE(r.ok()) << r.status().ToString();
-  ASSERT_EQ(r->per_viewpoint.size(), 1u);
-  EXPECT_GT(r->overall.global_visibility, 0.0);
-  EXPECT_GT(r->faces_total, 0u);
+  ASSERT_EQ(r->evaluation.per_viewpoint.size(), 1u);
+  EXPECT_GT(r->evaluation.overall.global_visibility, 0.0);
+  EXPECT_GT(r->evaluation.faces_total, 0u);
+  EXPECT_EQ(r->viewpoints, o.viewpoints);
+  EXPECT_FALSE(r->voxel_centers.empty());
+  EXPECT_EQ(r->evaluation.best_face_values.size(), r->voxel_centers.size());
+  EXPECT_EQ(r->evaluation.sole_viewer.size(), r->voxel_centers.size());
+}
+
+// An Evaluate streams its voxels as a Plan does: VoxelChunk messages in order, under 1 MiB each,
+// before the result, which counts them; a sampled evaluation sends their centres without values.
+TEST(EvaluateRpc, StreamsVoxelChunksInOrderBeforeTheResult) {
+  auto server = testing::StartServer(SmallServer());
+  ASSERT_TRUE(server);
+  const std::string bytes = testing::BoxRoomPly({8, 6, 3}, 0.05);
+  for (const uint64_t sample : {uint64_t{0}, uint64_t{500}}) {
+    std::vector<v1::EvaluateRequest> rs(2);
+    *rs[0].mutable_spec()->mutable_upload() = SpecFor(bytes);
+    v1::EvaluateParameters* p = rs[0].mutable_spec()->mutable_parameters();
+    *p->add_viewpoints() = wire::ToProto(WorldPoint(6, 5, 1.5));
+    p->set_resolution_m(0.05);
+    p->set_sample_faces(sample);
+    rs[1].mutable_chunk()->set_data(bytes);
+    const auto call = testing::RawEvaluate(testing::Address(*server), rs);
+    ASSERT_TRUE(call.status.ok()) << call.status.error_message();
+    ASSERT_TRUE(call.responses.back().has_result());
+    const v1::EvaluateResult& result = call.responses.back().result();
+    uint64_t next = 0;
+    int chunks = 0;
+    for (const auto& r : call.responses) {
+      EXPECT_LE(r.ByteSizeLong(), size_t{1} << 20) << "a message over 1 MiB";
+      if (!r.has_voxels()) continue;
+      ++chunks;
+      EXPECT_EQ(r.voxels().first_voxel_id(), next);
+      EXPECT_EQ(r.voxels().total_voxels(), result.voxel_count());
+      EXPECT_EQ(r.voxels().best_face_values_size(), sample == 0 ? r.voxels().centers_xyz_m_size() * 2 : 0);
+      next += uint64_t(r.voxels().centers_xyz_m_size() / 3);
+    }
+    EXPECT_GT(chunks, 1) << "the box at 5 cm takes more than one chunk";
+    EXPECT_GT(result.voxel_count(), 0u);
+    EXPECT_EQ(next, result.voxel_count());
+    EXPECT_EQ(result.evaluation().face_value_voxels(), sample == 0 ? result.voxel_count() : 0u);
+    EXPECT_EQ(result.viewpoints_size(), 1);
+  }
 }
 
 // A decompression bomb through the real reader: the upload limit bounds what it may decompress

@@ -57,9 +57,8 @@ server::Backend BlockingBackend::Make() {
     }
     return wait(ctx);
   };
-  b.evaluate = [wait](const SceneInput&, const EvaluateJobOptions&, const JobContext& ctx) -> Result<Evaluation> {
-    return wait(ctx);
-  };
+  b.evaluate = [wait](const SceneInput&, const EvaluateJobOptions&,
+                      const JobContext& ctx) -> Result<EvaluateJobResult> { return wait(ctx); };
   return b;
 }
 

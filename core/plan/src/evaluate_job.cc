@@ -35,15 +35,23 @@ EvaluateOptions EvaluateJobOptions::evaluate_options() const {
   o.threads = threads;
   o.sample_faces = sample_faces;
   o.seed = seed;
+  o.keep_face_values = sample_faces == 0;
   return o;
 }
 
-Result<Evaluation> RunEvaluation(const SceneInput& input, const EvaluateJobOptions& options, const JobContext& ctx) {
+Result<EvaluateJobResult> RunEvaluation(const SceneInput& input, const EvaluateJobOptions& options,
+                                        const JobContext& ctx) {
   VC_RETURN_IF_ERROR(options.Validate());
   VC_ASSIGN_OR_RETURN(VoxelScene scene, Voxelize(input, options.voxelize_options(), ctx));
   std::vector<WorldPoint> local_viewpoints = options.viewpoints;
   for (WorldPoint& p : local_viewpoints) p -= input.frame_origin_m;
-  return Evaluate(scene, local_viewpoints, options.evaluate_options(), ctx);
+  EvaluateJobResult result;
+  VC_ASSIGN_OR_RETURN(result.evaluation, Evaluate(scene, local_viewpoints, options.evaluate_options(), ctx));
+  result.viewpoints = options.viewpoints;
+  result.voxel_centers.reserve(scene.occupied.size());
+  for (size_t id = 0; id < scene.occupied.size(); ++id) result.voxel_centers.push_back(scene.Center(id));
+  result.frame_origin_m = scene.frame_origin_m;
+  return result;
 }
 
 }  // namespace vc

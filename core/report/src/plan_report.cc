@@ -10,6 +10,7 @@
 #include <map>
 #include <nlohmann/json.hpp>
 #include <optional>
+#include <unordered_set>
 
 #include "floor_plan.h"
 #include "raster.h"
@@ -156,12 +157,6 @@ std::string Short(double v) {
   char buf[64];
   std::snprintf(buf, sizeof(buf), "%.3g", v);
   return buf;
-}
-
-std::string StationsCsv(const std::vector<WorldPoint>& points) {
-  std::string out = "x,y,z\n";
-  for (const WorldPoint& p : points) out += Fixed(p.x(), 6) + "," + Fixed(p.y(), 6) + "," + Fixed(p.z(), 6) + "\n";
-  return out;
 }
 
 // Per station: its place in the route (1 = visited first), or 0 when the route leaves it out.
@@ -997,15 +992,12 @@ Result<double> TrueNorthAtSiteDeg(const PlanResult& result, const Crs& crs) {
   return -ccw_rad * 180.0 / M_PI;
 }
 
-}  // namespace
-
-Status WritePlanOutputs(const PlanResult& result, const std::string& out_dir, const UploadSummary* upload,
-                        const std::vector<std::string>& fixed_station_names, const Crs* crs,
-                        const FieldSheetOptions& field_sheet) {
-  VC_RETURN_IF_ERROR(MakeDir(out_dir));
-  const std::filesystem::path dir(out_dir);
+// The crew's files of a plan or an evaluation: stations.csv, stations.dxf, stations.geojson (with
+// `crs`) and fieldsheet.pdf.
+Status WriteStationFiles(const PlanResult& result, const std::filesystem::path& dir,
+                         const std::vector<std::string>& fixed_station_names, const Crs* crs,
+                         const FieldSheetOptions& field_sheet) {
   const CrsInfo* crs_info = crs == nullptr ? nullptr : &crs->info();
-  VC_RETURN_IF_ERROR(WriteFile(dir / "plan.json", PlanToJson(result, upload, fixed_station_names, crs_info)));
   const std::vector<FieldStation> field_stations = FieldStations(result, fixed_station_names);
   VC_RETURN_IF_ERROR(WriteFile(dir / "stations.csv", FieldStationsCsv(field_stations, crs_info)));
   VC_RETURN_IF_ERROR(WriteFile(dir / "stations.dxf", StationsDxf(result, field_stations)));
@@ -1018,7 +1010,13 @@ Status WritePlanOutputs(const PlanResult& result, const std::string& out_dir, co
     VC_ASSIGN_OR_RETURN(sheet_options.true_north_from_grid_deg, TrueNorthAtSiteDeg(result, *crs));
   }
   VC_ASSIGN_OR_RETURN(std::string sheet, FieldSheetPdf(result, field_stations, sheet_options));
-  VC_RETURN_IF_ERROR(WriteFile(dir / "fieldsheet.pdf", sheet));
+  return WriteFile(dir / "fieldsheet.pdf", sheet);
+}
+
+// The per-voxel files of a plan or an evaluation: visibility.ply, heatmap.png and report.html.
+// FAILED_PRECONDITION unless there is a best_face_values entry per voxel centre.
+Status WriteVisibilityFiles(const PlanResult& result, const std::filesystem::path& dir,
+                            const std::vector<std::string>& fixed_station_names) {
   if (result.voxel_centers.size() != result.evaluation.best_face_values.size()) {
     return FailedPreconditionError("visibility.ply needs one best_face_values entry per voxel centre (" +
                                    std::to_string(result.voxel_centers.size()) + " centres, " +
@@ -1027,12 +1025,141 @@ Status WritePlanOutputs(const PlanResult& result, const std::string& out_dir, co
   VC_RETURN_IF_ERROR(WriteFile(dir / "visibility.ply", VisibilityPly(result)));
   VC_ASSIGN_OR_RETURN(std::string heat, HeatmapPng(result));
   VC_RETURN_IF_ERROR(WriteFile(dir / "heatmap.png", heat));
-  VC_ASSIGN_OR_RETURN(std::string red, raster::EncodePng(DrawReduction(result)));
-  VC_RETURN_IF_ERROR(WriteFile(dir / "reduction.png", red));
   ReportHtmlOptions report_options;
   report_options.fixed_station_names = fixed_station_names;
-  VC_RETURN_IF_ERROR(WriteFile(dir / "report.html", PlanToHtml(result, report_options)));
-  return Status::Ok();
+  return WriteFile(dir / "report.html", PlanToHtml(result, report_options));
+}
+
+// Packs a voxel's integer index (its centre is (index + 0.5) x the resolution) into one word, 21 bits an axis.
+uint64_t PackedKey(int64_t x, int64_t y, int64_t z) {
+  constexpr int64_t kMask = (int64_t{1} << 21) - 1;
+  return (uint64_t(x & kMask) << 42) | (uint64_t(y & kMask) << 21) | uint64_t(z & kMask);
+}
+
+// Per voxel: whether some face of it has no occupied neighbour (the surface of the scene).
+std::vector<bool> ExposedVoxels(const std::vector<WorldPoint>& centers, double resolution_m) {
+  std::vector<std::array<int64_t, 3>> keys(centers.size());
+  std::unordered_set<uint64_t> occupied;
+  occupied.reserve(centers.size());
+  for (size_t i = 0; i < centers.size(); ++i) {
+    for (int a = 0; a < 3; ++a) keys[i][a] = std::llround(centers[i][a] / resolution_m - 0.5);  // (k + 0.5) res
+    occupied.insert(PackedKey(keys[i][0], keys[i][1], keys[i][2]));
+  }
+  std::vector<bool> exposed(centers.size(), false);
+  for (size_t i = 0; i < centers.size(); ++i) {
+    const auto& k = keys[i];
+    for (int a = 0; a < 3 && !exposed[i]; ++a) {
+      for (int step : {-1, 1}) {
+        std::array<int64_t, 3> n = k;
+        n[a] += step;
+        if (!occupied.contains(PackedKey(n[0], n[1], n[2]))) exposed[i] = true;
+      }
+    }
+  }
+  return exposed;
+}
+
+// The top of the highest voxel in the column of `station` (centres within half a voxel in x and y)
+// at most kMaxDropM below it (m, local); NaN when there is none.
+double FloorUnder(const WorldPoint& station, const std::vector<WorldPoint>& centers, double resolution_m) {
+  constexpr double kMaxDropM = 3.0;
+  const double half = resolution_m / 2;
+  const double reach = half + 1e-6;  // a station on a voxel boundary stands over both columns
+  double top = std::nan("");
+  for (const WorldPoint& v : centers) {
+    if (std::fabs(v.x() - station.x()) > reach || std::fabs(v.y() - station.y()) > reach) continue;
+    const double voxel_top = v.z() + half;
+    if (voxel_top > station.z() || voxel_top < station.z() - kMaxDropM) continue;
+    if (!(voxel_top <= top)) top = voxel_top;
+  }
+  return top;
+}
+
+}  // namespace
+
+Status WritePlanOutputs(const PlanResult& result, const std::string& out_dir, const UploadSummary* upload,
+                        const std::vector<std::string>& fixed_station_names, const Crs* crs,
+                        const FieldSheetOptions& field_sheet) {
+  VC_RETURN_IF_ERROR(MakeDir(out_dir));
+  const std::filesystem::path dir(out_dir);
+  const CrsInfo* crs_info = crs == nullptr ? nullptr : &crs->info();
+  VC_RETURN_IF_ERROR(WriteFile(dir / "plan.json", PlanToJson(result, upload, fixed_station_names, crs_info)));
+  VC_RETURN_IF_ERROR(WriteStationFiles(result, dir, fixed_station_names, crs, field_sheet));
+  VC_RETURN_IF_ERROR(WriteVisibilityFiles(result, dir, fixed_station_names));
+  VC_ASSIGN_OR_RETURN(std::string red, raster::EncodePng(DrawReduction(result)));
+  return WriteFile(dir / "reduction.png", red);
+}
+
+HeatMap MissedVoxelsHeatMap(const PlanResult& result, double cell_m) {
+  HeatMap map;
+  map.grid_spacing_m = cell_m;
+  const auto& values = result.evaluation.best_face_values;
+  if (result.stations.empty() || values.size() != result.voxel_centers.size() || result.resolution_m <= 0) return map;
+  // Levels: the stations' heights, a gap over 0.5 m starting a new one (as floor_plan groups candidates).
+  std::vector<double> zs;
+  for (const PlannedStation& s : result.stations) zs.push_back(s.position.z());
+  std::sort(zs.begin(), zs.end());
+  std::vector<std::pair<double, double>> levels;  // [lowest, highest] station z
+  for (double z : zs) {
+    if (levels.empty() || z - levels.back().second > 0.5) levels.push_back({z, z});
+    levels.back().second = z;
+  }
+  // Each level's floor: the lowest floor found under its stations, else its lowest station less the
+  // lowest tripod height.
+  const double lowest_tripod = floor_plan::LowestTripodHeight(result);
+  std::vector<double> floors;
+  for (const auto& [lo, hi] : levels) {
+    double floor = lo - lowest_tripod;
+    bool found = false;
+    for (const PlannedStation& s : result.stations) {
+      if (s.position.z() < lo || s.position.z() > hi || !std::isfinite(s.floor_z_m)) continue;
+      floor = found ? std::min(floor, s.floor_z_m) : s.floor_z_m;
+      found = true;
+    }
+    floors.push_back(floor);
+  }
+  const std::vector<bool> exposed = ExposedVoxels(result.voxel_centers, result.resolution_m);
+  std::map<std::array<int64_t, 3>, uint64_t> missed;  // (level, column x, column y) -> voxels missed there
+  for (size_t i = 0; i < values.size(); ++i) {
+    if (!exposed[i]) continue;
+    const WorldPoint& v = result.voxel_centers[i];
+    int level = -1;  // the highest whose floor's top voxel layer or more lies under v
+    while (level + 1 < int(levels.size()) && v.z() >= floors[size_t(level + 1)] - result.resolution_m) ++level;
+    if (level < 0) continue;  // below the lowest floor: the ground under the site
+    const bool seen = *std::max_element(values[i].begin(), values[i].end()) > 0;
+    missed[{level, int64_t(std::floor(v.x() / cell_m)), int64_t(std::floor(v.y() / cell_m))}] += seen ? 0 : 1;
+  }
+  for (const auto& [cell, count] : missed) {
+    const double floor = floors[size_t(cell[0])];
+    map.positions.emplace_back((double(cell[1]) + 0.5) * cell_m, (double(cell[2]) + 0.5) * cell_m,
+                               floor + lowest_tripod);
+    map.visible_voxels.push_back(count);
+    map.floor_z_m.push_back(floor);
+  }
+  return map;
+}
+
+PlanResult EvaluationAsPlan(const EvaluateJobResult& result) {
+  PlanResult plan;
+  plan.frame_origin_m = result.frame_origin_m;
+  plan.resolution_m = result.evaluation.resolution_m;
+  plan.evaluation = result.evaluation;
+  plan.voxel_centers = result.voxel_centers;
+  for (size_t i = 0; i < result.viewpoints.size(); ++i) {
+    PlannedStation& s = plan.stations.emplace_back();
+    s.position = result.viewpoints[i] - result.frame_origin_m;
+    s.floor_z_m = FloorUnder(s.position, result.voxel_centers, result.evaluation.resolution_m);
+    if (i < result.evaluation.per_viewpoint.size()) {
+      s.global_visibility = result.evaluation.per_viewpoint[i].global_visibility;
+    }
+  }
+  plan.occupied_voxels = result.voxel_centers.size();
+  plan.coverable_voxels = plan.occupied_voxels;
+  for (const auto& faces : result.evaluation.best_face_values) {
+    plan.covered_voxels += *std::max_element(faces.begin(), faces.end()) > 0 ? 1 : 0;
+  }
+  plan.heat_map = MissedVoxelsHeatMap(plan, plan.options.grid_spacing_m);
+  return plan;
 }
 
 std::string EvaluationToJson(const Evaluation& evaluation, const std::vector<WorldPoint>& viewpoints,
@@ -1042,13 +1169,17 @@ std::string EvaluationToJson(const Evaluation& evaluation, const std::vector<Wor
   return j.dump(2) + "\n";
 }
 
-Status WriteEvaluationOutputs(const Evaluation& evaluation, const std::vector<WorldPoint>& viewpoints,
-                              const std::string& out_dir, const CrsInfo* crs) {
+Status WriteEvaluationOutputs(const EvaluateJobResult& result, const std::string& out_dir, const Crs* crs,
+                              const FieldSheetOptions& field_sheet) {
   VC_RETURN_IF_ERROR(MakeDir(out_dir));
   const std::filesystem::path dir(out_dir);
-  VC_RETURN_IF_ERROR(WriteFile(dir / "evaluation.json", EvaluationToJson(evaluation, viewpoints, crs)));
-  VC_RETURN_IF_ERROR(WriteFile(dir / "stations.csv", StationsCsv(viewpoints)));
-  return Status::Ok();
+  const CrsInfo* crs_info = crs == nullptr ? nullptr : &crs->info();
+  VC_RETURN_IF_ERROR(
+      WriteFile(dir / "evaluation.json", EvaluationToJson(result.evaluation, result.viewpoints, crs_info)));
+  const PlanResult plan = EvaluationAsPlan(result);
+  VC_RETURN_IF_ERROR(WriteStationFiles(plan, dir, {}, crs, field_sheet));
+  if (plan.evaluation.best_face_values.empty()) return Status::Ok();  // sampled: no per-voxel values
+  return WriteVisibilityFiles(plan, dir, {});
 }
 
 Result<std::vector<WorldPoint>> ParseStationsCsv(std::string_view text, std::string_view source) {

@@ -63,7 +63,9 @@ TEST(EvaluateJobOptionsTest, TheOptionsItRunsWithCarryEveryRow) {
   EXPECT_EQ(e.seed, 9u);
   EXPECT_EQ(e.threads, 3);
   EXPECT_EQ(e.scanner.max_range_m, 12);
-  EXPECT_FALSE(e.keep_face_values);
+  EXPECT_FALSE(e.keep_face_values);  // sampling keeps none
+  o.sample_faces = 0;
+  EXPECT_TRUE(o.evaluate_options().keep_face_values);
   EXPECT_FALSE(e.keep_per_viewpoint_values);
   EXPECT_FALSE(e.keep_sparse_per_viewpoint_values);
 }
@@ -73,16 +75,32 @@ TEST(RunEvaluationTest, GivesEvaluateOnTheSceneAtTheJobsResolution) {
   for (const FaceSet faces : {FaceSet::kAll, FaceSet::kExposed}) {
     EvaluateJobOptions o = InsideTheBox(box);
     o.faces = faces;
-    const Result<Evaluation> job = RunEvaluation(box, o);
+    const Result<EvaluateJobResult> job = RunEvaluation(box, o);
     ASSERT_TRUE(job.ok()) << job.status().ToString();
     const Result<Evaluation> direct = Evaluate(*Voxelize(box, {0.2}), o.viewpoints, o.evaluate_options());
     ASSERT_TRUE(direct.ok());
-    EXPECT_EQ(job->resolution_m, 0.2);
-    EXPECT_EQ(job->faces_total, direct->faces_total);
-    ASSERT_EQ(job->per_viewpoint.size(), 1u);
-    EXPECT_EQ(job->overall.global_visibility, direct->overall.global_visibility);
-    EXPECT_GT(job->overall.global_visibility, 0.0);
+    EXPECT_EQ(job->evaluation.resolution_m, 0.2);
+    EXPECT_EQ(job->evaluation.faces_total, direct->faces_total);
+    ASSERT_EQ(job->evaluation.per_viewpoint.size(), 1u);
+    EXPECT_EQ(job->evaluation.overall.global_visibility, direct->overall.global_visibility);
+    EXPECT_GT(job->evaluation.overall.global_visibility, 0.0);
+    EXPECT_EQ(job->evaluation.best_face_values, direct->best_face_values);
+    EXPECT_EQ(job->evaluation.sole_viewer, direct->sole_viewer);
   }
+}
+
+TEST(RunEvaluationTest, ExactModeKeepsEveryVoxelsCentreBestFaceValuesAndSoleViewer) {
+  const SceneInput box = testing::Synthetic("box");
+  const EvaluateJobOptions o = InsideTheBox(box);
+  const Result<EvaluateJobResult> job = RunEvaluation(box, o);
+  ASSERT_TRUE(job.ok()) << job.status().ToString();
+  const VoxelScene scene = *Voxelize(box, {0.2});
+  ASSERT_EQ(job->voxel_centers.size(), scene.occupied.size());
+  for (size_t id : {size_t{0}, scene.occupied.size() - 1}) EXPECT_EQ(job->voxel_centers[id], scene.Center(id));
+  EXPECT_EQ(job->evaluation.best_face_values.size(), scene.occupied.size());
+  EXPECT_EQ(job->evaluation.sole_viewer.size(), scene.occupied.size());
+  EXPECT_EQ(job->viewpoints, o.viewpoints);
+  EXPECT_EQ(job->frame_origin_m, WorldPoint::Zero());
 }
 
 TEST(RunEvaluationTest, ViewpointsInTheInputsFrameAreEvaluatedAtTheirLocalPlace) {
@@ -96,21 +114,25 @@ TEST(RunEvaluationTest, ViewpointsInTheInputsFrameAreEvaluatedAtTheirLocalPlace)
   const Result<Evaluation> direct =
       Evaluate(*Voxelize(testing::Synthetic("box"), {0.2}), local, given.evaluate_options());
   ASSERT_TRUE(direct.ok());
-  const Result<Evaluation> job = RunEvaluation(georeferenced, given);
+  const Result<EvaluateJobResult> job = RunEvaluation(georeferenced, given);
   ASSERT_TRUE(job.ok()) << job.status().ToString();
-  EXPECT_GT(job->overall.global_visibility, 0.0);
-  EXPECT_EQ(job->overall.global_visibility, direct->overall.global_visibility);
+  EXPECT_GT(job->evaluation.overall.global_visibility, 0.0);
+  EXPECT_EQ(job->evaluation.overall.global_visibility, direct->overall.global_visibility);
+  EXPECT_EQ(job->frame_origin_m, origin);
+  EXPECT_EQ(job->viewpoints, given.viewpoints);
 }
 
 TEST(RunEvaluationTest, SamplesWhenAskedTo) {
   const SceneInput box = testing::Synthetic("box");
   EvaluateJobOptions o = InsideTheBox(box);
   o.sample_faces = 300;
-  const Result<Evaluation> r = RunEvaluation(box, o);
+  const Result<EvaluateJobResult> r = RunEvaluation(box, o);
   ASSERT_TRUE(r.ok()) << r.status().ToString();
-  EXPECT_TRUE(r->sampled);
-  EXPECT_EQ(r->faces_evaluated, 300u);
-  EXPECT_GT(r->global_visibility_ci95, 0.0);
+  EXPECT_TRUE(r->evaluation.sampled);
+  EXPECT_EQ(r->evaluation.faces_evaluated, 300u);
+  EXPECT_GT(r->evaluation.global_visibility_ci95, 0.0);
+  EXPECT_TRUE(r->evaluation.best_face_values.empty());
+  EXPECT_FALSE(r->voxel_centers.empty());
 }
 
 TEST(RunEvaluationTest, RefusesBadOptionsAndAnOverBudgetScene) {

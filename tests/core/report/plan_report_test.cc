@@ -8,11 +8,13 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
 #include "testing/test_paths.h"
 #include "vc/plan/keep_out.h"
+#include "vc/report/field_exports.h"
 
 namespace vc {
 namespace {
@@ -614,7 +616,7 @@ TEST(PlanReportTest, EvaluationJsonHasItsKeys) {
   EXPECT_DOUBLE_EQ(j["per_viewpoint"][1]["global_visibility"].get<double>(), 0.37);
   EXPECT_DOUBLE_EQ(j["per_viewpoint"][1]["x"].get<double>(), 3.5);
   const std::string dir = testing::MakeTempDir();
-  ASSERT_TRUE(WriteEvaluationOutputs(plan.evaluation, vps, dir).ok());
+  ASSERT_TRUE(WriteEvaluationOutputs({plan.evaluation, vps, plan.voxel_centers}, dir).ok());
   EXPECT_EQ(json::parse(ReadAll(dir + "/evaluation.json"))["faces_total"].get<int>(), 30);
 }
 
@@ -628,14 +630,148 @@ TEST(PlanReportTest, EvaluationJsonNamesTheCrsOfItsFrameWhenGivenOne) {
   crs.epsg = 2263;
   crs.axis_unit = "US survey foot";
   crs.metres_per_unit = 1200.0 / 3937.0;
-  const std::string dir = testing::MakeTempDir();
-  ASSERT_TRUE(WriteEvaluationOutputs(plan.evaluation, vps, dir, &crs).ok());
-  const json j = json::parse(ReadAll(dir + "/evaluation.json"))["crs"];
+  const json j = json::parse(EvaluationToJson(plan.evaluation, vps, &crs))["crs"];
   EXPECT_EQ(j["definition"], "EPSG:2263");
   EXPECT_EQ(j["name"], "NAD83 / New York Long Island (ftUS)");
   EXPECT_EQ(j["epsg"], 2263);
   EXPECT_EQ(j["axis_unit"], "US survey foot");
   EXPECT_DOUBLE_EQ(j["metres_per_unit"].get<double>(), 1200.0 / 3937.0);
+}
+
+// An evaluation of `viewpoints` (resolution 0.1 m) over `voxels`, each seen (best V 0.5 on one
+// face) or not.
+EvaluateJobResult SampleEvaluation(const std::vector<WorldPoint>& viewpoints,
+                                   const std::vector<std::pair<WorldPoint, bool>>& voxels) {
+  EvaluateJobResult r;
+  r.evaluation.resolution_m = 0.1;
+  r.evaluation.per_viewpoint.resize(viewpoints.size());
+  for (size_t i = 0; i < viewpoints.size(); ++i) r.evaluation.per_viewpoint[i].global_visibility = 0.1 * double(i + 1);
+  r.viewpoints = viewpoints;
+  for (const auto& [centre, seen] : voxels) {
+    r.voxel_centers.push_back(centre);
+    std::array<float, kFacesPerVoxel> v{};
+    v[5] = seen ? 0.5f : 0.f;
+    r.evaluation.best_face_values.push_back(v);
+    r.evaluation.sole_viewer.push_back(seen ? 0 : kNoViewer);
+  }
+  return r;
+}
+
+// Stations on two levels (1.6 m: floor 0.1 m; 4.6 m: floor 3.1 m at the default 1.5 m tripod);
+// voxels missed and seen, below the lowest floor, on the upper level, and a solid block whose
+// centre no face of which is exposed.
+EvaluateJobResult TwoLevelEvaluation() {
+  std::vector<std::pair<WorldPoint, bool>> voxels = {
+      {{2.05, 0.05, 0.55}, false},  {{2.05, 0.05, 0.65}, false},  // missed, level 0, column (2, 0)
+      {{2.05, 0.05, 0.75}, true},                                 // seen
+      {{2.05, 0.05, -0.45}, false},                               // below the lowest floor: the ground
+      {{0.55, 1.55, 3.55}, false},                                // missed, level 1, column (0, 1)
+      {{7.05, 0.05, 0.55}, true},                                 // seen: a cell counting 0
+      {{3.05, 1.05, 0.05}, true},    // the floor under station 1 (top 0.1 m, the level's floor): a cell counting 0
+      {{3.05, 1.05, -0.05}, false},  // under the floor's top layer: the ground
+  };
+  for (int x = 0; x < 3; ++x)
+    for (int y = 0; y < 3; ++y)
+      for (int z = 0; z < 3; ++z) voxels.push_back({{5.05 + 0.1 * x, 5.05 + 0.1 * y, 1.05 + 0.1 * z}, false});
+  return SampleEvaluation({{1, 1, 1.6}, {3, 1, 1.6}, {1, 1, 4.6}}, voxels);
+}
+
+TEST(MissedVoxelsHeatMapTest, CountsTheExposedVoxelsNoStationSeesPerColumnAndLevel) {
+  const PlanResult plan = EvaluationAsPlan(TwoLevelEvaluation());
+  const HeatMap map = MissedVoxelsHeatMap(plan, 1.0);
+  EXPECT_EQ(map.grid_spacing_m, 1.0);
+  std::map<std::array<double, 3>, uint64_t> cells;
+  ASSERT_EQ(map.positions.size(), map.visible_voxels.size());
+  for (size_t i = 0; i < map.positions.size(); ++i) {
+    cells[{map.positions[i].x(), map.positions[i].y(), map.positions[i].z()}] = map.visible_voxels[i];
+  }
+  const std::map<std::array<double, 3>, uint64_t> expected = {
+      {{2.5, 0.5, 1.6}, 2},   // the two missed voxels; not the seen one, not the ground's
+      {{0.5, 1.5, 4.6}, 1},   // the upper level's, at its stations' height
+      {{5.5, 5.5, 1.6}, 26},  // the block less its hidden centre
+      {{7.5, 0.5, 1.6}, 0},   // nothing missed there
+      {{3.5, 1.5, 1.6}, 0},   // the floor seen
+  };
+  EXPECT_EQ(cells, expected);
+  ASSERT_EQ(map.floor_z_m.size(), map.positions.size());
+  for (size_t i = 0; i < map.positions.size(); ++i) EXPECT_NEAR(map.floor_z_m[i], map.positions[i].z() - 1.5, 1e-12);
+}
+
+TEST(MissedVoxelsHeatMapTest, EmptyWithoutFaceValues) {
+  EvaluateJobResult sampled = TwoLevelEvaluation();
+  sampled.evaluation.best_face_values.clear();
+  EXPECT_TRUE(MissedVoxelsHeatMap(EvaluationAsPlan(sampled), 1.0).positions.empty());
+}
+
+TEST(EvaluationAsPlanTest, TheViewpointsAreItsStationsLocalWithTheirG) {
+  EvaluateJobResult r = TwoLevelEvaluation();
+  const WorldPoint origin(512000, 5612000, 100);
+  r.frame_origin_m = origin;
+  for (WorldPoint& v : r.viewpoints) v += origin;  // given in the input's frame
+  const PlanResult plan = EvaluationAsPlan(r);
+  ASSERT_EQ(plan.stations.size(), 3u);
+  EXPECT_LT((plan.stations[2].position - WorldPoint(1, 1, 4.6)).norm(), 1e-9);
+  EXPECT_DOUBLE_EQ(plan.stations[1].global_visibility, 0.2);
+  EXPECT_FALSE(plan.stations[0].fixed);
+  EXPECT_EQ(plan.frame_origin_m, origin);
+  EXPECT_EQ(plan.resolution_m, 0.1);
+  EXPECT_EQ(plan.occupied_voxels, r.voxel_centers.size());
+  EXPECT_EQ(plan.covered_voxels, 3u);  // the three seen voxels
+  EXPECT_EQ(plan.heat_map.positions.size(), 5u);
+  EXPECT_NEAR(plan.stations[1].floor_z_m, 0.1, 1e-9);   // the voxel under it, 1.5 m below
+  EXPECT_TRUE(std::isnan(plan.stations[0].floor_z_m));  // nothing under it
+  EXPECT_TRUE(std::isnan(plan.stations[2].floor_z_m));  // nothing under it either
+  EXPECT_EQ(plan.evaluation.best_face_values, r.evaluation.best_face_values);
+}
+
+TEST(WriteEvaluationOutputsTest, WritesSubmitsFilesWithTheCrewsStationsCsv) {
+  const EvaluateJobResult r = TwoLevelEvaluation();
+  const std::string dir = testing::MakeTempDir() + "/out";
+  ASSERT_TRUE(WriteEvaluationOutputs(r, dir).ok());
+  for (const char* name : {"evaluation.json", "stations.csv", "stations.dxf", "fieldsheet.pdf", "visibility.ply",
+                           "heatmap.png", "report.html"}) {
+    EXPECT_TRUE(std::filesystem::file_size(dir + "/" + name) > 0) << name;
+  }
+  for (const char* name : {"plan.json", "reduction.png", "stations.geojson"}) {
+    EXPECT_FALSE(std::filesystem::exists(dir + "/" + name)) << name;
+  }
+  const PlanResult plan = EvaluationAsPlan(r);
+  EXPECT_EQ(ReadAll(dir + "/stations.csv"), FieldStationsCsv(FieldStations(plan)));
+  EXPECT_NE(ReadAll(dir + "/stations.csv").find("\nstation,name,x_m,y_m,z_m,"), std::string::npos);
+  EXPECT_EQ(ReadAll(dir + "/heatmap.png"), *HeatmapPng(plan));
+}
+
+TEST(WriteEvaluationOutputsTest, ASampledEvaluationWritesTheStationFilesOnly) {
+  EvaluateJobResult r = TwoLevelEvaluation();
+  r.evaluation.best_face_values.clear();
+  r.evaluation.sole_viewer.clear();
+  r.evaluation.sampled = true;
+  const std::string dir = testing::MakeTempDir();
+  ASSERT_TRUE(WriteEvaluationOutputs(r, dir).ok());
+  for (const char* name : {"evaluation.json", "stations.csv", "stations.dxf", "fieldsheet.pdf"}) {
+    EXPECT_TRUE(std::filesystem::exists(dir + "/" + name)) << name;
+  }
+  for (const char* name : {"visibility.ply", "heatmap.png", "report.html"}) {
+    EXPECT_FALSE(std::filesystem::exists(dir + "/" + name)) << name;
+  }
+}
+
+TEST(WriteEvaluationOutputsTest, WithACrsWritesStationsGeoJsonAndNamesItInEvaluationJson) {
+  Result<Crs> crs = Crs::Create("EPSG:25832");
+  ASSERT_TRUE(crs.ok()) << crs.status().ToString();
+  EvaluateJobResult r = TwoLevelEvaluation();
+  const WorldPoint origin(512000, 5612000, 0);
+  r.frame_origin_m = origin;
+  for (WorldPoint& v : r.viewpoints) v += origin;
+  const std::string dir = testing::MakeTempDir();
+  ASSERT_TRUE(WriteEvaluationOutputs(r, dir, &*crs).ok());
+  const json geo = json::parse(ReadAll(dir + "/stations.geojson"));
+  EXPECT_EQ(geo["type"], "FeatureCollection");
+  int stations = 0;
+  for (const json& f : geo["features"]) stations += f["properties"]["kind"] == "station";
+  EXPECT_EQ(stations, 3);
+  EXPECT_EQ(json::parse(ReadAll(dir + "/evaluation.json"))["crs"]["definition"], "EPSG:25832");
+  EXPECT_NE(ReadAll(dir + "/stations.csv").find("512001.000000,5612001.000000"), std::string::npos);
 }
 
 TEST(ParseStationsCsvTest, AcceptsHeaderCommentsBlankLinesAndSpaces) {

@@ -1,7 +1,7 @@
 // vc::client::Client: the typed client of vc.v1.StationPlanner and of the gRPC health service.
 //
 // Uploads a scene in chunks (with its CRC32C), follows the event stream, and returns the core
-// types (vc::PlanResult, vc::Evaluation) rebuilt by vc::wire, ready for vc::WritePlanOutputs.
+// types (vc::PlanResult, vc::EvaluateJobResult) rebuilt by vc::wire, ready for vc::WritePlanOutputs.
 // Failures are vc::Status values: the call's gRPC status mapped by vc::wire::FromGrpcStatus (same
 // google.rpc.Code, same message), or DATA_LOSS / INTERNAL for a stream that does not add up.
 // Transient UNAVAILABLE failures before the server accepted the job are retried with exponential
@@ -70,18 +70,12 @@ struct JobTicket {
   uint32_t detach_grace_s = 0;
 };
 
-// An Evaluate job's outcome with the viewpoints it evaluated (as the server echoes them).
-struct EvaluateOutcome {
-  Evaluation evaluation;
-  std::vector<WorldPoint> viewpoints;
-};
-
 // A re-attached job's outcome: a plan or an evaluation, whichever kind the job is.
 struct AttachedJob {
   enum class Kind { kPlan, kEvaluation };
   Kind kind = Kind::kPlan;
-  PlanResult plan;             // when kind is kPlan
-  EvaluateOutcome evaluation;  // when kind is kEvaluation
+  PlanResult plan;               // when kind is kPlan
+  EvaluateJobResult evaluation;  // when kind is kEvaluation
 };
 
 // How the last Plan or Evaluate call got its scene to the server.
@@ -142,13 +136,14 @@ class Client {
   static Result<std::unique_ptr<Client>> Create(const ConnectionOptions& options);
 
   Result<PlanResult> Plan(const Upload& upload, const PlanOptions& options, const JobObserver& observer = {});
-  Result<Evaluation> Evaluate(const Upload& upload, const EvaluateJobOptions& options,
-                              const JobObserver& observer = {});
+  // The evaluation with its voxels (vc::EvaluateJobResult, rebuilt from the stream's chunks).
+  Result<EvaluateJobResult> Evaluate(const Upload& upload, const EvaluateJobOptions& options,
+                                     const JobObserver& observer = {});
   // Re-attaches to a detachable job by id (docs/PROTOCOL.md, "Detachable jobs"): the events so far
   // are replayed, then the job is followed to its end. FAILED_PRECONDITION when the job is of the
   // other kind; NOT_FOUND when the server does not hold it (any more).
   Result<PlanResult> AttachPlan(const std::string& job_id, const JobObserver& observer = {});
-  Result<EvaluateOutcome> AttachEvaluate(const std::string& job_id, const JobObserver& observer = {});
+  Result<EvaluateJobResult> AttachEvaluate(const std::string& job_id, const JobObserver& observer = {});
   // Re-attaches to a job of either kind: AttachPlan, then AttachEvaluate when the server refuses it
   // with FAILED_PRECONDITION before any event (the job is an Evaluate job); a plan job's own
   // failure is returned as it is. NOT_FOUND when the server does not hold the job.
@@ -175,7 +170,7 @@ class Client {
   // One AttachPlan / AttachEvaluate call to last_job_, followed to its end; `followed` says
   // whether the job's events came (the stream was alive) before it ended.
   Status AttachPlanOnce(const JobObserver& observer, PlanResult* out, bool* followed);
-  Status AttachEvaluateOnce(const JobObserver& observer, EvaluateOutcome* out, bool* followed);
+  Status AttachEvaluateOnce(const JobObserver& observer, EvaluateJobResult* out, bool* followed);
   // AttachPlan's calls to `job_id`, retried and re-attached, into `out`; `accepted` says whether
   // the job's Accepted event came (the server holds it as a plan job).
   Status FollowPlanJob(const std::string& job_id, const JobObserver& observer, PlanResult* out, bool* accepted);

@@ -1,6 +1,7 @@
-// evaluate's --plan: the stations, the scanner and the CRS of a plan.json that submit wrote, so an
-// evaluation of a plan needs no scanner flags repeated. Flags given explicitly override the
-// plan's scanner row by row (TakeScannerFromPlan), and the client says which ones differ.
+// evaluate's --plan: the stations, the scanner, the resolution and the CRS of a plan.json that
+// submit wrote, so an evaluation of a plan needs no scanner or resolution flags repeated. Flags
+// given explicitly override the plan's scanner row by row (TakeScannerFromPlan) and its resolution
+// (TakeResolutionFromPlan), and the client says which ones differ.
 #pragma once
 
 #include <CLI/CLI.hpp>
@@ -22,6 +23,8 @@ struct PlanForEvaluation {
   ScannerModel scanner;
   // crs.definition; empty when the plan names no CRS.
   std::string crs_definition;
+  // resolution_m: the voxel size the plan ran at (m).
+  double resolution_m = 0;
 };
 
 // Parses plan.json's `text`. INVALID_ARGUMENT naming `source` and the field ("plan.json:
@@ -37,5 +40,9 @@ struct PlanForEvaluation {
 // ("--max-range 30 m (the plan: 10 m)"), in row order.
 std::vector<std::string> TakeScannerFromPlan(const CLI::App& command, const ScannerModel& plan_scanner,
                                              ScannerModel* scanner);
+// Sets `resolution_m` (bound to `command`'s --resolution) to the plan's unless --resolution was
+// given; then, when the two differ, the line that says so ("--resolution 0.2 m (the plan: 0.1 m)").
+std::vector<std::string> TakeResolutionFromPlan(const CLI::App& command, double plan_resolution_m,
+                                                double* resolution_m);
 
 }  // namespace vc::client

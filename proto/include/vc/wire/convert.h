@@ -4,7 +4,8 @@
 //
 // Bulk data (the heat map and the per-voxel results) is split into chunks of at most about
 // 0.8 MiB each (kCandidatesPerHeatMapChunk, kVoxelsPerChunk) and reassembled by
-// PlanResultAssembler, which checks that every chunk arrived exactly once and in order.
+// PlanResultAssembler and EvaluateResultAssembler, which check that every chunk arrived exactly
+// once and in order (both through VoxelChunkAssembler for the voxels).
 // Positions on the wire are in the input's own frame (docs/PROTOCOL.md, "Frames"): a result's
 // local positions go out plus PlanResult::frame_origin_m and come back less it, so PlanResult is
 // local on both sides and its writers (vc/report) add the origin once more. Parameters
@@ -13,6 +14,7 @@
 // Functions are pure; PlanResultAssembler is not thread-safe.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <functional>
 #include <vector>
@@ -79,12 +81,41 @@ Evaluation FromProto(const v1::Evaluation& e);
 
 // The heat map (local) in chunks, in order, its positions and floor heights in the input's frame.
 std::vector<v1::HeatMapChunk> HeatMapChunks(const HeatMap& heat_map, const WorldPoint& frame_origin_m);
-// Calls fn with each VoxelChunk of result.voxel_centers (in the input's frame) and
-// result.evaluation.best_face_values, in order. Stops early and returns false when fn returns false.
+// Calls fn with each VoxelChunk of `centers` (local; sent plus frame_origin_m) with evaluation's
+// best_face_values and sole_viewer when it holds one per centre, in order. Stops early and returns
+// false when fn returns false.
+bool ForEachVoxelChunk(const std::vector<WorldPoint>& centers, const Evaluation& evaluation,
+                       const WorldPoint& frame_origin_m, const std::function<bool(v1::VoxelChunk&&)>& fn);
+// The chunks of a plan's voxels (result.voxel_centers, result.evaluation).
 bool ForEachVoxelChunk(const PlanResult& result, const std::function<bool(v1::VoxelChunk&&)>& fn);
+// The chunks of an evaluation's voxels (result.voxel_centers, result.evaluation).
+bool ForEachVoxelChunk(const EvaluateJobResult& result, const std::function<bool(v1::VoxelChunk&&)>& fn);
 // The summary that ends a Plan stream (everything but the chunked parts), in the input's frame
 // with result.frame_origin_m as frame_origin.
 v1::PlanResult ToProto(const PlanResult& result);
+
+// The voxels of the VoxelChunk messages of one stream (a Plan's or an Evaluate's), in id order.
+struct AssembledVoxels {
+  std::vector<WorldPoint> centers;                                  // local (less the frame's origin), m
+  std::vector<std::array<float, kFacesPerVoxel>> best_face_values;  // empty when none were sent
+  std::vector<int32_t> sole_viewer;                                 // empty when none were sent
+};
+
+// Puts the VoxelChunk messages of one stream together, checking that each arrived once, in order.
+class VoxelChunkAssembler {
+ public:
+  // DATA_LOSS if the chunk is out of order or inconsistent with the previous ones.
+  Status Add(const v1::VoxelChunk& chunk);
+  // The voxels, less `frame_origin_m`. DATA_LOSS unless `voxel_count` voxels arrived, with face
+  // values for `face_value_voxels` of them (0: whatever came), and every sole viewer names one of
+  // `stations` stations.
+  Result<AssembledVoxels> Finish(uint64_t voxel_count, uint64_t face_value_voxels, int stations,
+                                 const WorldPoint& frame_origin_m) &&;
+
+ private:
+  AssembledVoxels voxels_;  // centres in the input's frame until Finish
+  uint64_t total_ = 0;
+};
 
 // Rebuilds a vc::PlanResult from the chunks and the final summary of a Plan stream.
 class PlanResultAssembler {
@@ -103,13 +134,26 @@ class PlanResultAssembler {
   HeatMap heat_map_;
   bool heat_map_started_ = false;
   uint64_t heat_map_total_ = 0;
-  std::vector<WorldPoint> centers_;
-  std::vector<std::array<float, kFacesPerVoxel>> face_values_;
-  std::vector<int32_t> sole_viewers_;
-  uint64_t voxel_total_ = 0;
+  VoxelChunkAssembler voxels_;
 };
 
-// `viewpoints` as the job was given them (the input's frame).
-v1::EvaluateResult ToProto(const Evaluation& e, const std::vector<WorldPoint>& viewpoints);
+// The summary that ends an Evaluate stream (everything but the voxels): the viewpoints as the job
+// was given them (the input's frame), result.frame_origin_m as frame_origin.
+v1::EvaluateResult ToProto(const EvaluateJobResult& result);
+
+// Rebuilds a vc::EvaluateJobResult from the VoxelChunk messages and the final summary of an
+// Evaluate stream.
+class EvaluateResultAssembler {
+ public:
+  // DATA_LOSS if the chunk is out of order or inconsistent with the previous ones.
+  Status AddVoxels(const v1::VoxelChunk& chunk);
+  // The whole result, its voxel centres local (less summary.frame_origin), its viewpoints as sent.
+  // DATA_LOSS if the chunks received do not add up to what `summary` declares, or the origin is
+  // not finite.
+  Result<EvaluateJobResult> Finish(const v1::EvaluateResult& summary) &&;
+
+ private:
+  VoxelChunkAssembler voxels_;
+};
 
 }  // namespace vc::wire

@@ -20,7 +20,7 @@ struct Backend {
   std::function<Result<SceneInput>(std::string_view bytes, std::string_view source, const ReadOptions&)> read_scene;
   std::function<Result<PlanResult>(const SceneInput&, const PlanOptions&, const JobContext&, const PlanCallbacks&)>
       plan;
-  std::function<Result<Evaluation>(const SceneInput&, const EvaluateJobOptions&, const JobContext&)> evaluate;
+  std::function<Result<EvaluateJobResult>(const SceneInput&, const EvaluateJobOptions&, const JobContext&)> evaluate;
 
   // The production backend.
   static Backend Default();

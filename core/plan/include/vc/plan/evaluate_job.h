@@ -40,14 +40,27 @@ struct EvaluateJobOptions {
   // check or the scanner's, a scanner hfov_deg below 360 (viewpoints here carry no heading).
   // Fields are named as `namer` shows them (vc/base/parameter.h).
   Status Validate(const FieldNamer& namer = {}) const;
-  // The voxelisation and evaluation options this job runs with (exact mode keeps no face values).
+  // The voxelisation and evaluation options this job runs with (exact mode keeps each voxel's best
+  // face values and sole viewer, for visibility.ply, heatmap.png and report.html; sampling keeps none).
   VoxelizeOptions voxelize_options() const;
   EvaluateOptions evaluate_options() const;
 };
 
+// What an Evaluate job gives: the evaluation and the voxels it was made on.
+struct EvaluateJobResult {
+  // With, in exact mode, best_face_values and sole_viewer for every occupied voxel.
+  Evaluation evaluation;
+  // The viewpoints as the job was given them, in the input's own frame (m).
+  std::vector<WorldPoint> viewpoints;
+  // Occupied voxel centres in id order, in the scene's local frame (m).
+  std::vector<WorldPoint> voxel_centers;
+  // Where the local frame's origin lies in the input's frame (VoxelScene::frame_origin_m, m).
+  WorldPoint frame_origin_m = WorldPoint::Zero();
+};
+
 // Validates, voxelises `input` at options.resolution_m, moves the viewpoints to the scene's local
 // frame (less VoxelScene::frame_origin_m), then vc::Evaluate. Errors as those.
-Result<Evaluation> RunEvaluation(const SceneInput& input, const EvaluateJobOptions& options,
-                                 const JobContext& ctx = {});
+Result<EvaluateJobResult> RunEvaluation(const SceneInput& input, const EvaluateJobOptions& options,
+                                        const JobContext& ctx = {});
 
 }  // namespace vc

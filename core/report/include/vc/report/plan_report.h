@@ -12,6 +12,7 @@
 
 #include "vc/base/geometry.h"
 #include "vc/base/status.h"
+#include "vc/plan/evaluate_job.h"
 #include "vc/plan/planner.h"
 #include "vc/report/crs.h"
 #include "vc/report/field_sheet.h"
@@ -72,8 +73,32 @@ std::string ColouredPointsPly(const std::vector<std::string>& comments, const st
 // of that frame, as plan.json's `crs`.
 std::string EvaluationToJson(const Evaluation& evaluation, const std::vector<WorldPoint>& viewpoints,
                              const CrsInfo* crs = nullptr);
-Status WriteEvaluationOutputs(const Evaluation& evaluation, const std::vector<WorldPoint>& viewpoints,
-                              const std::string& out_dir, const CrsInfo* crs = nullptr);
+
+// The heat map of what an evaluation misses (heatmap.png's cells for evaluate): per level of the
+// stations (their heights grouped as heatmap.png groups candidates: a gap over 0.5 m starts a new
+// level; its floor the lowest floor_z_m of its stations, else its lowest station less the lowest
+// tripod height) and per `cell_m` square column of the local frame, the exposed voxels (some face
+// without an occupied neighbour) from that floor's top voxel layer up to the next level's that no
+// station sees (best V 0 on every face). One cell per column with an exposed voxel on the level (0
+// when all are seen), at the level's floor plus the lowest tripod height, with that floor as its
+// floor_z_m; local frame. Empty without best face values.
+HeatMap MissedVoxelsHeatMap(const PlanResult& result, double cell_m);
+
+// An evaluation as a plan of its viewpoints, for the writers of a plan's files: the viewpoints
+// (local) are its stations, in the order given, each with its G and, as floor_z_m, the top of the
+// highest voxel in its column at most 3 m below it (NaN when none); the voxels, the evaluation and
+// the frame as they are; covered_voxels the voxels some station sees (best V > 0), of all the
+// occupied ones (coverable_voxels: an evaluation has no candidates to bound what can be seen); the
+// heat map MissedVoxelsHeatMap's at the default grid spacing. The default PlanOptions otherwise.
+PlanResult EvaluationAsPlan(const EvaluateJobResult& result);
+
+// Writes evaluation.json, stations.csv (the crew's format, as WritePlanOutputs'), stations.dxf,
+// fieldsheet.pdf (laid out as `field_sheet` says) and, with `crs` (the CRS of the input's frame),
+// stations.geojson, of EvaluationAsPlan(result) through WritePlanOutputs' writers; and, when the
+// evaluation kept the best face values of every voxel (exact mode), visibility.ply, heatmap.png
+// (what the stations miss) and report.html. Errors as WritePlanOutputs'.
+Status WriteEvaluationOutputs(const EvaluateJobResult& result, const std::string& out_dir, const Crs* crs = nullptr,
+                              const FieldSheetOptions& field_sheet = {});
 
 // Pixel size of a picture.
 struct ImageSize {
