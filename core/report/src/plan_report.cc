@@ -202,6 +202,7 @@ constexpr int kDotRadius = 3;   // the dot at a station whose numbered disc is m
 constexpr int kHatchPitch = 6;  // pixels between a keep-out zone's hatch lines, along a row
 
 struct HeatLayout : floor_plan::Floors {
+  HeatmapMeaning meaning = HeatmapMeaning::kSeenFromCandidates;
   double cell_m = 1;
   double ppm = 10;  // pixels per metre
   int plot_w = 0, plot_h = 0;
@@ -320,6 +321,10 @@ double RoundStep(double span, int max_steps) {
 void HeatColourBar(Image& img, const HeatLayout& L, const PlanResult& r, uint64_t max_count) {
   const int x = L.width - kLegendWidth + 20, y = kMarginTop + 14;
   const int h = std::max(L.plot_h, kMinPlotHeight) - 14;
+  if (L.meaning == HeatmapMeaning::kMissedByStations) {
+    ColourBar(img, x, y, h, QuarterTicks(static_cast<double>(max_count), true), {"VOXELS NO", "STATION SEES"});
+    return;
+  }
   if (max_count == 0 || r.occupied_voxels < max_count) {
     ColourBar(img, x, y, h, QuarterTicks(static_cast<double>(max_count), true), {"VOXELS SEEN", "FROM HERE"});
     return;
@@ -500,7 +505,9 @@ bool DrawPanel(Image& img, const HeatLayout& L, const PlanResult& r, int panel, 
   img.TextVertical(left - kMarginLeft + 4, top + L.plot_h / 2 - raster::TextWidth("y (m)") / 2, "y (m)",
                    raster::kBlack);
   std::string title = "VISIBLE VOXELS PER CANDIDATE";
-  if (r.options.tripod_heights_m.size() > 1) {
+  if (L.meaning == HeatmapMeaning::kMissedByStations) {
+    title = "SURFACE VOXELS NO STATION SEES, PER " + Short(L.cell_m) + " M CELL";
+  } else if (r.options.tripod_heights_m.size() > 1) {
     title = "VISIBLE VOXELS, BEST OF " + std::to_string(r.options.tripod_heights_m.size()) + " HEIGHTS";
   }
   if (L.panel_z.size() > 1 || !r.floor_levels_m.empty())
@@ -534,8 +541,9 @@ void DrawEdgesAndRoute(Image& img, const HeatLayout& L, const PlanResult& r) {
   }
 }
 
-Image DrawHeatmap(const PlanResult& r) {
-  const HeatLayout L = ComputeHeatLayout(r);
+Image DrawHeatmap(const PlanResult& r, HeatmapMeaning meaning) {
+  HeatLayout L = ComputeHeatLayout(r);
+  L.meaning = meaning;
   Image img(L.width, L.height);
   uint64_t max_count = 0;
   for (uint64_t c : r.heat_map.visible_voxels) max_count = std::max(max_count, c);
@@ -930,7 +938,9 @@ std::string PlanToJson(const PlanResult& r, const UploadSummary* upload,
   return j.dump(2) + "\n";
 }
 
-Result<std::string> HeatmapPng(const PlanResult& result) { return raster::EncodePng(DrawHeatmap(result)); }
+Result<std::string> HeatmapPng(const PlanResult& result, HeatmapMeaning meaning) {
+  return raster::EncodePng(DrawHeatmap(result, meaning));
+}
 
 std::vector<HeatmapStationPlace> HeatmapStationPlaces(const PlanResult& result) {
   return StationPlaces(ComputeHeatLayout(result), result);
@@ -1016,14 +1026,14 @@ Status WriteStationFiles(const PlanResult& result, const std::filesystem::path& 
 // The per-voxel files of a plan or an evaluation: visibility.ply, heatmap.png and report.html.
 // FAILED_PRECONDITION unless there is a best_face_values entry per voxel centre.
 Status WriteVisibilityFiles(const PlanResult& result, const std::filesystem::path& dir,
-                            const std::vector<std::string>& fixed_station_names) {
+                            const std::vector<std::string>& fixed_station_names, HeatmapMeaning meaning) {
   if (result.voxel_centers.size() != result.evaluation.best_face_values.size()) {
     return FailedPreconditionError("visibility.ply needs one best_face_values entry per voxel centre (" +
                                    std::to_string(result.voxel_centers.size()) + " centres, " +
                                    std::to_string(result.evaluation.best_face_values.size()) + " face values)");
   }
   VC_RETURN_IF_ERROR(WriteFile(dir / "visibility.ply", VisibilityPly(result)));
-  VC_ASSIGN_OR_RETURN(std::string heat, HeatmapPng(result));
+  VC_ASSIGN_OR_RETURN(std::string heat, HeatmapPng(result, meaning));
   VC_RETURN_IF_ERROR(WriteFile(dir / "heatmap.png", heat));
   ReportHtmlOptions report_options;
   report_options.fixed_station_names = fixed_station_names;
@@ -1085,7 +1095,7 @@ Status WritePlanOutputs(const PlanResult& result, const std::string& out_dir, co
   const CrsInfo* crs_info = crs == nullptr ? nullptr : &crs->info();
   VC_RETURN_IF_ERROR(WriteFile(dir / "plan.json", PlanToJson(result, upload, fixed_station_names, crs_info)));
   VC_RETURN_IF_ERROR(WriteStationFiles(result, dir, fixed_station_names, crs, field_sheet));
-  VC_RETURN_IF_ERROR(WriteVisibilityFiles(result, dir, fixed_station_names));
+  VC_RETURN_IF_ERROR(WriteVisibilityFiles(result, dir, fixed_station_names, HeatmapMeaning::kSeenFromCandidates));
   VC_ASSIGN_OR_RETURN(std::string red, raster::EncodePng(DrawReduction(result)));
   return WriteFile(dir / "reduction.png", red);
 }
@@ -1179,7 +1189,7 @@ Status WriteEvaluationOutputs(const EvaluateJobResult& result, const std::string
   const PlanResult plan = EvaluationAsPlan(result);
   VC_RETURN_IF_ERROR(WriteStationFiles(plan, dir, {}, crs, field_sheet));
   if (plan.evaluation.best_face_values.empty()) return Status::Ok();  // sampled: no per-voxel values
-  return WriteVisibilityFiles(plan, dir, {});
+  return WriteVisibilityFiles(plan, dir, {}, HeatmapMeaning::kMissedByStations);
 }
 
 Result<std::vector<WorldPoint>> ParseStationsCsv(std::string_view text, std::string_view source) {

@@ -738,7 +738,30 @@ TEST(WriteEvaluationOutputsTest, WritesSubmitsFilesWithTheCrewsStationsCsv) {
   const PlanResult plan = EvaluationAsPlan(r);
   EXPECT_EQ(ReadAll(dir + "/stations.csv"), FieldStationsCsv(FieldStations(plan)));
   EXPECT_NE(ReadAll(dir + "/stations.csv").find("\nstation,name,x_m,y_m,z_m,"), std::string::npos);
-  EXPECT_EQ(ReadAll(dir + "/heatmap.png"), *HeatmapPng(plan));
+  EXPECT_EQ(ReadAll(dir + "/heatmap.png"), *HeatmapPng(plan, HeatmapMeaning::kMissedByStations));
+}
+
+// An evaluation's heat map counts what is missed: only its title and colour bar's words differ
+// from the same cells drawn as a plan's.
+TEST(WriteEvaluationOutputsTest, TheMissedVoxelsHeatMapSaysWhatItCountsInItsTitleAndColourBar) {
+  const PlanResult plan = EvaluationAsPlan(TwoLevelEvaluation());
+  const Picture missed = DecodePng(*HeatmapPng(plan, HeatmapMeaning::kMissedByStations));
+  const Picture seen = DecodePng(*HeatmapPng(plan));
+  ASSERT_EQ(missed.width, seen.width);
+  ASSERT_EQ(missed.height, seen.height);
+  int title_rows_differing = 0, plot_pixels_differing = 0;
+  for (int y = 0; y < missed.height; ++y) {
+    for (int x = 0; x < missed.width; ++x) {
+      if (missed.at(x, y) == seen.at(x, y)) continue;
+      if (y < 40) {
+        ++title_rows_differing;
+      } else if (x < missed.width - 110) {
+        ++plot_pixels_differing;
+      }
+    }
+  }
+  EXPECT_GT(title_rows_differing, 50);
+  EXPECT_EQ(plot_pixels_differing, 0);
 }
 
 TEST(WriteEvaluationOutputsTest, ASampledEvaluationWritesTheStationFilesOnly) {

@@ -105,10 +105,15 @@ struct ImageSize {
   int width = 0;
   int height = 0;
 };
-// heatmap.png's bytes: the candidates' cells under the floor plan and keep-out zones of each
-// level, the scan graph's edges, the walking route, the stations and a colour bar in per cent of
-// the scene (docs/PLANNING.md, "heatmap.png").
-Result<std::string> HeatmapPng(const PlanResult& result);
+// What heatmap.png's cells count (the title and the colour bar say it).
+enum class HeatmapMeaning {
+  kSeenFromCandidates,  // a plan's heat map: the voxels a tripod at the cell sees
+  kMissedByStations,    // an evaluation's (MissedVoxelsHeatMap): the surface voxels no station sees
+};
+// heatmap.png's bytes: the cells under the floor plan and keep-out zones of each level, the scan
+// graph's edges, the walking route, the stations and a colour bar (for a plan, in per cent of the
+// scene; docs/PLANNING.md, "heatmap.png").
+Result<std::string> HeatmapPng(const PlanResult& result, HeatmapMeaning meaning = HeatmapMeaning::kSeenFromCandidates);
 // Where heatmap.png draws a station, in pixels from the picture's top-left corner: its panel, the
 // station's own pixel, and the box of its numbered disc (centred on the station, or moved aside
 // with a leader line back to it, PlaceLabels).
