@@ -112,13 +112,13 @@ class InterruptCancelsTheJob {
   vc::client::JobTicket job_;
 };
 
-// Writes the evaluation's reports (stations.geojson and true north on the field sheet with a CRS),
-// prints G and the files written.
+// Writes the evaluation's reports (stations.geojson and true north on the field sheet with a CRS;
+// the field sheet's scan time from `scanner`, the job's, when known), prints G and the files written.
 int WriteEvaluation(const vc::EvaluateJobResult& result, const std::string& out_dir, const std::string& paper,
-                    const vc::Crs* crs = nullptr) {
+                    const vc::Crs* crs = nullptr, const vc::ScannerModel& scanner = {}) {
   vc::FieldSheetOptions sheet;
   sheet.paper = paper == "a4" ? vc::PaperSize::kA4 : vc::PaperSize::kA3;
-  vc::Status written = vc::WriteEvaluationOutputs(result, out_dir, crs, sheet);
+  vc::Status written = vc::WriteEvaluationOutputs(result, out_dir, crs, sheet, scanner);
   if (!written.ok()) return Fail("cannot write the reports", written);
   const vc::Evaluation& r = result.evaluation;
   const bool per_voxel = !r.best_face_values.empty();
@@ -511,7 +511,7 @@ int RunEvaluate(const CommandLine& cl, const CLI::App& evaluate, InterruptCancel
   if (!r.ok()) return FailCall("evaluate", r.status(), cl.conn.server);
   NoteCache((*client)->last_upload(), &prepared.summary, display);
   const std::optional<vc::Crs>& crs = checked->crs.crs;
-  return WriteEvaluation(*r, cl.out_dir, cl.paper, crs ? &*crs : nullptr);
+  return WriteEvaluation(*r, cl.out_dir, cl.paper, crs ? &*crs : nullptr, checked->eval.scanner);
 }
 
 // Parses the command line; on a mistake prints CLI11's message and, for a misspelt flag or

@@ -72,7 +72,7 @@ expect 3 "vc-client: notjson.json: not JSON (expected a plan.json written by vc-
   evaluate cloud.xyz --plan notjson.json
 expect 3 "vc-client: noz.json: no viewpoints[0].z (expected a plan.json written by vc-client submit) (nothing was sent)" \
   evaluate cloud.xyz --plan noz.json
-printf '{"schema": "vc.plan/1", "viewpoints": [{"x": 1, "y": 1, "z": 1.5}], "parameters": {"scanner": {"min_range_m": 0.5, "max_range_m": 75, "vfov_min_deg": null, "vfov_max_deg": null, "max_incidence_deg": null, "angular_step_deg": null, "max_spacing_m": null, "hfov_deg": 180}}}' >hfov.json
+printf '{"schema": "vc.plan/1", "resolution_m": 0.1, "viewpoints": [{"x": 1, "y": 1, "z": 1.5}], "parameters": {"scanner": {"min_range_m": 0.5, "max_range_m": 75, "vfov_min_deg": null, "vfov_max_deg": null, "max_incidence_deg": null, "angular_step_deg": null, "max_spacing_m": null, "hfov_deg": 180}}}' >hfov.json
 expect 3 "vc-client: hfov.json's scanner sees 180 deg around its heading, and evaluate takes no headings: add --hfov 360 to evaluate its stations all round (nothing was sent)" \
   evaluate cloud.xyz --plan hfov.json
 expect 3 "vc-client: evaluate needs the stations: --viewpoints stations.csv or --plan plan.json (nothing was sent)" \

@@ -1149,8 +1149,9 @@ HeatMap MissedVoxelsHeatMap(const PlanResult& result, double cell_m) {
   return map;
 }
 
-PlanResult EvaluationAsPlan(const EvaluateJobResult& result) {
+PlanResult EvaluationAsPlan(const EvaluateJobResult& result, const ScannerModel& scanner) {
   PlanResult plan;
+  plan.options.scanner = scanner;
   plan.frame_origin_m = result.frame_origin_m;
   plan.resolution_m = result.evaluation.resolution_m;
   plan.evaluation = result.evaluation;
@@ -1169,6 +1170,7 @@ PlanResult EvaluationAsPlan(const EvaluateJobResult& result) {
     plan.covered_voxels += *std::max_element(faces.begin(), faces.end()) > 0 ? 1 : 0;
   }
   plan.heat_map = MissedVoxelsHeatMap(plan, plan.options.grid_spacing_m);
+  plan.field_time = ComputeFieldTime(plan.stations.size(), 0.0, plan.options);
   return plan;
 }
 
@@ -1180,13 +1182,13 @@ std::string EvaluationToJson(const Evaluation& evaluation, const std::vector<Wor
 }
 
 Status WriteEvaluationOutputs(const EvaluateJobResult& result, const std::string& out_dir, const Crs* crs,
-                              const FieldSheetOptions& field_sheet) {
+                              const FieldSheetOptions& field_sheet, const ScannerModel& scanner) {
   VC_RETURN_IF_ERROR(MakeDir(out_dir));
   const std::filesystem::path dir(out_dir);
   const CrsInfo* crs_info = crs == nullptr ? nullptr : &crs->info();
   VC_RETURN_IF_ERROR(
       WriteFile(dir / "evaluation.json", EvaluationToJson(result.evaluation, result.viewpoints, crs_info)));
-  const PlanResult plan = EvaluationAsPlan(result);
+  const PlanResult plan = EvaluationAsPlan(result, scanner);
   VC_RETURN_IF_ERROR(WriteStationFiles(plan, dir, {}, crs, field_sheet));
   if (plan.evaluation.best_face_values.empty()) return Status::Ok();  // sampled: no per-voxel values
   return WriteVisibilityFiles(plan, dir, {}, HeatmapMeaning::kMissedByStations);

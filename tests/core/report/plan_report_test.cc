@@ -741,6 +741,21 @@ TEST(WriteEvaluationOutputsTest, WritesSubmitsFilesWithTheCrewsStationsCsv) {
   EXPECT_EQ(ReadAll(dir + "/heatmap.png"), *HeatmapPng(plan, HeatmapMeaning::kMissedByStations));
 }
 
+// With the job's scanner, the field sheet knows the scan time: set-up and scans of every station
+// (no walk: an evaluation has no route).
+TEST(WriteEvaluationOutputsTest, TheJobsScannerGivesTheFieldTime) {
+  const EvaluateJobResult r = TwoLevelEvaluation();
+  EXPECT_EQ(EvaluationAsPlan(r).field_time.scan_seconds_per_station, 0.0);
+  ScannerModel rtc360;
+  rtc360.name = "leica-rtc360";
+  const PlanResult plan = EvaluationAsPlan(r, rtc360);
+  ASSERT_GT(plan.field_time.scan_seconds_per_station, 0.0);
+  EXPECT_EQ(plan.options.scanner.name, "leica-rtc360");
+  EXPECT_DOUBLE_EQ(plan.field_time.scan_s, plan.field_time.scan_seconds_per_station * double(r.viewpoints.size()));
+  EXPECT_DOUBLE_EQ(plan.field_time.setup_s, plan.options.setup_seconds * double(r.viewpoints.size()));
+  EXPECT_EQ(plan.field_time.walk_s, 0.0);
+}
+
 // An evaluation's heat map counts what is missed: only its title and colour bar's words differ
 // from the same cells drawn as a plan's.
 TEST(WriteEvaluationOutputsTest, TheMissedVoxelsHeatMapSaysWhatItCountsInItsTitleAndColourBar) {

@@ -89,16 +89,19 @@ HeatMap MissedVoxelsHeatMap(const PlanResult& result, double cell_m);
 // highest voxel in its column at most 3 m below it (NaN when none); the voxels, the evaluation and
 // the frame as they are; covered_voxels the voxels some station sees (best V > 0), of all the
 // occupied ones (coverable_voxels: an evaluation has no candidates to bound what can be seen); the
-// heat map MissedVoxelsHeatMap's at the default grid spacing. The default PlanOptions otherwise.
-PlanResult EvaluationAsPlan(const EvaluateJobResult& result);
+// heat map MissedVoxelsHeatMap's at the default grid spacing; `scanner` (the job's) as the plan's
+// scanner, and the field time of set-up and scans it gives (ComputeFieldTime; no walk: an evaluation
+// has no route). The default PlanOptions otherwise.
+PlanResult EvaluationAsPlan(const EvaluateJobResult& result, const ScannerModel& scanner = {});
 
 // Writes evaluation.json, stations.csv (the crew's format, as WritePlanOutputs'), stations.dxf,
 // fieldsheet.pdf (laid out as `field_sheet` says) and, with `crs` (the CRS of the input's frame),
 // stations.geojson, of EvaluationAsPlan(result) through WritePlanOutputs' writers; and, when the
 // evaluation kept the best face values of every voxel (exact mode), visibility.ply, heatmap.png
 // (what the stations miss) and report.html. Errors as WritePlanOutputs'.
+// `scanner` is the job's (EvaluateJobOptions::scanner): the field sheet's scan time comes from it.
 Status WriteEvaluationOutputs(const EvaluateJobResult& result, const std::string& out_dir, const Crs* crs = nullptr,
-                              const FieldSheetOptions& field_sheet = {});
+                              const FieldSheetOptions& field_sheet = {}, const ScannerModel& scanner = {});
 
 // Pixel size of a picture.
 struct ImageSize {
