@@ -108,13 +108,16 @@ struct Route {
   // Empty where legs_m is NaN, and for k = 0 without a start. Every segment lies over walk nodes
   // or spans a gap of at most 2 voxels (file comment, "Gaps").
   std::vector<std::vector<WorldPoint>> polylines;
-  double length_m = 0;                // sum of the finite legs (m)
-  int parts = 0;                      // groups of stations no walkable path links (1 = one walk; 0 without stations)
-  std::vector<std::string> warnings;  // parts, stations or a start with no walk node near them
-  uint64_t walk_cells = 0;            // cells of the walk grid
-  uint64_t walk_nodes = 0;            // walk nodes (bridged ones included)
-  uint64_t bridged_nodes = 0;         // of those, the ones bridging floor gaps
-  double cell_m = 0;                  // the walk cell edge used (m)
+  double length_m = 0;  // sum of the finite legs (m)
+  int parts = 0;        // groups of stations no walkable path links (1 = one walk; 0 without stations)
+  // One per part after the first (its stations, where its walkable floor comes nearest to the
+  // others' within 3 m and what lies between: another storey, a rise, a wall, a sill or clutter),
+  // and one per station or start with no walk node near it (that station's part is not repeated).
+  std::vector<std::string> warnings;
+  uint64_t walk_cells = 0;     // cells of the walk grid
+  uint64_t walk_nodes = 0;     // walk nodes (bridged ones included)
+  uint64_t bridged_nodes = 0;  // of those, the ones bridging floor gaps
+  double cell_m = 0;           // the walk cell edge used (m)
 };
 
 // The route through `stations` (optical centres, world, m). floor_z_m: per station the top of the
