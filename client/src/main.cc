@@ -422,13 +422,14 @@ struct CheckedSubmit {
   vc::PlanOptions plan;
   vc::client::CrsChoice crs;
   vc::client::PreparedUpload prepared;
+  vc::client::PlanFileLines lines;  // where the files' entries were read, for the server's messages
 };
 
 vc::Result<CheckedSubmit> CheckSubmit(const CommandLine& cl) {
   CheckedSubmit checked{cl.plan, {}, {}};
   VC_ASSIGN_OR_RETURN(checked.crs, vc::client::CheckCrsFlag(cl.crs, cl.units));
-  VC_ASSIGN_OR_RETURN(const vc::client::PlanFileLines lines, vc::client::LoadPlanFiles(cl.plan_files, &checked.plan));
-  VC_RETURN_IF_ERROR(checked.plan.Validate(vc::client::PlanFlagNamer(lines)));
+  VC_ASSIGN_OR_RETURN(checked.lines, vc::client::LoadPlanFiles(cl.plan_files, &checked.plan));
+  VC_RETURN_IF_ERROR(checked.plan.Validate(vc::client::PlanFlagNamer(checked.lines)));
   VC_ASSIGN_OR_RETURN(checked.prepared, PrepareScene(cl, checked.crs.units, checked.plan.resolution_m));
   return checked;
 }
@@ -443,7 +444,12 @@ int RunSubmit(const CommandLine& cl, InterruptCancelsTheJob* interrupt) {
   AnnounceUpload(prepared, cl, display);
   auto r = (*client)->Plan(prepared.upload, checked->plan, Observe(display, interrupt));
   display.Done();
-  if (!r.ok()) return FailCall("plan", r.status(), cl.conn.server);
+  if (!r.ok()) {
+    // The server names a file's entry by its place ("fixed_stations[2]"); the user gets its line.
+    const vc::Status named(r.status().code(), vc::client::NameListEntries(r.status().message(),
+                                                                          vc::client::PlanFlagNamer(checked->lines)));
+    return FailCall("plan", named, cl.conn.server);
+  }
   NoteCache((*client)->last_upload(), &prepared.summary, display);
   const std::optional<vc::Crs>& crs = checked->crs.crs;
   return WritePlan(*r, cl.out_dir, cl.paper, &prepared.summary, FixedStationNames(cl.plan_files.fixed_stations),

@@ -1,5 +1,6 @@
 #include "vc/client/parameter_flags.h"
 
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -192,7 +193,10 @@ Result<PlanFileLines> LoadPlanFiles(const PlanFileFlags& files, PlanOptions* o) 
   if (!files.fixed_stations.empty()) {
     VC_ASSIGN_OR_RETURN(const std::vector<KnownStation> stations, ReadStationFile(files.fixed_stations));
     o->fixed_stations.clear();
-    for (const KnownStation& s : stations) o->fixed_stations.push_back(s.position_m);
+    for (const KnownStation& s : stations) {
+      o->fixed_stations.push_back(s.position_m);
+      lines.fixed_stations.push_back(s.source);
+    }
   }
   if (!files.keep_out.empty()) {
     VC_ASSIGN_OR_RETURN(std::string text, ReadText(files.keep_out, "keep-out"));
@@ -245,7 +249,9 @@ FieldNamer FlagNamer(FlagTable flags, PlanFileLines lines) {
     if (list == "keep_out") {
       return "--keep-out " + (i < lines.keep_out.size() ? "line " + std::to_string(lines.keep_out[i]) : "zone " + n);
     }
-    if (list == "fixed_stations") return "--fixed-stations station " + n;
+    if (list == "fixed_stations") {
+      return "--fixed-stations " + (i < lines.fixed_stations.size() ? lines.fixed_stations[i] : "station " + n);
+    }
     if (list == "candidates") return "--candidates point " + n;
     if (list == "tripod_heights_m") return "--tripod-heights value " + n;
     return std::string(path);
@@ -260,6 +266,28 @@ FieldNamer PlanFlagNamer(PlanFileLines lines) {
   FlagTable flags = ScannerFlags();
   VC_PLAN_PARAMETERS(VC_ROW_NAME)
   return FlagNamer(std::move(flags), std::move(lines));
+}
+
+std::string NameListEntries(std::string_view message, const FieldNamer& namer) {
+  std::string out;
+  size_t pos = 0;
+  while (pos < message.size()) {
+    // A path: a lower-case name and an index in brackets ("fixed_stations[12]").
+    const size_t open = message.find('[', pos);
+    const size_t close = open == std::string_view::npos ? open : message.find(']', open);
+    if (close == std::string_view::npos) break;
+    size_t start = open;
+    while (start > pos && (std::islower(static_cast<unsigned char>(message[start - 1])) || message[start - 1] == '_')) {
+      --start;
+    }
+    const std::string_view path = message.substr(start, close + 1 - start);
+    const bool indexed = start < open && SplitIndex(path).second != std::string_view::npos;
+    out.append(message.substr(pos, start - pos));
+    out += indexed ? namer(path) : std::string(path);
+    pos = close + 1;
+  }
+  out.append(message.substr(std::min(pos, message.size())));
+  return out;
 }
 
 FieldNamer EvaluateFlagNamer() {

@@ -443,10 +443,30 @@ TEST(PlanFlagNamerTest, AKeepOutConflictIsNamedByFlagAndLine) {
   ASSERT_TRUE(lines.ok()) << lines.status().ToString();
   EXPECT_EQ(lines->keep_out, (std::vector<size_t>{3, 4}));
   EXPECT_EQ(o.Validate(client::PlanFlagNamer(*lines)).message(),
-            "--keep-out line 4: --fixed-stations station 2 (5.5, 5.5, 1.5) lies inside this zone");
+            "--keep-out line 4: --fixed-stations " + files.fixed_stations + ":3 (5.5, 5.5, 1.5) lies inside this zone");
   EXPECT_EQ(o.Validate().message(), "keep_out[1]: fixed_stations[1] (5.5, 5.5, 1.5) lies inside this zone");
   o.keep_out[0].min.x() = 2;  // a zone the wire could carry: min above max
   EXPECT_EQ(o.Validate(client::PlanFlagNamer(*lines)).message(), "--keep-out line 3: box xmin (2) exceeds xmax (1)");
+}
+
+// The server checks fixed stations against the scene (outside its bounds, inside an occupied
+// voxel) and names them by their place; vc-client names the file and line they came from.
+TEST(PlanFlagNamerTest, TheServersMessagesAboutAFixedStationNameItsFileAndLine) {
+  client::PlanFileFlags files;
+  files.fixed_stations = WriteTemp("far_fixed.csv", "# scanned last week\nx,y,z\n1,1,1.5\n\n900,1,1.5\n");
+  PlanOptions o;
+  Result<client::PlanFileLines> lines = client::LoadPlanFiles(files, &o);
+  ASSERT_TRUE(lines.ok()) << lines.status().ToString();
+  EXPECT_EQ(lines->fixed_stations,
+            (std::vector<std::string>{files.fixed_stations + ":3", files.fixed_stations + ":5"}));
+  const std::string server =
+      "fixed_stations[1] (station 2 of the file, at 900, 1, 1.5) lies outside the scene's bounds (x -2..30 m)";
+  EXPECT_EQ(client::NameListEntries(server, client::PlanFlagNamer(*lines)),
+            "--fixed-stations " + files.fixed_stations +
+                ":5 (station 2 of the file, at 900, 1, 1.5) lies outside the scene's bounds (x -2..30 m)");
+  // Brackets that are no list entry, and entries past the file's, stay as they are or by place.
+  EXPECT_EQ(client::NameListEntries("voxel [3] of keep_out[0] and fixed_stations[7]", client::PlanFlagNamer(*lines)),
+            "voxel [3] of --keep-out zone 1 and --fixed-stations station 8");
 }
 
 TEST(ListParametersTest, StartIsXYOrXYZAndAnythingElseIsRefused) {

@@ -280,10 +280,11 @@ TEST(PlanResultChunks, ASoleViewerNamingAMissingStationOrOnSomeChunksOnlyIsDataL
 // field in proto/vc/v1/planner.proto and proto/src/convert.cc (both ways), then update the sizes.
 // (1440: Evaluation::per_viewpoint_sparse_values, which like per_viewpoint_face_values is the
 // reduction's working data and never part of a result on the wire. 1448 and 416: the scanner's
-// hfov_deg, a row carried as ScannerModel.hfov_deg. 1560: unseen_causes.)
+// hfov_deg, a row carried as ScannerModel.hfov_deg. 1560: unseen_causes. 1568 and 432: walk_max_step_m, a
+// row carried as PlanParameters.walk_max_step_m; PlanResult holds the options.)
 TEST(PlanResultChunks, EveryCoreFieldIsCarried) {
-  EXPECT_EQ(sizeof(PlanResult), 1560u) << "PlanResult changed: update the vc.v1 PlanResult and vc::wire";
-  EXPECT_EQ(sizeof(PlanOptions), 424u) << "PlanOptions changed: update vc.v1 PlanParameters and vc::wire";
+  EXPECT_EQ(sizeof(PlanResult), 1568u) << "PlanResult changed: update the vc.v1 PlanResult and vc::wire";
+  EXPECT_EQ(sizeof(PlanOptions), 432u) << "PlanOptions changed: update vc.v1 PlanParameters and vc::wire";
 }
 
 // A georeferenced plan: local positions, the frame's origin at UTM-like coordinates (and once

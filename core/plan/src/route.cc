@@ -26,9 +26,14 @@ constexpr int kDx[kDirs] = {1, -1, 0, 0, 1, -1, 1, -1};
 constexpr int kDy[kDirs] = {0, 0, 1, -1, 1, 1, -1, -1};
 constexpr int kSideX[kDirs] = {-1, -1, -1, -1, 0, 1, 0, 1};
 constexpr int kSideY[kDirs] = {-1, -1, -1, -1, 2, 2, 3, 3};
-// Bytes a walk node costs: surface, cell, 8 neighbours, Dijkstra stamp/distance/parent, heap and
-// the transient surface lists while building.
-constexpr uint64_t kBytesPerNode = 80;
+// Bytes a walk node costs: surface, cell, 8 neighbours and their link kinds, region, Dijkstra
+// stamp/distance/parent, heap and the transient surface lists while building.
+constexpr uint64_t kBytesPerNode = 92;
+// A link's kind: to a straight or a diagonal neighbour, or straight over a gap of 1 to
+// kMaxGapVoxels cells with no walk surface near its height (kOverGap + the gap's cells - 1).
+constexpr int kMaxGapVoxels = 2;
+constexpr uint8_t kStraight = 0, kDiagonal = 1, kOverGap = 2;
+constexpr int kLinkKinds = kOverGap + kMaxGapVoxels;
 constexpr float kInf = std::numeric_limits<float>::infinity();
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
@@ -44,15 +49,20 @@ struct WalkGraph {
   double r = 0;
   int k = 1;  // voxel columns per cell edge
   int nx = 0, ny = 0;
-  int step = 0;                      // max_step_m in voxels
-  std::vector<uint32_t> cell_begin;  // per cell, its first node; nx * ny + 1 entries
-  std::vector<int32_t> z;            // per node: the surface's top voxel index
-  std::vector<uint32_t> cell;        // per node: its cell (y * nx + x)
-  std::vector<int32_t> nbr;          // per node, kDirs neighbours or -1
-  std::vector<uint8_t> unknown;      // per node: bridged under space the scan did not observe
-  float unknown_factor = 1;          // cost factor of a link touching such a node
-  uint64_t bridged = 0;
-  float cost[2][64] = {};  // link cost (m) by [diagonal][|dz| voxels]
+  int step = 0;                       // max_step_m in voxels
+  std::vector<uint32_t> cell_begin;   // per cell, its first node; nx * ny + 1 entries
+  std::vector<int32_t> z;             // per node: the surface's top voxel index
+  std::vector<uint32_t> cell;         // per node: its cell (y * nx + x)
+  std::vector<int32_t> nbr;           // per node, kDirs neighbours or -1
+  std::vector<uint8_t> unknown;       // per node: bridged under space the scan did not observe
+  std::vector<uint8_t> bridged;       // per node: over unseen floor, its height a window's lowest floor
+  std::vector<int32_t> region;        // per node: its connected region (nodes linked by walks)
+  std::vector<uint32_t> region_size;  // per region: its nodes
+  float unknown_factor = 1;           // cost factor of a link touching such a node
+  uint64_t bridged_count = 0;
+  std::vector<uint8_t> link;        // per node, kDirs link kinds (kStraight, kDiagonal, kOverGap + cells)
+  int headroom = 0;                 // free voxels above a walk surface
+  float cost[kLinkKinds][64] = {};  // link cost (m) by [link kind][|dz| voxels]
 
   int CellX(uint32_t c) const { return int(c % uint32_t(nx)); }
   int CellY(uint32_t c) const { return int(c / uint32_t(nx)); }
@@ -66,14 +76,21 @@ struct WalkGraph {
   uint64_t cells() const { return uint64_t(nx) * uint64_t(ny); }
 };
 
-// In a CSR of (cell_begin, zs), the node of cell c with |z - zc| <= step closest to zc (the higher
-// on a tie), or -1.
-int NodeNear(const std::vector<uint32_t>& begin, const std::vector<int32_t>& zs, uint32_t c, int zc, int step) {
+// The height difference (voxels) a link between nodes a and b may span: max_step_m, and a voxel
+// more when either is bridged, since a bridged floor lies at the lowest seen floor near it, up to
+// a voxel below the floor around it where that is uneven or noisy.
+int LinkStep(const WalkGraph& g, int a, int b) { return g.step + (g.bridged[a] || g.bridged[b]); }
+
+// The node of cell c that node n links to: the one closest in height to n's (the higher on a tie)
+// within LinkStep, or -1.
+int NodeNear(const WalkGraph& g, uint32_t c, int n) {
   int best = -1;
-  for (uint32_t n = begin[c]; n < begin[c + 1]; ++n) {
-    const int d = std::abs(zs[n] - zc);
-    if (d > step) continue;
-    if (best < 0 || d < std::abs(zs[best] - zc) || (d == std::abs(zs[best] - zc) && zs[n] > zs[best])) best = int(n);
+  for (uint32_t m = g.cell_begin[c]; m < g.cell_begin[c + 1]; ++m) {
+    const int d = std::abs(g.z[m] - g.z[n]);
+    if (d > LinkStep(g, n, int(m))) continue;
+    if (best < 0 || d < std::abs(g.z[best] - g.z[n]) || (d == std::abs(g.z[best] - g.z[n]) && g.z[m] > g.z[best])) {
+      best = int(m);
+    }
   }
   return best;
 }
@@ -268,7 +285,8 @@ Status KeepNodesWhereAPersonFits(WalkGraph& g, const std::vector<Candidate>& nod
     g.z.push_back(cand.z);
     g.cell.push_back(cand.cell);
     g.unknown.push_back(unknown);
-    g.bridged += cand.lines != 0;
+    g.bridged.push_back(cand.lines != 0);
+    g.bridged_count += cand.lines != 0;
   }
   const uint64_t cells = g.cells();
   g.cell_begin.assign(cells + 1, 0);
@@ -277,14 +295,57 @@ Status KeepNodesWhereAPersonFits(WalkGraph& g, const std::vector<Candidate>& nod
   return Status::Ok();
 }
 
-// g's link costs and links to the 8 neighbours, mutual only, diagonals only with both sides walkable.
+// Whether no node of cell c lies within LinkStep of node a or of node b.
+bool NoSurfaceNear(const WalkGraph& g, uint32_t c, int a, int b) {
+  for (uint32_t m = g.cell_begin[c]; m < g.cell_begin[c + 1]; ++m) {
+    if (std::abs(g.z[m] - g.z[a]) <= LinkStep(g, a, int(m)) || std::abs(g.z[m] - g.z[b]) <= LinkStep(g, b, int(m))) {
+      return false;
+    }
+  }
+  return true;
+}
+
+// The node n links to over a gap in straight direction d (file comment, "Gaps"), and the gap's
+// cells; {-1, 0} if none.
+std::pair<int, int> LinkOverGap(const WalkGraph& g, int n, int d) {
+  const int i = g.CellX(g.cell[n]), j = g.CellY(g.cell[n]);
+  const int max_gap_cells = kMaxGapVoxels / g.k;
+  for (int span = 2; span <= max_gap_cells + 1; ++span) {
+    const int ti = i + kDx[d] * span, tj = j + kDy[d] * span;
+    if (ti < 0 || tj < 0 || ti >= g.nx || tj >= g.ny) return {-1, 0};
+    const int m = NodeNear(g, uint32_t(tj) * uint32_t(g.nx) + uint32_t(ti), n);
+    if (m < 0) continue;
+    if (NodeNear(g, g.cell[n], m) != n) return {-1, 0};
+    // Every cell between: no walk surface near either end's height, its column free from just
+    // above the lower end's surface up to the higher end's headroom (a gap, not a wall or a desk)
+    // and seen below that (a dip; unseen floor is max_gap_m's).
+    const int lo = std::min(g.z[n], g.z[m]) + 1, hi = std::max(g.z[n], g.z[m]) + g.headroom;
+    const int bottom = g.grid->min_index().z;
+    for (int t = 1; t < span; ++t) {
+      const int ci = i + kDx[d] * t, cj = j + kDy[d] * t, x = g.ColumnX(ci), y = g.ColumnY(cj);
+      if (!NoSurfaceNear(g, uint32_t(cj) * uint32_t(g.nx) + uint32_t(ci), n, m)) return {-1, 0};
+      if (g.grid->AnyOccupied({x, y, lo}, {x, y, hi}) || lo <= bottom ||
+          !g.grid->AnyOccupied({x, y, bottom}, {x, y, lo - 1})) {
+        return {-1, 0};
+      }
+    }
+    return {m, span - 1};
+  }
+  return {-1, 0};
+}
+
+// g's link costs and links to the 8 neighbours, mutual only, diagonals only with both sides
+// walkable, and straight ones over gaps of up to kMaxGapVoxels where a neighbour has no surface.
 Status LinkNeighbours(WalkGraph& g, const JobContext& ctx) {
   const double r = g.r, cell_m = g.k * r;
   for (int dz = 0; dz < 64; ++dz) {
-    g.cost[0][dz] = float(std::hypot(cell_m, dz * r));
-    g.cost[1][dz] = float(std::sqrt(2 * cell_m * cell_m + dz * r * dz * r));
+    g.cost[kStraight][dz] = float(std::hypot(cell_m, dz * r));
+    g.cost[kDiagonal][dz] = float(std::sqrt(2 * cell_m * cell_m + dz * r * dz * r));
+    for (int gap = 1; gap <= kMaxGapVoxels; ++gap)
+      g.cost[kOverGap + gap - 1][dz] = float(std::hypot((gap + 1) * cell_m, dz * r));
   }
   g.nbr.assign(size_t(g.size()) * kDirs, -1);
+  g.link.assign(size_t(g.size()) * kDirs, kStraight);
   for (int n = 0; n < g.size(); ++n) {
     if ((n & 0xffff) == 0) VC_RETURN_IF_ERROR(ctx.CheckCancelled("walking route"));
     const int i = g.CellX(g.cell[n]), j = g.CellY(g.cell[n]);
@@ -293,15 +354,45 @@ Status LinkNeighbours(WalkGraph& g, const JobContext& ctx) {
       found[d] = -1;
       const int ti = i + kDx[d], tj = j + kDy[d];
       if (ti < 0 || tj < 0 || ti >= g.nx || tj >= g.ny) continue;
-      const int m = NodeNear(g.cell_begin, g.z, uint32_t(tj) * uint32_t(g.nx) + uint32_t(ti), g.z[n], g.step);
-      if (m >= 0 && NodeNear(g.cell_begin, g.z, g.cell[n], g.z[m], g.step) == n) found[d] = m;
+      const uint32_t c = uint32_t(tj) * uint32_t(g.nx) + uint32_t(ti);
+      const int m = NodeNear(g, c, n);
+      if (m >= 0 && NodeNear(g, g.cell[n], m) == n) found[d] = m;
+      g.link[size_t(n) * kDirs + d] = d >= 4 ? kDiagonal : kStraight;
+      if (m < 0 && d < 4) {
+        const auto [over, gap] = LinkOverGap(g, n, d);
+        if (over >= 0) g.link[size_t(n) * kDirs + d] = uint8_t(kOverGap + gap - 1);
+        g.nbr[size_t(n) * kDirs + d] = over;
+      }
     }
     for (int d = 0; d < kDirs; ++d) {
-      if (d >= 4 && (found[kSideX[d]] < 0 || found[kSideY[d]] < 0)) continue;
+      if (found[d] < 0 || (d >= 4 && (found[kSideX[d]] < 0 || found[kSideY[d]] < 0))) continue;
       g.nbr[size_t(n) * kDirs + d] = found[d];
     }
   }
   return Status::Ok();
+}
+
+// g's regions: connected components of the links (breadth first).
+void LabelRegions(WalkGraph& g) {
+  g.region.assign(size_t(g.size()), -1);
+  g.region_size.clear();
+  std::vector<int> queue;
+  for (int s = 0; s < g.size(); ++s) {
+    if (g.region[s] >= 0) continue;
+    const int32_t label = int32_t(g.region_size.size());
+    g.region[s] = label;
+    queue.assign(1, s);
+    for (size_t q = 0; q < queue.size(); ++q) {
+      for (int d = 0; d < kDirs; ++d) {
+        const int m = g.nbr[size_t(queue[q]) * kDirs + d];
+        if (m >= 0 && g.region[m] < 0) {
+          g.region[m] = label;
+          queue.push_back(m);
+        }
+      }
+    }
+    g.region_size.push_back(uint32_t(queue.size()));
+  }
 }
 
 // The walk graph of `grid` with cells of k x k columns (file comment).
@@ -312,10 +403,11 @@ Result<WalkGraph> BuildWalkGraph(const OccupancyGrid& grid, const RouteOptions& 
   g.k = k;
   g.nx = (grid.dims().x() + k - 1) / k;
   g.ny = (grid.dims().y() + k - 1) / k;
-  g.step = std::min(63, static_cast<int>(std::floor(o.max_step_m / g.r + 1e-9)));
+  g.step = std::min(62, static_cast<int>(std::floor(o.max_step_m / g.r + 1e-9)));
   g.unknown_factor = static_cast<float>(o.unknown_cost_factor);
   VC_RETURN_IF_ERROR(MemoryCheck(g.cells(), 0, o, g.r, k));
   const int headroom = FreeVoxelsNeeded(g.r, o.headroom_m, 0);
+  g.headroom = headroom;
   std::vector<Candidate> nodes;
   {
     VC_ASSIGN_OR_RETURN(const CellSurfaces surfaces, StandingSurfaces(g, headroom, o, ctx));
@@ -325,6 +417,7 @@ Result<WalkGraph> BuildWalkGraph(const OccupancyGrid& grid, const RouteOptions& 
   VC_RETURN_IF_ERROR(KeepNodesWhereAPersonFits(g, nodes, headroom, o, ctx));
   nodes = {};
   VC_RETURN_IF_ERROR(LinkNeighbours(g, ctx));
+  LabelRegions(g);
   return g;
 }
 
@@ -356,7 +449,7 @@ class ShortestPaths {
       for (int k = 0; k < kDirs; ++k) {
         const int m = nb[k];
         if (m < 0) continue;
-        float step = g_.cost[k >= 4][std::abs(g_.z[m] - g_.z[n])];
+        float step = g_.cost[g_.link[size_t(n) * kDirs + k]][std::abs(g_.z[m] - g_.z[n])];
         if (g_.unknown[m] || g_.unknown[n]) step *= g_.unknown_factor;
         const float nd = d + step;
         if (nd < Dist(m)) {
@@ -413,17 +506,24 @@ void ForNodesNear(const WalkGraph& g, double x_m, double y_m, double radius_m, F
 
 double Horizontal2(const WorldPoint& a, const WorldPoint& b) { return (a - b).head<2>().squaredNorm(); }
 
-// The node a point with floor top `floor_m` snaps to (file comment), or -1.
-int SnapToFloor(const WalkGraph& g, const WorldPoint& floor_point, double tolerance_m, double radius_m) {
+// The node a point with floor top `floor_m` snaps to (file comment), or -1: within radius_m
+// horizontally and tolerance_m in height, the nearest horizontally (then in 3D, then the lowest
+// number); with largest_region, first the one in the largest region.
+int SnapToFloor(const WalkGraph& g, const WorldPoint& floor_point, double tolerance_m, double radius_m,
+                bool largest_region = false) {
   int best = -1;
+  uint32_t best_size = 0;
   double best_h = 0, best_d = 0;
   ForNodesNear(g, floor_point.x(), floor_point.y(), radius_m, [&](int n) {
     const WorldPoint p = g.Point(n);
-    if (std::abs(p.z() - floor_point.z()) > tolerance_m + 1e-9) return;
+    if (std::abs(p.z() - floor_point.z()) > tolerance_m + (g.bridged[n] ? g.r : 0) + 1e-9) return;
     const double h = Horizontal2(p, floor_point), d = (p - floor_point).squaredNorm();
     if (h > radius_m * radius_m) return;
-    if (best < 0 || h < best_h || (h == best_h && (d < best_d || (d == best_d && n < best)))) {
+    const uint32_t size = largest_region ? g.region_size[g.region[n]] : 0;
+    if (best < 0 || size > best_size ||
+        (size == best_size && (h < best_h || (h == best_h && (d < best_d || (d == best_d && n < best)))))) {
       best = n;
+      best_size = size;
       best_h = h;
       best_d = d;
     }
@@ -528,8 +628,11 @@ class RoutePlanner {
   void FindParts();
   // The order of the parts: the start's part first, then from the lowest floor up.
   void OrderParts();
-  // Warnings about a start linked to no station and about each part after the first.
+  // Warnings about a start linked to no station and about each part after the first, one each.
   void WarnAboutUnlinkedParts();
+  // Why `part` (its stations snapped) is apart: where its walkable floor comes nearest to the
+  // others' and what lies between, or that none is near (another storey).
+  std::string WhySplit(const std::vector<int>& part) const;
   // The open path problem of the stations of `part`, from the start when `from_the_start`.
   OpenPathProblem PartProblem(const std::vector<int>& part, bool from_the_start) const;
   // Orders the pi-th part in part order and appends its stations, legs and polylines to the route.
@@ -562,7 +665,7 @@ class RoutePlanner {
 Result<Route> RoutePlanner::Plan(const std::vector<double>& floor_z_m) {
   route_.walk_cells = g_.cells();
   route_.walk_nodes = uint64_t(g_.size());
-  route_.bridged_nodes = g_.bridged;
+  route_.bridged_nodes = g_.bridged_count;
   route_.cell_m = g_.k * g_.r;
   SnapStations(floor_z_m);
   SnapStart();
@@ -583,16 +686,19 @@ void RoutePlanner::SnapStations(const std::vector<double>& floor_z_m) {
     floor_point_[s] = WorldPoint(stations_[s].x(), stations_[s].y(), f);
     if (std::isnan(f)) {
       route_.warnings.push_back("station " + std::to_string(s + options_.first_station_number) +
-                                " has no floor below it: it is a part of its own, walking to it is not counted");
+                                " has no floor below it: the route has a part of its own for it, walking to it is "
+                                "not counted");
       continue;
     }
-    node_[s] = SnapToFloor(g_, floor_point_[s], tolerance_m, options_.snap_radius_m);
+    // Within the tripod's footprint, the floor a crew walks in on rather than clutter beside it.
+    node_[s] = SnapToFloor(g_, floor_point_[s], tolerance_m, std::max(options_.clearance_m, g_.k * g_.r), true);
+    if (node_[s] < 0) node_[s] = SnapToFloor(g_, floor_point_[s], tolerance_m, options_.snap_radius_m);
     if (node_[s] < 0) {
       route_.warnings.push_back(
           "station " + std::to_string(s + options_.first_station_number) +
           Fmt(" has no walkable cell within %.2g m", options_.snap_radius_m) +
           Fmt(" of (%.2f, %.2f)", stations_[s].x(), stations_[s].y()) +
-          Fmt(" on its floor (z = %.2f m): it is a part of its own, walking to it is not counted", f));
+          Fmt(" on its floor (z = %.2f m): the route has a part of its own for it, walking to it is not counted", f));
     }
   }
 }
@@ -691,6 +797,112 @@ void RoutePlanner::OrderParts() {
   });
 }
 
+// The highest thing (m above the lower of the two surfaces, up to the headroom) in the voxel
+// columns along the straight line between nodes a and b; 0 when they are free.
+double HighestBetween(const WalkGraph& g, int a, int b) {
+  const WorldPoint p = g.Point(a), q = g.Point(b);
+  const int floor_z = std::min(g.z[a], g.z[b]);
+  const int samples = std::max(1, static_cast<int>(std::ceil((q - p).head<2>().norm() / (0.5 * g.r))));
+  int highest = floor_z;
+  for (int k = 0; k <= samples; ++k) {
+    const VoxelIndex v = g.grid->WorldToIndex(p + (q - p) * (double(k) / samples));
+    for (int z = floor_z + g.headroom; z > highest; --z) {
+      if (g.grid->Occupied(v.x, v.y, z)) {
+        highest = z;
+        break;
+      }
+    }
+  }
+  return (highest - floor_z) * g.r;
+}
+
+// Where the walkable floor of region `from` comes nearest to that of the regions in `to`: a
+// breadth-first search over the cells from those holding a node of `from`, up to kSplitSearchM;
+// of the pairs found at the nearest ring, the one with the lowest obstacle between.
+struct NearestApproach {
+  int from_node = -1;  // a node of `from`, or -1 when no node of `to` lies within kSplitSearchM
+  int to_node = -1;    // the node of `to` it comes nearest to
+};
+constexpr double kSplitSearchM = 3.0;
+
+NearestApproach ApproachBetween(const WalkGraph& g, int32_t from, const std::vector<uint8_t>& to) {
+  const uint64_t cells = g.cells();
+  std::vector<int32_t> origin(cells, -1);  // per reached cell, the `from` node it was reached from
+  std::vector<uint32_t> frontier, next;
+  for (int n = 0; n < g.size(); ++n) {
+    if (g.region[n] == from && origin[g.cell[n]] < 0) {
+      origin[g.cell[n]] = n;
+      frontier.push_back(g.cell[n]);
+    }
+  }
+  const int max_rings = static_cast<int>(std::ceil(kSplitSearchM / (g.k * g.r)));
+  for (int ring = 0; ring <= max_rings && !frontier.empty(); ++ring) {
+    NearestApproach best;
+    double best_obstacle_m = 0;
+    for (uint32_t c : frontier) {
+      for (uint32_t m = g.cell_begin[c]; m < g.cell_begin[c + 1]; ++m) {
+        if (!to[g.region[m]]) continue;
+        const double obstacle_m = HighestBetween(g, origin[c], int(m));
+        if (best.to_node < 0 || obstacle_m < best_obstacle_m) {
+          best = {origin[c], int(m)};
+          best_obstacle_m = obstacle_m;
+        }
+      }
+    }
+    if (best.to_node >= 0) return best;
+    next.clear();
+    for (uint32_t c : frontier) {
+      const int i = g.CellX(c), j = g.CellY(c);
+      for (int d = 0; d < 4; ++d) {
+        const int ti = i + kDx[d], tj = j + kDy[d];
+        if (ti < 0 || tj < 0 || ti >= g.nx || tj >= g.ny) continue;
+        const uint32_t t = uint32_t(tj) * uint32_t(g.nx) + uint32_t(ti);
+        if (origin[t] >= 0) continue;
+        origin[t] = origin[c];
+        next.push_back(t);
+      }
+    }
+    frontier.swap(next);
+  }
+  return {};
+}
+
+std::string RoutePlanner::WhySplit(const std::vector<int>& part) const {
+  std::vector<uint8_t> others(g_.region_size.size(), 0);
+  for (int s = 0; s < n_; ++s) {
+    if (node_[s] >= 0 && part_of_[s] != part_of_[part.front()]) others[g_.region[node_[s]]] = 1;
+  }
+  const NearestApproach a = ApproachBetween(g_, g_.region[node_[part.front()]], others);
+  if (a.from_node < 0) {
+    return Fmt(
+        ": no floor the others walk on lies within %.0f m of its walkable floor, so it is another storey or "
+        "area that no stairs or ramp in the data links",
+        kSplitSearchM);
+  }
+  const WorldPoint p = g_.Point(a.from_node), q = g_.Point(a.to_node);
+  const double rise = q.z() - p.z();
+  const std::string where = Fmt(": its walkable floor ends at (%.2f, %.2f, %.2f)", p.x(), p.y(), p.z()) +
+                            Fmt(", %.2f m from the others' at (%.2f, %.2f", (q - p).head<2>().norm(), q.x(), q.y()) +
+                            Fmt(", %.2f), ", q.z());
+  if (std::abs(rise) > options_.max_step_m + g_.r) {
+    return where + Fmt("%.2f m ", std::abs(rise)) + (rise > 0 ? "higher" : "lower") +
+           (std::abs(rise) >= options_.headroom_m
+                ? std::string(": another storey, and no stairs or ramp in the data links them")
+                : Fmt(": a rise above the walkable step (%.2f m), and no stairs or ramp in the data",
+                      options_.max_step_m));
+  }
+  const double obstacle_m = HighestBetween(g_, a.from_node, a.to_node);
+  if (obstacle_m >= options_.headroom_m - g_.r) return where + "at about the same height, with a wall between";
+  if (obstacle_m > 0) {
+    return where + Fmt("at about the same height, with something %.2f m high between ", obstacle_m) +
+           Fmt("(a sill or step above the walkable step of %.2f m, or clutter)", options_.max_step_m);
+  }
+  return where +
+         Fmt("at about the same height: clutter within %.2f m of the way (the walking clearance) ",
+             options_.clearance_m) +
+         Fmt("or unseen floor wider than %.1f m closes it", 2 * options_.max_gap_m);
+}
+
 void RoutePlanner::WarnAboutUnlinkedParts() {
   if (options_.start && start_node_ >= 0 && start_part_ < 0) {
     route_.warnings.push_back(
@@ -699,12 +911,12 @@ void RoutePlanner::WarnAboutUnlinkedParts() {
   route_.parts = int(parts_.size());
   for (size_t pi = 1; pi < part_order_.size(); ++pi) {
     const std::vector<int>& part = parts_[part_order_[pi]];
+    if (node_[part.front()] < 0) continue;  // SnapStations said where and why
     const double z = LowestFloor(part);
-    route_.warnings.push_back(
-        StationList(part, options_.first_station_number) +
-        (std::isinf(z) ? std::string() : Fmt(" (floor z = %.2f m)", z)) +
-        " not linked to the others by any walkable path (no stairs or ramp found): the route has " +
-        std::to_string(parts_.size()) + " parts, walking between them is not counted");
+    route_.warnings.push_back(StationList(part, options_.first_station_number) +
+                              (std::isinf(z) ? std::string() : Fmt(" (floor z = %.2f m)", z)) +
+                              " not linked to the others by any walkable path" + WhySplit(part) + "; the route has " +
+                              std::to_string(parts_.size()) + " parts, walking between them is not counted");
   }
 }
 

@@ -87,7 +87,8 @@ TEST(CandidatesStageTest, AFixedStationInsideAWallIsRefused) {
   ASSERT_FALSE(r.ok());
   EXPECT_EQ(r.status().code(), StatusCode::kInvalidArgument);
   EXPECT_THAT(r.status().message(), HasSubstr("fixed_stations[0]"));
-  EXPECT_THAT(r.status().message(), HasSubstr("lies inside an occupied voxel"));
+  EXPECT_THAT(r.status().message(), HasSubstr("lies inside an occupied voxel (x -2"));  // the voxel's bounds
+  EXPECT_THAT(r.status().message(), HasSubstr("z 1"));
 }
 
 TEST(CandidatesStageTest, AFixedStationWithoutAFloorBelowIsWarnedAboutWithTheDistance) {
@@ -99,6 +100,8 @@ TEST(CandidatesStageTest, AFixedStationWithoutAFloorBelowIsWarnedAboutWithTheDis
   ASSERT_TRUE(r.ok()) << r.status().ToString();
   EXPECT_TRUE(HasWarning(*r, "fixed_stations[0] (station 1 of the file, at -0.75, -0.45, 1.6) has no floor below it"))
       << ::testing::PrintToString(r->warnings);
+  EXPECT_TRUE(HasWarning(*r, "down to the scene's bottom at z = -5")) << ::testing::PrintToString(r->warnings);
+  EXPECT_TRUE(HasWarning(*r, "6.6 m below it")) << ::testing::PrintToString(r->warnings);
   EXPECT_TRUE(HasWarning(*r, "fixed_stations[1]")) << ::testing::PrintToString(r->warnings);
   EXPECT_TRUE(HasWarning(*r, "straight below is 6.5 m down")) << ::testing::PrintToString(r->warnings);
   EXPECT_TRUE(HasWarning(*r, "fixed_stations[2]")) << ::testing::PrintToString(r->warnings);

@@ -49,7 +49,8 @@ struct PlanFileFlags {
 void AddPlanFileFlags(CLI::App* command, PlanFileFlags* files);
 // Where LoadPlanFiles found the zones, for messages that name them by line.
 struct PlanFileLines {
-  std::vector<size_t> keep_out;  // keep_out[i]: the line of zone i in the --keep-out file
+  std::vector<size_t> keep_out;             // keep_out[i]: the line of zone i in the --keep-out file
+  std::vector<std::string> fixed_stations;  // fixed_stations[i]: where station i was read ("file:line", "file, scan 3")
 };
 // Reads the files named in `files` into options->candidates, fixed_stations and keep_out, and the
 // start into options->route_start (z NaN when only x,y is given). NOT_FOUND / INVALID_ARGUMENT
@@ -63,10 +64,16 @@ struct PlanFileLines {
 // The names vc-client's messages give the fields PlanOptions::Validate and
 // EvaluateJobOptions::Validate check (vc/base/parameter.h, FieldNamer): each row by its flag
 // ("scanner.max_range_m" -> "--max-range"), a keep-out zone by its line ("keep_out[0]" ->
-// "--keep-out line 2"), a list entry by its place ("fixed_stations[0]" -> "--fixed-stations
-// station 1", "tripod_heights_m[1]" -> "--tripod-heights value 2"), route_start as --start. So
+// "--keep-out line 2"), a fixed station by where it was read ("fixed_stations[0]" ->
+// "--fixed-stations stations.csv:2"), a list entry by its place ("fixed_stations[0]" without its
+// source -> "--fixed-stations station 1", "tripod_heights_m[1]" -> "--tripod-heights value 2"),
+// route_start as --start. So
 // the client checks before it uploads, with the server's own rules, in the user's words.
 [[nodiscard]] FieldNamer PlanFlagNamer(PlanFileLines lines = {});
+// `message` (the server's, or Validate's without a namer) with each list entry it names by path
+// ("fixed_stations[2]", "keep_out[0]", "candidates[4]") named as `namer` names it
+// ("--fixed-stations stations.csv:4"), so a message about a file's entry names its line.
+[[nodiscard]] std::string NameListEntries(std::string_view message, const FieldNamer& namer);
 [[nodiscard]] FieldNamer EvaluateFlagNamer();
 
 }  // namespace vc::client

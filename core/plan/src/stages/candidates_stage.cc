@@ -16,7 +16,17 @@ std::string InputFrame(const VoxelScene& scene, const WorldPoint& local) {
   return Coordinate(p.x()) + ", " + Coordinate(p.y()) + ", " + Coordinate(p.z());
 }
 
-// INVALID_ARGUMENT naming `what`[i] when a user position is out of range or inside an occupied voxel.
+// The box [lo, hi] (local) in the input's frame.
+std::string Bounds(const VoxelScene& scene, const WorldPoint& local_lo, const WorldPoint& local_hi) {
+  const bool zero = scene.frame_origin_m.isZero();
+  const WorldPoint lo = zero ? local_lo : WorldPoint(local_lo + scene.frame_origin_m);
+  const WorldPoint hi = zero ? local_hi : WorldPoint(local_hi + scene.frame_origin_m);
+  return "x " + Coordinate(lo.x()) + ".." + Coordinate(hi.x()) + ", y " + Coordinate(lo.y()) + ".." +
+         Coordinate(hi.y()) + ", z " + Coordinate(lo.z()) + ".." + Coordinate(hi.z()) + " m";
+}
+
+// INVALID_ARGUMENT naming `what`[i] when a user position is out of range or inside an occupied
+// voxel (naming the voxel's bounds).
 Status CheckUserPositions(const VoxelScene& scene, const std::vector<WorldPoint>& user, const char* what) {
   for (size_t i = 0; i < user.size(); ++i) {
     const WorldPoint& p = user[i];
@@ -25,8 +35,14 @@ Status CheckUserPositions(const VoxelScene& scene, const std::vector<WorldPoint>
       return InvalidArgumentError(name + " is more than " + Num(kMaxViewpointIndex * scene.resolution_m) +
                                   " m from the origin along an axis; use coordinates in the scene's frame");
     }
-    if (scene.grid.Occupied(scene.grid.WorldToIndex(p))) {
-      return InvalidArgumentError(name + " lies inside an occupied voxel");
+    const VoxelIndex v = scene.grid.WorldToIndex(p);
+    if (scene.grid.Occupied(v)) {
+      const double r = scene.resolution_m;
+      const WorldPoint lo(v.x * r, v.y * r, v.z * r);
+      return InvalidArgumentError(name + " lies inside an occupied voxel (" +
+                                  Bounds(scene, lo, lo + WorldPoint::Constant(r)) +
+                                  "): a wall, the floor or furniture; is its height the floor's rather than the "
+                                  "scanner's?");
     }
   }
   return Status::Ok();
@@ -37,15 +53,6 @@ Status CheckUserPositions(const VoxelScene& scene, const std::vector<WorldPoint>
 constexpr double kFixedStationBoundsMargin_m = 2.0;
 // A fixed station whose nearest occupied voxel straight below is farther than this (m) gets a warning.
 constexpr double kFixedStationFloorWithin_m = 3.0;
-
-// The box [lo, hi] (local) in the input's frame.
-std::string Bounds(const VoxelScene& scene, const WorldPoint& local_lo, const WorldPoint& local_hi) {
-  const bool zero = scene.frame_origin_m.isZero();
-  const WorldPoint lo = zero ? local_lo : WorldPoint(local_lo + scene.frame_origin_m);
-  const WorldPoint hi = zero ? local_hi : WorldPoint(local_hi + scene.frame_origin_m);
-  return "x " + Coordinate(lo.x()) + ".." + Coordinate(hi.x()) + ", y " + Coordinate(lo.y()) + ".." +
-         Coordinate(hi.y()) + ", z " + Coordinate(lo.z()) + ".." + Coordinate(hi.z()) + " m";
-}
 
 // Distance (m) from p down to the top of the nearest occupied voxel straight below it; NaN if none.
 double DistanceToFloorBelow(const VoxelScene& scene, const WorldPoint& p) {
@@ -75,7 +82,10 @@ Result<std::vector<std::string>> CheckFixedStations(const VoxelScene& scene, con
     }
     const double below_m = DistanceToFloorBelow(scene, p);
     if (std::isnan(below_m)) {
-      warnings.push_back(name + " has no floor below it: no occupied voxel lies straight below");
+      warnings.push_back(name +
+                         " has no floor below it: no occupied voxel lies straight below, down to the scene's "
+                         "bottom at z = " +
+                         Coordinate(lo.z() + scene.frame_origin_m.z()) + " m, " + Num(p.z() - lo.z()) + " m below it");
     } else if (below_m > kFixedStationFloorWithin_m) {
       warnings.push_back(name + " has no floor within " + Num(kFixedStationFloorWithin_m) +
                          " m below it: the nearest occupied voxel straight below is " + Num(below_m) + " m down");

@@ -22,6 +22,7 @@ Result<RouteOutput> RunRouteStage(const RouteInput& in, const PlanOptions& optio
   RouteOptions o;
   o.headroom_m = *std::min_element(heights.begin(), heights.end()) + options.clearance_m;
   o.clearance_m = options.clearance_m;
+  o.max_step_m = options.walk_max_step_m;
   o.max_gap_m = kRouteMaxGapM;
   o.max_blocked_fraction = kRouteMaxBlockedFraction;
   o.memory_budget_bytes = options.memory_budget_bytes / 4;

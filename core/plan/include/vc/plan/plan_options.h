@@ -32,6 +32,7 @@
 //   reduction keep the stations' scan graph connected at this overlap.
 // - setup_seconds, scan_seconds, walk_speed_mps: the field time (route.h): per station set-up and
 //   scan, plus the walking route's length at this speed.
+// - walk_max_step_m: the walking route's RouteOptions::max_step_m (route.h).
 // - sparse_set_gain: the visibility sets' form (vc/visibility/voxel_set.h): a set goes sparse
 //   (Roaring) when that is at least this many times smaller than its dense bitset; no indoor scene
 //   of ours gains 4 x (docs/BENCHMARKS.md), a large site with a range limit gains 9-36 x. The
@@ -73,7 +74,9 @@
   X(double, setup_seconds, 120.0, "s", "setup-seconds", kNonNegative, "field time to set up the scanner per station") \
   X(double, scan_seconds, 0.0, "s", "scan-seconds", kNonNegative,                                                     \
     "field time of one scan (0 = the scanner preset's scan time)")                                                    \
-  X(double, walk_speed_mps, 1.0, "m/s", "walk-speed", kPositive, "walking speed between stations, carrying the kit")
+  X(double, walk_speed_mps, 1.0, "m/s", "walk-speed", kPositive, "walking speed between stations, carrying the kit")  \
+  X(double, walk_max_step_m, 0.25, "m", "walk-max-step", kNonNegative,                                                \
+    "largest rise the walking route takes in one step: stairs, sills, ramps")
 
 namespace vc {
 

@@ -13,11 +13,11 @@
 // may hold something (scan noise, chair legs, a door leaf): the planner passes 0.35, as geb079's
 // cluttered offices leave almost no fully free cylinder. Each node links to the
 // node of each of its 8 neighbour cells whose surface differs from its own by at most max_step_m
-// (the closest in height, the higher on a tie); a diagonal link needs both side cells to have such
-// a node, so paths never cut a wall's corner. A link costs the 3D distance between the two surface
-// points. Stairs and ramps in the scan thus link storeys; without them each storey is its own
-// component. k is limited to 2 * clearance_m / resolution (at least 1): with coarser cells a thin
-// wall could pass between two neighbouring cells' cylinders unseen.
+// (the closest in height, the higher on a tie; a voxel more where either node is bridged, below);
+// a diagonal link needs both side cells to have such a node, so paths never cut a wall's corner.
+// A link costs the 3D distance between the two surface points. Stairs and ramps in the scan thus link storeys; without
+// them each storey is its own component. k is limited to 2 * clearance_m / resolution (at least 1): with coarser cells
+// a thin wall could pass between two neighbouring cells' cylinders unseen.
 //
 // Holes. Scans leave the floor unseen in places (shadows under furniture; rooms seen only through
 // their doors, like geb079's offices). Let zb be the lowest real surface within max_gap_m of a
@@ -27,13 +27,24 @@
 // and the cylinder test above passes. "No surface at or below" keeps bridging off the air beside
 // a stair or a platform, whose floor below was seen; the price is that an unseen patch of an upper
 // storey over a seen lower one is not bridged, nor unseen floor near a lower surface (a sunken
-// area) at its own height, and that unseen ground just outside a scan's edge is walkable.
+// area) at its own height, and that unseen ground just outside a scan's edge is walkable. Since zb
+// is a minimum, it lies up to a voxel below the floor around it where that is uneven or noisy
+// (geb079's corridor floor spans three voxel levels), so a link or a snap to a bridged node may
+// span a voxel more than max_step_m.
+//
+// Gaps. A straight link spans a gap of 1 or 2 voxels (kMaxGapVoxels; cells of one voxel) whose
+// cells have no node within a step of either end, whose columns are free from just above the lower
+// end up to the higher end's headroom, and were seen below that: a drain, a duct or the joint
+// between two slabs, seen to its bottom, is stepped over, costing the straight distance; a wall, a
+// sill higher than max_step_m or a wider trench is not.
 //
 // Stations. A station's floor is floor_z_m (or, when NaN, the top of the highest occupied run
-// below the optical centre). It snaps to the walk node nearest horizontally, within 1 m, whose
-// surface is within max(max_step_m, 2 voxels) of that floor (the 3D-nearest on a tie, then the
-// lowest node number); a station without one is reported in `warnings` and forms a part of its
-// own. The start snaps the same way to the highest walk surface within 1 m horizontally that is at
+// below the optical centre). It snaps to a walk node whose surface is within max(max_step_m, 2
+// voxels) of that floor: within the tripod's footprint (clearance_m, at least a cell) the one of
+// the largest region (nodes linked by walks), so a station among clutter joins the floor a crew
+// walks in on rather than a box top beside it; else the nearest horizontally within 1 m (then the
+// 3D-nearest, then the lowest node number); a station without one is reported in `warnings` and
+// forms a part of its own. The start snaps the same way to the highest walk surface within 1 m horizontally that is at
 // most max_step_m above start.z (a floor point or a person's eye), else the nearest in height.
 //
 // Order. Shortest walking distances between all stations (Dijkstra from each station, with the
@@ -46,7 +57,7 @@
 //
 // Cost: the window minimum is 2 (2 max_gap_m / cell + 1) cells per cell (geb079 at 0.08 m with
 // max_gap_m 1.5: about 0.25 s for the whole route of 15 stations). Memory: one 4-byte offset per
-// cell and about 60 bytes per walk node (surface, neighbours, Dijkstra state); RESOURCE_EXHAUSTED
+// cell and about 92 bytes per walk node (surface, neighbours, Dijkstra state); RESOURCE_EXHAUSTED
 // when that exceeds memory_budget_bytes (geb079 at 0.08 m:
 // see docs/PLANNING.md). Stateless; safe to call from several threads.
 #pragma once
@@ -67,7 +78,7 @@ namespace vc::planner {
 struct RouteOptions {
   double headroom_m = 1.7;   // free height above a surface to walk on it (m); the planner passes tripod + clearance
   double clearance_m = 0.2;  // free horizontal radius around a walking person (m)
-  double max_step_m = 0.25;  // largest height change between neighbouring walk cells (stairs, ramps) (m)
+  double max_step_m = 0.25;  // largest rise between neighbouring walk cells: stairs, sills, ramps (m)
   double cell_m = 0;         // walk cell edge (m), rounded to whole voxels; 0 = the scene resolution
   double max_gap_m = 0.5;    // unseen floor within this of a seen one (same height) is walked on (m); 0 = none
   // Fraction of the walking cylinder's columns that may hold clutter or scan noise (0 = all free).
@@ -94,15 +105,19 @@ struct Route {
   std::vector<double> legs_m;
   // Per leg, the path over standing surfaces (world, m; z = the surface's top): first point the
   // previous station's floor point (or the start's walk point), last this station's floor point.
-  // Empty where legs_m is NaN, and for k = 0 without a start. Every segment lies over walk nodes.
+  // Empty where legs_m is NaN, and for k = 0 without a start. Every segment lies over walk nodes
+  // or spans a gap of at most 2 voxels (file comment, "Gaps").
   std::vector<std::vector<WorldPoint>> polylines;
-  double length_m = 0;                // sum of the finite legs (m)
-  int parts = 0;                      // groups of stations no walkable path links (1 = one walk; 0 without stations)
-  std::vector<std::string> warnings;  // parts, stations or a start with no walk node near them
-  uint64_t walk_cells = 0;            // cells of the walk grid
-  uint64_t walk_nodes = 0;            // walk nodes (bridged ones included)
-  uint64_t bridged_nodes = 0;         // of those, the ones bridging floor gaps
-  double cell_m = 0;                  // the walk cell edge used (m)
+  double length_m = 0;  // sum of the finite legs (m)
+  int parts = 0;        // groups of stations no walkable path links (1 = one walk; 0 without stations)
+  // One per part after the first (its stations, where its walkable floor comes nearest to the
+  // others' within 3 m and what lies between: another storey, a rise, a wall, a sill or clutter),
+  // and one per station or start with no walk node near it (that station's part is not repeated).
+  std::vector<std::string> warnings;
+  uint64_t walk_cells = 0;     // cells of the walk grid
+  uint64_t walk_nodes = 0;     // walk nodes (bridged ones included)
+  uint64_t bridged_nodes = 0;  // of those, the ones bridging floor gaps
+  double cell_m = 0;           // the walk cell edge used (m)
 };
 
 // The route through `stations` (optical centres, world, m). floor_z_m: per station the top of the
