@@ -61,7 +61,7 @@ expect 3 "vc-client: --target-coverage must be in (0, 1], got 1.5 (nothing was s
   submit cloud.xyz --target-coverage 1.5
 expect 3 "vc-client: --clearance (2 m) must be smaller than --tripod-height (1.5 m): the scanner would touch the floor (nothing was sent)" \
   submit cloud.xyz --clearance 2
-expect 3 "vc-client: --keep-out line 3: --fixed-stations station 1 (1, 1, 1.5) lies inside this zone (nothing was sent)" \
+expect 3 "vc-client: --keep-out line 3: --fixed-stations fixed.csv:2 (1, 1, 1.5) lies inside this zone (nothing was sent)" \
   submit cloud.xyz --keep-out zones.csv --fixed-stations fixed.csv
 expect 3 "vc-client: --max-range must be > 0 m, got -5 (nothing was sent)" \
   evaluate cloud.xyz --viewpoints fixed.csv --max-range -5
