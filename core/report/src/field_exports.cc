@@ -168,16 +168,17 @@ std::string FieldStationsCsv(const std::vector<FieldStation>& stations, const Cr
       "# vc stations: lengths in metres in " + FrameWords(crs) +
       " (x_m, y_m, z_m = the instrument's optical centre); "
       "rows in walking order; tripod_height_m above floor_z_m; gain_voxels and cumulative_coverage (0..1 of the "
-      "coverable voxels) in selection order\n"
+      "coverable voxels) in selection order, empty for stations that were not selected (an evaluation's)\n"
       "station,name,x_m,y_m,z_m,floor,floor_z_m,tripod_height_m,fixed,route_order,selection_order,gain_voxels,"
       "cumulative_coverage\n";
   for (const FieldStation& f : stations) {
     const bool floor = std::isfinite(f.floor_z_m);
+    const bool selected = std::isfinite(f.cumulative_coverage);
     out += std::to_string(f.number) + "," + f.name + "," + Fixed(f.position_m.x(), 6) + "," +
            Fixed(f.position_m.y(), 6) + "," + Fixed(f.position_m.z(), 6) + "," + f.floor + "," +
            (floor ? Fixed(f.floor_z_m, 3) : "") + "," + (floor ? Fixed(f.tripod_height_m, 3) : "") + "," +
            (f.fixed ? "existing" : "new") + "," + std::to_string(f.route_order) + "," + std::to_string(f.index + 1) +
-           "," + std::to_string(f.gain_voxels) + "," + Fixed(f.cumulative_coverage, 6) + "\n";
+           "," + (selected ? std::to_string(f.gain_voxels) + "," + Fixed(f.cumulative_coverage, 6) : ",") + "\n";
   }
   return out;
 }

@@ -1159,6 +1159,7 @@ PlanResult EvaluationAsPlan(const EvaluateJobResult& result, const ScannerModel&
   for (size_t i = 0; i < result.viewpoints.size(); ++i) {
     PlannedStation& s = plan.stations.emplace_back();
     s.position = result.viewpoints[i] - result.frame_origin_m;
+    s.cumulative_coverage = std::nan("");  // not a selection: no gains in an order
     s.floor_z_m = FloorUnder(s.position, result.voxel_centers, result.evaluation.resolution_m);
     if (i < result.evaluation.per_viewpoint.size()) {
       s.global_visibility = result.evaluation.per_viewpoint[i].global_visibility;

@@ -281,7 +281,7 @@ Json StationsJson(const PlanResult& r, const std::vector<FieldStation>& field, c
            {"route_order", route_order[k]},
            {"position", PointJson(s.position)},
            {"global_visibility", s.global_visibility},
-           {"marginal_gain", s.marginal_gain},
+           {"marginal_gain", std::isfinite(s.cumulative_coverage) ? Json(s.marginal_gain) : Json(nullptr)},
            {"cumulative_coverage", s.cumulative_coverage},
            {"fixed", s.fixed},
            {"sole_voxels", with_sole ? Json(sole_counts[k]) : Json(nullptr)}};

@@ -738,6 +738,15 @@ TEST(WriteEvaluationOutputsTest, WritesSubmitsFilesWithTheCrewsStationsCsv) {
   const PlanResult plan = EvaluationAsPlan(r);
   EXPECT_EQ(ReadAll(dir + "/stations.csv"), FieldStationsCsv(FieldStations(plan)));
   EXPECT_NE(ReadAll(dir + "/stations.csv").find("\nstation,name,x_m,y_m,z_m,"), std::string::npos);
+  // The stations were given, not selected: no gain or cumulative coverage (empty cells, not zeros).
+  std::istringstream rows(ReadAll(dir + "/stations.csv"));
+  int data_rows = 0;
+  for (std::string row; std::getline(rows, row);) {
+    if (row.empty() || row[0] == '#' || row.rfind("station,", 0) == 0) continue;
+    ++data_rows;
+    EXPECT_EQ(row.substr(row.size() - 2), ",,") << row;
+  }
+  EXPECT_EQ(data_rows, static_cast<int>(r.viewpoints.size()));
   EXPECT_EQ(ReadAll(dir + "/heatmap.png"), *HeatmapPng(plan, HeatmapMeaning::kMissedByStations));
 }
 

@@ -34,7 +34,9 @@ struct FieldStation {
   bool fixed = false;              // an existing station (PlanOptions::fixed_stations)
   int route_order = 0;             // place in the walking route (1 = first), 0 when the route leaves it out
   uint64_t gain_voxels = 0;        // voxels it adds to the stations picked before it (selection order)
-  double cumulative_coverage = 0;  // covered / coverable once it and those before it in selection order are scanned
+  // covered / coverable once it and those before it in selection order are scanned; NaN (and
+  // gain_voxels 0) for a station that was not selected: an evaluation's (EvaluationAsPlan)
+  double cumulative_coverage = 0;
 };
 
 // The stations of `result` in walking order. `fixed_station_names`: names of

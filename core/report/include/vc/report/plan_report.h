@@ -87,11 +87,12 @@ HeatMap MissedVoxelsHeatMap(const PlanResult& result, double cell_m);
 // An evaluation as a plan of its viewpoints, for the writers of a plan's files: the viewpoints
 // (local) are its stations, in the order given, each with its G and, as floor_z_m, the top of the
 // highest voxel in its column at most 3 m below it (NaN when none); the voxels, the evaluation and
-// the frame as they are; covered_voxels the voxels some station sees (best V > 0), of all the
-// occupied ones (coverable_voxels: an evaluation has no candidates to bound what can be seen); the
-// heat map MissedVoxelsHeatMap's at the default grid spacing; `scanner` (the job's) as the plan's
-// scanner, and the field time of set-up and scans it gives (ComputeFieldTime; no walk: an evaluation
-// has no route). The default PlanOptions otherwise.
+// the frame as they are; each station's cumulative_coverage NaN (it was not selected, so it has no
+// gain: stations.csv leaves both cells empty, report.html shows a dash); covered_voxels the voxels some station sees
+// (best V > 0), of all the occupied ones (coverable_voxels: an evaluation has no candidates to bound what can be seen);
+// the heat map MissedVoxelsHeatMap's at the default grid spacing; `scanner` (the job's) as the plan's scanner, and the
+// field time of set-up and scans it gives (ComputeFieldTime; no walk: an evaluation has no route). The default
+// PlanOptions otherwise.
 PlanResult EvaluationAsPlan(const EvaluateJobResult& result, const ScannerModel& scanner = {});
 
 // Writes evaluation.json, stations.csv (the crew's format, as WritePlanOutputs'), stations.dxf,
