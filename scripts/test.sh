@@ -2,9 +2,12 @@
 # Runs every test. Installs the dependencies, checks the layering, the code's health (functions at
 # most 150 lines, every path named exists, every public header tested) and the formatting, then:
 #   release  - the binaries and the slow tests: the tests of the real binaries (labels smoke and
-#              slow: vc-server and vc-client end to end, the paper experiment) and vc-bench --quick
+#              slow: vc-server and vc-client end to end, the paper experiment), the `heavy` ones
+#              (CBC against exhaustive search on hundreds of instances, geb079's full plan: 15 times
+#              slower under ASan) and vc-bench --quick
 #   asan     - AddressSanitizer + UndefinedBehaviorSanitizer (clang++): every test except the `slow`
-#              label (every unit test runs here, once); the same build holds the libFuzzer targets
+#              and `heavy` labels (every other unit test runs here, once); the same build holds the
+#              libFuzzer targets
 #   fuzz     - every libFuzzer target (fuzz/, from the asan build) for 10 s each, two at a time
 #   tsan     - ThreadSanitizer on the tests whose concurrency is all ours (label `tsan`): the worker
 #              pool, upload assembler, outbox, job runner, shard board, status mapping, wire code,
@@ -44,17 +47,17 @@ for p in "${presets[@]}"; do
       ;;
     asan)
       cmake --build --preset "$p"
-      echo "=== preset $p: tests (except label slow)"
-      ctest --preset "$p" -j2 -LE slow
+      echo "=== preset $p: tests (except labels slow and heavy)"
+      ctest --preset "$p" -j2 -LE 'slow|heavy'
       ;;
     release)
       if ((${#presets[@]} > 1)); then
         # The unit tests run once, under asan (below). The release build makes what only it can
-        # test: the shipped binaries end to end (labels smoke and slow), the slow experiments, and
-        # the benchmarks.
-        cmake --build --preset "$p" --target vc-server vc-client vc-synth vc-bench paper_result_test
-        echo "=== preset $p: the tests of the binaries and the slow ones (labels smoke, slow)"
-        ctest --preset "$p" -j2 -L 'smoke|slow'
+        # test: the shipped binaries end to end (labels smoke and slow), the slow experiments, the
+        # heavy solver tests (tests/core/CMakeLists.txt, plan_search_tests) and the benchmarks.
+        cmake --build --preset "$p" --target vc-server vc-client vc-synth vc-bench paper_result_test plan_search_tests
+        echo "=== preset $p: the tests of the binaries, the slow and the heavy ones (labels smoke, slow, heavy)"
+        ctest --preset "$p" -j2 -L 'smoke|slow|heavy'
       else
         cmake --build --preset "$p"
         echo "=== preset $p: tests"

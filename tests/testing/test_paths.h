@@ -16,5 +16,7 @@ std::string BinaryDir();
 std::string MakeTempDir();
 // The whole content of the file at `path` (bytes); empty if it cannot be read.
 std::string ReadFileBytes(const std::string& path);
+// The standard output of the shell command `command` (popen); empty if it cannot be started.
+std::string CommandOutput(const std::string& command);
 
 }  // namespace vc::testing

@@ -20,24 +20,16 @@
 namespace vc {
 namespace {
 
-constexpr double kDpi = 50;  // pdftoppm -r 50
+using testing::CommandOutput;
 
-std::string Run(const std::string& command) {
-  std::string out;
-  FILE* pipe = popen(command.c_str(), "r");
-  if (pipe == nullptr) return out;
-  char buf[4096];
-  for (size_t n; (n = fread(buf, 1, sizeof(buf), pipe)) > 0;) out.append(buf, n);
-  pclose(pipe);
-  return out;
-}
+constexpr double kDpi = 50;  // pdftoppm -r 50
 
 bool HavePoppler() { return std::filesystem::exists(VC_PDFTOPPM) && std::filesystem::exists(VC_PDFINFO); }
 
 // The PDF's text by pdftotext (poppler-utils, beside pdftoppm), laid out as on the page.
 std::string PdfText(const std::string& path) {
   const std::string pdftotext = (std::filesystem::path(VC_PDFTOPPM).parent_path() / "pdftotext").string();
-  return Run(pdftotext + " -layout " + path + " - 2>&1");
+  return CommandOutput(pdftotext + " -layout " + path + " - 2>&1");
 }
 
 struct Page {
@@ -84,10 +76,10 @@ ReadBack Rasterise(const std::string& pdf) {
   const std::string dir = testing::MakeTempDir();
   b.path = dir + "/fieldsheet.pdf";
   std::ofstream(b.path, std::ios::binary) << pdf;
-  b.info = Run(std::string(VC_PDFINFO) + " " + b.path + " 2>&1");
+  b.info = CommandOutput(std::string(VC_PDFINFO) + " " + b.path + " 2>&1");
   const size_t at = b.info.find("Pages:");
   if (at != std::string::npos) b.pages = std::stoi(b.info.substr(at + 6));
-  Run(std::string(VC_PDFTOPPM) + " -r 50 -png " + b.path + " " + dir + "/page 2>&1");
+  CommandOutput(std::string(VC_PDFTOPPM) + " -r 50 -png " + b.path + " " + dir + "/page 2>&1");
   for (int p = 1; p <= b.pages; ++p) {
     // pdftoppm numbers pages with as many digits as the last page number has.
     const std::string n = std::to_string(p), width = std::to_string(b.pages);

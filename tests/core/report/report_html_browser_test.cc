@@ -35,6 +35,8 @@
 namespace vc {
 namespace {
 
+using testing::CommandOutput;
+
 constexpr int kWidth = 1280, kHeight = 800;
 constexpr int kPanelWidth = 460;  // report_page.css: #panel's width (px)
 
@@ -59,17 +61,6 @@ int RunChromium(const std::string& dir, const std::string& url, const std::strin
                               std::to_string(kHeight) + " --virtual-time-budget=15000 " + action + " '" + url + "' >'" +
                               out + "' 2>'" + dir + "/chromium.log'";
   return std::system(command.c_str());
-}
-
-// The standard output of `command`.
-std::string CommandOutput(const std::string& command) {
-  std::string out;
-  FILE* pipe = popen(command.c_str(), "r");
-  if (pipe == nullptr) return out;
-  char buf[4096];
-  for (size_t n; (n = fread(buf, 1, sizeof(buf), pipe)) > 0;) out.append(buf, n);
-  pclose(pipe);
-  return out;
 }
 
 // A poppler-utils tool beside pdftoppm (tests/core/CMakeLists.txt finds pdftoppm).
