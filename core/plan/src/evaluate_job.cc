@@ -74,6 +74,10 @@ Result<EvaluateJobResult> RunEvaluation(const SceneInput& input, const EvaluateJ
   VC_ASSIGN_OR_RETURN(VoxelScene scene, Voxelize(input, options.voxelize_options(), ctx));
   std::vector<WorldPoint> local_viewpoints = options.viewpoints;
   for (WorldPoint& p : local_viewpoints) p -= input.frame_origin_m;
+  if (options.export_sets) {
+    VC_RETURN_IF_ERROR(planner::CheckVisibilitySetBudget(local_viewpoints.size(), scene.occupied.size(),
+                                                         options.memory_budget_bytes, "the seen sets (--export-sets)"));
+  }
   EvaluateJobResult result;
   VC_ASSIGN_OR_RETURN(result.evaluation, Evaluate(scene, local_viewpoints, options.evaluate_options(), ctx));
   result.viewpoints = options.viewpoints;

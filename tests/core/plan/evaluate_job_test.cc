@@ -12,6 +12,7 @@
 
 #include "testing/scenes.h"
 #include "testing/subvoxel_reference.h"
+#include "vc/plan/stages.h"
 #include "vc/scene/surface_patches.h"
 
 namespace vc {
@@ -261,6 +262,20 @@ TEST(RunEvaluationTest, TheSubvoxelTestWithoutPointsFallsBackToSurfaceAndSaysSo)
       RunEvaluation(LittleRoom(), ExportFromTwoPlaces(SelectionTest::kSurfaceVisibility));
   ASSERT_TRUE(surface.ok());
   EXPECT_EQ(job->seen_sets[0].words(), surface->seen_sets[0].words());
+}
+
+TEST(RunEvaluationTest, SeenSetsOverHalfTheBudgetAreRefused) {
+  const SceneInput room = LittleRoom();
+  EvaluateJobOptions o = ExportFromTwoPlaces(SelectionTest::kSurfaceVisibility);
+  const size_t voxels = Voxelize(room, {0.1})->occupied.size();
+  o.memory_budget_bytes = 4 << 20;
+  // Enough viewpoints that their dense sets need more than 2 MiB.
+  o.viewpoints.assign((2 << 20) / ((voxels + 63) / 64 * 8) + 1, WorldPoint(0.25, 0.3, 1.05));
+  const Result<EvaluateJobResult> job = RunEvaluation(room, o);
+  EXPECT_EQ(job.status().code(), StatusCode::kResourceExhausted) << job.status().ToString();
+  EXPECT_THAT(job.status().message(), HasSubstr("the seen sets (--export-sets)"));
+  o.viewpoints.resize(o.viewpoints.size() / 2);  // half as many fit
+  EXPECT_TRUE(planner::CheckVisibilitySetBudget(o.viewpoints.size(), voxels, o.memory_budget_bytes, "").ok());
 }
 
 }  // namespace

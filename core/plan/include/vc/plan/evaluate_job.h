@@ -72,7 +72,9 @@ struct EvaluateJobResult {
 
 // Validates, voxelises `input` at options.resolution_m, moves the viewpoints to the scene's local
 // frame (less VoxelScene::frame_origin_m), then vc::Evaluate, and with options.export_sets
-// vc::ComputeVisibilitySets (the sub-voxel test on the input's surface patches). Errors as those.
+// vc::ComputeVisibilitySets (the sub-voxel test on the input's surface patches). Errors as those, and
+// RESOURCE_EXHAUSTED, before the evaluation, when the seen sets would take more than half the
+// memory budget.
 Result<EvaluateJobResult> RunEvaluation(const SceneInput& input, const EvaluateJobOptions& options,
                                         const JobContext& ctx = {});
 
