@@ -270,6 +270,9 @@ Status FollowEvaluate(Stream& stream, const JobObserver& observer, JobTicket* ti
       case v1::EvaluateResponse::kVoxels:
         if (broken.ok()) broken = assembler.AddVoxels(r.voxels());
         break;
+      case v1::EvaluateResponse::kSeenSet:
+        if (broken.ok()) broken = assembler.AddSeenSet(r.seen_set());
+        break;
       case v1::EvaluateResponse::kResult:
         summary = r.result();
         break;

@@ -18,6 +18,7 @@
 #include "vc/client/compact_upload.h"
 #include "vc/client/crs_flag.h"
 #include "vc/client/did_you_mean.h"
+#include "vc/client/export_sets.h"
 #include "vc/client/parameter_flags.h"
 #include "vc/client/plan_file.h"
 #include "vc/client/plan_summary.h"
@@ -240,6 +241,8 @@ struct CommandLine {
   vc::EvaluateJobOptions eval;           // evaluate
   std::string viewpoints_csv;            // evaluate
   std::string plan_json;                 // evaluate (--plan: stations, scanner and CRS from a plan.json)
+  std::string export_dir;                // evaluate (--export-sets: each station's seen set as DIR/station_<n>.xyz)
+  bool force = false;                    // evaluate (--force: write --export-sets into a non-empty DIR)
   std::string job_id;                    // attach, cancel
   std::string health_service;            // health
   double inspect_resolution = 0;         // inspect
@@ -312,6 +315,13 @@ CLI::App* AddEvaluateCommand(CLI::App& app, CommandLine* cl) {
   evaluate->add_option("--detach-grace", cl->conn.detach_grace_s, kDetachHelp)->capture_default_str();
   AddPaperFlag(evaluate, &cl->paper);
   vc::client::AddEvaluateFlags(evaluate, &cl->eval);
+  auto* export_sets = evaluate->add_option(
+      "--export-sets", cl->export_dir,
+      "also write, per station, the voxels --test counts as seen from it as DIR/station_<n>.xyz (voxel centres, "
+      "the input's frame, metres; n from 1 in the stations' order): check the prediction with your own tools");
+  export_sets->type_name("DIR");
+  evaluate->add_flag("--force", cl->force, "write --export-sets into a directory that is not empty")
+      ->needs(export_sets);
   return evaluate;
 }
 
@@ -401,11 +411,16 @@ int RunAttach(vc::client::Client& client, const CommandLine& cl) {
 
 // The scene file, read and checked here before any connection: refused when the server's reader
 // would refuse it too (compact_upload.h); the upload for it in `units` at `resolution_m` otherwise.
+// The subvoxel test needs the points: with it the file goes raw.
 vc::Result<vc::client::PreparedUpload> PrepareScene(const CommandLine& cl, const std::string& units,
-                                                    double resolution_m) {
+                                                    double resolution_m, vc::SelectionTest test) {
   VC_ASSIGN_OR_RETURN(vc::client::Upload file_bytes, vc::client::ReadUpload(cl.file));
   file_bytes.units = units;
-  return vc::client::PrepareUpload(std::move(file_bytes), resolution_m, cl.raw_upload);
+  const bool needs_points = test == vc::SelectionTest::kSubvoxel && !cl.raw_upload;
+  VC_ASSIGN_OR_RETURN(vc::client::PreparedUpload prepared,
+                      vc::client::PrepareUpload(std::move(file_bytes), resolution_m, cl.raw_upload || needs_points));
+  if (needs_points) prepared.summary.why_raw = "the subvoxel test needs the points";
+  return prepared;
 }
 
 // Announces `prepared` on `display`.
@@ -430,7 +445,8 @@ vc::Result<CheckedSubmit> CheckSubmit(const CommandLine& cl) {
   VC_ASSIGN_OR_RETURN(checked.crs, vc::client::CheckCrsFlag(cl.crs, cl.units));
   VC_ASSIGN_OR_RETURN(checked.lines, vc::client::LoadPlanFiles(cl.plan_files, &checked.plan));
   VC_RETURN_IF_ERROR(checked.plan.Validate(vc::client::PlanFlagNamer(checked.lines)));
-  VC_ASSIGN_OR_RETURN(checked.prepared, PrepareScene(cl, checked.crs.units, checked.plan.resolution_m));
+  VC_ASSIGN_OR_RETURN(checked.prepared,
+                      PrepareScene(cl, checked.crs.units, checked.plan.resolution_m, checked.plan.selection_test));
   return checked;
 }
 
@@ -454,6 +470,20 @@ int RunSubmit(const CommandLine& cl, InterruptCancelsTheJob* interrupt) {
   const std::optional<vc::Crs>& crs = checked->crs.crs;
   return WritePlan(*r, cl.out_dir, cl.paper, &prepared.summary, FixedStationNames(cl.plan_files.fixed_stations),
                    crs ? &*crs : nullptr);
+}
+
+// evaluate --export-sets: the files, and a line saying what they hold.
+int WriteSeenSets(const vc::EvaluateJobResult& result, const std::string& dir) {
+  vc::Result<std::vector<std::string>> files = vc::client::WriteSeenSets(result, dir);
+  if (!files.ok()) return Fail("cannot write the seen sets", files.status());
+  uint64_t voxels = 0;
+  for (const vc::VoxelSet& s : result.seen_sets) voxels += s.count();
+  const std::string names =
+      files->size() == 1 ? "station_1.xyz" : "station_1.xyz .. station_" + std::to_string(files->size()) + ".xyz";
+  std::printf("wrote %s (%llu seen voxels, %s test, voxel centres in the input's frame) to %s\n", names.c_str(),
+              static_cast<unsigned long long>(voxels),
+              std::string(vc::SelectionTestName(result.selection_test)).c_str(), dir.c_str());
+  return 0;
 }
 
 // evaluate's counterpart of CheckSubmit.
@@ -500,7 +530,13 @@ vc::Result<CheckedEvaluate> CheckEvaluate(const CommandLine& cl, const CLI::App&
   }
   VC_ASSIGN_OR_RETURN(checked.crs, vc::client::CheckCrsFlag(crs, cl.units));
   VC_RETURN_IF_ERROR(checked.eval.Validate(vc::client::EvaluateFlagNamer()));
-  VC_ASSIGN_OR_RETURN(checked.prepared, PrepareScene(cl, checked.crs.units, checked.eval.resolution_m));
+  if (evaluate.get_option("--test")->count() > 0 && cl.export_dir.empty()) {
+    return vc::InvalidArgumentError("--test names the selection test of --export-sets' files; add --export-sets DIR");
+  }
+  checked.eval.export_sets = !cl.export_dir.empty();
+  if (checked.eval.export_sets) VC_RETURN_IF_ERROR(vc::client::PrepareExportDir(cl.export_dir, cl.force));
+  VC_ASSIGN_OR_RETURN(checked.prepared,
+                      PrepareScene(cl, checked.crs.units, checked.eval.resolution_m, checked.eval.test));
   return checked;
 }
 
@@ -516,8 +552,11 @@ int RunEvaluate(const CommandLine& cl, const CLI::App& evaluate, InterruptCancel
   display.Done();
   if (!r.ok()) return FailCall("evaluate", r.status(), cl.conn.server);
   NoteCache((*client)->last_upload(), &prepared.summary, display);
+  for (const std::string& w : r->warnings) std::cerr << "vc-client: warning: " << w << "\n";
   const std::optional<vc::Crs>& crs = checked->crs.crs;
-  return WriteEvaluation(*r, cl.out_dir, cl.paper, crs ? &*crs : nullptr, checked->eval.scanner);
+  const int written = WriteEvaluation(*r, cl.out_dir, cl.paper, crs ? &*crs : nullptr, checked->eval.scanner);
+  if (written != 0 || !checked->eval.export_sets) return written;
+  return WriteSeenSets(*r, cl.export_dir);
 }
 
 // Parses the command line; on a mistake prints CLI11's message and, for a misspelt flag or

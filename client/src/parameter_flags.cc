@@ -53,7 +53,9 @@ void AddEnumFlag(CLI::App* app, const ParamInfo& info, E* value, const std::map<
 
 void AddFlag(CLI::App* app, const ParamInfo& info, SelectionTest* value) {
   AddEnumFlag(app, info, value,
-              {{"surface", SelectionTest::kSurfaceVisibility}, {"compatibility", SelectionTest::kCompatibility}});
+              {{"surface", SelectionTest::kSurfaceVisibility},
+               {"compatibility", SelectionTest::kCompatibility},
+               {"subvoxel", SelectionTest::kSubvoxel}});
 }
 
 void AddFlag(CLI::App* app, const ParamInfo& info, SelectionSolver* value) {

@@ -69,7 +69,15 @@ Result<InputFormat> FromProto(v1::InputFormat f) {
 }
 
 v1::SelectionTest ToProto(SelectionTest t) {
-  return t == SelectionTest::kCompatibility ? v1::SELECTION_TEST_COMPATIBILITY : v1::SELECTION_TEST_SURFACE_VISIBILITY;
+  switch (t) {
+    case SelectionTest::kCompatibility:
+      return v1::SELECTION_TEST_COMPATIBILITY;
+    case SelectionTest::kSubvoxel:
+      return v1::SELECTION_TEST_SUBVOXEL;
+    case SelectionTest::kSurfaceVisibility:
+      break;
+  }
+  return v1::SELECTION_TEST_SURFACE_VISIBILITY;
 }
 
 v1::FaceSet ToProto(FaceSet f) { return f == FaceSet::kExposed ? v1::FACE_SET_EXPOSED : v1::FACE_SET_ALL; }
@@ -363,6 +371,7 @@ v1::EvaluateParameters ToProto(const EvaluateJobOptions& o) {
   VC_EVALUATE_PARAMETERS(VC_ROW_TO_PROTO)
   *p.mutable_scanner() = ToProto(o.scanner);
   for (const auto& v : o.viewpoints) *p.add_viewpoints() = ToProto(v);
+  p.set_export_sets(o.export_sets);
   return p;
 }
 
@@ -371,6 +380,7 @@ Result<EvaluateJobOptions> FromProto(const v1::EvaluateParameters& p) {
   VC_EVALUATE_PARAMETERS(VC_ROW_FROM_PROTO)
   if (p.has_scanner()) VC_RETURN_IF_ERROR(Apply(p.scanner(), &o.scanner));
   for (const auto& v : p.viewpoints()) o.viewpoints.push_back(FromProto(v));
+  o.export_sets = p.export_sets();
   return o;
 }
 
@@ -436,11 +446,13 @@ Result<SelectionTest> FromProto(v1::SelectionTest t) {
       return SelectionTest::kSurfaceVisibility;
     case v1::SELECTION_TEST_COMPATIBILITY:
       return SelectionTest::kCompatibility;
+    case v1::SELECTION_TEST_SUBVOXEL:
+      return SelectionTest::kSubvoxel;
     default:
       break;
   }
   return InvalidArgumentError("unknown selection test value " + std::to_string(int(t)) +
-                              "; use SURFACE_VISIBILITY or COMPATIBILITY");
+                              "; use SURFACE_VISIBILITY, COMPATIBILITY or SUBVOXEL");
 }
 
 v1::Progress ToProto(const ProgressEvent& e) {
@@ -819,7 +831,56 @@ v1::EvaluateResult ToProto(const EvaluateJobResult& result) {
   for (const auto& v : result.viewpoints) *r.add_viewpoints() = ToProto(v);
   r.set_voxel_count(result.voxel_centers.size());
   *r.mutable_frame_origin() = ToProto(result.frame_origin_m);
+  r.set_selection_test(ToProto(result.selection_test));
+  for (const VoxelSet& s : result.seen_sets) r.add_seen_voxels(s.count());
+  for (const auto& w : result.warnings) r.add_warnings(w);
   return r;
+}
+
+bool ForEachSeenSetChunk(const EvaluateJobResult& result, const std::function<bool(v1::SeenSetChunk&&)>& fn) {
+  for (size_t k = 0; k < result.seen_sets.size(); ++k) {
+    const VoxelSet& set = result.seen_sets[k];
+    const uint64_t total = set.count();
+    v1::SeenSetChunk c;
+    uint64_t sent = 0;
+    auto start = [&] {
+      c = v1::SeenSetChunk();
+      c.set_viewpoint(uint32_t(k));
+      c.set_first_index(sent);
+      c.set_total_voxels(total);
+    };
+    start();
+    bool ok = true;
+    set.ForEach([&](size_t id) {
+      if (!ok) return;
+      c.add_voxel_ids(uint32_t(id));
+      ++sent;
+      if (size_t(c.voxel_ids_size()) == kSeenIdsPerChunk && sent < total) {
+        ok = fn(std::move(c));
+        start();
+      }
+    });
+    if (!ok || !fn(std::move(c))) return false;
+  }
+  return true;
+}
+
+Status EvaluateResultAssembler::AddSeenSet(const v1::SeenSetChunk& c) {
+  const size_t k = c.viewpoint();
+  if (k == seen_ids_.size() && c.first_index() == 0) {
+    seen_ids_.emplace_back();
+    seen_totals_.push_back(c.total_voxels());
+  } else if (k + 1 != seen_ids_.size() || c.first_index() != seen_ids_.back().size() ||
+             c.total_voxels() != seen_totals_.back()) {
+    return ChunkError("seen set chunk out of order");
+  }
+  std::vector<uint32_t>& ids = seen_ids_.back();
+  for (uint32_t id : c.voxel_ids()) {
+    if (!ids.empty() && id <= ids.back()) return ChunkError("seen set chunk with ids out of order");
+    ids.push_back(id);
+  }
+  if (ids.size() > seen_totals_.back()) return ChunkError("more seen voxels than declared");
+  return Status::Ok();
 }
 
 Status EvaluateResultAssembler::AddVoxels(const v1::VoxelChunk& chunk) { return voxels_.Add(chunk); }
@@ -836,6 +897,30 @@ Result<EvaluateJobResult> EvaluateResultAssembler::Finish(const v1::EvaluateResu
   r.evaluation.sole_viewer = std::move(voxels.sole_viewer);
   r.voxel_centers = std::move(voxels.centers);
   for (const auto& v : p.viewpoints()) r.viewpoints.push_back(FromProto(v));
+  VC_ASSIGN_OR_RETURN(r.selection_test, FromProto(p.selection_test() == v1::SELECTION_TEST_UNSPECIFIED
+                                                      ? v1::SELECTION_TEST_SURFACE_VISIBILITY
+                                                      : p.selection_test()));
+  r.warnings.assign(p.warnings().begin(), p.warnings().end());
+  if (size_t(p.seen_voxels_size()) != seen_ids_.size() ||
+      (!seen_ids_.empty() && seen_ids_.size() != r.viewpoints.size())) {
+    return ChunkError("received seen sets of " + std::to_string(seen_ids_.size()) +
+                      " viewpoints; the result declares " + std::to_string(p.seen_voxels_size()) + " of " +
+                      std::to_string(r.viewpoints.size()));
+  }
+  for (size_t k = 0; k < seen_ids_.size(); ++k) {
+    const std::vector<uint32_t>& ids = seen_ids_[k];
+    if (ids.size() != p.seen_voxels(int(k)) || ids.size() != seen_totals_[k]) {
+      return ChunkError("received " + std::to_string(ids.size()) + " seen voxels of viewpoint " +
+                        std::to_string(k + 1) + ", declared " + std::to_string(p.seen_voxels(int(k))));
+    }
+    VoxelSet set(r.voxel_centers.size());
+    for (uint32_t id : ids) {
+      if (id >= set.size())
+        return ChunkError("a seen set names voxel " + std::to_string(id) + " of " + std::to_string(set.size()));
+      set.set(id);
+    }
+    r.seen_sets.push_back(std::move(set));
+  }
   return r;
 }
 

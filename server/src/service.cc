@@ -126,10 +126,15 @@ class EvaluateReactor final : public JobReactor<v1::EvaluateRequest, v1::Evaluat
   Status Run(const SceneInput& input, const JobContext& ctx, JobLog& log) override {
     log.set_details(fmt::format(" viewpoints={}", options_.viewpoints.size()));
     VC_ASSIGN_OR_RETURN(const EvaluateJobResult result, backend().evaluate(input, options_, ctx));
-    // The voxels, then the summary: together the whole EvaluateJobResult, as a plan's result.
+    // The voxels, the seen sets, then the summary: together the whole EvaluateJobResult, as a plan's result.
     wire::ForEachVoxelChunk(result, [this](v1::VoxelChunk&& c) {
       v1::EvaluateResponse r;
       *r.mutable_voxels() = std::move(c);
+      return channel().Post(std::move(r), /*bulk=*/true);
+    });
+    wire::ForEachSeenSetChunk(result, [this](v1::SeenSetChunk&& c) {
+      v1::EvaluateResponse r;
+      *r.mutable_seen_set() = std::move(c);
       return channel().Post(std::move(r), /*bulk=*/true);
     });
     v1::EvaluateResponse r;

@@ -233,7 +233,7 @@ TEST(ParameterTablesTest, EveryProtoFieldAndPlanJsonParameterHasARow) {
   want.insert("name");  // the preset, not a row (vc/visibility/scanner_presets.h)
   EXPECT_EQ(FieldNames(v1::ScannerModel::descriptor()), want);
   want = evaluate_rows;
-  want.insert({"scanner", "viewpoints"});
+  want.insert({"scanner", "viewpoints", "export_sets"});  // export_sets: --export-sets DIR, not a row
   EXPECT_EQ(FieldNames(v1::EvaluateParameters::descriptor()), want);
 
   std::set<std::string> keys;

@@ -512,5 +512,134 @@ TEST(EvaluateResultChunks, ASoleViewerNamingAMissingViewpointOrANonFiniteOriginI
   }
 }
 
+// BigEvaluation's with seen sets: viewpoint 0 sees every third voxel, viewpoint 1 nothing.
+EvaluateJobResult WithSeenSets(size_t voxels) {
+  EvaluateJobResult r = BigEvaluation(voxels);
+  r.selection_test = SelectionTest::kSubvoxel;
+  r.seen_sets.assign(2, VoxelSet(voxels));
+  for (size_t id = 0; id < voxels; id += 3) r.seen_sets[0].set(id);
+  r.warnings = {"a note"};
+  return r;
+}
+
+std::vector<v1::SeenSetChunk> SeenSetChunks(const EvaluateJobResult& r) {
+  std::vector<v1::SeenSetChunk> chunks;
+  ForEachSeenSetChunk(r, [&](v1::SeenSetChunk&& c) {
+    chunks.push_back(std::move(c));
+    return true;
+  });
+  return chunks;
+}
+
+TEST(EvaluateResultChunks, SeenSetsReassembleExactlyInChunksUnderOneMebibyte) {
+  const size_t voxels = 3 * kSeenIdsPerChunk + 10;
+  const EvaluateJobResult r = WithSeenSets(voxels);
+  const std::vector<v1::SeenSetChunk> chunks = SeenSetChunks(r);
+  ASSERT_EQ(chunks.size(), 3u);  // 393,220 / 3 ids: two chunks, then one empty chunk for viewpoint 1
+  EXPECT_EQ(chunks[1].viewpoint(), 0u);
+  EXPECT_EQ(chunks[1].first_index(), kSeenIdsPerChunk);
+  EXPECT_EQ(chunks[2].viewpoint(), 1u);
+  EXPECT_EQ(chunks[2].voxel_ids_size(), 0);
+  const v1::EvaluateResult summary = ToProto(r);
+  EXPECT_EQ(summary.selection_test(), v1::SELECTION_TEST_SUBVOXEL);
+  ASSERT_EQ(summary.seen_voxels_size(), 2);
+  EXPECT_EQ(summary.seen_voxels(0), r.seen_sets[0].count());
+  EvaluateResultAssembler a;
+  for (const v1::VoxelChunk& c : EvaluationChunks(r)) ASSERT_TRUE(a.AddVoxels(c).ok());
+  for (const v1::SeenSetChunk& c : chunks) {
+    EXPECT_LE(c.ByteSizeLong(), size_t{1} << 20);
+    ASSERT_TRUE(a.AddSeenSet(c).ok());
+  }
+  auto back = std::move(a).Finish(summary);
+  ASSERT_TRUE(back.ok()) << back.status().ToString();
+  EXPECT_EQ(back->selection_test, SelectionTest::kSubvoxel);
+  EXPECT_EQ(back->warnings, r.warnings);
+  ASSERT_EQ(back->seen_sets.size(), 2u);
+  EXPECT_EQ(back->seen_sets[0].words(), r.seen_sets[0].words());
+  EXPECT_EQ(back->seen_sets[1].count(), 0u);
+}
+
+TEST(EvaluateResultChunks, NoSeenSetsTravelUnlessComputed) {
+  const EvaluateJobResult r = BigEvaluation(100);
+  EXPECT_TRUE(SeenSetChunks(r).empty());
+  EvaluateResultAssembler a;
+  for (const v1::VoxelChunk& c : EvaluationChunks(r)) ASSERT_TRUE(a.AddVoxels(c).ok());
+  auto back = std::move(a).Finish(ToProto(r));
+  ASSERT_TRUE(back.ok());
+  EXPECT_TRUE(back->seen_sets.empty());
+}
+
+TEST(EvaluateResultChunks, AMissingOutOfOrderOrForeignSeenSetIsDataLoss) {
+  const EvaluateJobResult r = WithSeenSets(300);
+  const std::vector<v1::SeenSetChunk> chunks = SeenSetChunks(r);
+  ASSERT_EQ(chunks.size(), 2u);
+  {
+    EvaluateResultAssembler a;
+    EXPECT_EQ(a.AddSeenSet(chunks[1]).code(), StatusCode::kDataLoss);  // viewpoint 1 before viewpoint 0
+  }
+  {
+    EvaluateResultAssembler a;
+    v1::SeenSetChunk descending = chunks[0];
+    descending.set_voxel_ids(1, 0);
+    EXPECT_EQ(a.AddSeenSet(descending).code(), StatusCode::kDataLoss);
+  }
+  for (int bad = 0; bad < 3; ++bad) {
+    EvaluateResultAssembler a;
+    for (const v1::VoxelChunk& c : EvaluationChunks(r)) ASSERT_TRUE(a.AddVoxels(c).ok());
+    v1::EvaluateResult summary = ToProto(r);
+    ASSERT_TRUE(a.AddSeenSet(chunks[0]).ok());
+    if (bad == 0) summary.set_seen_voxels(0, summary.seen_voxels(0) + 1);  // declares more than came
+    if (bad == 1) summary.clear_seen_voxels();                             // the sets came undeclared
+    if (bad != 2) ASSERT_TRUE(a.AddSeenSet(chunks[1]).ok());               // bad == 2: viewpoint 1 never came
+    auto back = std::move(a).Finish(summary);
+    EXPECT_EQ(back.status().code(), StatusCode::kDataLoss) << bad;
+  }
+  {
+    EvaluateJobResult small = BigEvaluation(10);
+    EvaluateResultAssembler a;
+    for (const v1::VoxelChunk& c : EvaluationChunks(small)) ASSERT_TRUE(a.AddVoxels(c).ok());
+    v1::SeenSetChunk foreign;
+    foreign.set_total_voxels(1);
+    foreign.add_voxel_ids(10);  // not a voxel of the 10
+    v1::SeenSetChunk empty;
+    empty.set_viewpoint(1);
+    ASSERT_TRUE(a.AddSeenSet(foreign).ok());
+    ASSERT_TRUE(a.AddSeenSet(empty).ok());
+    v1::EvaluateResult summary = ToProto(small);
+    summary.add_seen_voxels(1);
+    summary.add_seen_voxels(0);
+    auto back = std::move(a).Finish(summary);
+    EXPECT_EQ(back.status().code(), StatusCode::kDataLoss);
+    EXPECT_NE(back.status().message().find("names voxel 10 of 10"), std::string::npos) << back.status().message();
+  }
+}
+
+TEST(EvaluateParameters, TheTestAndExportSetsRoundTrip) {
+  EvaluateJobOptions o;
+  o.viewpoints = {{1, 2, 3}};
+  o.test = SelectionTest::kSubvoxel;
+  o.export_sets = true;
+  const v1::EvaluateParameters p = ToProto(o);
+  EXPECT_EQ(p.test(), v1::SELECTION_TEST_SUBVOXEL);
+  EXPECT_TRUE(p.export_sets());
+  auto back = FromProto(p);
+  ASSERT_TRUE(back.ok());
+  EXPECT_EQ(back->test, SelectionTest::kSubvoxel);
+  EXPECT_TRUE(back->export_sets);
+  auto unset = FromProto(v1::EvaluateParameters());
+  ASSERT_TRUE(unset.ok());
+  EXPECT_EQ(unset->test, SelectionTest::kSurfaceVisibility);
+  EXPECT_FALSE(unset->export_sets);
+}
+
+TEST(PlanParameters, EverySelectionTestRoundTrips) {
+  for (const SelectionTest t :
+       {SelectionTest::kSurfaceVisibility, SelectionTest::kCompatibility, SelectionTest::kSubvoxel}) {
+    auto back = FromProto(ToProto(t));
+    ASSERT_TRUE(back.ok());
+    EXPECT_EQ(*back, t);
+  }
+}
+
 }  // namespace
 }  // namespace vc::wire

@@ -114,15 +114,18 @@ Result<PlanResult> Plan(const SceneInput& input, const PlanOptions& options, con
   planner::StageRunner runner(ctx);
   PlanResult result;
   result.options = options;
-  result.selection_test = options.selection_test;
 
   VC_ASSIGN_OR_RETURN(planner::VoxelizeOutput voxelized, runner.Run(Stage::kVoxelize, [&](const JobContext& c) {
     return planner::RunVoxelizeStage({input}, options, c);
   }));
   const VoxelScene& scene = voxelized.scene;
+  const std::span<const SurfacePatch> patches = voxelized.surface_patches;
+  result.selection_test = voxelized.selection_test;
   // The stages work in the scene's local frame (SceneInput::frame_origin_m, which Voxelize copies into
-  // the scene); result.options stays as given, in the input's frame.
-  const PlanOptions local_options = InLocalFrame(options, input.frame_origin_m);
+  // the scene); result.options stays as given, in the input's frame. They run the test that can run
+  // (VoxelizeOutput::selection_test).
+  PlanOptions local_options = InLocalFrame(options, input.frame_origin_m);
+  local_options.selection_test = voxelized.selection_test;
   result.frame_origin_m = input.frame_origin_m;
   result.resolution_m = scene.resolution_m;
   result.occupied_voxels = scene.occupied.size();
@@ -135,7 +138,8 @@ Result<PlanResult> Plan(const SceneInput& input, const PlanOptions& options, con
   result.grid_cells = candidates.grid_cells;
   result.cells_without_floor = candidates.cells_without_floor;
   result.cells_failing_clearance = candidates.cells_failing_clearance;
-  result.warnings = candidates.warnings;
+  result.warnings = std::move(voxelized.warnings);
+  result.warnings.insert(result.warnings.end(), candidates.warnings.begin(), candidates.warnings.end());
 
   if (local_options.sparse_set_gain <= 0) {  // sparse sets are checked as they are computed
     VC_RETURN_IF_ERROR(planner::CheckVisibilitySetBudget(
@@ -144,7 +148,8 @@ Result<PlanResult> Plan(const SceneInput& input, const PlanOptions& options, con
   }
   VC_ASSIGN_OR_RETURN(planner::VisibilityOutput visibility, runner.Run(Stage::kVisibility, [&](const JobContext& c) {
     return planner::RunVisibilityStage(
-        {scene, candidates.positions, candidates.floor_z_m, local_options.fixed_stations, callbacks}, local_options, c);
+        {scene, candidates.positions, candidates.floor_z_m, local_options.fixed_stations, callbacks, patches},
+        local_options, c);
   }));
   result.heat_map = std::move(visibility.heat_map);
   result.distribution = visibility.distribution;
@@ -154,7 +159,7 @@ Result<PlanResult> Plan(const SceneInput& input, const PlanOptions& options, con
   VC_ASSIGN_OR_RETURN(planner::SelectionOutput selected, runner.Run(Stage::kSelection, [&](const JobContext& c) {
     return planner::RunSelectionStage(
         {scene, *selector, std::move(visibility.sets), std::move(visibility.fixed_sets), candidates.positions,
-         candidates.floor_z_m, result.heat_map.visible_voxels, callbacks},
+         candidates.floor_z_m, result.heat_map.visible_voxels, callbacks, patches},
         local_options, c);
   }));
   result.stop_reason = selected.selection.stop;
@@ -169,7 +174,7 @@ Result<PlanResult> Plan(const SceneInput& input, const PlanOptions& options, con
 
   if (local_options.refine && !stations.empty()) {
     VC_ASSIGN_OR_RETURN(planner::RefineOutput refined, runner.Run(Stage::kRefine, [&](const JobContext& c) {
-      return planner::RunRefineStage({scene, std::move(stations), std::move(coverable)}, local_options, c);
+      return planner::RunRefineStage({scene, std::move(stations), std::move(coverable), patches}, local_options, c);
     }));
     stations = std::move(refined.stations);
     coverable = std::move(refined.coverable);

@@ -6,9 +6,14 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <random>
 #include <string>
+#include <vector>
 
 #include "testing/scenes.h"
+#include "testing/subvoxel_reference.h"
+#include "vc/plan/stages.h"
+#include "vc/scene/surface_patches.h"
 
 namespace vc {
 namespace {
@@ -142,6 +147,135 @@ TEST(RunEvaluationTest, RefusesBadOptionsAndAnOverBudgetScene) {
   o = InsideTheBox(box);
   o.memory_budget_bytes = 1024;
   EXPECT_EQ(RunEvaluation(box, o).status().code(), StatusCode::kResourceExhausted);
+}
+
+// A little room for the seen sets: a floor, a wall, a tilted board and a post, noisy points.
+SceneInput LittleRoom() {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> u(0, 1);
+  std::normal_distribution<float> noise(0, 0.004f);
+  std::vector<Eigen::Vector3f> points;
+  for (int i = 0; i < 5000; ++i) {
+    const float x = 2 * u(rng), y = 2 * u(rng);
+    points.emplace_back(x, y, 0.02f + noise(rng));
+    if (x > 0.5f && x < 1.3f && y > 0.5f && y < 1.1f) points.emplace_back(x, y, 0.3f + 0.6f * (x - 0.5f) + noise(rng));
+    points.emplace_back(1.9f + noise(rng), y, 1.2f * u(rng));
+  }
+  for (int i = 0; i < 600; ++i) {
+    const float a = 6.2832f * u(rng);
+    points.emplace_back(0.4f + 0.06f * std::cos(a), 1.5f + 0.06f * std::sin(a), 1.0f * u(rng));
+  }
+  return testing::Cloud(std::move(points));
+}
+
+EvaluateJobOptions ExportFromTwoPlaces(SelectionTest test) {
+  EvaluateJobOptions o;
+  o.resolution_m = 0.1;
+  o.test = test;
+  o.export_sets = true;
+  o.threads = 2;
+  o.scanner.min_range_m = 0;  // the references apply no range
+  o.viewpoints = {{0.25, 0.3, 1.05}, {1.45, 1.75, 0.55}};
+  return o;
+}
+
+TEST(RunEvaluationTest, ExportedSetsAreWhatTheTestsPerRayReferenceSees) {
+  const SceneInput room = LittleRoom();
+  const VoxelScene scene = *Voxelize(room, {0.1});
+  const std::vector<SurfacePatch> patches = ComputeSurfacePatches(scene, room.points);
+  const testing::SubvoxelReference subvoxel{scene, patches};
+  for (const SelectionTest test :
+       {SelectionTest::kSurfaceVisibility, SelectionTest::kCompatibility, SelectionTest::kSubvoxel}) {
+    const EvaluateJobOptions o = ExportFromTwoPlaces(test);
+    const Result<EvaluateJobResult> job = RunEvaluation(room, o);
+    ASSERT_TRUE(job.ok()) << job.status().ToString();
+    EXPECT_EQ(job->selection_test, test);
+    EXPECT_TRUE(job->warnings.empty());
+    ASSERT_EQ(job->seen_sets.size(), 2u);
+    for (size_t k = 0; k < 2; ++k) {
+      const WorldPoint& o_m = o.viewpoints[k];
+      size_t expected_count = 0;
+      for (size_t id = 0; id < scene.occupied.size(); ++id) {
+        const VoxelIndex v = KeyToIndex(scene.occupied[id]);
+        const bool expected = test == SelectionTest::kSubvoxel        ? subvoxel.Seen(o_m / 0.1, id)
+                              : test == SelectionTest::kCompatibility ? IsCompatible(scene.grid, o_m, v, o.scanner)
+                                                                      : IsSurfaceVisible(scene.grid, o_m, v, o.scanner);
+        ASSERT_EQ(job->seen_sets[k].test(id), expected)
+            << SelectionTestName(test) << " viewpoint " << k << " voxel " << id;
+        expected_count += expected;
+      }
+      EXPECT_EQ(job->seen_sets[k].count(), expected_count);
+      EXPECT_GT(expected_count, 50u) << SelectionTestName(test);                         // something is seen
+      EXPECT_LT(expected_count, scene.occupied.size() - 50) << SelectionTestName(test);  // and something hidden
+    }
+  }
+}
+
+TEST(RunEvaluationTest, TheSubvoxelTestSeesMoreOfTheRoomThanTheSurfaceTest) {
+  const SceneInput room = LittleRoom();
+  const Result<EvaluateJobResult> surface = RunEvaluation(room, ExportFromTwoPlaces(SelectionTest::kSurfaceVisibility));
+  const Result<EvaluateJobResult> subvoxel = RunEvaluation(room, ExportFromTwoPlaces(SelectionTest::kSubvoxel));
+  ASSERT_TRUE(surface.ok() && subvoxel.ok());
+  EXPECT_GT(subvoxel->seen_sets[0].count(), surface->seen_sets[0].count());
+  // The evaluation itself does not depend on the test of the seen sets.
+  EXPECT_EQ(subvoxel->evaluation.overall.global_visibility, surface->evaluation.overall.global_visibility);
+}
+
+TEST(RunEvaluationTest, ExportedSetsDoNotDependOnTheInputsFrame) {
+  const SceneInput near = LittleRoom();
+  SceneInput far = near;
+  const WorldPoint origin(512000, 5612000, 100);
+  far.frame_origin_m = origin;
+  EvaluateJobOptions near_options = ExportFromTwoPlaces(SelectionTest::kSubvoxel);
+  EvaluateJobOptions far_options = near_options;
+  for (WorldPoint& p : far_options.viewpoints) p += origin;
+  const Result<EvaluateJobResult> a = RunEvaluation(near, near_options);
+  const Result<EvaluateJobResult> b = RunEvaluation(far, far_options);
+  ASSERT_TRUE(a.ok() && b.ok());
+  EXPECT_EQ(b->frame_origin_m, origin);
+  ASSERT_EQ(a->seen_sets.size(), b->seen_sets.size());
+  for (size_t k = 0; k < a->seen_sets.size(); ++k) EXPECT_EQ(a->seen_sets[k].words(), b->seen_sets[k].words());
+}
+
+TEST(RunEvaluationTest, NoSeenSetsUnlessAsked) {
+  const SceneInput room = LittleRoom();
+  EvaluateJobOptions o = ExportFromTwoPlaces(SelectionTest::kSubvoxel);
+  o.export_sets = false;
+  const Result<EvaluateJobResult> job = RunEvaluation(room, o);
+  ASSERT_TRUE(job.ok());
+  EXPECT_TRUE(job->seen_sets.empty());
+}
+
+TEST(RunEvaluationTest, TheSubvoxelTestWithoutPointsFallsBackToSurfaceAndSaysSo) {
+  // A compact upload of the room: its voxels' centres, not its points.
+  const VoxelScene scene = *Voxelize(LittleRoom(), {0.1});
+  SceneInput voxels;
+  voxels.format = InputFormat::kVoxelStream;
+  voxels.voxel_resolution_m = 0.1;
+  for (size_t id = 0; id < scene.occupied.size(); ++id) voxels.points.push_back(scene.Center(id).cast<float>());
+  const Result<EvaluateJobResult> job = RunEvaluation(voxels, ExportFromTwoPlaces(SelectionTest::kSubvoxel));
+  ASSERT_TRUE(job.ok()) << job.status().ToString();
+  EXPECT_EQ(job->selection_test, SelectionTest::kSurfaceVisibility);
+  ASSERT_EQ(job->warnings.size(), 1u);
+  EXPECT_THAT(job->warnings[0], HasSubstr("the subvoxel test needs the input's points"));
+  const Result<EvaluateJobResult> surface =
+      RunEvaluation(LittleRoom(), ExportFromTwoPlaces(SelectionTest::kSurfaceVisibility));
+  ASSERT_TRUE(surface.ok());
+  EXPECT_EQ(job->seen_sets[0].words(), surface->seen_sets[0].words());
+}
+
+TEST(RunEvaluationTest, SeenSetsOverHalfTheBudgetAreRefused) {
+  const SceneInput room = LittleRoom();
+  EvaluateJobOptions o = ExportFromTwoPlaces(SelectionTest::kSurfaceVisibility);
+  const size_t voxels = Voxelize(room, {0.1})->occupied.size();
+  o.memory_budget_bytes = 4 << 20;
+  // Enough viewpoints that their dense sets need more than 2 MiB.
+  o.viewpoints.assign((2 << 20) / ((voxels + 63) / 64 * 8) + 1, WorldPoint(0.25, 0.3, 1.05));
+  const Result<EvaluateJobResult> job = RunEvaluation(room, o);
+  EXPECT_EQ(job.status().code(), StatusCode::kResourceExhausted) << job.status().ToString();
+  EXPECT_THAT(job.status().message(), HasSubstr("the seen sets (--export-sets)"));
+  o.viewpoints.resize(o.viewpoints.size() / 2);  // half as many fit
+  EXPECT_TRUE(planner::CheckVisibilitySetBudget(o.viewpoints.size(), voxels, o.memory_budget_bytes, "").ok());
 }
 
 }  // namespace

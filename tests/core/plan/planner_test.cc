@@ -1067,5 +1067,37 @@ TEST(PlannerTest, Geb079WorkedExample) {
   ASSERT_TRUE(WritePlanOutputs(*d, std::string(dir) + "/defaults").ok());
 }
 
+TEST(PlannerTest, TheSubvoxelTestRunsOnPointsAndSaysSoWhereThereAreNone) {
+  PlanOptions o = TestOptions();
+  o.selection_test = SelectionTest::kSubvoxel;
+  const SceneInput cloud = Synthetic("rooms:2");
+  const Result<PlanResult> subvoxel = Plan(cloud, o);
+  ASSERT_TRUE(subvoxel.ok()) << subvoxel.status().ToString();
+  EXPECT_EQ(subvoxel->selection_test, SelectionTest::kSubvoxel) << Describe(*subvoxel);
+  EXPECT_GT(subvoxel->stations.size(), 0u);
+  for (const std::string& w : subvoxel->warnings) EXPECT_EQ(w.find("subvoxel"), std::string::npos) << w;
+
+  // The same rooms as a compact upload (the voxels' centres): no points, so the surface test runs.
+  const VoxelScene scene = *Voxelize(cloud, {0.1});
+  SceneInput voxels;
+  voxels.format = InputFormat::kVoxelStream;
+  voxels.voxel_resolution_m = 0.1;
+  for (size_t id = 0; id < scene.occupied.size(); ++id) voxels.points.push_back(scene.Center(id).cast<float>());
+  const Result<PlanResult> fallback = Plan(voxels, o);
+  ASSERT_TRUE(fallback.ok()) << fallback.status().ToString();
+  EXPECT_EQ(fallback->selection_test, SelectionTest::kSurfaceVisibility);
+  EXPECT_EQ(fallback->options.selection_test, SelectionTest::kSubvoxel);  // as asked
+  ASSERT_FALSE(fallback->warnings.empty());
+  EXPECT_NE(fallback->warnings[0].find("the subvoxel test needs the input's points"), std::string::npos)
+      << fallback->warnings[0];
+  o.selection_test = SelectionTest::kSurfaceVisibility;
+  const Result<PlanResult> surface = Plan(voxels, o);
+  ASSERT_TRUE(surface.ok());
+  ASSERT_EQ(fallback->stations.size(), surface->stations.size());
+  for (size_t k = 0; k < surface->stations.size(); ++k) {
+    EXPECT_EQ(fallback->stations[k].position, surface->stations[k].position);
+  }
+}
+
 }  // namespace
 }  // namespace vc

@@ -68,7 +68,7 @@ Result<RefineOutput> RunRefineStage(RefineInput in, const PlanOptions& options, 
   TrialPositions trials = TrialsAround(in.scene.grid, stations, options);
   VC_RETURN_IF_ERROR(
       CheckVisibilitySetBudget(trials.positions.size(), n_voxels, options.memory_budget_bytes, "refinement"));
-  const VisibilitySetsOptions set_options = VisibilitySetsOptionsFor(options);
+  const VisibilitySetsOptions set_options = VisibilitySetsOptionsFor(options, in.surface_patches);
   VC_ASSIGN_OR_RETURN(std::vector<VoxelSet> trial_sets,
                       ComputeVisibilitySets(in.scene, trials.positions, set_options, ProgressRange(ctx, 0.0, 0.9)));
   for (const VoxelSet& s : trial_sets) UnionInto(in.coverable, s);

@@ -66,7 +66,7 @@ Result<LocalRefinementResult> SelectWithLocalCandidates(const SelectionInput& in
   for (const VoxelSet& s : sets) UnionInto(coverable, s);
   all.sets = std::move(sets);
 
-  const VisibilitySetsOptions set_options = VisibilitySetsOptionsFor(options);
+  const VisibilitySetsOptions set_options = VisibilitySetsOptionsFor(options, in.surface_patches);
   const JobContext quiet{ctx.cancel, {}};  // the selection stage reports the loop's progress itself
   const VisibilityFn visibility = [&](const std::vector<WorldPoint>& positions) -> Result<std::vector<VoxelSet>> {
     ctx.Report(Stage::kSelection, 0.0,

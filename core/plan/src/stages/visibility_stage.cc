@@ -19,9 +19,11 @@ Status CheckVisibilitySetBudget(uint64_t positions, uint64_t voxels, uint64_t bu
   return Status::Ok();
 }
 
-VisibilitySetsOptions VisibilitySetsOptionsFor(const PlanOptions& options) {
+VisibilitySetsOptions VisibilitySetsOptionsFor(const PlanOptions& options,
+                                               std::span<const SurfacePatch> surface_patches) {
   VisibilitySetsOptions set_options;
   set_options.test = options.selection_test;
+  set_options.surface_patches = surface_patches;
   set_options.threads = options.threads;
   set_options.scanner = options.scanner;
   set_options.compact_gain = options.sparse_set_gain;
@@ -36,12 +38,12 @@ VisibilitySetsOptions VisibilitySetsOptionsFor(const PlanOptions& options) {
 
 Result<VisibilityOutput> RunVisibilityStage(const VisibilityInput& in, const PlanOptions& options,
                                             const JobContext& ctx) {
-  const VisibilitySetsOptions set_options = VisibilitySetsOptionsFor(options);
+  const VisibilitySetsOptions set_options = VisibilitySetsOptionsFor(options, in.surface_patches);
   VisibilityOutput out;
   // One pass over the fixed stations and the candidates; the fixed stations' sets come first.
   std::vector<WorldPoint> all = in.fixed_stations;
   all.insert(all.end(), in.candidates.begin(), in.candidates.end());
-  if (in.callbacks.visibility_sets) {
+  if (in.callbacks.visibility_sets && in.surface_patches.empty()) {
     VC_ASSIGN_OR_RETURN(DistributedSets d, in.callbacks.visibility_sets(in.scene, all, set_options, ctx));
     if (d.sets.size() != all.size()) {
       return InternalError("the distributed visibility stage returned " + std::to_string(d.sets.size()) + " sets for " +

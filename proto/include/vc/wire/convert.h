@@ -32,6 +32,8 @@ namespace vc::wire {
 
 // Voxels per VoxelChunk: 48 bytes each (centre + 6 face values), so a chunk is ~0.8 MiB.
 inline constexpr size_t kVoxelsPerChunk = 16384;
+// Voxel ids per SeenSetChunk: at most 5 bytes each (varint), so a chunk is at most ~0.6 MiB.
+inline constexpr size_t kSeenIdsPerChunk = 131072;
 // Candidates per HeatMapChunk (~40 bytes each on the wire).
 inline constexpr size_t kCandidatesPerHeatMapChunk = 16384;
 
@@ -90,6 +92,9 @@ bool ForEachVoxelChunk(const std::vector<WorldPoint>& centers, const Evaluation&
 bool ForEachVoxelChunk(const PlanResult& result, const std::function<bool(v1::VoxelChunk&&)>& fn);
 // The chunks of an evaluation's voxels (result.voxel_centers, result.evaluation).
 bool ForEachVoxelChunk(const EvaluateJobResult& result, const std::function<bool(v1::VoxelChunk&&)>& fn);
+// Calls fn with each SeenSetChunk of result.seen_sets (viewpoints in order, each in order, at least
+// one chunk each). Stops early and returns false when fn returns false.
+bool ForEachSeenSetChunk(const EvaluateJobResult& result, const std::function<bool(v1::SeenSetChunk&&)>& fn);
 // The summary that ends a Plan stream (everything but the chunked parts), in the input's frame
 // with result.frame_origin_m as frame_origin.
 v1::PlanResult ToProto(const PlanResult& result);
@@ -147,13 +152,18 @@ class EvaluateResultAssembler {
  public:
   // DATA_LOSS if the chunk is out of order or inconsistent with the previous ones.
   Status AddVoxels(const v1::VoxelChunk& chunk);
-  // The whole result, its voxel centres local (less summary.frame_origin), its viewpoints as sent.
-  // DATA_LOSS if the chunks received do not add up to what `summary` declares, or the origin is
-  // not finite.
+  // DATA_LOSS if the chunk is out of order (viewpoints, or ids within one), or its ids descend.
+  Status AddSeenSet(const v1::SeenSetChunk& chunk);
+  // The whole result, its voxel centres local (less summary.frame_origin), its viewpoints as sent,
+  // its seen sets (when sent) over the voxels. DATA_LOSS if the chunks received do not add up to
+  // what `summary` declares (voxels, seen sets per viewpoint and their sizes), a seen id is not a
+  // voxel, or the origin is not finite.
   Result<EvaluateJobResult> Finish(const v1::EvaluateResult& summary) &&;
 
  private:
   VoxelChunkAssembler voxels_;
+  std::vector<std::vector<uint32_t>> seen_ids_;  // per viewpoint, as received
+  std::vector<uint64_t> seen_totals_;            // per viewpoint, as declared
 };
 
 }  // namespace vc::wire

@@ -43,7 +43,7 @@
   X(uint64_t, memory_budget_bytes, ::vc::kDefaultMemoryBudgetBytes, "bytes", "memory-budget-bytes", kPositive,        \
     "memory budget of the job (capped by the server's --max-memory-budget-bytes)")                                    \
   X(::vc::SelectionTest, selection_test, ::vc::SelectionTest::kSurfaceVisibility, "", "test", kAny,                   \
-    "selection test: surface or compatibility")                                                                       \
+    "selection test: surface, compatibility, or subvoxel (point clouds only; docs/VISIBILITY.md)")                    \
   X(double, grid_spacing_m, 1.0, "m", "grid-spacing", kPositive, "candidate grid spacing")                            \
   X(double, tripod_height_m, 1.5, "m", "tripod-height", kPositive, "scanner height above the floor")                  \
   X(double, clearance_m, 0.2, "m", "clearance", kNonNegative, "free space required around a candidate")               \

@@ -12,6 +12,7 @@
 #include <cstdint>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -22,6 +23,7 @@
 #include "vc/plan/route.h"
 #include "vc/plan/selector.h"
 #include "vc/scene/scene_input.h"
+#include "vc/scene/surface_patches.h"
 #include "vc/scene/voxel_scene.h"
 #include "vc/visibility/visibility.h"
 
@@ -46,8 +48,21 @@ struct VoxelizeInput {
 };
 struct VoxelizeOutput {
   VoxelScene scene;
+  // With options.selection_test kSubvoxel and an input of points: one patch per occupied voxel
+  // (ComputeSurfacePatches). Empty otherwise.
+  std::vector<SurfacePatch> surface_patches;
+  // The test the plan runs: options.selection_test, or kSurfaceVisibility for kSubvoxel on an input
+  // without points (an octree, a compact vc-voxels upload).
+  SelectionTest selection_test = SelectionTest::kSurfaceVisibility;
+  std::vector<std::string> warnings;  // for PlanResult::warnings: why the sub-voxel test did not run
 };
-// Voxelize with options.resolution_m and memory_budget_bytes; RESOURCE_EXHAUSTED over budget.
+// Whether `input` carries the points the sub-voxel test needs (not an octree, not a vc-voxels stream).
+[[nodiscard]] bool HasSurfacePoints(const SceneInput& input);
+// "the subvoxel test needs the input's points, and this octree has none", for an input without them.
+[[nodiscard]] std::string NoSurfacePointsNote(const SceneInput& input);
+// Voxelize with options.resolution_m and memory_budget_bytes, and the surface patches the sub-voxel
+// test needs (a warning, and the surface test, where the input has no points); RESOURCE_EXHAUSTED
+// over budget.
 [[nodiscard]] Result<VoxelizeOutput> RunVoxelizeStage(const VoxelizeInput& in, const PlanOptions& options,
                                                       const JobContext& ctx);
 
@@ -85,6 +100,7 @@ struct VisibilityInput {
   const std::vector<double>& floor_z_m;           // per candidate (for the heat map)
   const std::vector<WorldPoint>& fixed_stations;  // their sets are computed too, not in the heat map
   const PlanCallbacks& callbacks;                 // on_heat_map is called once, when the heat map is final
+  std::span<const SurfacePatch> surface_patches;  // VoxelizeOutput's: the sub-voxel test's patches
 };
 struct VisibilityOutput {
   std::vector<VoxelSet> sets;         // per candidate
@@ -94,9 +110,11 @@ struct VisibilityOutput {
   std::vector<std::string> warnings;  // from callbacks.visibility_sets
 };
 // The options the visibility stage computes its sets with (a peer computing a shard of them must
-// use the same).
-[[nodiscard]] VisibilitySetsOptions VisibilitySetsOptionsFor(const PlanOptions& options);
-// CANCELLED / DEADLINE_EXCEEDED from ctx.
+// use the same), with `surface_patches` (VoxelizeOutput's) for the sub-voxel test.
+[[nodiscard]] VisibilitySetsOptions VisibilitySetsOptionsFor(const PlanOptions& options,
+                                                             std::span<const SurfacePatch> surface_patches = {});
+// With surface patches (the sub-voxel test) the sets are computed here, never by
+// callbacks.visibility_sets: peers hold no patches. CANCELLED / DEADLINE_EXCEEDED from ctx.
 [[nodiscard]] Result<VisibilityOutput> RunVisibilityStage(const VisibilityInput& in, const PlanOptions& options,
                                                           const JobContext& ctx);
 
@@ -107,9 +125,10 @@ struct SelectionInput {
   std::vector<VoxelSet> sets;        // per candidate; consumed (freed when done)
   std::vector<VoxelSet> fixed_sets;  // per fixed station (options.fixed_stations); consumed
   const std::vector<WorldPoint>& candidates;
-  const std::vector<double>& floor_z_m;         // per candidate
-  const std::vector<uint64_t>& visible_voxels;  // per candidate: |set| (the heat map's counts)
-  const PlanCallbacks& callbacks;               // on_station is called per pick, in pick order
+  const std::vector<double>& floor_z_m;           // per candidate
+  const std::vector<uint64_t>& visible_voxels;    // per candidate: |set| (the heat map's counts)
+  const PlanCallbacks& callbacks;                 // on_station is called per pick, in pick order
+  std::span<const SurfacePatch> surface_patches;  // VoxelizeOutput's: the sub-voxel test's patches
 };
 struct SelectionOutput {
   Stations stations;                  // the fixed stations, then the picks, in pick order
@@ -137,8 +156,9 @@ struct SelectionOutput {
 // --- Stage::kRefine: each station to the best position of a sub-grid around it (s.7.4) ---
 struct RefineInput {
   const VoxelScene& scene;
-  Stations stations;   // consumed
-  VoxelSet coverable;  // consumed; grows by what the trial positions see
+  Stations stations;                              // consumed
+  VoxelSet coverable;                             // consumed; grows by what the trial positions see
+  std::span<const SurfacePatch> surface_patches;  // VoxelizeOutput's: the sub-voxel test's patches
 };
 struct RefineOutput {
   Stations stations;
