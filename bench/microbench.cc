@@ -86,20 +86,21 @@ void BM_EvaluateExact(benchmark::State& state) {
 }
 BENCHMARK(BM_EvaluateExact)->Unit(benchmark::kMillisecond);
 
-// A campus-like site for consolidation: a 400 x 200 voxel plane, a candidate every 4 voxels (5,000),
-// each seeing the voxels within 20 voxels of it but a pseudo-random quarter (occlusion), so that
-// greedy's many picks are mostly far apart and consolidation has many pairs to rule out.
-std::vector<vc::VoxelSet> CampusSets() {
-  constexpr int kWidth = 400, kHeight = 200, kStep = 4, kRadius = 20;
+// A campus-like site for consolidation: a width x height voxel plane (400 x 200), a candidate every
+// 4 voxels (5,000), each seeing the voxels within `radius` voxels of it (20) but a pseudo-random
+// quarter (occlusion), so that greedy's many picks are mostly far apart and consolidation has many
+// pairs to rule out.
+std::vector<vc::VoxelSet> CampusSets(int width = 400, int height = 200, int radius = 20) {
+  constexpr int kStep = 4;
   std::vector<vc::VoxelSet> sets;
-  for (int cy = 0; cy < kHeight; cy += kStep) {
-    for (int cx = 0; cx < kWidth; cx += kStep) {
-      vc::VoxelSet s(size_t(kWidth) * kHeight);
-      for (int y = std::max(0, cy - kRadius); y < std::min(kHeight, cy + kRadius + 1); ++y) {
-        for (int x = std::max(0, cx - kRadius); x < std::min(kWidth, cx + kRadius + 1); ++x) {
+  for (int cy = 0; cy < height; cy += kStep) {
+    for (int cx = 0; cx < width; cx += kStep) {
+      vc::VoxelSet s(size_t(width) * height);
+      for (int y = std::max(0, cy - radius); y < std::min(height, cy + radius + 1); ++y) {
+        for (int x = std::max(0, cx - radius); x < std::min(width, cx + radius + 1); ++x) {
           const uint32_t hash = uint32_t(x * 73856093) ^ uint32_t(y * 19349663) ^ uint32_t(sets.size() * 83492791);
-          if ((x - cx) * (x - cx) + (y - cy) * (y - cy) <= kRadius * kRadius && hash % 4 != 0) {
-            s.set(size_t(y) * kWidth + size_t(x));
+          if ((x - cx) * (x - cx) + (y - cy) * (y - cy) <= radius * radius && hash % 4 != 0) {
+            s.set(size_t(y) * width + size_t(x));
           }
         }
       }
@@ -125,5 +126,35 @@ void BM_ConsolidatePicks(benchmark::State& state) {
   state.counters["consolidated_picks"] = double(after);
 }
 BENCHMARK(BM_ConsolidatePicks)->Unit(benchmark::kMillisecond)->Iterations(1);
+
+// Consolidation through many passes: greedy's picks (to 99 %) and every third candidate besides,
+// most of them redundant, on a range(0) x range(1) plane with a view radius of range(2) voxels.
+void BM_ConsolidatePicksManyPasses(benchmark::State& state) {
+  const std::vector<vc::VoxelSet> sets = CampusSets(int(state.range(0)), int(state.range(1)), int(state.range(2)));
+  vc::planner::GreedyOptions options;
+  options.target_coverage = 0.99;
+  const auto greedy = vc::planner::SelectGreedy(sets, options);
+  std::vector<int> picks;
+  for (const vc::planner::GreedyPick& p : greedy->picks) picks.push_back(p.candidate);
+  for (size_t c = 0; c < sets.size(); c += 3) picks.push_back(int(c));
+  int dropped = 0, merged = 0;
+  size_t after = 0;
+  for (auto _ : state) {
+    const auto r = vc::planner::ConsolidatePicks(sets, picks, options);
+    after = r->picks.size();
+    dropped = r->dropped;
+    merged = r->merged;
+  }
+  state.counters["picks"] = double(picks.size());
+  state.counters["consolidated_picks"] = double(after);
+  state.counters["dropped"] = dropped;
+  state.counters["merged"] = merged;
+}
+BENCHMARK(BM_ConsolidatePicksManyPasses)
+    ->Args({400, 200, 20})
+    ->Args({600, 300, 15})
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(1)
+    ->MeasureProcessCPUTime();
 
 }  // namespace

@@ -168,6 +168,17 @@ std::string DistributionLine(const PlanResult& r) {
                 d.retried, double(d.bytes_exchanged) / 1048576.0);
 }
 
+std::string TimingLine(const PlanResult& r) {
+  if (r.timings.empty()) return "";
+  std::string out = "stages:";
+  for (size_t i = 0; i < r.timings.size(); ++i) {
+    const StageTiming& t = r.timings[i];
+    out += Format("%s %s %.2f s", i ? "," : "", std::string(StageName(t.stage)).c_str(), t.seconds);
+    if (t.peak_rss_bytes > 0) out += Format(" (peak %.0f MiB)", double(t.peak_rss_bytes) / 1048576.0);
+  }
+  return out + Format("; total %.2f s\n", r.total_seconds);
+}
+
 std::string FormatDuration(double seconds) {
   if (!std::isfinite(seconds) || seconds < 0) return "?";
   const long s = std::lround(seconds);
@@ -251,6 +262,7 @@ std::string PlanSummary(const PlanResult& r) {
   out += StopLine(r);
   out += OptimalityLine(r);
   out += DistributionLine(r);
+  out += TimingLine(r);
   out += ScanGraphLine(r);
   out += RouteLines(r);
   out += FieldTimeLine(r);

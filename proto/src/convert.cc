@@ -598,6 +598,7 @@ v1::PlanResult ToProto(const PlanResult& r) {
     auto* pt = p.add_timings();
     pt->set_stage(ToProto(t.stage));
     pt->set_seconds(t.seconds);
+    pt->set_peak_rss_bytes(t.peak_rss_bytes);
   }
   for (const auto& w : r.warnings) p.add_warnings(w);
   p.set_heat_map_candidates(r.heat_map.positions.size());
@@ -767,7 +768,7 @@ Result<PlanResult> PlanResultAssembler::Finish(const v1::PlanResult& p) && {
   r.evaluation = FromProto(p.evaluation());
   r.evaluation.best_face_values = std::move(voxels.best_face_values);
   r.evaluation.sole_viewer = std::move(voxels.sole_viewer);
-  for (const auto& t : p.timings()) r.timings.push_back({FromProto(t.stage()), t.seconds()});
+  for (const auto& t : p.timings()) r.timings.push_back({FromProto(t.stage()), t.seconds(), t.peak_rss_bytes()});
   r.total_seconds = p.total_seconds();
   r.warnings.assign(p.warnings().begin(), p.warnings().end());
   for (double z : p.floor_levels_m()) r.floor_levels_m.push_back(LessOrigin(z, origin.z()));

@@ -188,5 +188,14 @@ TEST(DistributionLineTest, OnlyAFannedOutPlanGetsOne) {
   EXPECT_NE(PlanSummary(r).find("fanned out: 31 shard(s)"), std::string::npos);
 }
 
+TEST(TimingLineTest, EachStagesTimeAndPeakMemoryWhereMeasured) {
+  PlanResult r;
+  EXPECT_EQ(TimingLine(r), "");
+  r.timings = {{Stage::kVisibility, 12.345, uint64_t{1536} << 20}, {Stage::kRoute, 0.5, 0}};
+  r.total_seconds = 13;
+  EXPECT_EQ(TimingLine(r), "stages: visibility 12.35 s (peak 1536 MiB), route 0.50 s; total 13.00 s\n");
+  EXPECT_NE(PlanSummary(r).find("stages: visibility 12.35 s"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace vc::client

@@ -91,7 +91,7 @@ PlanResult BigResult(size_t voxels, size_t candidates) {
   r.occupied_voxels = voxels;
   r.evaluation.per_viewpoint.resize(1);
   r.evaluation.overall.global_visibility = 0.42;
-  r.timings.push_back({Stage::kSelection, 1.5});
+  r.timings.push_back({Stage::kSelection, 1.5, uint64_t{3} << 30});
   r.total_seconds = 2.5;
   r.warnings.push_back("w");
   r.reduction.positions = {{1, 2, 3}};
@@ -164,6 +164,7 @@ TEST(PlanResultChunks, ReassembleExactlyAndStayUnderOneMebibyte) {
   EXPECT_EQ(back->reduction.matrix, r.reduction.matrix);
   EXPECT_DOUBLE_EQ(back->evaluation.overall.global_visibility, 0.42);
   EXPECT_EQ(back->timings[0].stage, Stage::kSelection);
+  EXPECT_EQ(back->timings[0].peak_rss_bytes, uint64_t{3} << 30);
   EXPECT_EQ(back->total_seconds, 2.5);
   EXPECT_EQ(back->warnings, r.warnings);
   EXPECT_EQ(back->reduction.positions, r.reduction.positions);

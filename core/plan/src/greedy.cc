@@ -433,8 +433,16 @@ class PerPick {
   std::unordered_map<int, Value> values_;  // node-based: references stay valid as it grows
 };
 
-// One ConsolidatePicks over non-empty sets and picks: each pass counts how often the picks cover
-// each voxel, then drops one pick or merges one pair, until a pass changes nothing.
+// One ConsolidatePicks over non-empty sets and picks: each pass drops one pick or merges one pair,
+// until a pass changes nothing.
+//
+// How often the picks cover each voxel is counted once and then updated by each change on the
+// voxels of the picks it removed or added. Whether a pick is needed (covers a voxel alone) and,
+// without registration, whether a pair can merge depend only on the picks involved and on those
+// counts at their voxels, so both are remembered (needed_, failed_) until a change adds or removes
+// a pick that shares a voxel with them: a pass rechecks only what a change touched. The first
+// droppable pick and the first mergeable pair are the same as if everything were rechecked, and so
+// are the picks.
 class Consolidation {
  public:
   Consolidation(const std::vector<VoxelSet>& sets, std::vector<int> picks, const GreedyOptions& options,
@@ -446,6 +454,7 @@ class Consolidation {
         words_((sets[0].size() + 63) / 64),
         candidate_words_((sets.size() + 63) / 64),
         picks_(std::move(picks)),
+        slots_(picks_.size()),
         c1_(words_),
         c2_(words_),
         c3_(words_),
@@ -460,6 +469,10 @@ class Consolidation {
     for (size_t r = 0; r < order_.size(); ++r) rank_[order_[r]] = static_cast<int>(r);
     if (min_overlap_ > 0) overlaps_.emplace(sets);
     groups_ = overlaps_ ? overlaps_->Components(picks_, min_overlap_) : 1;
+    std::iota(slots_.begin(), slots_.end(), 0);
+    slot_count_ = picks_.size();
+    needed_.assign(slot_count_, -1);
+    if (!overlaps_) failed_.assign((slot_count_ * slot_count_ + 63) / 64, 0);
   }
 
   Result<ConsolidateResult> Run() {
@@ -468,9 +481,11 @@ class Consolidation {
       ++pass_;
       pairs_ = picks_.size() * (picks_.size() - 1) / 2;
       pacer_.Restart();
+      (void)pacer_.Due();  // this report counts as the interval's
       ReportPass(0);
-      CountCoverage();
-      if (DropOne()) {
+      if (pass_ == 1) CountCoverage();
+      VC_ASSIGN_OR_RETURN(const bool dropped, DropOne());
+      if (dropped) {
         EndPass(0);
         continue;
       }
@@ -566,39 +581,65 @@ class Consolidation {
     return true;
   }
 
-  // Voxels covered at least once (c1_), twice (c2_), three times (c3_).
+  // How often the picks cover each voxel (counts_), and as bits the voxels covered at least once
+  // (c1_), twice (c2_), three times (c3_). Counted once; each change then recounts its picks only.
   void CountCoverage() {
-    std::fill(c1_.begin(), c1_.end(), 0);
-    std::fill(c2_.begin(), c2_.end(), 0);
-    std::fill(c3_.begin(), c3_.end(), 0);
-    for (int p : picks_) {
-      const std::vector<uint64_t>& w = Words(p);
-      for (size_t k = 0; k < words_; ++k) {
-        c3_[k] |= c2_[k] & w[k];
-        c2_[k] |= c1_[k] & w[k];
-        c1_[k] |= w[k];
+    counts_.assign(sets_[0].size(), 0);
+    for (int p : picks_) Recount(p, +1);
+  }
+  // Adds (delta +1) or removes (-1) one pick's voxels from the counts and their bits.
+  void Recount(int pick, int delta) {
+    const std::vector<uint64_t>& w = Words(pick);
+    for (size_t k : NonzeroWords(pick)) {
+      for (uint64_t bits = w[k]; bits != 0; bits &= bits - 1) {
+        const int j = std::countr_zero(bits);
+        uint32_t& n = counts_[k * 64 + static_cast<size_t>(j)];
+        n = delta > 0 ? n + 1 : n - 1;
+        const uint64_t bit = uint64_t{1} << j;
+        c1_[k] = n >= 1 ? c1_[k] | bit : c1_[k] & ~bit;
+        c2_[k] = n >= 2 ? c2_[k] | bit : c2_[k] & ~bit;
+        c3_[k] = n >= 3 ? c3_[k] | bit : c3_[k] & ~bit;
       }
     }
   }
+  // Whether the pick at position i covers a voxel no other pick covers; kept per slot until a
+  // change touches the pick.
+  bool Needed(size_t i) {
+    int8_t& known = needed_[static_cast<size_t>(slots_[i])];
+    if (known >= 0) return known;
+    const std::vector<uint64_t>& w = Words(picks_[i]);
+    bool needed = false;
+    for (size_t k : NonzeroWords(picks_[i])) {
+      if ((needed = (w[k] & ~c2_[k]) != 0)) break;
+    }
+    known = needed;
+    return needed;
+  }
 
   // Drops a pick nobody needs (all its voxels covered twice), the latest such pick first.
-  // Notes which picks cover a voxel alone (sole_) on the way.
-  bool DropOne() {
+  // Notes which picks cover a voxel alone (sole_) on the way. Checks cancellation after every pick
+  // and reports the picks checked at most once per pacer interval (registration makes each slow).
+  Result<bool> DropOne() {
     sole_.assign(picks_.size(), 0);
     if (picks_.size() <= 1) return false;
     for (size_t i = picks_.size(); i-- > 0;) {
-      if (IsFixed(picks_[i])) continue;
-      const std::vector<uint64_t>& w = Words(picks_[i]);
-      bool needed = false;
-      for (size_t k : NonzeroWords(picks_[i])) {
-        if ((needed = (w[k] & ~c2_[k]) != 0)) break;
+      VC_RETURN_IF_ERROR(ctx_.CheckCancelled("consolidation"));
+      if (pacer_.Due() && ctx_.progress) {
+        const uint64_t checked = picks_.size() - 1 - i;
+        ctx_.progress(ProgressEvent{Stage::kSelection, Fraction(0), PassNote() + ", looking for a pick to drop",
+                                    checked, picks_.size(), "picks checked"});
       }
+      if (IsFixed(picks_[i])) continue;
+      const bool needed = Needed(i);
       sole_[i] = needed;
       if (needed) continue;
       std::vector<int> after = picks_;
       after.erase(after.begin() + static_cast<std::ptrdiff_t>(i));
       if (!KeepsLinked(after)) continue;
+      const int dropped = picks_[i];
       picks_ = std::move(after);
+      slots_.erase(slots_.begin() + static_cast<std::ptrdiff_t>(i));
+      AfterChange({dropped}, -1, -1);
       ++out_.dropped;
       return true;
     }
@@ -613,7 +654,11 @@ class Consolidation {
       for (size_t b = a + 1; b < picks_.size(); ++b, ++checked) {
         VC_RETURN_IF_ERROR(ctx_.CheckCancelled("consolidation"));
         if (pacer_.Due()) ReportPass(checked);
-        if (IsFixed(picks_[a]) || IsFixed(picks_[b]) || !MergePair(a, b)) continue;
+        if (IsFixed(picks_[a]) || IsFixed(picks_[b]) || Failed(a, b)) continue;
+        if (!MergePair(a, b)) {
+          NoteFailed(a, b);
+          continue;
+        }
         EndPass(checked + 1);
         return true;
       }
@@ -703,6 +748,57 @@ class Consolidation {
     std::sort(common_.begin(), common_.end(), [&](int p, int q) { return rank_[p] < rank_[q]; });
   }
 
+  // The bit of failed_ for the picks at positions a and b (without registration).
+  size_t FailedBit(size_t a, size_t b) const {
+    const size_t s = static_cast<size_t>(std::min(slots_[a], slots_[b]));
+    const size_t t = static_cast<size_t>(std::max(slots_[a], slots_[b]));
+    return s * slot_count_ + t;
+  }
+  // Whether the picks at positions a and b were found unmergeable since the last change near them.
+  bool Failed(size_t a, size_t b) const {
+    if (failed_.empty()) return false;
+    const size_t bit = FailedBit(a, b);
+    return (failed_[bit >> 6] >> (bit & 63)) & 1;
+  }
+  void NoteFailed(size_t a, size_t b) {
+    if (failed_.empty()) return;
+    const size_t bit = FailedBit(a, b);
+    failed_[bit >> 6] |= uint64_t{1} << (bit & 63);
+  }
+  // After a change that removed the `removed` picks and added candidate `added` (-1: none) in
+  // `new_slot`: the counts are updated, and every pick that shares a voxel with one of them (its
+  // voxels' counts changed), and the new pick, loses what was known of it (Needed, failed_).
+  void AfterChange(std::vector<int> changed, int added, int new_slot) {
+    for (int c : changed) Recount(c, -1);
+    if (added >= 0) {
+      Recount(added, +1);
+      changed.push_back(added);
+    }
+    for (size_t i = 0; i < picks_.size(); ++i) {
+      bool touched = slots_[i] == new_slot;
+      for (size_t k = 0; k < changed.size() && !touched; ++k) touched = SeesInto(picks_[i], changed[k]);
+      if (!touched) continue;
+      needed_[static_cast<size_t>(slots_[i])] = -1;
+      if (!failed_.empty()) ForgetSlot(static_cast<size_t>(slots_[i]));
+    }
+  }
+  // Whether candidates x and c share a voxel (tested on c's nonzero words).
+  bool SeesInto(int x, int c) {
+    const std::vector<uint64_t>& wx = Words(x);
+    const std::vector<uint64_t>& wc = Words(c);
+    for (size_t k : NonzeroWords(c)) {
+      if (wx[k] & wc[k]) return true;
+    }
+    return false;
+  }
+  // Clears every failed_ bit of slot s.
+  void ForgetSlot(size_t s) {
+    for (size_t t = 0; t < slot_count_; ++t) {
+      const size_t bit = std::min(s, t) * slot_count_ + std::max(s, t);
+      failed_[bit >> 6] &= ~(uint64_t{1} << (bit & 63));
+    }
+  }
+
   // Replaces picks a < b by candidate c if c sees all of rest_ and the scan graph keeps its groups.
   bool TryStandIn(size_t a, size_t b, int c) {
     // A voxel of rest_ every candidate standing in must see: one test rules most out.
@@ -715,7 +811,10 @@ class Consolidation {
     after[a] = c;
     after.erase(after.begin() + static_cast<std::ptrdiff_t>(b));
     if (!KeepsLinked(after)) return false;
+    const int replaced_a = picks_[a], replaced_b = picks_[b];
     picks_ = std::move(after);
+    slots_.erase(slots_.begin() + static_cast<std::ptrdiff_t>(b));
+    AfterChange({replaced_a, replaced_b}, c, slots_[a]);
     ++out_.merged;
     return true;
   }
@@ -727,15 +826,20 @@ class Consolidation {
   const size_t words_;            // per voxel set
   const size_t candidate_words_;  // per candidate bitset (Neighbours)
   std::vector<int> picks_;
-  std::vector<int> order_;            // the non-fixed candidates by decreasing |set|, then index
-  std::vector<int> rank_;             // per candidate: its place in order_, -1 for a fixed one
-  std::vector<int> common_;           // CommonNeighboursInOrder's output
-  std::vector<char> sole_;            // per pick this pass: covers a voxel no other pick covers
+  std::vector<int> slots_;   // per pick: its row and column in failed_ (a stand-in takes the slot of the first pick)
+  std::vector<int> order_;   // the non-fixed candidates by decreasing |set|, then index
+  std::vector<int> rank_;    // per candidate: its place in order_, -1 for a fixed one
+  std::vector<int> common_;  // CommonNeighboursInOrder's output
+  std::vector<char> sole_;   // per pick this pass: covers a voxel no other pick covers
   std::optional<Overlaps> overlaps_;  // with registration
   int groups_ = 1;                    // components of the picks' scan graph
   PerPick<VoxelSet> dense_copies_;    // sparse picks, made dense
   PerPick<std::vector<size_t>> nonzero_words_;
   PerPick<std::vector<uint64_t>> neighbours_;
+  size_t slot_count_ = 0;         // the picks consolidation started with
+  std::vector<uint64_t> failed_;  // without registration: bit s * slot_count_ + t, s < t, for an unmergeable pair
+  std::vector<int8_t> needed_;    // per slot: Needed's answer, -1 when not known
+  std::vector<uint32_t> counts_;  // per voxel: how many picks cover it
   std::vector<uint64_t> c1_, c2_, c3_, rest_;
   std::vector<size_t> nonzero_;  // the words where rest_ has a voxel
   ConsolidateResult out_;

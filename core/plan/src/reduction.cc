@@ -1,10 +1,12 @@
 #include "vc/plan/reduction.h"
 
 #include <algorithm>
+#include <mutex>
 #include <string>
 #include <unordered_map>
 #include <utility>
 
+#include "progress_pacer.h"
 #include "vc/base/huge_pages.h"
 #include "vc/base/parallel.h"
 
@@ -189,7 +191,7 @@ Result<ReductionRun> RunReduction(int num_stations, uint64_t faces_total, const 
   bool use_cache = true;
   uint64_t cache_bytes = 0;
   std::vector<SparseFaceValues> cache(num_stations);
-  std::vector<FaceTop3> top3 = internal::FilledOnHugePages(faces_total, FaceTop3{});
+  std::vector<FaceTop3> top3 = vc::internal::FilledOnHugePages(faces_total, FaceTop3{});
   // Stations per call: at most batch_stations, and as many as keep the batch in flight within the
   // cache budget too — first for the worst case (every face seen: 8 bytes a face), then for what
   // the stations asked so far saw on average.
@@ -201,17 +203,32 @@ Result<ReductionRun> RunReduction(int num_stations, uint64_t faces_total, const 
   size_t batch = batch_for(faces_total * (sizeof(uint32_t) + sizeof(float)));
   uint64_t bytes_seen = 0, stations_seen = 0;
 
+  // Stations evaluated of those a build streams, with the time left at the rate so far, at most
+  // once per pacer interval (and at every batch's end); the evaluation may report from its workers.
+  internal::ProgressPacer build_pacer;
+  std::mutex build_pacer_mutex;
+  auto report_build = [&](double fraction, uint64_t done, uint64_t total, bool due) {
+    if (!ctx.progress) return;
+    std::lock_guard<std::mutex> lock(build_pacer_mutex);
+    if (!(due || build_pacer.Due())) return;
+    std::string note = "face values of the stations";
+    if (const std::string left = build_pacer.TimeLeft(done, total); !left.empty()) note += ", " + left;
+    ctx.progress(ProgressEvent{Stage::kReduction, fraction, std::move(note), done, total, "stations evaluated"});
+  };
+
   // Streams every active station's values into a fresh top-3 table, a batch at a time.
   auto build = [&](const std::vector<int>& stations, double progress_from, double progress_to) -> Status {
     std::fill(top3.begin(), top3.end(), FaceTop3{});
+    build_pacer.Restart();
     for (size_t first = 0; first < stations.size();) {
       const std::vector<int> part(stations.begin() + first,
                                   stations.begin() + std::min(first + batch, stations.size()));
       JobContext sub = ctx;
       const double lo = progress_from + (progress_to - progress_from) * first / stations.size();
       const double hi = progress_from + (progress_to - progress_from) * (first + part.size()) / stations.size();
-      sub.progress = [&ctx, lo, hi](const ProgressEvent& e) {
-        ctx.Report(Stage::kReduction, lo + (hi - lo) * e.fraction);
+      sub.progress = [&, lo, hi, first, part_size = part.size(), total = stations.size()](const ProgressEvent& e) {
+        const double f = std::clamp(e.fraction, 0.0, 1.0);
+        report_build(lo + (hi - lo) * f, first + static_cast<uint64_t>(f * double(part_size)), total, false);
       };
       if (!ctx.progress) sub.progress = nullptr;
       Result<std::vector<SparseFaceValues>> v = values(part, sub);
@@ -241,8 +258,8 @@ Result<ReductionRun> RunReduction(int num_stations, uint64_t faces_total, const 
           }
         }
       }
-      ctx.Report(Stage::kReduction, hi);
       first += part.size();
+      report_build(hi, first, stations.size(), true);
       batch = batch_for(bytes_seen / stations_seen);
     }
     return Status::Ok();
@@ -257,8 +274,20 @@ Result<ReductionRun> RunReduction(int num_stations, uint64_t faces_total, const 
   if (!options.remove) return run;
 
   ReductionMatrix current = run.initial;
+  // Removals so far of the most there can be (all stations but one, or down to reduce_to).
+  const uint64_t most_removals = static_cast<uint64_t>(std::max(num_stations - std::max(options.reduce_to, 1), 0));
+  internal::ProgressPacer removal_pacer;
   while (true) {
     VC_RETURN_IF_ERROR(ctx.CheckCancelled("reduction"));
+    const uint64_t removed = run.removed.size();
+    const double fraction = 0.8 + 0.2 * double(removed) / double(std::max<uint64_t>(most_removals, 1));
+    if (ctx.progress && removal_pacer.Due()) {
+      std::string note = std::to_string(active.size()) + " stations left";
+      if (const std::string left = removal_pacer.TimeLeft(removed, most_removals); !left.empty())
+        note += ", at most " + left;
+      ctx.progress(ProgressEvent{Stage::kReduction, fraction, std::move(note), removed, most_removals,
+                                 "stations removed (at most)"});
+    }
     std::vector<int> remove = ChooseRemoval(current, active, options.reduce_to, options.fixed, options.keeps);
     if (remove.empty()) break;
     const double loss = remove.size() == 1 ? current.at(remove[0], remove[0]) : current.at(remove[0], remove[1]);
@@ -272,7 +301,7 @@ Result<ReductionRun> RunReduction(int num_stations, uint64_t faces_total, const 
     if (use_cache) {
       VC_RETURN_IF_ERROR(RefillFromCache(cache, active, removed_now, options.threads, ctx, top3));
     } else {
-      VC_RETURN_IF_ERROR(build(active, 0.8, 0.8));
+      VC_RETURN_IF_ERROR(build(active, fraction, fraction));
     }
     current = ComputeReductionMatrix(top3, num_stations, faces_total, options.threads);
     run.global_visibility_after = current.global_visibility;

@@ -39,9 +39,9 @@ Status StageRunner::Begin(Stage stage) const {
   return ctx_.CheckCancelled(std::string(StageName(stage)).c_str());
 }
 
-void StageRunner::End(Stage stage, Clock::time_point begin) {
+void StageRunner::End(Stage stage, Clock::time_point begin, uint64_t peak_rss_bytes) {
   ctx_.Report(stage, 1.0);
-  timings_.push_back({stage, std::chrono::duration<double>(Clock::now() - begin).count()});
+  timings_.push_back({stage, std::chrono::duration<double>(Clock::now() - begin).count(), peak_rss_bytes});
 }
 
 }  // namespace vc::planner

@@ -792,6 +792,19 @@ Json CrsJson(const CrsInfo* crs) {
               {"metres_per_unit", crs->metres_per_unit}};
 }
 
+// plan.json's peak_rss_bytes: per stage the process's peak resident memory during it (null where
+// not measured) and `plan`, the largest.
+Json PeakRssJson(const std::vector<StageTiming>& timings) {
+  Json peak = Json::object();
+  uint64_t plan_peak = 0;
+  for (const StageTiming& t : timings) {
+    peak[std::string(StageName(t.stage))] = t.peak_rss_bytes == 0 ? Json(nullptr) : Json(t.peak_rss_bytes);
+    plan_peak = std::max(plan_peak, t.peak_rss_bytes);
+  }
+  peak["plan"] = plan_peak == 0 ? Json(nullptr) : Json(plan_peak);
+  return peak;
+}
+
 }  // namespace
 
 std::string PlanToJson(const PlanResult& r, const UploadSummary* upload,
@@ -923,6 +936,7 @@ std::string PlanToJson(const PlanResult& r, const UploadSummary* upload,
                                                             {"retried", r.distribution.retried},
                                                             {"bytes_exchanged", r.distribution.bytes_exchanged}}},
          {"timings_s", std::move(timings)},
+         {"peak_rss_bytes", PeakRssJson(r.timings)},
          {"parameters", ParametersJson(r.options)},
          {"upload", upload == nullptr
                         ? Json(nullptr)

@@ -413,6 +413,33 @@ TEST(ConsolidateTest, SameAsThePlainReferenceOnSitesWithFarApartPicks) {
   EXPECT_GT(changed, 10);  // the instances exercised drops and merges
 }
 
+// Picks drawn at random (not greedy's), so that many of them are redundant and one change makes
+// another possible: the pairs found unmergeable before a change are rechecked where it touched them.
+TEST(ConsolidateTest, SameAsThePlainReferenceWhenEachChangeEnablesTheNext) {
+  std::mt19937 rng(37);
+  int long_runs = 0;
+  for (int trial = 0; trial < 120; ++trial) {
+    const size_t n = 150 + rng() % 300;
+    std::vector<VoxelSet> sets;
+    for (size_t i = 0; i < 30 + rng() % 40; ++i) {
+      VoxelSet s(n);
+      const size_t start = rng() % n, len = 10 + rng() % 60;
+      for (size_t v = 0; v < len; ++v) {
+        if (rng() % 4 != 0) s.set((start + v) % n);
+      }
+      sets.push_back(s);
+    }
+    std::vector<int> picks(sets.size());
+    std::iota(picks.begin(), picks.end(), 0);
+    std::shuffle(picks.begin(), picks.end(), rng);
+    picks.resize(8 + rng() % 16);
+    const std::vector<int> want = ReferenceConsolidation(sets, picks);
+    EXPECT_EQ(Consolidated(sets, picks), want) << "trial " << trial;
+    long_runs += picks.size() - want.size() >= 4;
+  }
+  EXPECT_GT(long_runs, 30);  // most instances took several passes
+}
+
 // `pairs` pairs of half-rooms, each pair seen whole by one more candidate: consolidation merges one
 // pair per pass, so it takes pairs + 1 passes. The picks are the half-rooms (0 .. 2 pairs - 1).
 std::vector<VoxelSet> HalfRoomPairs(int pairs) {
@@ -455,7 +482,7 @@ TEST(ConsolidateTest, ReportsEveryPassWithCountsAndRisingFractions) {
     if (i > 0) {
       EXPECT_GE(e.fraction, events[i - 1].fraction) << "event " << i << ": " << e.message;
     }
-    if (e.unit.empty()) continue;
+    if (e.unit.empty() || e.unit == "picks checked") continue;  // the latter only in a slow pass
     EXPECT_EQ(e.unit, "pairs of picks");
     EXPECT_LE(e.done, e.total);
     if (e.done == 0) passes_seen.push_back(e.message.substr(0, e.message.find(" (")));
@@ -466,6 +493,31 @@ TEST(ConsolidateTest, ReportsEveryPassWithCountsAndRisingFractions) {
   EXPECT_EQ(passes_seen.back(), "consolidation pass 7");
   EXPECT_EQ(events.back().fraction, 1.0);
   EXPECT_NE(events.back().message.find("6 merged"), std::string::npos) << events.back().message;
+}
+
+// A long consolidation (every candidate of a strip picked, most of them redundant) reports each of
+// its many passes with the pairs of picks it has, the count falling by a pick per pass.
+TEST(ConsolidateTest, ALongConsolidationReportsEveryPassWithItsPairsOfPicks) {
+  std::vector<VoxelSet> sets;
+  for (size_t start = 0; start < 400; start += 4) {
+    VoxelSet s(420);
+    for (size_t v = start; v < start + 20; ++v) s.set(v);
+    sets.push_back(s);
+  }
+  std::vector<uint64_t> pass_totals;
+  JobContext ctx;
+  ctx.progress = [&](const ProgressEvent& e) {
+    if (e.unit == "pairs of picks" && e.done == 0) pass_totals.push_back(e.total);
+  };
+  Result<ConsolidateResult> r = ConsolidatePicks(sets, FirstPicks(static_cast<int>(sets.size())), {}, ctx);
+  ASSERT_TRUE(r.ok());
+  const int changes = r->dropped + r->merged;
+  EXPECT_GE(changes, 50);  // 100 picks of 20 voxels each, 4 apart: about one in five is needed
+  ASSERT_EQ(pass_totals.size(), size_t(changes) + 1);  // one report at each pass's start
+  for (size_t k = 0; k < pass_totals.size(); ++k) {
+    const uint64_t picks = sets.size() - k;
+    EXPECT_EQ(pass_totals[k], picks * (picks - 1) / 2) << "pass " << k + 1;
+  }
 }
 
 TEST(ConsolidateTest, CancelledDuringAPassReturnsCancelledAtOnce) {

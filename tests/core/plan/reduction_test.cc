@@ -330,6 +330,40 @@ TEST(ReductionTest, BatchesAndAPartlyFilledCacheGiveTheSameRun) {
   }
 }
 
+// The build reports the stations evaluated at every batch's end, up to all of them, and the
+// removals report their count against the most there can be; fractions never fall.
+TEST(ReductionTest, ReportsStationsEvaluatedAndRemovalsWithCounts) {
+  std::mt19937 rng(8);
+  Values v = RandomValues(rng, 6, 400, 0.2);
+  v.push_back(v[1]);
+  v.push_back(v[3]);
+  ReductionRunOptions o;
+  o.reduce_to = 3;
+  o.batch_stations = 2;
+  std::vector<ProgressEvent> events;
+  JobContext ctx;
+  ctx.progress = [&](const ProgressEvent& e) { events.push_back(e); };
+  const Result<ReductionRun> r = RunReduction(8, 400, FromTable(v), o, ctx);
+  ASSERT_TRUE(r.ok());
+  std::vector<uint64_t> evaluated;
+  bool removals_seen = false;
+  for (size_t i = 0; i < events.size(); ++i) {
+    EXPECT_EQ(events[i].stage, Stage::kReduction);
+    if (i > 0) EXPECT_GE(events[i].fraction, events[i - 1].fraction) << "event " << i;
+    if (events[i].unit == "stations evaluated") {
+      EXPECT_EQ(events[i].total, 8u);
+      evaluated.push_back(events[i].done);
+    }
+    if (events[i].unit == "stations removed (at most)") {
+      removals_seen = true;
+      EXPECT_EQ(events[i].total, 5u);  // 8 stations down to reduce_to 3
+    }
+  }
+  EXPECT_EQ(evaluated, (std::vector<uint64_t>{2, 4, 6, 8}));  // one batch of 2 at a time
+  EXPECT_TRUE(removals_seen);
+  EXPECT_EQ(events.back().fraction, 1.0);
+}
+
 // The batch in flight stays within the cache budget: the first is sized for the worst case (every
 // face seen, 8 bytes a face: one station here), the next ones for what the stations saw.
 TEST(ReductionTest, BatchesGrowFromTheWorstCaseToWhatStationsSee) {

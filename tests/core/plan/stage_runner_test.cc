@@ -1,6 +1,6 @@
 // The stage runner: timings in the order the stages ran, cancellation before a stage, errors
 // passed through, and progress relabelled to the running stage and mapped monotonically into
-// [0, 1] (also through ProgressRange sub-ranges).
+// [0, 1] (also through ProgressRange sub-ranges), and each stage's own peak resident memory.
 #include "vc/plan/stage_runner.h"
 
 #include <gtest/gtest.h>
@@ -50,6 +50,26 @@ TEST(StageRunnerTest, RecordsTimingsInTheOrderTheStagesRan) {
   EXPECT_GE(t[1].seconds, 0.03);
   EXPECT_LT(t[0].seconds, t[1].seconds);
   EXPECT_GE(runner.elapsed_seconds(), t[0].seconds + t[1].seconds + t[2].seconds);
+}
+
+TEST(StageRunnerTest, RecordsEachStagesPeakResidentMemory) {
+  constexpr size_t kBlockBytes = size_t{96} << 20;
+  const JobContext ctx;
+  StageRunner runner(ctx);
+  const auto hold_a_block = [&](const JobContext&) -> Result<int> {
+    std::vector<char> block(kBlockBytes, 1);  // written, so resident, then freed
+    asm volatile("" : : "r"(block.data()) : "memory");
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));  // sampled as well
+    return block[kBlockBytes - 1];
+  };
+  ASSERT_TRUE(runner.Run(Stage::kVisibility, hold_a_block).ok());
+  ASSERT_TRUE(runner.Run(Stage::kSelection, Ok).ok());
+  const std::vector<StageTiming>& t = runner.timings();
+  ASSERT_EQ(t.size(), 2u);
+  ASSERT_GT(t[0].peak_rss_bytes, 0u);
+  ASSERT_GT(t[1].peak_rss_bytes, 0u);
+  // The second stage began after the first stage's block was freed.
+  EXPECT_GE(t[0].peak_rss_bytes, t[1].peak_rss_bytes + kBlockBytes / 2);
 }
 
 TEST(StageRunnerTest, CancellationBeforeAStageStopsItWithCancelledNamingTheStage) {

@@ -72,7 +72,7 @@ PlanResult SamplePlan() {
     v[i % 6] = 0.2f * i;  // voxel 0 is seen by nobody
     r.evaluation.best_face_values.push_back(v);
   }
-  r.timings = {{Stage::kVoxelize, 0.5}, {Stage::kSelection, 0.01}};
+  r.timings = {{Stage::kVoxelize, 0.5, 300u << 20}, {Stage::kSelection, 0.01, 0}};
   r.total_seconds = 1.0;
   r.scan_graph.min_overlap = 0.3;
   r.scan_graph.connected = true;
@@ -94,10 +94,10 @@ PlanResult SamplePlan() {
 TEST(PlanReportTest, PlanJsonHasEveryDocumentedKey) {
   const json j = json::parse(PlanToJson(SamplePlan()));
   for (const char* key :
-       {"schema",         "resolution_m",       "selection_test", "stop_reason",  "viewpoints", "coverage",
-        "reduction",      "candidates",         "timings_s",      "parameters",   "warnings",   "scan_graph",
-        "route",          "field_time_s",       "optimality",     "distribution", "frame",      "crs",
-        "coverage_curve", "coverage_milestones"}) {
+       {"schema",         "resolution_m",        "selection_test", "stop_reason",  "viewpoints", "coverage",
+        "reduction",      "candidates",          "timings_s",      "parameters",   "warnings",   "scan_graph",
+        "route",          "field_time_s",        "optimality",     "distribution", "frame",      "crs",
+        "coverage_curve", "coverage_milestones", "peak_rss_bytes"}) {
     EXPECT_TRUE(j.contains(key)) << key;
   }
   const json& by_cause = j["coverage"]["uncoverable_by_cause"];
@@ -176,6 +176,9 @@ TEST(PlanReportTest, PlanJsonHasEveryDocumentedKey) {
   EXPECT_EQ(j["candidates"]["visible_voxels"].size(), 12u);
   EXPECT_EQ(j["candidates"]["visible_voxels"][11][3].get<int>(), 132);
   EXPECT_DOUBLE_EQ(j["timings_s"]["voxelize"].get<double>(), 0.5);
+  EXPECT_EQ(j["peak_rss_bytes"]["voxelize"].get<uint64_t>(), uint64_t{300} << 20);
+  EXPECT_TRUE(j["peak_rss_bytes"]["selection"].is_null());  // not measured
+  EXPECT_EQ(j["peak_rss_bytes"]["plan"].get<uint64_t>(), uint64_t{300} << 20);
   EXPECT_DOUBLE_EQ(j["parameters"]["grid_spacing_m"].get<double>(), 1.0);
   EXPECT_DOUBLE_EQ(j["parameters"]["tripod_height_m"].get<double>(), 1.5);
   EXPECT_EQ(j["parameters"]["selection_test"], "surface");

@@ -26,6 +26,10 @@ std::string OptimalityLine(const PlanResult& result);
 // reduction shards together); "" otherwise.
 std::string DistributionLine(const PlanResult& result);
 
+// Each stage's wall time and the server's peak resident memory during it ("stages: voxelize 0.21 s
+// (peak 312 MiB), ...; total 12.30 s"; no peak where the server measured none); "" without timings.
+std::string TimingLine(const PlanResult& result);
+
 // A duration as a crew reads it: "45 s", "12 min", "1 h 05 min".
 std::string FormatDuration(double seconds);
 

@@ -6,24 +6,30 @@
 // the stage with a JobContext whose progress is relabelled to the stage and mapped into [0, 1],
 // reports 1 when it succeeded, and records its wall time. A stage that splits its own work maps
 // the parts into sub-ranges with ProgressRange. Stages are keyed by vc::Stage, never by a string.
+// Each stage's peak resident memory is measured by a ResidentPeakMeter (vc/base/resident_memory.h):
+// exact where the stage raised the process's peak (VmHWM), sampled every 10 ms otherwise; process-
+// wide, so with several jobs in one process a stage's peak includes what the others hold.
 // Thread-compatible: one runner per plan, used from the thread that runs the plan; the contexts it
 // hands out forward progress from any thread (the caller's callback must be thread-safe anyway).
 #pragma once
 
 #include <chrono>
+#include <cstdint>
 #include <type_traits>
 #include <utility>
 #include <vector>
 
 #include "vc/base/progress.h"
+#include "vc/base/resident_memory.h"
 #include "vc/base/status.h"
 
 namespace vc {
 
-// How long one stage of a plan took.
+// How long one stage of a plan took, and the memory the process held at most meanwhile.
 struct StageTiming {
   Stage stage = Stage::kUnspecified;
-  double seconds = 0;  // wall time from the stage's begin to its end
+  double seconds = 0;           // wall time from the stage's begin to its end
+  uint64_t peak_rss_bytes = 0;  // the process's peak resident memory during the stage, bytes; 0: not measured
 };
 
 }  // namespace vc
@@ -44,14 +50,15 @@ class StageRunner {
   // Starts the clock of the whole job. ctx must outlive the runner.
   explicit StageRunner(const JobContext& ctx) : ctx_(ctx), start_(Clock::now()) {}
 
-  // Runs fn(stage_ctx) as `stage`: begin report, cancellation check, fn, end report, timing.
+  // Runs fn(stage_ctx) as `stage`: begin report, cancellation check, fn, end report, timing and peak memory.
   // fn returns a Result<T>; its error is returned as it is (no end report, no timing).
   template <typename Fn>
   [[nodiscard]] std::invoke_result_t<Fn&, const JobContext&> Run(Stage stage, Fn&& fn) {
     VC_RETURN_IF_ERROR(Begin(stage));
+    ResidentPeakMeter memory;
     const Clock::time_point begin = Clock::now();
     auto out = fn(StageContext(ctx_, stage));
-    if (out.ok()) End(stage, begin);
+    if (out.ok()) End(stage, begin, memory.Stop());
     return out;
   }
 
@@ -64,8 +71,8 @@ class StageRunner {
   using Clock = std::chrono::steady_clock;
   // Reports `stage` at 0; CANCELLED / DEADLINE_EXCEEDED naming the stage if the job was stopped.
   Status Begin(Stage stage) const;
-  // Reports `stage` at 1 and records its time since `begin`.
-  void End(Stage stage, Clock::time_point begin);
+  // Reports `stage` at 1 and records its time since `begin` and its peak resident memory.
+  void End(Stage stage, Clock::time_point begin, uint64_t peak_rss_bytes);
 
   const JobContext& ctx_;
   Clock::time_point start_;
