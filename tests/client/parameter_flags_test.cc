@@ -511,6 +511,23 @@ TEST(ParameterTablesTest, UnknownEnumNamesAreRefusedByTheFlag) {
   EXPECT_EQ(o.selection_test, SelectionTest::kSurfaceVisibility);
   EXPECT_THROW(app.parse("--solver cplex", false), CLI::ValidationError);
   EXPECT_EQ(o.solver, SelectionSolver::kAuto);
+  EXPECT_THROW(app.parse("--ground hills", false), CLI::ValidationError);
+  EXPECT_EQ(o.ground, GroundModel::kAuto);
+}
+
+TEST(ParameterTablesTest, TheGroundFlagTakesEachModelAndPlanJsonNamesIt) {
+  for (const auto& [flag, model] :
+       {std::pair{"floors", GroundModel::kFloors}, std::pair{"terrain", GroundModel::kTerrain},
+        std::pair{"auto", GroundModel::kAuto}}) {
+    PlanOptions o;
+    CLI::App app;
+    client::AddPlanFlags(&app, &o);
+    app.parse(std::string("--ground ") + flag, false);
+    EXPECT_EQ(o.ground, model) << flag;
+    PlanResult r;
+    r.options = o;
+    EXPECT_EQ(json::parse(PlanToJson(r))["parameters"]["ground"], flag);
+  }
 }
 
 // --scanner NAME: the preset fills every scanner row whose flag is not given; a given flag wins,
