@@ -403,6 +403,8 @@ void PrintPlan(const vc::PlanResult& plan, double wall_s, int threads) {
               plan.stations.size(), (unsigned long long)plan.candidate_count, (unsigned long long)plan.occupied_voxels,
               (unsigned long long)plan.coverable_voxels, (unsigned long long)plan.covered_voxels,
               plan.evaluation.overall.global_visibility);
+  std::printf("route %.1f m in %d part(s); ground: %s\n", plan.route.length_m, plan.route.parts,
+              plan.ground.reason.c_str());
 }
 
 // The candidate stage alone under each ground model (docs/PLANNING.md, "Terrain"): seconds,

@@ -313,9 +313,10 @@ TEST(PlanResultChunks, ASoleViewerNamingAMissingStationOrOnSomeChunksOnlyIsDataL
 // (1440: Evaluation::per_viewpoint_sparse_values, which like per_viewpoint_face_values is the
 // reduction's working data and never part of a result on the wire. 1448 and 416: the scanner's
 // hfov_deg, a row carried as ScannerModel.hfov_deg. 1560: unseen_causes. 1568 and 432: walk_max_step_m, a
-// row carried as PlanParameters.walk_max_step_m; PlanResult holds the options.)
+// row carried as PlanParameters.walk_max_step_m; PlanResult holds the options. 1616: ground, carried as
+// PlanResult.ground; PlanOptions' ground row, PlanParameters.ground, fits its padding.)
 TEST(PlanResultChunks, EveryCoreFieldIsCarried) {
-  EXPECT_EQ(sizeof(PlanResult), 1568u) << "PlanResult changed: update the vc.v1 PlanResult and vc::wire";
+  EXPECT_EQ(sizeof(PlanResult), 1616u) << "PlanResult changed: update the vc.v1 PlanResult and vc::wire";
   EXPECT_EQ(sizeof(PlanOptions), 432u) << "PlanOptions changed: update vc.v1 PlanParameters and vc::wire";
 }
 

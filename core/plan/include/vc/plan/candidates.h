@@ -22,8 +22,8 @@
 // columns are linked when their heights differ by at most walk_max_step_m, and the ground is the
 // largest linked component, so roofs, car tops and tables (higher than a step above what is around
 // them) are not ground. Each cell's candidate stands tripod height above the ground under its
-// centre. GroundModel::kAuto picks floors when at least kFloorShare of the standing surfaces that
-// are not roofs lie within a floor level's band, else terrain.
+// centre. GroundModel::kAuto finds that ground either way and picks floors when at least
+// kFloorShare of its surfaces lie within a floor level's band (or there is none), else terrain.
 // Internal to vc_core.
 #pragma once
 
@@ -53,8 +53,8 @@ std::string_view GroundModelName(GroundModel model);
 
 namespace vc::planner {
 
-// Auto picks floors when at least this share of the standing surfaces that are not roofs lies
-// within +-0.15 m (at least 2 voxels) of a floor level.
+// Auto picks floors when at least this share of the walkable ground's surfaces (its largest linked
+// component) lies within +-0.15 m (at least 2 voxels) of a floor level.
 inline constexpr double kFloorShare = 0.9;
 // Terrain: the steepest ground a tripod stands on and a route walks (rise over run: 0.36, 20 deg).
 inline constexpr double kTerrainMaxSlope = 0.36;
@@ -64,7 +64,7 @@ inline constexpr double kSlopeBaseM = 0.5;
 // The ground model a candidate grid used and why (PlanResult::ground; plan.json `ground`).
 struct GroundChoice {
   GroundModel model = GroundModel::kAuto;  // kFloors or kTerrain; kAuto only for user candidates
-  double floor_share = 0;                  // share of non-roof standing surfaces on a floor level, 0..1
+  double floor_share = 0;                  // share of the ground's surfaces on a floor level, 0..1
   std::string reason;                      // one sentence: forced, or auto's test and its numbers
 };
 
