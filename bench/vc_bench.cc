@@ -13,9 +13,11 @@
 #include <chrono>
 #include <cstdio>
 #include <iostream>
+#include <map>
 #include <random>
 #include <string>
 #include <thread>
+#include <utility>
 
 #include "bench_scene.h"
 #include "vc/plan/candidates.h"
@@ -174,7 +176,7 @@ struct BenchOptions {
   double spacing = 0.05, resolution = 0.1, grid = 1.0;
   int rays = 200000, octomap_rays = 20000, threads = 2, repeat = 5;
   bool quick = false, scaling = true, rays_only = false, fine_eval = false, all_targets = false, sets = true;
-  bool visibility_only = false;
+  bool visibility_only = false, candidates_only = false;
   int every = 4;
 };
 
@@ -195,6 +197,9 @@ void AddFlags(CLI::App& app, BenchOptions* o) {
   app.add_flag("--visibility-only", o->visibility_only,
                "only the grouped visibility sets of every --every-th candidate and the exact evaluation of 15 "
                "candidates, best of --repeat rounds (A/B runs of two builds)");
+  app.add_flag("--candidates-only", o->candidates_only,
+               "only the candidate stage under each ground model (auto, terrain, floors): counts, floor levels, "
+               "the terrain's ground, seconds (docs/PLANNING.md, \"Terrain\")");
   app.add_option("--every", o->every, "with --visibility-only: every how many candidates")
       ->check(CLI::Range(1, 1000000));
   app.add_flag("--all-targets", o->all_targets, "also time the SIMD batch kernel on every other instruction set");
@@ -398,6 +403,56 @@ void PrintPlan(const vc::PlanResult& plan, double wall_s, int threads) {
               plan.stations.size(), (unsigned long long)plan.candidate_count, (unsigned long long)plan.occupied_voxels,
               (unsigned long long)plan.coverable_voxels, (unsigned long long)plan.covered_voxels,
               plan.evaluation.overall.global_visibility);
+  std::printf("route %.1f m in %d part(s); ground: %s\n", plan.route.length_m, plan.route.parts,
+              plan.ground.reason.c_str());
+}
+
+// The candidate stage alone under each ground model (docs/PLANNING.md, "Terrain"): seconds,
+// candidates, cells, floor levels, the terrain's ground columns and auto's reason; for floors, how
+// many candidates stand in a cell where the terrain has none, or more than 1 m above its ground.
+int CandidatesOnly(const vc::VoxelScene& s, double grid) {
+  std::map<std::pair<long, long>, double> terrain_floor;  // per cell centre (mm): the terrain's floor
+  for (vc::GroundModel g : {vc::GroundModel::kAuto, vc::GroundModel::kTerrain, vc::GroundModel::kFloors}) {
+    vc::planner::CandidateOptions co;
+    co.grid_spacing_m = grid;
+    co.ground = g;
+    const auto t0 = Clock::now();
+    auto c = vc::planner::GenerateCandidates(s, co);
+    const double seconds = Seconds(t0);
+    if (!c.ok()) {
+      std::fprintf(stderr, "vc-bench: %s\n", c.status().ToString().c_str());
+      return 2;
+    }
+    uint64_t no_terrain = 0, above_terrain = 0;
+    for (size_t i = 0; i < c->positions.size(); ++i) {
+      const std::pair<long, long> cell{std::lround(c->positions[i].x() * 1000),
+                                       std::lround(c->positions[i].y() * 1000)};
+      if (g == vc::GroundModel::kTerrain) {
+        terrain_floor[cell] = c->floor_z_m[i];
+      } else if (g == vc::GroundModel::kFloors) {
+        const auto it = terrain_floor.find(cell);
+        if (it == terrain_floor.end()) {
+          ++no_terrain;
+        } else if (c->floor_z_m[i] > it->second + 1.0) {
+          ++above_terrain;
+        }
+      }
+    }
+    std::string levels;
+    for (const vc::planner::FloorLevel& l : c->levels) levels += " " + std::to_string(l.z_m).substr(0, 6);
+    std::printf(
+        "%s: %.2f s, %zu candidates of %llu cells (%llu without floor, %llu failing clearance); levels:%s; "
+        "terrain ground %llu columns; %s\n",
+        std::string(vc::GroundModelName(g)).c_str(), seconds, c->positions.size(),
+        static_cast<unsigned long long>(c->cells), static_cast<unsigned long long>(c->rejected_no_floor),
+        static_cast<unsigned long long>(c->rejected_clearance), levels.empty() ? " none" : levels.c_str(),
+        static_cast<unsigned long long>(c->ground_columns), c->ground.reason.c_str());
+    if (g == vc::GroundModel::kFloors) {
+      std::printf("floors: %llu candidates in cells where the terrain has none, %llu more than 1 m above its ground\n",
+                  static_cast<unsigned long long>(no_terrain), static_cast<unsigned long long>(above_terrain));
+    }
+  }
+  return 0;
 }
 
 // The full visibility-set computation for both tests, on the plan's candidates; the surface test
@@ -444,6 +499,7 @@ int RunBench(const BenchOptions& o) {
   const vc::SceneInput& input = loaded->input;
   const vc::VoxelScene& s = loaded->voxels;
   if (o.visibility_only) return VisibilityOnly(s, o.grid, o.every, o.threads, o.repeat);
+  if (o.candidates_only) return CandidatesOnly(s, o.grid);
 
   auto tree = input.octree ? std::const_pointer_cast<octomap::OcTree>(input.octree)
                            : vc::BuildOctree(s.resolution_m, s.occupied);

@@ -64,6 +64,11 @@ void AddFlag(CLI::App* app, const ParamInfo& info, SelectionSolver* value) {
       {{"greedy", SelectionSolver::kGreedy}, {"exact", SelectionSolver::kExact}, {"auto", SelectionSolver::kAuto}});
 }
 
+void AddFlag(CLI::App* app, const ParamInfo& info, GroundModel* value) {
+  AddEnumFlag(app, info, value,
+              {{"auto", GroundModel::kAuto}, {"floors", GroundModel::kFloors}, {"terrain", GroundModel::kTerrain}});
+}
+
 void AddFlag(CLI::App* app, const ParamInfo& info, FaceSet* value) {
   AddEnumFlag(app, info, value, {{"all", FaceSet::kAll}, {"exposed", FaceSet::kExposed}});
 }

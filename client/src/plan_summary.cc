@@ -264,6 +264,7 @@ std::string PlanSummary(const PlanResult& r) {
   out += DistributionLine(r);
   out += TimingLine(r);
   out += ScanGraphLine(r);
+  if (r.ground.model != GroundModel::kAuto) out += "ground: " + r.ground.reason + " (--ground)\n";
   out += RouteLines(r);
   out += FieldTimeLine(r);
   for (const std::string& w : r.warnings) out += "warning: " + w + "\n";

@@ -94,6 +94,33 @@ v1::SelectionSolver ToProto(SelectionSolver s) {
   return v1::SELECTION_SOLVER_GREEDY;
 }
 
+v1::GroundModel ToProto(GroundModel m) {
+  switch (m) {
+    case GroundModel::kFloors:
+      return v1::GROUND_MODEL_FLOORS;
+    case GroundModel::kTerrain:
+      return v1::GROUND_MODEL_TERRAIN;
+    case GroundModel::kAuto:
+      break;
+  }
+  return v1::GROUND_MODEL_AUTO;
+}
+
+Result<GroundModel> FromProto(v1::GroundModel m) {
+  switch (m) {
+    case v1::GROUND_MODEL_UNSPECIFIED:
+    case v1::GROUND_MODEL_AUTO:
+      return GroundModel::kAuto;
+    case v1::GROUND_MODEL_FLOORS:
+      return GroundModel::kFloors;
+    case v1::GROUND_MODEL_TERRAIN:
+      return GroundModel::kTerrain;
+    default:
+      break;
+  }
+  return InvalidArgumentError("unknown ground model value " + std::to_string(int(m)) + "; use AUTO, FLOORS or TERRAIN");
+}
+
 namespace {
 
 // A local position in the input's frame, and back. A zero origin leaves the bits as they are
@@ -117,6 +144,7 @@ T ToWire(T v) {
 v1::SelectionTest ToWire(SelectionTest t) { return ToProto(t); }
 v1::FaceSet ToWire(FaceSet f) { return ToProto(f); }
 v1::SelectionSolver ToWire(SelectionSolver s) { return ToProto(s); }
+v1::GroundModel ToWire(GroundModel m) { return ToProto(m); }
 
 template <typename T>
 Status FromWire(T wire, T* out) {
@@ -145,6 +173,11 @@ Status FromWire(v1::SelectionSolver wire, SelectionSolver* out) {
       break;
   }
   return InvalidArgumentError("unknown solver value " + std::to_string(int(wire)) + "; use GREEDY, EXACT or AUTO");
+}
+Status FromWire(v1::GroundModel wire, GroundModel* out) {
+  if (wire == v1::GROUND_MODEL_UNSPECIFIED) return Status::Ok();
+  VC_ASSIGN_OR_RETURN(*out, FromProto(wire));
+  return Status::Ok();
 }
 Status FromWire(v1::FaceSet wire, FaceSet* out) {
   switch (wire) {
@@ -604,6 +637,9 @@ v1::PlanResult ToProto(const PlanResult& r) {
   p.set_heat_map_candidates(r.heat_map.positions.size());
   p.set_voxel_count(r.voxel_centers.size());
   for (double z : r.floor_levels_m) p.add_floor_levels_m(PlusOrigin(z, origin.z()));
+  p.mutable_ground()->set_model(ToProto(r.ground.model));
+  p.mutable_ground()->set_floor_share(r.ground.floor_share);
+  p.mutable_ground()->set_reason(r.ground.reason);
   p.set_stop_reason(ToProto(r.stop_reason));
   p.set_total_seconds(r.total_seconds);
   p.set_greedy_stations(r.greedy_stations);
@@ -772,6 +808,9 @@ Result<PlanResult> PlanResultAssembler::Finish(const v1::PlanResult& p) && {
   r.total_seconds = p.total_seconds();
   r.warnings.assign(p.warnings().begin(), p.warnings().end());
   for (double z : p.floor_levels_m()) r.floor_levels_m.push_back(LessOrigin(z, origin.z()));
+  VC_ASSIGN_OR_RETURN(r.ground.model, FromProto(p.ground().model()));
+  r.ground.floor_share = p.ground().floor_share();
+  r.ground.reason = p.ground().reason();
   VC_ASSIGN_OR_RETURN(r.stop_reason, FromProto(p.stop_reason()));
   r.greedy_stations = p.greedy_stations();
   r.consolidated = p.consolidated();

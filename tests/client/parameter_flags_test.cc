@@ -48,6 +48,9 @@ SelectionTest Other(SelectionTest v, ParamCheck) {
 SelectionSolver Other(SelectionSolver v, ParamCheck) {
   return v == SelectionSolver::kExact ? SelectionSolver::kAuto : SelectionSolver::kExact;
 }
+GroundModel Other(GroundModel v, ParamCheck) {
+  return v == GroundModel::kTerrain ? GroundModel::kFloors : GroundModel::kTerrain;
+}
 FaceSet Other(FaceSet v, ParamCheck) { return v == FaceSet::kAll ? FaceSet::kExposed : FaceSet::kAll; }
 
 // A value the row's check refuses, if there is one.
@@ -98,6 +101,9 @@ std::string Args(std::string_view flag, SelectionTest v) {
 std::string Args(std::string_view flag, SelectionSolver v) {
   return "--" + std::string(flag) + " " + std::string(SelectionSolverName(v));
 }
+std::string Args(std::string_view flag, GroundModel v) {
+  return "--" + std::string(flag) + " " + std::string(GroundModelName(v));
+}
 std::string Args(std::string_view flag, FaceSet v) {
   return "--" + std::string(flag) + (v == FaceSet::kExposed ? " exposed" : " all");
 }
@@ -109,6 +115,7 @@ json JsonValue(T v) {
 }
 json JsonValue(SelectionTest v) { return std::string(SelectionTestName(v)); }
 json JsonValue(SelectionSolver v) { return std::string(SelectionSolverName(v)); }
+json JsonValue(GroundModel v) { return std::string(GroundModelName(v)); }
 
 std::set<std::string> FieldNames(const google::protobuf::Descriptor* d) {
   std::set<std::string> names;
@@ -511,6 +518,23 @@ TEST(ParameterTablesTest, UnknownEnumNamesAreRefusedByTheFlag) {
   EXPECT_EQ(o.selection_test, SelectionTest::kSurfaceVisibility);
   EXPECT_THROW(app.parse("--solver cplex", false), CLI::ValidationError);
   EXPECT_EQ(o.solver, SelectionSolver::kAuto);
+  EXPECT_THROW(app.parse("--ground hills", false), CLI::ValidationError);
+  EXPECT_EQ(o.ground, GroundModel::kAuto);
+}
+
+TEST(ParameterTablesTest, TheGroundFlagTakesEachModelAndPlanJsonNamesIt) {
+  for (const auto& [flag, model] :
+       {std::pair{"floors", GroundModel::kFloors}, std::pair{"terrain", GroundModel::kTerrain},
+        std::pair{"auto", GroundModel::kAuto}}) {
+    PlanOptions o;
+    CLI::App app;
+    client::AddPlanFlags(&app, &o);
+    app.parse(std::string("--ground ") + flag, false);
+    EXPECT_EQ(o.ground, model) << flag;
+    PlanResult r;
+    r.options = o;
+    EXPECT_EQ(json::parse(PlanToJson(r))["parameters"]["ground"], flag);
+  }
 }
 
 // --scanner NAME: the preset fills every scanner row whose flag is not given; a given flag wins,

@@ -54,6 +54,18 @@ TEST(PlanSummaryTest, StationsScanGraphRouteAndFieldTime) {
   EXPECT_NE(s.find("warning: w1\n"), std::string::npos);
 }
 
+// The ground model's line says which the candidates used and why; none for user candidates.
+TEST(PlanSummaryTest, TheGroundLineSaysWhichModelAndWhy) {
+  PlanResult r = ThreeStations();
+  EXPECT_EQ(PlanSummary(r).find("ground:"), std::string::npos);
+  r.ground.model = GroundModel::kTerrain;
+  r.ground.reason = "terrain: only 15% of the walkable ground's surfaces lie within 0.2 m of 3 floor levels";
+  EXPECT_NE(PlanSummary(r).find("\nground: terrain: only 15% of the walkable ground's surfaces lie within 0.2 m of 3 "
+                                "floor levels (--ground)\n"),
+            std::string::npos)
+      << PlanSummary(r);
+}
+
 // A crew reads the first figure: the share of the whole scene, then that of what any candidate can
 // see, and how much no candidate sees.
 TEST(PlanSummaryTest, TheHeadlineIsTheShareOfTheWholeScene) {

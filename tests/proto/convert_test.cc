@@ -61,6 +61,22 @@ TEST(PlanParameters, RoundTripKeepsEveryField) {
   EXPECT_FALSE(FromProto(ToProto(PlanOptions{}))->route_start.has_value());
 }
 
+TEST(PlanParameters, GroundModelsCrossTheWireAndAnUnknownOneIsRefused) {
+  for (GroundModel g : {GroundModel::kAuto, GroundModel::kFloors, GroundModel::kTerrain}) {
+    PlanOptions o;
+    o.ground = g;
+    Result<PlanOptions> back = FromProto(ToProto(o));
+    ASSERT_TRUE(back.ok()) << back.status().ToString();
+    EXPECT_EQ(back->ground, g);
+  }
+  v1::PlanParameters p;
+  p.set_ground(static_cast<v1::GroundModel>(9));
+  Result<PlanOptions> bad = FromProto(p);
+  ASSERT_FALSE(bad.ok());
+  EXPECT_EQ(bad.status().code(), StatusCode::kInvalidArgument);
+  EXPECT_NE(bad.status().message().find("unknown ground model value 9"), std::string::npos) << bad.status().ToString();
+}
+
 TEST(PlanParameters, UnsetFieldsTakeTheDefaults) {
   auto o = FromProto(v1::PlanParameters{});
   ASSERT_TRUE(o.ok());
@@ -128,6 +144,22 @@ PlanResult BigResult(size_t voxels, size_t candidates) {
   r.coverage_curve = {{1, 5, 0.5, 0.25, 165}, {2, 9, 0.9, 0.45, 330}};
   r.unseen_causes = {1, 2, 3, 4, 5, 6, 7};
   return r;
+}
+
+TEST(PlanResultChunks, TheGroundChoiceRoundTrips) {
+  PlanResult r = BigResult(3, 2);
+  r.ground = {GroundModel::kTerrain, 0.37, "terrain: only 37%"};
+  PlanResultAssembler a;
+  for (const auto& c : HeatMapChunks(r.heat_map, r.frame_origin_m)) ASSERT_TRUE(a.AddHeatMap(c).ok());
+  ForEachVoxelChunk(r, [&](v1::VoxelChunk&& c) {
+    EXPECT_TRUE(a.AddVoxels(c).ok());
+    return true;
+  });
+  auto back = std::move(a).Finish(ToProto(r));
+  ASSERT_TRUE(back.ok()) << back.status().ToString();
+  EXPECT_EQ(back->ground.model, GroundModel::kTerrain);
+  EXPECT_EQ(back->ground.floor_share, 0.37);
+  EXPECT_EQ(back->ground.reason, "terrain: only 37%");
 }
 
 TEST(PlanResultChunks, ReassembleExactlyAndStayUnderOneMebibyte) {
@@ -282,9 +314,10 @@ TEST(PlanResultChunks, ASoleViewerNamingAMissingStationOrOnSomeChunksOnlyIsDataL
 // (1440: Evaluation::per_viewpoint_sparse_values, which like per_viewpoint_face_values is the
 // reduction's working data and never part of a result on the wire. 1448 and 416: the scanner's
 // hfov_deg, a row carried as ScannerModel.hfov_deg. 1560: unseen_causes. 1568 and 432: walk_max_step_m, a
-// row carried as PlanParameters.walk_max_step_m; PlanResult holds the options.)
+// row carried as PlanParameters.walk_max_step_m; PlanResult holds the options. 1616: ground, carried as
+// PlanResult.ground; PlanOptions' ground row, PlanParameters.ground, fits its padding.)
 TEST(PlanResultChunks, EveryCoreFieldIsCarried) {
-  EXPECT_EQ(sizeof(PlanResult), 1568u) << "PlanResult changed: update the vc.v1 PlanResult and vc::wire";
+  EXPECT_EQ(sizeof(PlanResult), 1616u) << "PlanResult changed: update the vc.v1 PlanResult and vc::wire";
   EXPECT_EQ(sizeof(PlanOptions), 432u) << "PlanOptions changed: update vc.v1 PlanParameters and vc::wire";
 }
 

@@ -5,9 +5,11 @@
 #include <cstdint>
 #include <limits>
 #include <set>
+#include <string>
 #include <tuple>
 #include <utility>
 
+#include "format.h"
 #include "standing_surfaces.h"
 
 namespace vc::planner {
@@ -198,6 +200,317 @@ std::vector<WorldPoint> PassagePoints(const OccupancyGrid& grid, int floor_top, 
   return out;
 }
 
+// Standing-surface heights over all columns, indexed by z - min.z: all of them and the roofs.
+struct SurfaceHistogram {
+  std::vector<uint64_t> all, roofs;
+};
+
+Result<SurfaceHistogram> HistogramSurfaces(const OccupancyGrid& grid, int free_needed, const JobContext& ctx) {
+  const Eigen::Vector3i dims = grid.dims();
+  const VoxelIndex& m = grid.min_index();
+  SurfaceHistogram h{std::vector<uint64_t>(dims.z(), 0), std::vector<uint64_t>(dims.z(), 0)};
+  std::vector<Surface> scratch;
+  for (int y = 0; y < dims.y(); ++y) {
+    if ((y & 15) == 0) {
+      VC_RETURN_IF_ERROR(ctx.CheckCancelled("candidate generation"));
+      ctx.Report(Stage::kCandidates, 0.5 * y / std::max(1, dims.y()));
+    }
+    for (int x = 0; x < dims.x(); ++x) {
+      ColumnSurfaces(grid, m.x + x, m.y + y, free_needed, scratch);
+      for (const Surface& s : scratch) {
+        ++h.all[s.z - m.z];
+        if (s.roof()) ++h.roofs[s.z - m.z];
+      }
+    }
+  }
+  return h;
+}
+
+// A floor level: its height (z - min.z), its columns within the band, and the roofs among them.
+struct Level {
+  int z;
+  uint64_t columns;
+  uint64_t roofs;
+};
+
+// The dominant levels, strongest first with suppression of weaker ones nearby, less those that are
+// mostly roofs; ascending.
+std::vector<Level> FindLevels(const SurfaceHistogram& h, int band, int free_needed) {
+  const int nz = static_cast<int>(h.all.size());
+  auto band_sum = [&](const std::vector<uint64_t>& v, int z) {
+    uint64_t s = 0;
+    for (int k = std::max(0, z - band); k <= std::min(nz - 1, z + band); ++k) s += v[k];
+    return s;
+  };
+  std::vector<uint64_t> score(nz);
+  for (int z = 0; z < nz; ++z) score[z] = band_sum(h.all, z);
+  std::vector<bool> suppressed(nz, false);
+  std::vector<Level> levels;
+  uint64_t strongest = 0;
+  for (int iter = 0; iter < 32; ++iter) {
+    int best = -1;
+    for (int z = 0; z < nz; ++z) {
+      if (!suppressed[z] && score[z] > 0 && (best < 0 || score[z] > score[best])) best = z;
+    }
+    if (best < 0) break;
+    if (levels.empty()) strongest = score[best];
+    if (score[best] * 4 < strongest) break;
+    // The level's height: the fullest bin within the band.
+    int mode = best;
+    for (int k = std::max(0, best - band); k <= std::min(nz - 1, best + band); ++k) {
+      if (h.all[k] > h.all[mode]) mode = k;
+    }
+    levels.push_back({mode, band_sum(h.all, mode), band_sum(h.roofs, mode)});
+    for (int z = std::max(0, mode - free_needed + 1); z <= std::min(nz - 1, mode + free_needed - 1); ++z) {
+      suppressed[z] = true;
+    }
+  }
+  std::sort(levels.begin(), levels.end(), [](const Level& a, const Level& b) { return a.z < b.z; });
+  std::vector<Level> kept;
+  for (const Level& l : levels) {
+    if (l.roofs * 2 <= l.columns) kept.push_back(l);
+  }
+  return kept;
+}
+
+// The terrain model's ground: every column's standing surfaces (columns y * nx + x relative to the
+// grid's minimum; surfaces top to bottom) and which of them belong to the ground component.
+struct GroundField {
+  int nx = 0, ny = 0;
+  std::vector<uint32_t> first;  // per column, its first surface; one more entry at the end
+  std::vector<int> z;           // per surface: voxel index z of its top voxel
+  std::vector<int> free_above;  // per surface: free voxels above it
+  std::vector<uint8_t> ground;  // per surface: in the ground component
+  uint64_t columns = 0;         // columns with a ground surface
+  uint32_t Column(int x, int y) const { return static_cast<uint32_t>(y) * static_cast<uint32_t>(nx) + x; }
+};
+
+uint32_t FindRoot(std::vector<uint32_t>& parent, uint32_t i) {
+  while (parent[i] != i) i = parent[i] = parent[parent[i]];
+  return i;
+}
+
+// The surface of column (x, y) (relative) with z within `window` of `z_ref` closest to it, or kNoSurface.
+int ClosestSurface(const GroundField& f, int x, int y, int z_ref, int window) {
+  if (x < 0 || y < 0 || x >= f.nx || y >= f.ny) return kNoSurface;
+  int best = kNoSurface;
+  const uint32_t c = f.Column(x, y);
+  for (uint32_t i = f.first[c]; i < f.first[c + 1]; ++i) {
+    if (std::abs(f.z[i] - z_ref) <= window &&
+        (best == kNoSurface || std::abs(f.z[i] - z_ref) < std::abs(best - z_ref))) {
+      best = f.z[i];
+    }
+  }
+  return best;
+}
+
+// Whether the surface at height z of column (x, y) is no steeper than kTerrainMaxSlope along x and
+// along y, measured to the closest surfaces `base` columns away on each side (centred when both
+// exist; a side with no surface within a 45-degree rise plus a step, a wall or a drop, is left out).
+bool GentleSlope(const GroundField& f, int x, int y, int z, int base, int step) {
+  const int window = base + step;
+  for (const auto& [dx, dy] : {std::pair{1, 0}, std::pair{0, 1}}) {
+    const int plus = ClosestSurface(f, x + dx * base, y + dy * base, z, window);
+    const int minus = ClosestSurface(f, x - dx * base, y - dy * base, z, window);
+    double slope = 0;
+    if (plus != kNoSurface && minus != kNoSurface) {
+      slope = std::abs(plus - minus) / (2.0 * base);
+    } else if (plus != kNoSurface || minus != kNoSurface) {
+      slope = std::abs((plus != kNoSurface ? plus : minus) - z) / static_cast<double>(base);
+    }
+    if (slope > kTerrainMaxSlope) return false;
+  }
+  return true;
+}
+
+// The ground of the terrain model: standing surfaces of gentle slope, linked between 4-adjacent
+// columns when their heights differ by at most walk_max_step_m (at least a voxel); the largest
+// linked component is the ground.
+Result<GroundField> FindGround(const OccupancyGrid& grid, int free_needed, const CandidateOptions& o,
+                               const JobContext& ctx) {
+  const double r = grid.resolution_m();
+  const VoxelIndex& m = grid.min_index();
+  GroundField f;
+  f.nx = grid.dims().x();
+  f.ny = grid.dims().y();
+  f.first.reserve(static_cast<size_t>(f.nx) * f.ny + 1);
+  std::vector<Surface> scratch;
+  for (int y = 0; y < f.ny; ++y) {
+    if ((y & 15) == 0) VC_RETURN_IF_ERROR(ctx.CheckCancelled("terrain ground"));
+    for (int x = 0; x < f.nx; ++x) {
+      f.first.push_back(static_cast<uint32_t>(f.z.size()));
+      ColumnSurfaces(grid, m.x + x, m.y + y, free_needed, scratch);
+      for (const Surface& s : scratch) {
+        if (s.roof()) continue;
+        f.z.push_back(s.z);
+        f.free_above.push_back(s.free_above);
+      }
+    }
+  }
+  f.first.push_back(static_cast<uint32_t>(f.z.size()));
+  const int base = std::max(1, static_cast<int>(std::lround(kSlopeBaseM / r)));
+  const int step = std::max(1, static_cast<int>(std::floor(o.walk_max_step_m / r + 1e-9)));
+  std::vector<uint8_t> gentle(f.z.size(), 0);
+  std::vector<uint32_t> parent(f.z.size());
+  for (uint32_t i = 0; i < parent.size(); ++i) parent[i] = i;
+  for (int y = 0; y < f.ny; ++y) {
+    if ((y & 15) == 0) {
+      VC_RETURN_IF_ERROR(ctx.CheckCancelled("terrain ground"));
+      ctx.Report(Stage::kCandidates, 0.5 + 0.25 * y / std::max(1, f.ny));
+    }
+    for (int x = 0; x < f.nx; ++x) {
+      const uint32_t c = f.Column(x, y);
+      for (uint32_t i = f.first[c]; i < f.first[c + 1]; ++i) gentle[i] = GentleSlope(f, x, y, f.z[i], base, step);
+    }
+  }
+  for (int y = 0; y < f.ny; ++y) {
+    for (int x = 0; x < f.nx; ++x) {
+      const uint32_t c = f.Column(x, y);
+      for (const auto& [nx, ny] : {std::pair{x + 1, y}, std::pair{x, y + 1}}) {
+        if (nx >= f.nx || ny >= f.ny) continue;
+        const uint32_t n = f.Column(nx, ny);
+        for (uint32_t i = f.first[c]; i < f.first[c + 1]; ++i) {
+          for (uint32_t j = f.first[n]; j < f.first[n + 1]; ++j) {
+            if (gentle[i] && gentle[j] && std::abs(f.z[i] - f.z[j]) <= step) {
+              parent[FindRoot(parent, i)] = FindRoot(parent, j);
+            }
+          }
+        }
+      }
+    }
+  }
+  std::vector<uint32_t> size(parent.size(), 0);
+  uint32_t largest = 0;
+  for (uint32_t i = 0; i < parent.size(); ++i) {
+    if (!gentle[i]) continue;
+    const uint32_t root = FindRoot(parent, i);
+    if (++size[root] > size[largest] || !gentle[largest]) largest = root;
+  }
+  f.ground.assign(f.z.size(), 0);
+  for (int y = 0; y < f.ny; ++y) {
+    for (int x = 0; x < f.nx; ++x) {
+      const uint32_t c = f.Column(x, y);
+      bool any = false;
+      for (uint32_t i = f.first[c]; i < f.first[c + 1]; ++i) {
+        f.ground[i] = gentle[i] && FindRoot(parent, i) == largest;
+        any |= f.ground[i] != 0;
+      }
+      f.columns += any;
+    }
+  }
+  return f;
+}
+
+// The ground's surfaces, and those of them within `band` of a kept level.
+struct SurfaceCount {
+  uint64_t surfaces = 0, on_levels = 0;
+};
+
+SurfaceCount CountOnLevels(const GroundField& f, int min_z, int nz, const std::vector<Level>& kept, int band) {
+  std::vector<bool> on_level(nz, false);
+  for (const Level& l : kept) {
+    for (int k = std::max(0, l.z - band); k <= std::min(nz - 1, l.z + band); ++k) on_level[k] = true;
+  }
+  SurfaceCount c;
+  for (size_t i = 0; i < f.z.size(); ++i) {
+    if (!f.ground[i]) continue;
+    ++c.surfaces;
+    if (on_level[f.z[i] - min_z]) ++c.on_levels;
+  }
+  return c;
+}
+
+// The model to use for `requested`: auto takes floors when at least kFloorShare of the ground's
+// surfaces lie on a kept level (or there is no ground), else terrain. The reason gives the test's
+// numbers.
+GroundChoice ChooseGround(GroundModel requested, const SurfaceCount& count, size_t levels, double band_m) {
+  GroundChoice c;
+  c.floor_share =
+      count.surfaces == 0 ? 0.0 : static_cast<double>(count.on_levels) / static_cast<double>(count.surfaces);
+  const std::string measured = std::to_string(static_cast<int>(std::lround(c.floor_share * 100))) +
+                               "% of the walkable ground's surfaces lie within " + Num(band_m) + " m of " +
+                               std::to_string(levels) + (levels == 1 ? " floor level" : " floor levels");
+  if (requested != GroundModel::kAuto) {
+    c.model = requested;
+    c.reason = std::string(GroundModelName(requested)) + ", as requested; " + measured;
+    return c;
+  }
+  const std::string threshold =
+      " (floors from " + std::to_string(static_cast<int>(std::lround(kFloorShare * 100))) + "%)";
+  c.model = c.floor_share >= kFloorShare || count.surfaces == 0 ? GroundModel::kFloors : GroundModel::kTerrain;
+  c.reason =
+      c.model == GroundModel::kFloors ? "floors: " + measured + threshold : "terrain: only " + measured + threshold;
+  return c;
+}
+
+// One grid position (x, y) over the floor whose top voxel has index z and `free_above` free voxels
+// above it: a candidate per height with the headroom and clearance, appended to `out` with `level`.
+// Returns how many; counts the rejected heights in *no_clearance.
+int PlaceOnFloor(const OccupancyGrid& grid, double x, double y, int z, int free_above,
+                 const std::vector<double>& heights, const CandidateOptions& options, int level, CandidateGrid& out,
+                 uint64_t* no_clearance) {
+  const double top = grid.IndexSpaceToWorld(Eigen::Vector3d(0, 0, z + 1)).z();
+  int placed = 0;
+  for (double h : heights) {
+    const WorldPoint p(x, y, top + h);
+    if (free_above < FreeVoxelsNeeded(grid.resolution_m(), h, options.clearance_m) ||
+        !HasClearance(grid, p, options.clearance_m)) {
+      ++*no_clearance;
+      continue;
+    }
+    out.positions.push_back(p);
+    out.floor_z_m.push_back(top);
+    out.level.push_back(level);
+    out.height_m.push_back(h);
+    ++placed;
+  }
+  return placed;
+}
+
+// Candidates on the terrain model's ground: per grid cell, over each ground surface of the column
+// under its centre, or else over the highest ground surface of the 8 columns around it.
+Status PlaceOnTerrain(const OccupancyGrid& grid, const GroundField& f, const std::vector<double>& xs,
+                      const std::vector<double>& ys, const std::vector<double>& heights,
+                      const CandidateOptions& options, CandidateGrid& out, const JobContext& ctx) {
+  const VoxelIndex& m = grid.min_index();
+  for (size_t iy = 0; iy < ys.size(); ++iy) {
+    VC_RETURN_IF_ERROR(ctx.CheckCancelled("candidate generation"));
+    ctx.Report(Stage::kCandidates, 0.75 + 0.25 * static_cast<double>(iy) / ys.size());
+    for (size_t ix = 0; ix < xs.size(); ++ix) {
+      out.cells += heights.size();
+      const Eigen::Vector3d u = grid.WorldToIndexSpace(WorldPoint(xs[ix], ys[iy], 0));
+      const int cx = static_cast<int>(std::floor(u.x())) - m.x, cy = static_cast<int>(std::floor(u.y())) - m.y;
+      std::vector<uint32_t> under;
+      for (int ring = 0; ring <= 1 && under.empty(); ++ring) {
+        uint32_t highest = 0;
+        bool found = false;
+        for (int dy = -ring; dy <= ring; ++dy) {
+          for (int dx = -ring; dx <= ring; ++dx) {
+            const int x = cx + dx, y = cy + dy;
+            if (x < 0 || y < 0 || x >= f.nx || y >= f.ny) continue;
+            const uint32_t c = f.Column(x, y);
+            for (uint32_t i = f.first[c]; i < f.first[c + 1]; ++i) {
+              if (!f.ground[i]) continue;
+              if (ring == 0) {
+                under.push_back(i);
+              } else if (!found || f.z[i] > f.z[highest]) {
+                highest = i;
+                found = true;
+              }
+            }
+          }
+        }
+        if (found) under.push_back(highest);
+      }
+      if (under.empty()) out.rejected_no_floor += heights.size();
+      for (uint32_t i : under) {
+        PlaceOnFloor(grid, xs[ix], ys[iy], f.z[i], f.free_above[i], heights, options, -1, out, &out.rejected_clearance);
+      }
+    }
+  }
+  return Status::Ok();
+}
+
 }  // namespace
 
 bool HasClearance(const OccupancyGrid& grid, const WorldPoint& p, double clearance_m) {
@@ -237,86 +550,58 @@ std::optional<double> FloorTopNear(const OccupancyGrid& grid, double x_m, double
   return grid.IndexSpaceToWorld(Eigen::Vector3d(0, 0, z + 1)).z();
 }
 
+}  // namespace vc::planner
+
+namespace vc {
+
+std::string_view GroundModelName(GroundModel model) {
+  switch (model) {
+    case GroundModel::kFloors:
+      return "floors";
+    case GroundModel::kTerrain:
+      return "terrain";
+    case GroundModel::kAuto:
+      break;
+  }
+  return "auto";
+}
+
+namespace planner {
+
 Result<CandidateGrid> GenerateCandidates(const VoxelScene& scene, const CandidateOptions& options,
                                          const JobContext& ctx) {
   const OccupancyGrid& grid = scene.grid;
   const double r = grid.resolution_m();
   const int free_needed = FreeVoxelsNeeded(r, options);
   const int band = BandVoxels(r);
-  const Eigen::Vector3i dims = grid.dims();
   CandidateGrid out;
   const std::vector<double> heights =
       options.tripod_heights_m.empty() ? std::vector<double>{options.tripod_height_m} : options.tripod_heights_m;
 
-  // 1. Histogram of standing surfaces over all columns.
-  // Histograms are indexed by z - min.z.
+  // 1. Histogram of standing surfaces over all columns; the floor levels; the ground model.
   const VoxelIndex m = grid.min_index();
-  std::vector<uint64_t> hist(dims.z(), 0), roofs(dims.z(), 0);
-  std::vector<Surface> scratch;
-  for (int y = 0; y < dims.y(); ++y) {
-    if ((y & 15) == 0) {
-      VC_RETURN_IF_ERROR(ctx.CheckCancelled("candidate generation"));
-      ctx.Report(Stage::kCandidates, 0.5 * y / std::max(1, dims.y()));
-    }
-    for (int x = 0; x < dims.x(); ++x) {
-      ColumnSurfaces(grid, m.x + x, m.y + y, free_needed, scratch);
-      for (const Surface& s : scratch) {
-        ++hist[s.z - m.z];
-        if (s.roof()) ++roofs[s.z - m.z];
-      }
-    }
-  }
-
-  // 2. Dominant levels, strongest first, with suppression of weaker ones nearby.
-  auto band_sum = [&](const std::vector<uint64_t>& h, int z) {
-    uint64_t s = 0;
-    for (int k = std::max(0, z - band); k <= std::min(dims.z() - 1, z + band); ++k) s += h[k];
-    return s;
-  };
-  std::vector<uint64_t> score(dims.z());
-  for (int z = 0; z < dims.z(); ++z) score[z] = band_sum(hist, z);
-  std::vector<bool> suppressed(dims.z(), false);
-  struct Level {
-    int z;
-    uint64_t columns;
-    uint64_t roofs;
-  };
-  std::vector<Level> levels;
-  uint64_t strongest = 0;
-  for (int iter = 0; iter < 32; ++iter) {
-    int best = -1;
-    for (int z = 0; z < dims.z(); ++z) {
-      if (!suppressed[z] && score[z] > 0 && (best < 0 || score[z] > score[best])) best = z;
-    }
-    if (best < 0) break;
-    if (levels.empty()) strongest = score[best];
-    if (score[best] * 4 < strongest) break;
-    // The level's height: the fullest bin within the band.
-    int mode = best;
-    for (int k = std::max(0, best - band); k <= std::min(dims.z() - 1, best + band); ++k) {
-      if (hist[k] > hist[mode]) mode = k;
-    }
-    levels.push_back({mode, band_sum(hist, mode), band_sum(roofs, mode)});
-    for (int z = std::max(0, mode - free_needed + 1); z <= std::min(dims.z() - 1, mode + free_needed - 1); ++z) {
-      suppressed[z] = true;
-    }
-  }
-  std::sort(levels.begin(), levels.end(), [](const Level& a, const Level& b) { return a.z < b.z; });
-  // Roofs: levels whose surfaces are mostly the outside of a ceiling.
-  std::vector<Level> kept;
-  for (const Level& l : levels) {
-    if (l.roofs * 2 <= l.columns) kept.push_back(l);
+  VC_ASSIGN_OR_RETURN(const SurfaceHistogram hist, HistogramSurfaces(grid, free_needed, ctx));
+  const std::vector<Level> kept = FindLevels(hist, band, free_needed);
+  VC_ASSIGN_OR_RETURN(const GroundField ground, FindGround(grid, free_needed, options, ctx));
+  out.ground =
+      ChooseGround(options.ground, CountOnLevels(ground, m.z, grid.dims().z(), kept, band), kept.size(), band * r);
+  const WorldPoint lo = scene.BoundsMin(), hi = scene.BoundsMax();
+  const std::vector<double> xs = AxisCells(lo.x(), hi.x(), options.grid_spacing_m);
+  const std::vector<double> ys = AxisCells(lo.y(), hi.y(), options.grid_spacing_m);
+  if (out.ground.model == GroundModel::kTerrain) {
+    out.ground_columns = ground.columns;
+    VC_RETURN_IF_ERROR(PlaceOnTerrain(grid, ground, xs, ys, heights, options, out, ctx));
+    ctx.Report(Stage::kCandidates, 1.0);
+    return out;
   }
   for (const Level& l : kept) {
     out.levels.push_back({grid.IndexSpaceToWorld(Eigen::Vector3d(0, 0, m.z + l.z + 1)).z(), l.columns});
   }
 
-  // 3. Cells of the grid over the footprint, per level. place() examines one position: the floor
+  // 2. Cells of the grid over the footprint, per level. place() examines one position: the floor
   // under it, then each height's headroom and clearance; it appends the kept candidates and
   // returns how many.
-  const WorldPoint lo = scene.BoundsMin(), hi = scene.BoundsMax();
-  const std::vector<double> xs = AxisCells(lo.x(), hi.x(), options.grid_spacing_m);
-  const std::vector<double> ys = AxisCells(lo.y(), hi.y(), options.grid_spacing_m);
+  std::vector<Surface> scratch;
   auto place = [&](double x, double y, size_t li, int lz, uint64_t* no_floor, uint64_t* no_clearance) {
     const Eigen::Vector3d u = grid.WorldToIndexSpace(WorldPoint(x, y, lo.z()));
     int free_above = 0;
@@ -326,21 +611,7 @@ Result<CandidateGrid> GenerateCandidates(const VoxelScene& scene, const Candidat
       *no_floor += heights.size();
       return 0;
     }
-    const double top = grid.IndexSpaceToWorld(Eigen::Vector3d(0, 0, z + 1)).z();
-    int placed = 0;
-    for (double h : heights) {
-      const WorldPoint p(x, y, top + h);
-      if (free_above < FreeVoxelsNeeded(r, h, options.clearance_m) || !HasClearance(grid, p, options.clearance_m)) {
-        ++*no_clearance;
-        continue;
-      }
-      out.positions.push_back(p);
-      out.floor_z_m.push_back(top);
-      out.level.push_back(static_cast<int>(li));
-      out.height_m.push_back(h);
-      ++placed;
-    }
-    return placed;
+    return PlaceOnFloor(grid, x, y, z, free_above, heights, options, static_cast<int>(li), out, no_clearance);
   };
   // Per level, per grid cell (iy * |xs| + ix): whether the cell got a candidate.
   std::vector<std::vector<uint8_t>> on_grid(kept.size(), std::vector<uint8_t>(xs.size() * ys.size(), 0));
@@ -379,4 +650,5 @@ Result<CandidateGrid> GenerateCandidates(const VoxelScene& scene, const Candidat
   return out;
 }
 
-}  // namespace vc::planner
+}  // namespace planner
+}  // namespace vc

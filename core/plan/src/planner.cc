@@ -135,6 +135,7 @@ Result<PlanResult> Plan(const SceneInput& input, const PlanOptions& options, con
   }));
   result.candidate_count = candidates.positions.size();
   result.floor_levels_m = candidates.floor_levels_m;
+  result.ground = candidates.ground;
   result.grid_cells = candidates.grid_cells;
   result.cells_without_floor = candidates.cells_without_floor;
   result.cells_failing_clearance = candidates.cells_failing_clearance;

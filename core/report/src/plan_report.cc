@@ -62,6 +62,14 @@ Json ParameterJson(T v) {
 }
 Json ParameterJson(SelectionTest t) { return std::string(SelectionTestName(t)); }
 Json ParameterJson(SelectionSolver s) { return std::string(SelectionSolverName(s)); }
+Json ParameterJson(GroundModel m) { return std::string(GroundModelName(m)); }
+
+// plan.json's `ground` (docs/PLANNING.md, "Terrain"): the model the candidates used and why; null
+// when the user passed the candidates.
+Json GroundJson(const planner::GroundChoice& g) {
+  if (g.model == GroundModel::kAuto) return nullptr;
+  return Json{{"model", std::string(GroundModelName(g.model))}, {"floor_share", g.floor_share}, {"reason", g.reason}};
+}
 
 // plan.json's `optimality` (docs/PLANNING.md, "Exact selection").
 Json OptimalityJson(const planner::Optimality& o) {
@@ -924,6 +932,7 @@ std::string PlanToJson(const PlanResult& r, const UploadSummary* upload,
          {"coverage", std::move(coverage)},
          {"reduction", std::move(reduction)},
          {"candidates", std::move(candidates)},
+         {"ground", GroundJson(r.ground)},
          {"scan_graph", std::move(scan_graph)},
          {"route", std::move(route)},
          {"field_time_s", std::move(field_time)},

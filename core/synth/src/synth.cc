@@ -48,6 +48,9 @@ struct Model {
   std::vector<bool> is_room;  // air boxes that get a cornice along their walls
   std::vector<Box> solid;     // obstacles inside the free space
   SceneInfo info;             // rooms, floors and bounds still in design coordinates
+  // An open site (outdoors): the faces on the air's bounding box (the sky and the site's edges)
+  // are not sampled, so only the ground and what stands on it are.
+  bool open_site = false;
 
   void Room(const Box& b) {
     air.push_back(b);
@@ -257,6 +260,25 @@ Model MakeStairs() {
   return m;
 }
 
+Model MakeSlope() {
+  // A site 40 x 30 m rising 4 m along x: 40 terraces 1 m deep, each 0.1 m above the one before
+  // (a 1:10 slope, as a voxel staircase), open to the sky. On it two solid buildings with flat
+  // roofs and a van, whose tops have free space above them but are not reachable on foot.
+  constexpr double kDepth = 1.0, kRise = 0.1, kSky = 12.0;
+  constexpr int kTerraces = 40;
+  Model m;
+  m.open_site = true;
+  for (int i = 0; i < kTerraces; ++i) m.Opening(Cuboid(i * kDepth, 0, i * kRise, (i + 1) * kDepth, 30, kSky));
+  m.Solid(Cuboid(8, 6, -1, 16, 14, 6.0));    // building A: 8 x 8 m, roof 4.5-5.2 m above the ground
+  m.Solid(Cuboid(24, 16, -1, 32, 24, 8.0));  // building B: 8 x 8 m, roof 4.9-5.6 m above the ground
+  m.Solid(Cuboid(34, 5, -1, 38.5, 7, 5.6));  // a van 4.5 x 2 m, top 1.8-2.2 m above the ground
+  m.info.description =
+      "an open site 40 x 30 m rising 4 m along x in 0.1 m terraces 1 m deep, with two 8 x 8 m buildings "
+      "(flat roofs) and a van; terrain, optimum unknown";
+  m.info.optimum_stations = 0;
+  return m;
+}
+
 Model MakeHall() {
   Model m;
   // Nave (south), aisle (north, ground level) and gallery above the aisle, split by an arcade
@@ -335,9 +357,11 @@ const SceneKind kScenes[] = {
     {"tworooms", false, "two rooms joined by one off-centre door", [](int) { return MakeTwoRooms(); }},
     {"stairs", false, "two storeys joined by a straight flight of steps", [](int) { return MakeStairs(); }},
     {"hall", false, "the benchmark hall", [](int) { return MakeHall(); }},
+    {"slope", false, "an open sloping site with buildings", [](int) { return MakeSlope(); }},
 };
 
-constexpr char kValidSpecs[] = "box, lroom, comb:K, rooms:N, hub:K, twofloor, tworooms, stairs, hall (K, N in 1..50)";
+constexpr char kValidSpecs[] =
+    "box, lroom, comb:K, rooms:N, hub:K, twofloor, tworooms, stairs, hall, slope (K, N in 1..50)";
 
 Status BadSpec(std::string_view spec, std::string_view why) {
   return InvalidArgumentError("invalid scene '" + std::string(spec) + "' (" + std::string(why) +
@@ -449,10 +473,17 @@ constexpr double kProbeM = 1e-7;
 
 class Sampler {
  public:
-  Sampler(const Model& m, double spacing) : spacing_(spacing) {
+  Sampler(const Model& m, double spacing) : spacing_(spacing), open_site_(m.open_site) {
     boxes_ = m.air;
     boxes_.insert(boxes_.end(), m.solid.begin(), m.solid.end());
     num_air_ = m.air.size();
+    hull_ = m.air.empty() ? Box{} : m.air.front();
+    for (const Box& b : m.air) {
+      for (int a = 0; a < 3; ++a) {
+        hull_.lo[a] = std::min(hull_.lo[a], b.lo[a]);
+        hull_.hi[a] = std::max(hull_.hi[a], b.hi[a]);
+      }
+    }
   }
 
   // Visits every face; with fn == nullptr only counts.
@@ -532,6 +563,7 @@ class Sampler {
     const Box& f = boxes_[box];
     const int u = (a + 1) % 3, v = (a + 2) % 3;
     const double c = side ? f.hi[a] : f.lo[a];
+    if (open_site_ && (a == 2 ? c == hull_.hi[2] : c == hull_.lo[a] || c == hull_.hi[a])) return 0;
     const size_t face_index = FaceIndex(box, a, side);
     // Boxes touching this face's closed rectangle; their edges cut it into cells.
     std::vector<size_t> near;
@@ -624,6 +656,8 @@ class Sampler {
   }
 
   double spacing_;
+  bool open_site_;          // Model::open_site: faces on hull_'s sky and sides are not sampled
+  Box hull_;                // bounding box of the air boxes
   std::vector<Box> boxes_;  // air boxes first, then solids
   size_t num_air_ = 0;
 };
@@ -645,7 +679,8 @@ Status SynthOptions::Validate() const {
 
 std::string ListScenes() {
   std::string out;
-  for (const char* spec : {"box", "lroom", "comb:3", "rooms:3", "hub:2", "twofloor", "tworooms", "stairs", "hall"}) {
+  for (const char* spec :
+       {"box", "lroom", "comb:3", "rooms:3", "hub:2", "twofloor", "tworooms", "stairs", "hall", "slope"}) {
     Result<SceneInfo> info = DescribeScene(spec);
     if (!info.ok()) continue;
     out += info->name;

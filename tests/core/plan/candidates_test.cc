@@ -5,11 +5,14 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iostream>
 #include <map>
 #include <set>
+#include <string>
 #include <vector>
 
 #include "testing/scenes.h"
+#include "vc/synth/synth.h"
 
 namespace vc::planner {
 namespace {
@@ -260,6 +263,94 @@ TEST(CandidatesTest, HubDoorsGetCandidatesWhereTheOptimumStands) {
     }
     EXPECT_GT(grid_d, 0.3) << optimum.transpose();
     EXPECT_LT(passage_d, 0.1) << optimum.transpose();
+  }
+}
+
+// The synthetic scene `spec` at 0.1 m.
+VoxelScene SyntheticAt10cm(const std::string& spec) {
+  Result<VoxelScene> scene = Voxelize(testing::Synthetic(spec), VoxelizeOptions{0.1});
+  EXPECT_TRUE(scene.ok()) << scene.status().ToString();
+  return scene.ok() ? std::move(*scene) : VoxelScene{};
+}
+
+TEST(CandidatesTest, AutoPicksFloorsInBuildingsAndTerrainOnTheSlopingSite) {
+  for (const char* spec : {"twofloor", "stairs", "hub:1", "tworooms"}) {
+    const CandidateGrid c = Generate(SyntheticAt10cm(spec));
+    EXPECT_EQ(c.ground.model, GroundModel::kFloors) << spec << ": " << c.ground.reason;
+    EXPECT_GE(c.ground.floor_share, kFloorShare) << spec;
+    EXPECT_FALSE(c.levels.empty()) << spec;
+    std::cout << "[ " << spec << " ] " << c.ground.reason << "\n";
+  }
+  const CandidateGrid slope = Generate(SyntheticAt10cm("slope"));
+  EXPECT_EQ(slope.ground.model, GroundModel::kTerrain) << slope.ground.reason;
+  EXPECT_LT(slope.ground.floor_share, kFloorShare);
+  EXPECT_NE(slope.ground.reason.find("terrain: only"), std::string::npos) << slope.ground.reason;
+  std::cout << "[ slope ] " << slope.ground.reason << "\n";
+}
+
+// The slope scene's design (docs/SCENES.md): terraces 1 m deep rising 0.1 m along x from x = 0,
+// and the footprints of its two buildings and its van, shifted by kSceneOffsetM.
+double SlopeGroundZ(double x) { return 0.1 * std::floor(x - kSceneOffsetM.x()) + kSceneOffsetM.z(); }
+bool OnARoof(const WorldPoint& p) {
+  const double x = p.x() - kSceneOffsetM.x(), y = p.y() - kSceneOffsetM.y();
+  return (x > 8 && x < 16 && y > 6 && y < 14) || (x > 24 && x < 32 && y > 16 && y < 24) ||
+         (x > 34 && x < 38.5 && y > 5 && y < 7);
+}
+
+TEST(CandidatesTest, TerrainCandidatesStandOnTheGroundOnlyNeverOnRoofsOrTheVan) {
+  const CandidateGrid c = Generate(SyntheticAt10cm("slope"));
+  ASSERT_EQ(c.ground.model, GroundModel::kTerrain);
+  EXPECT_TRUE(c.levels.empty());
+  // 40 x 30 cells, less the buildings' and the van's footprints and the cells by their walls.
+  EXPECT_GT(c.positions.size(), 900u);
+  EXPECT_LT(c.positions.size(), 1200u);
+  for (size_t i = 0; i < c.positions.size(); ++i) {
+    const WorldPoint& p = c.positions[i];
+    EXPECT_FALSE(OnARoof(p)) << p.transpose();
+    // The floor is the terrace under the candidate, or the next one within the 3 x 3 columns.
+    EXPECT_NEAR(c.floor_z_m[i], SlopeGroundZ(p.x()), 0.11) << p.transpose();
+    EXPECT_NEAR(p.z() - c.floor_z_m[i], 1.5, 1e-9);
+    EXPECT_EQ(c.level[i], -1);
+  }
+  EXPECT_EQ(c.rejected_no_floor + c.rejected_clearance + c.positions.size(), c.cells);
+}
+
+TEST(CandidatesTest, EitherModelCanBeForced) {
+  const VoxelScene slope = SyntheticAt10cm("slope");
+  CandidateOptions o;
+  o.ground = GroundModel::kFloors;
+  const CandidateGrid floors = Generate(slope, o);
+  EXPECT_EQ(floors.ground.model, GroundModel::kFloors);
+  EXPECT_NE(floors.ground.reason.find("floors, as requested"), std::string::npos) << floors.ground.reason;
+  EXPECT_FALSE(floors.levels.empty());
+  // A few levels of a 4 m slope: far fewer candidates than the terrain's.
+  EXPECT_LT(floors.positions.size(), Generate(slope).positions.size() / 2);
+
+  Builder b;
+  b.Room(25, true);
+  o.ground = GroundModel::kTerrain;
+  const CandidateGrid terrain = Generate(b.Build(), o);
+  EXPECT_EQ(terrain.ground.model, GroundModel::kTerrain);
+  EXPECT_NE(terrain.ground.reason.find("terrain, as requested"), std::string::npos) << terrain.ground.reason;
+  ASSERT_EQ(terrain.positions.size(), 20u);  // the same cells as the floor level's, never on the ceiling's top
+  for (size_t i = 0; i < terrain.positions.size(); ++i) EXPECT_NEAR(terrain.floor_z_m[i], 0.1, 1e-9);
+}
+
+TEST(CandidatesTest, TerrainGroundIsTheLargestWalkableComponentNotADeskOrAPlatform) {
+  // A 5 x 4 m open ramp rising one voxel every 0.5 m along x, a desk 0.8 m high on it and a
+  // 1 m high platform in a corner: neither is linked to the ramp by a step of at most 0.25 m.
+  Builder b;
+  for (int x = 0; x < 50; ++x) b.Box(x, 0, 0, x, 39, x / 5);
+  b.Box(20, 15, 12, 29, 24, 12);  // the desk's top, 0.8 m above the ramp at x 2.0 .. 2.9 m
+  b.Box(40, 30, 0, 49, 39, 19);   // the platform: top 1 m above the ramp's end
+  CandidateOptions o;
+  o.ground = GroundModel::kTerrain;
+  const CandidateGrid c = Generate(b.Build(), o);
+  ASSERT_GT(c.positions.size(), 10u);
+  for (size_t i = 0; i < c.positions.size(); ++i) {
+    const WorldPoint& p = c.positions[i];
+    const int ix = static_cast<int>(std::floor(p.x() / kR)) + 20;  // Builder::Build moves x by -20 voxels
+    EXPECT_NEAR(c.floor_z_m[i], (ix / 5 + 1) * kR, 2 * kR + 1e-9) << p.transpose();
   }
 }
 

@@ -82,6 +82,31 @@ TEST_P(KnownOptimumTest, FindsTheOptimumAndAStationInEveryRoom) {
   EXPECT_EQ(r->selection_test, SelectionTest::kSurfaceVisibility);
 }
 
+// The sloping site (docs/SCENES.md, "slope"): auto picks terrain; every station stands 1.5 m over
+// the terrace under it, none on a roof or the van; the route walks the slope in one part.
+TEST(PlannerTest, SlopingSitePlansOnTheTerrainWithOneRoute) {
+  PlanOptions o = TestOptions();
+  o.grid_spacing_m = 2.0;
+  o.solver = SelectionSolver::kGreedy;
+  Result<PlanResult> r = Plan(Synthetic("slope"), o);
+  ASSERT_TRUE(r.ok()) << r.status().ToString();
+  std::cout << "[ slope ] " << Describe(*r) << "; " << r->ground.reason << "; route " << r->route.length_m << " m in "
+            << r->route.parts << " part(s)\n";
+  EXPECT_EQ(r->ground.model, GroundModel::kTerrain) << r->ground.reason;
+  EXPECT_TRUE(r->floor_levels_m.empty());
+  ASSERT_GE(r->stations.size(), 2u);
+  for (const PlannedStation& s : r->stations) {
+    const double x = s.position.x() - kSceneOffsetM.x(), y = s.position.y() - kSceneOffsetM.y();
+    const bool on_roof = (x > 8 && x < 16 && y > 6 && y < 14) || (x > 24 && x < 32 && y > 16 && y < 24) ||
+                         (x > 34 && x < 38.5 && y > 5 && y < 7);
+    EXPECT_FALSE(on_roof) << s.position.transpose();
+    EXPECT_NEAR(s.floor_z_m, 0.1 * std::floor(x) + kSceneOffsetM.z(), 0.11) << s.position.transpose();
+    EXPECT_NEAR(s.position.z() - s.floor_z_m, 1.5, 1e-9);
+  }
+  EXPECT_EQ(r->route.parts, 1);
+  for (const std::string& w : r->warnings) std::cout << "  warning: " << w << "\n";
+}
+
 INSTANTIATE_TEST_SUITE_P(Scenes, KnownOptimumTest,
                          ::testing::Values(Known{"box", 1}, Known{"lroom", 1}, Known{"comb:3", 3}, Known{"comb:5", 5}),
                          [](const auto& info) {

@@ -614,6 +614,7 @@ TEST(RouteTest, Geb079CandidatesSmoke) {
   ASSERT_TRUE(scene.ok()) << scene.status().ToString();
   Result<CandidateGrid> c = GenerateCandidates(*scene, {});
   ASSERT_TRUE(c.ok()) << c.status().ToString();
+  EXPECT_EQ(c->ground.model, GroundModel::kFloors) << c->ground.reason;
   // Farthest-point sampling over the level-0 candidates, from the first.
   std::vector<int> pool;
   for (size_t i = 0; i < c->positions.size(); ++i)

@@ -120,8 +120,13 @@ Result<CandidatesOutput> UserCandidates(const VoxelScene& scene, const PlanOptio
 
 // The generated grid; FAILED_PRECONDITION when no floor is found or no candidate survives.
 Result<CandidatesOutput> GridCandidates(const VoxelScene& scene, const PlanOptions& options, const JobContext& ctx) {
-  const CandidateOptions cand_options{options.grid_spacing_m, options.tripod_height_m, options.clearance_m,
-                                      options.tripod_heights_m, options.doorway_candidates};
+  const CandidateOptions cand_options{.grid_spacing_m = options.grid_spacing_m,
+                                      .tripod_height_m = options.tripod_height_m,
+                                      .clearance_m = options.clearance_m,
+                                      .tripod_heights_m = options.tripod_heights_m,
+                                      .doorway_candidates = options.doorway_candidates,
+                                      .ground = options.ground,
+                                      .walk_max_step_m = options.walk_max_step_m};
   VC_ASSIGN_OR_RETURN(CandidateGrid grid, GenerateCandidates(scene, cand_options, ctx));
   CandidatesOutput out;
   if (!options.keep_out.empty()) {
@@ -139,20 +144,24 @@ Result<CandidatesOutput> GridCandidates(const VoxelScene& scene, const PlanOptio
     grid.floor_z_m.resize(kept);
   }
   for (const FloorLevel& l : grid.levels) out.floor_levels_m.push_back(l.z_m);
+  out.ground = grid.ground;
   out.grid_cells = grid.cells;
   out.cells_without_floor = grid.rejected_no_floor;
   out.cells_failing_clearance = grid.rejected_clearance;
   if (grid.positions.empty()) {
-    if (grid.levels.empty()) {
+    const bool terrain = grid.ground.model == GroundModel::kTerrain;
+    if (terrain ? grid.ground_columns == 0 : grid.levels.empty()) {
       return FailedPreconditionError("no floor found: no occupied voxel has tripod_height_m + clearance_m = " +
                                      Num(options.tripod_height_m + options.clearance_m) +
                                      " m of free space above it; lower them or pass candidates");
     }
     std::string levels;
     for (double z : out.floor_levels_m) levels += (levels.empty() ? "" : ", ") + Num(z);
+    const std::string ground = terrain ? "terrain ground, " + std::to_string(grid.ground_columns) + " voxel columns"
+                                       : "floor levels at z = " + levels + " m";
     return FailedPreconditionError(
         "no candidate survived: of " + std::to_string(grid.cells) + " grid cells, " +
-        std::to_string(grid.rejected_no_floor) + " had no floor below (floor levels at z = " + levels + " m) and " +
+        std::to_string(grid.rejected_no_floor) + " had no floor below (" + ground + ") and " +
         std::to_string(grid.rejected_clearance) +
         " had occupied voxels within clearance_m = " + Num(options.clearance_m) + " m" +
         (out.in_keep_out ? ", and " + std::to_string(out.in_keep_out) + " candidates lay in keep-out zones"

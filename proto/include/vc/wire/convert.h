@@ -60,6 +60,9 @@ v1::CoveragePoint ToProto(const CoveragePoint& c);
 CoveragePoint FromProto(const v1::CoveragePoint& p);
 // SelectionSolver <-> its enum (UNSPECIFIED in PlanParameters keeps the default).
 v1::SelectionSolver ToProto(SelectionSolver s);
+// GroundModel <-> its enum; FromProto takes UNSPECIFIED as auto, INVALID_ARGUMENT for an unknown value.
+v1::GroundModel ToProto(GroundModel m);
+Result<GroundModel> FromProto(v1::GroundModel m);
 
 // Parameters (generated from the parameter tables, vc/base/parameter.h). ToProto sets every field;
 // FromProto applies the fields present in `p` to a default-constructed struct. INVALID_ARGUMENT

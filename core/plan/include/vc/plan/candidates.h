@@ -14,11 +14,23 @@
 // the levels come from the lowest, and each cell gets one candidate per height (in the order of the heights
 // given) that fits under what is above its floor. With doorway_candidates, positions in narrow passages
 // (doorways, pinch points; issue 21) follow the grid's and pass the same floor and clearance checks.
+//
+// Terrain (GroundModel::kTerrain; issue 35): where the ground is not a few flat floors (outdoors,
+// ramps, sloping sites) the floor levels above miss most of it. There the ground is a height field:
+// a standing surface is walkable where its local slope (its height difference to the surfaces
+// kSlopeBaseM away along x and y) is at most kTerrainMaxSlope, two walkable surfaces of 4-adjacent
+// columns are linked when their heights differ by at most walk_max_step_m, and the ground is the
+// largest linked component, so roofs, car tops and tables (higher than a step above what is around
+// them) are not ground. Each cell's candidate stands tripod height above the ground under its
+// centre. GroundModel::kAuto finds that ground either way and picks floors when at least
+// kFloorShare of its surfaces lie within a floor level's band (or there is none), else terrain.
 // Internal to vc_core.
 #pragma once
 
 #include <cstdint>
 #include <optional>
+#include <string>
+#include <string_view>
 #include <vector>
 
 #include "vc/base/geometry.h"
@@ -26,7 +38,35 @@
 #include "vc/base/status.h"
 #include "vc/scene/voxel_scene.h"
 
+namespace vc {
+
+// How the candidates' ground is modelled (PlanOptions::ground; docs/PLANNING.md, "Terrain").
+enum class GroundModel : uint8_t {
+  kAuto,     // the default: floors when the standing surfaces cluster at a few levels, else terrain
+  kFloors,   // discrete floor levels (buildings)
+  kTerrain,  // a height field of walkable ground (outdoor sites, ramps, slopes)
+};
+// "auto", "floors", "terrain".
+std::string_view GroundModelName(GroundModel model);
+
+}  // namespace vc
+
 namespace vc::planner {
+
+// Auto picks floors when at least this share of the walkable ground's surfaces (its largest linked
+// component) lies within +-0.15 m (at least 2 voxels) of a floor level.
+inline constexpr double kFloorShare = 0.9;
+// Terrain: the steepest ground a tripod stands on and a route walks (rise over run: 0.36, 20 deg).
+inline constexpr double kTerrainMaxSlope = 0.36;
+// Terrain: the horizontal distance over which a surface's slope is measured, each side (m).
+inline constexpr double kSlopeBaseM = 0.5;
+
+// The ground model a candidate grid used and why (PlanResult::ground; plan.json `ground`).
+struct GroundChoice {
+  GroundModel model = GroundModel::kAuto;  // kFloors or kTerrain; kAuto only for user candidates
+  double floor_share = 0;                  // share of the ground's surfaces on a floor level, 0..1
+  std::string reason;                      // one sentence: forced, or auto's test and its numbers
+};
 
 struct CandidateOptions {
   double grid_spacing_m = 1.0;   // grid cell size (m)
@@ -41,6 +81,10 @@ struct CandidateOptions {
   // (and at least 2 clearance_m), on the passage's centre line every grid_spacing_m / 4, and
   // beyond its ends at grid_spacing_m / 8, then every grid_spacing_m / 4, up to grid_spacing_m / 2.
   bool doorway_candidates = false;
+  // The ground model: auto (by the floor-share test), floors or terrain.
+  GroundModel ground = GroundModel::kAuto;
+  // Terrain: the largest rise between adjacent ground columns (m), as the walking route's.
+  double walk_max_step_m = 0.25;
 };
 
 struct FloorLevel {
@@ -51,9 +95,11 @@ struct FloorLevel {
 struct CandidateGrid {
   std::vector<WorldPoint> positions;  // kept candidates, level by level, then y, then x
   std::vector<double> floor_z_m;      // per candidate: top of the floor under it (m)
-  std::vector<int> level;             // per candidate: index into levels
+  std::vector<int> level;             // per candidate: index into levels; -1 on terrain
   std::vector<double> height_m;       // per candidate: its tripod height above floor_z_m (m)
-  std::vector<FloorLevel> levels;     // ascending z
+  std::vector<FloorLevel> levels;     // ascending z; empty on terrain
+  GroundChoice ground;                // the model used and why
+  uint64_t ground_columns = 0;        // terrain: voxel columns of the ground component
   // Grid cells x levels x heights examined; of those, the ones without a standing surface of the
   // level below, and the ones with floor but occupied voxels within the clearance (or, at a
   // height above the lowest, within height + clearance above the floor).

@@ -10,6 +10,7 @@
 #include "vc/base/geometry.h"
 #include "vc/base/parameter.h"
 #include "vc/base/status.h"
+#include "vc/plan/candidates.h"
 #include "vc/plan/keep_out.h"
 #include "vc/plan/selector.h"
 #include "vc/scene/voxel_scene.h"
@@ -20,6 +21,8 @@
 // which GreedyOptions is declared from. Notes on some rows:
 // - doorway_candidates: candidates in narrow passages (vc/plan/candidates.h; docs/PLANNING.md,
 //   "Doorway candidates").
+// - ground: the candidates' ground model, floor levels or a terrain height field, or auto per site
+//   (vc/plan/candidates.h; docs/PLANNING.md, "Terrain").
 // - solver / solve_seconds: greedy, the exact integer program (CBC) with a time limit, or auto
 //   (the default: the integer program within the limit, keeping greedy's plan unless it finds a
 //   better one; docs/PLANNING.md, "Exact selection").
@@ -49,6 +52,8 @@
   X(double, clearance_m, 0.2, "m", "clearance", kNonNegative, "free space required around a candidate")               \
   X(bool, doorway_candidates, false, "", "doorway-candidates", kAny,                                                  \
     "also candidates in doorways and narrow passages, on a finer grid")                                               \
+  X(::vc::GroundModel, ground, ::vc::GroundModel::kAuto, "", "ground", kAny,                                          \
+    "ground model: floors (a few flat levels), terrain (a walkable height field) or auto (per site)")                 \
   VC_GREEDY_PARAMETERS(X)                                                                                             \
   X(::vc::SelectionSolver, solver, ::vc::SelectionSolver::kAuto, "", "solver", kAny,                                  \
     "station selection: greedy, exact (integer program, proven gap) or auto")                                         \

@@ -159,6 +159,9 @@ struct PlanResult {
   // Floor levels found for the operating plane (top of the floor, m), ascending; empty with
   // user-supplied candidates.
   std::vector<double> floor_levels_m;
+  // The candidates' ground model (floors or terrain) and why (docs/PLANNING.md, "Terrain"); model
+  // kAuto with user-supplied candidates.
+  planner::GroundChoice ground;
   // Why selection stopped (StopReasonName: "exhausted", "target_reached", "max_stations", "min_gain",
   // "gain_rule").
   StopReason stop_reason = StopReason::kExhausted;

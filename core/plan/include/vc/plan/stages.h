@@ -74,6 +74,7 @@ struct CandidatesOutput {
   std::vector<WorldPoint> positions;   // local frame (m)
   std::vector<double> floor_z_m;       // per candidate (m); NaN for user candidates
   std::vector<double> floor_levels_m;  // floor levels found (m), ascending; empty for user candidates
+  GroundChoice ground;                 // the ground model used and why; kAuto for user candidates
   uint64_t grid_cells = 0;             // grid cells x levels examined
   uint64_t cells_without_floor = 0;
   uint64_t cells_failing_clearance = 0;

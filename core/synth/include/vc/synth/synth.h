@@ -1,8 +1,8 @@
 // Synthetic scenes whose answer is known: point clouds sampled on the surfaces of simple buildings
 // (one room, an L-shaped room, a comb of dead-end bays, rooms along a corridor, a hub hall whose
 // rooms are best seen from their doorways, two storeys, two
-// rooms joined by a door, two storeys joined by a flight of steps, and the chapel-like benchmark
-// hall), for oracle tests of the planner and for benchmarks.
+// rooms joined by a door, two storeys joined by a flight of steps, the chapel-like benchmark
+// hall, and an open sloping site with buildings), for oracle tests of the planner and for benchmarks.
 //
 // Why the API is split: DescribeScene says what a scene is (its known optimum, the regions that each
 // need their own station, its floors) without generating anything; ForEachScenePoint streams the
@@ -13,8 +13,9 @@
 // axis-aligned solid boxes inside them (pillars, pews, beams, cornices). Points are sampled on the
 // boundary of that free space, i.e. on the surfaces a scanner standing inside would record; the
 // outside of the building is never sampled (it could not be covered, and it would tie the roof with
-// the floor as the largest horizontal layer). Every face is sampled on a grid whose lines include
-// every box edge that crosses it, so the surface is watertight after voxelisation at any resolution
+// the floor as the largest horizontal layer). An open site (slope) is the exception: there the
+// faces on the air's bounding box, the sky and the site's edges, are not sampled. Every face is sampled on a grid whose
+// lines include every box edge that crosses it, so the surface is watertight after voxelisation at any resolution
 // >= 2 x spacing. The whole scene is shifted by kSceneOffsetM so no surface plane lies on a multiple
 // of 0.1, 0.08, 0.05, 0.02 or 0.01 m. Details and dimensions: docs/SCENES.md.
 //
@@ -77,7 +78,7 @@ struct SceneInfo {
 std::string ListScenes();
 
 // Describes the scene `spec` ("box", "lroom", "comb:K", "rooms:N", "hub:K", "hall", "twofloor",
-// "tworooms", "stairs"; K and N in 1..50). INVALID_ARGUMENT naming the valid specs for anything else.
+// "tworooms", "stairs", "slope"; K and N in 1..50). INVALID_ARGUMENT naming the valid specs for anything else.
 Result<SceneInfo> DescribeScene(std::string_view spec);
 
 // Calls fn once per point (world, m) of the scene, in a fixed order; memory does not grow with the
