@@ -303,10 +303,11 @@ TEST(PlanResultChunks, ASoleViewerNamingAMissingStationOrOnSomeChunksOnlyIsDataL
 // (1440: Evaluation::per_viewpoint_sparse_values, which like per_viewpoint_face_values is the
 // reduction's working data and never part of a result on the wire. 1448 and 416: the scanner's
 // hfov_deg, a row carried as ScannerModel.hfov_deg. 1560: unseen_causes. 1568 and 432: walk_max_step_m, a
-// row carried as PlanParameters.walk_max_step_m; PlanResult holds the options.)
+// row carried as PlanParameters.walk_max_step_m; PlanResult holds the options. 1576 and 440:
+// min_gain_m2_per_minute, a row carried as PlanParameters.min_gain_m2_per_minute.)
 TEST(PlanResultChunks, EveryCoreFieldIsCarried) {
-  EXPECT_EQ(sizeof(PlanResult), 1568u) << "PlanResult changed: update the vc.v1 PlanResult and vc::wire";
-  EXPECT_EQ(sizeof(PlanOptions), 432u) << "PlanOptions changed: update vc.v1 PlanParameters and vc::wire";
+  EXPECT_EQ(sizeof(PlanResult), 1576u) << "PlanResult changed: update the vc.v1 PlanResult and vc::wire";
+  EXPECT_EQ(sizeof(PlanOptions), 440u) << "PlanOptions changed: update vc.v1 PlanParameters and vc::wire";
 }
 
 // A georeferenced plan: local positions, the frame's origin at UTM-like coordinates (and once
