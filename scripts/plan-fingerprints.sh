@@ -4,11 +4,14 @@
 # stations, G, covered/coverable voxels and a hash of the stations' coordinates. Run it on two
 # builds and diff the output (docs/BENCHMARKS.md, "Plans must not change by accident").
 # Usage: scripts/plan-fingerprints.sh [BUILD_DIR (default build/release)] [--quick] [--fan-out]
+#        [--sparse] [--gain-rule-off]
 #   --quick: geb079 and the known-optimum scenes only (skips the 1.7 M-point synthetic hall).
 #   --fan-out: plan through a coordinator that leaves every shard of 16 candidates to two peer
 #     vc-servers (docs/DEPLOY.md, "Scaling out"): the lines must be the same as without.
 #   --sparse: every visibility set sparse (--sparse-set-gain 1e-9; vc/visibility/voxel_set.h):
 #     the lines must be the same as without.
+#   --gain-rule-off: the default gain rule switched off (--min-gain-m2-per-minute 0): the plans as
+#     the 99 % target alone stops them, the lines from before the rule became the default.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bin=${1:-build/release}
@@ -18,6 +21,7 @@ for a in "${@:2}"; do
     --quick) quick=--quick ;;
     --fan-out) fan_out=1 ;;
     --sparse) client_flags+=(--sparse-set-gain 1e-9) ;;
+    --gain-rule-off) client_flags+=(--min-gain-m2-per-minute 0) ;;
     *) echo "plan-fingerprints: unknown option $a" >&2; exit 2 ;;
   esac
 done

@@ -102,6 +102,12 @@ void AddScannerFlags(CLI::App* command, ScannerModel* o) {
 
 void AddPlanFlags(CLI::App* command, PlanOptions* o) {
   VC_PLAN_PARAMETERS(VC_ROW_FLAG)
+  // --min-gain-voxels-per-minute given alone takes the place of the default area rule; given with
+  // --min-gain-m2-per-minute, both > 0 is PlanOptions::Validate's error naming both.
+  CLI::Option* area_rule = command->get_option("--min-gain-m2-per-minute");
+  command->get_option("--min-gain-voxels-per-minute")->each([o, area_rule](const std::string&) {
+    if (area_rule->count() == 0) o->min_gain_m2_per_minute = 0;
+  });
   command
       ->add_option("--tripod-heights", o->tripod_heights_m,
                    "several scanner heights above the floor, comma-separated (m); replaces --tripod-height")

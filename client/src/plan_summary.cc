@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <iterator>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -140,10 +141,19 @@ std::string StopLine(const PlanResult& r) {
                     static_cast<unsigned long long>(o.min_marginal_gain_voxels));
     case StopReason::kGainRule: {
       const double minutes = (o.setup_seconds + r.field_time.scan_seconds_per_station) / 60.0;
+      const std::optional<GainRule> rule = GainRuleOf(o, r.resolution_m);
+      if (!rule) return "stopped: gain rule\n";
+      const double voxels = rule->voxels_per_minute * minutes;
+      if (o.min_gain_voxels_per_minute > 0) {
+        return Format(
+            "stopped: gain rule, the next station adds under %.0f voxels for its %s of set-up and scan "
+            "(--min-gain-voxels-per-minute %g)\n",
+            voxels, FormatDuration(60.0 * minutes).c_str(), rule->value);
+      }
       return Format(
-          "stopped: gain rule, the next station adds under %.0f voxels for its %s of set-up and scan "
-          "(--min-gain-voxels-per-minute %g)\n",
-          o.min_gain_voxels_per_minute * minutes, FormatDuration(60.0 * minutes).c_str(), o.min_gain_voxels_per_minute);
+          "stopped: gain rule, the next station adds under %.3g m2 of surface (%.0f voxels at %g m) for its %s of "
+          "set-up and scan (--min-gain-m2-per-minute %g)\n",
+          rule->value * minutes, voxels, r.resolution_m, FormatDuration(60.0 * minutes).c_str(), rule->value);
     }
   }
   return "";

@@ -387,6 +387,8 @@ v1::PlanParameters ToProto(const PlanOptions& o) {
 Result<PlanOptions> FromProto(const v1::PlanParameters& p) {
   PlanOptions o;
   VC_PLAN_PARAMETERS(VC_ROW_FROM_PROTO)
+  // The voxel gain rule, given alone, takes the place of the default area rule.
+  if (o.min_gain_voxels_per_minute > 0 && !p.has_min_gain_m2_per_minute()) o.min_gain_m2_per_minute = 0;
   if (p.has_scanner()) VC_RETURN_IF_ERROR(Apply(p.scanner(), &o.scanner));
   for (const auto& c : p.candidates()) o.candidates.push_back(FromProto(c));
   o.tripod_heights_m.assign(p.tripod_heights_m().begin(), p.tripod_heights_m().end());

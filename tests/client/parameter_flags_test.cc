@@ -539,6 +539,36 @@ TEST(ParameterTablesTest, TheGroundFlagTakesEachModelAndPlanJsonNamesIt) {
 
 // --scanner NAME: the preset fills every scanner row whose flag is not given; a given flag wins,
 // even when it gives the row's default.
+// --min-gain-voxels-per-minute alone takes the place of the default area rule; both > 0, in
+// either order, is refused naming both flags.
+TEST(GainRuleFlagsTest, TheVoxelRuleAloneReplacesTheAreaRuleAndBothAreRefused) {
+  PlanOptions alone;
+  CLI::App alone_app;
+  client::AddPlanFlags(&alone_app, &alone);
+  alone_app.parse("--min-gain-voxels-per-minute 50", false);
+  EXPECT_EQ(alone.min_gain_voxels_per_minute, 50);
+  EXPECT_EQ(alone.min_gain_m2_per_minute, 0.0);
+  EXPECT_TRUE(alone.Validate(client::PlanFlagNamer()).ok());
+  for (const std::string args : {"--min-gain-voxels-per-minute 50 --min-gain-m2-per-minute 0.5",
+                                 "--min-gain-m2-per-minute 0.5 --min-gain-voxels-per-minute 50"}) {
+    PlanOptions both;
+    CLI::App both_app;
+    client::AddPlanFlags(&both_app, &both);
+    both_app.parse(args, false);
+    EXPECT_EQ(both.min_gain_m2_per_minute, 0.5) << args;
+    EXPECT_EQ(both.Validate(client::PlanFlagNamer())
+                  .message()
+                  .rfind("--min-gain-voxels-per-minute (50) and --min-gain-m2-per-minute (0.5) are both set", 0),
+              0u)
+        << both.Validate(client::PlanFlagNamer()).message();
+  }
+  PlanOptions area_off;
+  CLI::App off_app;
+  client::AddPlanFlags(&off_app, &area_off);
+  off_app.parse("--min-gain-m2-per-minute 0 --min-gain-voxels-per-minute 50", false);
+  EXPECT_TRUE(area_off.Validate(client::PlanFlagNamer()).ok());
+}
+
 TEST(ScannerPresetFlagTest, ThePresetFillsTheRowsAndExplicitFlagsOverrideIt) {
   ScannerModel want = *ScannerFromPreset("leica-rtc360");
   want.max_range_m = 40.0;

@@ -153,6 +153,12 @@ TEST(StopLineTest, NamesTheRuleThatStoppedTheSelection) {
   EXPECT_EQ(StopLine(r),
             "stopped: gain rule, the next station adds under 30 voxels for its 3 min of set-up and scan "
             "(--min-gain-voxels-per-minute 10)\n");
+  r.options.min_gain_voxels_per_minute = 0;
+  r.options.min_gain_m2_per_minute = 0.5;
+  r.resolution_m = 0.1;
+  EXPECT_EQ(StopLine(r),
+            "stopped: gain rule, the next station adds under 1.5 m2 of surface (150 voxels at 0.1 m) for its 3 min "
+            "of set-up and scan (--min-gain-m2-per-minute 0.5)\n");
   r.stop_reason = StopReason::kMinGain;
   EXPECT_NE(StopLine(r).find("candidates exhausted"), std::string::npos);
   r.stop_reason = StopReason::kExhausted;

@@ -25,6 +25,7 @@ TEST(PlanParameters, RoundTripKeepsEveryField) {
   o.min_marginal_gain_voxels = 17;
   o.target_coverage = 0.9;
   o.min_gain_voxels_per_minute = 12.5;
+  o.min_gain_m2_per_minute = 0;
   o.refine = !PlanOptions{}.refine;
   o.refine_radius_m = 0.8;
   o.refine_step_m = 0.1;
@@ -51,6 +52,7 @@ TEST(PlanParameters, RoundTripKeepsEveryField) {
   EXPECT_EQ(back->solver, SelectionSolver::kExact);
   EXPECT_EQ(back->solve_seconds, 7.5);
   EXPECT_EQ(back->min_gain_voxels_per_minute, 12.5);
+  EXPECT_EQ(back->min_gain_m2_per_minute, 0.0);
   EXPECT_TRUE(back->local_candidates);
   EXPECT_EQ(back->local_candidates_radius_m, 0.75);
   EXPECT_EQ(back->local_candidates_step_m, 0.3);
@@ -81,6 +83,26 @@ TEST(PlanParameters, UnsetFieldsTakeTheDefaults) {
   auto o = FromProto(v1::PlanParameters{});
   ASSERT_TRUE(o.ok());
   EXPECT_EQ(ToProto(*o).SerializeAsString(), ToProto(PlanOptions{}).SerializeAsString());
+}
+
+// A request with the voxel gain rule and no area rule: the voxel rule takes the default area
+// rule's place; with both fields set, both are kept (and PlanOptions::Validate refuses both > 0).
+TEST(PlanParameters, VoxelGainRuleAloneReplacesTheAreaRule) {
+  v1::PlanParameters p;
+  p.set_min_gain_voxels_per_minute(50);
+  auto o = FromProto(p);
+  ASSERT_TRUE(o.ok());
+  EXPECT_EQ(o->min_gain_voxels_per_minute, 50);
+  EXPECT_EQ(o->min_gain_m2_per_minute, 0.0);
+  EXPECT_TRUE(o->Validate().ok());
+  p.set_min_gain_m2_per_minute(0.25);
+  o = FromProto(p);
+  ASSERT_TRUE(o.ok());
+  EXPECT_EQ(o->min_gain_m2_per_minute, 0.25);
+  EXPECT_EQ(o->Validate().code(), StatusCode::kInvalidArgument);
+  p.clear_min_gain_voxels_per_minute();
+  p.clear_min_gain_m2_per_minute();
+  EXPECT_EQ(FromProto(p)->min_gain_m2_per_minute, PlanOptions{}.min_gain_m2_per_minute);
 }
 
 PlanResult BigResult(size_t voxels, size_t candidates) {
@@ -315,10 +337,11 @@ TEST(PlanResultChunks, ASoleViewerNamingAMissingStationOrOnSomeChunksOnlyIsDataL
 // reduction's working data and never part of a result on the wire. 1448 and 416: the scanner's
 // hfov_deg, a row carried as ScannerModel.hfov_deg. 1560: unseen_causes. 1568 and 432: walk_max_step_m, a
 // row carried as PlanParameters.walk_max_step_m; PlanResult holds the options. 1616: ground, carried as
-// PlanResult.ground; PlanOptions' ground row, PlanParameters.ground, fits its padding.)
+// PlanResult.ground; PlanOptions' ground row, PlanParameters.ground, fits its padding. 1624 and 440:
+// min_gain_m2_per_minute, a row carried as PlanParameters.min_gain_m2_per_minute.)
 TEST(PlanResultChunks, EveryCoreFieldIsCarried) {
-  EXPECT_EQ(sizeof(PlanResult), 1616u) << "PlanResult changed: update the vc.v1 PlanResult and vc::wire";
-  EXPECT_EQ(sizeof(PlanOptions), 432u) << "PlanOptions changed: update vc.v1 PlanParameters and vc::wire";
+  EXPECT_EQ(sizeof(PlanResult), 1624u) << "PlanResult changed: update the vc.v1 PlanResult and vc::wire";
+  EXPECT_EQ(sizeof(PlanOptions), 440u) << "PlanOptions changed: update vc.v1 PlanParameters and vc::wire";
 }
 
 // A georeferenced plan: local positions, the frame's origin at UTM-like coordinates (and once

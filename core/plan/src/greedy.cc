@@ -154,6 +154,13 @@ std::string FormatPercent(double fraction) {
   return text;
 }
 
+// The gain rule in voxels per minute: min_gain_voxels_per_minute when > 0, else
+// min_gain_m2_per_minute x surface_voxels_per_m2 (0 = off).
+double GainRuleVoxelsPerMinute(const GreedyOptions& options) {
+  if (options.min_gain_voxels_per_minute > 0) return options.min_gain_voxels_per_minute;
+  return options.min_gain_m2_per_minute * options.surface_voxels_per_m2;
+}
+
 // INVALID_ARGUMENT for options out of range or `fixed` beyond the `candidates` sets.
 Status CheckOptions(const GreedyOptions& options, size_t candidates) {
   if (options.max_stations < 0) return InvalidArgumentError("max_stations must be >= 0");
@@ -165,6 +172,12 @@ Status CheckOptions(const GreedyOptions& options, size_t candidates) {
   }
   if (!(options.min_gain_voxels_per_minute >= 0.0 && std::isfinite(options.min_gain_voxels_per_minute))) {
     return InvalidArgumentError("min_gain_voxels_per_minute must be finite and >= 0");
+  }
+  if (!(options.min_gain_m2_per_minute >= 0.0 && std::isfinite(options.min_gain_m2_per_minute))) {
+    return InvalidArgumentError("min_gain_m2_per_minute must be finite and >= 0");
+  }
+  if (!(options.surface_voxels_per_m2 >= 0.0 && std::isfinite(options.surface_voxels_per_m2))) {
+    return InvalidArgumentError("surface_voxels_per_m2 must be finite and >= 0");
   }
   if (!(options.station_seconds >= 0.0 && std::isfinite(options.station_seconds))) {
     return InvalidArgumentError("station_seconds must be finite and >= 0");
@@ -197,7 +210,7 @@ class GreedyRun {
         ctx_(ctx),
         fixed_(static_cast<size_t>(options.fixed)),
         min_gain_(std::max<uint64_t>(options.min_marginal_gain_voxels, 1)),
-        gain_rule_voxels_(options.min_gain_voxels_per_minute * options.station_seconds / 60.0),
+        gain_rule_voxels_(GainRuleVoxelsPerMinute(options) * options.station_seconds / 60.0),
         registration_(options.min_overlap > 0),
         uncovered_(sets[0].size()),
         picked_(sets.size(), 0),
@@ -403,8 +416,8 @@ class GreedyRun {
   const JobContext& ctx_;
   const size_t fixed_;
   const uint64_t min_gain_;  // min_marginal_gain_voxels, at least 1: a 0 gain always stops
-  // The gain rule's threshold: min_gain_voxels_per_minute x station_seconds / 60 (0 = off); it
-  // stops no plan before its first station.
+  // The gain rule's threshold: GainRuleVoxelsPerMinute x station_seconds / 60 (0 = off); it stops
+  // no plan before its first station.
   const double gain_rule_voxels_;
   const bool registration_;
   VoxelSet uncovered_;

@@ -19,6 +19,11 @@ Status PlanOptions::Validate(const FieldNamer& namer) const {
   VC_RETURN_IF_ERROR(CheckNamedParameter(VC_PARAMETER_INFO(type, row, __VA_ARGS__), row, namer));
   VC_PLAN_PARAMETERS(VC_CHECK_ROW)
 #undef VC_CHECK_ROW
+  if (min_gain_voxels_per_minute > 0 && min_gain_m2_per_minute > 0) {
+    return InvalidArgumentError(name("min_gain_voxels_per_minute") + " (" + Num(min_gain_voxels_per_minute) + ") and " +
+                                name("min_gain_m2_per_minute") + " (" + Num(min_gain_m2_per_minute) +
+                                ") are both set: the gain rule counts voxels or square metres, give one (the other 0)");
+  }
   VC_RETURN_IF_ERROR(scanner.Validate(namer));
   if (scanner.HasHorizontalFieldOfView()) {
     return InvalidArgumentError(name("scanner.hfov_deg") + " is " + Num(scanner.hfov_deg) +
@@ -87,6 +92,18 @@ PlanOptions InLocalFrame(PlanOptions options, const WorldPoint& frame_origin_m) 
     for (size_t i = 0; i < zone.polygon_xy_m.size(); ++i) zone.polygon_xy_m[i] -= frame_origin_m[i % 2];
   }
   return options;
+}
+
+std::optional<GainRule> GainRuleOf(const PlanOptions& options, double resolution_m) {
+  if (options.min_gain_voxels_per_minute > 0) {
+    return GainRule{"min_gain_voxels_per_minute", options.min_gain_voxels_per_minute,
+                    options.min_gain_voxels_per_minute};
+  }
+  if (options.min_gain_m2_per_minute > 0 && resolution_m > 0) {
+    return GainRule{"min_gain_m2_per_minute", options.min_gain_m2_per_minute,
+                    options.min_gain_m2_per_minute / (resolution_m * resolution_m)};
+  }
+  return std::nullopt;
 }
 
 std::vector<double> PlanOptions::TripodHeights() const {

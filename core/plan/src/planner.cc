@@ -156,7 +156,7 @@ Result<PlanResult> Plan(const SceneInput& input, const PlanOptions& options, con
   result.distribution = visibility.distribution;
   for (std::string& w : visibility.warnings) result.warnings.push_back(std::move(w));
 
-  const std::unique_ptr<planner::Selector> selector = planner::SelectorFor(local_options);
+  const std::unique_ptr<planner::Selector> selector = planner::SelectorFor(local_options, scene.resolution_m);
   VC_ASSIGN_OR_RETURN(planner::SelectionOutput selected, runner.Run(Stage::kSelection, [&](const JobContext& c) {
     return planner::RunSelectionStage(
         {scene, *selector, std::move(visibility.sets), std::move(visibility.fixed_sets), candidates.positions,

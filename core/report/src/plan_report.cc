@@ -787,6 +787,18 @@ Json CoverageMilestonesJson(const PlanResult& r) {
   return out;
 }
 
+// plan.json's `gain_rule`: the rule's parameter and value, and its threshold for one station in
+// voxels and minutes of set-up and scan; null when the rule is off.
+Json GainRuleJson(const PlanResult& r) {
+  const std::optional<GainRule> rule = GainRuleOf(r.options, r.resolution_m);
+  if (!rule) return nullptr;
+  const double minutes = (r.options.setup_seconds + r.field_time.scan_seconds_per_station) / 60.0;
+  return {{"parameter", std::string(rule->parameter)},
+          {"value", rule->value},
+          {"station_minutes", minutes},
+          {"threshold_voxels", rule->voxels_per_minute * minutes}};
+}
+
 // A height for plan.json: null when NaN.
 Json HeightJson(double v) { return std::isfinite(v) ? Json(v) : Json(nullptr); }
 
@@ -926,6 +938,7 @@ std::string PlanToJson(const PlanResult& r, const UploadSummary* upload,
          {"resolution_m", r.resolution_m},
          {"selection_test", std::string(SelectionTestName(r.selection_test))},
          {"stop_reason", std::string(StopReasonName(r.stop_reason))},
+         {"gain_rule", GainRuleJson(r)},
          {"greedy_stations", r.greedy_stations},
          {"consolidated", r.consolidated},
          {"viewpoints", std::move(viewpoints)},

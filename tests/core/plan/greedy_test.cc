@@ -263,6 +263,27 @@ TEST(GreedyTest, GainRuleStopsWhereAStationIsWorthLessThanItsMinutes) {
   EXPECT_EQ(Greedy(sets, o).picks.size(), 3u);
 }
 
+TEST(GreedyTest, AreaGainRuleConvertsSquareMetresToVoxels) {
+  // Gains 6, 3, 1 at 2 minutes a station and 4 surface voxels per m^2 (0.5 m voxels).
+  std::vector<VoxelSet> sets = {MakeSet(10, {0, 1, 2, 3, 4, 5}), MakeSet(10, {6, 7, 8}), MakeSet(10, {9})};
+  GreedyOptions o = FullCoverage();
+  o.station_seconds = 120;
+  o.surface_voxels_per_m2 = 4;
+  o.min_gain_m2_per_minute = 0.5;  // 1 m^2 = 4 voxels a station: the gain of 3 stops it
+  GreedyResult r = Greedy(sets, o);
+  EXPECT_EQ(Picks(r), std::vector<int>({0}));
+  EXPECT_EQ(r.stop, StopReason::kGainRule);
+  o.min_gain_m2_per_minute = 0.375;  // 3 voxels: the gain of 3 is worth its time
+  r = Greedy(sets, o);
+  EXPECT_EQ(Picks(r), std::vector<int>({0, 1}));
+  EXPECT_EQ(r.stop, StopReason::kGainRule);
+  o.min_gain_voxels_per_minute = 0.25;  // the voxel rule takes the area rule's place: 0.5 voxels
+  EXPECT_EQ(Greedy(sets, o).picks.size(), 3u);
+  o.min_gain_voxels_per_minute = 0;
+  o.surface_voxels_per_m2 = 0;  // no conversion: the area rule never stops
+  EXPECT_EQ(Greedy(sets, o).picks.size(), 3u);
+}
+
 TEST(GreedyTest, GainRuleAlwaysPlacesTheFirstStation) {
   std::vector<VoxelSet> sets = {MakeSet(10, {0, 1, 2, 3, 4, 5}), MakeSet(10, {6, 7, 8})};
   GreedyOptions o = FullCoverage();
@@ -552,6 +573,12 @@ TEST(GreedyTest, RejectsBadOptions) {
   EXPECT_EQ(SelectGreedy(ThreeRooms(), o).status().code(), StatusCode::kInvalidArgument);
   o = {};
   o.min_gain_voxels_per_minute = -1;
+  EXPECT_EQ(SelectGreedy(ThreeRooms(), o).status().code(), StatusCode::kInvalidArgument);
+  o = {};
+  o.min_gain_m2_per_minute = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_EQ(SelectGreedy(ThreeRooms(), o).status().code(), StatusCode::kInvalidArgument);
+  o = {};
+  o.surface_voxels_per_m2 = -1;
   EXPECT_EQ(SelectGreedy(ThreeRooms(), o).status().code(), StatusCode::kInvalidArgument);
   o = {};
   o.station_seconds = std::numeric_limits<double>::infinity();

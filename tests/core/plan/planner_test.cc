@@ -63,9 +63,11 @@ TEST_P(KnownOptimumTest, FindsTheOptimumAndAStationInEveryRoom) {
   Result<SceneInfo> info = DescribeScene(k.spec);
   ASSERT_TRUE(info.ok());
   EXPECT_EQ(info->optimum_stations, k.stations);
-  // The optimum is the number of stations that see every coverable voxel: plan for all of them.
+  // The optimum is the number of stations that see every coverable voxel: plan for all of them
+  // (the gain rule would leave comb:5's last 94 voxels, under 1 m^2, to a sixth station).
   PlanOptions o = TestOptions();
   o.target_coverage = 1.0;
+  o.min_gain_m2_per_minute = 0;
   Result<PlanResult> r = Plan(Synthetic(k.spec), o);
   ASSERT_TRUE(r.ok()) << r.status().ToString();
   std::cout << "[ " << k.spec << " ] " << Describe(*r) << "\n";
@@ -120,7 +122,8 @@ INSTANTIATE_TEST_SUITE_P(Scenes, KnownOptimumTest,
 TEST_P(KnownOptimumTest, ExactSolverProvesTheOptimum) {
   const Known k = GetParam();
   PlanOptions o = TestOptions();
-  o.target_coverage = 1.0;
+  o.target_coverage = 1.0;  // every coverable voxel, as above
+  o.min_gain_m2_per_minute = 0;
   o.solver = SelectionSolver::kExact;
   Result<PlanResult> r = Plan(Synthetic(k.spec), o);
   ASSERT_TRUE(r.ok()) << r.status().ToString();
@@ -320,7 +323,8 @@ TEST(PlannerTest, CompatibilityNeedsMoreStationsThanSurfaceVisibility) {
   for (const char* spec : {"box", "lroom", "comb:3"}) {
     PlanOptions o = TestOptions();
     o.selection_test = SelectionTest::kCompatibility;
-    o.target_coverage = 1.0;  // compare station counts at full coverage
+    o.target_coverage = 1.0;       // compare station counts at full coverage,
+    o.min_gain_m2_per_minute = 0;  // which the gain rule would stop short of
     Result<PlanResult> r = Plan(Synthetic(spec), o);
     ASSERT_TRUE(r.ok()) << r.status().ToString();
     std::cout << "[ " << spec << ", compatibility ] " << Describe(*r) << "\n";
@@ -985,9 +989,9 @@ TEST(PlannerTest, CoverageCurveAgreesWithTheStationsAndStationsCsv) {
   }
 }
 
-// The gain rule: with greedy's own gains (no consolidation, no reduction) the plan keeps exactly
-// the stations whose gain is worth their minutes; the exact solver (auto) then needs no more
-// stations for at least as much; the default (0) leaves the plan as it was.
+// The gain rule in voxels: with greedy's own gains (no consolidation, no reduction) the plan keeps
+// exactly the stations whose gain is worth their minutes; the exact solver (auto) then needs no
+// more stations for at least as much. The default is the area rule (the test below), not this one.
 TEST(PlannerTest, GainRuleKeepsTheStationsWorthTheirMinutes) {
   PlanOptions o = TestOptions();
   o.solver = SelectionSolver::kGreedy;
@@ -996,6 +1000,7 @@ TEST(PlannerTest, GainRuleKeepsTheStationsWorthTheirMinutes) {
   o.target_coverage = 1.0;
   o.setup_seconds = 120;
   o.scan_seconds = 60;  // 3 minutes a station
+  o.min_gain_m2_per_minute = 0;
   const SceneInput scene = Synthetic("rooms:3");
   Result<PlanResult> all = Plan(scene, o);
   ASSERT_TRUE(all.ok()) << all.status().ToString();
@@ -1020,6 +1025,49 @@ TEST(PlannerTest, GainRuleKeepsTheStationsWorthTheirMinutes) {
   EXPECT_GE(exact->covered_voxels, ruled->covered_voxels);
   EXPECT_EQ(exact->stop_reason, StopReason::kGainRule);
   EXPECT_EQ(PlanOptions{}.min_gain_voxels_per_minute, 0.0);
+}
+
+// The area rule is the voxel rule at 1 / resolution^2 voxels per m^2: the same threshold in m^2
+// keeps the same stations; both > 0 is refused, naming both.
+TEST(PlannerTest, AreaGainRuleIsTheVoxelRuleInSquareMetres) {
+  PlanOptions o = TestOptions();
+  o.solver = SelectionSolver::kGreedy;
+  o.consolidate = false;
+  o.reduce = false;
+  o.target_coverage = 1.0;
+  o.setup_seconds = 120;
+  o.scan_seconds = 60;  // 3 minutes a station
+  o.min_gain_m2_per_minute = 0;
+  const SceneInput scene = Synthetic("rooms:3");
+  Result<PlanResult> all = Plan(scene, o);
+  ASSERT_TRUE(all.ok()) << all.status().ToString();
+  ASSERT_GE(all->stations.size(), 4u);
+  const double threshold = static_cast<double>(all->stations[all->stations.size() / 2].marginal_gain) + 0.5;
+  o.min_gain_voxels_per_minute = threshold / 3.0;
+  Result<PlanResult> voxels = Plan(scene, o);
+  ASSERT_TRUE(voxels.ok()) << voxels.status().ToString();
+  o.min_gain_voxels_per_minute = 0;
+  const double res = all->resolution_m;
+  o.min_gain_m2_per_minute = threshold * res * res / 3.0;
+  Result<PlanResult> area = Plan(scene, o);
+  ASSERT_TRUE(area.ok()) << area.status().ToString();
+  EXPECT_LT(area->stations.size(), all->stations.size());
+  EXPECT_EQ(area->stations.size(), voxels->stations.size());
+  EXPECT_EQ(area->stop_reason, StopReason::kGainRule);
+  const std::optional<GainRule> rule = GainRuleOf(o, res);
+  ASSERT_TRUE(rule.has_value());
+  EXPECT_EQ(rule->parameter, "min_gain_m2_per_minute");
+  EXPECT_NEAR(rule->voxels_per_minute, threshold / 3.0, 1e-9);
+  EXPECT_FALSE(GainRuleOf(o, 0).has_value());
+  o.min_gain_voxels_per_minute = 10;
+  EXPECT_EQ(GainRuleOf(o, res)->parameter, "min_gain_voxels_per_minute");
+  const Status both = o.Validate();
+  EXPECT_EQ(both.code(), StatusCode::kInvalidArgument);
+  EXPECT_NE(both.message().find("min_gain_voxels_per_minute (10) and min_gain_m2_per_minute"), std::string::npos)
+      << both.message();
+  o.min_gain_m2_per_minute = 0;
+  o.min_gain_voxels_per_minute = 0;
+  EXPECT_FALSE(GainRuleOf(o, res).has_value());
 }
 
 TEST(PlannerTest, RealScanGeb079) {

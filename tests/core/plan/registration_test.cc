@@ -148,7 +148,11 @@ TEST(Registration, ReportedOverlapsAreTheIntersectionsOfTheStationsSets) {
 }
 
 TEST(Registration, StoreysNoCandidateLinksAreReportedAsGroups) {
-  Result<PlanResult> r = Plan(Synthetic("twofloor"), Options(0.3));
+  PlanOptions o = Options(0.3);
+  // The 99 % target alone: below it (the default gain rule stops greedy at 1 m^2 a station) the
+  // exact solver finds a connected plan through the stair opening for what greedy covered.
+  o.min_gain_m2_per_minute = 0;
+  Result<PlanResult> r = Plan(Synthetic("twofloor"), o);
   ASSERT_TRUE(r.ok()) << r.status().ToString();
   std::cout << "[ twofloor 0.3 ] " << Describe(*r) << "\n";
   ASSERT_FALSE(r->scan_graph.connected);

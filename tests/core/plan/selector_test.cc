@@ -293,11 +293,13 @@ TEST(SelectionStageTest, SelectorOptionsForCarriesEveryGreedyRowAndMinOverlap) {
   VC_GREEDY_PARAMETERS(VC_CHANGE_ROW)
 #undef VC_CHANGE_ROW
   plan.min_overlap = 0.3;
-  const GreedyOptions o = SelectorOptionsFor(plan);
+  const GreedyOptions o = SelectorOptionsFor(plan, 0.08);
 #define VC_EXPECT_ROW(type, name, ...) EXPECT_EQ(o.name, plan.name) << #name;
   VC_GREEDY_PARAMETERS(VC_EXPECT_ROW)
 #undef VC_EXPECT_ROW
   EXPECT_EQ(o.min_overlap, 0.3);
+  EXPECT_DOUBLE_EQ(o.surface_voxels_per_m2, 156.25);  // 1 / 0.08^2
+  EXPECT_EQ(SelectorOptionsFor(plan, 0).surface_voxels_per_m2, 0.0);
   EXPECT_TRUE(o.lazy);
   EXPECT_EQ(o.fixed, 0);
 }

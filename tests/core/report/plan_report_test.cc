@@ -97,7 +97,7 @@ TEST(PlanReportTest, PlanJsonHasEveryDocumentedKey) {
        {"schema",         "resolution_m",        "selection_test", "stop_reason",  "viewpoints", "coverage",
         "reduction",      "candidates",          "timings_s",      "parameters",   "warnings",   "scan_graph",
         "route",          "field_time_s",        "optimality",     "distribution", "frame",      "crs",
-        "coverage_curve", "coverage_milestones", "peak_rss_bytes"}) {
+        "coverage_curve", "coverage_milestones", "peak_rss_bytes", "gain_rule"}) {
     EXPECT_TRUE(j.contains(key)) << key;
   }
   const json& by_cause = j["coverage"]["uncoverable_by_cause"];
@@ -203,6 +203,28 @@ TEST(PlanReportTest, PlanJsonHasTheCoverageCurveAndItsMilestones) {
   j = json::parse(PlanToJson(r));
   EXPECT_TRUE(j["coverage_milestones"][0]["stations"].is_null());
   EXPECT_TRUE(j["coverage_milestones"][0]["scene_fraction"].is_null());
+}
+
+// The gain rule that ran: its parameter and value, and one station's threshold in voxels
+// (0.5 m2/min at 0.1 m and 2 min a station: 1 m2, 100 voxels); null when off.
+TEST(PlanReportTest, PlanJsonSaysTheGainRuleAndItsValue) {
+  PlanResult r = SamplePlan();
+  r.options.min_gain_voxels_per_minute = 0;
+  r.options.min_gain_m2_per_minute = 0.5;
+  r.options.setup_seconds = 120;
+  r.field_time.scan_seconds_per_station = 0;
+  json j = json::parse(PlanToJson(r));
+  EXPECT_EQ(j["gain_rule"]["parameter"], "min_gain_m2_per_minute");
+  EXPECT_DOUBLE_EQ(j["gain_rule"]["value"].get<double>(), 0.5);
+  EXPECT_DOUBLE_EQ(j["gain_rule"]["station_minutes"].get<double>(), 2.0);
+  EXPECT_NEAR(j["gain_rule"]["threshold_voxels"].get<double>(), 100.0, 1e-9);
+  r.options.min_gain_m2_per_minute = 0;
+  r.options.min_gain_voxels_per_minute = 30;
+  j = json::parse(PlanToJson(r));
+  EXPECT_EQ(j["gain_rule"]["parameter"], "min_gain_voxels_per_minute");
+  EXPECT_DOUBLE_EQ(j["gain_rule"]["threshold_voxels"].get<double>(), 60.0);
+  r.options.min_gain_voxels_per_minute = 0;
+  EXPECT_TRUE(json::parse(PlanToJson(r))["gain_rule"].is_null());
 }
 
 TEST(PlanReportTest, WritesAllFilesWithPngsOfTheExpectedSize) {

@@ -40,9 +40,9 @@ class SharedDeadlineSelector final : public Selector {
   Clock::time_point deadline_;
 };
 
-ExactSelectorOptions ExactOptionsFor(const PlanOptions& options) {
+ExactSelectorOptions ExactOptionsFor(const PlanOptions& options, double resolution_m) {
   ExactSelectorOptions exact;
-  exact.greedy = SelectorOptionsFor(options);
+  exact.greedy = SelectorOptionsFor(options, resolution_m);
   exact.time_limit_s = options.solve_seconds;
   exact.memory_budget_bytes = options.memory_budget_bytes / 2;
   exact.swap_search = options.solver == SelectionSolver::kExact;
@@ -105,24 +105,28 @@ Result<LocalRefinementResult> SelectWithLocalCandidates(const SelectionInput& in
 
 #define VC_COPY_ROW(type, name, ...) out.name = options.name;
 
-GreedyOptions SelectorOptionsFor(const PlanOptions& options) {
+GreedyOptions SelectorOptionsFor(const PlanOptions& options, double resolution_m) {
   GreedyOptions out;
   VC_GREEDY_PARAMETERS(VC_COPY_ROW)
   out.min_overlap = options.min_overlap;
+  out.surface_voxels_per_m2 = resolution_m > 0 ? 1.0 / (resolution_m * resolution_m) : 0.0;
   out.station_seconds = options.setup_seconds + ComputeFieldTime(1, 0.0, options).scan_seconds_per_station;
   return out;
 }
 
 #undef VC_COPY_ROW
 
-std::unique_ptr<Selector> SelectorFor(const PlanOptions& options) {
-  if (options.solver == SelectionSolver::kGreedy) return std::make_unique<GreedySelector>(SelectorOptionsFor(options));
+std::unique_ptr<Selector> SelectorFor(const PlanOptions& options, double resolution_m) {
+  if (options.solver == SelectionSolver::kGreedy) {
+    return std::make_unique<GreedySelector>(SelectorOptionsFor(options, resolution_m));
+  }
   if (options.local_candidates) {
     return std::make_unique<SharedDeadlineSelector>(
-        ExactOptionsFor(options), Clock::now() + std::chrono::duration_cast<Clock::duration>(
-                                                     std::chrono::duration<double>(options.solve_seconds)));
+        ExactOptionsFor(options, resolution_m),
+        Clock::now() +
+            std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(options.solve_seconds)));
   }
-  return std::make_unique<ExactSelector>(ExactOptionsFor(options));
+  return std::make_unique<ExactSelector>(ExactOptionsFor(options, resolution_m));
 }
 
 Result<SelectionOutput> RunSelectionStage(SelectionInput in, const PlanOptions& options, const JobContext& ctx) {

@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <optional>
+#include <string_view>
 #include <vector>
 
 #include "vc/base/geometry.h"
@@ -113,10 +114,22 @@ struct PlanOptions {
   // > local_candidates_radius_m with local_candidates on), a bad keep-out zone, a
   // non-finite fixed station or one inside a keep-out zone, a route_start with a non-finite x or y
   // or an infinite z. A fixed station inside a zone is named after the zone ("keep_out[1]:
-  // fixed_stations[0] (x, y, z) lies inside this zone"). Fields are named as `namer` shows them
+  // fixed_stations[0] (x, y, z) lies inside this zone"), min_gain_voxels_per_minute and
+  // min_gain_m2_per_minute both > 0 (named together). Fields are named as `namer` shows them
   // (vc/base/parameter.h; empty: by their paths, "scanner.max_range_m", "keep_out[0]").
   Status Validate(const FieldNamer& namer = {}) const;
 };
+
+// The gain rule a plan runs with (docs/PLANNING.md, "The gain rule"), when one is on.
+struct GainRule {
+  std::string_view parameter;    // "min_gain_m2_per_minute" or "min_gain_voxels_per_minute"
+  double value = 0;              // the parameter's value, in its unit (m2/min or voxels/min)
+  double voxels_per_minute = 0;  // the same rule in voxels: value x 1 / resolution^2 for m2/min
+};
+
+// The gain rule of `options` at `resolution_m` (the voxel rule when > 0, else the area rule), or
+// nullopt when both are 0 or resolution_m is not > 0 for the area rule.
+[[nodiscard]] std::optional<GainRule> GainRuleOf(const PlanOptions& options, double resolution_m);
 
 // `options` with every position (candidates, keep-out zones, fixed stations, route start) moved
 // from the input's frame to the local frame whose origin lies at `frame_origin_m` in the input's

@@ -127,6 +127,9 @@ class Selector {
 //   The first station is always placed. With min_overlap, the rule reads the linked candidates'
 //   gains; the chains of connecting stations are picked as before.
 //   The exact solver then seeks the fewest stations covering what greedy covered when it stopped.
+// - min_gain_m2_per_minute: the same rule in square metres of surface (docs/PLANNING.md, "The gain
+//   rule"): a gain of g voxels is g x resolution^2 m^2 (GreedyOptions::surface_voxels_per_m2). The
+//   voxel rule, when > 0, takes its place; PlanOptions::Validate refuses both > 0.
 // - consolidate: after greedy selection, drop picks the others cover and replace two picks by one
 //   candidate that sees all they alone covered (coverage never shrinks; docs/PLANNING.md).
 #define VC_GREEDY_PARAMETERS(X)                                                                                        \
@@ -136,6 +139,8 @@ class Selector {
     "stop at this covered fraction of the coverable voxels")                                                           \
   X(double, min_gain_voxels_per_minute, 0.0, "voxels/min", "min-gain-voxels-per-minute", kNonNegative,                 \
     "stop when the best station adds fewer voxels per minute of its set-up and scan (0 = off)")                        \
+  X(double, min_gain_m2_per_minute, 0.5, "m2/min", "min-gain-m2-per-minute", kNonNegative,                             \
+    "stop when the best station adds less surface per minute of its set-up and scan (0 = off)")                        \
   X(bool, consolidate, true, "", "consolidate", kAny, "drop covered picks and merge pairs after greedy")
 
 // The options of greedy selection: of GreedySelector, SelectGreedy and ConsolidatePicks (greedy.h).
@@ -159,6 +164,9 @@ struct GreedyOptions {
   // Set-up and scan time of one station, s: the gain rule's cost (PlanOptions::setup_seconds plus
   // the scan time, FieldTime::scan_seconds_per_station). 0: the gain rule never stops.
   double station_seconds = 0;
+  // Surface voxels per m^2 (1 / resolution^2, the planner sets it): min_gain_m2_per_minute's
+  // conversion. 0: the area rule never stops.
+  double surface_voxels_per_m2 = 0;
   // CELF lazy evaluation (true) or the plain recount of every candidate per round (false).
   bool lazy = true;
   // The first `fixed` sets are stations already placed: picked first, in order (whatever their

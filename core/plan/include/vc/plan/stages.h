@@ -147,12 +147,14 @@ struct SelectionOutput {
 [[nodiscard]] Result<SelectionOutput> RunSelectionStage(SelectionInput in, const PlanOptions& options,
                                                         const JobContext& ctx);
 
-// GreedySelector's options for a plan with `options`: its VC_GREEDY_PARAMETERS rows and min_overlap.
-[[nodiscard]] GreedyOptions SelectorOptionsFor(const PlanOptions& options);
+// GreedySelector's options for a plan with `options` over a scene of `resolution_m`: its
+// VC_GREEDY_PARAMETERS rows, min_overlap, the station's set-up and scan seconds and the area
+// rule's 1 / resolution_m^2 surface voxels per m^2 (0 when resolution_m is not > 0).
+[[nodiscard]] GreedyOptions SelectorOptionsFor(const PlanOptions& options, double resolution_m);
 // The selector options.solver names: GreedySelector, or ExactSelector with options.solve_seconds
 // and half the job's memory budget (the visibility sets hold the rest). With local_candidates its
 // solves share options.solve_seconds counted from this call: make it right before the stage.
-[[nodiscard]] std::unique_ptr<Selector> SelectorFor(const PlanOptions& options);
+[[nodiscard]] std::unique_ptr<Selector> SelectorFor(const PlanOptions& options, double resolution_m);
 
 // --- Stage::kRefine: each station to the best position of a sub-grid around it (s.7.4) ---
 struct RefineInput {
