@@ -641,7 +641,9 @@ TEST(PlanReportTest, EvaluationJsonHasItsKeys) {
   EXPECT_DOUBLE_EQ(j["per_viewpoint"][1]["global_visibility"].get<double>(), 0.37);
   EXPECT_DOUBLE_EQ(j["per_viewpoint"][1]["x"].get<double>(), 3.5);
   const std::string dir = testing::MakeTempDir();
-  ASSERT_TRUE(WriteEvaluationOutputs({plan.evaluation, vps, plan.voxel_centers}, dir).ok());
+  ASSERT_TRUE(WriteEvaluationOutputs(
+                  {.evaluation = plan.evaluation, .viewpoints = vps, .voxel_centers = plan.voxel_centers}, dir)
+                  .ok());
   EXPECT_EQ(json::parse(ReadAll(dir + "/evaluation.json"))["faces_total"].get<int>(), 30);
 }
 

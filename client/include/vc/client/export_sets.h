@@ -1,9 +1,8 @@
-// evaluate --export-sets DIR (docs/VISIBILITY.md, "Checking a prediction: evaluate --export-sets"): each viewpoint's seen set
-// under the evaluation's selection test as DIR/station_<n>.xyz, so that anyone can check the
-// prediction with their own tools. A file holds the centres of the voxels the test counts as seen
-// from viewpoint n (1-based, in the order the viewpoints were given), one "x y z" line each, in
-// metres in the input's own frame (the scene's local frame plus its origin), to the millimetre, in
-// voxel id order. A viewpoint that sees nothing gets an empty file.
+// evaluate --export-sets DIR (docs/VISIBILITY.md, "Checking a prediction: evaluate --export-sets"): each viewpoint's
+// seen set under the evaluation's selection test as DIR/station_<n>.xyz, so that anyone can check the prediction with
+// their own tools. A file holds the centres of the voxels the test counts as seen from viewpoint n (1-based, in the
+// order the viewpoints were given), one "x y z" line each, in metres in the input's own frame (the scene's local frame
+// plus its origin), to the millimetre, in voxel id order. A viewpoint that sees nothing gets an empty file.
 #pragma once
 
 #include <string>
