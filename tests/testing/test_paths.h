@@ -5,6 +5,20 @@
 
 namespace vc::testing {
 
+// Whether this test binary runs under AddressSanitizer: its quarantine keeps freed blocks resident
+// (up to 256 MB), so tests of the process's resident memory cannot see a block's release there.
+#if defined(__SANITIZE_ADDRESS__)
+inline constexpr bool kAddressSanitizer = true;
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+inline constexpr bool kAddressSanitizer = true;
+#else
+inline constexpr bool kAddressSanitizer = false;
+#endif
+#else
+inline constexpr bool kAddressSanitizer = false;
+#endif
+
 // ../shared/data beside the checkout (real scans; see its README).
 std::string SharedDataPath(const std::string& relative);
 // tests/data in the checkout (small hand-made fixtures).
