@@ -761,11 +761,11 @@ class Consolidation {
     std::sort(common_.begin(), common_.end(), [&](int p, int q) { return rank_[p] < rank_[q]; });
   }
 
+  // The bit of failed_ for the pair of slots s and t, in either order.
+  size_t SlotPairBit(size_t s, size_t t) const { return std::min(s, t) * slot_count_ + std::max(s, t); }
   // The bit of failed_ for the picks at positions a and b (without registration).
   size_t FailedBit(size_t a, size_t b) const {
-    const size_t s = static_cast<size_t>(std::min(slots_[a], slots_[b]));
-    const size_t t = static_cast<size_t>(std::max(slots_[a], slots_[b]));
-    return s * slot_count_ + t;
+    return SlotPairBit(static_cast<size_t>(slots_[a]), static_cast<size_t>(slots_[b]));
   }
   // Whether the picks at positions a and b were found unmergeable since the last change near them.
   bool Failed(size_t a, size_t b) const {
@@ -807,7 +807,7 @@ class Consolidation {
   // Clears every failed_ bit of slot s.
   void ForgetSlot(size_t s) {
     for (size_t t = 0; t < slot_count_; ++t) {
-      const size_t bit = std::min(s, t) * slot_count_ + std::max(s, t);
+      const size_t bit = SlotPairBit(s, t);
       failed_[bit >> 6] &= ~(uint64_t{1} << (bit & 63));
     }
   }

@@ -989,18 +989,25 @@ TEST(PlannerTest, CoverageCurveAgreesWithTheStationsAndStationsCsv) {
   }
 }
 
-// The gain rule in voxels: with greedy's own gains (no consolidation, no reduction) the plan keeps
-// exactly the stations whose gain is worth their minutes; the exact solver (auto) then needs no
-// more stations for at least as much. The default is the area rule (the test below), not this one.
-TEST(PlannerTest, GainRuleKeepsTheStationsWorthTheirMinutes) {
+// Greedy's own gains to every last voxel (no consolidation, no reduction), 3 minutes a station,
+// no gain rule yet: the gain-rule tests below set one.
+PlanOptions GainRuleTestOptions() {
   PlanOptions o = TestOptions();
   o.solver = SelectionSolver::kGreedy;
   o.consolidate = false;
   o.reduce = false;
   o.target_coverage = 1.0;
   o.setup_seconds = 120;
-  o.scan_seconds = 60;  // 3 minutes a station
+  o.scan_seconds = 60;
   o.min_gain_m2_per_minute = 0;
+  return o;
+}
+
+// The gain rule in voxels: with greedy's own gains (no consolidation, no reduction) the plan keeps
+// exactly the stations whose gain is worth their minutes; the exact solver (auto) then needs no
+// more stations for at least as much. The default is the area rule (the test below), not this one.
+TEST(PlannerTest, GainRuleKeepsTheStationsWorthTheirMinutes) {
+  PlanOptions o = GainRuleTestOptions();
   const SceneInput scene = Synthetic("rooms:3");
   Result<PlanResult> all = Plan(scene, o);
   ASSERT_TRUE(all.ok()) << all.status().ToString();
@@ -1030,14 +1037,7 @@ TEST(PlannerTest, GainRuleKeepsTheStationsWorthTheirMinutes) {
 // The area rule is the voxel rule at 1 / resolution^2 voxels per m^2: the same threshold in m^2
 // keeps the same stations; both > 0 is refused, naming both.
 TEST(PlannerTest, AreaGainRuleIsTheVoxelRuleInSquareMetres) {
-  PlanOptions o = TestOptions();
-  o.solver = SelectionSolver::kGreedy;
-  o.consolidate = false;
-  o.reduce = false;
-  o.target_coverage = 1.0;
-  o.setup_seconds = 120;
-  o.scan_seconds = 60;  // 3 minutes a station
-  o.min_gain_m2_per_minute = 0;
+  PlanOptions o = GainRuleTestOptions();
   const SceneInput scene = Synthetic("rooms:3");
   Result<PlanResult> all = Plan(scene, o);
   ASSERT_TRUE(all.ok()) << all.status().ToString();
