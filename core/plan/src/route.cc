@@ -2,6 +2,7 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -37,6 +38,9 @@ constexpr int kLinkKinds = kOverGap + kMaxGapVoxels;
 constexpr float kInf = std::numeric_limits<float>::infinity();
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
+using Clock = std::chrono::steady_clock;
+double SecondsSince(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+
 std::string Fmt(const char* format, double a, double b = 0, double c = 0) {
   char buf[160];
   std::snprintf(buf, sizeof buf, format, a, b, c);
@@ -60,6 +64,7 @@ struct WalkGraph {
   std::vector<uint32_t> region_size;  // per region: its nodes
   float unknown_factor = 1;           // cost factor of a link touching such a node
   uint64_t bridged_count = 0;
+  double bridging_s = 0;            // seconds spent on the window minimum and the bridged candidates
   std::vector<uint8_t> link;        // per node, kDirs link kinds (kStraight, kDiagonal, kOverGap + cells)
   int headroom = 0;                 // free voxels above a walk surface
   float cost[kLinkKinds][64] = {};  // link cost (m) by [link kind][|dz| voxels]
@@ -411,7 +416,9 @@ Result<WalkGraph> BuildWalkGraph(const OccupancyGrid& grid, const RouteOptions& 
   std::vector<Candidate> nodes;
   {
     VC_ASSIGN_OR_RETURN(const CellSurfaces surfaces, StandingSurfaces(g, headroom, o, ctx));
+    const Clock::time_point t = Clock::now();
     VC_ASSIGN_OR_RETURN(nodes, ListCandidates(g, surfaces, headroom, o, ctx));
+    g.bridging_s = SecondsSince(t);
   }
   MergeBridgedCandidates(nodes, g.step);
   VC_RETURN_IF_ERROR(KeepNodesWhereAPersonFits(g, nodes, headroom, o, ctx));
@@ -667,13 +674,17 @@ Result<Route> RoutePlanner::Plan(const std::vector<double>& floor_z_m) {
   route_.walk_nodes = uint64_t(g_.size());
   route_.bridged_nodes = g_.bridged_count;
   route_.cell_m = g_.k * g_.r;
+  Clock::time_point t = Clock::now();
   SnapStations(floor_z_m);
   SnapStart();
   VC_RETURN_IF_ERROR(DistancesBetweenStations());
   VC_RETURN_IF_ERROR(DistancesFromStart());
+  route_.seconds.distances_s = SecondsSince(t);
+  t = Clock::now();
   FindParts();
   OrderParts();
   WarnAboutUnlinkedParts();
+  route_.seconds.parts_s = SecondsSince(t);
   for (size_t pi = 0; pi < part_order_.size(); ++pi) VC_RETURN_IF_ERROR(WalkPart(pi));
   return std::move(route_);
 }
@@ -939,7 +950,10 @@ Status RoutePlanner::WalkPart(size_t pi) {
   const bool from_the_start = part_order_[pi] == start_part_;
   const OpenPathProblem problem = PartProblem(part, from_the_start);
   VC_RETURN_IF_ERROR(ctx_.CheckCancelled("walking route"));
+  Clock::time_point t = Clock::now();
   const std::vector<int> local = OrderOpenPath(problem);
+  route_.seconds.order_s += SecondsSince(t);
+  t = Clock::now();
   for (size_t li = 0; li < local.size(); ++li) {
     const int s = part[local[li]];
     const bool first = li == 0;
@@ -959,6 +973,7 @@ Status RoutePlanner::WalkPart(size_t pi) {
     route_.legs_m.push_back(PolylineLength(route_.polylines.back()));
     route_.length_m += route_.legs_m.back();
   }
+  route_.seconds.legs_s += SecondsSince(t);
   return Status::Ok();
 }
 
@@ -1098,9 +1113,14 @@ Result<Route> PlanRoute(const VoxelScene& scene, const std::vector<WorldPoint>& 
   const double r = grid.resolution_m();
   if (!(r > 0) || grid.brick_count() == 0) return InvalidArgumentError("the scene has no voxels to walk on");
   VC_ASSIGN_OR_RETURN(const int k, WalkCellVoxels(options, r));
+  const Clock::time_point t = Clock::now();
   VC_ASSIGN_OR_RETURN(const WalkGraph g, BuildWalkGraph(grid, options, k, ctx));
+  const double walk_graph_s = SecondsSince(t);
   RoutePlanner planner(g, stations, options, ctx);
-  return planner.Plan(floor_z_m);
+  VC_ASSIGN_OR_RETURN(Route route, planner.Plan(floor_z_m));
+  route.seconds.walk_graph_s = walk_graph_s;
+  route.seconds.bridging_s = g.bridging_s;
+  return route;
 }
 
 }  // namespace vc::planner

@@ -97,6 +97,16 @@ struct RouteOptions {
   uint64_t memory_budget_bytes = uint64_t{1} << 30;  // bound on the walk graph's memory (bytes)
 };
 
+// Seconds each phase of PlanRoute took (wall clock; docs/BENCHMARKS.md, "The walking route at campus scale").
+struct RouteSeconds {
+  double walk_graph_s = 0;  // walk cells, standing surfaces, bridging, the person's cylinder, links, regions
+  double bridging_s = 0;    // of walk_graph_s: the window minimum and the bridged candidates (file comment, "Holes")
+  double distances_s = 0;   // snapping, walking distances between stations and from the start
+  double parts_s = 0;       // parts, their order, and each split's warning (where and why)
+  double order_s = 0;       // the order within each part (OrderOpenPath)
+  double legs_s = 0;        // each leg's path (one bounded Dijkstra per leg)
+};
+
 struct Route {
   // Every station index exactly once, in visiting order.
   std::vector<int> order;
@@ -118,6 +128,7 @@ struct Route {
   uint64_t walk_nodes = 0;     // walk nodes (bridged ones included)
   uint64_t bridged_nodes = 0;  // of those, the ones bridging floor gaps
   double cell_m = 0;           // the walk cell edge used (m)
+  RouteSeconds seconds;        // where the time went
 };
 
 // The route through `stations` (optical centres, world, m). floor_z_m: per station the top of the
