@@ -279,7 +279,9 @@ TEST(OpenPathTest, HeuristicMatchesExhaustiveSearchOnSmallInstances) {
       start = Eigen::Vector2d(x, y);
     }
     const OpenPathProblem p = Euclidean(pts, start);
-    const std::vector<int> order = OrderOpenPath(p);
+    const Result<std::vector<int>> ordered = OrderOpenPath(p);
+    ASSERT_TRUE(ordered.ok()) << ordered.status().ToString();
+    const std::vector<int>& order = *ordered;
     std::vector<int> sorted = order;
     std::sort(sorted.begin(), sorted.end());
     for (int i = 0; i < n; ++i) ASSERT_EQ(sorted[i], i);
@@ -294,6 +296,63 @@ TEST(OpenPathTest, HeuristicMatchesExhaustiveSearchOnSmallInstances) {
   }
   std::cout << "[ open path ] optimal in " << exact << " of " << total << ", worst ratio " << worst << "\n";
   EXPECT_GE(exact, total * 9 / 10);
+}
+
+TEST(OpenPathTest, NeighbourListMovesFixWhatTheFullMovesFix) {
+  // The two cases above, with moves only among each point's 2 nearest.
+  const OpenPathProblem behind = Euclidean({{1, 0}, {3, 0}, {5, 0}, {-1.1, 0}}, Eigen::Vector2d(0, 0));
+  Result<std::vector<int>> better = ImprovePathNear(behind, NearestNeighbourPath(behind, -1), 2);
+  ASSERT_TRUE(better.ok());
+  EXPECT_EQ(*better, (std::vector<int>{3, 0, 1, 2}));
+  const OpenPathProblem square = Euclidean({{0, 0}, {1, 0}, {0, 1}, {1, 1}}, std::nullopt);
+  Result<std::vector<int>> fixed = ImprovePathNear(square, {0, 3, 1, 2}, 2);
+  ASSERT_TRUE(fixed.ok());
+  EXPECT_NEAR(OpenPathLength(square, *fixed), 3.0, 1e-9);
+}
+
+// Above kExhaustiveOrderMax points: kLargeOrderRestarts restarts with neighbour-list moves, within
+// 3 % of the full moves from one start (600 random points in a 100 x 100 m square; the exhaustive
+// rule, n restarts of the full moves, would take minutes), with and without a start.
+TEST(OpenPathTest, LargeInstancesUseNeighbourListsAndStayClose) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(0, 100);
+  std::vector<Eigen::Vector2d> pts(600);
+  for (auto& q : pts) {
+    const double x = u(rng), y = u(rng);
+    q = {x, y};
+  }
+  ASSERT_GT(int(pts.size()), kExhaustiveOrderMax);
+  for (const std::optional<Eigen::Vector2d>& start : {std::optional<Eigen::Vector2d>(), std::optional(pts[0])}) {
+    const OpenPathProblem p = Euclidean(pts, start);
+    const auto t0 = std::chrono::steady_clock::now();
+    const Result<std::vector<int>> order = OrderOpenPath(p);
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    ASSERT_TRUE(order.ok()) << order.status().ToString();
+    std::vector<int> sorted = *order;
+    std::sort(sorted.begin(), sorted.end());
+    for (int i = 0; i < p.n; ++i) ASSERT_EQ(sorted[i], i);
+    const double full = OpenPathLength(p, ImprovePath(p, NearestNeighbourPath(p, start ? -1 : 0)));
+    const double got = OpenPathLength(p, *order), nn = OpenPathLength(p, NearestNeighbourPath(p, start ? -1 : 0));
+    std::cout << "[ open path, 600 points" << (start ? ", from a start" : "") << " ] " << got << " m in " << seconds
+              << " s; full moves from one start " << full << " m; nearest neighbour " << nn << " m\n";
+    EXPECT_LE(got, full * 1.03);
+    EXPECT_LT(got, nn * 0.95);
+  }
+}
+
+TEST(OpenPathTest, LargeOrderingIsCancellable) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(0, 100);
+  std::vector<Eigen::Vector2d> pts(kExhaustiveOrderMax + 50);
+  for (auto& q : pts) {
+    const double x = u(rng), y = u(rng);
+    q = {x, y};
+  }
+  CancelToken cancel;
+  cancel.Cancel();
+  JobContext ctx;
+  ctx.cancel = &cancel;
+  EXPECT_EQ(OrderOpenPath(Euclidean(pts, std::nullopt), ctx).status().code(), StatusCode::kCancelled);
 }
 
 // A 10 x 10 m open floor (slab at z 0), nothing else.

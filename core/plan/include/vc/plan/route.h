@@ -156,7 +156,20 @@ double OpenPathLength(const OpenPathProblem& problem, const std::vector<int>& or
 std::vector<int> NearestNeighbourPath(const OpenPathProblem& problem, int first);
 // `order` improved by 2-opt and Or-opt moves until none shortens it.
 std::vector<int> ImprovePath(const OpenPathProblem& problem, std::vector<int> order);
-// The heuristic PlanRoute uses: nearest neighbour (from the start, else from every point), improved, shortest kept.
-std::vector<int> OrderOpenPath(const OpenPathProblem& problem);
+// Up to this many points OrderOpenPath restarts from every point and improves with every move;
+// above it, from kLargeOrderRestarts spread points with moves among kOrderNeighbours nearest points.
+inline constexpr int kExhaustiveOrderMax = 150;
+inline constexpr int kLargeOrderRestarts = 8;
+inline constexpr int kOrderNeighbours = 12;
+// `order` improved by 2-opt and Or-opt moves that link a point to one of its `neighbours` nearest
+// (neighbour lists; Johnson & McGeoch 1997), or put a segment at either end, until none shortens
+// it. CANCELLED / DEADLINE_EXCEEDED from ctx (checked every pass).
+Result<std::vector<int>> ImprovePathNear(const OpenPathProblem& problem, std::vector<int> order, int neighbours,
+                                         const JobContext& ctx = {});
+// The heuristic PlanRoute uses. Up to kExhaustiveOrderMax points: nearest neighbour (from the
+// start, else from every point), ImprovePath, the shortest kept. Above: nearest neighbour from the
+// start, else from kLargeOrderRestarts points spread by farthest-point (point 0 first), each
+// ImprovePathNear with kOrderNeighbours, the shortest kept. CANCELLED / DEADLINE_EXCEEDED from ctx.
+Result<std::vector<int>> OrderOpenPath(const OpenPathProblem& problem, const JobContext& ctx = {});
 
 }  // namespace vc::planner
