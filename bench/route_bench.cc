@@ -32,7 +32,8 @@ struct RouteBenchOptions {
   std::string scene = "rooms:3";
   double spacing = 0.05, resolution = 0, grid = 1.0;
   int stations = 300, threads = 2;
-  std::string baseline;  // NAME=SECONDS
+  std::string ground = "auto";  // the candidates' ground model
+  std::string baseline;         // NAME=SECONDS
   bool warnings = false;
 };
 
@@ -83,6 +84,9 @@ int Run(const RouteBenchOptions& o) {
   vc::planner::CandidateOptions co;
   co.grid_spacing_m = o.grid;
   co.walk_max_step_m = po.walk_max_step_m;
+  co.ground = o.ground == "terrain"  ? vc::GroundModel::kTerrain
+              : o.ground == "floors" ? vc::GroundModel::kFloors
+                                     : vc::GroundModel::kAuto;
   t0 = Clock::now();
   vc::Result<vc::planner::CandidateGrid> c = vc::planner::GenerateCandidates(*scene, co);
   if (!c.ok()) return std::fprintf(stderr, "vc-route-bench: %s\n", c.status().ToString().c_str()), 2;
@@ -146,6 +150,8 @@ int main(int argc, char** argv) {
   app.add_option("--stations", o.stations, "about this many stations, every k-th candidate")
       ->check(CLI::Range(1, 1000000));
   app.add_option("--threads", o.threads, "worker threads (0 = all cores)")->check(CLI::NonNegativeNumber);
+  app.add_option("--ground", o.ground, "the candidates' ground model")
+      ->check(CLI::IsMember({"auto", "terrain", "floors"}));
   app.add_option("--baseline", o.baseline, "NAME=SECONDS: print the route's seconds as a ratio to this baseline");
   app.add_flag("--warnings", o.warnings, "print every warning (default: the first 3)");
   app.add_flag("--quick", quick, "rooms:3 with 20 stations (CI)");

@@ -431,6 +431,13 @@ std::vector<int32_t> WeakComponents(const WalkGraph& g) {
   return root;
 }
 
+// max_step_m in whole voxels of edge r_m (file comment, "Walk graph"): at least one when max_step_m
+// > 0, since with voxels coarser than the step a walkable slope still rises a voxel at a time.
+int StepVoxels(double max_step_m, double r_m) {
+  const int step = static_cast<int>(std::floor(max_step_m / r_m + 1e-9));
+  return max_step_m > 0 ? std::max(1, step) : 0;
+}
+
 // The walk graph of `grid` with cells of k x k columns (file comment).
 Result<WalkGraph> BuildWalkGraph(const OccupancyGrid& grid, const RouteOptions& o, int k, const JobContext& ctx) {
   WalkGraph g;
@@ -439,7 +446,7 @@ Result<WalkGraph> BuildWalkGraph(const OccupancyGrid& grid, const RouteOptions& 
   g.k = k;
   g.nx = (grid.dims().x() + k - 1) / k;
   g.ny = (grid.dims().y() + k - 1) / k;
-  g.step = std::min(62, static_cast<int>(std::floor(o.max_step_m / g.r + 1e-9)));
+  g.step = std::min(62, StepVoxels(o.max_step_m, g.r));
   g.unknown_factor = static_cast<float>(o.unknown_cost_factor);
   VC_RETURN_IF_ERROR(MemoryCheck(g.cells(), 0, o, g.r, k));
   const int headroom = FreeVoxelsNeeded(g.r, o.headroom_m, 0);

@@ -18,6 +18,7 @@
 #include "testing/test_paths.h"
 #include "vc/plan/candidates.h"
 #include "vc/scene/scene_input.h"
+#include "vc/synth/synth.h"
 
 namespace vc::planner {
 namespace {
@@ -655,6 +656,38 @@ TEST(RouteTest, OverTheMemoryBudgetIsResourceExhausted) {
   const Result<Route> r = PlanRoute(OpenFloor(), {At(5, 5)}, {}, o);
   EXPECT_EQ(r.status().code(), StatusCode::kResourceExhausted);
   EXPECT_NE(r.status().message().find("cell_m"), std::string::npos);
+}
+
+// The sloping site (vc-synth slope: 0.1 m terraces every 1 m, a 1:10 slope) at 0.4 m voxels,
+// coarser than the 0.25 m step: the ground rises a voxel (0.4 m) every 4 m, which is still a
+// walkable slope, so the route climbs it in one walk along the site's free edge (y = 27.5 m);
+// the roof of building B (5 m above the ground) stays a part of its own. Before, the step in
+// voxels was 0 at this resolution and every voxel of rise split the route (3 parts here without
+// bridging; fr_campus at 0.4 m).
+TEST(RouteTest, SlopeAtVoxelsCoarserThanTheStepIsOneWalk) {
+  VoxelizeOptions vo;
+  vo.resolution_m = 0.4;
+  Result<VoxelScene> scene = Voxelize(testing::Synthetic("slope"), vo);
+  ASSERT_TRUE(scene.ok()) << scene.status().ToString();
+  auto station = [](double x, double y, double ground_m) -> WorldPoint {
+    return kSceneOffsetM + WorldPoint(x, y, ground_m + 1.5);
+  };
+  const std::vector<WorldPoint> slope{station(1.5, 27.5, 0.1), station(20.5, 27.5, 2.0), station(38.5, 27.5, 3.8)};
+  RouteOptions seen_only;  // no bridging, whose extra voxel of step would hide the defect
+  seen_only.max_gap_m = 0;
+  const Route up = Plan(*scene, slope, seen_only);
+  EXPECT_EQ(up.parts, 1);
+  EXPECT_EQ(up.order, (std::vector<int>{0, 1, 2}));
+  EXPECT_GT(up.length_m, 37.0);
+  EXPECT_LT(up.length_m, 40.0);
+  EXPECT_TRUE(up.warnings.empty()) << up.warnings.front();
+  std::vector<WorldPoint> with_roof = slope;
+  with_roof.push_back(station(28, 20, 8.0));
+  const Route roof = Plan(*scene, with_roof, seen_only);
+  EXPECT_EQ(roof.parts, 2);
+  ASSERT_EQ(roof.warnings.size(), 1u);
+  EXPECT_NE(roof.warnings[0].find("station 3 "), std::string::npos) << roof.warnings[0];
+  EXPECT_NE(roof.warnings[0].find("lower"), std::string::npos) << roof.warnings[0];
 }
 
 TEST(RouteTest, CancelledIsCancelled) {
