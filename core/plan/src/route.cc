@@ -752,7 +752,7 @@ Result<Route> RoutePlanner::Plan(const std::vector<double>& floor_z_m) {
   // The distances, and a part's copy of them for its ordering (OpenPathProblem).
   const uint64_t distance_bytes = 2 * sizeof(double) * uint64_t(n_) * uint64_t(n_);
   if (distance_bytes > options_.memory_budget_bytes) {
-    return ResourceExhaustedError("the walking route's distances between " + std::to_string(n_) + " stations need " +
+    return ResourceExhaustedError("the walking distances between " + std::to_string(n_) + " stations need " +
                                   std::to_string(distance_bytes >> 20) + " MiB, over the memory budget of " +
                                   std::to_string(options_.memory_budget_bytes >> 20) +
                                   " MiB; plan fewer stations (a coarser grid_spacing_m) or give a larger budget");

@@ -690,6 +690,20 @@ TEST(RouteTest, SlopeAtVoxelsCoarserThanTheStepIsOneWalk) {
   EXPECT_NE(roof.warnings[0].find("lower"), std::string::npos) << roof.warnings[0];
 }
 
+// The distances between stations count against the budget too (16 bytes a pair): 400 stations
+// on the open floor need 2.4 MiB, its walk graph under 1 MiB.
+TEST(RouteTest, DistancesOverTheMemoryBudgetAreResourceExhausted) {
+  std::vector<WorldPoint> stations;
+  for (int i = 0; i < 400; ++i) stations.push_back(At(5 + (i % 20) * 4, 5 + (i / 20) * 4));
+  RouteOptions o;
+  o.memory_budget_bytes = 2 << 20;
+  const Result<Route> r = PlanRoute(OpenFloor(), stations, {}, o);
+  ASSERT_EQ(r.status().code(), StatusCode::kResourceExhausted) << r.status().ToString();
+  EXPECT_NE(r.status().message().find("distances between 400 stations"), std::string::npos) << r.status().message();
+  o.memory_budget_bytes = 4 << 20;
+  EXPECT_TRUE(PlanRoute(OpenFloor(), stations, {}, o).ok());
+}
+
 TEST(RouteTest, CancelledIsCancelled) {
   CancelToken cancel;
   cancel.Cancel();
