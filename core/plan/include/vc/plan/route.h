@@ -58,7 +58,7 @@
 // stations (exact), 16 landmark stations per component (the first station, then farthest-point
 // by straight distance) give exact distances to all, and every other pair gets the walk via its
 // best landmark (an upper bound; landmarks as in Goldberg & Harrelson 2005): 294 stations on
-// fr_campus at 0.2 m, 789k walk nodes: 76 s -> 10 s, the route 2.2 % longer (docs/BENCHMARKS.md).
+// fr_campus at 0.2 m, 789k walk nodes: 81 s -> 10 s, the route 2.2 % longer (docs/BENCHMARKS.md).
 // The start's part is walked first, then the others from the lowest floor up (ties: lowest
 // station number). Within a part the order is an open path (no return): OrderOpenPath (below;
 // Croes 1958; Or 1976). Ties are broken by index, so the route is deterministic. Leg lengths and
