@@ -12,14 +12,17 @@
 #     the lines must be the same as without.
 #   --gain-rule-off: the default gain rule switched off (--min-gain-m2-per-minute 0): the plans as
 #     the 99 % target alone stops them, the lines from before the rule became the default.
+#   --route: each line also gives the walking route: its length, parts and a hash of its order, legs
+#     and polylines (to the micrometre), for changes to the route stage (route.h).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bin=${1:-build/release}
-quick="" fan_out="" client_flags=()
+quick="" fan_out="" route="" client_flags=()
 for a in "${@:2}"; do
   case "$a" in
     --quick) quick=--quick ;;
     --fan-out) fan_out=1 ;;
+    --route) route=1 ;;
     --sparse) client_flags+=(--sparse-set-gain 1e-9) ;;
     --gain-rule-off) client_flags+=(--min-gain-m2-per-minute 0) ;;
     *) echo "plan-fingerprints: unknown option $a" >&2; exit 2 ;;
@@ -65,13 +68,21 @@ for f in "${files[@]}"; do
   out="$work/out-$(basename "$f")"
   "$bin/client/vc-client" submit "$f" --server "127.0.0.1:$port" --out "$out" "${client_flags[@]}" >/dev/null 2>"$work/err" ||
     { cat "$work/err"; exit 1; }
-  python3 - "$f" "$out/plan.json" <<'PY'
+  python3 - "$f" "$out/plan.json" "$route" <<'PY'
 import hashlib, json, os, sys
 p = json.load(open(sys.argv[2]))
 xyz = [[v["x"], v["y"], v["z"]] for v in p["viewpoints"]]
 h = hashlib.sha256(json.dumps(xyz).encode()).hexdigest()[:12]
 c = p["coverage"]
-print(f'{os.path.basename(sys.argv[1]):16s} stations={len(xyz):3d} G={c["global_visibility"]:.6f} '
-      f'covered={c["covered_voxels"]}/{c["coverable_voxels"]} stations_sha={h}')
+line = (f'{os.path.basename(sys.argv[1]):16s} stations={len(xyz):3d} G={c["global_visibility"]:.6f} '
+        f'covered={c["covered_voxels"]}/{c["coverable_voxels"]} stations_sha={h}')
+if sys.argv[3]:
+    r = p["route"]
+    um = lambda v: None if v is None else round(v * 1e6)
+    key = [r["order"], [um(v) for v in r["legs_m"]], r["parts"],
+           [[[um(v) for v in q] for q in pl] for pl in r["polyline"]]]
+    rh = hashlib.sha256(json.dumps(key).encode()).hexdigest()[:12]
+    line += f' route={r["length_m"]:.3f}m/{r["parts"]}parts route_sha={rh}'
+print(line)
 PY
 done

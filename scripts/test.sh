@@ -4,7 +4,7 @@
 #   release  - the binaries and the slow tests: the tests of the real binaries (labels smoke and
 #              slow: vc-server and vc-client end to end, the paper experiment), the `heavy` ones
 #              (CBC against exhaustive search on hundreds of instances, geb079's full plan: 15 times
-#              slower under ASan) and vc-bench --quick
+#              slower under ASan) and vc-bench --quick, vc-route-bench --quick
 #   asan     - AddressSanitizer + UndefinedBehaviorSanitizer (clang++): every test except the `slow`
 #              and `heavy` labels (every other unit test runs here, once); the same build holds the
 #              libFuzzer targets
@@ -55,7 +55,7 @@ for p in "${presets[@]}"; do
         # The unit tests run once, under asan (below). The release build makes what only it can
         # test: the shipped binaries end to end (labels smoke and slow), the slow experiments, the
         # heavy solver tests (tests/core/CMakeLists.txt, plan_search_tests) and the benchmarks.
-        cmake --build --preset "$p" --target vc-server vc-client vc-synth vc-bench paper_result_test plan_search_tests
+        cmake --build --preset "$p" --target vc-server vc-client vc-synth vc-bench vc-route-bench paper_result_test plan_search_tests
         echo "=== preset $p: the tests of the binaries, the slow and the heavy ones (labels smoke, slow, heavy)"
         ctest --preset "$p" -j2 -L 'smoke|slow|heavy'
       else
@@ -66,6 +66,7 @@ for p in "${presets[@]}"; do
       echo "=== preset $p: vc-bench --quick, and --visibility-only (figures only, no timing assertions)"
       "build/$p/bench/vc-bench" --quick
       "build/$p/bench/vc-bench" --quick --visibility-only --repeat 1
+      "build/$p/bench/vc-route-bench" --quick
       ;;
   esac
   echo "=== preset $p done after $(( $(date +%s) - start )) s"

@@ -49,13 +49,28 @@ FinalStations AssembleFinalStations(const planner::Stations& stations, const std
   return out;
 }
 
-// A warning when a tenth or more of the `occupied` voxels is visible from no candidate.
-std::optional<std::string> UncoverableWarning(uint64_t occupied, uint64_t coverable) {
+// A warning when a tenth or more of the `occupied` voxels is visible from no candidate, with what
+// may reach them under the candidates' ground model.
+std::optional<std::string> UncoverableWarning(uint64_t occupied, uint64_t coverable, GroundModel ground) {
   const double uncoverable = occupied ? double(occupied - coverable) / occupied : 0.0;
   if (uncoverable < 0.10) return std::nullopt;
+  std::string remedy;
+  switch (ground) {
+    case GroundModel::kFloors:
+      remedy = "a finer grid_spacing_m, other floor levels or user candidates may reach them";
+      break;
+    case GroundModel::kTerrain:
+      remedy =
+          "candidates stand only on the terrain's walkable ground (ground = terrain), so roofs, upper storeys "
+          "and ground it does not link are reached only by user candidates there or ground = floors; a finer "
+          "grid_spacing_m may reach the rest";
+      break;
+    case GroundModel::kAuto:
+      remedy = "user candidates nearer to them may reach them";
+      break;
+  }
   return Percent(uncoverable) + " of occupied voxels (" + std::to_string(occupied - coverable) +
-         ") are visible from no candidate and cannot be covered — a finer grid_spacing_m, "
-         "other floor levels or user candidates may reach them";
+         ") are visible from no candidate and cannot be covered — " + remedy;
 }
 
 // A warning when selection stopped on max_stations or min_marginal_gain_voxels.
@@ -181,7 +196,8 @@ Result<PlanResult> Plan(const SceneInput& input, const PlanOptions& options, con
     coverable = std::move(refined.coverable);
   }
   result.coverable_voxels = coverable.count();
-  if (auto w = UncoverableWarning(result.occupied_voxels, result.coverable_voxels)) result.warnings.push_back(*w);
+  if (auto w = UncoverableWarning(result.occupied_voxels, result.coverable_voxels, result.ground.model))
+    result.warnings.push_back(*w);
   {
     std::vector<WorldPoint> seeing = candidates.positions;
     seeing.insert(seeing.end(), stations.positions.begin(), stations.positions.end());

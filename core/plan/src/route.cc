@@ -2,9 +2,13 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <atomic>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <memory>
+#include <mutex>
 #include <numeric>
 #include <tuple>
 #include <utility>
@@ -36,6 +40,15 @@ constexpr uint8_t kStraight = 0, kDiagonal = 1, kOverGap = 2;
 constexpr int kLinkKinds = kOverGap + kMaxGapVoxels;
 constexpr float kInf = std::numeric_limits<float>::infinity();
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+// Progress reports per long loop (JobContext: at most a few hundred per stage).
+constexpr int kProgressSteps = 50;
+// Above kExhaustiveOrderMax stations (file comment, "Order"): each station's exact distances reach
+// its kNearStations nearest stations; kLandmarks landmarks per component estimate the rest.
+constexpr int kNearStations = 16;
+constexpr int kLandmarks = 16;
+
+using Clock = std::chrono::steady_clock;
+double SecondsSince(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
 std::string Fmt(const char* format, double a, double b = 0, double c = 0) {
   char buf[160];
@@ -60,6 +73,7 @@ struct WalkGraph {
   std::vector<uint32_t> region_size;  // per region: its nodes
   float unknown_factor = 1;           // cost factor of a link touching such a node
   uint64_t bridged_count = 0;
+  double bridging_s = 0;            // seconds spent on the window minimum and the bridged candidates
   std::vector<uint8_t> link;        // per node, kDirs link kinds (kStraight, kDiagonal, kOverGap + cells)
   int headroom = 0;                 // free voxels above a walk surface
   float cost[kLinkKinds][64] = {};  // link cost (m) by [link kind][|dz| voxels]
@@ -395,6 +409,35 @@ void LabelRegions(WalkGraph& g) {
   }
 }
 
+// Per node, a label shared by every node linked to it in either direction (weakly connected
+// components, by union-find): no walk leads from one label to another. (g.region follows links one
+// way, and a diagonal link may be one-way where its side cells hold other surfaces.)
+std::vector<int32_t> WeakComponents(const WalkGraph& g) {
+  std::vector<int32_t> root(size_t(g.size()));
+  std::iota(root.begin(), root.end(), 0);
+  auto find = [&root](int32_t a) {
+    while (root[a] != a) a = root[a] = root[root[a]];
+    return a;
+  };
+  for (int n = 0; n < g.size(); ++n) {
+    for (int d = 0; d < kDirs; ++d) {
+      const int m = g.nbr[size_t(n) * kDirs + d];
+      if (m < 0) continue;
+      const int32_t a = find(n), b = find(m);
+      if (a != b) root[std::max(a, b)] = std::min(a, b);
+    }
+  }
+  for (int n = 0; n < g.size(); ++n) root[n] = find(n);
+  return root;
+}
+
+// max_step_m in whole voxels of edge r_m (file comment, "Walk graph"): at least one when max_step_m
+// > 0, since with voxels coarser than the step a walkable slope still rises a voxel at a time.
+int StepVoxels(double max_step_m, double r_m) {
+  const int step = static_cast<int>(std::floor(max_step_m / r_m + 1e-9));
+  return max_step_m > 0 ? std::max(1, step) : 0;
+}
+
 // The walk graph of `grid` with cells of k x k columns (file comment).
 Result<WalkGraph> BuildWalkGraph(const OccupancyGrid& grid, const RouteOptions& o, int k, const JobContext& ctx) {
   WalkGraph g;
@@ -403,7 +446,7 @@ Result<WalkGraph> BuildWalkGraph(const OccupancyGrid& grid, const RouteOptions& 
   g.k = k;
   g.nx = (grid.dims().x() + k - 1) / k;
   g.ny = (grid.dims().y() + k - 1) / k;
-  g.step = std::min(62, static_cast<int>(std::floor(o.max_step_m / g.r + 1e-9)));
+  g.step = std::min(62, StepVoxels(o.max_step_m, g.r));
   g.unknown_factor = static_cast<float>(o.unknown_cost_factor);
   VC_RETURN_IF_ERROR(MemoryCheck(g.cells(), 0, o, g.r, k));
   const int headroom = FreeVoxelsNeeded(g.r, o.headroom_m, 0);
@@ -411,7 +454,9 @@ Result<WalkGraph> BuildWalkGraph(const OccupancyGrid& grid, const RouteOptions& 
   std::vector<Candidate> nodes;
   {
     VC_ASSIGN_OR_RETURN(const CellSurfaces surfaces, StandingSurfaces(g, headroom, o, ctx));
+    const Clock::time_point t = Clock::now();
     VC_ASSIGN_OR_RETURN(nodes, ListCandidates(g, surfaces, headroom, o, ctx));
+    g.bridging_s = SecondsSince(t);
   }
   MergeBridgedCandidates(nodes, g.step);
   VC_RETURN_IF_ERROR(KeepNodesWhereAPersonFits(g, nodes, headroom, o, ctx));
@@ -426,17 +471,20 @@ class ShortestPaths {
  public:
   explicit ShortestPaths(const WalkGraph& g) : g_(g), stamp_(g.size(), 0), dist_(g.size()), parent_(g.size()) {}
 
-  // Distances from `source`, until every node of `targets` (-1 entries ignored) is settled or
-  // none is left to reach; over all reachable nodes if `targets` is empty.
-  Status Run(int source, const std::vector<int>& targets, const JobContext& ctx) {
+  // Distances from `source`, until every node of `targets` (-1 entries ignored) is settled, or
+  // `stop_after` of them when positive, or none is left to reach; over all reachable nodes if
+  // `targets` is empty. settled() lists the targets settled, nearest first.
+  Status Run(int source, const std::vector<int>& targets, const JobContext& ctx, int stop_after = 0) {
     ++run_;
     heap_.clear();
+    settled_.clear();
     Set(source, 0, -1);
     heap_.push_back({0.0f, source});
     std::vector<int> sorted_targets(targets);
     std::sort(sorted_targets.begin(), sorted_targets.end());
     sorted_targets.erase(std::unique(sorted_targets.begin(), sorted_targets.end()), sorted_targets.end());
     int remaining = int(std::count_if(sorted_targets.begin(), sorted_targets.end(), [](int t) { return t >= 0; }));
+    if (stop_after > 0) remaining = std::min(remaining, stop_after);
     uint64_t pops = 0;
     while (!heap_.empty() && (targets.empty() || remaining > 0)) {
       std::pop_heap(heap_.begin(), heap_.end(), std::greater<>());
@@ -444,7 +492,10 @@ class ShortestPaths {
       heap_.pop_back();
       if (d > dist_[n]) continue;
       if ((++pops & 0xffff) == 0) VC_RETURN_IF_ERROR(ctx.CheckCancelled("walking route"));
-      if (std::binary_search(sorted_targets.begin(), sorted_targets.end(), n)) --remaining;
+      if (std::binary_search(sorted_targets.begin(), sorted_targets.end(), n)) {
+        --remaining;
+        settled_.push_back(n);
+      }
       const int32_t* nb = &g_.nbr[size_t(n) * kDirs];
       for (int k = 0; k < kDirs; ++k) {
         const int m = nb[k];
@@ -462,6 +513,7 @@ class ShortestPaths {
     return Status::Ok();
   }
   float Dist(int n) const { return stamp_[n] == run_ ? dist_[n] : kInf; }
+  const std::vector<int>& settled() const { return settled_; }
   // Nodes from the last run's source to `target` (reached), in walking order.
   std::vector<int> PathTo(int target) const {
     std::vector<int> path;
@@ -482,6 +534,30 @@ class ShortestPaths {
   std::vector<float> dist_;
   std::vector<int32_t> parent_;
   std::vector<std::pair<float, int>> heap_;
+  std::vector<int> settled_;
+};
+
+// ShortestPaths states for parallel workers, each taken by one worker at a time (a state is the
+// size of the graph: allocating one per station would cost more than a short run).
+class ShortestPathsPool {
+ public:
+  explicit ShortestPathsPool(const WalkGraph& g) : g_(g) {}
+  std::unique_ptr<ShortestPaths> Take() {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    if (free_.empty()) return std::make_unique<ShortestPaths>(g_);
+    std::unique_ptr<ShortestPaths> sp = std::move(free_.back());
+    free_.pop_back();
+    return sp;
+  }
+  void Give(std::unique_ptr<ShortestPaths> sp) {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    free_.push_back(std::move(sp));
+  }
+
+ private:
+  const WalkGraph& g_;
+  std::mutex mutex_;
+  std::vector<std::unique_ptr<ShortestPaths>> free_;
 };
 
 // Cell (clamped) of world x or y.
@@ -608,7 +684,6 @@ class RoutePlanner {
         floor_point_(n_),
         node_(n_, -1),
         sp_(g),
-        dist_(size_t(n_) * n_, kNaN),
         from_start_(n_, kNaN) {}
 
   // The route; `floor_z_m` as PlanRoute's (validated).
@@ -619,9 +694,16 @@ class RoutePlanner {
   void SnapStations(const std::vector<double>& floor_z_m);
   // The start's walk node and floor point when options.start is set (-1, with a warning: none).
   void SnapStart();
-  // Walking distances between stations: one Dijkstra per station, on options.threads workers, each
-  // with its own state.
+  // Walking distances between stations (file comment, "Order"), on options.threads workers: up to
+  // kExhaustiveOrderMax stations all pairs exactly, else ExactNearDistances and LandmarkDistances.
   Status DistancesBetweenStations();
+  // Per station, the distances to its kNearStations nearest stations (and any settled on the way).
+  Status ExactNearDistances(const std::vector<int32_t>& component);
+  // Per weak component, kLandmarks landmark stations' distances to all its stations, and the
+  // estimate via the best landmark for every pair still without a distance.
+  Status LandmarkDistances(const std::vector<int32_t>& component);
+  // A progress report when `done` of the stations crosses one of kProgressSteps steps.
+  void ReportDone(int done, const char* what) const;
   // Walking distances from the start to each station, when the start snapped to a node.
   Status DistancesFromStart();
   // Parts: stations linked by finite distances (connected components are transitive).
@@ -667,13 +749,26 @@ Result<Route> RoutePlanner::Plan(const std::vector<double>& floor_z_m) {
   route_.walk_nodes = uint64_t(g_.size());
   route_.bridged_nodes = g_.bridged_count;
   route_.cell_m = g_.k * g_.r;
+  // The distances, and a part's copy of them for its ordering (OpenPathProblem).
+  const uint64_t distance_bytes = 2 * sizeof(double) * uint64_t(n_) * uint64_t(n_);
+  if (distance_bytes > options_.memory_budget_bytes) {
+    return ResourceExhaustedError("the walking distances between " + std::to_string(n_) + " stations need " +
+                                  std::to_string(distance_bytes >> 20) + " MiB, over the memory budget of " +
+                                  std::to_string(options_.memory_budget_bytes >> 20) +
+                                  " MiB; plan fewer stations (a coarser grid_spacing_m) or give a larger budget");
+  }
+  dist_.assign(size_t(n_) * n_, kNaN);
+  Clock::time_point t = Clock::now();
   SnapStations(floor_z_m);
   SnapStart();
   VC_RETURN_IF_ERROR(DistancesBetweenStations());
   VC_RETURN_IF_ERROR(DistancesFromStart());
+  route_.seconds.distances_s = SecondsSince(t);
+  t = Clock::now();
   FindParts();
   OrderParts();
   WarnAboutUnlinkedParts();
+  route_.seconds.parts_s = SecondsSince(t);
   for (size_t pi = 0; pi < part_order_.size(); ++pi) VC_RETURN_IF_ERROR(WalkPart(pi));
   return std::move(route_);
 }
@@ -725,30 +820,186 @@ void RoutePlanner::SnapStart() {
 
 Status RoutePlanner::DistancesBetweenStations() {
   const int n = n_;
+  // Targets of a station: the others of its weak component, the only ones it may reach.
+  std::vector<int32_t> component(n, -1);
+  {
+    const std::vector<int32_t> label = WeakComponents(g_);
+    for (int s = 0; s < n; ++s) {
+      if (node_[s] >= 0) component[s] = label[node_[s]];
+    }
+  }
+  if (n > kExhaustiveOrderMax) {
+    VC_RETURN_IF_ERROR(ExactNearDistances(component));
+    return LandmarkDistances(component);
+  }
   std::vector<Status> run_status(n, Status::Ok());
+  std::atomic<int> done{0};
+  ShortestPathsPool pool(g_);
   VC_RETURN_IF_ERROR(ParallelChunks(
       uint64_t(n), 1, options_.threads, ctx_,
       [&](uint64_t, uint64_t begin, uint64_t) {
         const int s = int(begin);
-        if (node_[s] < 0) return;
-        dist_[size_t(s) * n + s] = 0;
-        std::vector<int> targets;
-        for (int t = s + 1; t < n; ++t) {
-          if (node_[t] >= 0) targets.push_back(node_[t]);
+        if (node_[s] >= 0) {
+          dist_[size_t(s) * n + s] = 0;
+          std::vector<int> targets;
+          for (int t = s + 1; t < n; ++t) {
+            if (component[t] == component[s]) targets.push_back(node_[t]);
+          }
+          if (!targets.empty()) {
+            std::unique_ptr<ShortestPaths> own = pool.Take();
+            run_status[s] = own->Run(node_[s], targets, ctx_);
+            for (int t = s + 1; t < n && run_status[s].ok(); ++t) {
+              if (component[t] != component[s] || own->Dist(node_[t]) == kInf) continue;
+              const double d = Connector(s) + double(own->Dist(node_[t])) + Connector(t);
+              dist_[size_t(s) * n + t] = dist_[size_t(t) * n + s] = d;  // each pair written by s only
+            }
+            pool.Give(std::move(own));
+          }
         }
-        if (targets.empty()) return;
-        ShortestPaths own(g_);
-        run_status[s] = own.Run(node_[s], targets, ctx_);
-        if (!run_status[s].ok()) return;
-        for (int t = s + 1; t < n; ++t) {
-          if (node_[t] < 0 || own.Dist(node_[t]) == kInf) continue;
-          const double d = Connector(s) + double(own.Dist(node_[t])) + Connector(t);
-          dist_[size_t(s) * n + t] = dist_[size_t(t) * n + s] = d;  // each pair written by s only
-        }
+        ReportDone(++done, "walking distances between stations");
       },
       "walking route"));
   for (const Status& st : run_status) VC_RETURN_IF_ERROR(st);
   return Status::Ok();
+}
+
+Status RoutePlanner::ExactNearDistances(const std::vector<int32_t>& component) {
+  const int n = n_;
+  std::vector<Status> run_status(n, Status::Ok());
+  std::atomic<int> done{0};
+  ShortestPathsPool pool(g_);
+  VC_RETURN_IF_ERROR(ParallelChunks(
+      uint64_t(n), 1, options_.threads, ctx_,
+      [&](uint64_t, uint64_t begin, uint64_t) {
+        const int s = int(begin);
+        if (node_[s] >= 0) {
+          dist_[size_t(s) * n + s] = 0;
+          std::vector<int> targets;
+          for (int t = 0; t < n; ++t) {
+            if (t != s && component[t] == component[s]) targets.push_back(node_[t]);
+          }
+          if (!targets.empty()) {
+            std::unique_ptr<ShortestPaths> own = pool.Take();
+            run_status[s] = own->Run(node_[s], targets, ctx_, kNearStations);
+            // Row s only (no other worker writes it): every station on a settled node.
+            std::vector<int> settled = own->settled();
+            std::sort(settled.begin(), settled.end());
+            for (int t = 0; t < n && run_status[s].ok(); ++t) {
+              if (t == s || component[t] != component[s]) continue;
+              if (std::binary_search(settled.begin(), settled.end(), node_[t])) {
+                dist_[size_t(s) * n + t] = Connector(s) + double(own->Dist(node_[t])) + Connector(t);
+              }
+            }
+            pool.Give(std::move(own));
+          }
+        }
+        ReportDone(++done, "walking distances to each station's nearest stations");
+      },
+      "walking route"));
+  for (const Status& st : run_status) VC_RETURN_IF_ERROR(st);
+  // Both directions the shorter of the two runs' values (they differ by float rounding at most).
+  for (int s = 0; s < n; ++s) {
+    for (int t = s + 1; t < n; ++t) {
+      double& a = dist_[size_t(s) * n + t];
+      double& b = dist_[size_t(t) * n + s];
+      if (std::isnan(a) || b < a) a = b;
+      b = a;
+    }
+  }
+  return Status::Ok();
+}
+
+Status RoutePlanner::LandmarkDistances(const std::vector<int32_t>& component) {
+  const int n = n_;
+  std::vector<std::vector<int>> groups;  // stations per weak component, ascending
+  {
+    std::vector<int> order(n);
+    std::iota(order.begin(), order.end(), 0);
+    std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return component[a] < component[b]; });
+    for (int s : order) {
+      if (component[s] < 0) continue;
+      if (groups.empty() || component[groups.back().front()] != component[s]) groups.emplace_back();
+      groups.back().push_back(s);
+    }
+  }
+  // Landmarks by farthest point (straight, between floor points): the group's first station,
+  // then each time the station farthest from those chosen.
+  struct Landmark {
+    size_t group;
+    int station;
+    std::vector<double> row;  // distances (m) to the group's stations, NaN where not reached
+  };
+  std::vector<Landmark> landmarks;
+  for (size_t gi = 0; gi < groups.size(); ++gi) {
+    const std::vector<int>& group = groups[gi];
+    if (group.size() < 2) continue;
+    std::vector<double> nearest(group.size(), std::numeric_limits<double>::infinity());
+    for (int landmark = group.front(), count = 0; landmark >= 0 && count < kLandmarks; ++count) {
+      landmarks.push_back({gi, landmark, {}});
+      for (size_t i = 0; i < group.size(); ++i) {
+        nearest[i] = std::min(nearest[i], (floor_point_[group[i]] - floor_point_[landmark]).norm());
+      }
+      const size_t far = size_t(std::max_element(nearest.begin(), nearest.end()) - nearest.begin());
+      landmark = nearest[far] > 0 ? group[far] : -1;
+    }
+  }
+  std::vector<Status> run_status(landmarks.size(), Status::Ok());
+  std::atomic<int> done{0};
+  ShortestPathsPool pool(g_);
+  VC_RETURN_IF_ERROR(ParallelChunks(
+      uint64_t(landmarks.size()), 1, options_.threads, ctx_,
+      [&](uint64_t, uint64_t begin, uint64_t) {
+        Landmark& l = landmarks[begin];
+        const std::vector<int>& group = groups[l.group];
+        std::unique_ptr<ShortestPaths> own = pool.Take();
+        run_status[begin] = own->Run(node_[l.station], {}, ctx_);
+        l.row.assign(group.size(), kNaN);
+        for (size_t i = 0; i < group.size() && run_status[begin].ok(); ++i) {
+          const int t = group[i];
+          if (own->Dist(node_[t]) == kInf) continue;
+          l.row[i] = t == l.station ? 0.0 : Connector(l.station) + double(own->Dist(node_[t])) + Connector(t);
+        }
+        pool.Give(std::move(own));
+        const int finished = ++done;
+        ctx_.ReportCount(Stage::kRoute, uint64_t(finished), uint64_t(landmarks.size()), "landmarks",
+                         "walking distances from landmark stations");
+      },
+      "walking route"));
+  for (const Status& st : run_status) VC_RETURN_IF_ERROR(st);
+  // A landmark's distances are exact; every other pair without one: the walk via the landmark that
+  // makes it shortest (an upper bound).
+  for (const Landmark& l : landmarks) {
+    const std::vector<int>& group = groups[l.group];
+    for (size_t i = 0; i < group.size(); ++i) {
+      double& a = dist_[size_t(l.station) * n + group[i]];
+      if (!std::isnan(l.row[i]) && !(l.row[i] >= a)) a = dist_[size_t(group[i]) * n + l.station] = l.row[i];
+    }
+  }
+  size_t first = 0;
+  for (size_t gi = 0; gi < groups.size(); ++gi) {
+    const std::vector<int>& group = groups[gi];
+    size_t last = first;
+    while (last < landmarks.size() && landmarks[last].group == gi) ++last;
+    for (size_t i = 0; i < group.size(); ++i) {
+      for (size_t j = i + 1; j < group.size(); ++j) {
+        double& a = dist_[size_t(group[i]) * n + group[j]];
+        if (!std::isnan(a)) continue;
+        for (size_t li = first; li < last; ++li) {
+          const double via = landmarks[li].row[i] + landmarks[li].row[j];
+          if (!std::isnan(via) && !(via >= a)) a = via;
+        }
+        dist_[size_t(group[j]) * n + group[i]] = a;
+      }
+    }
+    first = last;
+  }
+  return Status::Ok();
+}
+
+void RoutePlanner::ReportDone(int done, const char* what) const {
+  if (done * kProgressSteps / n_ != (done - 1) * kProgressSteps / n_) {
+    ctx_.ReportCount(Stage::kRoute, uint64_t(done), uint64_t(n_), "stations", what);
+  }
 }
 
 Status RoutePlanner::DistancesFromStart() {
@@ -939,7 +1190,10 @@ Status RoutePlanner::WalkPart(size_t pi) {
   const bool from_the_start = part_order_[pi] == start_part_;
   const OpenPathProblem problem = PartProblem(part, from_the_start);
   VC_RETURN_IF_ERROR(ctx_.CheckCancelled("walking route"));
-  const std::vector<int> local = OrderOpenPath(problem);
+  Clock::time_point t = Clock::now();
+  VC_ASSIGN_OR_RETURN(const std::vector<int> local, OrderOpenPath(problem, ctx_));
+  route_.seconds.order_s += SecondsSince(t);
+  t = Clock::now();
   for (size_t li = 0; li < local.size(); ++li) {
     const int s = part[local[li]];
     const bool first = li == 0;
@@ -959,6 +1213,7 @@ Status RoutePlanner::WalkPart(size_t pi) {
     route_.legs_m.push_back(PolylineLength(route_.polylines.back()));
     route_.length_m += route_.legs_m.back();
   }
+  route_.seconds.legs_s += SecondsSince(t);
   return Status::Ok();
 }
 
@@ -1074,13 +1329,223 @@ std::vector<int> ImprovePath(const OpenPathProblem& p, std::vector<int> order) {
   return order;
 }
 
-std::vector<int> OrderOpenPath(const OpenPathProblem& p) {
-  if (p.n == 0) return {};
-  if (!p.from_start_m.empty()) return ImprovePath(p, NearestNeighbourPath(p, -1));
+namespace {
+
+// The K points nearest to each point (by distance_m; ties to the lower index), and to the start.
+struct NeighbourLists {
+  int k = 0;
+  std::vector<int> of;          // n x k: of[a * k + r] is a's r-th nearest other point
+  std::vector<int> from_start;  // k points nearest the start; empty without a start
+};
+
+NeighbourLists NearestPoints(const OpenPathProblem& p, int neighbours) {
+  NeighbourLists out;
+  out.k = std::max(0, std::min(neighbours, p.n - 1));
+  std::vector<int> idx;
+  auto nearest = [&](auto&& dist, int self) {
+    idx.clear();
+    for (int b = 0; b < p.n; ++b) {
+      if (b != self) idx.push_back(b);
+    }
+    std::partial_sort(idx.begin(), idx.begin() + out.k, idx.end(),
+                      [&](int x, int y) { return dist(x) < dist(y) || (dist(x) == dist(y) && x < y); });
+  };
+  out.of.reserve(size_t(p.n) * out.k);
+  for (int a = 0; a < p.n; ++a) {
+    nearest([&](int b) { return p.distance_m[size_t(a) * p.n + b]; }, a);
+    out.of.insert(out.of.end(), idx.begin(), idx.begin() + out.k);
+  }
+  if (!p.from_start_m.empty()) {
+    nearest([&](int b) { return p.from_start_m[b]; }, -1);
+    out.from_start.assign(idx.begin(), idx.begin() + out.k);
+  }
+  return out;
+}
+
+// ImprovePathNear's moves over one path; `pos` is the inverse of `order`.
+class NearMoves {
+ public:
+  NearMoves(const OpenPathProblem& p, const NeighbourLists& near, std::vector<int>& order)
+      : p_(p), near_(near), order_(order), n_(int(order.size())), pos_(p.n) {
+    Reindex();
+  }
+  // One pass of 2-opt moves (each reversal adds an edge to one of an end's nearest points), then
+  // of Or-opt moves (a segment of 1-3 points, either way round, next to one of its ends' nearest
+  // points, or at either end of the path); whether any shortened the path.
+  bool Pass() { return TwoOptPass() | OrOptPass(); }
+
+ private:
+  static constexpr double kEps = 1e-9;
+  // From a to b; a < 0 is the start (0 without one); b < 0 is the free end (0).
+  double D(int a, int b) const {
+    if (b < 0) return 0;
+    if (a < 0) return p_.from_start_m.empty() ? 0 : p_.from_start_m[b];
+    return p_.distance_m[size_t(a) * p_.n + b];
+  }
+  int At(int i) const { return i < 0 || i >= n_ ? -1 : order_[i]; }
+  const int* Near(int a) const { return &near_.of[size_t(a) * near_.k]; }
+  void Reindex() {
+    for (int i = 0; i < n_; ++i) pos_[order_[i]] = i;
+  }
+  // The change of reversing order[i..j].
+  double ReverseDelta(int i, int j) const {
+    const int a = At(i - 1), b = At(j + 1), oi = order_[i], oj = order_[j];
+    return D(a, oj) + (b < 0 ? 0 : D(oi, b)) - D(a, oi) - (b < 0 ? 0 : D(oj, b));
+  }
+  void Reverse(int i, int j) {
+    std::reverse(order_.begin() + i, order_.begin() + j + 1);
+    for (int t = i; t <= j; ++t) pos_[order_[t]] = t;
+  }
+  bool TwoOptPass();
+  bool OrOptPass();
+  bool MoveSegment(int i, int len);
+
+  const OpenPathProblem& p_;
+  const NeighbourLists& near_;
+  std::vector<int>& order_;
+  const int n_;
+  std::vector<int> pos_;
+  std::vector<int> rest_;
+};
+
+bool NearMoves::TwoOptPass() {
+  bool improved = false;
+  for (int q = -1; q < n_; ++q) {
+    // A new edge from order[q] (or the start) to a nearer point c = order[j]: reverse order[q+1..j].
+    const int i = q + 1;
+    if (i < n_ && (q >= 0 || !p_.from_start_m.empty())) {
+      const int a = At(q);
+      const int* list = q >= 0 ? Near(a) : near_.from_start.data();
+      const int len = q >= 0 ? near_.k : int(near_.from_start.size());
+      for (int r = 0; r < len; ++r) {
+        const int c = list[r];
+        if (D(a, c) >= D(a, order_[i]) - kEps) break;
+        const int j = pos_[c];
+        if (j > i && ReverseDelta(i, j) < -kEps) {
+          Reverse(i, j);
+          improved = true;
+          break;
+        }
+      }
+    }
+    // A new edge from order[q] back to a nearer point c = order[i]: reverse order[i..q-1].
+    const int j = q - 1;
+    if (q >= 1) {
+      const int b = order_[q];
+      for (int r = 0; r < near_.k; ++r) {
+        const int c = Near(b)[r];
+        if (D(c, b) >= D(order_[j], b) - kEps) break;
+        const int ic = pos_[c];
+        if (ic < j && ReverseDelta(ic, j) < -kEps) {
+          Reverse(ic, j);
+          improved = true;
+          break;
+        }
+      }
+    }
+  }
+  return improved;
+}
+
+bool NearMoves::OrOptPass() {
+  bool improved = false;
+  for (int len = 1; len <= 3; ++len) {
+    for (int i = 0; i + len <= n_; ++i) improved |= MoveSegment(i, len);
+  }
+  return improved;
+}
+
+// Moves order[i..i+len-1] to its best place among those next to its ends' nearest points and the
+// path's two ends, if that shortens the path.
+bool NearMoves::MoveSegment(int i, int len) {
+  const int first = order_[i], last = order_[i + len - 1], a = At(i - 1), b = At(i + len);
+  const double gain = D(a, first) + D(last, b) - (b < 0 ? 0 : D(a, b));
+  const int m = n_ - len;  // places in the path without the segment: 0..m
+  auto rest_at = [&](int g) { return g < 0 || g >= m ? -1 : order_[g < i ? g : g + len]; };
+  double best = -kEps;
+  int best_g = -1;
+  bool best_rev = false;
+  auto consider = [&](int g) {
+    if (g < 0 || g > m) return;
+    const int x = rest_at(g - 1), y = rest_at(g);
+    for (int rev = 0; rev < (len > 1 ? 2 : 1); ++rev) {
+      if (g == i && !rev) continue;
+      const int s = rev ? last : first, e = rev ? first : last;
+      const double delta = D(x, s) + D(e, y) - (y < 0 ? 0 : D(x, y)) - gain;
+      if (delta < best) {
+        best = delta;
+        best_g = g;
+        best_rev = rev;
+      }
+    }
+  };
+  consider(0);
+  consider(m);
+  for (int end : {first, last}) {
+    for (int r = 0; r < near_.k; ++r) {
+      const int c = Near(end)[r], pc = pos_[c];
+      if (pc >= i && pc < i + len) continue;
+      const int gc = pc < i ? pc : pc - len;  // c's place without the segment
+      consider(gc);
+      consider(gc + 1);
+    }
+  }
+  if (best_g < 0) return false;
+  rest_.assign(order_.begin(), order_.begin() + i);
+  rest_.insert(rest_.end(), order_.begin() + i + len, order_.end());
+  std::vector<int> seg(order_.begin() + i, order_.begin() + i + len);
+  if (best_rev) std::reverse(seg.begin(), seg.end());
+  rest_.insert(rest_.begin() + best_g, seg.begin(), seg.end());
+  order_.swap(rest_);
+  Reindex();
+  return true;
+}
+
+// Up to `count` points spread over the problem: point 0, then each time the point farthest from
+// those chosen (ties to the lower index).
+std::vector<int> SpreadPoints(const OpenPathProblem& p, int count) {
+  std::vector<int> chosen{0};
+  std::vector<double> nearest(p.distance_m.begin(), p.distance_m.begin() + p.n);
+  while (int(chosen.size()) < std::min(count, p.n)) {
+    int far = 0;
+    for (int a = 1; a < p.n; ++a) {
+      if (nearest[a] > nearest[far]) far = a;
+    }
+    chosen.push_back(far);
+    for (int a = 0; a < p.n; ++a) nearest[a] = std::min(nearest[a], p.distance_m[size_t(far) * p.n + a]);
+  }
+  return chosen;
+}
+
+}  // namespace
+
+Result<std::vector<int>> ImprovePathNear(const OpenPathProblem& p, std::vector<int> order, int neighbours,
+                                         const JobContext& ctx) {
+  const NeighbourLists near = NearestPoints(p, neighbours);
+  NearMoves moves(p, near, order);
+  for (bool improved = true; improved;) {
+    VC_RETURN_IF_ERROR(ctx.CheckCancelled("walking route"));
+    improved = moves.Pass();
+  }
+  return order;
+}
+
+Result<std::vector<int>> OrderOpenPath(const OpenPathProblem& p, const JobContext& ctx) {
+  if (p.n == 0) return std::vector<int>{};
+  const bool large = p.n > kExhaustiveOrderMax;
+  auto improve = [&](std::vector<int> order) -> Result<std::vector<int>> {
+    if (!large) return ImprovePath(p, std::move(order));
+    return ImprovePathNear(p, std::move(order), kOrderNeighbours, ctx);
+  };
+  if (!p.from_start_m.empty()) return improve(NearestNeighbourPath(p, -1));
+  std::vector<int> firsts(size_t(p.n));
+  std::iota(firsts.begin(), firsts.end(), 0);
+  if (large) firsts = SpreadPoints(p, kLargeOrderRestarts);
   std::vector<int> best;
   double best_len = 0;
-  for (int first = 0; first < p.n; ++first) {
-    std::vector<int> o = ImprovePath(p, NearestNeighbourPath(p, first));
+  for (int first : firsts) {
+    VC_RETURN_IF_ERROR(ctx.CheckCancelled("walking route"));
+    VC_ASSIGN_OR_RETURN(std::vector<int> o, improve(NearestNeighbourPath(p, first)));
     const double len = OpenPathLength(p, o);
     if (best.empty() || len < best_len - 1e-9) {
       best = std::move(o);
@@ -1098,9 +1563,14 @@ Result<Route> PlanRoute(const VoxelScene& scene, const std::vector<WorldPoint>& 
   const double r = grid.resolution_m();
   if (!(r > 0) || grid.brick_count() == 0) return InvalidArgumentError("the scene has no voxels to walk on");
   VC_ASSIGN_OR_RETURN(const int k, WalkCellVoxels(options, r));
+  const Clock::time_point t = Clock::now();
   VC_ASSIGN_OR_RETURN(const WalkGraph g, BuildWalkGraph(grid, options, k, ctx));
+  const double walk_graph_s = SecondsSince(t);
   RoutePlanner planner(g, stations, options, ctx);
-  return planner.Plan(floor_z_m);
+  VC_ASSIGN_OR_RETURN(Route route, planner.Plan(floor_z_m));
+  route.seconds.walk_graph_s = walk_graph_s;
+  route.seconds.bridging_s = g.bridging_s;
+  return route;
 }
 
 }  // namespace vc::planner

@@ -106,7 +106,18 @@ TEST(PlannerTest, SlopingSitePlansOnTheTerrainWithOneRoute) {
     EXPECT_NEAR(s.position.z() - s.floor_z_m, 1.5, 1e-9);
   }
   EXPECT_EQ(r->route.parts, 1);
-  for (const std::string& w : r->warnings) std::cout << "  warning: " << w << "\n";
+  // The roofs are seen from no candidate (14.7 %): the warning names what reaches them on terrain,
+  // not "other floor levels", which the terrain does not have (issue 35).
+  int uncoverable = 0;
+  for (const std::string& w : r->warnings) {
+    std::cout << "  warning: " << w << "\n";
+    if (w.find("cannot be covered") == std::string::npos) continue;
+    ++uncoverable;
+    EXPECT_NE(w.find("terrain's walkable ground"), std::string::npos) << w;
+    EXPECT_NE(w.find("roofs"), std::string::npos) << w;
+    EXPECT_EQ(w.find("floor levels"), std::string::npos) << w;
+  }
+  EXPECT_EQ(uncoverable, 1);
 }
 
 INSTANTIATE_TEST_SUITE_P(Scenes, KnownOptimumTest,

@@ -18,6 +18,7 @@
 #include "testing/test_paths.h"
 #include "vc/plan/candidates.h"
 #include "vc/scene/scene_input.h"
+#include "vc/synth/synth.h"
 
 namespace vc::planner {
 namespace {
@@ -279,7 +280,9 @@ TEST(OpenPathTest, HeuristicMatchesExhaustiveSearchOnSmallInstances) {
       start = Eigen::Vector2d(x, y);
     }
     const OpenPathProblem p = Euclidean(pts, start);
-    const std::vector<int> order = OrderOpenPath(p);
+    const Result<std::vector<int>> ordered = OrderOpenPath(p);
+    ASSERT_TRUE(ordered.ok()) << ordered.status().ToString();
+    const std::vector<int>& order = *ordered;
     std::vector<int> sorted = order;
     std::sort(sorted.begin(), sorted.end());
     for (int i = 0; i < n; ++i) ASSERT_EQ(sorted[i], i);
@@ -294,6 +297,63 @@ TEST(OpenPathTest, HeuristicMatchesExhaustiveSearchOnSmallInstances) {
   }
   std::cout << "[ open path ] optimal in " << exact << " of " << total << ", worst ratio " << worst << "\n";
   EXPECT_GE(exact, total * 9 / 10);
+}
+
+TEST(OpenPathTest, NeighbourListMovesFixWhatTheFullMovesFix) {
+  // The two cases above, with moves only among each point's 2 nearest.
+  const OpenPathProblem behind = Euclidean({{1, 0}, {3, 0}, {5, 0}, {-1.1, 0}}, Eigen::Vector2d(0, 0));
+  Result<std::vector<int>> better = ImprovePathNear(behind, NearestNeighbourPath(behind, -1), 2);
+  ASSERT_TRUE(better.ok());
+  EXPECT_EQ(*better, (std::vector<int>{3, 0, 1, 2}));
+  const OpenPathProblem square = Euclidean({{0, 0}, {1, 0}, {0, 1}, {1, 1}}, std::nullopt);
+  Result<std::vector<int>> fixed = ImprovePathNear(square, {0, 3, 1, 2}, 2);
+  ASSERT_TRUE(fixed.ok());
+  EXPECT_NEAR(OpenPathLength(square, *fixed), 3.0, 1e-9);
+}
+
+// Above kExhaustiveOrderMax points: kLargeOrderRestarts restarts with neighbour-list moves, within
+// 3 % of the full moves from one start (600 random points in a 100 x 100 m square; the exhaustive
+// rule, n restarts of the full moves, would take minutes), with and without a start.
+TEST(OpenPathTest, LargeInstancesUseNeighbourListsAndStayClose) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(0, 100);
+  std::vector<Eigen::Vector2d> pts(600);
+  for (auto& q : pts) {
+    const double x = u(rng), y = u(rng);
+    q = {x, y};
+  }
+  ASSERT_GT(int(pts.size()), kExhaustiveOrderMax);
+  for (const std::optional<Eigen::Vector2d>& start : {std::optional<Eigen::Vector2d>(), std::optional(pts[0])}) {
+    const OpenPathProblem p = Euclidean(pts, start);
+    const auto t0 = std::chrono::steady_clock::now();
+    const Result<std::vector<int>> order = OrderOpenPath(p);
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    ASSERT_TRUE(order.ok()) << order.status().ToString();
+    std::vector<int> sorted = *order;
+    std::sort(sorted.begin(), sorted.end());
+    for (int i = 0; i < p.n; ++i) ASSERT_EQ(sorted[i], i);
+    const double full = OpenPathLength(p, ImprovePath(p, NearestNeighbourPath(p, start ? -1 : 0)));
+    const double got = OpenPathLength(p, *order), nn = OpenPathLength(p, NearestNeighbourPath(p, start ? -1 : 0));
+    std::cout << "[ open path, 600 points" << (start ? ", from a start" : "") << " ] " << got << " m in " << seconds
+              << " s; full moves from one start " << full << " m; nearest neighbour " << nn << " m\n";
+    EXPECT_LE(got, full * 1.03);
+    EXPECT_LT(got, nn * 0.95);
+  }
+}
+
+TEST(OpenPathTest, LargeOrderingIsCancellable) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(0, 100);
+  std::vector<Eigen::Vector2d> pts(kExhaustiveOrderMax + 50);
+  for (auto& q : pts) {
+    const double x = u(rng), y = u(rng);
+    q = {x, y};
+  }
+  CancelToken cancel;
+  cancel.Cancel();
+  JobContext ctx;
+  ctx.cancel = &cancel;
+  EXPECT_EQ(OrderOpenPath(Euclidean(pts, std::nullopt), ctx).status().code(), StatusCode::kCancelled);
 }
 
 // A 10 x 10 m open floor (slab at z 0), nothing else.
@@ -596,6 +656,52 @@ TEST(RouteTest, OverTheMemoryBudgetIsResourceExhausted) {
   const Result<Route> r = PlanRoute(OpenFloor(), {At(5, 5)}, {}, o);
   EXPECT_EQ(r.status().code(), StatusCode::kResourceExhausted);
   EXPECT_NE(r.status().message().find("cell_m"), std::string::npos);
+}
+
+// The sloping site (vc-synth slope: 0.1 m terraces every 1 m, a 1:10 slope) at 0.4 m voxels,
+// coarser than the 0.25 m step: the ground rises a voxel (0.4 m) every 4 m, which is still a
+// walkable slope, so the route climbs it in one walk along the site's free edge (y = 27.5 m);
+// the roof of building B (5 m above the ground) stays a part of its own. Before, the step in
+// voxels was 0 at this resolution and every voxel of rise split the route (3 parts here without
+// bridging; fr_campus at 0.4 m).
+TEST(RouteTest, SlopeAtVoxelsCoarserThanTheStepIsOneWalk) {
+  VoxelizeOptions vo;
+  vo.resolution_m = 0.4;
+  Result<VoxelScene> scene = Voxelize(testing::Synthetic("slope"), vo);
+  ASSERT_TRUE(scene.ok()) << scene.status().ToString();
+  auto station = [](double x, double y, double ground_m) -> WorldPoint {
+    return kSceneOffsetM + WorldPoint(x, y, ground_m + 1.5);
+  };
+  const std::vector<WorldPoint> slope{station(1.5, 27.5, 0.1), station(20.5, 27.5, 2.0), station(38.5, 27.5, 3.8)};
+  RouteOptions seen_only;  // no bridging, whose extra voxel of step would hide the defect
+  seen_only.max_gap_m = 0;
+  const Route up = Plan(*scene, slope, seen_only);
+  EXPECT_EQ(up.parts, 1);
+  EXPECT_EQ(up.order, (std::vector<int>{0, 1, 2}));
+  EXPECT_GT(up.length_m, 37.0);
+  EXPECT_LT(up.length_m, 40.0);
+  EXPECT_TRUE(up.warnings.empty()) << up.warnings.front();
+  std::vector<WorldPoint> with_roof = slope;
+  with_roof.push_back(station(28, 20, 8.0));
+  const Route roof = Plan(*scene, with_roof, seen_only);
+  EXPECT_EQ(roof.parts, 2);
+  ASSERT_EQ(roof.warnings.size(), 1u);
+  EXPECT_NE(roof.warnings[0].find("station 3 "), std::string::npos) << roof.warnings[0];
+  EXPECT_NE(roof.warnings[0].find("lower"), std::string::npos) << roof.warnings[0];
+}
+
+// The distances between stations count against the budget too (16 bytes a pair): 400 stations
+// on the open floor need 2.4 MiB, its walk graph under 1 MiB.
+TEST(RouteTest, DistancesOverTheMemoryBudgetAreResourceExhausted) {
+  std::vector<WorldPoint> stations;
+  for (int i = 0; i < 400; ++i) stations.push_back(At(5 + (i % 20) * 4, 5 + (i / 20) * 4));
+  RouteOptions o;
+  o.memory_budget_bytes = 2 << 20;
+  const Result<Route> r = PlanRoute(OpenFloor(), stations, {}, o);
+  ASSERT_EQ(r.status().code(), StatusCode::kResourceExhausted) << r.status().ToString();
+  EXPECT_NE(r.status().message().find("distances between 400 stations"), std::string::npos) << r.status().message();
+  o.memory_budget_bytes = 4 << 20;
+  EXPECT_TRUE(PlanRoute(OpenFloor(), stations, {}, o).ok());
 }
 
 TEST(RouteTest, CancelledIsCancelled) {

@@ -13,6 +13,8 @@
 // may hold something (scan noise, chair legs, a door leaf): the planner passes 0.35, as geb079's
 // cluttered offices leave almost no fully free cylinder. Each node links to the
 // node of each of its 8 neighbour cells whose surface differs from its own by at most max_step_m
+// (in whole voxels, at least one when max_step_m > 0: with voxels coarser than the step, as
+// fr_campus at 0.4 m, a walkable slope still rises a voxel at a time)
 // (the closest in height, the higher on a tie; a voxel more where either node is bridged, below);
 // a diagonal link needs both side cells to have such a node, so paths never cut a wall's corner.
 // A link costs the 3D distance between the two surface points. Stairs and ramps in the scan thus link storeys; without
@@ -47,19 +49,28 @@
 // forms a part of its own. The start snaps the same way to the highest walk surface within 1 m horizontally that is at
 // most max_step_m above start.z (a floor point or a person's eye), else the nearest in height.
 //
-// Order. Shortest walking distances between all stations (Dijkstra from each station, with the
-// connectors from each station's floor point to its node) define the parts: groups of stations
-// linked by walkable paths. The start's part is walked first, then the others from the lowest
-// floor up (ties: lowest station number). Within a part the order is an open path (no return):
-// nearest neighbour from the start, or without a start from every station in turn, each improved
-// by 2-opt and Or-opt (segments of 1-3 stations, either direction) to a local optimum, the
-// shortest kept (Croes 1958; Or 1976). Ties are broken by index, so the route is deterministic.
+// Order. Shortest walking distances between stations (Dijkstra, with the connectors from each
+// station's floor point to its node) define the parts: groups of stations linked by walkable
+// paths. A station's Dijkstra targets only the stations of its weak component (nodes linked in
+// either direction), so it never searches a component for a station it cannot reach. Up to
+// kExhaustiveOrderMax (150) stations every pair is exact (one Dijkstra per station, stopped once
+// the later stations are settled). Above, each station's Dijkstra stops at its 16 nearest
+// stations (exact), 16 landmark stations per component (the first station, then farthest-point
+// by straight distance) give exact distances to all, and every other pair gets the walk via its
+// best landmark (an upper bound; landmarks as in Goldberg & Harrelson 2005): 294 stations on
+// fr_campus at 0.2 m, 789k walk nodes: 81 s -> 10 s, the route 2.2 % longer (docs/BENCHMARKS.md).
+// The start's part is walked first, then the others from the lowest floor up (ties: lowest
+// station number). Within a part the order is an open path (no return): OrderOpenPath (below;
+// Croes 1958; Or 1976). Ties are broken by index, so the route is deterministic. Leg lengths and
+// polylines are always exact (one Dijkstra per leg, stopped at its end).
 //
 // Cost: the window minimum is 2 (2 max_gap_m / cell + 1) cells per cell (geb079 at 0.08 m with
 // max_gap_m 1.5: about 0.25 s for the whole route of 15 stations). Memory: one 4-byte offset per
-// cell and about 92 bytes per walk node (surface, neighbours, Dijkstra state); RESOURCE_EXHAUSTED
-// when that exceeds memory_budget_bytes (geb079 at 0.08 m:
-// see docs/PLANNING.md). Stateless; safe to call from several threads.
+// cell and about 92 bytes per walk node (surface, neighbours, Dijkstra state), and 16 bytes per
+// pair of stations (the distances and a part's copy); RESOURCE_EXHAUSTED when either exceeds
+// memory_budget_bytes (geb079 at 0.08 m: see docs/PLANNING.md). Progress (Stage::kRoute) is
+// reported per station and landmark; ctx is honoured in every long loop. Stateless; safe to call
+// from several threads.
 #pragma once
 
 #include <cstdint>
@@ -97,6 +108,16 @@ struct RouteOptions {
   uint64_t memory_budget_bytes = uint64_t{1} << 30;  // bound on the walk graph's memory (bytes)
 };
 
+// Seconds each phase of PlanRoute took (wall clock; docs/BENCHMARKS.md, "The walking route at campus scale").
+struct RouteSeconds {
+  double walk_graph_s = 0;  // walk cells, standing surfaces, bridging, the person's cylinder, links, regions
+  double bridging_s = 0;    // of walk_graph_s: the window minimum and the bridged candidates (file comment, "Holes")
+  double distances_s = 0;   // snapping, walking distances between stations and from the start
+  double parts_s = 0;       // parts, their order, and each split's warning (where and why)
+  double order_s = 0;       // the order within each part (OrderOpenPath)
+  double legs_s = 0;        // each leg's path (one bounded Dijkstra per leg)
+};
+
 struct Route {
   // Every station index exactly once, in visiting order.
   std::vector<int> order;
@@ -118,13 +139,14 @@ struct Route {
   uint64_t walk_nodes = 0;     // walk nodes (bridged ones included)
   uint64_t bridged_nodes = 0;  // of those, the ones bridging floor gaps
   double cell_m = 0;           // the walk cell edge used (m)
+  RouteSeconds seconds;        // where the time went
 };
 
 // The route through `stations` (optical centres, world, m). floor_z_m: per station the top of the
 // floor under it (m), NaN when unknown; empty = all unknown. INVALID_ARGUMENT for non-finite
 // stations or options, a floor_z_m of the wrong size, or a cell coarser than the clearance allows;
-// RESOURCE_EXHAUSTED when the walk graph exceeds the budget; CANCELLED / DEADLINE_EXCEEDED from
-// ctx. No stations: an empty route.
+// RESOURCE_EXHAUSTED when the walk graph or the distances between stations exceed the budget; CANCELLED /
+// DEADLINE_EXCEEDED from ctx. No stations: an empty route.
 Result<Route> PlanRoute(const VoxelScene& scene, const std::vector<WorldPoint>& stations,
                         const std::vector<double>& floor_z_m, const RouteOptions& options, const JobContext& ctx = {});
 
@@ -145,7 +167,20 @@ double OpenPathLength(const OpenPathProblem& problem, const std::vector<int>& or
 std::vector<int> NearestNeighbourPath(const OpenPathProblem& problem, int first);
 // `order` improved by 2-opt and Or-opt moves until none shortens it.
 std::vector<int> ImprovePath(const OpenPathProblem& problem, std::vector<int> order);
-// The heuristic PlanRoute uses: nearest neighbour (from the start, else from every point), improved, shortest kept.
-std::vector<int> OrderOpenPath(const OpenPathProblem& problem);
+// Up to this many points OrderOpenPath restarts from every point and improves with every move;
+// above it, from kLargeOrderRestarts spread points with moves among kOrderNeighbours nearest points.
+inline constexpr int kExhaustiveOrderMax = 150;
+inline constexpr int kLargeOrderRestarts = 8;
+inline constexpr int kOrderNeighbours = 12;
+// `order` improved by 2-opt and Or-opt moves that link a point to one of its `neighbours` nearest
+// (neighbour lists; Johnson & McGeoch 1997), or put a segment at either end, until none shortens
+// it. CANCELLED / DEADLINE_EXCEEDED from ctx (checked every pass).
+Result<std::vector<int>> ImprovePathNear(const OpenPathProblem& problem, std::vector<int> order, int neighbours,
+                                         const JobContext& ctx = {});
+// The heuristic PlanRoute uses. Up to kExhaustiveOrderMax points: nearest neighbour (from the
+// start, else from every point), ImprovePath, the shortest kept. Above: nearest neighbour from the
+// start, else from kLargeOrderRestarts points spread by farthest-point (point 0 first), each
+// ImprovePathNear with kOrderNeighbours, the shortest kept. CANCELLED / DEADLINE_EXCEEDED from ctx.
+Result<std::vector<int>> OrderOpenPath(const OpenPathProblem& problem, const JobContext& ctx = {});
 
 }  // namespace vc::planner
