@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Plans that must not change by accident: plans geb079, the synthetic hall, the real hall scan and
-# every known-optimum scene through a real vc-server and vc-client, and prints one line per scene:
+# every known-optimum scene (the hubs and tworooms since issue 36) through a real vc-server and vc-client, and prints one line per scene:
 # stations, G, covered/coverable voxels and a hash of the stations' coordinates. Run it on two
 # builds and diff the output (docs/BENCHMARKS.md, "Plans must not change by accident").
 # Usage: scripts/plan-fingerprints.sh [BUILD_DIR (default build/release)] [--quick] [--fan-out]
@@ -53,7 +53,7 @@ else
   start_server server.log
 fi
 
-scenes=(box lroom comb:3 comb:5 rooms:3 twofloor)
+scenes=(box lroom comb:3 comb:5 rooms:3 twofloor tworooms hub:1 hub:2 hub:3)
 [[ "$quick" == "--quick" ]] || scenes+=(hall)
 files=(../shared/data/geb079/geb079.bt)
 [[ "$quick" == "--quick" ]] || files+=(../shared/data/hall-scan/scan.dat.bz2)
