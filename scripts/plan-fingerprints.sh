@@ -4,7 +4,7 @@
 # stations, G, covered/coverable voxels and a hash of the stations' coordinates. Run it on two
 # builds and diff the output (docs/BENCHMARKS.md, "Plans must not change by accident").
 # Usage: scripts/plan-fingerprints.sh [BUILD_DIR (default build/release)] [--quick] [--fan-out]
-#        [--sparse] [--gain-rule-off]
+#        [--sparse] [--gain-rule-off] [--no-doorway-candidates]
 #   --quick: geb079 and the known-optimum scenes only (skips the 1.7 M-point synthetic hall).
 #   --fan-out: plan through a coordinator that leaves every shard of 16 candidates to two peer
 #     vc-servers (docs/DEPLOY.md, "Scaling out"): the lines must be the same as without.
@@ -12,6 +12,8 @@
 #     the lines must be the same as without.
 #   --gain-rule-off: the default gain rule switched off (--min-gain-m2-per-minute 0): the plans as
 #     the 99 % target alone stops them, the lines from before the rule became the default.
+#   --no-doorway-candidates: the grid's candidates alone (doorway candidates are on by default
+#     since issue 36): the lines from before they became the default.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bin=${1:-build/release}
@@ -22,6 +24,7 @@ for a in "${@:2}"; do
     --fan-out) fan_out=1 ;;
     --sparse) client_flags+=(--sparse-set-gain 1e-9) ;;
     --gain-rule-off) client_flags+=(--min-gain-m2-per-minute 0) ;;
+    --no-doorway-candidates) client_flags+=(--no-doorway-candidates) ;;
     *) echo "plan-fingerprints: unknown option $a" >&2; exit 2 ;;
   esac
 done
