@@ -237,6 +237,33 @@ Model MakeCourt(int k) {
   return m;
 }
 
+Model MakeTee() {
+  // A square hall 6 x 6 m with a room on three sides (north, east, west; none south), each behind
+  // a door 1 x 2.1 m centred on its wall: doors crossed along both axes, none facing another. The
+  // north room's station just inside its door sees the hall's southern 4.1 m, the east and west
+  // ones the strip left along the north wall between them (docs/SCENES.md has the proof): optimum
+  // 3, no station in the hall; the 1 m grid alone needs 4.
+  constexpr double hall = 6.0, wall = 0.25, depth = 3.0, width = 4.0, door = 1.0;
+  constexpr double lo = (hall - width) / 2, d0 = (hall - door) / 2;
+  Model m;
+  m.Room(Cuboid(0, 0, 0, hall, hall, kRoomHeightM));
+  m.Room(Cuboid(lo, hall + wall, 0, lo + width, hall + wall + depth, kRoomHeightM));
+  m.Opening(Cuboid(d0, hall, 0, d0 + door, hall + wall, 2.1));
+  m.Room(Cuboid(hall + wall, lo, 0, hall + wall + depth, lo + width, kRoomHeightM));
+  m.Opening(Cuboid(hall, d0, 0, hall + wall, d0 + door, 2.1));
+  m.Room(Cuboid(-wall - depth, lo, 0, -wall, lo + width, kRoomHeightM));
+  m.Opening(Cuboid(-wall, d0, 0, 0, d0 + door, 2.1));
+  m.info.rooms = {{{lo, hall + wall, 0}, {lo + width, hall + wall + depth, kRoomHeightM}},
+                  {{hall + wall, lo, 0}, {hall + wall + depth, lo + width, kRoomHeightM}},
+                  {{-wall - depth, lo, 0}, {-wall, lo + width, kRoomHeightM}}};
+  m.info.description =
+      "square hall 6 x 6 m with a room 4 x 3 m behind a centred 1 m door on three sides (north, east, west); one "
+      "station just inside each door sees its room and, together, the hall";
+  m.info.optimum_stations = 3;
+  m.info.floor_heights_m = {0};
+  return m;
+}
+
 Model MakeTwoFloor() {
   Model m;
   m.Room(Cuboid(0, 0, 0, 8, 6, 3.0));
@@ -389,6 +416,7 @@ const SceneKind kScenes[] = {
     {"comb", true, "comb:K, a corridor with K dead-end bays", [](int k) { return MakeComb(k); }},
     {"rooms", true, "rooms:N, N closed rooms off a corridor", [](int n) { return MakeRooms(n); }},
     {"hub", true, "hub:K, a hub hall with K small rooms on each side", [](int k) { return MakeHub(k); }},
+    {"tee", false, "a square hall with a room on three sides", [](int) { return MakeTee(); }},
     {"court", true, "court:K, a hall with K rooms on each side behind off-centre doors and one at each end",
      [](int k) { return MakeCourt(k); }},
     {"twofloor", false, "two storeys joined by a stair opening", [](int) { return MakeTwoFloor(); }},
@@ -399,7 +427,7 @@ const SceneKind kScenes[] = {
 };
 
 constexpr char kValidSpecs[] =
-    "box, lroom, comb:K, rooms:N, hub:K, court:K, twofloor, tworooms, stairs, hall, slope (K, N in 1..50)";
+    "box, lroom, comb:K, rooms:N, hub:K, court:K, tee, twofloor, tworooms, stairs, hall, slope (K, N in 1..50)";
 
 Status BadSpec(std::string_view spec, std::string_view why) {
   return InvalidArgumentError("invalid scene '" + std::string(spec) + "' (" + std::string(why) +
@@ -717,8 +745,8 @@ Status SynthOptions::Validate() const {
 
 std::string ListScenes() {
   std::string out;
-  for (const char* spec :
-       {"box", "lroom", "comb:3", "rooms:3", "hub:2", "court:2", "twofloor", "tworooms", "stairs", "hall", "slope"}) {
+  for (const char* spec : {"box", "lroom", "comb:3", "rooms:3", "hub:2", "court:2", "tee", "twofloor", "tworooms",
+                           "stairs", "hall", "slope"}) {
     Result<SceneInfo> info = DescribeScene(spec);
     if (!info.ok()) continue;
     out += info->name;

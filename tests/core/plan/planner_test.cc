@@ -165,9 +165,9 @@ TEST(PlannerTest, HubsReachTheirOptimumWithDoorwayCandidatesAndTheExactSolver) {
 }
 
 // Rooms around a hall at the defaults (doorway candidates, --solver auto, the 0.99 target and the
-// gain rule; issue 36): hub:K and court:K (doors off-centre and crossed along both axes, rooms at
-// the hall's ends; docs/SCENES.md) reach their optimum, a station in every room and none in the
-// hall, proven optimal over the candidates.
+// gain rule; issue 36): hub:K, court:K (doors off-centre and crossed along both axes, rooms at the
+// hall's ends) and tee (rooms on three sides of a square hall; docs/SCENES.md) reach their optimum,
+// a station in every room and none in the hall, proven optimal over the candidates.
 void ExpectOptimumAtTheDefaults(std::initializer_list<const char*> specs) {
   for (const char* spec : specs) {
     Result<SceneInfo> info = DescribeScene(spec);
@@ -189,7 +189,9 @@ void ExpectOptimumAtTheDefaults(std::initializer_list<const char*> specs) {
   }
 }
 
-TEST(PlannerTest, RoomsAroundAHallReachTheirOptimumAtTheDefaults) { ExpectOptimumAtTheDefaults({"hub:1", "court:1"}); }
+TEST(PlannerTest, RoomsAroundAHallReachTheirOptimumAtTheDefaults) {
+  ExpectOptimumAtTheDefaults({"hub:1", "court:1", "tee"});
+}
 
 // The same on larger ones (hub:2, hub:3, court:2: 2-8 s of selection each in release under load;
 // label heavy).
