@@ -2,8 +2,10 @@
 # Greedy against the exact selector (docs/PLANNING.md, "Exact selection"): plans geb079 and the
 # synthetic scenes through a real vc-server and vc-client once per solver, with the default
 # parameters (target coverage 0.99), and prints one row per scene and solver: stations, coverage,
-# the optimality status, lower bound and gap, the selection stage's time and the whole plan's (and,
-# with --local-candidates among FLAGS, the positions it added and the stations of each selection).
+# the optimality status, lower bound and gap, the selection stage's time and the whole plan's, the
+# model's size, then the share of the whole scene (occupied voxels) covered, the field time (set-up,
+# scans and walking, minutes), G and the stop reason (and, with --local-candidates among FLAGS, the
+# positions it added and the stations of each selection).
 # Usage: scripts/compare-solvers.sh [BUILD_DIR (default build/release)] [SOLVERS (default "greedy exact")]
 #   [SCENES (default: geb079 and the synthetic scenes; "hall" and "hall-scan" add the halls)] [-- FLAGS...]
 set -euo pipefail
@@ -32,7 +34,8 @@ for _ in $(seq 1 100); do
 done
 [[ -n "$port" ]] || { cat "$work/server.log"; exit 1; }
 
-printf '%-10s %-7s %8s %9s %-10s %6s %6s %9s %8s  %s\n' scene solver stations coverage status bound gap select_s total_s "model (candidates/classes/rows; before)"
+printf '%-10s %-7s %8s %9s %-10s %6s %6s %9s %8s  %s\n' scene solver stations coverage status bound gap select_s total_s \
+  "model (candidates/classes/rows; before)  scene% field_min G stop"
 for s in $scenes; do
   case "$s" in
     geb079) f=../shared/data/geb079/geb079.bt ;;
@@ -53,6 +56,8 @@ gap = f'{100 * o["gap"]:.0f}%' if o["status"] != "heuristic" else "-"
 print(f'{sys.argv[1]:10s} {sys.argv[2]:7s} {len(p["viewpoints"]):8d} {100 * c["covered_voxels"] / c["coverable_voxels"]:8.2f}% '
       f'{o["status"]:10s} {bound:>6s} {gap:>6s} {t["selection"]:9.2f} {t["total"]:8.2f}  '
       f'{m["candidates"]}/{m["voxel_classes"]}/{m["rows"]}; {b["candidates"]}/{b["voxel_classes"]}'
+      f'  {100 * c["covered_voxels"] / c["occupied_voxels"]:.2f}% {p["field_time_s"]["total"] / 60:.0f} '
+      f'{c["global_visibility"]:.3f} {p["stop_reason"]}'
       + (f'  [{o["note"]}]' if o.get("note") else '')
       + (f'  local: +{o["local_candidates"]["added"]} positions, stations per selection '
          + ' -> '.join(str(n) for n in o["local_candidates"]["stations_per_solve"]) if o.get("local_candidates") else ''))

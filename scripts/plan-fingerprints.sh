@@ -1,10 +1,11 @@
 #!/usr/bin/env bash
 # Plans that must not change by accident: plans geb079, the synthetic hall, the real hall scan and
-# every known-optimum scene through a real vc-server and vc-client, and prints one line per scene:
+# the known-optimum scenes (the hubs and tworooms since issue 36; court:K and tee are left to
+# PlannerTest.*RoomsAroundAHall*) through a real vc-server and vc-client, and prints one line per scene:
 # stations, G, covered/coverable voxels and a hash of the stations' coordinates. Run it on two
 # builds and diff the output (docs/BENCHMARKS.md, "Plans must not change by accident").
 # Usage: scripts/plan-fingerprints.sh [BUILD_DIR (default build/release)] [--quick] [--fan-out]
-#        [--sparse] [--gain-rule-off]
+#        [--sparse] [--gain-rule-off] [--no-doorway-candidates]
 #   --quick: geb079 and the known-optimum scenes only (skips the 1.7 M-point synthetic hall).
 #   --fan-out: plan through a coordinator that leaves every shard of 16 candidates to two peer
 #     vc-servers (docs/DEPLOY.md, "Scaling out"): the lines must be the same as without.
@@ -14,6 +15,8 @@
 #     the 99 % target alone stops them, the lines from before the rule became the default.
 #   --route: each line also gives the walking route: its length, parts and a hash of its order, legs
 #     and polylines (to the micrometre), for changes to the route stage (route.h).
+#   --no-doorway-candidates: the grid's candidates alone (doorway candidates are on by default
+#     since issue 36): the lines from before they became the default.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bin=${1:-build/release}
@@ -25,6 +28,7 @@ for a in "${@:2}"; do
     --route) route=1 ;;
     --sparse) client_flags+=(--sparse-set-gain 1e-9) ;;
     --gain-rule-off) client_flags+=(--min-gain-m2-per-minute 0) ;;
+    --no-doorway-candidates) client_flags+=(--no-doorway-candidates) ;;
     *) echo "plan-fingerprints: unknown option $a" >&2; exit 2 ;;
   esac
 done
@@ -56,7 +60,7 @@ else
   start_server server.log
 fi
 
-scenes=(box lroom comb:3 comb:5 rooms:3 twofloor)
+scenes=(box lroom comb:3 comb:5 rooms:3 twofloor tworooms hub:1 hub:2 hub:3)
 [[ "$quick" == "--quick" ]] || scenes+=(hall)
 files=(../shared/data/geb079/geb079.bt)
 [[ "$quick" == "--quick" ]] || files+=(../shared/data/hall-scan/scan.dat.bz2)

@@ -29,7 +29,7 @@ namespace {
 constexpr double kEnvelopeM = 0.3;       // wall thickness around the free space, for the bounds
 constexpr double kCorniceM = 0.2;        // cornice (crown moulding) section, m
 constexpr double kJitterFraction = 0.1;  // in-plane jitter, fraction of the local grid step
-constexpr int kMaxCount = 50;            // largest K of comb:K and hub:K and N of rooms:N
+constexpr int kMaxCount = 50;            // largest K of comb:K, hub:K and court:K and N of rooms:N
 
 double Snap(double v) { return std::round(v * 1e6) / 1e6; }  // micrometres: equal edges compare equal
 
@@ -201,6 +201,69 @@ Model MakeHub(int k) {
   return m;
 }
 
+Model MakeCourt(int k) {
+  // Hub-like, but not hub:K: the hub's 5k x 4.5 m hall and 2k rooms, with each door off its room's
+  // centre (north doors 0.75 m west of it, south doors 0.75 m east, so no two face each other), and
+  // a room 3 x 3 m at each end of the hall behind a door in the end wall (a door crossed along x,
+  // the others along y). A station 0.125 m inside each side door, on its centre line, sees the far
+  // half of the hall up to 3.25 m either side (docs/SCENES.md has the proof); the end rooms need
+  // one station each, in line with their doors.
+  constexpr double seg = 5.0, d = 4.5, wall = 0.25, dr = 3.0, wr = 4.5, door = 1.0, shift = 0.75;
+  constexpr double end = 3.0, end_lo = (d - end) / 2;  // end rooms: 3 x 3 m, centred on the hall's width
+  Model m;
+  m.Room(Cuboid(0, 0, 0, k * seg, d, kRoomHeightM));
+  for (int i = 0; i < k; ++i) {
+    const double x = i * seg + (seg - wr) / 2, xc = i * seg + seg / 2;
+    m.Room(Cuboid(x, d + wall, 0, x + wr, d + wall + dr, kRoomHeightM));
+    m.Opening(Cuboid(xc - shift - door / 2, d, 0, xc - shift + door / 2, d + wall, 2.1));
+    m.Room(Cuboid(x, -wall - dr, 0, x + wr, -wall, kRoomHeightM));
+    m.Opening(Cuboid(xc + shift - door / 2, -wall, 0, xc + shift + door / 2, 0, 2.1));
+    m.info.rooms.push_back({{x, d + wall, 0}, {x + wr, d + wall + dr, kRoomHeightM}});
+    m.info.rooms.push_back({{x, -wall - dr, 0}, {x + wr, -wall, kRoomHeightM}});
+  }
+  const double east = k * seg;
+  m.Room(Cuboid(-wall - end, end_lo, 0, -wall, end_lo + end, kRoomHeightM));
+  m.Opening(Cuboid(-wall, d / 2 - door / 2, 0, 0, d / 2 + door / 2, 2.1));
+  m.Room(Cuboid(east + wall, end_lo, 0, east + wall + end, end_lo + end, kRoomHeightM));
+  m.Opening(Cuboid(east, d / 2 - door / 2, 0, east + wall, d / 2 + door / 2, 2.1));
+  m.info.rooms.push_back({{-wall - end, end_lo, 0}, {-wall, end_lo + end, kRoomHeightM}});
+  m.info.rooms.push_back({{east + wall, end_lo, 0}, {east + wall + end, end_lo + end, kRoomHeightM}});
+  m.info.description = "court hall " + std::to_string(5 * k) + " x 4.5 m with " + std::to_string(k) +
+                       " rooms on each side, doors off-centre and not facing each other, and a room behind "
+                       "each end wall; every room needs a station, and one just inside each side door also "
+                       "sees half the hall";
+  m.info.optimum_stations = 2 * k + 2;
+  m.info.floor_heights_m = {0};
+  return m;
+}
+
+Model MakeTee() {
+  // A square hall 6 x 6 m with a room on three sides (north, east, west; none south), each behind
+  // a door 1 x 2.1 m centred on its wall: doors crossed along both axes, none facing another. The
+  // north room's station just inside its door sees the hall's southern 4.1 m, the east and west
+  // ones the strip left along the north wall between them (docs/SCENES.md has the proof): optimum
+  // 3, no station in the hall; the 1 m grid alone needs 4.
+  constexpr double hall = 6.0, wall = 0.25, depth = 3.0, width = 4.0, door = 1.0;
+  constexpr double lo = (hall - width) / 2, d0 = (hall - door) / 2;
+  Model m;
+  m.Room(Cuboid(0, 0, 0, hall, hall, kRoomHeightM));
+  m.Room(Cuboid(lo, hall + wall, 0, lo + width, hall + wall + depth, kRoomHeightM));
+  m.Opening(Cuboid(d0, hall, 0, d0 + door, hall + wall, 2.1));
+  m.Room(Cuboid(hall + wall, lo, 0, hall + wall + depth, lo + width, kRoomHeightM));
+  m.Opening(Cuboid(hall, d0, 0, hall + wall, d0 + door, 2.1));
+  m.Room(Cuboid(-wall - depth, lo, 0, -wall, lo + width, kRoomHeightM));
+  m.Opening(Cuboid(-wall, d0, 0, 0, d0 + door, 2.1));
+  m.info.rooms = {{{lo, hall + wall, 0}, {lo + width, hall + wall + depth, kRoomHeightM}},
+                  {{hall + wall, lo, 0}, {hall + wall + depth, lo + width, kRoomHeightM}},
+                  {{-wall - depth, lo, 0}, {-wall, lo + width, kRoomHeightM}}};
+  m.info.description =
+      "square hall 6 x 6 m with a room 4 x 3 m behind a centred 1 m door on three sides (north, east, west); one "
+      "station just inside each door sees its room and, together, the hall";
+  m.info.optimum_stations = 3;
+  m.info.floor_heights_m = {0};
+  return m;
+}
+
 Model MakeTwoFloor() {
   Model m;
   m.Room(Cuboid(0, 0, 0, 8, 6, 3.0));
@@ -353,6 +416,9 @@ const SceneKind kScenes[] = {
     {"comb", true, "comb:K, a corridor with K dead-end bays", [](int k) { return MakeComb(k); }},
     {"rooms", true, "rooms:N, N closed rooms off a corridor", [](int n) { return MakeRooms(n); }},
     {"hub", true, "hub:K, a hub hall with K small rooms on each side", [](int k) { return MakeHub(k); }},
+    {"tee", false, "a square hall with a room on three sides", [](int) { return MakeTee(); }},
+    {"court", true, "court:K, a hall with K rooms on each side behind off-centre doors and one at each end",
+     [](int k) { return MakeCourt(k); }},
     {"twofloor", false, "two storeys joined by a stair opening", [](int) { return MakeTwoFloor(); }},
     {"tworooms", false, "two rooms joined by one off-centre door", [](int) { return MakeTwoRooms(); }},
     {"stairs", false, "two storeys joined by a straight flight of steps", [](int) { return MakeStairs(); }},
@@ -361,7 +427,7 @@ const SceneKind kScenes[] = {
 };
 
 constexpr char kValidSpecs[] =
-    "box, lroom, comb:K, rooms:N, hub:K, twofloor, tworooms, stairs, hall, slope (K, N in 1..50)";
+    "box, lroom, comb:K, rooms:N, hub:K, court:K, tee, twofloor, tworooms, stairs, hall, slope (K, N in 1..50)";
 
 Status BadSpec(std::string_view spec, std::string_view why) {
   return InvalidArgumentError("invalid scene '" + std::string(spec) + "' (" + std::string(why) +
@@ -679,8 +745,8 @@ Status SynthOptions::Validate() const {
 
 std::string ListScenes() {
   std::string out;
-  for (const char* spec :
-       {"box", "lroom", "comb:3", "rooms:3", "hub:2", "twofloor", "tworooms", "stairs", "hall", "slope"}) {
+  for (const char* spec : {"box", "lroom", "comb:3", "rooms:3", "hub:2", "court:2", "tee", "twofloor", "tworooms",
+                           "stairs", "hall", "slope"}) {
     Result<SceneInfo> info = DescribeScene(spec);
     if (!info.ok()) continue;
     out += info->name;

@@ -18,7 +18,8 @@
 namespace vc {
 namespace {
 
-const char* const kSmallScenes[] = {"box", "lroom", "comb:3", "rooms:3", "hub:2", "twofloor", "tworooms", "stairs"};
+const char* const kSmallScenes[] = {"box",     "lroom", "comb:3",   "rooms:3",  "hub:2",
+                                    "court:2", "tee",   "twofloor", "tworooms", "stairs"};
 
 // A dense voxel grid over a scene's bounds (plus a margin), filled from its points; keys are
 // floor(p / resolution) as in OctoMap.
@@ -137,7 +138,7 @@ TEST(SynthOptionsTest, ValidateRejectsSpacingOutsideRangeOrNotFinite) {
 
 TEST(DescribeSceneTest, BadSpecsAreInvalidArgumentListingValidNames) {
   for (const char* bad : {"", "castle", "Box", "comb", "comb:", "comb:0", "comb:51", "comb:x", "comb:2x", "rooms:-1",
-                          "rooms:1.5", "box:2", "hall:1", "hub", "hub:0", "hub:51"}) {
+                          "rooms:1.5", "box:2", "hall:1", "hub", "hub:0", "hub:51", "court", "court:51", "tee:1"}) {
     Result<SceneInfo> info = DescribeScene(bad);
     ASSERT_FALSE(info.ok()) << bad;
     EXPECT_EQ(info.status().code(), StatusCode::kInvalidArgument) << bad;
@@ -147,8 +148,9 @@ TEST(DescribeSceneTest, BadSpecsAreInvalidArgumentListingValidNames) {
 
 TEST(DescribeSceneTest, KnownScenesReportTheirOptimumRoomsAndFloors) {
   const std::vector<std::pair<std::string, int>> expected = {
-      {"box", 1},   {"lroom", 1}, {"comb:1", 1},   {"comb:7", 7},   {"comb:50", 50}, {"rooms:1", 2}, {"rooms:4", 5},
-      {"hub:1", 2}, {"hub:3", 6}, {"twofloor", 2}, {"tworooms", 2}, {"stairs", 0},   {"hall", 0}};
+      {"box", 1},      {"lroom", 1},    {"comb:1", 1}, {"comb:7", 7},  {"comb:50", 50}, {"rooms:1", 2},
+      {"rooms:4", 5},  {"hub:1", 2},    {"hub:3", 6},  {"court:1", 4}, {"court:3", 8},  {"tee", 3},
+      {"twofloor", 2}, {"tworooms", 2}, {"stairs", 0}, {"hall", 0}};
   for (const auto& [spec, optimum] : expected) {
     Result<SceneInfo> info = DescribeScene(spec);
     ASSERT_TRUE(info.ok()) << spec << ": " << info.status().ToString();
@@ -285,6 +287,56 @@ TEST(SceneVoxelsTest, HubRoomsAreJoinedToTheHallOnlyThroughTheirDoors) {
   EXPECT_FALSE(grid.Reached(grid.KeyOf(WorldPoint(5, 6, 1) + kSceneOffsetM)));  // between two rooms
 }
 
+TEST(DescribeSceneTest, CourtRoomsAreTheSideRoomsThenTheEndRooms) {
+  Result<SceneInfo> court = DescribeScene("court:2");
+  ASSERT_TRUE(court.ok());
+  ASSERT_EQ(court->rooms.size(), 6u);  // per 5 m segment north, south; then west and east
+  ExpectBox(court->rooms[0], {0.25, 4.75, 0}, {4.75, 7.75, 3}, "north room 0");
+  ExpectBox(court->rooms[1], {0.25, -3.25, 0}, {4.75, -0.25, 3}, "south room 0");
+  ExpectBox(court->rooms[3], {5.25, -3.25, 0}, {9.75, -0.25, 3}, "south room 1");
+  ExpectBox(court->rooms[4], {-3.25, 0.75, 0}, {-0.25, 3.75, 3}, "west room");
+  ExpectBox(court->rooms[5], {10.25, 0.75, 0}, {13.25, 3.75, 3}, "east room");
+  ExpectBox({court->bounds_min, court->bounds_max}, {-3.55, -3.55, -0.3}, {13.55, 8.05, 3.3}, "court:2 bounds");
+}
+
+TEST(SceneVoxelsTest, CourtRoomsAreJoinedToTheHallOnlyThroughTheirOffCentreDoors) {
+  Result<SceneInfo> info = DescribeScene("court:2");
+  ASSERT_TRUE(info.ok());
+  VoxelGrid grid = Voxelize("court:2", 0.05, 0.1);
+  EXPECT_FALSE(grid.FloodEscapes(grid.KeyOf(WorldPoint(5, 2.25, 1.5) + kSceneOffsetM)));
+  for (const AxisBox& room : info->rooms) EXPECT_TRUE(grid.Reached(grid.KeyOf(SeedPoint(room))));
+  // North door 1: x in [6.25, 7.25] (0.75 m west of its room's centre); south door 1 x in
+  // [7.75, 8.75]; the west door y in [1.75, 2.75] through the end wall x in [-0.25, 0].
+  const WorldPoint north = WorldPoint(6.75, 4.625, 1.0) + kSceneOffsetM;
+  const WorldPoint south = WorldPoint(8.25, -0.125, 1.0) + kSceneOffsetM;
+  const WorldPoint west = WorldPoint(-0.125, 2.25, 1.0) + kSceneOffsetM;
+  for (const WorldPoint& door : {north, south, west}) {
+    EXPECT_TRUE(grid.Reached(grid.KeyOf(door))) << door.transpose();
+    EXPECT_FALSE(grid.Reached(grid.KeyOf(door + WorldPoint(0, 0, 1.5)))) << "above the head " << door.transpose();
+  }
+  EXPECT_FALSE(grid.Reached(grid.KeyOf(WorldPoint(7.5, 4.625, 1.0) + kSceneOffsetM)));   // the hub's door place
+  EXPECT_FALSE(grid.Reached(grid.KeyOf(WorldPoint(7.5, -0.125, 1.0) + kSceneOffsetM)));  // the same, south
+  EXPECT_FALSE(grid.Reached(grid.KeyOf(west + WorldPoint(0, 0.8, 0))));                  // end wall beside the door
+}
+
+TEST(SceneVoxelsTest, TeeRoomsAreJoinedToTheHallOnlyThroughTheirCentredDoors) {
+  Result<SceneInfo> info = DescribeScene("tee");
+  ASSERT_TRUE(info.ok());
+  ASSERT_EQ(info->rooms.size(), 3u);  // north, east, west
+  ExpectBox(info->rooms[0], {1, 6.25, 0}, {5, 9.25, 3}, "north room");
+  ExpectBox(info->rooms[1], {6.25, 1, 0}, {9.25, 5, 3}, "east room");
+  ExpectBox(info->rooms[2], {-3.25, 1, 0}, {-0.25, 5, 3}, "west room");
+  VoxelGrid grid = Voxelize("tee", 0.05, 0.1);
+  EXPECT_FALSE(grid.FloodEscapes(grid.KeyOf(WorldPoint(3, 3, 1.5) + kSceneOffsetM)));
+  for (const AxisBox& room : info->rooms) EXPECT_TRUE(grid.Reached(grid.KeyOf(SeedPoint(room))));
+  for (const WorldPoint& door : {WorldPoint(3, 6.125, 1.0), WorldPoint(6.125, 3, 1.0), WorldPoint(-0.125, 3, 1.0)}) {
+    EXPECT_TRUE(grid.Reached(grid.KeyOf(door + kSceneOffsetM))) << door.transpose();
+    EXPECT_FALSE(grid.Reached(grid.KeyOf(door + WorldPoint(0, 0, 1.5) + kSceneOffsetM))) << door.transpose();
+  }
+  EXPECT_FALSE(grid.Reached(grid.KeyOf(WorldPoint(3, -0.125, 1.0) + kSceneOffsetM)));   // no south door
+  EXPECT_FALSE(grid.Reached(grid.KeyOf(WorldPoint(4.2, 6.125, 1.0) + kSceneOffsetM)));  // beside the north door
+}
+
 // Stairs: 19 treads, step k spanning x in [1.3 + 0.3 (k - 1), 1.3 + 0.3 k], y in [0, 1], top at
 // z = 0.165 k; the 20th riser, at x = 7, goes up to the upper floor at z = 3.3.
 constexpr double kStairX0 = 1.3, kGoing = 0.3, kRise = 0.165;
@@ -378,7 +430,8 @@ TEST(SceneVoxelsTest, StairsFlightIsSolidWithHeadroomAndJoinsTheStoreys) {
 
 TEST(DescribeSceneTest, ListNamesEveryScene) {
   const std::string list = ListScenes();
-  for (const char* name : {"box", "lroom", "comb", "rooms", "hub", "twofloor", "tworooms", "stairs", "hall"}) {
+  for (const char* name :
+       {"box", "lroom", "comb", "rooms", "hub", "court", "tee", "twofloor", "tworooms", "stairs", "hall"}) {
     EXPECT_NE(list.find(name), std::string::npos) << name;
   }
 }
@@ -403,7 +456,8 @@ TEST(GenerateSceneTest, SameSeedGivesIdenticalPointsOtherSeedDiffers) {
 }
 
 TEST(GenerateSceneTest, CountMatchesTheStream) {
-  for (const char* spec : {"box", "lroom", "comb:2", "rooms:2", "hub:1", "twofloor", "tworooms", "stairs"}) {
+  for (const char* spec :
+       {"box", "lroom", "comb:2", "rooms:2", "hub:1", "court:1", "tee", "twofloor", "tworooms", "stairs"}) {
     for (double spacing : {0.07, 0.2}) {
       SynthOptions o;
       o.spacing_m = spacing;
@@ -416,7 +470,8 @@ TEST(GenerateSceneTest, CountMatchesTheStream) {
 }
 
 TEST(GenerateSceneTest, EveryPointIsFiniteAndInsideTheBounds) {
-  for (const char* spec : {"box", "lroom", "comb:3", "rooms:3", "hub:2", "twofloor", "tworooms", "stairs", "hall"}) {
+  for (const char* spec :
+       {"box", "lroom", "comb:3", "rooms:3", "hub:2", "court:2", "tee", "twofloor", "tworooms", "stairs", "hall"}) {
     SynthOptions o;
     o.spacing_m = 0.2;
     Result<SceneInfo> info = DescribeScene(spec);

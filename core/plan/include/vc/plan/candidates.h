@@ -80,6 +80,7 @@ struct CandidateOptions {
   // level's obstacle slice at tripod height, along x or y, is narrower than 2 grid_spacing_m
   // (and at least 2 clearance_m), on the passage's centre line every grid_spacing_m / 4, and
   // beyond its ends at grid_spacing_m / 8, then every grid_spacing_m / 4, up to grid_spacing_m / 2.
+  // Off here (the bare grid); plans take PlanOptions::doorway_candidates, which is on by default.
   bool doorway_candidates = false;
   // The ground model: auto (by the floor-share test), floors or terrain.
   GroundModel ground = GroundModel::kAuto;

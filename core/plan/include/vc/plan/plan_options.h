@@ -21,7 +21,8 @@
 // min_marginal_gain_voxels, target_coverage, consolidate) are VC_GREEDY_PARAMETERS (selector.h),
 // which GreedyOptions is declared from. Notes on some rows:
 // - doorway_candidates: candidates in narrow passages (vc/plan/candidates.h; docs/PLANNING.md,
-//   "Doorway candidates").
+//   "Doorway candidates"); on by default since issue 36, so that the exact selector reaches the
+//   optimum of rooms around a hall (a station just inside each door).
 // - ground: the candidates' ground model, floor levels or a terrain height field, or auto per site
 //   (vc/plan/candidates.h; docs/PLANNING.md, "Terrain").
 // - solver / solve_seconds: greedy, the exact integer program (CBC) with a time limit, or auto
@@ -51,7 +52,7 @@
   X(double, grid_spacing_m, 1.0, "m", "grid-spacing", kPositive, "candidate grid spacing")                            \
   X(double, tripod_height_m, 1.5, "m", "tripod-height", kPositive, "scanner height above the floor")                  \
   X(double, clearance_m, 0.2, "m", "clearance", kNonNegative, "free space required around a candidate")               \
-  X(bool, doorway_candidates, false, "", "doorway-candidates", kAny,                                                  \
+  X(bool, doorway_candidates, true, "", "doorway-candidates", kAny,                                                   \
     "also candidates in doorways and narrow passages, on a finer grid")                                               \
   X(::vc::GroundModel, ground, ::vc::GroundModel::kAuto, "", "ground", kAny,                                          \
     "ground model: floors (a few flat levels), terrain (a walkable height field) or auto (per site)")                 \

@@ -1,6 +1,7 @@
 // Synthetic scenes whose answer is known: point clouds sampled on the surfaces of simple buildings
 // (one room, an L-shaped room, a comb of dead-end bays, rooms along a corridor, a hub hall whose
-// rooms are best seen from their doorways, two storeys, two
+// rooms are best seen from their doorways, a court hall with rooms on all sides behind off-centre
+// doors, a square hall with rooms on three sides, two storeys, two
 // rooms joined by a door, two storeys joined by a flight of steps, the chapel-like benchmark
 // hall, and an open sloping site with buildings), for oracle tests of the planner and for benchmarks.
 //
@@ -77,7 +78,7 @@ struct SceneInfo {
 // Names, descriptions and optima of the available scenes, one line each, for `vc-synth --list`.
 std::string ListScenes();
 
-// Describes the scene `spec` ("box", "lroom", "comb:K", "rooms:N", "hub:K", "hall", "twofloor",
+// Describes the scene `spec` ("box", "lroom", "comb:K", "rooms:N", "hub:K", "court:K", "tee", "hall", "twofloor",
 // "tworooms", "stairs", "slope"; K and N in 1..50). INVALID_ARGUMENT naming the valid specs for anything else.
 Result<SceneInfo> DescribeScene(std::string_view spec);
 
