@@ -4,7 +4,8 @@
 #   release  - the binaries and the slow tests: the tests of the real binaries (labels smoke and
 #              slow: vc-server and vc-client end to end, the paper experiment), the `heavy` ones
 #              (CBC against exhaustive search on hundreds of instances, geb079's full plan: 15 times
-#              slower under ASan) and vc-bench --quick, vc-route-bench --quick
+#              slower under ASan), the `meter` ones (resident memory, which ASan's quarantine hides)
+#              and vc-bench --quick, vc-route-bench --quick
 #   asan     - AddressSanitizer + UndefinedBehaviorSanitizer (clang++): every test except the `slow`
 #              and `heavy` labels (every other unit test runs here, once); the same build holds the
 #              libFuzzer targets
@@ -54,10 +55,11 @@ for p in "${presets[@]}"; do
       if ((${#presets[@]} > 1)); then
         # The unit tests run once, under asan (below). The release build makes what only it can
         # test: the shipped binaries end to end (labels smoke and slow), the slow experiments, the
-        # heavy solver tests (tests/core/CMakeLists.txt, plan_search_tests) and the benchmarks.
-        cmake --build --preset "$p" --target vc-server vc-client vc-synth vc-bench vc-route-bench paper_result_test plan_search_tests
-        echo "=== preset $p: the tests of the binaries, the slow and the heavy ones (labels smoke, slow, heavy)"
-        ctest --preset "$p" -j2 -L 'smoke|slow|heavy'
+        # heavy solver tests (tests/core/CMakeLists.txt, plan_search_tests), the memory meter's tests
+        # (meter_tests: they skip under ASan) and the benchmarks.
+        cmake --build --preset "$p" --target vc-server vc-client vc-synth vc-bench vc-route-bench paper_result_test plan_search_tests meter_tests
+        echo "=== preset $p: the tests of the binaries, the slow, heavy and meter ones (labels smoke, slow, heavy, meter)"
+        ctest --preset "$p" -j2 -L 'smoke|slow|heavy|meter'
       else
         cmake --build --preset "$p"
         echo "=== preset $p: tests"
