@@ -198,6 +198,12 @@ int ExplainMisses(const std::string& label, const std::vector<vc::CapturedScan>&
         }
       }
       tally.Add(why, true);
+      if (ray.outcome == vc::SubvoxelRay::Outcome::kBlocked) {
+        const double blocker_m = ray.blocker_s * (o - c).norm();
+        tally.Add(std::string("miss, first blocker ") + Bin(blocker_m, {{1, "< 1"}, {2, "1-2"}}, ">= 2") +
+                      " m from the station",
+                  true);
+      }
       const bool surface = vc::IsSurfaceVisible(model.grid, o, vc::KeyToIndex(model.occupied[id]), scanner);
       tally.Add(std::string("miss, surface test ") + (surface ? "sees it" : "misses it too") + ", " +
                     (HasMemberWithinOneVoxel(model, a.predicted_set, id) ? "slack recovers it" : "not within slack"),
