@@ -104,6 +104,9 @@ SubvoxelRay TraceSegment(const VoxelScene& scene, std::span<const SurfacePatch> 
   const VoxelIndex v = KeyToIndex(scene.occupied[id]);
   const SurfacePatch& target = patches[id];
   const OccupancyGrid& g = scene.grid;
+  const VoxelIndex& lo = g.min_index();
+  const int lo3[3] = {lo.x, lo.y, lo.z};
+  const uint32_t dims[3] = {uint32_t(g.dims().x()), uint32_t(g.dims().y()), uint32_t(g.dims().z())};
   Walk walk(uo, aim);
   double t_in = 0, first = kNoHit;
   bool same_at_first = false;
@@ -111,7 +114,14 @@ SubvoxelRay TraceSegment(const VoxelScene& scene, std::span<const SurfacePatch> 
   while (t_in <= first) {
     const VoxelIndex cur{walk.cur[0], walk.cur[1], walk.cur[2]};
     if (cur == v) break;
-    if (g.Occupied(cur)) {
+    const uint32_t rel[3] = {uint32_t(cur.x - lo3[0]), uint32_t(cur.y - lo3[1]), uint32_t(cur.z - lo3[2])};
+    const bool in_grid = rel[0] < dims[0] && rel[1] < dims[1] && rel[2] < dims[2];
+    const uint64_t brick = in_grid ? g.BrickLinear(rel[0] >> 3, rel[1] >> 3, rel[2] >> 3) : 0;
+    if (in_grid && g.BrickSlot(brick) == 0) {
+      // An empty brick: jump across its free box (walk.h), which holds no blocker; the walk's
+      // end, v, is occupied, so it does not end inside the box.
+      if (!JumpAcrossFreeBrickBox(g, brick, rel, lo3, walk)) break;
+    } else if (in_grid && g.Occupied(cur)) {
       const int64_t w = scene.IdOf(IndexToKey(cur));
       const SurfacePatch& patch = patches[size_t(w)];
       const Eigen::Vector3d center = g.WorldToIndexSpace(patch.centroid_m.cast<double>());
