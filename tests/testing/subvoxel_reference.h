@@ -27,13 +27,23 @@ struct SubvoxelReference {
   // A point (m, the scene's local frame) in index space.
   Eigen::Vector3d IS(const Eigen::Vector3f& p_m) const { return p_m.cast<double>() / scene.resolution_m; }
 
-  // Voxel w's box: its points' box grown by kSubvoxelBoxPad edges, clipped to its cube.
+  // Whether the voxel next to c along axis i (side -1 or +1) is occupied.
+  bool Occupied(const VoxelIndex& c, int i, int side) const {
+    VoxelIndex n = c;
+    (i == 0 ? n.x : i == 1 ? n.y : n.z) += side;
+    return scene.IdOf(IndexToKey(n)) >= 0;
+  }
+
+  // Voxel w's box: its points' box grown by kSubvoxelBoxPad edges, clipped to its cube, and reaching
+  // the cube's face on each side whose face-neighbour is occupied.
   void Box(size_t w, Eigen::Vector3d* lo, Eigen::Vector3d* hi) const {
     const VoxelIndex c = KeyToIndex(scene.occupied[w]);
     const Eigen::Vector3d cube(c.x, c.y, c.z);
     for (int i = 0; i < 3; ++i) {
       (*lo)[i] = std::max(cube[i], cube[i] + double(patches[w].box_lo[i]) / kPatchBoxSteps - kSubvoxelBoxPad);
       (*hi)[i] = std::min(cube[i] + 1, cube[i] + double(patches[w].box_hi[i]) / kPatchBoxSteps + kSubvoxelBoxPad);
+      if (Occupied(c, i, -1)) (*lo)[i] = cube[i];
+      if (Occupied(c, i, +1)) (*hi)[i] = cube[i] + 1;
     }
   }
 

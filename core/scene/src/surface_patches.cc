@@ -110,6 +110,14 @@ std::vector<SurfacePatch> SurfacePatchBuilder::Finish() const {
     const Sums& s = sums_[id];
     patches[id] = PatchOf(s.n, s.sum, Outer(s), s.lo, s.hi, scene_.Center(id), scene_.resolution_m);
   }
+  for (size_t id = 0; id < sums_.size(); ++id) {
+    const VoxelIndex v = KeyToIndex(scene_.occupied[id]);
+    for (int bit = 0; bit < 6; ++bit) {
+      VoxelIndex n = v;
+      (bit / 2 == 0 ? n.x : bit / 2 == 1 ? n.y : n.z) += bit % 2 ? 1 : -1;
+      if (scene_.IdOf(IndexToKey(n)) >= 0) patches[id].occupied_neighbours |= uint8_t(1u << bit);
+    }
+  }
   const std::vector<SurfacePatch> own = patches;  // planes fitted to each voxel's own points
   for (size_t id = 0; id < sums_.size(); ++id) {
     if (!own[id].flat && sums_[id].n > 0) BorrowPlane(id, own, patches[id]);

@@ -32,8 +32,13 @@ Eigen::AlignedBox3d SubvoxelBoxIS(const VoxelScene& scene, std::span<const Surfa
   const SurfacePatch& p = patches[id];
   Eigen::Vector3d box_lo, box_hi;
   for (int i = 0; i < 3; ++i) {
-    box_lo[i] = lo[i] + double(p.box_lo[i]) / kPatchBoxSteps - kSubvoxelBoxPad;
-    box_hi[i] = lo[i] + double(p.box_hi[i]) / kPatchBoxSteps + kSubvoxelBoxPad;
+    // On a side whose face-neighbour is occupied the surface goes on: the box reaches the face.
+    box_lo[i] = (p.occupied_neighbours >> (2 * i)) & 1u
+                    ? lo[i]
+                    : lo[i] + double(p.box_lo[i]) / kPatchBoxSteps - kSubvoxelBoxPad;
+    box_hi[i] = (p.occupied_neighbours >> (2 * i + 1)) & 1u
+                    ? hi[i]
+                    : lo[i] + double(p.box_hi[i]) / kPatchBoxSteps + kSubvoxelBoxPad;
   }
   return {box_lo.cwiseMax(lo), box_hi.cwiseMin(hi)};
 }

@@ -192,6 +192,33 @@ TEST(SubvoxelTest, AVoxelBlocksOnlyOverItsPointsBox) {
   EXPECT_TRUE(reference.Seen(past / 0.1, target));
 }
 
+TEST(SubvoxelTest, ASparselySampledWallStillHidesWhatIsBehindIt) {
+  // A wall at x = 2.05 m sampled every 5 cm (half an edge: its points' boxes alone would leave gaps
+  // between voxels) before a densely sampled wall at x = 3.05 m: the boxes of the front wall reach
+  // the faces they share with occupied neighbours, so no beam passes between them.
+  std::vector<Eigen::Vector3f> points;
+  for (int i = 0; i <= 40; ++i) {
+    for (int j = 0; j <= 40; ++j) points.emplace_back(2.05f, -1.0f + 0.05f * float(i), -1.0f + 0.05f * float(j));
+  }
+  for (int i = 0; i <= 100; ++i) {
+    for (int j = 0; j <= 100; ++j) points.emplace_back(3.05f, -0.5f + 0.01f * float(i), -0.5f + 0.01f * float(j));
+  }
+  const Scene s(points);
+  const WorldPoint o(0.05, 0.03, 0.02);
+  VisibilitySetsOptions options;
+  options.test = SelectionTest::kSubvoxel;
+  options.surface_patches = s.patches;
+  auto sets = ComputeVisibilitySets(s.scene, {o}, options);
+  ASSERT_TRUE(sets.ok()) << sets.status().ToString();
+  uint64_t front_seen = 0, back_seen = 0;
+  for (size_t id = 0; id < s.scene.occupied.size(); ++id) {
+    const bool back = KeyToIndex(s.scene.occupied[id]).x == 30;
+    if ((*sets)[0].test(id)) ++(back ? back_seen : front_seen);
+  }
+  EXPECT_EQ(back_seen, 0u);
+  EXPECT_GT(double(front_seen), 0.95 * 400);  // of the front wall's 20 x 20 voxels
+}
+
 TEST(SubvoxelTest, AVoxelThatIsNotFlatIsSeenByAFaceOfItsBox) {
   // A cluster of points filling the middle of the cube [2.0, 2.1) x [0, 0.1) x [0, 0.1) (not flat),
   // seen from o = (1, 1, 0.05); a sliver of points at y in [0.10, 0.11] in the cube before it,

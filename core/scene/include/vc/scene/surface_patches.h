@@ -59,6 +59,9 @@ struct SurfacePatch {
   // voxel no point fell in.
   uint8_t box_lo[3] = {0, 0, 0};
   uint8_t box_hi[3] = {kPatchBoxSteps, kPatchBoxSteps, kPatchBoxSteps};
+  // Which of the six face-neighbours of the voxel are occupied: bit 2i for the one at -1 along
+  // axis i, bit 2i + 1 for +1 (a surface that goes on across that face).
+  uint8_t occupied_neighbours = 0;
 };
 static_assert(sizeof(SurfacePatch) == 40, "SurfacePatch is documented as 40 bytes");
 
