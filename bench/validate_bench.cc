@@ -186,7 +186,7 @@ int ExplainMisses(const std::string& label, const std::vector<vc::CapturedScan>&
         const vc::VoxelIndex wi = vc::KeyToIndex(model.occupied[size_t(ray.first_blocker)]);
         const int chebyshev = std::max({std::abs(vi.x - wi.x), std::abs(vi.y - wi.y), std::abs(vi.z - wi.z)});
         const double behind_edges = (1 - ray.blocker_s) * (o - c).norm() / r;
-        why += std::string("blocked by a ") + (w.flat ? "flat patch" : "cube") + ", " +
+        why += std::string("blocked by a ") + (w.flat ? "flat patch" : "box (not flat)") + ", " +
                (chebyshev <= 1   ? "adjacent"
                 : chebyshev <= 3 ? "2-3 voxels away"
                                  : "farther") +
