@@ -11,11 +11,19 @@
 // of ../shared/data/README.md (yaw +40.8 deg, translation (1.974, 0.058, 0.016) m), whose direction
 // the tool checks by the overlap of the two scans. The hall scan covers -91..+91 deg of azimuth
 // only: it is measured both all round (hfov 360) and with hfov 182 centred on its heading 0 (+x).
+//
+// --tests and --scenes pick what runs; --explain breaks the subvoxel test's misses down (the
+// captured voxels by patch kind, incidence and distance with the share missed, each miss by its
+// first blocker (flat patch or cube, how near) and whether the surface test or one voxel of slack
+// has it), for the scans predicted all round.
 #include <CLI/CLI.hpp>
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <initializer_list>
+#include <map>
 #include <numbers>
 #include <string>
 #include <utility>
@@ -23,7 +31,9 @@
 
 #include "vc/scene/occupancy_grid.h"
 #include "vc/scene/scene_input.h"
+#include "vc/scene/surface_patches.h"
 #include "vc/synth/scanner_sim.h"
+#include "vc/visibility/subvoxel.h"
 #include "vc/visibility/validation.h"
 
 namespace {
@@ -31,16 +41,27 @@ namespace {
 using Clock = std::chrono::steady_clock;
 double Since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
-constexpr vc::SelectionTest kTests[] = {vc::SelectionTest::kSurfaceVisibility, vc::SelectionTest::kCompatibility,
-                                        vc::SelectionTest::kSubvoxel};
-
 struct BenchOptions {
   double resolution_m = vc::kDefaultResolutionM;
   double step_deg = 0.1;
   double noise_m = 0.01;
   int threads = 0;
   std::string data_dir = "../shared/data";
+  // The selection tests measured (--tests).
+  std::vector<vc::SelectionTest> tests = {vc::SelectionTest::kSurfaceVisibility, vc::SelectionTest::kCompatibility,
+                                          vc::SelectionTest::kSubvoxel};
+  // Which groups of scenes run (--scenes): planes, room, partial, real.
+  std::vector<std::string> scenes = {"planes", "room", "partial", "real"};
+  // Break the subvoxel test's misses down by category (--explain).
+  bool explain = false;
 };
+
+int ExplainMisses(const std::string& label, const std::vector<vc::CapturedScan>& scans, const BenchOptions& bench,
+                  const vc::ScannerModel& scanner);
+
+bool Runs(const BenchOptions& bench, const std::string& group) {
+  return std::find(bench.scenes.begin(), bench.scenes.end(), group) != bench.scenes.end();
+}
 
 void PrintHeader() {
   std::printf("%-34s %-13s %-6s %9s %9s %9s %7s %7s %7s %7s\n", "scene", "test", "scan", "captured", "predicted",
@@ -50,7 +71,7 @@ void PrintHeader() {
 // Runs every selection test on `scans` with `scanner`'s limits and prints one line per test and scan.
 int Report(const std::string& label, const std::vector<vc::CapturedScan>& scans, const BenchOptions& bench,
            const vc::ScannerModel& scanner = {}) {
-  for (const vc::SelectionTest test : kTests) {
+  for (const vc::SelectionTest test : bench.tests) {
     vc::ValidationOptions options;
     options.scanner = scanner;
     options.resolution_m = bench.resolution_m;
@@ -69,6 +90,126 @@ int Report(const std::string& label, const std::vector<vc::CapturedScan>& scans,
                   report->precision_meaningful ? precision_slack : "-",
                   a.position_occupied ? "  (station in an occupied voxel)" : "");
     }
+  }
+  const bool subvoxel =
+      std::find(bench.tests.begin(), bench.tests.end(), vc::SelectionTest::kSubvoxel) != bench.tests.end();
+  if (bench.explain && subvoxel && !scanner.HasHorizontalFieldOfView())
+    return ExplainMisses(label, scans, bench, scanner);
+  return 0;
+}
+
+bool HasMemberWithinOneVoxel(const vc::VoxelScene& model, const vc::VoxelSet& set, size_t id);
+
+// Captured voxels and the subvoxel test's misses among them, by category (--explain).
+class Tally {
+ public:
+  void Add(const std::string& category, bool missed) {
+    auto& [captured, misses] = rows_[category];
+    ++captured;
+    misses += missed;
+  }
+  void Print(const std::string& label, const std::string& scan, uint64_t all_misses) const {
+    for (const auto& [category, row] : rows_) {
+      std::printf("# explain %-34s scan %-3s %-44s captured %7llu missed %7llu (%5.3f of them, %5.3f of all misses)\n",
+                  label.c_str(), scan.c_str(), category.c_str(), (unsigned long long)row.first,
+                  (unsigned long long)row.second, row.first ? double(row.second) / double(row.first) : 0.0,
+                  all_misses ? double(row.second) / double(all_misses) : 0.0);
+    }
+  }
+
+ private:
+  std::map<std::string, std::pair<uint64_t, uint64_t>> rows_;
+};
+
+const char* Bin(double x, std::initializer_list<std::pair<double, const char*>> bins, const char* last) {
+  for (const auto& [bound, name] : bins) {
+    if (x < bound) return name;
+  }
+  return last;
+}
+
+std::string PatchKind(const vc::SurfacePatch& p) {
+  if (p.flat) return p.borrowed ? "borrowed flat" : "flat";
+  return p.points < vc::kFlatMinPoints ? "not flat, < 3 points" : "not flat";
+}
+
+// Why the subvoxel test misses captured voxels of `scans` (all round, `scanner`'s limits): each
+// captured voxel by its patch, incidence and distance; each miss by its first blocker, and whether
+// the surface test or one voxel of slack would have had it.
+int ExplainMisses(const std::string& label, const std::vector<vc::CapturedScan>& scans, const BenchOptions& bench,
+                  const vc::ScannerModel& scanner) {
+  vc::ValidationOptions options;
+  options.scanner = scanner;
+  options.resolution_m = bench.resolution_m;
+  options.selection_test = vc::SelectionTest::kSubvoxel;
+  options.threads = bench.threads;
+  options.keep_sets = true;
+  auto report = vc::ValidateAgainstScans(scans, options);
+  if (!report.ok()) return std::fprintf(stderr, "%s: %s\n", label.c_str(), report.status().ToString().c_str()), 1;
+  const vc::VoxelScene& model = report->model;
+  vc::SurfacePatchBuilder builder(model);
+  for (const vc::CapturedScan& scan : scans) {
+    for (const auto& p : scan.points_m) builder.Add(p);
+  }
+  const std::vector<vc::SurfacePatch> patches = builder.Finish();
+  const double r = model.resolution_m;
+  for (size_t i = 0; i < scans.size(); ++i) {
+    const vc::ScanAgreement& a = report->scans[i];
+    const vc::WorldPoint& o = scans[i].position_m;
+    Tally tally;
+    const uint64_t misses = a.captured - a.both;
+    a.captured_set.ForEach([&](size_t id) {
+      const bool missed = !a.predicted_set.test(id);
+      const vc::SurfacePatch& p = patches[id];
+      const vc::WorldPoint c = p.centroid_m.cast<double>();
+      const std::string kind = PatchKind(p);
+      tally.Add("target: " + kind, missed);
+      if (p.flat) {
+        const double cos_in = std::abs(p.normal.cast<double>().dot((o - c).normalized()));
+        const double incidence_deg = std::acos(std::min(1.0, cos_in)) * 180.0 / std::numbers::pi;
+        tally.Add(std::string("flat target, incidence ") +
+                      Bin(incidence_deg, {{45, "0-45"}, {70, "45-70"}, {80, "70-80"}}, "80-90") + " deg",
+                  missed);
+      }
+      tally.Add(std::string("distance ") + Bin((o - c).norm(), {{3, "0-3"}, {6, "3-6"}, {12, "6-12"}}, "12+") + " m",
+                missed);
+      if (!missed) return;
+      const vc::SubvoxelRay ray = vc::ExplainSubvoxel(model, patches, o, id, scanner);
+      std::string why = "miss: ";
+      if (ray.outcome == vc::SubvoxelRay::Outcome::kOutsideLimits) {
+        why += "outside the limits";
+      } else if (ray.outcome != vc::SubvoxelRay::Outcome::kBlocked) {
+        why += "explained as seen (engine and query disagree)";
+      } else {
+        const vc::SurfacePatch& w = patches[size_t(ray.first_blocker)];
+        const vc::VoxelIndex vi = vc::KeyToIndex(model.occupied[id]);
+        const vc::VoxelIndex wi = vc::KeyToIndex(model.occupied[size_t(ray.first_blocker)]);
+        const int chebyshev = std::max({std::abs(vi.x - wi.x), std::abs(vi.y - wi.y), std::abs(vi.z - wi.z)});
+        const double behind_edges = (1 - ray.blocker_s) * (o - c).norm() / r;
+        why += std::string("blocked by a ") + (w.flat ? "flat patch" : "box (not flat)") + ", " +
+               (chebyshev <= 1   ? "adjacent"
+                : chebyshev <= 3 ? "2-3 voxels away"
+                                 : "farther") +
+               ", hit " + Bin(behind_edges, {{0.5, "<0.5"}, {1, "0.5-1"}, {2, "1-2"}}, "2+") + " edges before the aim";
+        if (p.flat && w.flat) {
+          const double cos_n = std::abs(p.normal.dot(w.normal));
+          why += cos_n >= std::cos(vc::kSameSurfaceMaxAngleDeg * std::numbers::pi / 180) ? ", normals agree"
+                                                                                         : ", normals differ";
+        }
+      }
+      tally.Add(why, true);
+      if (ray.outcome == vc::SubvoxelRay::Outcome::kBlocked) {
+        const double blocker_m = ray.blocker_s * (o - c).norm();
+        tally.Add(std::string("miss, first blocker ") + Bin(blocker_m, {{1, "< 1"}, {2, "1-2"}}, ">= 2") +
+                      " m from the station",
+                  true);
+      }
+      const bool surface = vc::IsSurfaceVisible(model.grid, o, vc::KeyToIndex(model.occupied[id]), scanner);
+      tally.Add(std::string("miss, surface test ") + (surface ? "sees it" : "misses it too") + ", " +
+                    (HasMemberWithinOneVoxel(model, a.predicted_set, id) ? "slack recovers it" : "not within slack"),
+                true);
+    });
+    tally.Print(label, a.name, misses);
   }
   return 0;
 }
@@ -237,8 +378,28 @@ int main(int argc, char** argv) {
   app.add_option("--noise", bench.noise_m, "range noise of the noisy simulated scans, m")->capture_default_str();
   app.add_option("--threads", bench.threads, "threads for the visibility sets (0 = all)")->capture_default_str();
   app.add_option("--data", bench.data_dir, "folder of the real scans")->capture_default_str();
-  app.add_flag("--simulated-only", simulated_only, "skip the real scans");
+  app.add_flag("--simulated-only", simulated_only, "skip the real scans (as --scenes planes,room,partial)");
+  std::vector<std::string> tests;
+  app.add_option("--tests", tests, "selection tests measured (default: surface compatibility subvoxel)")
+      ->check(CLI::IsMember({"surface", "compatibility", "subvoxel"}))
+      ->delimiter(',');
+  app.add_option("--scenes", bench.scenes, "groups of scenes (default: all)")
+      ->check(CLI::IsMember({"planes", "room", "partial", "real"}))
+      ->delimiter(',')
+      ->capture_default_str();
+  app.add_flag("--explain", bench.explain,
+               "break the subvoxel test's misses down by patch, incidence, distance and first blocker "
+               "(scans predicted all round)");
   CLI11_PARSE(app, argc, argv);
+  if (!tests.empty()) {
+    bench.tests.clear();
+    for (const std::string& name : tests) {
+      bench.tests.push_back(name == "surface"         ? vc::SelectionTest::kSurfaceVisibility
+                            : name == "compatibility" ? vc::SelectionTest::kCompatibility
+                                                      : vc::SelectionTest::kSubvoxel);
+    }
+  }
+  if (simulated_only) std::erase(bench.scenes, std::string("real"));
 
   const auto start = Clock::now();
   std::printf(
@@ -246,8 +407,9 @@ int main(int argc, char** argv) {
       "prec '-': one scan, so only recall is meaningful\n",
       bench.resolution_m, bench.step_deg);
   PrintHeader();
-  if (TiltedPlanes(bench) != 0 || Room(bench) != 0 || PartialRoomScans(bench) != 0) return 1;
-  if (!simulated_only && RealScans(bench) != 0) return 1;
+  if ((Runs(bench, "planes") && TiltedPlanes(bench) != 0) || (Runs(bench, "room") && Room(bench) != 0) ||
+      (Runs(bench, "partial") && PartialRoomScans(bench) != 0) || (Runs(bench, "real") && RealScans(bench) != 0))
+    return 1;
   std::printf("# %.1f s\n", Since(start));
   return 0;
 }

@@ -30,18 +30,25 @@ void SurfacePatchBuilder::Add(const Eigen::Vector3f& point_m) {
   s.yy += d.y() * d.y();
   s.yz += d.y() * d.z();
   s.zz += d.z() * d.z();
+  s.lo = s.lo.cwiseMin(d.cast<float>());
+  s.hi = s.hi.cwiseMax(d.cast<float>());
 }
 
 namespace {
 
-// The patch of one voxel from its sums (offsets from `center`, m) at edge `r` (m).
-SurfacePatch PatchOf(double n, const Eigen::Vector3d& sum, const Eigen::Matrix3d& outer, const WorldPoint& center,
-                     double r) {
+// The patch of one voxel from its sums and box (offsets from `center`, m) at edge `r` (m).
+SurfacePatch PatchOf(double n, const Eigen::Vector3d& sum, const Eigen::Matrix3d& outer, const Eigen::Vector3f& lo,
+                     const Eigen::Vector3f& hi, const WorldPoint& center, double r) {
   SurfacePatch patch;
   patch.points = uint16_t(std::min(n, 65535.0));
   if (n == 0) {
     patch.centroid_m = center.cast<float>();
     return patch;
+  }
+  const double step = r / kPatchBoxSteps;
+  for (int i = 0; i < 3; ++i) {
+    patch.box_lo[i] = uint8_t(std::clamp(std::floor((double(lo[i]) + 0.5 * r) / step), 0.0, double(kPatchBoxSteps)));
+    patch.box_hi[i] = uint8_t(std::clamp(std::ceil((double(hi[i]) + 0.5 * r) / step), 0.0, double(kPatchBoxSteps)));
   }
   const Eigen::Vector3d mean = sum / n;
   // Keep the centroid strictly inside the cube after rounding to float.
@@ -101,7 +108,15 @@ std::vector<SurfacePatch> SurfacePatchBuilder::Finish() const {
   std::vector<SurfacePatch> patches(sums_.size());
   for (size_t id = 0; id < sums_.size(); ++id) {
     const Sums& s = sums_[id];
-    patches[id] = PatchOf(s.n, s.sum, Outer(s), scene_.Center(id), scene_.resolution_m);
+    patches[id] = PatchOf(s.n, s.sum, Outer(s), s.lo, s.hi, scene_.Center(id), scene_.resolution_m);
+  }
+  for (size_t id = 0; id < sums_.size(); ++id) {
+    const VoxelIndex v = KeyToIndex(scene_.occupied[id]);
+    for (int bit = 0; bit < 6; ++bit) {
+      VoxelIndex n = v;
+      (bit / 2 == 0 ? n.x : bit / 2 == 1 ? n.y : n.z) += bit % 2 ? 1 : -1;
+      if (scene_.IdOf(IndexToKey(n)) >= 0) patches[id].occupied_neighbours |= uint8_t(1u << bit);
+    }
   }
   const std::vector<SurfacePatch> own = patches;  // planes fitted to each voxel's own points
   for (size_t id = 0; id < sums_.size(); ++id) {

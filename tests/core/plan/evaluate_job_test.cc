@@ -205,8 +205,10 @@ TEST(RunEvaluationTest, ExportedSetsAreWhatTheTestsPerRayReferenceSees) {
         expected_count += expected;
       }
       EXPECT_EQ(job->seen_sets[k].count(), expected_count);
-      EXPECT_GT(expected_count, 50u) << SelectionTestName(test);                         // something is seen
-      EXPECT_LT(expected_count, scene.occupied.size() - 50) << SelectionTestName(test);  // and something hidden
+      EXPECT_GT(expected_count, 50u) << SelectionTestName(test);  // something is seen
+      // And something hidden (the subvoxel test, whose blockers are its points' boxes, sees all but
+      // a few dozen of the room's 946 voxels from one of the places).
+      EXPECT_LT(expected_count, scene.occupied.size() - 20) << SelectionTestName(test);
     }
   }
 }

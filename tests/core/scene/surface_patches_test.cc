@@ -51,6 +51,30 @@ TEST(SurfacePatchesTest, PointsOnAPlaneGiveItsNormalCentroidAndAreFlat) {
   EXPECT_TRUE(p.flat);
 }
 
+TEST(SurfacePatchesTest, TheBoxHoldsThePointsRoundedOutwards) {
+  // Two points of the cube [0, 0.1)^3: the box spans them, in 1/255 edge steps, rounded outwards.
+  const std::vector<Eigen::Vector3f> points = {{0.021f, 0.05f, 0.003f}, {0.04f, 0.07f, 0.097f}};
+  const VoxelScene scene = SceneOf(points);
+  const std::vector<SurfacePatch> patches = ComputeSurfacePatches(scene, points);
+  ASSERT_EQ(patches.size(), 1u);
+  const SurfacePatch& p = patches[0];
+  for (int i = 0; i < 3; ++i) {
+    const double lo = std::min(points[0][i], points[1][i]) / 0.1 * kPatchBoxSteps;
+    const double hi = std::max(points[0][i], points[1][i]) / 0.1 * kPatchBoxSteps;
+    EXPECT_LE(p.box_lo[i], lo) << i;
+    EXPECT_GT(p.box_lo[i] + 1, lo) << i;
+    EXPECT_GE(p.box_hi[i], hi) << i;
+    EXPECT_LT(p.box_hi[i] - 1, hi) << i;
+  }
+  // A voxel no point fell in keeps the whole cube.
+  SurfacePatchBuilder empty(scene);
+  const SurfacePatch none = empty.Finish()[0];
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_EQ(none.box_lo[i], 0);
+    EXPECT_EQ(none.box_hi[i], kPatchBoxSteps);
+  }
+}
+
 TEST(SurfacePatchesTest, PointsOnALineAreNotFlat) {
   std::vector<Eigen::Vector3f> points;
   for (int i = 0; i < 20; ++i) points.emplace_back(0.01f + 0.004f * float(i), 0.05f, 0.05f);

@@ -140,6 +140,148 @@ TEST(SubvoxelTest, AGrazingBeamPassesOverAFloorPatch) {
   EXPECT_LT(double((*cubes)[0].count()), 0.2 * n);
 }
 
+// Patches from `points` at 0.1 m, for the hand-made scenes below.
+struct Scene {
+  std::vector<Eigen::Vector3f> points;
+  VoxelScene scene;
+  std::vector<SurfacePatch> patches;
+  explicit Scene(std::vector<Eigen::Vector3f> p)
+      : points(std::move(p)), scene(SceneOf(points, 0.1)), patches(ComputeSurfacePatches(scene, points)) {}
+  size_t Id(const WorldPoint& p) const {
+    VoxelKey key;
+    EXPECT_TRUE(CoordToKey(0.1, p, &key));
+    const int64_t id = scene.IdOf(key);
+    EXPECT_GE(id, 0);
+    return size_t(id);
+  }
+};
+
+TEST(SubvoxelTest, AVoxelBlocksOnlyOverItsPointsBox) {
+  // A clump of points in the low corner of the cube [1, 1.1) x [0, 0.1) x [0, 0.1) (not flat), and a
+  // target clump 0.5 m behind it along +x. A beam through the clump is blocked; one through the
+  // cube's far corner, 0.05 m from the clump (more than kSubvoxelBoxPad edges beyond its box), is not.
+  std::mt19937 rng(4);
+  std::uniform_real_distribution<float> u(0.0f, 0.02f);
+  std::vector<Eigen::Vector3f> points;
+  for (int i = 0; i < 40; ++i) points.emplace_back(1.0f + u(rng), u(rng), u(rng));
+  for (int i = 0; i < 40; ++i) points.emplace_back(1.5f + u(rng), 0.005f + u(rng), 0.005f + u(rng));
+  const Scene s(points);
+  ASSERT_EQ(s.scene.occupied.size(), 2u);
+  const size_t clump = s.Id({1.01, 0.01, 0.01}), target = s.Id({1.51, 0.01, 0.01});
+  ASSERT_FALSE(s.patches[clump].flat);
+  const Eigen::AlignedBox3d box = SubvoxelBoxIS(s.scene, s.patches, clump);
+  EXPECT_DOUBLE_EQ(box.min().x(), 10.0);  // clipped to the cube
+  EXPECT_LT(box.max().y(), 0.2 + kSubvoxelBoxPad + 0.01);
+  const Eigen::Vector3d aim = SubvoxelAimIS(s.scene, s.patches, target);
+  // From straight behind the target's centroid along -x, through the clump's box: blocked by it.
+  const WorldPoint through(0.2, aim.y() * 0.1, aim.z() * 0.1);
+  const SubvoxelRay blocked = ExplainSubvoxel(s.scene, s.patches, through, target);
+  EXPECT_EQ(blocked.outcome, SubvoxelRay::Outcome::kBlocked);
+  EXPECT_EQ(blocked.first_blocker, int64_t(clump));
+  EXPECT_FALSE(IsSubvoxelVisible(s.scene, s.patches, through, target));
+  // From a point whose beam to the centroid crosses the clump's cube at its far corner: clear.
+  const Eigen::Vector3d corner(1.05, 0.09, 0.09);  // in the clump's cube, beyond its box
+  const WorldPoint past = corner + (corner - aim * 0.1) * 2;
+  const SubvoxelRay clear = ExplainSubvoxel(s.scene, s.patches, past, target);
+  EXPECT_EQ(clear.outcome, SubvoxelRay::Outcome::kClear);
+  EXPECT_EQ(clear.first_blocker, -1);
+  EXPECT_TRUE(IsSubvoxelVisible(s.scene, s.patches, past, target));
+  // The reference agrees on both.
+  const testing::SubvoxelReference reference{s.scene, s.patches};
+  EXPECT_FALSE(reference.Seen(through / 0.1, target));
+  EXPECT_TRUE(reference.Seen(past / 0.1, target));
+}
+
+TEST(SubvoxelTest, ASparselySampledWallStillHidesWhatIsBehindIt) {
+  // A wall at x = 2.05 m sampled every 5 cm (half an edge: its points' boxes alone would leave gaps
+  // between voxels) before a densely sampled wall at x = 3.05 m: the boxes of the front wall reach
+  // the faces they share with occupied neighbours, so no beam passes between them.
+  std::vector<Eigen::Vector3f> points;
+  for (int i = 0; i <= 40; ++i) {
+    for (int j = 0; j <= 40; ++j) points.emplace_back(2.05f, -1.0f + 0.05f * float(i), -1.0f + 0.05f * float(j));
+  }
+  for (int i = 0; i <= 100; ++i) {
+    for (int j = 0; j <= 100; ++j) points.emplace_back(3.05f, -0.5f + 0.01f * float(i), -0.5f + 0.01f * float(j));
+  }
+  const Scene s(points);
+  const WorldPoint o(0.05, 0.03, 0.02);
+  VisibilitySetsOptions options;
+  options.test = SelectionTest::kSubvoxel;
+  options.surface_patches = s.patches;
+  auto sets = ComputeVisibilitySets(s.scene, {o}, options);
+  ASSERT_TRUE(sets.ok()) << sets.status().ToString();
+  uint64_t front_seen = 0, back_seen = 0;
+  for (size_t id = 0; id < s.scene.occupied.size(); ++id) {
+    const bool back = KeyToIndex(s.scene.occupied[id]).x == 30;
+    if ((*sets)[0].test(id)) ++(back ? back_seen : front_seen);
+  }
+  EXPECT_EQ(back_seen, 0u);
+  EXPECT_GT(double(front_seen), 0.95 * 400);  // of the front wall's 20 x 20 voxels
+}
+
+TEST(SubvoxelTest, AVoxelThatIsNotFlatIsSeenByAFaceOfItsBox) {
+  // A cluster of points filling the middle of the cube [2.0, 2.1) x [0, 0.1) x [0, 0.1) (not flat),
+  // seen from o = (1, 1, 0.05); a sliver of points at y in [0.10, 0.11] in the cube before it,
+  // [1.9, 2.0) x [0.1, 0.2), lies across the segment to the cluster's centroid but not across the one
+  // to the centre of the cluster's box face at y = 0.1 (which faces o).
+  std::mt19937 rng(6);
+  std::uniform_real_distribution<float> u(0, 1);
+  std::vector<Eigen::Vector3f> points;
+  for (int i = 0; i < 200; ++i)
+    points.emplace_back(2.02f + 0.06f * u(rng), 0.02f + 0.06f * u(rng), 0.02f + 0.06f * u(rng));
+  for (int i = 0; i < 100; ++i)
+    points.emplace_back(1.96f + 0.03f * u(rng), 0.10f + 0.01f * u(rng), 0.02f + 0.06f * u(rng));
+  const Scene s(points);
+  ASSERT_EQ(s.scene.occupied.size(), 2u);
+  const size_t cluster = s.Id({2.05, 0.05, 0.05}), sliver = s.Id({1.975, 0.105, 0.05});
+  ASSERT_FALSE(s.patches[cluster].flat);
+  const WorldPoint o(1.0, 1.0, 0.05);
+  const Eigen::Vector3d uo = o / 0.1;
+  const testing::SubvoxelReference reference{s.scene, s.patches};
+  const SubvoxelRay centroid = ExplainSubvoxel(s.scene, s.patches, o, sliver);
+  EXPECT_TRUE(centroid.seen());  // the sliver itself is in view
+  EXPECT_FALSE(reference.SegmentSees(uo, SubvoxelAimIS(s.scene, s.patches, cluster), cluster));
+  const Eigen::AlignedBox3d box = SubvoxelBoxIS(s.scene, s.patches, cluster);
+  EXPECT_NEAR(box.max().y(), 1.0, 0.01);  // the points' box (y <= 0.08 m) grown by kSubvoxelBoxPad
+  EXPECT_TRUE(reference.SegmentSees(uo, Eigen::Vector3d(box.center().x(), box.max().y(), box.center().z()), cluster));
+  EXPECT_TRUE(reference.Seen(uo, cluster));
+  EXPECT_TRUE(IsSubvoxelVisible(s.scene, s.patches, o, cluster));
+  EXPECT_TRUE(ExplainSubvoxel(s.scene, s.patches, o, cluster).seen());
+}
+
+TEST(SubvoxelTest, ExplainNamesTheOutcome) {
+  const std::vector<Eigen::Vector3f> points = ClutterPoints(4);
+  const VoxelScene scene = SceneOf(points, 0.1);
+  const std::vector<SurfacePatch> patches = ComputeSurfacePatches(scene, points);
+  const WorldPoint o(1.0, 1.0, 1.0);
+  ScannerModel scanner;
+  scanner.min_range_m = 0.0;
+  scanner.max_range_m = 1.2;
+  uint64_t outside = 0, blocked = 0, seen = 0;
+  for (const WorldPoint& from : {o, WorldPoint(0.25, 1.2, 0.3), WorldPoint(1.0, 0.2, 0.15)})
+    for (size_t id = 0; id < scene.occupied.size(); ++id) {
+      const SubvoxelRay ray = ExplainSubvoxel(scene, patches, from, id, scanner);
+      EXPECT_EQ(ray.seen(), IsSubvoxelVisible(scene, patches, from, id, scanner)) << id;
+      outside += ray.outcome == SubvoxelRay::Outcome::kOutsideLimits;
+      if (ray.outcome == SubvoxelRay::Outcome::kBlocked) {
+        ++blocked;
+        ASSERT_GE(ray.first_blocker, 0);
+        EXPECT_NE(size_t(ray.first_blocker), id);
+        EXPECT_GE(ray.blocker_s, 0.0);
+        EXPECT_LE(ray.blocker_s, 1.0);
+      }
+      seen += ray.seen();
+    }
+  EXPECT_GT(outside, 100u);
+  EXPECT_GT(blocked, 10u);
+  EXPECT_GT(seen, 10u);
+  // Invalid: a viewpoint inside an occupied voxel, and patches that are not one per voxel.
+  const WorldPoint inside = scene.Center(0);
+  EXPECT_EQ(ExplainSubvoxel(scene, patches, inside, 1).outcome, SubvoxelRay::Outcome::kInvalid);
+  EXPECT_EQ(ExplainSubvoxel(scene, std::span<const SurfacePatch>(patches).first(3), o, 1).outcome,
+            SubvoxelRay::Outcome::kInvalid);
+}
+
 TEST(SubvoxelTest, WithoutPatchesTheSurfaceTestRuns) {
   const std::vector<Eigen::Vector3f> points = ClutterPoints(2);
   const VoxelScene scene = SceneOf(points, 0.1);
@@ -203,8 +345,9 @@ TEST(SubvoxelTest, APlaneFullyInViewIsFullyPredictedAtEveryTilt) {
       const double surface = Recall(scans, SelectionTest::kSurfaceVisibility);
       const double subvoxel = Recall(scans, SelectionTest::kSubvoxel);
       SCOPED_TRACE("tilt " + std::to_string(tilt_deg) + " noise " + std::to_string(noise_m));
-      // Measured (docs/VISIBILITY.md): 1.000 without noise; 0.944-1.000 with 1 cm of noise.
-      EXPECT_GE(subvoxel, noise_m == 0 ? 0.99 : 0.93);
+      // Measured (docs/VISIBILITY.md): 1.000 without noise; 0.987-1.000 with 1 cm of noise. The
+      // issue's target: 0.95.
+      EXPECT_GE(subvoxel, noise_m == 0 ? 0.99 : 0.95);
       EXPECT_GE(subvoxel, surface);
       if (tilt_deg >= 30) {  // the second layer counts
         EXPECT_GT(subvoxel, surface + 0.2);
