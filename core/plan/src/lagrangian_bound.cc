@@ -231,7 +231,6 @@ class Subgradient {
     std::sort(first, last, cheaper);
   }
 
-
   const CoverProblem& p_;
   const LagrangianOptions& o_;
   std::vector<int> core_;               // the classes of the current core, ascending

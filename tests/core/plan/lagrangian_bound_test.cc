@@ -70,8 +70,8 @@ TEST(LagrangianBoundTest, NeverAboveTheExhaustiveOptimumFullAndPartial) {
       Result<LagrangianBound> got =
           ComputeLagrangianBound(p, {.upper_bound = p.columns, .first_core_seers = first_core});
       ASSERT_TRUE(got.ok()) << got.status().ToString();
-      const std::string what = "trial " + std::to_string(trial) + ", need " + std::to_string(p.need) +
-                               ", first core " + std::to_string(first_core);
+      const std::string what = "trial " + std::to_string(trial) + ", need " + std::to_string(p.need) + ", first core " +
+                               std::to_string(first_core);
       EXPECT_LE(got->bound, optimum) << what;
       EXPECT_LE(got->relaxation, optimum + 1e-9) << what;
       EXPECT_GE(got->bound, got->counting_bound) << what;
