@@ -7,7 +7,8 @@
 # scans and walking, minutes), G and the stop reason (and, with --local-candidates among FLAGS, the
 # positions it added and the stations of each selection).
 # Usage: scripts/compare-solvers.sh [BUILD_DIR (default build/release)] [SOLVERS (default "greedy exact")]
-#   [SCENES (default: geb079 and the synthetic scenes; "hall" and "hall-scan" add the halls)] [-- FLAGS...]
+#   [SCENES (default: geb079 and the synthetic scenes; "hall" and "hall-scan" add the halls,
+#   "room-scan1" the real furnished room)] [-- FLAGS...]
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bin=${1:-build/release}
@@ -40,6 +41,7 @@ for s in $scenes; do
   case "$s" in
     geb079) f=../shared/data/geb079/geb079.bt ;;
     hall-scan) f=../shared/data/hall-scan/scan.dat.bz2 ;;
+    room-scan1) f=../shared/data/room-2scans/room_scan1.pcd ;;
     *) f="$work/${s/:/_}.ply"; [[ -f "$f" ]] || "$bin/core/vc-synth" "$s" --spacing 0.05 --out "$f" >/dev/null ;;
   esac
   for solver in $solvers; do

@@ -10,130 +10,192 @@
 namespace vc::planner {
 namespace {
 
-// One evaluation of L(u): its value, the rounding-error allowance and the subproblems' solutions.
+// One evaluation of L(u): its value, the rounding-error allowance and the columns chosen.
 struct Evaluation {
   long double value = 0;
   long double tolerance = 0;
-  std::vector<char> x;    // per column: chosen (reduced cost < 0)
-  std::vector<double> y;  // per class: covered share in the knapsack
+  std::vector<int> chosen;  // the columns of reduced cost < 0, ascending
+};
+
+// A class in the knapsack: u_k / w_k, then the class (the order's tie-break).
+struct Priced {
+  double ratio;
+  int k;
 };
 
 class Subgradient {
  public:
   Subgradient(const CoverProblem& p, const LagrangianOptions& o) : p_(p), o_(o) {
-    sees_.resize(p.columns);
+    std::vector<uint64_t> width(p.columns, 0);
     for (size_t k = 0; k < p.weight.size(); ++k) {
-      for (int j : p.seen_by[k]) sees_[j].push_back(static_cast<int>(k));
-      if (!p.seen_by[k].empty()) {
-        coverable_ += p.weight[k];
-        pairs_ += p.seen_by[k].size();
-      }
+      for (int j : p.seen_by[k]) width[j] += p.weight[k];
+      if (!p.seen_by[k].empty()) coverable_ += p.weight[k];
+      most_seers_ = std::max(most_seers_, p.seen_by[k].size());
     }
-    uint64_t widest = 1;
-    for (const std::vector<int>& s : sees_) {
-      uint64_t w = 0;
-      for (int k : s) w += p.weight[k];
-      widest = std::max(widest, w);
-    }
-    widest_ = widest;
+    for (uint64_t w : width) widest_ = std::max(widest_, w);
     u_.assign(p.weight.size(), 0.0);
-    for (size_t k = 0; k < p.weight.size(); ++k) {
-      if (!p.seen_by[k].empty()) u_[k] = static_cast<double>(p.weight[k]) / static_cast<double>(widest);
-    }
+    y_.assign(p.weight.size(), 0.0);
+    g_.assign(p.weight.size(), 0.0);
+    covered_.assign(p.weight.size(), 0);
   }
 
   int CountingBound() const { return static_cast<int>((p_.need + widest_ - 1) / widest_); }
 
+  // The cores, each twice the last's seer limit, until one holds every class (or the budget ends).
   Result<LagrangianBound> Run(const JobContext& ctx) {
     LagrangianBound out;
     out.counting_bound = CountingBound();
     out.bound = out.counting_bound;
     out.relaxation = static_cast<double>(p_.need) / static_cast<double>(widest_);
     const double ub = o_.upper_bound > 0 ? o_.upper_bound : std::max(1, p_.columns);
-    double scale = 2.0;
-    int since_better = 0;
-    std::vector<double> g(p_.weight.size(), 0.0);
-    for (int it = 0; it < o_.max_iterations && out.bound < ub; ++it) {
-      if (out.pair_visits + 2 * pairs_ > o_.max_pair_visits && it > 0) break;
-      VC_RETURN_IF_ERROR(ctx.CheckCancelled("Lagrangian bound"));
-      const Evaluation e = Evaluate();
-      out.pair_visits += 2 * pairs_;
-      out.iterations = it + 1;
-      const double value = static_cast<double>(e.value);
-      if (value > out.relaxation) {
-        out.relaxation = value;
-        out.bound = std::max(out.bound, static_cast<int>(std::ceil(e.value - e.tolerance)));
-        since_better = 0;
-      } else if (++since_better >= o_.patience) {
-        scale /= 2;
-        since_better = 0;
-        if (scale < o_.min_step_scale) break;
-      }
-      // The subgradient g_k = y_k - (columns chosen that see k); no step into u_k < 0 at u_k = 0.
-      double norm2 = 0;
-      for (size_t k = 0; k < g.size(); ++k) {
-        if (p_.seen_by[k].empty()) continue;
-        int covered = 0;
-        for (int j : p_.seen_by[k]) covered += e.x[j];
-        g[k] = e.y[k] - covered;
-        if (u_[k] <= 0 && g[k] < 0) g[k] = 0;
-        norm2 += static_cast<double>(p_.weight[k]) * g[k] * g[k];
-      }
-      if (norm2 <= 0) break;  // x, y satisfy the relaxed rows with complementary slackness: u is optimal
-      // The step in the metric scaled by the class weights (a voxel's price moves, not a class's).
-      const double step = scale * std::max(ub - value, 1e-3) / norm2;
-      for (size_t k = 0; k < g.size(); ++k) {
-        u_[k] = std::max(0.0, u_[k] + step * static_cast<double>(p_.weight[k]) * g[k]);
-      }
+    bool first = true;
+    for (uint64_t limit = std::max(1, o_.first_core_seers);; limit *= 2) {
+      const bool whole = limit >= most_seers_;
+      SetCore(whole ? most_seers_ : limit, first);
+      first = false;
+      VC_ASSIGN_OR_RETURN(const bool budget_left, Phase(ctx, ub, out));
+      if (!budget_left || whole || out.bound >= ub) break;
     }
     out.bound = std::max(0, std::min(out.bound, p_.columns));
     return out;
   }
 
  private:
-  // L(u) at the current multipliers; each sum in long double, with its terms' magnitudes.
-  Evaluation Evaluate() const {
-    Evaluation e;
-    e.x.assign(p_.columns, 0);
-    e.y.assign(p_.weight.size(), 0.0);
-    long double magnitude = 0;
+  // The core: the classes some column sees and at most `limit` columns see. The other classes keep
+  // u_k = 0: free in the knapsack and in no column's price, so L(u) is the same over the core and
+  // over every class, and each core's multipliers start the next. The first core starts at
+  // Beasley's u_k = w_k / (the widest core column that sees k): every reduced cost is then >= 0.
+  void SetCore(uint64_t limit, bool beasley_start) {
+    sees_.assign(p_.columns, {});
+    core_.clear();
+    pairs_ = 0;
+    for (size_t k = 0; k < p_.weight.size(); ++k) {
+      const size_t n = p_.seen_by[k].size();
+      if (n == 0 || n > limit) continue;
+      core_.push_back(static_cast<int>(k));
+      for (int j : p_.seen_by[k]) sees_[j].push_back(static_cast<int>(k));
+      pairs_ += n;
+    }
+    if (!beasley_start) return;
+    std::vector<uint64_t> width(p_.columns, 0);
     for (int j = 0; j < p_.columns; ++j) {
-      long double s = 0;
-      for (int k : sees_[j]) s += u_[k];
+      for (int k : sees_[j]) width[j] += p_.weight[k];
+    }
+    for (int k : core_) {
+      uint64_t seer = 1;
+      for (int j : p_.seen_by[k]) seer = std::max(seer, width[j]);
+      u_[k] = static_cast<double>(p_.weight[k]) / static_cast<double>(seer);
+    }
+  }
+
+  // Subgradient steps over the current core: at most max_iterations, until lambda falls below
+  // min_step_scale or the bound reaches UB. False when the pair-visit budget ran out.
+  Result<bool> Phase(const JobContext& ctx, double ub, LagrangianBound& out) {
+    double scale = 2.0;
+    double best = -1;  // this core's best L(u)
+    int since_better = 0;
+    uint64_t chosen_pairs = 0;  // the last subgradient's pair visits
+    for (int it = 0; it < o_.max_iterations && out.bound < ub; ++it) {
+      if (out.pair_visits + pairs_ + chosen_pairs > o_.max_pair_visits && out.iterations > 0) return false;
+      VC_RETURN_IF_ERROR(ctx.CheckCancelled("Lagrangian bound"));
+      const Evaluation e = Evaluate();
+      ++out.iterations;
+      const double value = static_cast<double>(e.value);
+      if (value > out.relaxation) {
+        out.relaxation = value;
+        out.bound = std::max(out.bound, static_cast<int>(std::ceil(e.value - e.tolerance)));
+      }
+      if (value > best) {
+        best = value;
+        since_better = 0;
+      } else if (++since_better >= o_.patience) {
+        scale /= 2;
+        since_better = 0;
+        if (scale < o_.min_step_scale) break;
+      }
+      // The subgradient g_k = y_k - (columns chosen that see k) over the core; no step into u_k < 0
+      // at u_k = 0. Only the chosen columns' pairs are visited (few have a reduced cost below 0).
+      chosen_pairs = 0;
+      for (int j : e.chosen) {
+        for (int k : sees_[j]) ++covered_[k];
+        chosen_pairs += sees_[j].size();
+      }
+      out.pair_visits += pairs_ + chosen_pairs;
+      double norm2 = 0;
+      for (int k : core_) {
+        g_[k] = y_[k] - covered_[k];
+        covered_[k] = 0;
+        if (u_[k] <= 0 && g_[k] < 0) g_[k] = 0;
+        norm2 += static_cast<double>(p_.weight[k]) * g_[k] * g_[k];
+      }
+      if (norm2 <= 0) break;  // x, y satisfy the relaxed rows with complementary slackness: u is optimal
+      // The step in the metric scaled by the class weights (a voxel's price moves, not a class's).
+      const double step = scale * std::max(ub - value, 1e-3) / norm2;
+      for (int k : core_) u_[k] = std::max(0.0, u_[k] + step * static_cast<double>(p_.weight[k]) * g_[k]);
+    }
+    return true;
+  }
+
+  // sum_{k in sees} u_k in double (four partial sums; the bound's hot loop).
+  double PriceOf(const std::vector<int>& sees) const {
+    double a = 0, b = 0, c = 0, d = 0;
+    size_t i = 0;
+    for (; i + 4 <= sees.size(); i += 4) {
+      a += u_[sees[i]];
+      b += u_[sees[i + 1]];
+      c += u_[sees[i + 2]];
+      d += u_[sees[i + 3]];
+    }
+    for (; i < sees.size(); ++i) a += u_[sees[i]];
+    return (a + b) + (c + d);
+  }
+
+  // L(u) at the current multipliers, the knapsack's y in y_. A column's price is a double sum of
+  // n terms >= 0, off by at most n 2^-53 of itself; the sums over columns and classes are in long
+  // double, with their terms' magnitudes. The tolerance covers both.
+  Evaluation Evaluate() {
+    Evaluation e;
+    long double magnitude = 0;
+    long double price_error = 0;
+    for (int j = 0; j < p_.columns; ++j) {
+      const double s = PriceOf(sees_[j]);
       const long double reduced = 1.0L - s;
       magnitude += 1.0L + s;
+      price_error += static_cast<long double>(sees_[j].size() + 1) * 0x1p-52L * s;
       if (reduced < 0) {
-        e.x[j] = 1;
+        e.chosen.push_back(j);
         e.value += reduced;
       }
     }
-    e.value += Knapsack(e.y, magnitude);
-    e.tolerance = 1e-9L * (1.0L + magnitude);
+    e.value += Knapsack(magnitude);
+    e.tolerance = 1e-9L * (1.0L + magnitude) + price_error;
     return e;
   }
 
   // min sum_k u_k y_k s.t. sum_k w_k y_k >= need, y in [0, 1], over the classes some column sees:
-  // the free classes (u_k = 0) first, then by u_k / w_k ascending (ties: the lower class), the last split.
-  long double Knapsack(std::vector<double>& y, long double& magnitude) const {
-    uint64_t taken = 0;
-    std::vector<int> priced;
-    for (size_t k = 0; k < p_.weight.size(); ++k) {
-      if (p_.seen_by[k].empty()) continue;
-      if (u_[k] <= 0) {
-        y[k] = 1;
-        taken += p_.weight[k];
+  // the free classes (u_k = 0, every class outside the core among them) first, then by u_k / w_k
+  // ascending (ties: the lower class), the last split. y_ is set over the core.
+  long double Knapsack(long double& magnitude) {
+    uint64_t taken = coverable_;
+    priced_.clear();
+    for (int k : core_) {
+      y_[k] = 0;
+      if (u_[k] > 0) {
+        priced_.push_back({u_[k] / static_cast<double>(p_.weight[k]), k});
+        taken -= p_.weight[k];
       } else {
-        priced.push_back(static_cast<int>(k));
+        y_[k] = 1;
       }
     }
     long double cost = 0;
     if (taken >= p_.need) return cost;
-    if (p_.need < coverable_) OrderCheapestFirst(priced, p_.need - taken);
-    for (int k : priced) {
+    if (p_.need < coverable_) OrderCheapestFirst(priced_, p_.need - taken);
+    for (const Priced& c : priced_) {
+      const int k = c.k;
       const uint64_t rest = p_.need - taken;
       const uint64_t w = p_.weight[k];
       const double share = w <= rest ? 1.0 : static_cast<double>(rest) / static_cast<double>(w);
-      y[k] = share;
+      y_[k] = share;
       cost += static_cast<long double>(u_[k]) * share;
       magnitude += static_cast<long double>(u_[k]);
       taken += std::min(w, rest);
@@ -145,22 +207,20 @@ class Subgradient {
   // Moves the classes the knapsack takes to the front of `priced` (by u_k / w_k ascending, ties:
   // the lower class), the last of them, which may be split, last: a weighted quickselect for the
   // class where the weight reaches `need`, then a sort of the few around it.
-  void OrderCheapestFirst(std::vector<int>& priced, uint64_t need) const {
-    const auto cheaper = [&](int a, int b) {
-      const double ra = u_[a] / static_cast<double>(p_.weight[a]);
-      const double rb = u_[b] / static_cast<double>(p_.weight[b]);
-      return ra != rb ? ra < rb : a < b;
+  void OrderCheapestFirst(std::vector<Priced>& priced, uint64_t need) const {
+    const auto cheaper = [](const Priced& a, const Priced& b) {
+      return a.ratio != b.ratio ? a.ratio < b.ratio : a.k < b.k;
     };
     auto first = priced.begin(), last = priced.end();
     while (last - first > 32) {
       auto mid = first + (last - first) / 2;
       std::nth_element(first, mid, last, cheaper);
       uint64_t below = 0;
-      for (auto it = first; it != mid; ++it) below += p_.weight[*it];
+      for (auto it = first; it != mid; ++it) below += p_.weight[it->k];
       if (below >= need) {
         last = mid;
       } else {
-        need -= below + std::min(need - below, p_.weight[*mid]);
+        need -= below + std::min(need - below, p_.weight[mid->k]);
         if (need == 0) {
           last = mid + 1;
           break;
@@ -173,11 +233,17 @@ class Subgradient {
 
   const CoverProblem& p_;
   const LagrangianOptions& o_;
-  std::vector<std::vector<int>> sees_;  // per column: the classes it sees, ascending
-  std::vector<double> u_;               // per class: the multiplier of y_k <= sum x_j
+  std::vector<int> core_;               // the classes of the current core, ascending
+  std::vector<std::vector<int>> sees_;  // per column: the core classes it sees, ascending
+  std::vector<double> u_;               // per class: the multiplier of y_k <= sum x_j (0 outside the core)
+  std::vector<double> y_;               // per core class: its share in the last knapsack
+  std::vector<double> g_;               // per core class: the last subgradient
+  std::vector<int> covered_;            // per class: chosen columns that see it (0 between iterations)
+  std::vector<Priced> priced_;          // the knapsack's classes of u_k > 0 (kept to reuse its memory)
   uint64_t coverable_ = 0;              // weight of the classes some column sees
   uint64_t widest_ = 1;                 // the widest column's weight (at least 1)
-  uint64_t pairs_ = 0;                  // (class, column) pairs
+  uint64_t pairs_ = 0;                  // (class, column) pairs of the core
+  size_t most_seers_ = 0;               // the most columns that see one class
 };
 
 Status CheckProblem(const CoverProblem& p) {

@@ -11,19 +11,30 @@
 // the second a fractional knapsack (classes by u_k / w_k ascending, the last one split). For every
 // u >= 0, L(u) <= the LP optimum <= the integer optimum (weak duality), so the bound is
 // ceil(max L(u) - tolerance), with a tolerance above the rounding error of the sums (long double).
-// u starts at w_k / W (W: the widest candidate's weight), where L(u) = need / W is the counting
-// bound, so the bound is never below it. The multipliers then move along the subgradient
-// g_k = y_k - sum_{j in S_k} x_j (components with u_k = 0 and g_k < 0 set to 0) with the step of
-// Beasley 1990, lambda (UB - L(u)) / |g|^2 (UB: an upper bound on the optimum, e.g. greedy's
-// count; lambda starts at 2 and halves after `patience` iterations without a better L), taken in
-// the metric scaled by the class weights (u_k moves by step * w_k * g_k, |g|^2 = sum w_k g_k^2):
-// classes of one voxel and of thousands then move at one price per voxel. On geb079's 49,706
-// classes this reaches the LP bound at 99 % (68) in 300 iterations, where unscaled steps stall.
+// The multipliers move along the subgradient g_k = y_k - sum_{j in S_k} x_j (components with
+// u_k = 0 and g_k < 0 set to 0) with the step of Beasley 1990, lambda (UB - L(u)) / |g|^2 (UB: an
+// upper bound on the optimum, e.g. greedy's count; lambda starts at 2 and halves after `patience`
+// iterations without a better L), taken in the metric scaled by the class weights (u_k moves by
+// step * w_k * g_k, |g|^2 = sum w_k g_k^2): classes of one voxel and of thousands then move at one
+// price per voxel.
 //
-// Cost: each iteration visits every (class, candidate) pair twice and finds the knapsack's
-// cheapest classes by a weighted quickselect (linear); it stops after max_iterations, when lambda
-// falls below min_step_scale, when the bound reaches UB, or before max_pair_visits pairs would be
-// exceeded. No clocks and one thread: the same input gives the same bound on any machine.
+// Cores (issue 36): the steps run first over the classes at most first_core_seers candidates see,
+// then over those at most twice as many see, and so on until every class is in. A class outside the
+// core keeps u_k = 0: it is free in the knapsack and in no candidate's price, so L(u) over the core
+// is L(u) of the whole problem (every core's L is a valid bound) and each core's multipliers start
+// the next. The first core starts at Beasley's u_k = w_k / (the widest core candidate that sees k),
+// where every reduced cost is >= 0. Why: a partial cover leaves the slack to the classes many
+// candidates see, so the rare classes carry the bound, and a core of them costs a fraction of the
+// pairs: on geb079 (398 candidates, 99,863 classes, 5.4 M pairs) the classes at most 16 see hold
+// 0.2 M pairs and the bound reaches 46 where 49 steps over every class reached 33
+// (docs/PLANNING.md, "The Lagrangian bound over cores").
+//
+// Cost: each step visits every (class, candidate) pair of the core once (a candidate's price, in
+// double with a proven error allowance), the pairs of the candidates with reduced cost < 0 once
+// (the subgradient), and finds the knapsack's cheapest classes by a weighted quickselect (linear).
+// Each core stops after max_iterations steps or when lambda falls below min_step_scale; the whole
+// stops when the bound reaches UB or before max_pair_visits pairs would be exceeded. No clocks and
+// one thread: the same input gives the same bound on any machine.
 // Thread-safe (no state between calls).
 #pragma once
 
@@ -45,8 +56,9 @@ struct CoverProblem {
 
 struct LagrangianOptions {
   int upper_bound = 0;           // stations of a known plan (> 0), scales the step; 0 = the column count
-  int max_iterations = 300;      // subgradient iterations, at most
+  int max_iterations = 300;      // subgradient iterations per core, at most
   int patience = 20;             // iterations without a better L(u) before lambda halves
+  int first_core_seers = 16;     // the first core: the classes at most this many columns see (below 1: 1)
   double min_step_scale = 1e-3;  // stop once lambda falls below this
   uint64_t max_pair_visits = uint64_t{2} << 30;  // stop once this many (class, column) pairs were visited
 };
@@ -55,7 +67,7 @@ struct LagrangianBound {
   int bound = 0;             // proven lower bound on the optimum, in stations (0 when need is 0)
   double relaxation = 0;     // the best L(u) found, in stations (bound = ceil of it, less the tolerance)
   int counting_bound = 0;    // ceil(need / W), the start's bound, for comparison
-  int iterations = 0;        // subgradient iterations run
+  int iterations = 0;        // subgradient iterations run, over all cores
   uint64_t pair_visits = 0;  // (class, column) pairs visited
 };
 
