@@ -634,6 +634,28 @@ class Consolidation {
     return false;
   }
 
+  // The candidates that see one voxel only `pick` covers (the first such voxel), as bits; kept while
+  // that voxel stays covered by `pick` alone. For a needed pick only (Needed).
+  const std::vector<uint64_t>& Seers(int pick) {
+    auto it = seers_.find(pick);
+    if (it != seers_.end() && counts_[it->second.first] == 1) return it->second.second;
+    const std::vector<uint64_t>& w = Words(pick);
+    size_t probe = 0;
+    for (size_t k : NonzeroWords(pick)) {
+      if (const uint64_t sole = w[k] & ~c2_[k]; sole != 0) {
+        probe = k * 64 + static_cast<size_t>(std::countr_zero(sole));
+        break;
+      }
+    }
+    std::vector<uint64_t> bits(candidate_words_, 0);
+    for (size_t c = 0; c < sets_.size(); ++c) {
+      if (sets_[c].test(probe)) bits[c >> 6] |= uint64_t{1} << (c & 63);
+    }
+    auto& entry = seers_[pick];
+    entry = {probe, std::move(bits)};
+    return entry.second;
+  }
+
   // Whether candidate c is among `bits` (nullptr: no constraint).
   static bool Has(const std::vector<uint64_t>* bits, int c) { return !bits || (((*bits)[c >> 6] >> (c & 63)) & 1); }
 
@@ -777,7 +799,19 @@ class Consolidation {
   // there is none, the pair is passed over before rest_ is computed (most pairs on a large site);
   // otherwise only the common neighbours are tried, in order_.
   bool MergePair(size_t a, size_t b) {
-    if (sole_[a] && sole_[b] && !Meet(Neighbours(picks_[a]), Neighbours(picks_[b]))) return false;
+    if (sole_[a] && sole_[b]) {
+      // A stand-in must see a voxel only a covers and one only b covers: the candidates that see
+      // both are few, and most pairs on a large site have none.
+      const std::vector<uint64_t>& seers_a = Seers(picks_[a]);
+      const std::vector<uint64_t>& seers_b = Seers(picks_[b]);
+      if (!Meet(seers_a, seers_b)) return false;
+      FindRest(picks_[a], picks_[b]);
+      CommonNeighboursInOrder(seers_a, seers_b);
+      for (int c : common_) {
+        if (TryStandIn(a, b, c)) return true;
+      }
+      return false;
+    }
     const auto [in_a, in_b] = FindRest(picks_[a], picks_[b]);
     const std::vector<uint64_t>* need_a = in_a ? &Neighbours(picks_[a]) : nullptr;
     const std::vector<uint64_t>* need_b = in_b ? &Neighbours(picks_[b]) : nullptr;
@@ -904,7 +938,8 @@ class Consolidation {
   PerPick<VoxelSet> dense_copies_;    // sparse picks, made dense
   PerPick<std::vector<size_t>> nonzero_words_;
   PerPick<std::vector<uint64_t>> neighbours_;
-  size_t slot_count_ = 0;         // the picks consolidation started with
+  std::unordered_map<int, std::pair<size_t, std::vector<uint64_t>>> seers_;  // Seers: probe voxel, bits
+  size_t slot_count_ = 0;                                                    // the picks consolidation started with
   std::vector<uint64_t> failed_;  // without registration: bit s * slot_count_ + t, s < t, for an unmergeable pair
   std::vector<int8_t> needed_;    // per slot: Needed's answer, -1 when not known
   std::vector<uint32_t> counts_;  // per voxel: how many picks cover it
