@@ -177,13 +177,19 @@ struct BenchOptions {
   int rays = 200000, octomap_rays = 20000, threads = 2, repeat = 5;
   bool quick = false, scaling = true, rays_only = false, fine_eval = false, all_targets = false, sets = true;
   bool visibility_only = false, candidates_only = false;
+  bool resolution_given = false;  // --resolution on the command line: an OctoMap is resampled to it
   int every = 4;
 };
+
+// The working resolution for `input`: an OctoMap's own unless --resolution was given.
+double WorkingResolution(const vc::SceneInput& input, const BenchOptions& o) {
+  return input.octree && !o.resolution_given ? 0.0 : o.resolution;
+}
 
 void AddFlags(CLI::App& app, BenchOptions* o) {
   app.add_option("--scene", o->scene, "synthetic scene spec (hall, box, comb:5, ...) or a file path");
   app.add_option("--spacing", o->spacing, "point spacing of synthetic scenes, m");
-  app.add_option("--resolution", o->resolution, "working resolution, m");
+  app.add_option("--resolution", o->resolution, "working resolution, m (an OctoMap: its own unless given)");
   app.add_option("--grid", o->grid, "candidate grid spacing, m");
   app.add_option("--rays", o->rays, "rays for our traversal");
   app.add_option("--octomap-rays", o->octomap_rays, "rays (a prefix of ours) for OctoMap castRay");
@@ -230,7 +236,7 @@ vc::Result<LoadedScene> LoadAndVoxelize(const BenchOptions& o) {
   VC_ASSIGN_OR_RETURN(vc::SceneInput input, LoadScene(o.scene, o.spacing, 1));
   const double load_s = Seconds(t0);
   vc::VoxelizeOptions vo;
-  vo.resolution_m = input.octree ? 0.0 : o.resolution;
+  vo.resolution_m = WorkingResolution(input, o);
   t0 = Clock::now();
   VC_ASSIGN_OR_RETURN(vc::VoxelScene s, vc::Voxelize(input, vo));
   const double vox_s = Seconds(t0);
@@ -380,7 +386,7 @@ struct TimedPlan {
 // Plans `in` with the candidate grid `grid_m`; prints "plan failed" when it fails.
 TimedPlan RunPlan(const vc::SceneInput& in, const BenchOptions& o, double grid_m) {
   vc::PlanOptions po;
-  po.resolution_m = in.octree ? 0.0 : o.resolution;
+  po.resolution_m = WorkingResolution(in, o);
   po.grid_spacing_m = grid_m;
   po.threads = o.threads;
   const auto start = Clock::now();
@@ -524,6 +530,7 @@ int main(int argc, char** argv) {
   BenchOptions o;
   AddFlags(app, &o);
   CLI11_PARSE(app, argc, argv);
+  o.resolution_given = app.count("--resolution") > 0;
   std::setvbuf(stdout, nullptr, _IOLBF, 0);  // figures appear as they are measured
   if (o.fine_eval) return FineEvaluation(o.threads);
   if (o.quick) ApplyQuick(&o);

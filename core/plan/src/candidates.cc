@@ -66,6 +66,13 @@ int FreeVoxelsNeeded(double resolution_m, const CandidateOptions& o) {
 // Half-width (voxels) of a level's height band: 0.15 m, at least 2 voxels.
 int BandVoxels(double resolution_m) { return std::max(2, static_cast<int>(std::ceil(0.15 / resolution_m - 1e-9))); }
 
+// The band of auto's floor test (ChooseGround): the level band, but at most +-0.4 m (at least one
+// voxel). At 0.4 m the level band's 2 voxels are +-0.8 m, and 3 levels of a 4 m slope held all its
+// ground (`slope` 100 %, fr_campus 84 %: floors); one voxel, +-0.4 m, gives 75 % and terrain.
+int AutoBandVoxels(double resolution_m, int band) {
+  return std::max(1, std::min(band, static_cast<int>(std::floor(0.4 / resolution_m + 1e-9))));
+}
+
 constexpr int kNoSurface = std::numeric_limits<int>::min();
 
 // The standing surface with z in [ref - band, ref + band] closest to ref (the higher on a tie) in
@@ -348,7 +355,12 @@ Result<GroundField> FindGround(const OccupancyGrid& grid, int free_needed, const
     }
   }
   f.first.push_back(static_cast<uint32_t>(f.z.size()));
-  const int base = std::max(1, static_cast<int>(std::lround(kSlopeBaseM / r)));
+  // The slope's base: kSlopeBaseM, but at least so many voxels that one voxel of rise across the
+  // centred base (2 x base) is within kTerrainMaxSlope. Any slope rises a voxel at a time; at 0.4 m
+  // 0.5 m rounded to 1 voxel, every such rise measured 1 / 2 = 0.5 > 0.36, and the ground broke
+  // into strips between them (fr_campus: 1,511 terrain candidates, so auto picked floors).
+  const int min_base = static_cast<int>(std::ceil(1.0 / (2.0 * kTerrainMaxSlope) - 1e-9));
+  const int base = std::max(min_base, static_cast<int>(std::lround(kSlopeBaseM / r)));
   const int step = std::max(1, static_cast<int>(std::floor(o.walk_max_step_m / r + 1e-9)));
   std::vector<uint8_t> gentle(f.z.size(), 0);
   std::vector<uint32_t> parent(f.z.size());
@@ -583,8 +595,9 @@ Result<CandidateGrid> GenerateCandidates(const VoxelScene& scene, const Candidat
   VC_ASSIGN_OR_RETURN(const SurfaceHistogram hist, HistogramSurfaces(grid, free_needed, ctx));
   const std::vector<Level> kept = FindLevels(hist, band, free_needed);
   VC_ASSIGN_OR_RETURN(const GroundField ground, FindGround(grid, free_needed, options, ctx));
-  out.ground =
-      ChooseGround(options.ground, CountOnLevels(ground, m.z, grid.dims().z(), kept, band), kept.size(), band * r);
+  const int auto_band = AutoBandVoxels(r, band);
+  out.ground = ChooseGround(options.ground, CountOnLevels(ground, m.z, grid.dims().z(), kept, auto_band), kept.size(),
+                            auto_band * r);
   const WorldPoint lo = scene.BoundsMin(), hi = scene.BoundsMax();
   const std::vector<double> xs = AxisCells(lo.x(), hi.x(), options.grid_spacing_m);
   const std::vector<double> ys = AxisCells(lo.y(), hi.y(), options.grid_spacing_m);

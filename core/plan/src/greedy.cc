@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <bit>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <numeric>
@@ -471,7 +472,10 @@ class Consolidation {
         c1_(words_),
         c2_(words_),
         c3_(words_),
-        rest_(words_) {
+        rest_(words_),
+        block_words_((((words_ + kWordsPerBlock - 1) / kWordsPerBlock) + 63) / 64),
+        budget_s_(options.consolidate_budget_s),
+        start_(std::chrono::steady_clock::now()) {
     for (size_t i = static_cast<size_t>(std::max(fixed_, 0)); i < sets.size(); ++i) {
       order_.push_back(static_cast<int>(i));
     }
@@ -502,16 +506,29 @@ class Consolidation {
         EndPass(0);
         continue;
       }
+      if (out_.budget_reached) break;
       VC_ASSIGN_OR_RETURN(const bool merged, MergeOne());
       if (!merged) break;
     }
-    ctx_.Report(Stage::kSelection, 1.0, PassNote() + ", done");
+    out_.seconds = Elapsed();
+    ctx_.Report(Stage::kSelection, 1.0,
+                PassNote() + (out_.budget_reached
+                                  ? ", stopped at its time budget of " + std::to_string(std::lround(budget_s_)) + " s"
+                                  : ", done"));
     out_.picks = std::move(picks_);
     return std::move(out_);
   }
 
  private:
   bool IsFixed(int candidate) const { return candidate < fixed_; }
+  double Elapsed() const { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count(); }
+  // Whether the time budget is spent (then noted in out_): the search for a change stops, and the
+  // picks are those of the changes made so far (each keeps the coverage).
+  bool OverBudget() {
+    if (budget_s_ <= 0 || out_.budget_reached) return out_.budget_reached;
+    out_.budget_reached = Elapsed() > budget_s_;
+    return out_.budget_reached;
+  }
 
   // "consolidation pass 2 (1 dropped, 0 merged)".
   std::string PassNote() const {
@@ -563,12 +580,14 @@ class Consolidation {
   // (in b). Far-apart picks have no common neighbour and are passed over at once. A dense
   // candidate is tested on the pick's nonzero words only: on a large site that is a small share of
   // the scene, and this was most of consolidation's time (every pick against every candidate).
+  // Candidates that share no block with the pick (Blocks) are ruled out first, on a few words each.
   const std::vector<uint64_t>& Neighbours(int pick) {
     return neighbours_.Get(pick, [&] {
       const std::vector<uint64_t>& words = Words(pick);
       const std::vector<size_t>& nonzero = NonzeroWords(pick);
       std::vector<uint64_t> bits(candidate_words_, 0);
       for (size_t c = 0; c < sets_.size(); ++c) {
+        if (!ShareABlock(static_cast<int>(c), pick)) continue;
         bool meets = false;
         if (sets_[c].sparse()) {
           meets = sets_[c].Intersects(sets_[pick]);
@@ -580,6 +599,61 @@ class Consolidation {
       }
       return bits;
     });
+  }
+
+  // The blocks of kWordsPerBlock words (512 voxels) in which each candidate has a voxel, as bits,
+  // computed for every candidate on first use: two candidates that share no block share no voxel.
+  // On a campus a station sees a small part of the scene, so most pairs of candidates are told apart
+  // here in a few words instead of on the pick's nonzero words.
+  const uint64_t* Blocks(int c) {
+    if (blocks_.empty()) {
+      blocks_.assign(sets_.size() * block_words_, 0);
+      for (size_t i = 0; i < sets_.size(); ++i) {
+        uint64_t* b = &blocks_[i * block_words_];
+        if (sets_[i].sparse()) {
+          sets_[i].ForEach([&](size_t id) {
+            const size_t block = id / (64 * kWordsPerBlock);
+            b[block >> 6] |= uint64_t{1} << (block & 63);
+          });
+          continue;
+        }
+        const std::vector<uint64_t>& w = sets_[i].words();
+        for (size_t k = 0; k < w.size(); ++k) {
+          if (w[k]) b[(k / kWordsPerBlock) >> 6] |= uint64_t{1} << ((k / kWordsPerBlock) & 63);
+        }
+      }
+    }
+    return &blocks_[static_cast<size_t>(c) * block_words_];
+  }
+  bool ShareABlock(int x, int y) {
+    const uint64_t* bx = Blocks(x);
+    const uint64_t* by = Blocks(y);
+    for (size_t k = 0; k < block_words_; ++k) {
+      if (bx[k] & by[k]) return true;
+    }
+    return false;
+  }
+
+  // The candidates that see one voxel only `pick` covers (the first such voxel), as bits; kept while
+  // that voxel stays covered by `pick` alone. For a needed pick only (Needed).
+  const std::vector<uint64_t>& Seers(int pick) {
+    auto it = seers_.find(pick);
+    if (it != seers_.end() && counts_[it->second.first] == 1) return it->second.second;
+    const std::vector<uint64_t>& w = Words(pick);
+    size_t probe = 0;
+    for (size_t k : NonzeroWords(pick)) {
+      if (const uint64_t sole = w[k] & ~c2_[k]; sole != 0) {
+        probe = k * 64 + static_cast<size_t>(std::countr_zero(sole));
+        break;
+      }
+    }
+    std::vector<uint64_t> bits(candidate_words_, 0);
+    for (size_t c = 0; c < sets_.size(); ++c) {
+      if (sets_[c].test(probe)) bits[c >> 6] |= uint64_t{1} << (c & 63);
+    }
+    auto& entry = seers_[pick];
+    entry = {probe, std::move(bits)};
+    return entry.second;
   }
 
   // Whether candidate c is among `bits` (nullptr: no constraint).
@@ -637,6 +711,7 @@ class Consolidation {
     if (picks_.size() <= 1) return false;
     for (size_t i = picks_.size(); i-- > 0;) {
       VC_RETURN_IF_ERROR(ctx_.CheckCancelled("consolidation"));
+      if (OverBudget()) return false;
       if (pacer_.Due() && ctx_.progress) {
         const uint64_t checked = picks_.size() - 1 - i;
         ctx_.progress(ProgressEvent{Stage::kSelection, Fraction(0), PassNote() + ", looking for a pick to drop",
@@ -666,6 +741,7 @@ class Consolidation {
     for (size_t a = 0; a < picks_.size(); ++a) {
       for (size_t b = a + 1; b < picks_.size(); ++b, ++checked) {
         VC_RETURN_IF_ERROR(ctx_.CheckCancelled("consolidation"));
+        if (OverBudget()) return false;
         if (pacer_.Due()) ReportPass(checked);
         if (IsFixed(picks_[a]) || IsFixed(picks_[b]) || Failed(a, b)) continue;
         if (!MergePair(a, b)) {
@@ -723,7 +799,19 @@ class Consolidation {
   // there is none, the pair is passed over before rest_ is computed (most pairs on a large site);
   // otherwise only the common neighbours are tried, in order_.
   bool MergePair(size_t a, size_t b) {
-    if (sole_[a] && sole_[b] && !Meet(Neighbours(picks_[a]), Neighbours(picks_[b]))) return false;
+    if (sole_[a] && sole_[b]) {
+      // A stand-in must see a voxel only a covers and one only b covers: the candidates that see
+      // both are few, and most pairs on a large site have none.
+      const std::vector<uint64_t>& seers_a = Seers(picks_[a]);
+      const std::vector<uint64_t>& seers_b = Seers(picks_[b]);
+      if (!Meet(seers_a, seers_b)) return false;
+      FindRest(picks_[a], picks_[b]);
+      CommonNeighboursInOrder(seers_a, seers_b);
+      for (int c : common_) {
+        if (TryStandIn(a, b, c)) return true;
+      }
+      return false;
+    }
     const auto [in_a, in_b] = FindRest(picks_[a], picks_[b]);
     const std::vector<uint64_t>* need_a = in_a ? &Neighbours(picks_[a]) : nullptr;
     const std::vector<uint64_t>* need_b = in_b ? &Neighbours(picks_[b]) : nullptr;
@@ -797,6 +885,7 @@ class Consolidation {
   }
   // Whether candidates x and c share a voxel (tested on c's nonzero words).
   bool SeesInto(int x, int c) {
+    if (!ShareABlock(x, c)) return false;
     const std::vector<uint64_t>& wx = Words(x);
     const std::vector<uint64_t>& wc = Words(c);
     for (size_t k : NonzeroWords(c)) {
@@ -849,12 +938,18 @@ class Consolidation {
   PerPick<VoxelSet> dense_copies_;    // sparse picks, made dense
   PerPick<std::vector<size_t>> nonzero_words_;
   PerPick<std::vector<uint64_t>> neighbours_;
-  size_t slot_count_ = 0;         // the picks consolidation started with
+  std::unordered_map<int, std::pair<size_t, std::vector<uint64_t>>> seers_;  // Seers: probe voxel, bits
+  size_t slot_count_ = 0;                                                    // the picks consolidation started with
   std::vector<uint64_t> failed_;  // without registration: bit s * slot_count_ + t, s < t, for an unmergeable pair
   std::vector<int8_t> needed_;    // per slot: Needed's answer, -1 when not known
   std::vector<uint32_t> counts_;  // per voxel: how many picks cover it
   std::vector<uint64_t> c1_, c2_, c3_, rest_;
   std::vector<size_t> nonzero_;  // the words where rest_ has a voxel
+  static constexpr size_t kWordsPerBlock = 8;
+  const size_t block_words_;      // per candidate in blocks_
+  std::vector<uint64_t> blocks_;  // Blocks: block_words_ per candidate
+  const double budget_s_;         // GreedyOptions::consolidate_budget_s
+  const std::chrono::steady_clock::time_point start_;
   ConsolidateResult out_;
   int pass_ = 0;                   // 1-based number of the pass running
   uint64_t pairs_ = 0;             // pairs of picks in this pass

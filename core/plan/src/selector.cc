@@ -61,6 +61,7 @@ Result<Selection> GreedySelector::Select(const std::vector<VoxelSet>& sets, int 
                         ConsolidatePicks(sets, std::move(out.picks), options, ProgressRange(ctx, reached, 1.0)));
     out.picks = std::move(merged.picks);
     out.saved_by_improvement = merged.dropped + merged.merged;
+    out.consolidation_stopped = merged.budget_reached;
   }
   out.optimality.stations = static_cast<int>(out.picks.size());
   out.optimality.gap = out.picks.empty() ? 0.0 : 1.0;

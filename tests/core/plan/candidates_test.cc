@@ -315,6 +315,24 @@ TEST(CandidatesTest, TerrainCandidatesStandOnTheGroundOnlyNeverOnRoofsOrTheVan) 
   EXPECT_EQ(c.rejected_no_floor + c.rejected_clearance + c.positions.size(), c.cells);
 }
 
+// At 0.4 m the slope's 0.5 m base is one voxel, so a slope rising a voxel at a time measured 0.5 at
+// every rise: the ground broke into strips, the largest one a terrace, and auto picked floors.
+TEST(CandidatesTest, TerrainAtCoarseVoxelsKeepsTheSlopeWhole) {
+  Result<VoxelScene> scene = Voxelize(testing::Synthetic("slope"), VoxelizeOptions{0.4});
+  ASSERT_TRUE(scene.ok()) << scene.status().ToString();
+  const CandidateGrid c = Generate(*scene);
+  ASSERT_EQ(c.ground.model, GroundModel::kTerrain) << c.ground.reason;
+  // Most of the 40 x 30 cells (at 0.1 m: 900-1200), not one terrace's 4 x 30.
+  EXPECT_GT(c.positions.size(), 800u);
+  for (size_t i = 0; i < c.positions.size(); ++i) {
+    const WorldPoint& p = c.positions[i];
+    EXPECT_FALSE(OnARoof(p)) << p.transpose();
+    // On the ground: within a voxel and a half of the terrace under it (the voxels are 0.4 m).
+    EXPECT_NEAR(c.floor_z_m[i], SlopeGroundZ(p.x()), 0.6) << p.transpose();
+  }
+  std::cout << "[ slope at 0.4 m ] " << c.positions.size() << " candidates, " << c.ground.reason << "\n";
+}
+
 TEST(CandidatesTest, EitherModelCanBeForced) {
   const VoxelScene slope = SyntheticAt10cm("slope");
   CandidateOptions o;

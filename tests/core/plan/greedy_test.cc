@@ -461,6 +461,38 @@ TEST(ConsolidateTest, SameAsThePlainReferenceWhenEachChangeEnablesTheNext) {
   EXPECT_GT(long_runs, 30);  // most instances took several passes
 }
 
+// A large universe (2^16 voxels, 128 blocks of 512) with clusters of candidates far apart,
+// some of them sparse: the blocks each candidate touches rule most pairs out before any voxel is
+// compared, and the picks stay those of the plain reference.
+TEST(ConsolidateTest, SameAsThePlainReferenceOnALargeSiteOfFarApartClusters) {
+  std::mt19937 rng(35);
+  const size_t n = size_t{1} << 16;
+  int changed = 0;
+  for (int trial = 0; trial < 8; ++trial) {
+    std::vector<VoxelSet> sets;
+    for (int cluster = 0; cluster < 6; ++cluster) {
+      const size_t base = rng() % (n - 3000);
+      for (int i = 0; i < 8; ++i) {
+        VoxelSet s(n);
+        const size_t start = base + rng() % 800, len = 300 + rng() % 1200;
+        for (size_t v = 0; v < len; ++v) {
+          if (rng() % 4 != 0) s.set(start + v);
+        }
+        if (i % 3 == 0) s.Compact(0.0001);  // sparse when the bitmap is smaller at all
+        sets.push_back(s);
+      }
+    }
+    std::vector<int> picks(sets.size());
+    std::iota(picks.begin(), picks.end(), 0);
+    std::shuffle(picks.begin(), picks.end(), rng);
+    picks.resize(30 + rng() % 18);
+    const std::vector<int> want = ReferenceConsolidation(sets, picks);
+    EXPECT_EQ(Consolidated(sets, picks), want) << "trial " << trial;
+    changed += want != picks;
+  }
+  EXPECT_GE(changed, 6);  // most trials dropped or merged (7 of 8 with this seed)
+}
+
 // `pairs` pairs of half-rooms, each pair seen whole by one more candidate: consolidation merges one
 // pair per pass, so it takes pairs + 1 passes. The picks are the half-rooms (0 .. 2 pairs - 1).
 std::vector<VoxelSet> HalfRoomPairs(int pairs) {
@@ -539,6 +571,30 @@ TEST(ConsolidateTest, ALongConsolidationReportsEveryPassWithItsPairsOfPicks) {
     const uint64_t picks = sets.size() - k;
     EXPECT_EQ(pass_totals[k], picks * (picks - 1) / 2) << "pass " << k + 1;
   }
+}
+
+// The time budget: spent at once, nothing is changed and the result says so; none (0), the picks
+// are the reference's.
+TEST(ConsolidateTest, StopsAtItsTimeBudgetKeepingThePicksSoFar) {
+  const std::vector<VoxelSet> sets = HalfRoomPairs(6);
+  GreedyOptions o;
+  o.consolidate_budget_s = 1e-12;
+  std::string last;
+  JobContext ctx;
+  ctx.progress = [&](const ProgressEvent& e) { last = e.message; };
+  Result<ConsolidateResult> r = ConsolidatePicks(sets, FirstPicks(12), o, ctx);
+  ASSERT_TRUE(r.ok());
+  EXPECT_TRUE(r->budget_reached);
+  EXPECT_EQ(r->picks, FirstPicks(12));
+  EXPECT_EQ(r->merged + r->dropped, 0);
+  EXPECT_NE(last.find("stopped at its time budget"), std::string::npos) << last;
+  o.consolidate_budget_s = 0;
+  r = ConsolidatePicks(sets, FirstPicks(12), o, ctx);
+  ASSERT_TRUE(r.ok());
+  EXPECT_FALSE(r->budget_reached);
+  EXPECT_EQ(r->merged, 6);
+  EXPECT_EQ(r->picks, ReferenceConsolidation(sets, FirstPicks(12)));
+  EXPECT_NE(last.find(", done"), std::string::npos) << last;
 }
 
 TEST(ConsolidateTest, CancelledDuringAPassReturnsCancelledAtOnce) {

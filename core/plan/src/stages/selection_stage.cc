@@ -160,6 +160,12 @@ Result<SelectionOutput> RunSelectionStage(SelectionInput in, const PlanOptions& 
   } else {
     VC_ASSIGN_OR_RETURN(out.selection, in.selector.Select(sets, fixed, ctx));
   }
+  if (out.selection.consolidation_stopped) {
+    out.warnings.push_back("consolidation stopped at its time budget of " +
+                           std::to_string(std::lround(SelectorOptionsFor(options, 0).consolidate_budget_s)) +
+                           " s: the plan keeps the picks it had dropped or merged by then; a few more stations "
+                           "might have been saved (docs/PLANNING.md, \"Greedy selection (§7.3) and consolidation\")");
+  }
   const size_t n_voxels = sets.empty() ? 0 : sets[0].size();
   out.coverable = VoxelSet(n_voxels);
   for (const VoxelSet& s : sets) UnionInto(out.coverable, s);

@@ -57,6 +57,10 @@ struct ConsolidateResult {
   std::vector<int> picks;  // candidate indices; a replacement takes the place of the earlier pick
   int dropped = 0;         // picks removed as covered by the others
   int merged = 0;          // pairs replaced by one candidate
+  // The time budget (GreedyOptions::consolidate_budget_s) ran out: the picks are those of the
+  // changes made until then (each keeps the coverage), and a further change may have been possible.
+  bool budget_reached = false;
+  double seconds = 0;  // consolidation's wall time
 };
 // CANCELLED / DEADLINE_EXCEEDED from ctx.
 Result<ConsolidateResult> ConsolidatePicks(const std::vector<VoxelSet>& sets, std::vector<int> picks,

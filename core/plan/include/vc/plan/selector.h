@@ -95,6 +95,7 @@ struct Selection {
   uint64_t covered = 0;                      // voxels the first pass covered when it stopped
   int first_pass_picks = 0;                  // picks before any improvement pass (greedy picks, fixed excluded)
   int saved_by_improvement = 0;              // picks the improvement pass saved (consolidation)
+  bool consolidation_stopped = false;        // consolidation stopped at its time budget (greedy.h)
   int connectors = 0;                        // first-pass picks made to link the scan graph (min_overlap)
   int new_groups = 0;                        // times the first pass found no chain to a gaining candidate
   Optimality optimality;                     // how far from the optimum (greedy: heuristic, no bound)
@@ -173,6 +174,11 @@ struct GreedyOptions {
   // gain), never dropped or replaced; the stopping rules then apply to what they cover.
   // GreedySelector::Select sets it from its argument.
   int fixed = 0;
+  // Consolidation's time budget, s of wall time (0 = none): when it runs out, consolidation stops
+  // looking for a change and keeps the picks of the changes made so far (each keeps the coverage;
+  // ConsolidateResult::budget_reached, Selection::consolidation_stopped). Drops and merges are found
+  // in pick order, so a stop keeps the early ones. Small sites finish in well under a second.
+  double consolidate_budget_s = 60;
 };
 
 // SelectGreedy (lazy unless options.lazy is false), then, with options.consolidate, ConsolidatePicks.
