@@ -699,6 +699,11 @@ class RoutePlanner {
   Status DistancesBetweenStations();
   // Per station, the distances to its kNearStations nearest stations (and any settled on the way).
   Status ExactNearDistances(const std::vector<int32_t>& component);
+  // One shortest-path run, in parallel, from each station with a walk node to the stations t with
+  // is_target(s, t) (stopping after stop_after of them when positive); record(s, run) writes what it
+  // found into the pairs only station s writes. Progress is reported as `what`.
+  Status FromEachStation(const char* what, int stop_after, const std::function<bool(int s, int t)>& is_target,
+                         const std::function<void(int s, const ShortestPaths& run)>& record);
   // Per weak component, kLandmarks landmark stations' distances to all its stations, and the
   // estimate via the best landmark for every pair still without a distance.
   Status LandmarkDistances(const std::vector<int32_t>& component);
@@ -832,38 +837,20 @@ Status RoutePlanner::DistancesBetweenStations() {
     VC_RETURN_IF_ERROR(ExactNearDistances(component));
     return LandmarkDistances(component);
   }
-  std::vector<Status> run_status(n, Status::Ok());
-  std::atomic<int> done{0};
-  ShortestPathsPool pool(g_);
-  VC_RETURN_IF_ERROR(ParallelChunks(
-      uint64_t(n), 1, options_.threads, ctx_,
-      [&](uint64_t, uint64_t begin, uint64_t) {
-        const int s = int(begin);
-        if (node_[s] >= 0) {
-          dist_[size_t(s) * n + s] = 0;
-          std::vector<int> targets;
-          for (int t = s + 1; t < n; ++t) {
-            if (component[t] == component[s]) targets.push_back(node_[t]);
-          }
-          if (!targets.empty()) {
-            std::unique_ptr<ShortestPaths> own = pool.Take();
-            run_status[s] = own->Run(node_[s], targets, ctx_);
-            for (int t = s + 1; t < n && run_status[s].ok(); ++t) {
-              if (component[t] != component[s] || own->Dist(node_[t]) == kInf) continue;
-              const double d = Connector(s) + double(own->Dist(node_[t])) + Connector(t);
-              dist_[size_t(s) * n + t] = dist_[size_t(t) * n + s] = d;  // each pair written by s only
-            }
-            pool.Give(std::move(own));
-          }
+  return FromEachStation(
+      "walking distances between stations", 0, [&](int s, int t) { return t > s && component[t] == component[s]; },
+      [&](int s, const ShortestPaths& run) {
+        for (int t = s + 1; t < n; ++t) {
+          if (component[t] != component[s] || run.Dist(node_[t]) == kInf) continue;
+          const double d = Connector(s) + double(run.Dist(node_[t])) + Connector(t);
+          dist_[size_t(s) * n + t] = dist_[size_t(t) * n + s] = d;  // each pair written by s only
         }
-        ReportDone(++done, "walking distances between stations");
-      },
-      "walking route"));
-  for (const Status& st : run_status) VC_RETURN_IF_ERROR(st);
-  return Status::Ok();
+      });
 }
 
-Status RoutePlanner::ExactNearDistances(const std::vector<int32_t>& component) {
+Status RoutePlanner::FromEachStation(const char* what, int stop_after,
+                                     const std::function<bool(int s, int t)>& is_target,
+                                     const std::function<void(int s, const ShortestPaths& run)>& record) {
   const int n = n_;
   std::vector<Status> run_status(n, Status::Ok());
   std::atomic<int> done{0};
@@ -876,27 +863,38 @@ Status RoutePlanner::ExactNearDistances(const std::vector<int32_t>& component) {
           dist_[size_t(s) * n + s] = 0;
           std::vector<int> targets;
           for (int t = 0; t < n; ++t) {
-            if (t != s && component[t] == component[s]) targets.push_back(node_[t]);
+            if (is_target(s, t)) targets.push_back(node_[t]);
           }
           if (!targets.empty()) {
             std::unique_ptr<ShortestPaths> own = pool.Take();
-            run_status[s] = own->Run(node_[s], targets, ctx_, kNearStations);
-            // Row s only (no other worker writes it): every station on a settled node.
-            std::vector<int> settled = own->settled();
-            std::sort(settled.begin(), settled.end());
-            for (int t = 0; t < n && run_status[s].ok(); ++t) {
-              if (t == s || component[t] != component[s]) continue;
-              if (std::binary_search(settled.begin(), settled.end(), node_[t])) {
-                dist_[size_t(s) * n + t] = Connector(s) + double(own->Dist(node_[t])) + Connector(t);
-              }
-            }
+            run_status[s] = own->Run(node_[s], targets, ctx_, stop_after);
+            if (run_status[s].ok()) record(s, *own);
             pool.Give(std::move(own));
           }
         }
-        ReportDone(++done, "walking distances to each station's nearest stations");
+        ReportDone(++done, what);
       },
       "walking route"));
   for (const Status& st : run_status) VC_RETURN_IF_ERROR(st);
+  return Status::Ok();
+}
+
+Status RoutePlanner::ExactNearDistances(const std::vector<int32_t>& component) {
+  const int n = n_;
+  VC_RETURN_IF_ERROR(FromEachStation(
+      "walking distances to each station's nearest stations", kNearStations,
+      [&](int s, int t) { return t != s && component[t] == component[s]; },
+      [&](int s, const ShortestPaths& run) {
+        // Row s only (no other worker writes it): every station on a settled node.
+        std::vector<int> settled = run.settled();
+        std::sort(settled.begin(), settled.end());
+        for (int t = 0; t < n; ++t) {
+          if (t == s || component[t] != component[s]) continue;
+          if (std::binary_search(settled.begin(), settled.end(), node_[t])) {
+            dist_[size_t(s) * n + t] = Connector(s) + double(run.Dist(node_[t])) + Connector(t);
+          }
+        }
+      }));
   // Both directions the shorter of the two runs' values (they differ by float rounding at most).
   for (int s = 0; s < n; ++s) {
     for (int t = s + 1; t < n; ++t) {
