@@ -397,8 +397,8 @@ TEST(CandidatesTest, ADoorGetsTheSamePassageCandidatesOnTerrainAsOnItsFloorLevel
 
 // hillside (docs/SCENES.md): terraces 0.5 m deep rising 0.1 m along x; a house over design
 // x 8-14.6, y 4-10 whose room's floor, z 1.5, is the ground outside its door (x 8-8.3, y 6.5-7.5).
-double HillsideGroundZ(double x_design) {
-  if (x_design > 8 && x_design < 14.3) return 1.5;
+double HillsideGroundZ(double x_design, double y_design) {
+  if (x_design > 8 && x_design < 14.3 && y_design > 4.3 && y_design < 9.7) return 1.5;  // the room, the door
   return 0.1 * std::floor(x_design / 0.5);
 }
 
@@ -414,7 +414,7 @@ TEST(CandidatesTest, ADoorOntoSlopingGroundGetsCandidatesOnTheGroundInTheDoorway
     EXPECT_EQ(c.level[i], -1);
     EXPECT_NEAR(p.z() - c.floor_z_m[i], 1.5, 1e-9) << p.transpose();
     // On the ground under it: the terrace or the room's floor, within a voxel.
-    EXPECT_NEAR(c.floor_z_m[i] - kSceneOffsetM.z(), HillsideGroundZ(x), 0.11) << x << ", " << y;
+    EXPECT_NEAR(c.floor_z_m[i] - kSceneOffsetM.z(), HillsideGroundZ(x, y), 0.11) << x << ", " << y;
     // On the door's centre line, at most half a cell beyond the wall.
     EXPECT_NEAR(y, 7.0, 0.05 + 1e-9) << x << ", " << y;
     EXPECT_NEAR(x, 8.15, 0.15 + 0.5 + 1e-9) << x << ", " << y;
