@@ -205,7 +205,8 @@ void AddFlags(CLI::App& app, BenchOptions* o) {
                "candidates, best of --repeat rounds (A/B runs of two builds)");
   app.add_flag("--candidates-only", o->candidates_only,
                "only the candidate stage under each ground model (auto, terrain, floors): counts, floor levels, "
-               "the terrain's ground, seconds (docs/PLANNING.md, \"Terrain\")");
+               "the terrain's ground, seconds; then terrain and floors with doorway candidates (docs/PLANNING.md, "
+               "\"Terrain\")");
   app.add_option("--every", o->every, "with --visibility-only: every how many candidates")
       ->check(CLI::Range(1, 1000000));
   app.add_flag("--all-targets", o->all_targets, "also time the SIMD batch kernel on every other instruction set");
@@ -457,6 +458,22 @@ int CandidatesOnly(const vc::VoxelScene& s, double grid) {
       std::printf("floors: %llu candidates in cells where the terrain has none, %llu more than 1 m above its ground\n",
                   static_cast<unsigned long long>(no_terrain), static_cast<unsigned long long>(above_terrain));
     }
+  }
+  // The plan's default adds doorway candidates (PlanOptions::doorway_candidates), on terrain too.
+  for (vc::GroundModel g : {vc::GroundModel::kTerrain, vc::GroundModel::kFloors}) {
+    vc::planner::CandidateOptions co;
+    co.grid_spacing_m = grid;
+    co.ground = g;
+    co.doorway_candidates = true;
+    const auto t0 = Clock::now();
+    auto c = vc::planner::GenerateCandidates(s, co);
+    if (!c.ok()) {
+      std::fprintf(stderr, "vc-bench: %s\n", c.status().ToString().c_str());
+      return 2;
+    }
+    std::printf("%s with doorway candidates: %.2f s, %zu candidates, %llu of them in passages\n",
+                std::string(vc::GroundModelName(g)).c_str(), Seconds(t0), c->positions.size(),
+                static_cast<unsigned long long>(c->passage_candidates));
   }
   return 0;
 }

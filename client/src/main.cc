@@ -205,11 +205,12 @@ constexpr const char* kDetachHelp =
 
 constexpr const char* kUnitsHelp =
     "unit of the file's coordinates when the file does not say: m, cm, mm, ft (international foot), us-ft "
-    "(US survey foot); default m";
+    "(US survey foot); default m (E57 and octrees are metres by their formats)";
 
 constexpr const char* kCrsHelp =
     "CRS of the file's coordinates (EPSG:25832, WKT or a PROJ string; a projected CRS): labels plan.json and "
-    "stations.csv and writes stations.geojson; without --units the file is read in the CRS's unit";
+    "stations.csv and writes stations.geojson; without --units the file is read in the CRS's unit (an E57 or "
+    "an octree in metres)";
 
 // --units on `command`, checked here with the server's own list (MetresPerUnit).
 void AddUnitsFlag(CLI::App* command, std::string* units) {
@@ -409,12 +410,28 @@ int RunAttach(vc::client::Client& client, const CommandLine& cl) {
   return WritePlan(job->plan, cl.out_dir, cl.paper, nullptr, {}, crs_ptr);
 }
 
+// The scene file's bytes, and the format they hold when that can be told here (else the reader's
+// error comes with PrepareScene): --crs and --units depend on it (E57 holds metres; CheckCrsFlag).
+struct SceneFile {
+  vc::client::Upload bytes;
+  std::optional<vc::InputFormat> format;
+};
+
+vc::Result<SceneFile> ReadSceneBytes(const CommandLine& cl) {
+  SceneFile file;
+  VC_ASSIGN_OR_RETURN(file.bytes, vc::client::ReadUpload(cl.file));
+  const vc::ReadOptions limits = vc::ReadLimits(vc::kDefaultMaxUploadBytes, vc::kDefaultMemoryBudgetBytes);
+  vc::Result<vc::InputFormat> format = vc::DetectSceneFormat(file.bytes.bytes, cl.file, limits);
+  if (format.ok()) file.format = *format;
+  return file;
+}
+
 // The scene file, read and checked here before any connection: refused when the server's reader
 // would refuse it too (compact_upload.h); the upload for it in `units` at `resolution_m` otherwise.
 // The subvoxel test needs the points: with it the file goes raw.
-vc::Result<vc::client::PreparedUpload> PrepareScene(const CommandLine& cl, const std::string& units,
+vc::Result<vc::client::PreparedUpload> PrepareScene(const CommandLine& cl, SceneFile file, const std::string& units,
                                                     double resolution_m, vc::SelectionTest test) {
-  VC_ASSIGN_OR_RETURN(vc::client::Upload file_bytes, vc::client::ReadUpload(cl.file));
+  vc::client::Upload file_bytes = std::move(file.bytes);
   file_bytes.units = units;
   const bool needs_points = test == vc::SelectionTest::kSubvoxel && !cl.raw_upload;
   VC_ASSIGN_OR_RETURN(vc::client::PreparedUpload prepared,
@@ -442,11 +459,13 @@ struct CheckedSubmit {
 
 vc::Result<CheckedSubmit> CheckSubmit(const CommandLine& cl) {
   CheckedSubmit checked{cl.plan, {}, {}};
-  VC_ASSIGN_OR_RETURN(checked.crs, vc::client::CheckCrsFlag(cl.crs, cl.units));
+  vc::Result<SceneFile> file = ReadSceneBytes(cl);  // its error comes after the flags'
+  VC_ASSIGN_OR_RETURN(checked.crs, vc::client::CheckCrsFlag(cl.crs, cl.units, file.ok() ? file->format : std::nullopt));
   VC_ASSIGN_OR_RETURN(checked.lines, vc::client::LoadPlanFiles(cl.plan_files, &checked.plan));
   VC_RETURN_IF_ERROR(checked.plan.Validate(vc::client::PlanFlagNamer(checked.lines)));
-  VC_ASSIGN_OR_RETURN(checked.prepared,
-                      PrepareScene(cl, checked.crs.units, checked.plan.resolution_m, checked.plan.selection_test));
+  if (!file.ok()) return file.status();
+  VC_ASSIGN_OR_RETURN(checked.prepared, PrepareScene(cl, std::move(file).value(), checked.crs.units,
+                                                     checked.plan.resolution_m, checked.plan.selection_test));
   return checked;
 }
 
@@ -457,6 +476,7 @@ int RunSubmit(const CommandLine& cl, InterruptCancelsTheJob* interrupt) {
   if (!client.ok()) return Fail("cannot set up the connection", client.status());
   vc::client::ProgressDisplay display(stderr, isatty(fileno(stderr)) != 0);
   vc::client::PreparedUpload& prepared = checked->prepared;
+  if (!checked->crs.note.empty()) display.Note(checked->crs.note);
   AnnounceUpload(prepared, cl, display);
   auto r = (*client)->Plan(prepared.upload, checked->plan, Observe(display, interrupt));
   display.Done();
@@ -528,15 +548,17 @@ vc::Result<CheckedEvaluate> CheckEvaluate(const CommandLine& cl, const CLI::App&
   } else {
     VC_ASSIGN_OR_RETURN(checked.eval.viewpoints, vc::client::LoadViewpoints(cl.viewpoints_csv));
   }
-  VC_ASSIGN_OR_RETURN(checked.crs, vc::client::CheckCrsFlag(crs, cl.units));
+  vc::Result<SceneFile> file = ReadSceneBytes(cl);  // its error comes after the flags'
+  VC_ASSIGN_OR_RETURN(checked.crs, vc::client::CheckCrsFlag(crs, cl.units, file.ok() ? file->format : std::nullopt));
   VC_RETURN_IF_ERROR(checked.eval.Validate(vc::client::EvaluateFlagNamer()));
   if (evaluate.get_option("--test")->count() > 0 && cl.export_dir.empty()) {
     return vc::InvalidArgumentError("--test names the selection test of --export-sets' files; add --export-sets DIR");
   }
   checked.eval.export_sets = !cl.export_dir.empty();
   if (checked.eval.export_sets) VC_RETURN_IF_ERROR(vc::client::PrepareExportDir(cl.export_dir, cl.force));
-  VC_ASSIGN_OR_RETURN(checked.prepared,
-                      PrepareScene(cl, checked.crs.units, checked.eval.resolution_m, checked.eval.test));
+  if (!file.ok()) return file.status();
+  VC_ASSIGN_OR_RETURN(checked.prepared, PrepareScene(cl, std::move(file).value(), checked.crs.units,
+                                                     checked.eval.resolution_m, checked.eval.test));
   return checked;
 }
 
@@ -547,6 +569,7 @@ int RunEvaluate(const CommandLine& cl, const CLI::App& evaluate, InterruptCancel
   if (!client.ok()) return Fail("cannot set up the connection", client.status());
   vc::client::ProgressDisplay display(stderr, isatty(fileno(stderr)) != 0);
   vc::client::PreparedUpload& prepared = checked->prepared;
+  if (!checked->crs.note.empty()) display.Note(checked->crs.note);
   AnnounceUpload(prepared, cl, display);
   auto r = (*client)->Evaluate(prepared.upload, checked->eval, Observe(display, interrupt));
   display.Done();

@@ -5,6 +5,8 @@
 # connects, so the count is seen to move. Usage: preflight_cli_test.sh VC_CLIENT
 set -euo pipefail
 client_bin="$1"
+# An E57 of two scans (the fuzz seed written by the tests' E57 writer).
+e57_seed="$(cd "$(dirname "$0")" && pwd)/../../fuzz/corpus/e57_fuzzer/two_scans.e57"
 work="$(mktemp -d)"
 listener=""
 cleanup() {
@@ -94,6 +96,12 @@ expect 3 "vc-client: --crs EPSG:2263 (NAD83 / New York Long Island (ftUS)) has i
   evaluate cloud.xyz --viewpoints fixed.csv --crs EPSG:2263 --units m
 expect 3 "vc-client: --crs: \"EPSG:99999\" is not a CRS PROJ knows (proj_create: crs not found) (nothing was sent)" \
   attach j-0123456789abcdef --crs EPSG:99999
+# An E57 holds metres by its standard (ASTM E2807), whatever the CRS's unit: no --units for it.
+cp "$e57_seed" site.e57
+expect 3 "vc-client: --units us-ft does not apply to the scene file: it is E57, in metres by its standard (ASTM E2807), whatever the CRS's unit. Drop --units; --crs EPSG:2263 (NAD83 / New York Long Island (ftUS)) still labels the outputs (nothing was sent)" \
+  submit site.e57 --crs EPSG:2263 --units us-ft
+expect 3 "vc-client: site.e57: E57 files hold metres by the standard (ASTM E2807), but units of 0.3048 m were given; read the E57 without units (with a CRS in feet, vc-client --crs alone: the file is read in metres) (nothing was sent)" \
+  submit site.e57 --units ft
 expect 109 "vc-client: unknown flag --grid-spaceing; did you mean --grid-spacing?" submit cloud.xyz --grid-spaceing 2
 expect 106 "vc-client: unknown command 'sumbit'; did you mean submit?" sumbit cloud.xyz
 
@@ -102,4 +110,10 @@ status=0
 "$client_bin" --server "$server" --retries 1 submit cloud.xyz >out 2>err || status=$?
 [[ "$status" == 14 ]] || { cat err >&2; fail "a good submit exited $status, not 14"; }
 [[ "$(cat connections)" -ge 1 ]] || fail "a good submit did not connect: the count proves nothing"
+# The E57 with a CRS in feet goes, read in metres, and vc-client says so.
+status=0
+"$client_bin" --server "$server" --retries 1 submit site.e57 --crs EPSG:2263 >out 2>err || status=$?
+[[ "$status" == 14 ]] || { cat err >&2; fail "submit site.e57 --crs EPSG:2263 exited $status, not 14"; }
+grep -qF "the scene file is E57, in metres by its standard (ASTM E2807): read in metres, not in --crs EPSG:2263 (NAD83 / New York Long Island (ftUS))'s US survey foot; the outputs are in metres (the CRS's coordinates times 0.3048006096) and stations.geojson is converted" err ||
+  { cat err >&2; fail "submit site.e57 --crs EPSG:2263: no note that it is read in metres"; }
 echo "preflight_cli_test: ok"

@@ -110,16 +110,10 @@ std::vector<double> AxisCells(double lo, double hi, double spacing) {
   return v;
 }
 
-// Narrow passages of the level whose floor voxels are below index z `floor_top` (the first free
-// voxel above the floor): the obstacle slice marks a column blocked if a voxel between the lowest
-// tripod height minus and plus the clearance above the floor is occupied. A free run of the slice
-// along x (or y) is a cross-section of a passage if both its ends are blocked and it is at least
-// 2 clearance_m and less than 2 grid_spacing_m wide; adjacent lines whose runs have the same
-// midpoint (to grid_spacing_m / 4) form one passage, from its first line to its last. Positions, at
-// the passage's midpoint across it, along it every grid_spacing_m / 4 from its centre, and beyond
-// each end at half that step and then every step up to grid_spacing_m / 2 (just inside the rooms
-// a door joins). A position rounding to the same point of a grid_spacing_m / 8 lattice as an earlier one is dropped.
-std::vector<WorldPoint> PassagePoints(const OccupancyGrid& grid, int floor_top, const CandidateOptions& o) {
+// The obstacle slice of the level whose floor voxels are below index z `floor_top` (the first free
+// voxel above the floor): per column (y * dims.x + x, relative to the grid's minimum), blocked if
+// a voxel between the lowest tripod height minus and plus the clearance above the floor is occupied.
+std::vector<uint8_t> FloorSlice(const OccupancyGrid& grid, int floor_top, const CandidateOptions& o) {
   const double r = grid.resolution_m();
   const VoxelIndex& m = grid.min_index();
   const Eigen::Vector3i dims = grid.dims();
@@ -136,6 +130,21 @@ std::vector<WorldPoint> PassagePoints(const OccupancyGrid& grid, int floor_top, 
       }
     }
   }
+  return blocked;
+}
+
+// Narrow passages of an obstacle slice (FloorSlice, TerrainSlice): a free run of the slice along x
+// (or y) is a cross-section of a passage if both its ends are blocked and it is at least
+// 2 clearance_m and less than 2 grid_spacing_m wide; adjacent lines whose runs have the same
+// midpoint (to grid_spacing_m / 4) form one passage, from its first line to its last. Positions, at
+// the passage's midpoint across it, along it every grid_spacing_m / 4 from its centre, and beyond
+// each end at half that step and then every step up to grid_spacing_m / 2 (just inside the rooms
+// a door joins). A position rounding to the same point of a grid_spacing_m / 8 lattice as an earlier one is dropped.
+std::vector<WorldPoint> PassagePoints(const OccupancyGrid& grid, const std::vector<uint8_t>& blocked,
+                                      const CandidateOptions& o) {
+  const double r = grid.resolution_m();
+  const VoxelIndex& m = grid.min_index();
+  const Eigen::Vector3i dims = grid.dims();
   const double fine = o.grid_spacing_m / 4;
   const int max_width = static_cast<int>(std::ceil(2 * o.grid_spacing_m / r - 1e-9));  // exclusive, voxels
   const int min_width = std::max(1, static_cast<int>(std::floor(2 * o.clearance_m / r)));
@@ -479,48 +488,125 @@ int PlaceOnFloor(const OccupancyGrid& grid, double x, double y, int z, int free_
   return placed;
 }
 
-// Candidates on the terrain model's ground: per grid cell, over each ground surface of the column
-// under its centre, or else over the highest ground surface of the 8 columns around it.
+// Candidates over the terrain's ground at (x, y): over each ground surface of the column under it,
+// or else over the highest ground surface of the 8 columns around it. Returns how many; counts the
+// heights without ground in *no_floor and those rejected in *no_clearance.
+int PlaceOnGround(const OccupancyGrid& grid, const GroundField& f, double x, double y,
+                  const std::vector<double>& heights, const CandidateOptions& options, CandidateGrid& out,
+                  uint64_t* no_floor, uint64_t* no_clearance) {
+  const VoxelIndex& m = grid.min_index();
+  const Eigen::Vector3d u = grid.WorldToIndexSpace(WorldPoint(x, y, 0));
+  const int cx = static_cast<int>(std::floor(u.x())) - m.x, cy = static_cast<int>(std::floor(u.y())) - m.y;
+  std::vector<uint32_t> under;
+  for (int ring = 0; ring <= 1 && under.empty(); ++ring) {
+    uint32_t highest = 0;
+    bool found = false;
+    for (int dy = -ring; dy <= ring; ++dy) {
+      for (int dx = -ring; dx <= ring; ++dx) {
+        const int cxx = cx + dx, cyy = cy + dy;
+        if (cxx < 0 || cyy < 0 || cxx >= f.nx || cyy >= f.ny) continue;
+        const uint32_t c = f.Column(cxx, cyy);
+        for (uint32_t i = f.first[c]; i < f.first[c + 1]; ++i) {
+          if (!f.ground[i]) continue;
+          if (ring == 0) {
+            under.push_back(i);
+          } else if (!found || f.z[i] > f.z[highest]) {
+            highest = i;
+            found = true;
+          }
+        }
+      }
+    }
+    if (found) under.push_back(highest);
+  }
+  if (under.empty()) *no_floor += heights.size();
+  int placed = 0;
+  for (uint32_t i : under) {
+    placed += PlaceOnFloor(grid, x, y, f.z[i], f.free_above[i], heights, options, -1, out, no_clearance);
+  }
+  return placed;
+}
+
+// Candidates on the terrain model's ground, per grid cell (PlaceOnGround); on_grid (per cell,
+// iy * |xs| + ix) gets whether the cell got one.
 Status PlaceOnTerrain(const OccupancyGrid& grid, const GroundField& f, const std::vector<double>& xs,
                       const std::vector<double>& ys, const std::vector<double>& heights,
-                      const CandidateOptions& options, CandidateGrid& out, const JobContext& ctx) {
-  const VoxelIndex& m = grid.min_index();
+                      const CandidateOptions& options, CandidateGrid& out, std::vector<uint8_t>& on_grid,
+                      const JobContext& ctx) {
+  on_grid.assign(xs.size() * ys.size(), 0);
   for (size_t iy = 0; iy < ys.size(); ++iy) {
     VC_RETURN_IF_ERROR(ctx.CheckCancelled("candidate generation"));
     ctx.Report(Stage::kCandidates, 0.75 + 0.25 * static_cast<double>(iy) / ys.size());
     for (size_t ix = 0; ix < xs.size(); ++ix) {
       out.cells += heights.size();
-      const Eigen::Vector3d u = grid.WorldToIndexSpace(WorldPoint(xs[ix], ys[iy], 0));
-      const int cx = static_cast<int>(std::floor(u.x())) - m.x, cy = static_cast<int>(std::floor(u.y())) - m.y;
-      std::vector<uint32_t> under;
-      for (int ring = 0; ring <= 1 && under.empty(); ++ring) {
-        uint32_t highest = 0;
-        bool found = false;
-        for (int dy = -ring; dy <= ring; ++dy) {
-          for (int dx = -ring; dx <= ring; ++dx) {
-            const int x = cx + dx, y = cy + dy;
-            if (x < 0 || y < 0 || x >= f.nx || y >= f.ny) continue;
-            const uint32_t c = f.Column(x, y);
-            for (uint32_t i = f.first[c]; i < f.first[c + 1]; ++i) {
-              if (!f.ground[i]) continue;
-              if (ring == 0) {
-                under.push_back(i);
-              } else if (!found || f.z[i] > f.z[highest]) {
-                highest = i;
-                found = true;
-              }
-            }
-          }
-        }
-        if (found) under.push_back(highest);
-      }
-      if (under.empty()) out.rejected_no_floor += heights.size();
-      for (uint32_t i : under) {
-        PlaceOnFloor(grid, xs[ix], ys[iy], f.z[i], f.free_above[i], heights, options, -1, out, &out.rejected_clearance);
-      }
+      on_grid[iy * xs.size() + ix] = PlaceOnGround(grid, f, xs[ix], ys[iy], heights, options, out,
+                                                   &out.rejected_no_floor, &out.rejected_clearance) > 0;
     }
   }
   return Status::Ok();
+}
+
+// The terrain's obstacle slice (as FloorSlice's, for PassagePoints), following the ground: each
+// column's reference is its lowest ground surface or, for a column without ground (a wall, an
+// object, a gap in the map), that of the nearest ground column within grid_spacing_m (4-connected,
+// breadth first); a column is blocked if a voxel within the clearance of the lowest tripod height
+// above its reference is occupied, or if no ground column is that near.
+std::vector<uint8_t> TerrainSlice(const OccupancyGrid& grid, const GroundField& f, const CandidateOptions& o) {
+  const double r = grid.resolution_m();
+  const VoxelIndex& m = grid.min_index();
+  const int above = static_cast<int>(std::floor(LowestHeight(o) / r));
+  const int c = static_cast<int>(std::ceil(o.clearance_m / r - 1e-9));
+  const int reach = std::max(1, static_cast<int>(std::ceil(o.grid_spacing_m / r - 1e-9)));
+  const size_t n = static_cast<size_t>(f.nx) * f.ny;
+  std::vector<int> ref(n, kNoSurface), dist(n, -1);
+  std::vector<uint32_t> queue;
+  for (uint32_t col = 0; col < n; ++col) {
+    for (uint32_t i = f.first[col]; i < f.first[col + 1]; ++i) {
+      if (f.ground[i]) ref[col] = f.z[i];  // surfaces run top to bottom: the last is the lowest
+    }
+    if (ref[col] != kNoSurface) {
+      dist[col] = 0;
+      queue.push_back(col);
+    }
+  }
+  for (size_t head = 0; head < queue.size(); ++head) {
+    const uint32_t col = queue[head];
+    if (dist[col] >= reach) continue;
+    const int x = static_cast<int>(col % f.nx), y = static_cast<int>(col / f.nx);
+    for (const auto& [nx, ny] : {std::pair{x + 1, y}, std::pair{x - 1, y}, std::pair{x, y + 1}, std::pair{x, y - 1}}) {
+      if (nx < 0 || ny < 0 || nx >= f.nx || ny >= f.ny) continue;
+      const uint32_t next = f.Column(nx, ny);
+      if (dist[next] >= 0) continue;
+      dist[next] = dist[col] + 1;
+      ref[next] = ref[col];
+      queue.push_back(next);
+    }
+  }
+  std::vector<uint8_t> blocked(n, 1);
+  const int z_max = m.z + grid.dims().z() - 1;
+  for (uint32_t col = 0; col < n; ++col) {
+    if (ref[col] == kNoSurface) continue;
+    const int eye = ref[col] + 1 + above;
+    bool occupied = false;
+    for (int z = std::max(eye - c, m.z); z <= std::min(eye + c, z_max) && !occupied; ++z) {
+      occupied = grid.Occupied(m.x + static_cast<int>(col % f.nx), m.y + static_cast<int>(col / f.nx), z);
+    }
+    blocked[col] = occupied;
+  }
+  return blocked;
+}
+
+// Whether the grid cell nearest to q (per cell iy * |xs| + ix in `on_grid`) got a candidate and q
+// lies within grid_spacing_m / 8 of its centre in x and in y (a passage position the grid has).
+bool NearAGridCandidate(const WorldPoint& q, const std::vector<double>& xs, const std::vector<double>& ys,
+                        const std::vector<uint8_t>& on_grid, double grid_spacing_m) {
+  auto nearest = [&](const std::vector<double>& cells, double v) {
+    const long i = std::lround((v - cells.front()) / grid_spacing_m);
+    return static_cast<size_t>(std::clamp<long>(i, 0, static_cast<long>(cells.size()) - 1));
+  };
+  const double fine = grid_spacing_m / 4;
+  const size_t ix = nearest(xs, q.x()), iy = nearest(ys, q.y());
+  return on_grid[iy * xs.size() + ix] && std::abs(xs[ix] - q.x()) < fine / 2 && std::abs(ys[iy] - q.y()) < fine / 2;
 }
 
 }  // namespace
@@ -560,6 +646,57 @@ std::optional<double> FloorTopNear(const OccupancyGrid& grid, double x_m, double
                             FreeVoxelsNeeded(r, options), scratch);
   if (z == kNoSurface) return std::nullopt;
   return grid.IndexSpaceToWorld(Eigen::Vector3d(0, 0, z + 1)).z();
+}
+
+std::optional<double> GroundTopReached(const OccupancyGrid& grid, const WorldPoint& from, double from_floor_z_m,
+                                       double x_m, double y_m, const CandidateOptions& options) {
+  const double r = grid.resolution_m();
+  const int free_needed = FreeVoxelsNeeded(r, options);
+  const int step = std::max(1, static_cast<int>(std::floor(options.walk_max_step_m / r + 1e-9)));
+  const Eigen::Vector3d a = grid.WorldToIndexSpace(WorldPoint(from.x(), from.y(), from_floor_z_m));
+  const Eigen::Vector3d b = grid.WorldToIndexSpace(WorldPoint(x_m, y_m, from_floor_z_m));
+  const int z0 = static_cast<int>(std::lround(a.z())) - 1;  // the floor's top voxel
+  int z = z0, last_x = static_cast<int>(std::floor(a.x())), last_y = static_cast<int>(std::floor(a.y()));
+  const double run = (b - a).head<2>().norm();  // voxels
+  const int samples = std::max(1, static_cast<int>(std::ceil(run * 4)));
+  int gap = 0;  // columns in a row without a surface within a step: a gap in the map, crossed up to 2
+  std::vector<Surface> scratch;
+  for (int k = 1; k <= samples; ++k) {
+    const double t = static_cast<double>(k) / samples;
+    const int cx = static_cast<int>(std::floor(a.x() + t * (b.x() - a.x())));
+    const int cy = static_cast<int>(std::floor(a.y() + t * (b.y() - a.y())));
+    if (cx == last_x && cy == last_y) continue;
+    last_x = cx;
+    last_y = cy;
+    ColumnSurfaces(grid, cx, cy, free_needed, scratch);
+    int best = kNoSurface;
+    for (const Surface& s : scratch) {
+      if (s.roof() || std::abs(s.z - z) > step) continue;
+      if (best == kNoSurface || std::abs(s.z - z) < std::abs(best - z) ||
+          (std::abs(s.z - z) == std::abs(best - z) && s.z > best)) {
+        best = s.z;
+      }
+    }
+    if (best != kNoSurface) {
+      z = best;
+      gap = 0;
+      continue;
+    }
+    // No surface within a step: a wall or an object if anything is occupied from a step below to
+    // the headroom above, else a gap in the map (or a drop, which the next columns show).
+    bool occupied = false;
+    for (int zz = z - step; zz <= z + free_needed && !occupied; ++zz) occupied = grid.Occupied(cx, cy, zz);
+    if (occupied || ++gap > 2) return std::nullopt;
+  }
+  if (gap > 0) return std::nullopt;  // no ground under (x_m, y_m) itself
+  if (std::abs(z - z0) * r > kTerrainMaxSlope * run * r + r + 1e-9) return std::nullopt;
+  return grid.IndexSpaceToWorld(Eigen::Vector3d(0, 0, z + 1)).z();
+}
+
+std::optional<double> MovedStationFloor(const OccupancyGrid& grid, const WorldPoint& from, double from_floor_z_m,
+                                        double x_m, double y_m, const CandidateOptions& options) {
+  if (options.ground == GroundModel::kTerrain) return GroundTopReached(grid, from, from_floor_z_m, x_m, y_m, options);
+  return FloorTopNear(grid, x_m, y_m, from_floor_z_m, options);
 }
 
 }  // namespace vc::planner
@@ -603,7 +740,17 @@ Result<CandidateGrid> GenerateCandidates(const VoxelScene& scene, const Candidat
   const std::vector<double> ys = AxisCells(lo.y(), hi.y(), options.grid_spacing_m);
   if (out.ground.model == GroundModel::kTerrain) {
     out.ground_columns = ground.columns;
-    VC_RETURN_IF_ERROR(PlaceOnTerrain(grid, ground, xs, ys, heights, options, out, ctx));
+    std::vector<uint8_t> on_grid;
+    VC_RETURN_IF_ERROR(PlaceOnTerrain(grid, ground, xs, ys, heights, options, out, on_grid, ctx));
+    if (options.doorway_candidates) {
+      VC_RETURN_IF_ERROR(ctx.CheckCancelled("candidate generation"));
+      uint64_t no_floor = 0, no_clearance = 0;
+      for (const WorldPoint& q : PassagePoints(grid, TerrainSlice(grid, ground, options), options)) {
+        if (NearAGridCandidate(q, xs, ys, on_grid, options.grid_spacing_m)) continue;
+        out.passage_candidates +=
+            PlaceOnGround(grid, ground, q.x(), q.y(), heights, options, out, &no_floor, &no_clearance);
+      }
+    }
     ctx.Report(Stage::kCandidates, 1.0);
     return out;
   }
@@ -641,21 +788,13 @@ Result<CandidateGrid> GenerateCandidates(const VoxelScene& scene, const Candidat
     }
   }
   if (options.doorway_candidates) {
-    const double fine = options.grid_spacing_m / 4;
     uint64_t no_floor = 0, no_clearance = 0;
     for (size_t li = 0; li < kept.size(); ++li) {
       VC_RETURN_IF_ERROR(ctx.CheckCancelled("candidate generation"));
       const int lz = m.z + kept[li].z;
-      for (const WorldPoint& q : PassagePoints(grid, lz + 1, options)) {
-        // The nearest grid cell; skip q if it got a candidate within fine / 2 of q in x and y.
-        auto nearest = [&](const std::vector<double>& cells, double v) {
-          const long i = std::lround((v - cells.front()) / options.grid_spacing_m);
-          return static_cast<size_t>(std::clamp<long>(i, 0, static_cast<long>(cells.size()) - 1));
-        };
-        const size_t ix = nearest(xs, q.x()), iy = nearest(ys, q.y());
-        const bool near_grid = on_grid[li][iy * xs.size() + ix] && std::abs(xs[ix] - q.x()) < fine / 2 &&
-                               std::abs(ys[iy] - q.y()) < fine / 2;
-        if (!near_grid) out.passage_candidates += place(q.x(), q.y(), li, lz, &no_floor, &no_clearance);
+      for (const WorldPoint& q : PassagePoints(grid, FloorSlice(grid, lz + 1, options), options)) {
+        if (NearAGridCandidate(q, xs, ys, on_grid[li], options.grid_spacing_m)) continue;
+        out.passage_candidates += place(q.x(), q.y(), li, lz, &no_floor, &no_clearance);
       }
     }
   }

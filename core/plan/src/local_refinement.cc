@@ -78,7 +78,7 @@ Result<LocalRefinementResult> RefineLocally(const Selector& selector, const Voxe
         for (int ix = -n; ix <= n; ++ix) {
           if (ix == 0 && iy == 0) continue;
           const double x = s.x() + ix * options.step_m, y = s.y() + iy * options.step_m;
-          const std::optional<double> top = FloorTopNear(scene.grid, x, y, floor_z, at_height);
+          const std::optional<double> top = MovedStationFloor(scene.grid, s, floor_z, x, y, at_height);
           if (!top) continue;
           const WorldPoint p(x, y, *top + height);
           if (!HasClearance(scene.grid, p, candidate_options.clearance_m)) continue;

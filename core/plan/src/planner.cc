@@ -175,7 +175,7 @@ Result<PlanResult> Plan(const SceneInput& input, const PlanOptions& options, con
   VC_ASSIGN_OR_RETURN(planner::SelectionOutput selected, runner.Run(Stage::kSelection, [&](const JobContext& c) {
     return planner::RunSelectionStage(
         {scene, *selector, std::move(visibility.sets), std::move(visibility.fixed_sets), candidates.positions,
-         candidates.floor_z_m, result.heat_map.visible_voxels, callbacks, patches},
+         candidates.floor_z_m, result.heat_map.visible_voxels, callbacks, patches, candidates.ground.model},
         local_options, c);
   }));
   result.stop_reason = selected.selection.stop;
@@ -190,7 +190,8 @@ Result<PlanResult> Plan(const SceneInput& input, const PlanOptions& options, con
 
   if (local_options.refine && !stations.empty()) {
     VC_ASSIGN_OR_RETURN(planner::RefineOutput refined, runner.Run(Stage::kRefine, [&](const JobContext& c) {
-      return planner::RunRefineStage({scene, std::move(stations), std::move(coverable), patches}, local_options, c);
+      return planner::RunRefineStage(
+          {scene, std::move(stations), std::move(coverable), patches, candidates.ground.model}, local_options, c);
     }));
     stations = std::move(refined.stations);
     coverable = std::move(refined.coverable);

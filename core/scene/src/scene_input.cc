@@ -51,6 +51,18 @@ Status CheckOctreeUnits(std::string_view source, const ReadOptions& options) {
                   " m were given; read the octree without units");
 }
 
+// An E57 file's Cartesian coordinates and poses are metres by the standard (ASTM E2807), so no
+// other unit applies (docs/PLANNING.md, "Units"): a CRS in feet does not make them feet.
+Status CheckE57Units(std::string_view source, const ReadOptions& options) {
+  if (options.metres_per_unit == 1.0) return Status::Ok();
+  std::ostringstream units;
+  units << options.metres_per_unit;
+  return readers::InvalidInput(source, "E57 files hold metres by the standard (ASTM E2807), but units of " +
+                                           units.str() +
+                                           " m were given; read the E57 without units (with a CRS in feet, "
+                                           "vc-client --crs alone: the file is read in metres)");
+}
+
 Result<SceneInput> FromOctree(Result<std::shared_ptr<octomap::OcTree>> read, InputFormat format) {
   if (!read.ok()) {
     if (read.status().code() != StatusCode::kResourceExhausted) return read.status();
@@ -127,6 +139,7 @@ Result<SceneInput> ReadDecompressed(std::string_view bytes, std::string_view sou
     case InputFormat::kLas:
       return FromCloud(readers::ReadLas(bytes, source, options), InputFormat::kLas, source);
     case InputFormat::kE57:
+      VC_RETURN_IF_ERROR(CheckE57Units(source, options));
       return ReadE57Input(bytes, source, options);
     case InputFormat::kPcd:
       return FromCloud(readers::ReadPcd(bytes, source, options), InputFormat::kPcd, source);
@@ -153,6 +166,19 @@ InputFormat DetectInputFormat(std::string_view bytes) {
 }
 
 Compression DetectCompression(std::string_view bytes) { return readers::DetectCompression(bytes); }
+
+bool FormatHoldsMetres(InputFormat format) {
+  return format == InputFormat::kE57 || format == InputFormat::kOctomapBinary || format == InputFormat::kOctomapText;
+}
+
+Result<InputFormat> DetectSceneFormat(std::string_view bytes, std::string_view source_name,
+                                      const ReadOptions& options) {
+  const Compression compression = readers::DetectCompression(bytes);
+  if (compression == Compression::kNone) return DetectInputFormat(bytes);
+  VC_ASSIGN_OR_RETURN(const std::string plain,
+                      readers::Decompress(bytes, compression, source_name, options.max_decompressed_bytes));
+  return DetectInputFormat(plain);
+}
 
 std::string_view InputFormatName(InputFormat format) {
   switch (format) {

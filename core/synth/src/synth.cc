@@ -342,6 +342,32 @@ Model MakeSlope() {
   return m;
 }
 
+Model MakeHillside() {
+  // A site 20 x 14 m rising 4 m along x: 40 terraces 0.5 m deep, each 0.1 m above the one before
+  // (a 1:5 slope), open to the sky. A house is cut into it: walls 0.3 m thick round a room
+  // 6 x 5.4 m whose floor is the ground outside its downhill wall, where a door 1 m wide and 2.1 m
+  // high opens onto the slope; the ground rises beside and behind the house.
+  constexpr double kDepth = 0.5, kRise = 0.1, kSky = 10.0, kFloor = 1.5, kCeiling = 4.2, kRoof = 4.5;
+  constexpr int kTerraces = 40;
+  Model m;
+  m.open_site = true;
+  for (int i = 0; i < kTerraces; ++i) m.Opening(Cuboid(i * kDepth, 0, i * kRise, (i + 1) * kDepth, 14, kSky));
+  m.Opening(Cuboid(8.3, 4.3, kFloor, 14.3, 9.7, kCeiling));  // the room
+  m.Opening(Cuboid(8, 6.5, kFloor, 8.3, 7.5, 3.6));          // the door, in the downhill wall
+  m.Solid(Cuboid(8, 4, 0, 8.3, 6.5, kRoof));                 // downhill wall, either side of the door
+  m.Solid(Cuboid(8, 7.5, 0, 8.3, 10, kRoof));
+  m.Solid(Cuboid(8, 6.5, 3.6, 8.3, 7.5, kRoof));  // over the door
+  m.Solid(Cuboid(14.3, 4, 0, 14.6, 10, kRoof));   // uphill wall
+  m.Solid(Cuboid(8.3, 4, 0, 14.3, 4.3, kRoof));   // side walls
+  m.Solid(Cuboid(8.3, 9.7, 0, 14.3, 10, kRoof));
+  m.Solid(Cuboid(8.3, 4.3, kCeiling, 14.3, 9.7, kRoof));  // the roof slab
+  m.info.description =
+      "an open site 20 x 14 m rising 4 m along x in 0.1 m terraces 0.5 m deep, with a house cut into it "
+      "whose door opens onto the slope; terrain, optimum unknown";
+  m.info.optimum_stations = 0;
+  return m;
+}
+
 Model MakeHall() {
   Model m;
   // Nave (south), aisle (north, ground level) and gallery above the aisle, split by an arcade
@@ -424,10 +450,13 @@ const SceneKind kScenes[] = {
     {"stairs", false, "two storeys joined by a straight flight of steps", [](int) { return MakeStairs(); }},
     {"hall", false, "the benchmark hall", [](int) { return MakeHall(); }},
     {"slope", false, "an open sloping site with buildings", [](int) { return MakeSlope(); }},
+    {"hillside", false, "a sloping site with a house whose door opens onto the slope",
+     [](int) { return MakeHillside(); }},
 };
 
 constexpr char kValidSpecs[] =
-    "box, lroom, comb:K, rooms:N, hub:K, court:K, tee, twofloor, tworooms, stairs, hall, slope (K, N in 1..50)";
+    "box, lroom, comb:K, rooms:N, hub:K, court:K, tee, twofloor, tworooms, stairs, hall, slope, hillside (K, N in "
+    "1..50)";
 
 Status BadSpec(std::string_view spec, std::string_view why) {
   return InvalidArgumentError("invalid scene '" + std::string(spec) + "' (" + std::string(why) +
@@ -746,7 +775,7 @@ Status SynthOptions::Validate() const {
 std::string ListScenes() {
   std::string out;
   for (const char* spec : {"box", "lroom", "comb:3", "rooms:3", "hub:2", "court:2", "tee", "twofloor", "tworooms",
-                           "stairs", "hall", "slope"}) {
+                           "stairs", "hall", "slope", "hillside"}) {
     Result<SceneInfo> info = DescribeScene(spec);
     if (!info.ok()) continue;
     out += info->name;

@@ -17,7 +17,8 @@ int main(int argc, char** argv) {
   vc::SynthOptions options;
   app.add_option(
       "scene", scene,
-      "scene spec: box, lroom, comb:K, rooms:N, hub:K, court:K, tee, twofloor, tworooms, stairs, hall, slope");
+      "scene spec: box, lroom, comb:K, rooms:N, hub:K, court:K, tee, twofloor, tworooms, stairs, hall, slope, "
+      "hillside");
   app.add_option("--spacing", options.spacing_m, "sample spacing on every surface, metres (0.005..1)");
   app.add_option("--seed", options.seed, "seed of the in-plane jitter");
   app.add_option("--out", out, "output PLY file");

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <iostream>
 #include <map>
+#include <optional>
 #include <set>
 #include <string>
 #include <vector>
@@ -370,6 +371,121 @@ TEST(CandidatesTest, TerrainGroundIsTheLargestWalkableComponentNotADeskOrAPlatfo
     const int ix = static_cast<int>(std::floor(p.x() / kR)) + 20;  // Builder::Build moves x by -20 voxels
     EXPECT_NEAR(c.floor_z_m[i], (ix / 5 + 1) * kR, 2 * kR + 1e-9) << p.transpose();
   }
+}
+
+// On a flat floor the terrain's obstacle slice is the floor level's: the same door gets the same
+// passage candidates under either model.
+TEST(CandidatesTest, ADoorGetsTheSamePassageCandidatesOnTerrainAsOnItsFloorLevel) {
+  Builder b;
+  b.Room(25, true);
+  b.Box(24, 1, 1, 26, 38, 24);
+  b.Erase(24, 15, 1, 26, 23, 20);
+  CandidateOptions o;
+  o.doorway_candidates = true;
+  o.ground = GroundModel::kFloors;
+  const CandidateGrid floors = Generate(b.Build(), o);
+  o.ground = GroundModel::kTerrain;
+  const CandidateGrid terrain = Generate(b.Build(), o);
+  ASSERT_GT(floors.passage_candidates, 0u);
+  ASSERT_EQ(terrain.passage_candidates, floors.passage_candidates);
+  ASSERT_EQ(terrain.positions.size(), floors.positions.size());
+  for (size_t i = 0; i < floors.positions.size(); ++i) {
+    EXPECT_EQ(terrain.positions[i], floors.positions[i]) << i;
+    EXPECT_EQ(terrain.floor_z_m[i], floors.floor_z_m[i]) << i;
+  }
+}
+
+// hillside (docs/SCENES.md): terraces 0.5 m deep rising 0.1 m along x; a house over design
+// x 8-14.6, y 4-10 whose room's floor, z 1.5, is the ground outside its door (x 8-8.3, y 6.5-7.5).
+double HillsideGroundZ(double x_design, double y_design) {
+  if (x_design > 8 && x_design < 14.3 && y_design > 4.3 && y_design < 9.7) return 1.5;  // the room, the door
+  return 0.1 * std::floor(x_design / 0.5);
+}
+
+TEST(CandidatesTest, ADoorOntoSlopingGroundGetsCandidatesOnTheGroundInTheDoorway) {
+  const CandidateGrid c = WithPassages(SyntheticAt10cm("hillside"));
+  ASSERT_EQ(c.ground.model, GroundModel::kTerrain) << c.ground.reason;
+  ASSERT_GT(c.passage_candidates, 0u);
+  bool in_doorway = false, outside = false, inside = false;
+  for (size_t i = c.positions.size() - c.passage_candidates; i < c.positions.size(); ++i) {
+    const WorldPoint& p = c.positions[i];
+    const double x = p.x() - kSceneOffsetM.x(), y = p.y() - kSceneOffsetM.y();
+    std::cout << "[ hillside passage ] " << x << ", " << y << ", floor " << c.floor_z_m[i] - kSceneOffsetM.z() << "\n";
+    EXPECT_EQ(c.level[i], -1);
+    EXPECT_NEAR(p.z() - c.floor_z_m[i], 1.5, 1e-9) << p.transpose();
+    // On the ground under it: the terrace or the room's floor, within a voxel.
+    EXPECT_NEAR(c.floor_z_m[i] - kSceneOffsetM.z(), HillsideGroundZ(x, y), 0.11) << x << ", " << y;
+    // On the door's centre line, at most half a cell beyond the wall.
+    EXPECT_NEAR(y, 7.0, 0.05 + 1e-9) << x << ", " << y;
+    EXPECT_NEAR(x, 8.15, 0.15 + 0.5 + 1e-9) << x << ", " << y;
+    in_doorway = in_doorway || (x > 8 && x < 8.3);
+    outside = outside || x < 8;
+    inside = inside || x > 8.3;
+  }
+  EXPECT_TRUE(in_doorway);
+  EXPECT_TRUE(outside);
+  EXPECT_TRUE(inside);
+}
+
+// A ramp rising one voxel every 3 columns (a slope of 1:3, within the terrain's 0.36) across a
+// 6 x 4 m grid at 0.1 m, column x's top at ((x / 3) + 1) * 0.1 m (Builder::Build moves x by -20).
+double RampTopZ(double x_m) {
+  const int ix = static_cast<int>(std::floor(x_m / kR)) + 20;
+  return (ix / 3 + 1) * kR;
+}
+
+TEST(CandidatesTest, AStationMovedOnTerrainStandsOnTheGroundUnderItsNewPlace) {
+  Builder b;
+  for (int x = 0; x < 60; ++x) b.Box(x, 0, 0, x, 39, x / 3);
+  const VoxelScene s = b.Build();
+  CandidateOptions o;
+  o.ground = GroundModel::kTerrain;
+  const WorldPoint from(1.05, 0.25, 0);  // column 30, top 1.1 m
+  const double floor = RampTopZ(from.x());
+  ASSERT_NEAR(floor, 1.1, 1e-9);
+  for (double dx : {-1.0, -0.5, 0.0, 0.5, 1.0}) {
+    for (double dy : {-1.0, 0.0, 1.0}) {
+      if (dx == 0 && dy == 0) continue;
+      const double x = from.x() + dx, y = from.y() + dy;
+      const std::optional<double> top = MovedStationFloor(s.grid, from, floor, x, y, o);
+      ASSERT_TRUE(top.has_value()) << dx << ", " << dy;
+      EXPECT_NEAR(*top, RampTopZ(x), 1e-9) << dx << ", " << dy;
+    }
+  }
+  // The floor level's band (+-0.2 m here) loses the ground 1 m up or down the ramp (0.3 m away).
+  o.ground = GroundModel::kFloors;
+  EXPECT_FALSE(MovedStationFloor(s.grid, from, floor, from.x() + 1.0, from.y(), o).has_value());
+  EXPECT_FALSE(MovedStationFloor(s.grid, from, floor, from.x() - 1.0, from.y(), o).has_value());
+}
+
+TEST(CandidatesTest, AStationMovedOnTerrainDoesNotCrossAWallAStepOrASteepRise) {
+  Builder b;
+  b.Box(0, 0, 0, 59, 39, 0);      // flat ground, top 0.1 m
+  b.Box(30, 0, 1, 30, 19, 20);    // a wall 2 m high along y at x 1.0 m, over y -1.7 .. 0.2 m
+  b.Box(40, 20, 1, 59, 39, 5);    // a platform 0.5 m high (2 steps of 0.25 m)
+  b.Box(10, 25, 1, 14, 39, 1);    // a strip raised one voxel: a sill
+  b.Erase(20, 25, 0, 20, 39, 0);  // a one-voxel gap in the map
+  const VoxelScene s = b.Build();
+  CandidateOptions o;
+  o.ground = GroundModel::kTerrain;
+  const WorldPoint from(0.55, -1.0, 0);                                           // column 25, row 7
+  EXPECT_FALSE(MovedStationFloor(s.grid, from, 0.1, 1.55, -1.0, o).has_value());  // the wall
+  const std::optional<double> beside = MovedStationFloor(s.grid, from, 0.1, 0.55, -0.5, o);
+  ASSERT_TRUE(beside.has_value());
+  EXPECT_NEAR(*beside, 0.1, 1e-9);
+  const WorldPoint open(0.55, 1.0, 0);  // column 25, row 27: past the wall's end
+  EXPECT_FALSE(MovedStationFloor(s.grid, open, 0.1, 2.55, 1.0, o).has_value());  // onto the platform
+  const std::optional<double> over_sill = MovedStationFloor(s.grid, open, 0.1, -1.45, 1.0, o);
+  ASSERT_TRUE(over_sill.has_value());  // across the sill (one voxel up and down) and the gap
+  EXPECT_NEAR(*over_sill, 0.1, 1e-9);
+  const std::optional<double> on_sill = MovedStationFloor(s.grid, open, 0.1, -0.75, 1.0, o);
+  ASSERT_TRUE(on_sill.has_value());
+  EXPECT_NEAR(*on_sill, 0.2, 1e-9);
+  // A 1 m move may rise 0.36 m and a voxel: a 0.5 m step up a steeper ramp is too much.
+  Builder steep;
+  for (int x = 0; x < 60; ++x) steep.Box(x, 0, 0, x, 39, x / 2);  // 1:2
+  const VoxelScene st = steep.Build();
+  EXPECT_FALSE(MovedStationFloor(st.grid, WorldPoint(1.05, 0.25, 0), 1.6, 2.05, 0.25, o).has_value());
 }
 
 TEST(CandidatesTest, Cancelled) {

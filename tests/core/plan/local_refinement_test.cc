@@ -335,5 +335,78 @@ TEST(LocalRefinementHubTest, OnTheGridAloneGreedyAndExactNeedThreeEvenWithTheLoo
   }
 }
 
+// A ramp rising one voxel every 4 columns (1:4, terrain's ground) along x, 6 x 4 m at 0.1 m:
+// column x's top is at ((x / 4) + 1) * 0.1 m. The positions added around two picks 1 m apart, on a
+// 0.5 m sub-grid within 1.5 m, for `ground`.
+struct Ramp {
+  VoxelScene scene;
+  CandidateSets in;
+  FakeVisibility fake;
+  Ramp() {
+    testing::VoxelBuilder b;
+    for (int x = 0; x < 60; ++x) b.Box(x, 0, 0, x, 39, x / 4);
+    scene = b.Build(0.1);
+    CandidateOptions o;
+    o.ground = GroundModel::kTerrain;
+    Result<CandidateGrid> g = GenerateCandidates(scene, o);
+    EXPECT_TRUE(g.ok());
+    // The candidates nearest to (3, 2) m and (4, 2) m: both see part, nothing sees all.
+    auto nearest = [&](const WorldPoint& q) {
+      size_t best = 0;
+      for (size_t i = 0; i < g->positions.size(); ++i) {
+        if ((g->positions[i] - q).head<2>().norm() < (g->positions[best] - q).head<2>().norm()) best = i;
+      }
+      return g->positions[best];
+    };
+    fake.left = nearest(WorldPoint(3, 2, 0));
+    fake.right = nearest(WorldPoint(4, 2, 0));
+    fake.all = WorldPoint(-100, -100, 0);
+    in.positions = g->positions;
+    in.floor_z_m = g->floor_z_m;
+    in.sets = *fake(in.positions);
+  }
+  static double TopZ(double x_m) { return (static_cast<int>(std::floor(x_m / 0.1)) / 4 + 1) * 0.1; }
+  std::vector<WorldPoint> Added(GroundModel ground) {
+    CountingSelector selector;
+    const VisibilityFn fn = [&](const std::vector<WorldPoint>& p) { return fake(p); };
+    CandidateOptions o;
+    o.ground = ground;
+    LocalRefinementOptions lo;
+    lo.radius_m = 1.5;
+    lo.step_m = 0.5;
+    lo.max_rounds = 1;
+    Result<LocalRefinementResult> r = RefineLocally(selector, scene, in, 0, o, fn, lo);
+    EXPECT_TRUE(r.ok()) << r.status().ToString();
+    if (!r.ok()) return {};
+    EXPECT_EQ(r->stations_per_solve.front(), 2);
+    std::vector<WorldPoint> added(r->candidates.positions.begin() + static_cast<std::ptrdiff_t>(in.positions.size()),
+                                  r->candidates.positions.end());
+    for (size_t i = in.positions.size(); i < r->candidates.positions.size(); ++i) {
+      EXPECT_NEAR(r->candidates.positions[i].z() - r->candidates.floor_z_m[i], 1.5, 1e-9);
+    }
+    return added;
+  }
+};
+
+TEST(LocalRefinementTest, OnTerrainAddedPositionsStandAtTheirHeightOverTheGroundUnderThem) {
+  Ramp ramp;
+  const std::vector<WorldPoint> terrain = ramp.Added(GroundModel::kTerrain);
+  ASSERT_FALSE(terrain.empty());
+  bool uphill = false, downhill = false;
+  for (const WorldPoint& p : terrain) {
+    EXPECT_NEAR(p.z(), Ramp::TopZ(p.x()) + 1.5, 1e-9) << p.transpose();
+    uphill = uphill || p.x() > ramp.fake.right.x() + 1.4;
+    downhill = downhill || p.x() < ramp.fake.left.x() - 1.4;
+  }
+  EXPECT_TRUE(uphill);
+  EXPECT_TRUE(downhill);
+  // The floor level's band (+-0.2 m) loses the positions 1.5 m up and down the ramp (0.3-0.4 m away).
+  const std::vector<WorldPoint> floors = ramp.Added(GroundModel::kFloors);
+  EXPECT_LT(floors.size(), terrain.size());
+  for (const WorldPoint& p : floors) {
+    EXPECT_FALSE(p.x() > ramp.fake.right.x() + 1.4 || p.x() < ramp.fake.left.x() - 1.4) << p.transpose();
+  }
+}
+
 }  // namespace
 }  // namespace vc::planner

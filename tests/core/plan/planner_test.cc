@@ -19,6 +19,7 @@
 #include "testing/scenes.h"
 #include "testing/test_paths.h"
 #include "vc/plan/keep_out.h"
+#include "vc/plan/route.h"
 #include "vc/report/plan_report.h"
 #include "vc/synth/synth.h"
 
@@ -118,6 +119,44 @@ TEST(PlannerTest, SlopingSitePlansOnTheTerrainWithOneRoute) {
     EXPECT_EQ(w.find("floor levels"), std::string::npos) << w;
   }
   EXPECT_EQ(uncoverable, 1);
+}
+
+// hillside (docs/SCENES.md): a house cut into a 1:5 slope, its door opening onto it. On terrain
+// with doorway candidates, refinement and local candidates over 1-1.5 m (rises of 0.2-0.3 m, more
+// than the floor level's band): every station stands at tripod height over the ground of its own
+// voxel column (the terrace, or the room's floor through the door), and the route is one walk.
+TEST(PlannerTest, HillsideStationsStayOnTheGroundThroughRefinementAndLocalCandidates) {
+  PlanOptions o = TestOptions();
+  o.solver = SelectionSolver::kGreedy;
+  o.refine = true;
+  o.refine_radius_m = 1.5;
+  o.refine_step_m = 0.5;
+  o.local_candidates = true;
+  o.local_candidates_radius_m = 1.0;
+  o.local_candidates_step_m = 0.5;
+  const SceneInput input = Synthetic("hillside");
+  Result<PlanResult> r = Plan(input, o);
+  ASSERT_TRUE(r.ok()) << r.status().ToString();
+  std::cout << "[ hillside ] " << Describe(*r) << "; " << r->ground.reason << "; route " << r->route.length_m
+            << " m in " << r->route.parts << " part(s)\n";
+  EXPECT_EQ(r->ground.model, GroundModel::kTerrain) << r->ground.reason;
+  const Result<VoxelScene> scene = Voxelize(input, VoxelizeOptions{0.1});
+  ASSERT_TRUE(scene.ok());
+  ASSERT_GE(r->stations.size(), 2u);
+  int moved = 0;
+  for (const PlannedStation& s : r->stations) {
+    const double x = s.position.x() - kSceneOffsetM.x(), y = s.position.y() - kSceneOffsetM.y();
+    const bool in_house = x > 8 && x < 14.3 && y > 4.3 && y < 9.7;  // the room and its door
+    const double ground = in_house ? 1.5 : 0.1 * std::floor(x / 0.5);
+    std::cout << "  " << (s.position - kSceneOffsetM).transpose() << " floor " << s.floor_z_m - kSceneOffsetM.z()
+              << (s.candidate_index < 0 ? " (moved or added)" : "") << "\n";
+    EXPECT_NEAR(s.floor_z_m, planner::FloorBelow(scene->grid, s.position), 1e-9) << s.position.transpose();
+    EXPECT_NEAR(s.floor_z_m - kSceneOffsetM.z(), ground, 0.11) << s.position.transpose();
+    EXPECT_NEAR(s.position.z() - s.floor_z_m, 1.5, 1e-9) << s.position.transpose();
+    moved += s.candidate_index < 0;
+  }
+  EXPECT_GT(moved, 0);
+  EXPECT_EQ(r->route.parts, 1);
 }
 
 INSTANTIATE_TEST_SUITE_P(Scenes, KnownOptimumTest,

@@ -325,6 +325,26 @@ TEST(SceneInputTest, OctreesAreReadInMetresOnly) {
   }
 }
 
+// E57 and octrees fix metres (so --units and a CRS's unit do not apply to them); DetectSceneFormat
+// sees through compression, as ReadScene does.
+TEST(SceneInputTest, FormatsThatHoldMetresAndTheFormatUnderCompression) {
+  EXPECT_TRUE(FormatHoldsMetres(InputFormat::kE57));
+  EXPECT_TRUE(FormatHoldsMetres(InputFormat::kOctomapBinary));
+  EXPECT_TRUE(FormatHoldsMetres(InputFormat::kOctomapText));
+  for (InputFormat f : {InputFormat::kPly, InputFormat::kPcd, InputFormat::kXyz, InputFormat::kLas,
+                        InputFormat::kOctomapGraph, InputFormat::kVoxelStream}) {
+    EXPECT_FALSE(FormatHoldsMetres(f)) << InputFormatName(f);
+  }
+  EXPECT_EQ(*DetectSceneFormat(kPly, "p.ply"), InputFormat::kPly);
+  EXPECT_EQ(*DetectSceneFormat(Gzip(kPly), "p.ply.gz"), InputFormat::kPly);
+  std::stringstream bt;
+  ASSERT_TRUE(SmallTree()->writeBinary(bt));
+  EXPECT_EQ(*DetectSceneFormat(Bzip2(bt.str()), "t.bt.bz2"), InputFormat::kOctomapBinary);
+  const Result<InputFormat> truncated = DetectSceneFormat(Gzip(kXyz).substr(0, 12), "cut.gz");
+  ASSERT_FALSE(truncated.ok());
+  EXPECT_EQ(truncated.status().code(), StatusCode::kInvalidArgument);
+}
+
 TEST(SceneInputTest, ReadSceneFileNotFound) {
   Result<SceneInput> r = ReadSceneFile("/nonexistent/dir/cloud.ply");
   ASSERT_FALSE(r.ok());

@@ -430,8 +430,8 @@ TEST(SceneVoxelsTest, StairsFlightIsSolidWithHeadroomAndJoinsTheStoreys) {
 
 TEST(DescribeSceneTest, ListNamesEveryScene) {
   const std::string list = ListScenes();
-  for (const char* name :
-       {"box", "lroom", "comb", "rooms", "hub", "court", "tee", "twofloor", "tworooms", "stairs", "hall"}) {
+  for (const char* name : {"box", "lroom", "comb", "rooms", "hub", "court", "tee", "twofloor", "tworooms", "stairs",
+                           "hall", "slope", "hillside"}) {
     EXPECT_NE(list.find(name), std::string::npos) << name;
   }
 }
@@ -457,7 +457,7 @@ TEST(GenerateSceneTest, SameSeedGivesIdenticalPointsOtherSeedDiffers) {
 
 TEST(GenerateSceneTest, CountMatchesTheStream) {
   for (const char* spec :
-       {"box", "lroom", "comb:2", "rooms:2", "hub:1", "court:1", "tee", "twofloor", "tworooms", "stairs"}) {
+       {"box", "lroom", "comb:2", "rooms:2", "hub:1", "court:1", "tee", "twofloor", "tworooms", "stairs", "hillside"}) {
     for (double spacing : {0.07, 0.2}) {
       SynthOptions o;
       o.spacing_m = spacing;
@@ -470,8 +470,8 @@ TEST(GenerateSceneTest, CountMatchesTheStream) {
 }
 
 TEST(GenerateSceneTest, EveryPointIsFiniteAndInsideTheBounds) {
-  for (const char* spec :
-       {"box", "lroom", "comb:3", "rooms:3", "hub:2", "court:2", "tee", "twofloor", "tworooms", "stairs", "hall"}) {
+  for (const char* spec : {"box", "lroom", "comb:3", "rooms:3", "hub:2", "court:2", "tee", "twofloor", "tworooms",
+                           "stairs", "hall", "hillside"}) {
     SynthOptions o;
     o.spacing_m = 0.2;
     Result<SceneInfo> info = DescribeScene(spec);

@@ -31,22 +31,31 @@ double StationHeight(const Stations& stations, size_t k, const std::vector<doubl
 }
 
 // Every sub-grid point within options.refine_radius_m of a station (not the station itself, and
-// not a fixed station), moved onto the floor near the station's at the station's tripod height,
-// and kept if it has the clearance and lies in no keep-out zone.
-TrialPositions TrialsAround(const OccupancyGrid& grid, const Stations& stations, const PlanOptions& options) {
+// not a fixed station), moved onto the floor near the station's (on terrain, `ground`, the ground
+// reached on foot: MovedStationFloor) at the station's tripod height, and kept if it has the
+// clearance and lies in no keep-out zone.
+TrialPositions TrialsAround(const OccupancyGrid& grid, const Stations& stations, GroundModel ground,
+                            const PlanOptions& options) {
   const std::vector<double> heights = options.TripodHeights();
   const int steps = static_cast<int>(std::floor(options.refine_radius_m / options.refine_step_m + 1e-9));
   TrialPositions trials;
   for (size_t k = 0; k < stations.size(); ++k) {
     if (stations.fixed[k]) continue;
     const double height = std::isnan(stations.floor_z_m[k]) ? 0.0 : StationHeight(stations, k, heights);
-    const CandidateOptions cand_options{options.grid_spacing_m, height, options.clearance_m, {}};
+    const CandidateOptions cand_options{.grid_spacing_m = options.grid_spacing_m,
+                                        .tripod_height_m = height,
+                                        .clearance_m = options.clearance_m,
+                                        .tripod_heights_m = {},
+                                        .doorway_candidates = false,
+                                        .ground = ground,
+                                        .walk_max_step_m = options.walk_max_step_m};
     for (int iy = -steps; iy <= steps; ++iy) {
       for (int ix = -steps; ix <= steps; ++ix) {
         if (ix == 0 && iy == 0) continue;
         WorldPoint p = stations.positions[k] + WorldPoint(ix * options.refine_step_m, iy * options.refine_step_m, 0);
         if (!std::isnan(stations.floor_z_m[k])) {
-          std::optional<double> top = FloorTopNear(grid, p.x(), p.y(), stations.floor_z_m[k], cand_options);
+          std::optional<double> top =
+              MovedStationFloor(grid, stations.positions[k], stations.floor_z_m[k], p.x(), p.y(), cand_options);
           if (!top) continue;
           p.z() = *top + height;
         }
@@ -65,7 +74,7 @@ TrialPositions TrialsAround(const OccupancyGrid& grid, const Stations& stations,
 Result<RefineOutput> RunRefineStage(RefineInput in, const PlanOptions& options, const JobContext& ctx) {
   const size_t n_voxels = in.scene.occupied.size();
   Stations& stations = in.stations;
-  TrialPositions trials = TrialsAround(in.scene.grid, stations, options);
+  TrialPositions trials = TrialsAround(in.scene.grid, stations, in.ground, options);
   VC_RETURN_IF_ERROR(
       CheckVisibilitySetBudget(trials.positions.size(), n_voxels, options.memory_budget_bytes, "refinement"));
   const VisibilitySetsOptions set_options = VisibilitySetsOptionsFor(options, in.surface_patches);

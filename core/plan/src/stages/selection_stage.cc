@@ -79,8 +79,13 @@ Result<LocalRefinementResult> SelectWithLocalCandidates(const SelectionInput& in
   };
 
   const std::vector<double> heights = options.TripodHeights();
-  const CandidateOptions cand_options{options.grid_spacing_m, *std::min_element(heights.begin(), heights.end()),
-                                      options.clearance_m, options.tripod_heights_m, false};
+  const CandidateOptions cand_options{.grid_spacing_m = options.grid_spacing_m,
+                                      .tripod_height_m = *std::min_element(heights.begin(), heights.end()),
+                                      .clearance_m = options.clearance_m,
+                                      .tripod_heights_m = options.tripod_heights_m,
+                                      .doorway_candidates = false,
+                                      .ground = in.ground,
+                                      .walk_max_step_m = options.walk_max_step_m};
   LocalRefinementOptions local{options.local_candidates_radius_m, options.local_candidates_step_m,
                                options.local_candidates_rounds, options.keep_out};
   local.target_coverage = options.target_coverage;

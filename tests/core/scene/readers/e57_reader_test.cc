@@ -469,15 +469,23 @@ TEST(E57Reader, ScansPosedAtSurveyCoordinatesReadInALocalFrameToTheMillimetre) {
   EXPECT_LE((in->scan_origins[1] - Eigen::Vector3d(344.125, 336.75, 310.5)).norm(), 1e-9);
 }
 
-TEST(E57Reader, UnitsScalePointsAndScanOrigins) {
+// E57 coordinates are metres by the standard (ASTM E2807): other units are refused, not applied,
+// and the file reads in metres as before.
+TEST(E57Reader, UnitsOtherThanMetresAreRefusedSinceE57HoldsMetres) {
   ReadOptions options;
-  options.metres_per_unit = *MetresPerUnit("ft");
-  Result<SceneInput> in = ReadScene(WriteE57(SurveyScans(options.metres_per_unit)), "ft.e57", options);
-  ASSERT_TRUE(in.ok()) << in.status().message();
-  EXPECT_EQ(in->frame_origin_m, kSurveyOrigin);
-  EXPECT_TRUE(HoldsInInputFrame(*in, SurveyPoints(), 1e-3));
-  ASSERT_EQ(in->scan_origins.size(), 2u);
-  EXPECT_LE((in->scan_origins[1] - Eigen::Vector3d(344.125, 336.75, 310.5)).norm(), 1e-6);
+  options.metres_per_unit = *MetresPerUnit("us-ft");
+  const Result<SceneInput> in = ReadScene(WriteE57(SurveyScans()), "site.e57", options);
+  ASSERT_FALSE(in.ok());
+  EXPECT_EQ(in.status().code(), StatusCode::kInvalidArgument);
+  EXPECT_EQ(in.status().message().rfind("site.e57: E57 files hold metres by the standard (ASTM E2807), but units of "
+                                        "0.304801 m were given; read the E57 without units",
+                                        0),
+            0u)
+      << in.status().message();
+  options.metres_per_unit = 1.0;
+  const Result<SceneInput> metres = ReadScene(WriteE57(SurveyScans()), "site.e57", options);
+  ASSERT_TRUE(metres.ok()) << metres.status().message();
+  EXPECT_TRUE(HoldsInInputFrame(*metres, SurveyPoints(), 1e-3));
 }
 
 }  // namespace

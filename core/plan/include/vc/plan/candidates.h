@@ -123,4 +123,21 @@ bool HasClearance(const OccupancyGrid& grid, const WorldPoint& p, double clearan
 std::optional<double> FloorTopNear(const OccupancyGrid& grid, double x_m, double y_m, double near_z_m,
                                    const CandidateOptions& options);
 
+// Terrain: top (m) of the ground under (x_m, y_m) reached on foot from the floor whose top is
+// `from_floor_z_m` under `from` (x, y): walking the straight line between them column by column,
+// in each the standing surface (not a roof, with the headroom of options' lowest height) closest
+// to the last one within walk_max_step_m (at least a voxel); up to 2 columns in a row with nothing
+// occupied near are a gap in the map and crossed. nullopt where a wall, an object or a drop is in
+// the way, where (x_m, y_m) has no such surface, or where the whole rise is more than
+// kTerrainMaxSlope times the horizontal distance plus a voxel.
+std::optional<double> GroundTopReached(const OccupancyGrid& grid, const WorldPoint& from, double from_floor_z_m,
+                                       double x_m, double y_m, const CandidateOptions& options);
+
+// The floor (top, m) of a station moved from `from`, whose floor's top is from_floor_z_m, to
+// (x_m, y_m) (refinement, local candidates): GroundTopReached when options.ground is kTerrain (so
+// on a slope the station keeps its height over the local ground), else FloorTopNear (the floor
+// level's band).
+std::optional<double> MovedStationFloor(const OccupancyGrid& grid, const WorldPoint& from, double from_floor_z_m,
+                                        double x_m, double y_m, const CandidateOptions& options);
+
 }  // namespace vc::planner

@@ -61,7 +61,8 @@ struct LocalRefinementResult {
 
 // Solves with `selector` over `in`, then, each round, adds around every picked station (beyond the
 // `fixed` first ones) the positions of a step_m sub-grid within radius_m (square) that stand on the
-// station's floor (FloorTopNear, with the station's own height above that floor), with the
+// station's floor (MovedStationFloor: the floor level's band, or on terrain (candidate_options.ground)
+// the ground reached on foot; with the station's own height above that floor), with the
 // clearance (HasClearance), outside options.keep_out, and are not yet candidates (at most
 // options.max_added over all rounds); solves again over all; keeps the new solve if it is better:
 // reaching target_coverage beats not reaching it, then fewer stations, or as many covering more

@@ -130,6 +130,9 @@ struct SelectionInput {
   const std::vector<uint64_t>& visible_voxels;    // per candidate: |set| (the heat map's counts)
   const PlanCallbacks& callbacks;                 // on_station is called per pick, in pick order
   std::span<const SurfacePatch> surface_patches;  // VoxelizeOutput's: the sub-voxel test's patches
+  // The candidates' ground model (CandidatesOutput::ground): on kTerrain the local candidates
+  // stand on the ground reached on foot from their station (MovedStationFloor).
+  GroundModel ground = GroundModel::kAuto;
 };
 struct SelectionOutput {
   Stations stations;                  // the fixed stations, then the picks, in pick order
@@ -162,6 +165,9 @@ struct RefineInput {
   Stations stations;                              // consumed
   VoxelSet coverable;                             // consumed; grows by what the trial positions see
   std::span<const SurfacePatch> surface_patches;  // VoxelizeOutput's: the sub-voxel test's patches
+  // The candidates' ground model (CandidatesOutput::ground): on kTerrain a moved station stands on
+  // the ground reached on foot from where it was (MovedStationFloor), else on its floor level.
+  GroundModel ground = GroundModel::kAuto;
 };
 struct RefineOutput {
   Stations stations;

@@ -63,8 +63,9 @@ struct ReadOptions {
   // Refuse inputs whose parsed form (points, OctoMap nodes) would take more than this many bytes.
   uint64_t max_result_bytes = uint64_t{2} << 30;
   // Metres per unit of the input's coordinates (vc-client --units; MetresPerUnit): points are
-  // scaled by this as they are read. 1 for metres. Octrees are read in metres only (other units
-  // are INVALID_ARGUMENT); a vc-voxels stream is in metres already and is not scaled.
+  // scaled by this as they are read. 1 for metres. Octrees and E57 files are read in metres only
+  // (FormatHoldsMetres; other units are INVALID_ARGUMENT); a vc-voxels stream is in metres already
+  // and is not scaled.
   double metres_per_unit = 1.0;
 };
 
@@ -124,6 +125,13 @@ Result<SceneInput> ReadScene(std::string_view bytes, std::string_view source_nam
 [[nodiscard]] InputFormat DetectInputFormat(std::string_view bytes);
 // The compression ReadScene finds around `bytes` (gzip, bzip2 magic; kNone otherwise).
 [[nodiscard]] Compression DetectCompression(std::string_view bytes);
+// The format ReadScene reads `bytes` as: DetectInputFormat after any gzip or bzip2 (a compressed
+// input is decompressed for it, within options.max_decompressed_bytes). The decompression's errors.
+[[nodiscard]] Result<InputFormat> DetectSceneFormat(std::string_view bytes, std::string_view source_name,
+                                                    const ReadOptions& options = {});
+// Whether `format` fixes its coordinates' unit to metres, so that no --units applies: E57 (ASTM
+// E2807 stores Cartesian coordinates in metres) and OctoMap octrees (their resolution is in metres).
+[[nodiscard]] bool FormatHoldsMetres(InputFormat format);
 
 // Reads a whole file and calls ReadScene. NOT_FOUND if it cannot be opened.
 Result<SceneInput> ReadSceneFile(const std::string& path, const ReadOptions& options = {});

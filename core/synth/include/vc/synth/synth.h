@@ -14,7 +14,7 @@
 // axis-aligned solid boxes inside them (pillars, pews, beams, cornices). Points are sampled on the
 // boundary of that free space, i.e. on the surfaces a scanner standing inside would record; the
 // outside of the building is never sampled (it could not be covered, and it would tie the roof with
-// the floor as the largest horizontal layer). An open site (slope) is the exception: there the
+// the floor as the largest horizontal layer). An open site (slope, hillside) is the exception: there the
 // faces on the air's bounding box, the sky and the site's edges, are not sampled. Every face is sampled on a grid whose
 // lines include every box edge that crosses it, so the surface is watertight after voxelisation at any resolution
 // >= 2 x spacing. The whole scene is shifted by kSceneOffsetM so no surface plane lies on a multiple
@@ -79,7 +79,8 @@ struct SceneInfo {
 std::string ListScenes();
 
 // Describes the scene `spec` ("box", "lroom", "comb:K", "rooms:N", "hub:K", "court:K", "tee", "hall", "twofloor",
-// "tworooms", "stairs", "slope"; K and N in 1..50). INVALID_ARGUMENT naming the valid specs for anything else.
+// "tworooms", "stairs", "slope", "hillside"; K and N in 1..50). INVALID_ARGUMENT naming the valid specs for
+// anything else.
 Result<SceneInfo> DescribeScene(std::string_view spec);
 
 // Calls fn once per point (world, m) of the scene, in a fixed order; memory does not grow with the
