@@ -48,9 +48,10 @@ using vc::bench::PeakRssMiB;
 // grid, and the exact evaluation of 15 evenly spaced candidates keeping every station's face
 // values (what the reduction does). Each round's seconds, the best, and a check value.
 // `test` names the selection test of the sets ("surface", "subvoxel": the patches come from the
-// input's points; "subvoxel-per-voxel" and "surface-per-voxel": the per-ray engines).
+// input's points; "subvoxel-per-voxel" and "surface-per-voxel": the per-ray engines); `sets_only`
+// skips the evaluation.
 int VisibilityOnly(const vc::SceneInput& input, const vc::VoxelScene& s, double grid, int every, int threads,
-                   int repeat, const std::string& test) {
+                   int repeat, const std::string& test, bool sets_only) {
   vc::planner::CandidateOptions co;
   co.grid_spacing_m = grid;
   auto candidates = vc::planner::GenerateCandidates(s, co);
@@ -103,7 +104,7 @@ int VisibilityOnly(const vc::SceneInput& input, const vc::VoxelScene& s, double 
     std::snprintf(line, sizeof line, "%zu visible, hash %016llx", visible, (unsigned long long)hash);
     return std::string(line);
   });
-  if (test != "surface") return 0;
+  if (sets_only) return 0;
   std::snprintf(title, sizeof title, "exact evaluation of %zu candidates, per-station values kept, %d threads",
                 fifteen.size(), threads);
   rounds(title, [&] {
@@ -202,6 +203,7 @@ struct BenchOptions {
   bool resolution_given = false;  // --resolution on the command line: an OctoMap is resampled to it
   int every = 4;
   std::string test = "surface";  // --visibility-only's selection test
+  bool test_given = false;       // --test on the command line: the sets only
 };
 
 // The working resolution for `input`: an OctoMap's own unless --resolution was given.
@@ -233,7 +235,7 @@ void AddFlags(CLI::App& app, BenchOptions* o) {
       ->check(CLI::Range(1, 1000000));
   app.add_option("--test", o->test,
                  "with --visibility-only: the sets' selection test (surface, subvoxel, or either with -per-voxel "
-                 "for the per-ray engine); a test other than surface times the sets only")
+                 "for the per-ray engine); given, only the sets are timed")
       ->check(CLI::IsMember({"surface", "subvoxel", "surface-per-voxel", "subvoxel-per-voxel"}));
   app.add_flag("--all-targets", o->all_targets, "also time the SIMD batch kernel on every other instruction set");
   app.add_flag("--fine-eval", o->fine_eval,
@@ -531,7 +533,7 @@ int RunBench(const BenchOptions& o) {
   }
   const vc::SceneInput& input = loaded->input;
   const vc::VoxelScene& s = loaded->voxels;
-  if (o.visibility_only) return VisibilityOnly(input, s, o.grid, o.every, o.threads, o.repeat, o.test);
+  if (o.visibility_only) return VisibilityOnly(input, s, o.grid, o.every, o.threads, o.repeat, o.test, o.test_given);
   if (o.candidates_only) return CandidatesOnly(s, o.grid);
 
   auto tree = input.octree ? std::const_pointer_cast<octomap::OcTree>(input.octree)
@@ -557,6 +559,7 @@ int main(int argc, char** argv) {
   BenchOptions o;
   AddFlags(app, &o);
   CLI11_PARSE(app, argc, argv);
+  o.test_given = app.count("--test") > 0;
   o.resolution_given = app.count("--resolution") > 0;
   std::setvbuf(stdout, nullptr, _IOLBF, 0);  // figures appear as they are measured
   if (o.fine_eval) return FineEvaluation(o.threads);
