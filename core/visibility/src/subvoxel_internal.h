@@ -1,5 +1,5 @@
-// The sub-voxel test's per-ray core (subvoxel.h), shared by the single queries and the bulk engine
-// (visibility.cc). Private to the visibility layer.
+// The sub-voxel test's per-ray core (subvoxel.h), shared by the single queries, the per-voxel sets
+// (visibility.cc) and the batched engine (subvoxel_bulk.cc). Private to the visibility layer.
 #pragma once
 
 #include <Eigen/Core>
