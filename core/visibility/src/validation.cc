@@ -143,13 +143,12 @@ Status AddVoxelsOfSeenFaces(const VoxelScene& model, const std::vector<WorldPoin
   eo.threads = options.threads;
   eo.keep_sparse_per_viewpoint_values = true;
   VC_ASSIGN_OR_RETURN(Evaluation ev, Evaluate(model, positions, eo, ctx));
-  const float least = options.count_faces == ValidationOptions::FaceRule::kFull ? 0.5f : 0.0f;
+  const bool full_only = options.count_faces == ValidationOptions::FaceRule::kFull;
   for (size_t k = 0; k < positions.size(); ++k) {
     const SparseFaceValues& seen = ev.per_viewpoint_sparse_values[k];
     for (size_t i = 0; i < seen.size(); ++i) {
-      if (seen.values[i] > least || (least > 0 && seen.values[i] == least)) {
-        predicted[k].set(seen.faces[i] / kFacesPerVoxel);
-      }
+      // V is 0.3 for a partially visible face and at least 0.5 for a fully visible one.
+      if (full_only ? seen.values[i] >= 0.5f : seen.values[i] > 0.0f) predicted[k].set(seen.faces[i] / kFacesPerVoxel);
     }
   }
   return Status::Ok();
