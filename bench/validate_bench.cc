@@ -54,6 +54,9 @@ struct BenchOptions {
   std::vector<std::string> scenes = {"planes", "room", "partial", "real"};
   // Break the subvoxel test's misses down by category (--explain).
   bool explain = false;
+  // Voxels of faces seen by the corner rule also count as predicted (--faces, --face-set).
+  vc::ValidationOptions::FaceRule count_faces = vc::ValidationOptions::FaceRule::kNone;
+  vc::FaceSet count_faces_of = vc::FaceSet::kAll;
 };
 
 int ExplainMisses(const std::string& label, const std::vector<vc::CapturedScan>& scans, const BenchOptions& bench,
@@ -77,6 +80,8 @@ int Report(const std::string& label, const std::vector<vc::CapturedScan>& scans,
     options.resolution_m = bench.resolution_m;
     options.selection_test = test;
     options.threads = bench.threads;
+    options.count_faces = bench.count_faces;
+    options.count_faces_of = bench.count_faces_of;
     auto report = vc::ValidateAgainstScans(scans, options);
     if (!report.ok()) return std::fprintf(stderr, "%s: %s\n", label.c_str(), report.status().ToString().c_str()), 1;
     for (const vc::ScanAgreement& a : report->scans) {
@@ -110,7 +115,7 @@ class Tally {
   }
   void Print(const std::string& label, const std::string& scan, uint64_t all_misses) const {
     for (const auto& [category, row] : rows_) {
-      std::printf("# explain %-34s scan %-3s %-44s captured %7llu missed %7llu (%5.3f of them, %5.3f of all misses)\n",
+      std::printf("# explain %-34s scan %-3s %-44s voxels %7llu missed %7llu (%5.3f of them, %5.3f of all)\n",
                   label.c_str(), scan.c_str(), category.c_str(), (unsigned long long)row.first,
                   (unsigned long long)row.second, row.first ? double(row.second) / double(row.first) : 0.0,
                   all_misses ? double(row.second) / double(all_misses) : 0.0);
@@ -210,6 +215,47 @@ int ExplainMisses(const std::string& label, const std::vector<vc::CapturedScan>&
                 true);
     });
     tally.Print(label, a.name, misses);
+    // Over-predictions: voxels predicted for this scan that it did not capture (another scan did).
+    Tally over;
+    const uint64_t overs = a.predicted - a.both;
+    a.predicted_set.ForEach([&](size_t id) {
+      if (a.captured_set.test(id)) return;
+      const vc::SurfacePatch& p = patches[id];
+      const vc::WorldPoint c = p.centroid_m.cast<double>();
+      over.Add("over: target " + PatchKind(p), true);
+      over.Add(
+          std::string("over: target of ") + Bin(p.points, {{3, "1-2"}, {10, "3-9"}, {30, "10-29"}}, "30+") + " points",
+          true);
+      if (p.flat) {
+        const double cos_in = std::abs(p.normal.cast<double>().dot((o - c).normalized()));
+        const double incidence_deg = std::acos(std::min(1.0, cos_in)) * 180.0 / std::numbers::pi;
+        over.Add(std::string("over: flat target, incidence ") +
+                     Bin(incidence_deg, {{45, "0-45"}, {70, "45-70"}, {80, "70-80"}}, "80-90") + " deg",
+                 true);
+      }
+      over.Add(
+          std::string("over: distance ") + Bin((o - c).norm(), {{3, "0-3"}, {6, "3-6"}, {12, "6-12"}}, "12+") + " m",
+          true);
+      const vc::SubvoxelRay ray = vc::ExplainSubvoxel(model, patches, o, id, scanner);
+      std::string why = "over: seen ";
+      if (ray.outcome == vc::SubvoxelRay::Outcome::kClear) {
+        why += "clear (no blocker)";
+      } else if (ray.outcome == vc::SubvoxelRay::Outcome::kSameSurface) {
+        const vc::VoxelIndex vi = vc::KeyToIndex(model.occupied[id]);
+        const vc::VoxelIndex wi = vc::KeyToIndex(model.occupied[size_t(ray.first_blocker)]);
+        const int chebyshev = std::max({std::abs(vi.x - wi.x), std::abs(vi.y - wi.y), std::abs(vi.z - wi.z)});
+        why += std::string("past the same surface, blocker ") + (chebyshev <= 1 ? "adjacent" : "farther");
+      } else {
+        why += "by a face of its box";
+      }
+      over.Add(why, true);
+      const bool surface = vc::IsSurfaceVisible(model.grid, o, vc::KeyToIndex(model.occupied[id]), scanner);
+      over.Add(std::string("over: surface test ") + (surface ? "predicts it too" : "does not") + ", " +
+                   (HasMemberWithinOneVoxel(model, a.captured_set, id) ? "a captured voxel within one voxel"
+                                                                       : "none within one voxel"),
+               true);
+    });
+    over.Print(label, a.name, overs);
   }
   return 0;
 }
@@ -390,7 +436,20 @@ int main(int argc, char** argv) {
   app.add_flag("--explain", bench.explain,
                "break the subvoxel test's misses down by patch, incidence, distance and first blocker "
                "(scans predicted all round)");
+  std::string faces = "none", face_set = "all";
+  app.add_option("--faces", faces,
+                 "voxels that also count as predicted: none, those with a face fully visible (full), or at least "
+                 "partially visible (partial), by the paper's corner rays")
+      ->check(CLI::IsMember({"none", "full", "partial"}))
+      ->capture_default_str();
+  app.add_option("--face-set", face_set, "the faces --faces looks at: all six, or the exposed ones")
+      ->check(CLI::IsMember({"all", "exposed"}))
+      ->capture_default_str();
   CLI11_PARSE(app, argc, argv);
+  bench.count_faces = faces == "full"      ? vc::ValidationOptions::FaceRule::kFull
+                      : faces == "partial" ? vc::ValidationOptions::FaceRule::kPartial
+                                           : vc::ValidationOptions::FaceRule::kNone;
+  bench.count_faces_of = face_set == "exposed" ? vc::FaceSet::kExposed : vc::FaceSet::kAll;
   if (!tests.empty()) {
     bench.tests.clear();
     for (const std::string& name : tests) {
@@ -404,8 +463,8 @@ int main(int argc, char** argv) {
   const auto start = Clock::now();
   std::printf(
       "# resolution %.3f m, simulated step %.2f deg; recall1 / prec1: with one voxel of slack; "
-      "prec '-': one scan, so only recall is meaningful\n",
-      bench.resolution_m, bench.step_deg);
+      "prec '-': one scan, so only recall is meaningful; faces counted too: %s (%s)\n",
+      bench.resolution_m, bench.step_deg, faces.c_str(), face_set.c_str());
   PrintHeader();
   if ((Runs(bench, "planes") && TiltedPlanes(bench) != 0) || (Runs(bench, "room") && Room(bench) != 0) ||
       (Runs(bench, "partial") && PartialRoomScans(bench) != 0) || (Runs(bench, "real") && RealScans(bench) != 0))

@@ -25,6 +25,7 @@
 #include "vc/raycast/ray_traversal.h"
 #include "vc/scene/octomap_adapter.h"
 #include "vc/scene/scene_input.h"
+#include "vc/scene/surface_patches.h"
 #include "vc/scene/voxel_scene.h"
 #include "vc/synth/synth.h"
 #include "vc/visibility/visibility.h"
@@ -46,7 +47,11 @@ using vc::bench::PeakRssMiB;
 // machine"): the grouped surface-visibility sets of every `every`-th candidate of the plan's
 // grid, and the exact evaluation of 15 evenly spaced candidates keeping every station's face
 // values (what the reduction does). Each round's seconds, the best, and a check value.
-int VisibilityOnly(const vc::VoxelScene& s, double grid, int every, int threads, int repeat) {
+// `test` names the selection test of the sets ("surface", "subvoxel": the patches come from the
+// input's points; "subvoxel-per-voxel" and "surface-per-voxel": the per-ray engines); `sets_only`
+// skips the evaluation.
+int VisibilityOnly(const vc::SceneInput& input, const vc::VoxelScene& s, double grid, int every, int threads,
+                   int repeat, const std::string& test, bool sets_only) {
   vc::planner::CandidateOptions co;
   co.grid_spacing_m = grid;
   auto candidates = vc::planner::GenerateCandidates(s, co);
@@ -71,17 +76,35 @@ int VisibilityOnly(const vc::VoxelScene& s, double grid, int every, int threads,
     }
     std::printf(" s; best %.3f s; %s\n", best, check.c_str());
   };
-  char title[160];
-  std::snprintf(title, sizeof title, "visibility sets (surface, grouped), %zu of %zu candidates, %d threads",
+  const bool subvoxel = test.rfind("subvoxel", 0) == 0;
+  const bool per_voxel = test.find("per-voxel") != std::string::npos;
+  std::vector<vc::SurfacePatch> patches;
+  if (subvoxel) patches = vc::ComputeSurfacePatches(s, input.points);
+  char title[200];
+  std::snprintf(title, sizeof title, "visibility sets (%s), %zu of %zu candidates, %d threads", test.c_str(),
                 some.size(), all.size(), threads);
   rounds(title, [&] {
     vc::VisibilitySetsOptions o;
     o.threads = threads;
+    o.per_voxel = per_voxel;
+    if (subvoxel) {
+      o.test = vc::SelectionTest::kSubvoxel;
+      o.surface_patches = patches;
+    }
     auto sets = vc::ComputeVisibilitySets(s, some, o);
+    if (!sets.ok()) return sets.status().ToString();
     size_t visible = 0;
-    for (const auto& set : *sets) visible += set.count();
-    return std::to_string(visible) + " visible";
+    uint64_t hash = 1469598103934665603ull;  // FNV-1a over the sets' ids
+    for (const auto& set : *sets) {
+      visible += set.count();
+      set.ForEach([&](uint32_t id) { hash = (hash ^ id) * 1099511628211ull; });
+      hash = (hash ^ 0xffffffffull) * 1099511628211ull;
+    }
+    char line[96];
+    std::snprintf(line, sizeof line, "%zu visible, hash %016llx", visible, (unsigned long long)hash);
+    return std::string(line);
   });
+  if (sets_only) return 0;
   std::snprintf(title, sizeof title, "exact evaluation of %zu candidates, per-station values kept, %d threads",
                 fifteen.size(), threads);
   rounds(title, [&] {
@@ -179,6 +202,8 @@ struct BenchOptions {
   bool visibility_only = false, candidates_only = false;
   bool resolution_given = false;  // --resolution on the command line: an OctoMap is resampled to it
   int every = 4;
+  std::string test = "surface";  // --visibility-only's selection test
+  bool test_given = false;       // --test on the command line: the sets only
 };
 
 // The working resolution for `input`: an OctoMap's own unless --resolution was given.
@@ -209,6 +234,10 @@ void AddFlags(CLI::App& app, BenchOptions* o) {
                "\"Terrain\")");
   app.add_option("--every", o->every, "with --visibility-only: every how many candidates")
       ->check(CLI::Range(1, 1000000));
+  app.add_option("--test", o->test,
+                 "with --visibility-only: the sets' selection test (surface, subvoxel, or either with -per-voxel "
+                 "for the per-ray engine); given, only the sets are timed")
+      ->check(CLI::IsMember({"surface", "subvoxel", "surface-per-voxel", "subvoxel-per-voxel"}));
   app.add_flag("--all-targets", o->all_targets, "also time the SIMD batch kernel on every other instruction set");
   app.add_flag("--fine-eval", o->fine_eval,
                "only the fine evaluation: the hall sampled at 0.005 m, a 10-station plan evaluated at 0.01 m "
@@ -521,7 +550,7 @@ int RunBench(const BenchOptions& o) {
   }
   const vc::SceneInput& input = loaded->input;
   const vc::VoxelScene& s = loaded->voxels;
-  if (o.visibility_only) return VisibilityOnly(s, o.grid, o.every, o.threads, o.repeat);
+  if (o.visibility_only) return VisibilityOnly(input, s, o.grid, o.every, o.threads, o.repeat, o.test, o.test_given);
   if (o.candidates_only) return CandidatesOnly(s, o.grid);
 
   auto tree = input.octree ? std::const_pointer_cast<octomap::OcTree>(input.octree)
@@ -547,6 +576,7 @@ int main(int argc, char** argv) {
   BenchOptions o;
   AddFlags(app, &o);
   CLI11_PARSE(app, argc, argv);
+  o.test_given = app.count("--test") > 0;
   o.resolution_given = app.count("--resolution") > 0;
   std::setvbuf(stdout, nullptr, _IOLBF, 0);  // figures appear as they are measured
   if (o.fine_eval) return FineEvaluation(o.threads);

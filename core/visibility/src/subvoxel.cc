@@ -1,11 +1,13 @@
 // The sub-voxel selection test (subvoxel.h, docs/VISIBILITY.md "Sub-voxel surfaces").
 #include "vc/visibility/subvoxel.h"
 
+#include <bit>
 #include <cmath>
 #include <limits>
 #include <numbers>
 
 #include "subvoxel_internal.h"
+#include "vc/base/popcount.h"
 #include "vc/raycast/walk.h"
 #include "visibility_internal.h"
 
@@ -103,17 +105,19 @@ void NearestFace(Eigen::Vector3d n, const Eigen::Vector3d& to_viewpoint, int* ax
 }
 
 // The segment uo -> aim (index space; aim inside target voxel `id`'s cube) judged by the test:
-// clear, first blocker on the target's surface, or blocked.
+// clear, first blocker on the target's surface, or blocked. The walk starts at parameter
+// `s_start` of the segment (0: at uo); the caller knows the part before it meets no occupied voxel.
 SubvoxelRay TraceSegment(const VoxelScene& scene, std::span<const SurfacePatch> patches, const Eigen::Vector3d& uo,
-                         const Eigen::Vector3d& aim, size_t id) {
+                         const Eigen::Vector3d& aim, size_t id, double s_start = 0,
+                         const SubvoxelTables* tables = nullptr) {
   const VoxelIndex v = KeyToIndex(scene.occupied[id]);
   const SurfacePatch& target = patches[id];
   const OccupancyGrid& g = scene.grid;
   const VoxelIndex& lo = g.min_index();
   const int lo3[3] = {lo.x, lo.y, lo.z};
   const uint32_t dims[3] = {uint32_t(g.dims().x()), uint32_t(g.dims().y()), uint32_t(g.dims().z())};
-  Walk walk(uo, aim);
-  double t_in = 0, first = kNoHit;
+  Walk walk(s_start > 0 ? Eigen::Vector3d(uo + s_start * (aim - uo)) : uo, aim);
+  double t_in = s_start, first = kNoHit;
   bool same_at_first = false;
   int64_t first_blocker = -1;
   while (t_in <= first) {
@@ -122,15 +126,17 @@ SubvoxelRay TraceSegment(const VoxelScene& scene, std::span<const SurfacePatch> 
     const uint32_t rel[3] = {uint32_t(cur.x - lo3[0]), uint32_t(cur.y - lo3[1]), uint32_t(cur.z - lo3[2])};
     const bool in_grid = rel[0] < dims[0] && rel[1] < dims[1] && rel[2] < dims[2];
     const uint64_t brick = in_grid ? g.BrickLinear(rel[0] >> 3, rel[1] >> 3, rel[2] >> 3) : 0;
-    if (in_grid && g.BrickSlot(brick) == 0) {
+    const uint32_t slot = in_grid ? g.BrickSlot(brick) : 0;
+    if (in_grid && slot == 0) {
       // An empty brick: jump across its free box (walk.h), which holds no blocker; the walk's
       // end, v, is occupied, so it does not end inside the box.
       if (!JumpAcrossFreeBrickBox(g, brick, rel, lo3, walk)) break;
-    } else if (in_grid && g.Occupied(cur)) {
-      const int64_t w = scene.IdOf(IndexToKey(cur));
+    } else if (in_grid && (g.BrickBits(slot)[rel[2] & 7] >> (((rel[1] & 7) << 3) | (rel[0] & 7))) & 1u) {
+      const int64_t w = tables ? tables->Id(slot, rel) : scene.IdOf(IndexToKey(cur));
       const SurfacePatch& patch = patches[size_t(w)];
-      const Eigen::Vector3d center = g.WorldToIndexSpace(patch.centroid_m.cast<double>());
-      const double s = BlockerHit(uo, aim, SubvoxelBoxIS(scene, patches, size_t(w)), patch, center);
+      const double s = tables ? BlockerHit(uo, aim, tables->Box(size_t(w)), patch, tables->Centroid(size_t(w)))
+                              : BlockerHit(uo, aim, SubvoxelBoxIS(scene, patches, size_t(w)), patch,
+                                           g.WorldToIndexSpace(patch.centroid_m.cast<double>()));
       if (s <= first) {
         const bool same = SameSurface(uo + s * (aim - uo), aim, target, patch);
         // At a tie, the blocker reported is one on the target's surface when there is one.
@@ -140,7 +146,9 @@ SubvoxelRay TraceSegment(const VoxelScene& scene, std::span<const SurfacePatch> 
       }
     }
     if (walk.remaining == 0) break;
-    t_in = std::min({walk.t_max[0], walk.t_max[1], walk.t_max[2]});
+    // The walk's parameter is along its own segment, from s_start; the blockers' along uo -> aim.
+    const double t_walk = std::min({walk.t_max[0], walk.t_max[1], walk.t_max[2]});
+    t_in = s_start > 0 ? s_start + t_walk * (1 - s_start) : t_walk;
     walk.Advance();
   }
   SubvoxelRay ray;
@@ -154,33 +162,90 @@ SubvoxelRay TraceSegment(const VoxelScene& scene, std::span<const SurfacePatch> 
 
 }  // namespace
 
-SubvoxelRay TraceSubvoxel(const VoxelScene& scene, std::span<const SurfacePatch> patches, const Eigen::Vector3d& uo,
-                          size_t id, const ScannerLimits& limits) {
+bool SubvoxelAimPasses(const VoxelScene& scene, std::span<const SurfacePatch> patches, const Eigen::Vector3d& uo,
+                       size_t id, const ScannerLimits& limits, Eigen::Vector3d* aim) {
   const SurfacePatch& target = patches[id];
-  const Eigen::Vector3d aim = SubvoxelAimIS(scene, patches, id);
-  const Eigen::Vector3d to_viewpoint = uo - aim;
+  *aim = SubvoxelAimIS(scene, patches, id);
+  const Eigen::Vector3d to_viewpoint = uo - *aim;
   int axis = 0, sign = 1;
   NearestFace(target.flat ? target.normal.cast<double>() : to_viewpoint, to_viewpoint, &axis, &sign);
-  if (!limits.Passes(aim, axis, sign)) {
-    SubvoxelRay ray;
-    ray.outcome = SubvoxelRay::Outcome::kOutsideLimits;
-    return ray;
-  }
-  const SubvoxelRay ray = TraceSegment(scene, patches, uo, aim, id);
-  if (ray.seen() || target.flat) return ray;
-  // A voxel that is not flat is also seen where the centre of a face of its box that faces o is.
+  return limits.Passes(*aim, axis, sign);
+}
+
+int SubvoxelFaceAims(const VoxelScene& scene, std::span<const SurfacePatch> patches, const Eigen::Vector3d& uo,
+                     size_t id, Eigen::Vector3d faces[3]) {
+  if (patches[id].flat) return 0;
   const Eigen::AlignedBox3d box = SubvoxelBoxIS(scene, patches, id);
+  int n = 0;
   for (int i = 0; i < 3; ++i) {
     for (const bool high : {false, true}) {
       const double side = high ? box.max()[i] : box.min()[i];
       if (high ? !(uo[i] > side) : !(uo[i] < side)) continue;
       Eigen::Vector3d face = box.center();
       face[i] = side;
-      const SubvoxelRay to_face = TraceSegment(scene, patches, uo, SubvoxelInside(scene, id, face), id);
-      if (to_face.seen()) return to_face;
+      faces[n++] = SubvoxelInside(scene, id, face);
     }
   }
+  return n;
+}
+
+SubvoxelRay TraceSubvoxelSegment(const VoxelScene& scene, std::span<const SurfacePatch> patches,
+                                 const Eigen::Vector3d& uo, size_t id, const Eigen::Vector3d& end, double s_start,
+                                 const SubvoxelTables* tables) {
+  return TraceSegment(scene, patches, uo, end, id, s_start, tables);
+}
+
+SubvoxelRay TraceSubvoxel(const VoxelScene& scene, std::span<const SurfacePatch> patches, const Eigen::Vector3d& uo,
+                          size_t id, const ScannerLimits& limits) {
+  Eigen::Vector3d aim;
+  if (!SubvoxelAimPasses(scene, patches, uo, id, limits, &aim)) {
+    SubvoxelRay ray;
+    ray.outcome = SubvoxelRay::Outcome::kOutsideLimits;
+    return ray;
+  }
+  const SubvoxelRay ray = TraceSegment(scene, patches, uo, aim, id);
+  if (ray.seen()) return ray;
+  // A voxel that is not flat is also seen where the centre of a face of its box that faces o is.
+  Eigen::Vector3d faces[3];
+  const int n = SubvoxelFaceAims(scene, patches, uo, id, faces);
+  for (int f = 0; f < n; ++f) {
+    const SubvoxelRay to_face = TraceSegment(scene, patches, uo, faces[f], id);
+    if (to_face.seen()) return to_face;
+  }
   return ray;
+}
+
+SubvoxelTables::SubvoxelTables(const VoxelScene& scene, std::span<const SurfacePatch> patches) : grid_(&scene.grid) {
+  const OccupancyGrid& g = scene.grid;
+  const uint64_t slots = g.occupied_bricks();
+  start_.assign(slots + 1, 0);
+  for (uint64_t k = 0; k < slots; ++k) {
+    uint32_t count = 0;
+    for (int z = 0; z < OccupancyGrid::kBrick; ++z) count += uint32_t(std::popcount(g.payload()[k * 8 + z]));
+    start_[k + 1] = start_[k] + count;
+  }
+  ids_.assign(start_[slots], 0);
+  const VoxelIndex& lo = g.min_index();
+  for (size_t id = 0; id < scene.occupied.size(); ++id) {
+    const VoxelIndex v = KeyToIndex(scene.occupied[id]);
+    const uint32_t rel[3] = {uint32_t(v.x - lo.x), uint32_t(v.y - lo.y), uint32_t(v.z - lo.z)};
+    const uint32_t slot = g.BrickSlot(g.BrickLinear(rel[0] >> 3, rel[1] >> 3, rel[2] >> 3));
+    ids_[start_[slot - 1] + Rank(slot, rel)] = uint32_t(id);
+  }
+  boxes_.resize(scene.occupied.size());
+  centroids_.resize(scene.occupied.size());
+  for (size_t id = 0; id < scene.occupied.size(); ++id) {
+    boxes_[id] = SubvoxelBoxIS(scene, patches, id);
+    centroids_[id] = g.WorldToIndexSpace(patches[id].centroid_m.cast<double>());
+  }
+}
+
+VC_POPCOUNT_CLONES uint32_t SubvoxelTables::Rank(uint32_t slot, const uint32_t rel[3]) const {
+  const uint64_t* words = grid_->BrickBits(slot);
+  const uint32_t z = rel[2] & 7, bit = ((rel[1] & 7) << 3) | (rel[0] & 7);
+  uint32_t rank = uint32_t(std::popcount(words[z] & ((uint64_t{1} << bit) - 1)));
+  for (uint32_t k = 0; k < z; ++k) rank += uint32_t(std::popcount(words[k]));
+  return rank;
 }
 
 bool SubvoxelVisibleFrom(const VoxelScene& scene, std::span<const SurfacePatch> patches, const Eigen::Vector3d& uo,

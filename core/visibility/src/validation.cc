@@ -130,6 +130,30 @@ ScanAgreement Compare(const CapturedScan& scan, const VoxelScene& model, VoxelSe
   return a;
 }
 
+// Adds to predicted[k] every voxel with a face (of options.count_faces_of) that Evaluate, from
+// positions[k] under the scanner's limits, finds fully visible (kFull: V >= 0.5) or at least
+// partially visible (kPartial: V > 0).
+Status AddVoxelsOfSeenFaces(const VoxelScene& model, const std::vector<WorldPoint>& positions,
+                            const std::vector<Heading>& headings_deg, const ValidationOptions& options,
+                            std::vector<VoxelSet>& predicted, const JobContext& ctx) {
+  EvaluateOptions eo;
+  eo.scanner = options.scanner;
+  eo.headings_deg = headings_deg;
+  eo.faces = options.count_faces_of;
+  eo.threads = options.threads;
+  eo.keep_sparse_per_viewpoint_values = true;
+  VC_ASSIGN_OR_RETURN(Evaluation ev, Evaluate(model, positions, eo, ctx));
+  const bool full_only = options.count_faces == ValidationOptions::FaceRule::kFull;
+  for (size_t k = 0; k < positions.size(); ++k) {
+    const SparseFaceValues& seen = ev.per_viewpoint_sparse_values[k];
+    for (size_t i = 0; i < seen.size(); ++i) {
+      // V is 0.3 for a partially visible face and at least 0.5 for a fully visible one.
+      if (full_only ? seen.values[i] >= 0.5f : seen.values[i] > 0.0f) predicted[k].set(seen.faces[i] / kFacesPerVoxel);
+    }
+  }
+  return Status::Ok();
+}
+
 }  // namespace
 
 Result<ValidationReport> ValidateAgainstScans(const std::vector<CapturedScan>& scans, const ValidationOptions& options,
@@ -160,6 +184,9 @@ Result<ValidationReport> ValidateAgainstScans(const std::vector<CapturedScan>& s
     sets_options.surface_patches = patches;
   }
   VC_ASSIGN_OR_RETURN(std::vector<VoxelSet> predicted, ComputeVisibilitySets(model, positions, sets_options, ctx));
+  if (options.count_faces != ValidationOptions::FaceRule::kNone) {
+    VC_RETURN_IF_ERROR(AddVoxelsOfSeenFaces(model, positions, sets_options.headings_deg, options, predicted, ctx));
+  }
 
   ValidationReport report;
   report.resolution_m = model.resolution_m;

@@ -15,6 +15,7 @@
 #include <bit>
 #include <cmath>
 #include <cstdio>
+#include <memory>
 #include <optional>
 #include <string>
 
@@ -232,6 +233,8 @@ struct SetsContext {
   std::vector<VoxelIndex> index;
   std::vector<uint32_t> candidates;
   std::optional<internal::SurfaceTargets> targets;
+  // Sub-voxel test, unless per voxel: what the traces' walks look up (subvoxel_bulk.cc).
+  std::unique_ptr<internal::SubvoxelTables> subvoxel_tables;
 };
 
 // The dense sets of `viewpoints` (ComputeVisibilitySets without compaction).
@@ -313,7 +316,11 @@ Result<std::vector<VoxelSet>> ComputeDenseSets(const SetsContext& sc, const std:
   const bool subvoxel = options.test == SelectionTest::kSubvoxel;
   Status st = ParallelChunks(tasks, 1, options.threads, ctx, [&](uint64_t task, uint64_t, uint64_t) {
     const size_t k = task / id_chunks, c = task % id_chunks;
-    if (valid[k] && subvoxel) {
+    if (valid[k] && subvoxel && sc.subvoxel_tables) {
+      const std::span<const uint32_t> ids(candidates.data() + chunk_start[c], chunk_start[c + 1] - chunk_start[c]);
+      internal::SubvoxelVisibleAmong(sc.scene, options.surface_patches, *sc.subvoxel_tables, uo[k], limits[k], ids,
+                                     sets[k]);
+    } else if (valid[k] && subvoxel) {
       for (size_t j = chunk_start[c]; j < chunk_start[c + 1]; ++j) {
         const uint32_t id = candidates[j];
         if (internal::SubvoxelVisibleFrom(sc.scene, options.surface_patches, uo[k], id, limits[k])) sets[k].set(id);
@@ -358,7 +365,7 @@ Result<std::vector<VoxelSet>> ComputeVisibilitySets(const VoxelScene& scene, con
   if (options.test == SelectionTest::kSubvoxel && options.surface_patches.empty()) {
     options.test = SelectionTest::kSurfaceVisibility;  // no points, no patches (subvoxel.h)
   }
-  SetsContext sc{scene, scene.grid, scene.occupied.size(), std::vector<VoxelIndex>(scene.occupied.size()), {}, {}};
+  SetsContext sc{scene, scene.grid, scene.occupied.size(), std::vector<VoxelIndex>(scene.occupied.size()), {}, {}, {}};
   for (size_t i = 0; i < sc.n; ++i) sc.index[i] = KeyToIndex(scene.occupied[i]);
   if (options.test == SelectionTest::kSubvoxel) {
     // Every voxel: a voxel enclosed by occupied cubes can still be reached past flat patches.
@@ -369,6 +376,9 @@ Result<std::vector<VoxelSet>> ComputeVisibilitySets(const VoxelScene& scene, con
   }
   if (options.test == SelectionTest::kSurfaceVisibility && !options.per_voxel) {
     sc.targets.emplace(sc.g, sc.index, sc.candidates);
+  }
+  if (options.test == SelectionTest::kSubvoxel && !options.per_voxel) {
+    sc.subvoxel_tables = std::make_unique<internal::SubvoxelTables>(scene, options.surface_patches);
   }
   auto check_bytes = [&](uint64_t bytes) {
     return CheckSetBytes(bytes, viewpoints.size(), sc.n, options.max_set_bytes);

@@ -88,6 +88,52 @@ TEST(ValidateAgainstScansTest, SlackNeverLowersRecallOrPrecision) {
   }
 }
 
+// Counting faces too (ValidationOptions::count_faces) only adds voxels: the test's set is kept, the
+// voxels of fully visible faces are a subset of those of faces at least partially visible, and
+// nothing hidden behind a wall is added. On the noisy tilted plane (two voxel layers) the partial
+// faces recover the surface test's misses (measured: recall 0.52 -> 1.00 at 30 deg, 1 cm noise).
+TEST(ValidateAgainstScansTest, CountingFacesOnlyAddsVoxelsAndNotHiddenOnes) {
+  const AnalyticScene walls = TwoWalls();
+  const std::vector<CapturedScan> scans = {Scan(walls, {0, 0, 0}, "front"), Scan(walls, {6, 0, 0}, "back")};
+  std::vector<ValidationReport> reports;
+  for (const auto rule : {ValidationOptions::FaceRule::kNone, ValidationOptions::FaceRule::kFull,
+                          ValidationOptions::FaceRule::kPartial}) {
+    ValidationOptions options;
+    options.keep_sets = true;
+    options.count_faces = rule;
+    auto report = ValidateAgainstScans(scans, options);
+    ASSERT_TRUE(report.ok()) << report.status().ToString();
+    reports.push_back(std::move(*report));
+  }
+  for (size_t i = 0; i < 2; ++i) {
+    const VoxelSet& none = reports[0].scans[i].predicted_set;
+    const VoxelSet& full = reports[1].scans[i].predicted_set;
+    const VoxelSet& partial = reports[2].scans[i].predicted_set;
+    EXPECT_TRUE(full.Contains(none));
+    EXPECT_TRUE(partial.Contains(full));
+    EXPECT_FALSE(partial.Intersects(reports[2].scans[1 - i].captured_set));  // the other wall stays hidden
+  }
+
+  auto plane = TiltedPlaneScene(30.0, 3.05);
+  ASSERT_TRUE(plane.ok());
+  SimulatedScanner scanner;
+  scanner.hfov_deg = 100.0;
+  scanner.vfov_min_deg = -45.0;
+  scanner.vfov_max_deg = 45.0;
+  scanner.horizontal_step_deg = scanner.vertical_step_deg = 0.25;
+  scanner.range_noise_sigma_m = 0.01;
+  auto scan = SimulateScan(*plane, scanner);
+  ASSERT_TRUE(scan.ok());
+  const std::vector<CapturedScan> noisy = {{"plane", {0, 0, 0}, scan->points_m}};
+  ValidationOptions options;
+  auto plain = ValidateAgainstScans(noisy, options);
+  options.count_faces = ValidationOptions::FaceRule::kPartial;
+  auto with_partial = ValidateAgainstScans(noisy, options);
+  ASSERT_TRUE(plain.ok() && with_partial.ok());
+  EXPECT_LT(plain->scans[0].recall, 0.7);
+  EXPECT_GE(with_partial->scans[0].recall, 0.99);
+}
+
 // Two scans of the cluttered room that each cover 150 deg of azimuth: predicted all round, each
 // scan's position is credited with the half of the room it never scanned; with hfov_deg 150 and
 // each scan's heading the prediction keeps to its sector, so precision rises and recall stays.

@@ -57,6 +57,15 @@ struct ValidationOptions {
   int threads = 0;
   // Bound on the model (bytes), as VoxelizeOptions::memory_budget_bytes.
   uint64_t memory_budget_bytes = kDefaultMemoryBudgetBytes;
+  // Faces (paper s.2.2.1, ALGORITHM.md s.4: corner rays, a voxel's own cube transparent) that also
+  // make a voxel count as predicted, on top of the selection test's set: none (the default), a
+  // face fully visible (4 corners) or a face at least partially visible (1-4 corners), each within
+  // the scanner's range and field of view (V > 0 and V >= 0.5 in Evaluate's terms). For
+  // measuring what counting partial faces would do (docs/VISIBILITY.md "Partial faces").
+  enum class FaceRule { kNone, kFull, kPartial };
+  FaceRule count_faces = FaceRule::kNone;
+  // Which faces count_faces looks at (all six, as G's F, or the exposed ones).
+  FaceSet count_faces_of = FaceSet::kAll;
   // Keep the model and each scan's captured and predicted sets in the report (for pictures of
   // where they disagree, and for measurements the counts cannot give).
   bool keep_sets = false;

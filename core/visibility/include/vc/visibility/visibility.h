@@ -134,8 +134,10 @@ struct VisibilitySetsOptions {
   SelectionTest test = SelectionTest::kSurfaceVisibility;
   // Worker threads; 0 = hardware concurrency.
   int threads = 0;
-  // Surface test only: decide every voxel by its own rays instead of by groups of faces (same
-  // answers, slower; kept as the reference for tests and benchmarks).
+  // Surface test: decide every voxel by its own rays instead of by groups of faces (same answers,
+  // slower). Sub-voxel test: trace every voxel on its own instead of walking its segments in SIMD
+  // batches first (the same answers but at exact lattice ties, docs/VISIBILITY.md; slower). Kept
+  // as the reference for tests and benchmarks.
   bool per_voxel = false;
   // The instrument's limits (vc/visibility/scanner_limits.h): a voxel counts only through a face
   // (compatibility: its centre, judged on the face the ray enters by) that passes all of them.
