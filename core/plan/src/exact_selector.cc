@@ -399,6 +399,8 @@ Result<CoverProblem> RareVoxelProblem(const std::vector<VoxelSet>& sets, const S
 // on geb079 the first two cores, docs/PLANNING.md "The Lagrangian bound over cores").
 constexpr uint64_t kBoundPairVisits = uint64_t{3} << 27;
 constexpr uint64_t kRareVoxelPairs = uint64_t{1} << 20;
+// Auto's swap search before the integer program may use this share of the time limit.
+constexpr double kSwapShare = 0.25;
 
 // The Lagrangian bound on the columns over the reduced model's classes.
 Result<int> ModelLagrangianBound(const ReducedModel& m, uint64_t need, int upper_bound, const JobContext& ctx) {
@@ -551,10 +553,11 @@ struct SwapState {
 
 // Greedy's picks improved by exchanges that keep the covered weight at or above `target`: drop a
 // pick, replace two picks by one candidate, or swap one pick for a candidate that covers more.
-// Stops when none applies or at the deadline.
+// Stops when none applies or at the deadline. Once at most `enough` picks are left (a proven
+// bound; 0: none) only the 1-for-1 exchanges go on, for coverage.
 Result<std::vector<int>> SwapLocalSearch(const Classes& cl, std::vector<int> picks, int fixed, int n_candidates,
                                          uint64_t target, bool max_mode, Clock::time_point deadline,
-                                         const JobContext& ctx) {
+                                         const JobContext& ctx, size_t enough = 0) {
   SwapState st{&cl, std::vector<int>(cl.weight.size(), 0), 0};
   std::vector<char> picked(n_candidates, 0);
   for (int p : picks) {
@@ -571,8 +574,9 @@ Result<std::vector<int>> SwapLocalSearch(const Classes& cl, std::vector<int> pic
   while (improved && Clock::now() < deadline) {
     improved = false;
     VC_RETURN_IF_ERROR(ctx.CheckCancelled("swap local search"));
+    const bool fewer = picks.size() > enough;  // fewer picks may still be possible
     // Drop a pick the others cover well enough.
-    for (size_t i = 0; i < picks.size() && !improved; ++i) {
+    for (size_t i = 0; fewer && i < picks.size() && !improved; ++i) {
       if (picks[i] < fixed) continue;
       st.Remove(picks[i]);
       if (st.covered >= floor) {
@@ -584,7 +588,7 @@ Result<std::vector<int>> SwapLocalSearch(const Classes& cl, std::vector<int> pic
       }
     }
     // 2-for-1.
-    for (size_t i = 0; i < picks.size() && !improved && Clock::now() < deadline; ++i) {
+    for (size_t i = 0; fewer && i < picks.size() && !improved && Clock::now() < deadline; ++i) {
       if (picks[i] < fixed) continue;
       VC_RETURN_IF_ERROR(ctx.CheckCancelled("swap local search"));
       st.Remove(picks[i]);
@@ -785,6 +789,8 @@ class ExactRun {
   void SetCoveredBound(const CoverModel& model, const CbcOutcome& outcome, bool proven, const std::vector<int>& picks);
   void SetStationBound(const CoverModel& model, const CbcOutcome& outcome, bool proven, size_t stations);
   Status SetRelaxedBound(const ReducedModel* m, uint64_t need, bool model_fits);
+  Result<int> ModelBound(const ReducedModel& m, uint64_t need);
+  Result<std::optional<Selection>> TryTheBoundFirst(const Classes& cl, const ReducedModel& m, uint64_t need);
   Result<int> RareVoxelBound();
   bool AtLeastAsGoodAsGreedy(const std::vector<int>& picks) const;
   bool StrictlyBetterThanGreedy(const std::vector<int>& picks) const;
@@ -806,6 +812,7 @@ class ExactRun {
   const StopReason greedy_stop_;
   bool greedy_connected_ = true;    // set once the flow model has checked greedy's plan
   std::optional<SizeProbe> probe_;  // the model's size before the reduction, once probed
+  std::optional<int> model_bound_;  // ModelBound, once computed
   Selection out_;
 };
 
@@ -871,6 +878,10 @@ Result<Selection> ExactRun::Select() {
   if (model.station_cols().count == 0 || (!max_mode_ && need == 0)) return FinishForced(m, need);
   const uint64_t estimate = model.EstimatedBytes();
   if (estimate > options_.memory_budget_bytes) return SelectOverBudget(&cl, &m, need, estimate);
+  if (options_.prefer_greedy && !max_mode_ && !connect_) {
+    VC_ASSIGN_OR_RETURN(std::optional<Selection> proven, TryTheBoundFirst(cl, m, need));
+    if (proven) return std::move(*proven);
+  }
   VC_ASSIGN_OR_RETURN(CbcOutcome outcome, SolveWithCbc(model, greedy_picks_, n, start_, options_.time_limit_s,
                                                        ProgressRange(ctx_, kArcsEnd, 1.0)));
   return Read(model, outcome);
@@ -926,14 +937,13 @@ Result<Selection> ExactRun::SelectOverBudget(const Classes* cl, const ReducedMod
 Status ExactRun::SetRelaxedBound(const ReducedModel* m, uint64_t need, bool model_fits) {
   if (max_mode_) return Status::Ok();
   Optimality& opt = out_.optimality;
-  const int upper_bound = static_cast<int>(greedy_picks_.size());
   int bound = 0;
   if (m != nullptr) {
     const int forced = static_cast<int>(m->forced.size());
     bound = forced + static_cast<int>(CountingBound(*m, need));
     if (model_fits) {
-      VC_ASSIGN_OR_RETURN(int columns, ModelLagrangianBound(*m, need, std::max(1, upper_bound - forced), ctx_));
-      bound = std::max(bound, forced + columns);
+      VC_ASSIGN_OR_RETURN(int model_bound, ModelBound(*m, need));
+      bound = std::max(bound, model_bound);
     }
   }
   if (m == nullptr || !model_fits) {
@@ -943,6 +953,42 @@ Status ExactRun::SetRelaxedBound(const ReducedModel* m, uint64_t need, bool mode
   opt.lower_bound = bound;
   if (opt.lower_bound > 0) opt.status = OptimalityStatus::kFeasible;
   return Status::Ok();
+}
+
+// The forced candidates plus the best of the counting and the Lagrangian bound over the reduced
+// model's classes (computed once).
+Result<int> ExactRun::ModelBound(const ReducedModel& m, uint64_t need) {
+  if (!model_bound_) {
+    const int forced = static_cast<int>(m.forced.size());
+    const int upper_bound = static_cast<int>(greedy_picks_.size());
+    VC_ASSIGN_OR_RETURN(int columns, ModelLagrangianBound(m, need, std::max(1, upper_bound - forced), ctx_));
+    model_bound_ = forced + std::max(static_cast<int>(CountingBound(m, need)), columns);
+  }
+  return *model_bound_;
+}
+
+// Auto's way past the integer program where a cheap bound settles it (issue 36: on atrium:2 the
+// root LP alone outlasts the 20 s limit, while the Lagrangian bound, a fraction of a second, is
+// already the optimum). Greedy's plan at the bound is optimal as it is; above it, the swap local
+// search from greedy's plan (kSwapShare of the time limit) that reaches the bound is optimal too.
+// Otherwise nothing: CBC runs as before, warm-started from greedy, and reuses the bound if its
+// root LP is cut off.
+Result<std::optional<Selection>> ExactRun::TryTheBoundFirst(const Classes& cl, const ReducedModel& m, uint64_t need) {
+  VC_ASSIGN_OR_RETURN(const int bound, ModelBound(m, need));
+  Optimality& opt = out_.optimality;
+  const auto proven = [&](std::vector<int> picks) {
+    opt.status = OptimalityStatus::kOptimal;
+    opt.lower_bound = bound;
+    opt.note = "the Lagrangian or counting bound proves it; no integer program solved";
+    return std::optional<Selection>(Finish(std::move(picks)));
+  };
+  if (static_cast<int>(greedy_picks_.size()) <= bound) return proven(greedy_picks_);
+  const Clock::time_point deadline =
+      start_ + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(options_.time_limit_s * kSwapShare));
+  VC_ASSIGN_OR_RETURN(std::vector<int> picks, SwapLocalSearch(cl, greedy_picks_, fixed_, static_cast<int>(sets_.size()),
+                                                              target_, false, deadline, ctx_, static_cast<size_t>(bound)));
+  if (static_cast<int>(picks.size()) <= bound && Covered(sets_, picks) >= target_) return proven(std::move(picks));
+  return std::optional<Selection>();
 }
 
 // The fixed stations outside the model plus the Lagrangian bound of RareVoxelProblem.
