@@ -983,10 +983,11 @@ Result<std::optional<Selection>> ExactRun::TryTheBoundFirst(const Classes& cl, c
     return std::optional<Selection>(Finish(std::move(picks)));
   };
   if (static_cast<int>(greedy_picks_.size()) <= bound) return proven(greedy_picks_);
-  const Clock::time_point deadline =
-      start_ + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(options_.time_limit_s * kSwapShare));
-  VC_ASSIGN_OR_RETURN(std::vector<int> picks, SwapLocalSearch(cl, greedy_picks_, fixed_, static_cast<int>(sets_.size()),
-                                                              target_, false, deadline, ctx_, static_cast<size_t>(bound)));
+  const Clock::time_point deadline = start_ + std::chrono::duration_cast<Clock::duration>(
+                                                  std::chrono::duration<double>(options_.time_limit_s * kSwapShare));
+  VC_ASSIGN_OR_RETURN(std::vector<int> picks,
+                      SwapLocalSearch(cl, greedy_picks_, fixed_, static_cast<int>(sets_.size()), target_, false,
+                                      deadline, ctx_, static_cast<size_t>(bound)));
   if (static_cast<int>(picks.size()) <= bound && Covered(sets_, picks) >= target_) return proven(std::move(picks));
   return std::optional<Selection>();
 }

@@ -334,8 +334,8 @@ Model MakeAtrium(int k) {
   for (const auto* side : {&north, &south, &west, &east}) {
     m.info.rooms.insert(m.info.rooms.end(), side->begin(), side->end());
   }
-  m.info.description = "atrium " + std::to_string(5 * k) + " x " + std::to_string(5 * k) + " x 4 m with a central pier and " +
-                       std::to_string(k) +
+  m.info.description = "atrium " + std::to_string(5 * k) + " x " + std::to_string(5 * k) +
+                       " x 4 m with a central pier and " + std::to_string(k) +
                        " rooms on each of its four sides behind off-centre 1 m doors; every room needs a station, "
                        "and those just inside the doors see the atrium";
   m.info.optimum_stations = 4 * k;
@@ -498,11 +498,13 @@ const SceneKind kScenes[] = {
     {"rooms", true, 1, kMaxCount, "rooms:N, N closed rooms off a corridor", [](int n) { return MakeRooms(n); }},
     {"hub", true, 1, kMaxCount, "hub:K, a hub hall with K small rooms on each side", [](int k) { return MakeHub(k); }},
     {"tee", false, 0, 0, "a square hall with a room on three sides", [](int) { return MakeTee(); }},
-    {"court", true, 1, kMaxCount, "court:K, a hall with K rooms on each side behind off-centre doors and one at each end",
+    {"court", true, 1, kMaxCount,
+     "court:K, a hall with K rooms on each side behind off-centre doors and one at each end",
      [](int k) { return MakeCourt(k); }},
     {"star", true, 2, 4, "star:K, a square hub with K arms (2..4) behind doors at different positions",
      [](int k) { return MakeStar(k); }},
-    {"atrium", true, 2, kMaxCount, "atrium:K, a square atrium with a central pier and K rooms on each of its four sides",
+    {"atrium", true, 2, kMaxCount,
+     "atrium:K, a square atrium with a central pier and K rooms on each of its four sides",
      [](int k) { return MakeAtrium(k); }},
     {"twofloor", false, 0, 0, "two storeys joined by a stair opening", [](int) { return MakeTwoFloor(); }},
     {"tworooms", false, 0, 0, "two rooms joined by one off-centre door", [](int) { return MakeTwoRooms(); }},

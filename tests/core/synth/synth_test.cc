@@ -18,8 +18,8 @@
 namespace vc {
 namespace {
 
-const char* const kSmallScenes[] = {"box",    "lroom",  "comb:3",   "rooms:3",  "hub:2",  "court:2",
-                                    "tee",    "star:4", "atrium:2", "twofloor", "tworooms", "stairs"};
+const char* const kSmallScenes[] = {"box", "lroom",  "comb:3",   "rooms:3",  "hub:2",    "court:2",
+                                    "tee", "star:4", "atrium:2", "twofloor", "tworooms", "stairs"};
 
 // A dense voxel grid over a scene's bounds (plus a margin), filled from its points; keys are
 // floor(p / resolution) as in OctoMap.
@@ -137,9 +137,10 @@ TEST(SynthOptionsTest, ValidateRejectsSpacingOutsideRangeOrNotFinite) {
 }
 
 TEST(DescribeSceneTest, BadSpecsAreInvalidArgumentListingValidNames) {
-  for (const char* bad : {"", "castle", "Box", "comb", "comb:", "comb:0", "comb:51", "comb:x", "comb:2x", "rooms:-1",
-                          "rooms:1.5", "box:2", "hall:1", "hub", "hub:0", "hub:51", "court", "court:51", "tee:1",
-                          "star", "star:1", "star:5", "atrium", "atrium:1", "atrium:51"}) {
+  for (const char* bad :
+       {"",         "castle",    "Box",    "comb",   "comb:",  "comb:0",   "comb:51",  "comb:x", "comb:2x",
+        "rooms:-1", "rooms:1.5", "box:2",  "hall:1", "hub",    "hub:0",    "hub:51",   "court",  "court:51",
+        "tee:1",    "star",      "star:1", "star:5", "atrium", "atrium:1", "atrium:51"}) {
     Result<SceneInfo> info = DescribeScene(bad);
     ASSERT_FALSE(info.ok()) << bad;
     EXPECT_EQ(info.status().code(), StatusCode::kInvalidArgument) << bad;
@@ -149,8 +150,8 @@ TEST(DescribeSceneTest, BadSpecsAreInvalidArgumentListingValidNames) {
 
 TEST(DescribeSceneTest, KnownScenesReportTheirOptimumRoomsAndFloors) {
   const std::vector<std::pair<std::string, int>> expected = {
-      {"box", 1},      {"lroom", 1},    {"comb:1", 1}, {"comb:7", 7},  {"comb:50", 50}, {"rooms:1", 2},
-      {"rooms:4", 5},  {"hub:1", 2},    {"hub:3", 6},  {"court:1", 4}, {"court:3", 8},  {"tee", 3},
+      {"box", 1},      {"lroom", 1},    {"comb:1", 1}, {"comb:7", 7},   {"comb:50", 50},  {"rooms:1", 2},
+      {"rooms:4", 5},  {"hub:1", 2},    {"hub:3", 6},  {"court:1", 4},  {"court:3", 8},   {"tee", 3},
       {"star:2", 2},   {"star:3", 3},   {"star:4", 4}, {"atrium:2", 8}, {"atrium:3", 12}, {"atrium:50", 200},
       {"twofloor", 2}, {"tworooms", 2}, {"stairs", 0}, {"hall", 0}};
   for (const auto& [spec, optimum] : expected) {
@@ -363,8 +364,8 @@ TEST(SceneVoxelsTest, StarArmsAreJoinedToTheHubOnlyThroughTheirDoors) {
     EXPECT_TRUE(grid.Reached(grid.KeyOf(door + kSceneOffsetM))) << door.transpose();
     EXPECT_FALSE(grid.Reached(grid.KeyOf(door + WorldPoint(0, 0, 1.5) + kSceneOffsetM))) << door.transpose();
   }
-  EXPECT_FALSE(grid.Reached(grid.KeyOf(WorldPoint(3, 6.125, 1.0) + kSceneOffsetM)));    // beside the north door
-  EXPECT_FALSE(grid.Reached(grid.KeyOf(WorldPoint(-0.125, 3, 1.0) + kSceneOffsetM)));   // beside the west door
+  EXPECT_FALSE(grid.Reached(grid.KeyOf(WorldPoint(3, 6.125, 1.0) + kSceneOffsetM)));   // beside the north door
+  EXPECT_FALSE(grid.Reached(grid.KeyOf(WorldPoint(-0.125, 3, 1.0) + kSceneOffsetM)));  // beside the west door
 }
 
 TEST(SceneVoxelsTest, AtriumRoomsAreJoinedOnlyThroughTheirDoorsAndThePierIsSolid) {
@@ -484,9 +485,8 @@ TEST(SceneVoxelsTest, StairsFlightIsSolidWithHeadroomAndJoinsTheStoreys) {
 
 TEST(DescribeSceneTest, ListNamesEveryScene) {
   const std::string list = ListScenes();
-  for (const char* name :
-       {"box", "lroom", "comb", "rooms", "hub", "court", "tee", "star", "atrium", "twofloor", "tworooms", "stairs",
-        "hall"}) {
+  for (const char* name : {"box", "lroom", "comb", "rooms", "hub", "court", "tee", "star", "atrium", "twofloor",
+                           "tworooms", "stairs", "hall"}) {
     EXPECT_NE(list.find(name), std::string::npos) << name;
   }
 }
@@ -511,9 +511,8 @@ TEST(GenerateSceneTest, SameSeedGivesIdenticalPointsOtherSeedDiffers) {
 }
 
 TEST(GenerateSceneTest, CountMatchesTheStream) {
-  for (const char* spec :
-       {"box", "lroom", "comb:2", "rooms:2", "hub:1", "court:1", "tee", "star:3", "atrium:2", "twofloor", "tworooms",
-        "stairs"}) {
+  for (const char* spec : {"box", "lroom", "comb:2", "rooms:2", "hub:1", "court:1", "tee", "star:3", "atrium:2",
+                           "twofloor", "tworooms", "stairs"}) {
     for (double spacing : {0.07, 0.2}) {
       SynthOptions o;
       o.spacing_m = spacing;
