@@ -8,7 +8,8 @@
 # positions it added and the stations of each selection).
 # Usage: scripts/compare-solvers.sh [BUILD_DIR (default build/release)] [SOLVERS (default "greedy exact")]
 #   [SCENES (default: geb079 and the synthetic scenes; "hall" and "hall-scan" add the halls,
-#   "room-scan1" the real furnished room)] [-- FLAGS...]
+#   "room-scan1" the real furnished room, "room-merged" both room scans in one frame,
+#   scripts/merge-room-scans.py)] [-- FLAGS...]
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bin=${1:-build/release}
@@ -42,6 +43,7 @@ for s in $scenes; do
     geb079) f=../shared/data/geb079/geb079.bt ;;
     hall-scan) f=../shared/data/hall-scan/scan.dat.bz2 ;;
     room-scan1) f=../shared/data/room-2scans/room_scan1.pcd ;;
+    room-merged) f="$work/room-merged.ply"; [[ -f "$f" ]] || python3 scripts/merge-room-scans.py "$f" >/dev/null ;;
     *) f="$work/${s/:/_}.ply"; [[ -f "$f" ]] || "$bin/core/vc-synth" "$s" --spacing 0.05 --out "$f" >/dev/null ;;
   esac
   for solver in $solvers; do

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Plans that must not change by accident: plans geb079, the synthetic hall, the real hall scan and
-# the known-optimum scenes (the hubs and tworooms since issue 36; court:K and tee are left to
-# PlannerTest.*RoomsAroundAHall*) through a real vc-server and vc-client, and prints one line per scene:
+# the known-optimum scenes (the hubs and tworooms since issue 36, the held-out star:4 and atrium:2
+# since hx-hub2; court:K and tee are left to PlannerTest.*RoomsAroundAHall*) through a real
+# vc-server and vc-client, and prints one line per scene:
 # stations, G, covered/coverable voxels and a hash of the stations' coordinates. Run it on two
 # builds and diff the output (docs/BENCHMARKS.md, "Plans must not change by accident").
 # Usage: scripts/plan-fingerprints.sh [BUILD_DIR (default build/release)] [--quick] [--fan-out]
@@ -60,7 +61,7 @@ else
   start_server server.log
 fi
 
-scenes=(box lroom comb:3 comb:5 rooms:3 twofloor tworooms hub:1 hub:2 hub:3)
+scenes=(box lroom comb:3 comb:5 rooms:3 twofloor tworooms hub:1 hub:2 hub:3 star:4 atrium:2)
 [[ "$quick" == "--quick" ]] || scenes+=(hall)
 files=(../shared/data/geb079/geb079.bt)
 [[ "$quick" == "--quick" ]] || files+=(../shared/data/hall-scan/scan.dat.bz2)

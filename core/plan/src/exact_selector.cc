@@ -399,6 +399,11 @@ Result<CoverProblem> RareVoxelProblem(const std::vector<VoxelSet>& sets, const S
 // on geb079 the first two cores, docs/PLANNING.md "The Lagrangian bound over cores").
 constexpr uint64_t kBoundPairVisits = uint64_t{3} << 27;
 constexpr uint64_t kRareVoxelPairs = uint64_t{1} << 20;
+// Auto's swap search before the integer program may use this share of the time limit.
+constexpr double kSwapShare = 0.25;
+// ... and the search that raises the bound on a model of at most kSearchColumns columns the next.
+constexpr double kSearchShare = 0.25;
+constexpr size_t kSearchColumns = 64;
 
 // The Lagrangian bound on the columns over the reduced model's classes.
 Result<int> ModelLagrangianBound(const ReducedModel& m, uint64_t need, int upper_bound, const JobContext& ctx) {
@@ -551,10 +556,11 @@ struct SwapState {
 
 // Greedy's picks improved by exchanges that keep the covered weight at or above `target`: drop a
 // pick, replace two picks by one candidate, or swap one pick for a candidate that covers more.
-// Stops when none applies or at the deadline.
+// Stops when none applies or at the deadline. Once at most `enough` picks are left (a proven
+// bound; 0: none) only the 1-for-1 exchanges go on, for coverage.
 Result<std::vector<int>> SwapLocalSearch(const Classes& cl, std::vector<int> picks, int fixed, int n_candidates,
                                          uint64_t target, bool max_mode, Clock::time_point deadline,
-                                         const JobContext& ctx) {
+                                         const JobContext& ctx, size_t enough = 0) {
   SwapState st{&cl, std::vector<int>(cl.weight.size(), 0), 0};
   std::vector<char> picked(n_candidates, 0);
   for (int p : picks) {
@@ -571,8 +577,9 @@ Result<std::vector<int>> SwapLocalSearch(const Classes& cl, std::vector<int> pic
   while (improved && Clock::now() < deadline) {
     improved = false;
     VC_RETURN_IF_ERROR(ctx.CheckCancelled("swap local search"));
+    const bool fewer = picks.size() > enough;  // fewer picks may still be possible
     // Drop a pick the others cover well enough.
-    for (size_t i = 0; i < picks.size() && !improved; ++i) {
+    for (size_t i = 0; fewer && i < picks.size() && !improved; ++i) {
       if (picks[i] < fixed) continue;
       st.Remove(picks[i]);
       if (st.covered >= floor) {
@@ -584,7 +591,7 @@ Result<std::vector<int>> SwapLocalSearch(const Classes& cl, std::vector<int> pic
       }
     }
     // 2-for-1.
-    for (size_t i = 0; i < picks.size() && !improved && Clock::now() < deadline; ++i) {
+    for (size_t i = 0; fewer && i < picks.size() && !improved && Clock::now() < deadline; ++i) {
       if (picks[i] < fixed) continue;
       VC_RETURN_IF_ERROR(ctx.CheckCancelled("swap local search"));
       st.Remove(picks[i]);
@@ -635,6 +642,102 @@ Result<std::vector<int>> SwapLocalSearch(const Classes& cl, std::vector<int> pic
   }
   return picks;
 }
+
+// Whether `size` columns of the reduced model cover at least `need` voxels: a depth-first search
+// over the columns in order of decreasing weight that prunes a node when its covered weight plus
+// the largest marginal gains still to be picked (an upper bound: coverage is submodular, so a
+// gain only shrinks as picks are added) falls short. Exhaustive, hence a proof either way, unless
+// the deadline stops it (kUnknown).
+class FixedSizeSearch {
+ public:
+  enum class Outcome { kNo, kYes, kUnknown };
+
+  FixedSizeSearch(const ReducedModel& m, uint64_t need, Clock::time_point deadline, const JobContext& ctx)
+      : m_(m), need_(need), deadline_(deadline), ctx_(ctx), sees_(m.columns.size()), count_(m.weight.size(), 0) {
+    std::vector<uint64_t> width(m.columns.size(), 0);
+    for (size_t k = 0; k < m.weight.size(); ++k) {
+      for (int j : m.seen_by[k]) {
+        sees_[j].push_back(static_cast<int>(k));
+        width[j] += m.weight[k];
+      }
+    }
+    order_.resize(m.columns.size());
+    for (size_t j = 0; j < order_.size(); ++j) order_[j] = static_cast<int>(j);
+    std::stable_sort(order_.begin(), order_.end(), [&](int a, int b) { return width[a] > width[b]; });
+  }
+
+  Result<Outcome> Run(int size) {
+    covered_ = 0;
+    picks_.clear();
+    std::fill(count_.begin(), count_.end(), 0);
+    stopped_ = false;
+    VC_ASSIGN_OR_RETURN(bool yes, Visit(0, size));
+    return yes ? Outcome::kYes : stopped_ ? Outcome::kUnknown : Outcome::kNo;
+  }
+
+ private:
+  void Add(int j, int delta) {
+    for (int k : sees_[j]) {
+      if (delta > 0 ? count_[k]++ == 0 : --count_[k] == 0) {
+        covered_ = delta > 0 ? covered_ + m_.weight[k] : covered_ - m_.weight[k];
+      }
+    }
+  }
+
+  // Picks `left` more columns among order_[from..]; true once the picks cover need_.
+  Result<bool> Visit(size_t from, int left) {
+    if (covered_ >= need_) return true;
+    if (left == 0 || from >= order_.size()) return false;
+    if ((++nodes_ & 255) == 0) {
+      VC_RETURN_IF_ERROR(ctx_.CheckCancelled("exact selection"));
+      if (Clock::now() > deadline_) stopped_ = true;
+    }
+    if (stopped_) return false;
+    // Marginal gains of the columns still open, and the best `left` of them per suffix start.
+    const size_t n = order_.size() - from;
+    std::vector<uint64_t> gain(n);
+    for (size_t i = 0; i < n; ++i) {
+      for (int k : sees_[order_[from + i]]) gain[i] += count_[k] == 0 ? m_.weight[k] : 0;
+    }
+    std::vector<uint64_t> sorted = gain;
+    std::sort(sorted.begin(), sorted.end(), std::greater<>());
+    uint64_t best = 0;
+    for (int r = 0; r < left && r < static_cast<int>(n); ++r) best += sorted[r];
+    if (covered_ + best < need_) return false;
+    for (size_t i = 0; i < n; ++i) {
+      // The child's bound: its own gain plus the left - 1 largest gains after it (the parent's
+      // gains bound the child's).
+      std::vector<uint64_t> after(gain.begin() + static_cast<std::ptrdiff_t>(i) + 1, gain.end());
+      const size_t take = std::min<size_t>(after.size(), static_cast<size_t>(left - 1));
+      std::partial_sort(after.begin(), after.begin() + static_cast<std::ptrdiff_t>(take), after.end(),
+                        std::greater<>());
+      uint64_t bound = covered_ + gain[i];
+      for (size_t r = 0; r < take; ++r) bound += after[r];
+      if (bound < need_) continue;
+      const int j = order_[from + i];
+      Add(j, 1);
+      picks_.push_back(j);
+      VC_ASSIGN_OR_RETURN(bool yes, Visit(from + i + 1, left - 1));
+      if (yes) return true;
+      picks_.pop_back();
+      Add(j, -1);
+      if (stopped_) return false;
+    }
+    return false;
+  }
+
+  const ReducedModel& m_;
+  const uint64_t need_;
+  const Clock::time_point deadline_;
+  const JobContext& ctx_;
+  std::vector<std::vector<int>> sees_;  // per column: its classes
+  std::vector<int> order_;              // columns by decreasing weight
+  std::vector<int> count_;              // per class: picks that see it
+  std::vector<int> picks_;
+  uint64_t covered_ = 0;
+  uint64_t nodes_ = 0;
+  bool stopped_ = false;
+};
 
 // The directed arcs of the columns' scan graph: both directions of each edge, in order of the
 // edge's lower column, then its higher one.
@@ -785,6 +888,8 @@ class ExactRun {
   void SetCoveredBound(const CoverModel& model, const CbcOutcome& outcome, bool proven, const std::vector<int>& picks);
   void SetStationBound(const CoverModel& model, const CbcOutcome& outcome, bool proven, size_t stations);
   Status SetRelaxedBound(const ReducedModel* m, uint64_t need, bool model_fits);
+  Result<int> ModelBound(const ReducedModel& m, uint64_t need);
+  Result<std::optional<Selection>> TryTheBoundFirst(const Classes& cl, const ReducedModel& m, uint64_t need);
   Result<int> RareVoxelBound();
   bool AtLeastAsGoodAsGreedy(const std::vector<int>& picks) const;
   bool StrictlyBetterThanGreedy(const std::vector<int>& picks) const;
@@ -806,6 +911,7 @@ class ExactRun {
   const StopReason greedy_stop_;
   bool greedy_connected_ = true;    // set once the flow model has checked greedy's plan
   std::optional<SizeProbe> probe_;  // the model's size before the reduction, once probed
+  std::optional<int> model_bound_;  // ModelBound, once computed
   Selection out_;
 };
 
@@ -871,6 +977,10 @@ Result<Selection> ExactRun::Select() {
   if (model.station_cols().count == 0 || (!max_mode_ && need == 0)) return FinishForced(m, need);
   const uint64_t estimate = model.EstimatedBytes();
   if (estimate > options_.memory_budget_bytes) return SelectOverBudget(&cl, &m, need, estimate);
+  if (options_.prefer_greedy && !max_mode_ && !connect_) {
+    VC_ASSIGN_OR_RETURN(std::optional<Selection> proven, TryTheBoundFirst(cl, m, need));
+    if (proven) return std::move(*proven);
+  }
   VC_ASSIGN_OR_RETURN(CbcOutcome outcome, SolveWithCbc(model, greedy_picks_, n, start_, options_.time_limit_s,
                                                        ProgressRange(ctx_, kArcsEnd, 1.0)));
   return Read(model, outcome);
@@ -926,14 +1036,13 @@ Result<Selection> ExactRun::SelectOverBudget(const Classes* cl, const ReducedMod
 Status ExactRun::SetRelaxedBound(const ReducedModel* m, uint64_t need, bool model_fits) {
   if (max_mode_) return Status::Ok();
   Optimality& opt = out_.optimality;
-  const int upper_bound = static_cast<int>(greedy_picks_.size());
   int bound = 0;
   if (m != nullptr) {
     const int forced = static_cast<int>(m->forced.size());
     bound = forced + static_cast<int>(CountingBound(*m, need));
     if (model_fits) {
-      VC_ASSIGN_OR_RETURN(int columns, ModelLagrangianBound(*m, need, std::max(1, upper_bound - forced), ctx_));
-      bound = std::max(bound, forced + columns);
+      VC_ASSIGN_OR_RETURN(int model_bound, ModelBound(*m, need));
+      bound = std::max(bound, model_bound);
     }
   }
   if (m == nullptr || !model_fits) {
@@ -943,6 +1052,62 @@ Status ExactRun::SetRelaxedBound(const ReducedModel* m, uint64_t need, bool mode
   opt.lower_bound = bound;
   if (opt.lower_bound > 0) opt.status = OptimalityStatus::kFeasible;
   return Status::Ok();
+}
+
+// The forced candidates plus the best of the counting and the Lagrangian bound over the reduced
+// model's classes (computed once).
+Result<int> ExactRun::ModelBound(const ReducedModel& m, uint64_t need) {
+  if (!model_bound_) {
+    const int forced = static_cast<int>(m.forced.size());
+    const int upper_bound = static_cast<int>(greedy_picks_.size());
+    VC_ASSIGN_OR_RETURN(int columns, ModelLagrangianBound(m, need, std::max(1, upper_bound - forced), ctx_));
+    model_bound_ = forced + std::max(static_cast<int>(CountingBound(m, need)), columns);
+  }
+  return *model_bound_;
+}
+
+// Auto's way past the integer program where a cheap bound settles it (issue 36: on atrium:2 the
+// root LP alone outlasts the 20 s limit, while the Lagrangian bound, a fraction of a second, is
+// already the optimum). Greedy's plan at the bound is optimal as it is; above it, the swap local
+// search from greedy's plan (kSwapShare of the time limit) that reaches the bound is optimal too.
+// Otherwise nothing: CBC runs as before, warm-started from greedy, and reuses the bound if its
+// root LP is cut off.
+Result<std::optional<Selection>> ExactRun::TryTheBoundFirst(const Classes& cl, const ReducedModel& m, uint64_t need) {
+  VC_ASSIGN_OR_RETURN(int bound, ModelBound(m, need));
+  Optimality& opt = out_.optimality;
+  std::string how = "the Lagrangian or counting bound proves it";
+  const auto proven = [&](std::vector<int> picks) {
+    opt.status = OptimalityStatus::kOptimal;
+    opt.lower_bound = bound;
+    opt.note = how + "; no integer program solved";
+    return std::optional<Selection>(Finish(std::move(picks)));
+  };
+  if (static_cast<int>(greedy_picks_.size()) <= bound) return proven(greedy_picks_);
+  const Clock::time_point deadline = start_ + std::chrono::duration_cast<Clock::duration>(
+                                                  std::chrono::duration<double>(options_.time_limit_s * kSwapShare));
+  VC_ASSIGN_OR_RETURN(std::vector<int> picks,
+                      SwapLocalSearch(cl, greedy_picks_, fixed_, static_cast<int>(sets_.size()), target_, false,
+                                      deadline, ctx_, static_cast<size_t>(bound)));
+  if (static_cast<int>(picks.size()) <= bound && Covered(sets_, picks) >= target_) return proven(std::move(picks));
+  // A small model: raise the bound by proving, size by size, that no plan of `bound` stations
+  // reaches the target (FixedSizeSearch). A plan found at some size only stops the search: CBC
+  // finds one too, so the plan stays what CBC returns (and the same as before this step).
+  if (m.columns.size() <= kSearchColumns) {
+    const Clock::time_point search_deadline =
+        start_ + std::chrono::duration_cast<Clock::duration>(
+                     std::chrono::duration<double>(options_.time_limit_s * (kSwapShare + kSearchShare)));
+    FixedSizeSearch search(m, need, search_deadline, ctx_);
+    const int forced = static_cast<int>(m.forced.size());
+    while (bound < static_cast<int>(picks.size())) {
+      VC_ASSIGN_OR_RETURN(FixedSizeSearch::Outcome o, search.Run(bound - forced));
+      if (o != FixedSizeSearch::Outcome::kNo) break;
+      ++bound;  // no plan of `bound` stations: every plan has more
+      how = "a search over every plan of " + std::to_string(bound - 1) + " stations proves it";
+    }
+    model_bound_ = bound;
+    if (static_cast<int>(picks.size()) <= bound) return proven(std::move(picks));
+  }
+  return std::optional<Selection>();
 }
 
 // The fixed stations outside the model plus the Lagrangian bound of RareVoxelProblem.
@@ -992,6 +1157,9 @@ Result<Selection> ExactRun::Read(const CoverModel& model, const CbcOutcome& outc
     SetCoveredBound(model, outcome, proven, picks);
   } else {
     SetStationBound(model, outcome, proven, picks.size());
+    // A bound that meets the plan proves it, though the time limit stopped CBC's search (hub:6:
+    // 12 stations, root bound 12, at 20 s).
+    if (opt.lower_bound >= static_cast<double>(picks.size())) opt.status = OptimalityStatus::kOptimal;
   }
   return Finish(std::move(picks));
 }

@@ -29,7 +29,7 @@ namespace {
 constexpr double kEnvelopeM = 0.3;       // wall thickness around the free space, for the bounds
 constexpr double kCorniceM = 0.2;        // cornice (crown moulding) section, m
 constexpr double kJitterFraction = 0.1;  // in-plane jitter, fraction of the local grid step
-constexpr int kMaxCount = 50;            // largest K of comb:K, hub:K and court:K and N of rooms:N
+constexpr int kMaxCount = 50;            // largest K of comb:K, hub:K, court:K and atrium:K and N of rooms:N
 
 double Snap(double v) { return std::round(v * 1e6) / 1e6; }  // micrometres: equal edges compare equal
 
@@ -264,6 +264,85 @@ Model MakeTee() {
   return m;
 }
 
+Model MakeStar(int k) {
+  // A square hub 6 x 6 m with k arms (2..4, in the order north, south, east, west), rooms and
+  // corridors of different sizes, each behind a door 1 x 2.1 m in the 0.25 m wall at its own
+  // position: north at x = 2 (a corridor 2.5 x 7 m), south at x = 3.5 (a room 3.5 x 4 m), east at
+  // y = 1.5 (a corridor 6 x 2 m), west at y = 4 (a room 4 x 4 m). The stations just inside the north
+  // and south doors see the whole hub between them (docs/SCENES.md has the proof): optimum k.
+  constexpr double hub = 6.0, wall = 0.25, door = 1.0;
+  struct Arm {
+    Box room;
+    Box opening;
+  };
+  const Arm arms[] = {
+      {Cuboid(1.0, hub + wall, 0, 3.5, hub + wall + 7.0, kRoomHeightM), Cuboid(1.5, hub, 0, 2.5, hub + wall, 2.1)},
+      {Cuboid(2.0, -wall - 4.0, 0, 5.5, -wall, kRoomHeightM), Cuboid(3.0, -wall, 0, 4.0, 0, 2.1)},
+      {Cuboid(hub + wall, 0.75, 0, hub + wall + 6.0, 2.75, kRoomHeightM), Cuboid(hub, 1.0, 0, hub + wall, 2.0, 2.1)},
+      {Cuboid(-wall - 4.0, 1.5, 0, -wall, 5.5, kRoomHeightM), Cuboid(-wall, 3.5, 0, 0, 4.5, 2.1)},
+  };
+  static_assert(door == 1.0, "the doors above are 1 m wide");
+  Model m;
+  m.Room(Cuboid(0, 0, 0, hub, hub, kRoomHeightM));
+  for (int i = 0; i < k; ++i) {
+    m.Room(arms[i].room);
+    m.Opening(arms[i].opening);
+    m.info.rooms.push_back({{arms[i].room.lo[0], arms[i].room.lo[1], arms[i].room.lo[2]},
+                            {arms[i].room.hi[0], arms[i].room.hi[1], arms[i].room.hi[2]}});
+  }
+  m.info.description = "square hub 6 x 6 m with " + std::to_string(k) +
+                       " arms (rooms and corridors, north, south, east, west) behind 1 m doors at different "
+                       "positions; every arm needs a station, and the two just inside the north and south "
+                       "doors see the hub";
+  m.info.optimum_stations = k;
+  m.info.floor_heights_m = {0};
+  return m;
+}
+
+Model MakeAtrium(int k) {
+  // A square atrium 5k x 5k m, 4 m high, with a pier 1.2 x 1.2 m at its centre (floor to ceiling)
+  // and k rooms 4.5 x 3 m (3 m high) on each of its four sides, 4k rooms, each behind a door
+  // 1 x 2.1 m in the 0.25 m wall, 0.75 m off the room's centre: north doors at x = 5i + 1.75,
+  // south doors at x = 5i + 3.25, west doors at y = 5i + 1.75, east doors at y = 5i + 3.25, so the
+  // scene is the same turned by 90 degrees about the pier and no door faces another. The stations
+  // just inside the doors see the whole atrium around the pier (docs/SCENES.md has the proof):
+  // optimum 4k, none in the atrium.
+  constexpr double seg = 5.0, wall = 0.25, depth = 3.0, width = 4.5, door = 1.0, shift = 0.75;
+  constexpr double atrium_height = 4.0, pier = 1.2;
+  const double a = k * seg, mid = a / 2;
+  Model m;
+  m.Room(Cuboid(0, 0, 0, a, a, atrium_height));
+  m.Solid(Cuboid(mid - pier / 2, mid - pier / 2, 0, mid + pier / 2, mid + pier / 2, atrium_height));
+  std::vector<AxisBox> north, south, west, east;
+  auto add = [&m](std::vector<AxisBox>& rooms, const Box& room, const Box& opening) {
+    m.Room(room);
+    m.Opening(opening);
+    rooms.push_back({{room.lo[0], room.lo[1], room.lo[2]}, {room.hi[0], room.hi[1], room.hi[2]}});
+  };
+  for (int i = 0; i < k; ++i) {
+    const double lo = i * seg + (seg - width) / 2, hi = lo + width;
+    const double c_lo = i * seg + seg / 2 - shift, c_hi = i * seg + seg / 2 + shift;  // 5i + 1.75, 5i + 3.25
+    add(north, Cuboid(lo, a + wall, 0, hi, a + wall + depth, kRoomHeightM),
+        Cuboid(c_lo - door / 2, a, 0, c_lo + door / 2, a + wall, 2.1));
+    add(south, Cuboid(lo, -wall - depth, 0, hi, -wall, kRoomHeightM),
+        Cuboid(c_hi - door / 2, -wall, 0, c_hi + door / 2, 0, 2.1));
+    add(west, Cuboid(-wall - depth, lo, 0, -wall, hi, kRoomHeightM),
+        Cuboid(-wall, c_lo - door / 2, 0, 0, c_lo + door / 2, 2.1));
+    add(east, Cuboid(a + wall, lo, 0, a + wall + depth, hi, kRoomHeightM),
+        Cuboid(a, c_hi - door / 2, 0, a + wall, c_hi + door / 2, 2.1));
+  }
+  for (const auto* side : {&north, &south, &west, &east}) {
+    m.info.rooms.insert(m.info.rooms.end(), side->begin(), side->end());
+  }
+  m.info.description = "atrium " + std::to_string(5 * k) + " x " + std::to_string(5 * k) +
+                       " x 4 m with a central pier and " + std::to_string(k) +
+                       " rooms on each of its four sides behind off-centre 1 m doors; every room needs a station, "
+                       "and those just inside the doors see the atrium";
+  m.info.optimum_stations = 4 * k;
+  m.info.floor_heights_m = {0};
+  return m;
+}
+
 Model MakeTwoFloor() {
   Model m;
   m.Room(Cuboid(0, 0, 0, 8, 6, 3.0));
@@ -432,31 +511,39 @@ Model MakeHall() {
 struct SceneKind {
   const char* name;
   bool takes_count;
+  int min_count;  // the range of K (takes_count only)
+  int max_count;
   const char* summary;  // for ListScenes
   Model (*make)(int);
 };
 
 const SceneKind kScenes[] = {
-    {"box", false, "one closed room", [](int) { return MakeBox(); }},
-    {"lroom", false, "an L-shaped room", [](int) { return MakeLRoom(); }},
-    {"comb", true, "comb:K, a corridor with K dead-end bays", [](int k) { return MakeComb(k); }},
-    {"rooms", true, "rooms:N, N closed rooms off a corridor", [](int n) { return MakeRooms(n); }},
-    {"hub", true, "hub:K, a hub hall with K small rooms on each side", [](int k) { return MakeHub(k); }},
-    {"tee", false, "a square hall with a room on three sides", [](int) { return MakeTee(); }},
-    {"court", true, "court:K, a hall with K rooms on each side behind off-centre doors and one at each end",
+    {"box", false, 0, 0, "one closed room", [](int) { return MakeBox(); }},
+    {"lroom", false, 0, 0, "an L-shaped room", [](int) { return MakeLRoom(); }},
+    {"comb", true, 1, kMaxCount, "comb:K, a corridor with K dead-end bays", [](int k) { return MakeComb(k); }},
+    {"rooms", true, 1, kMaxCount, "rooms:N, N closed rooms off a corridor", [](int n) { return MakeRooms(n); }},
+    {"hub", true, 1, kMaxCount, "hub:K, a hub hall with K small rooms on each side", [](int k) { return MakeHub(k); }},
+    {"tee", false, 0, 0, "a square hall with a room on three sides", [](int) { return MakeTee(); }},
+    {"court", true, 1, kMaxCount,
+     "court:K, a hall with K rooms on each side behind off-centre doors and one at each end",
      [](int k) { return MakeCourt(k); }},
-    {"twofloor", false, "two storeys joined by a stair opening", [](int) { return MakeTwoFloor(); }},
-    {"tworooms", false, "two rooms joined by one off-centre door", [](int) { return MakeTwoRooms(); }},
-    {"stairs", false, "two storeys joined by a straight flight of steps", [](int) { return MakeStairs(); }},
-    {"hall", false, "the benchmark hall", [](int) { return MakeHall(); }},
-    {"slope", false, "an open sloping site with buildings", [](int) { return MakeSlope(); }},
-    {"hillside", false, "a sloping site with a house whose door opens onto the slope",
+    {"star", true, 2, 4, "star:K, a square hub with K arms (2..4) behind doors at different positions",
+     [](int k) { return MakeStar(k); }},
+    {"atrium", true, 2, kMaxCount,
+     "atrium:K, a square atrium with a central pier and K rooms on each of its four sides",
+     [](int k) { return MakeAtrium(k); }},
+    {"twofloor", false, 0, 0, "two storeys joined by a stair opening", [](int) { return MakeTwoFloor(); }},
+    {"tworooms", false, 0, 0, "two rooms joined by one off-centre door", [](int) { return MakeTwoRooms(); }},
+    {"stairs", false, 0, 0, "two storeys joined by a straight flight of steps", [](int) { return MakeStairs(); }},
+    {"hall", false, 0, 0, "the benchmark hall", [](int) { return MakeHall(); }},
+    {"slope", false, 0, 0, "an open sloping site with buildings", [](int) { return MakeSlope(); }},
+    {"hillside", false, 0, 0, "a sloping site with a house whose door opens onto the slope",
      [](int) { return MakeHillside(); }},
 };
 
 constexpr char kValidSpecs[] =
-    "box, lroom, comb:K, rooms:N, hub:K, court:K, tee, twofloor, tworooms, stairs, hall, slope, hillside (K, N in "
-    "1..50)";
+    "box, lroom, comb:K, rooms:N, hub:K, court:K, tee, star:K, atrium:K, twofloor, tworooms, stairs, hall, slope, "
+    "hillside (K, N in 1..50; star:K in 2..4, atrium:K in 2..50)";
 
 Status BadSpec(std::string_view spec, std::string_view why) {
   return InvalidArgumentError("invalid scene '" + std::string(spec) + "' (" + std::string(why) +
@@ -475,9 +562,10 @@ Result<Model> BuildModel(std::string_view spec) {
       if (colon == std::string_view::npos) return BadSpec(spec, "it needs a count, e.g. " + std::string(name) + ":3");
       const std::string_view digits = spec.substr(colon + 1);
       const auto [ptr, ec] = std::from_chars(digits.data(), digits.data() + digits.size(), count);
-      if (digits.empty() || ec != std::errc() || ptr != digits.data() + digits.size() || count < 1 ||
-          count > kMaxCount) {
-        return BadSpec(spec, "the count must be an integer in 1..50");
+      if (digits.empty() || ec != std::errc() || ptr != digits.data() + digits.size() || count < kind.min_count ||
+          count > kind.max_count) {
+        return BadSpec(spec, "the count must be an integer in " + std::to_string(kind.min_count) + ".." +
+                                 std::to_string(kind.max_count));
       }
     } else if (colon != std::string_view::npos) {
       return BadSpec(spec, std::string(name) + " takes no count");
@@ -774,8 +862,8 @@ Status SynthOptions::Validate() const {
 
 std::string ListScenes() {
   std::string out;
-  for (const char* spec : {"box", "lroom", "comb:3", "rooms:3", "hub:2", "court:2", "tee", "twofloor", "tworooms",
-                           "stairs", "hall", "slope", "hillside"}) {
+  for (const char* spec : {"box", "lroom", "comb:3", "rooms:3", "hub:2", "court:2", "tee", "star:3", "atrium:2",
+                           "twofloor", "tworooms", "stairs", "hall", "slope", "hillside"}) {
     Result<SceneInfo> info = DescribeScene(spec);
     if (!info.ok()) continue;
     out += info->name;

@@ -216,8 +216,10 @@ TEST(PlannerTest, HubsReachTheirOptimumWithDoorwayCandidatesAndTheExactSolver) {
 
 // Rooms around a hall at the defaults (doorway candidates, --solver auto, the 0.99 target and the
 // gain rule; issue 36): hub:K, court:K (doors off-centre and crossed along both axes, rooms at the
-// hall's ends) and tee (rooms on three sides of a square hall; docs/SCENES.md) reach their optimum,
-// a station in every room and none in the hall, proven optimal over the candidates.
+// hall's ends), tee (rooms on three sides of a square hall) and the held-out star:K (arms behind
+// doors at different positions) and atrium:K (rooms on four sides of an atrium with a pier;
+// docs/SCENES.md) reach their optimum, a station in every room and none in the hall, proven
+// optimal over the candidates.
 void ExpectOptimumAtTheDefaults(std::initializer_list<const char*> specs) {
   for (const char* spec : specs) {
     Result<SceneInfo> info = DescribeScene(spec);
@@ -240,13 +242,13 @@ void ExpectOptimumAtTheDefaults(std::initializer_list<const char*> specs) {
 }
 
 TEST(PlannerTest, RoomsAroundAHallReachTheirOptimumAtTheDefaults) {
-  ExpectOptimumAtTheDefaults({"hub:1", "court:1", "tee"});
+  ExpectOptimumAtTheDefaults({"hub:1", "court:1", "tee", "star:3", "star:4"});
 }
 
-// The same on larger ones (hub:2, hub:3, court:2: 2-8 s of selection each in release under load;
-// label heavy).
+// The same on larger ones (hub:2, hub:3, court:2, atrium:2, atrium:3: 0.2-3 s of selection each in
+// release under load; label heavy).
 TEST(PlannerTest, LargerRoomsAroundAHallReachTheirOptimumAtTheDefaults) {
-  ExpectOptimumAtTheDefaults({"hub:2", "hub:3", "court:2"});
+  ExpectOptimumAtTheDefaults({"hub:2", "hub:3", "court:2", "atrium:2", "atrium:3"});
 }
 
 // --local-candidates (docs/PLANNING.md, "Local candidates"): on a 2 m grid the comb's bays are

@@ -18,8 +18,8 @@
 namespace vc {
 namespace {
 
-const char* const kSmallScenes[] = {"box",     "lroom", "comb:3",   "rooms:3",  "hub:2",
-                                    "court:2", "tee",   "twofloor", "tworooms", "stairs"};
+const char* const kSmallScenes[] = {"box", "lroom",  "comb:3",   "rooms:3",  "hub:2",    "court:2",
+                                    "tee", "star:4", "atrium:2", "twofloor", "tworooms", "stairs"};
 
 // A dense voxel grid over a scene's bounds (plus a margin), filled from its points; keys are
 // floor(p / resolution) as in OctoMap.
@@ -137,8 +137,10 @@ TEST(SynthOptionsTest, ValidateRejectsSpacingOutsideRangeOrNotFinite) {
 }
 
 TEST(DescribeSceneTest, BadSpecsAreInvalidArgumentListingValidNames) {
-  for (const char* bad : {"", "castle", "Box", "comb", "comb:", "comb:0", "comb:51", "comb:x", "comb:2x", "rooms:-1",
-                          "rooms:1.5", "box:2", "hall:1", "hub", "hub:0", "hub:51", "court", "court:51", "tee:1"}) {
+  for (const char* bad :
+       {"",         "castle",    "Box",    "comb",   "comb:",  "comb:0",   "comb:51",  "comb:x", "comb:2x",
+        "rooms:-1", "rooms:1.5", "box:2",  "hall:1", "hub",    "hub:0",    "hub:51",   "court",  "court:51",
+        "tee:1",    "star",      "star:1", "star:5", "atrium", "atrium:1", "atrium:51"}) {
     Result<SceneInfo> info = DescribeScene(bad);
     ASSERT_FALSE(info.ok()) << bad;
     EXPECT_EQ(info.status().code(), StatusCode::kInvalidArgument) << bad;
@@ -148,8 +150,9 @@ TEST(DescribeSceneTest, BadSpecsAreInvalidArgumentListingValidNames) {
 
 TEST(DescribeSceneTest, KnownScenesReportTheirOptimumRoomsAndFloors) {
   const std::vector<std::pair<std::string, int>> expected = {
-      {"box", 1},      {"lroom", 1},    {"comb:1", 1}, {"comb:7", 7},  {"comb:50", 50}, {"rooms:1", 2},
-      {"rooms:4", 5},  {"hub:1", 2},    {"hub:3", 6},  {"court:1", 4}, {"court:3", 8},  {"tee", 3},
+      {"box", 1},      {"lroom", 1},    {"comb:1", 1}, {"comb:7", 7},   {"comb:50", 50},  {"rooms:1", 2},
+      {"rooms:4", 5},  {"hub:1", 2},    {"hub:3", 6},  {"court:1", 4},  {"court:3", 8},   {"tee", 3},
+      {"star:2", 2},   {"star:3", 3},   {"star:4", 4}, {"atrium:2", 8}, {"atrium:3", 12}, {"atrium:50", 200},
       {"twofloor", 2}, {"tworooms", 2}, {"stairs", 0}, {"hall", 0}};
   for (const auto& [spec, optimum] : expected) {
     Result<SceneInfo> info = DescribeScene(spec);
@@ -337,6 +340,58 @@ TEST(SceneVoxelsTest, TeeRoomsAreJoinedToTheHallOnlyThroughTheirCentredDoors) {
   EXPECT_FALSE(grid.Reached(grid.KeyOf(WorldPoint(4.2, 6.125, 1.0) + kSceneOffsetM)));  // beside the north door
 }
 
+TEST(DescribeSceneTest, StarCountsOutsideTwoToFourNameTheirRange) {
+  Result<SceneInfo> info = DescribeScene("star:5");
+  ASSERT_FALSE(info.ok());
+  EXPECT_NE(info.status().message().find("2..4"), std::string::npos) << info.status().message();
+}
+
+TEST(SceneVoxelsTest, StarArmsAreJoinedToTheHubOnlyThroughTheirDoors) {
+  Result<SceneInfo> info = DescribeScene("star:4");
+  ASSERT_TRUE(info.ok());
+  ASSERT_EQ(info->rooms.size(), 4u);  // north, south, east, west
+  ExpectBox(info->rooms[0], {1, 6.25, 0}, {3.5, 13.25, 3}, "north corridor");
+  ExpectBox(info->rooms[1], {2, -4.25, 0}, {5.5, -0.25, 3}, "south room");
+  ExpectBox(info->rooms[2], {6.25, 0.75, 0}, {12.25, 2.75, 3}, "east corridor");
+  ExpectBox(info->rooms[3], {-4.25, 1.5, 0}, {-0.25, 5.5, 3}, "west room");
+  EXPECT_EQ(DescribeScene("star:3")->rooms.size(), 3u);
+  VoxelGrid grid = Voxelize("star:4", 0.05, 0.1);
+  EXPECT_FALSE(grid.FloodEscapes(grid.KeyOf(WorldPoint(3, 3, 1.5) + kSceneOffsetM)));
+  for (const AxisBox& room : info->rooms) EXPECT_TRUE(grid.Reached(grid.KeyOf(SeedPoint(room))));
+  // The doors: north x in [1.5, 2.5], south x in [3, 4], east y in [1, 2], west y in [3.5, 4.5].
+  for (const WorldPoint& door : {WorldPoint(2, 6.125, 1.0), WorldPoint(3.5, -0.125, 1.0), WorldPoint(6.125, 1.5, 1.0),
+                                 WorldPoint(-0.125, 4, 1.0)}) {
+    EXPECT_TRUE(grid.Reached(grid.KeyOf(door + kSceneOffsetM))) << door.transpose();
+    EXPECT_FALSE(grid.Reached(grid.KeyOf(door + WorldPoint(0, 0, 1.5) + kSceneOffsetM))) << door.transpose();
+  }
+  EXPECT_FALSE(grid.Reached(grid.KeyOf(WorldPoint(3, 6.125, 1.0) + kSceneOffsetM)));   // beside the north door
+  EXPECT_FALSE(grid.Reached(grid.KeyOf(WorldPoint(-0.125, 3, 1.0) + kSceneOffsetM)));  // beside the west door
+}
+
+TEST(SceneVoxelsTest, AtriumRoomsAreJoinedOnlyThroughTheirDoorsAndThePierIsSolid) {
+  Result<SceneInfo> info = DescribeScene("atrium:2");
+  ASSERT_TRUE(info.ok());
+  ASSERT_EQ(info->rooms.size(), 8u);  // north 0, 1, south 0, 1, west 0, 1, east 0, 1
+  ExpectBox(info->rooms[0], {0.25, 10.25, 0}, {4.75, 13.25, 3}, "north room 0");
+  ExpectBox(info->rooms[3], {5.25, -3.25, 0}, {9.75, -0.25, 3}, "south room 1");
+  ExpectBox(info->rooms[4], {-3.25, 0.25, 0}, {-0.25, 4.75, 3}, "west room 0");
+  ExpectBox(info->rooms[7], {10.25, 5.25, 0}, {13.25, 9.75, 3}, "east room 1");
+  VoxelGrid grid = Voxelize("atrium:2", 0.05, 0.1);
+  EXPECT_FALSE(grid.FloodEscapes(grid.KeyOf(WorldPoint(2, 2, 3.5) + kSceneOffsetM)));
+  for (const AxisBox& room : info->rooms) EXPECT_TRUE(grid.Reached(grid.KeyOf(SeedPoint(room))));
+  // Doors 0.75 m off their rooms' centres: north at x = 5i + 1.75, south at x = 5i + 3.25, west at
+  // y = 5i + 1.75, east at y = 5i + 3.25 (the scene turned by 90 degrees is itself).
+  for (const WorldPoint& door : {WorldPoint(1.75, 10.125, 1.0), WorldPoint(8.25, -0.125, 1.0),
+                                 WorldPoint(-0.125, 6.75, 1.0), WorldPoint(10.125, 3.25, 1.0)}) {
+    EXPECT_TRUE(grid.Reached(grid.KeyOf(door + kSceneOffsetM))) << door.transpose();
+    EXPECT_FALSE(grid.Reached(grid.KeyOf(door + WorldPoint(0, 0, 1.5) + kSceneOffsetM))) << door.transpose();
+  }
+  EXPECT_FALSE(grid.Reached(grid.KeyOf(WorldPoint(2.5, 10.125, 1.0) + kSceneOffsetM)));  // beside a north door
+  EXPECT_FALSE(grid.Reached(grid.KeyOf(WorldPoint(5, 5, 1.0) + kSceneOffsetM)));         // inside the pier
+  EXPECT_FALSE(grid.Reached(grid.KeyOf(WorldPoint(5, 5, 3.5) + kSceneOffsetM)));         // up to the ceiling
+  EXPECT_TRUE(grid.Reached(grid.KeyOf(WorldPoint(5, 3.6, 3.5) + kSceneOffsetM)));        // beside it
+}
+
 // Stairs: 19 treads, step k spanning x in [1.3 + 0.3 (k - 1), 1.3 + 0.3 k], y in [0, 1], top at
 // z = 0.165 k; the 20th riser, at x = 7, goes up to the upper floor at z = 3.3.
 constexpr double kStairX0 = 1.3, kGoing = 0.3, kRise = 0.165;
@@ -430,8 +485,8 @@ TEST(SceneVoxelsTest, StairsFlightIsSolidWithHeadroomAndJoinsTheStoreys) {
 
 TEST(DescribeSceneTest, ListNamesEveryScene) {
   const std::string list = ListScenes();
-  for (const char* name : {"box", "lroom", "comb", "rooms", "hub", "court", "tee", "twofloor", "tworooms", "stairs",
-                           "hall", "slope", "hillside"}) {
+  for (const char* name : {"box", "lroom", "comb", "rooms", "hub", "court", "tee", "star", "atrium", "twofloor",
+                           "tworooms", "stairs", "hall", "slope", "hillside"}) {
     EXPECT_NE(list.find(name), std::string::npos) << name;
   }
 }
@@ -456,8 +511,8 @@ TEST(GenerateSceneTest, SameSeedGivesIdenticalPointsOtherSeedDiffers) {
 }
 
 TEST(GenerateSceneTest, CountMatchesTheStream) {
-  for (const char* spec :
-       {"box", "lroom", "comb:2", "rooms:2", "hub:1", "court:1", "tee", "twofloor", "tworooms", "stairs", "hillside"}) {
+  for (const char* spec : {"box", "lroom", "comb:2", "rooms:2", "hub:1", "court:1", "tee", "star:3", "atrium:2",
+                           "twofloor", "tworooms", "stairs", "hillside"}) {
     for (double spacing : {0.07, 0.2}) {
       SynthOptions o;
       o.spacing_m = spacing;

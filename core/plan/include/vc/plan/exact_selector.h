@@ -65,7 +65,10 @@ struct ExactSelectorOptions {
   // finds a strictly better one: fewer stations reaching the target (max_stations: more covered,
   // or as many with fewer stations), or a connected one where greedy's is not. The optimality
   // figures are the solver's either way. SelectionSolver::kAuto sets it, so a plan whose greedy
-  // selection is already optimal stays exactly what greedy planned.
+  // selection is already optimal stays exactly what greedy planned. With it (the station count as
+  // objective, no min_overlap) the counting and Lagrangian bounds come first: greedy's plan at the
+  // bound, or the swap local search from it (up to a quarter of time_limit_s) reaching the bound,
+  // is proven optimal without the integer program (a note says so); otherwise CBC runs as before.
   bool prefer_greedy = false;
 };
 

@@ -78,9 +78,9 @@ struct SceneInfo {
 // Names, descriptions and optima of the available scenes, one line each, for `vc-synth --list`.
 std::string ListScenes();
 
-// Describes the scene `spec` ("box", "lroom", "comb:K", "rooms:N", "hub:K", "court:K", "tee", "hall", "twofloor",
-// "tworooms", "stairs", "slope", "hillside"; K and N in 1..50). INVALID_ARGUMENT naming the valid specs for
-// anything else.
+// Describes the scene `spec` ("box", "lroom", "comb:K", "rooms:N", "hub:K", "court:K", "tee", "star:K", "atrium:K",
+// "hall", "twofloor", "tworooms", "stairs", "slope", "hillside"; K and N in 1..50, star's K in 2..4, atrium's in
+// 2..50). INVALID_ARGUMENT naming the valid specs for anything else.
 Result<SceneInfo> DescribeScene(std::string_view spec);
 
 // Calls fn once per point (world, m) of the scene, in a fixed order; memory does not grow with the
