@@ -639,6 +639,10 @@ Evaluation ExactEvaluation::Finish() {
       for (int f = 0; f < kFacesPerVoxel; ++f) ev_.best_face_values[i][f] = float(best[i * kFacesPerVoxel + f]);
     ev_.sole_viewer = std::move(works_[0]->viewer);
   }
+  if (job_.options.keep_join_state) {
+    ev_.best_values = std::move(works_[0]->best);
+    ev_.best_perceptions = std::move(works_[0]->best_p);
+  }
   return std::move(ev_);
 }
 
@@ -678,6 +682,73 @@ Result<Evaluation> Evaluate(const VoxelScene& scene, const std::vector<WorldPoin
                                 "resolution");
   }
   return EvaluateExact(job, std::move(ev));
+}
+
+namespace {
+
+// OK when `first` and `second` can be joined (JoinEvaluations), else what differs.
+Status CheckJoinable(const Evaluation& first, const Evaluation& second) {
+  auto refuse = [](const std::string& what) {
+    return InvalidArgumentError("cannot join the two evaluations: " + what);
+  };
+  if (first.sampled || second.sampled) return refuse("a sampled evaluation has no per-face values to join");
+  if (first.resolution_m != second.resolution_m || first.faces_total != second.faces_total) {
+    return refuse("they are of different scenes or face sets (|F| " + std::to_string(first.faces_total) + " and " +
+                  std::to_string(second.faces_total) + ")");
+  }
+  for (const Evaluation* e : {&first, &second}) {
+    if (e->best_perceptions.size() != e->best_values.size() || (e->faces_total > 0 && e->best_values.empty())) {
+      return refuse("evaluate both with EvaluateOptions::keep_join_state");
+    }
+  }
+  if (first.best_values.size() != second.best_values.size()) {
+    return refuse("they are of scenes of " + std::to_string(first.best_values.size() / kFacesPerVoxel) + " and " +
+                  std::to_string(second.best_values.size() / kFacesPerVoxel) + " voxels");
+  }
+  if (first.sole_viewer.size() != second.sole_viewer.size() ||
+      first.best_face_values.size() != second.best_face_values.size()) {
+    return refuse("evaluate both with keep_face_values, or neither");
+  }
+  if (first.per_viewpoint_face_values.empty() != second.per_viewpoint_face_values.empty() ||
+      first.per_viewpoint_sparse_values.empty() != second.per_viewpoint_sparse_values.empty()) {
+    return refuse("they keep different per-viewpoint values");
+  }
+  return Status::Ok();
+}
+
+template <typename T>
+void Append(std::vector<T>& to, std::vector<T>& from) {
+  to.insert(to.end(), std::make_move_iterator(from.begin()), std::make_move_iterator(from.end()));
+}
+
+}  // namespace
+
+Result<Evaluation> JoinEvaluations(Evaluation first, Evaluation second) {
+  VC_RETURN_IF_ERROR(CheckJoinable(first, second));
+  const int32_t shift = static_cast<int32_t>(first.per_viewpoint.size());
+  // The best (V, perception) of a face does not depend on the order the viewpoints come in
+  // (KeepBest), and faces outside F hold (0, kNone), which add nothing to a tally: summed in face
+  // order, the figures are those of Finish over all the viewpoints.
+  Tally total;
+  for (size_t slot = 0; slot < first.best_values.size(); ++slot) {
+    KeepBest(second.best_values[slot], second.best_perceptions[slot], first.best_values[slot],
+             first.best_perceptions[slot]);
+    total.Add(Perception(first.best_perceptions[slot]), first.best_values[slot]);
+  }
+  first.overall = total.Figures(first.faces_total);
+  for (size_t i = 0; i < first.best_face_values.size(); ++i) {
+    for (int f = 0; f < kFacesPerVoxel; ++f) {
+      first.best_face_values[i][f] = float(first.best_values[i * kFacesPerVoxel + f]);
+    }
+  }
+  for (size_t i = 0; i < first.sole_viewer.size(); ++i) {
+    const int32_t b = second.sole_viewer[i];
+    first.sole_viewer[i] = CombineViewers(first.sole_viewer[i], b >= 0 ? b + shift : b);
+  }
+  Append(first.per_viewpoint, second.per_viewpoint);
+  Append(first.per_viewpoint_face_values, second.per_viewpoint_face_values);
+  Append(first.per_viewpoint_sparse_values, second.per_viewpoint_sparse_values);
+  return first;
 }
 
 }  // namespace vc

@@ -20,6 +20,7 @@
 #include "testing/test_paths.h"
 #include "vc/plan/keep_out.h"
 #include "vc/plan/route.h"
+#include "vc/plan/stages.h"
 #include "vc/report/plan_report.h"
 #include "vc/synth/synth.h"
 
@@ -577,6 +578,43 @@ TEST(PlannerTest, ReductionOneStationAtATimeMatchesTheBatch) {
   EXPECT_EQ(single->reduction.removed, batch->reduction.removed);
   EXPECT_DOUBLE_EQ(single->reduction.global_visibility_after, batch->reduction.global_visibility_after);
   EXPECT_DOUBLE_EQ(single->evaluation.overall.global_visibility, batch->evaluation.overall.global_visibility);
+}
+
+// With a memory budget that splits the reduction's stations into batches, the batches' evaluations,
+// joined, are the final evaluation (the evaluation stage evaluates nothing again: it reports no
+// stations), and it is the one evaluation of the final stations gives and the one-batch plan has.
+TEST(PlannerTest, ReductionBatchesJoinedAreTheFinalEvaluation) {
+  PlanOptions o = TestOptions();
+  o.target_coverage = 1.0;
+  Result<PlanResult> one = Plan(Synthetic("comb:5"), o);
+  o.memory_budget_bytes = 16'000'000;  // cache budget 4 MB: the first batch is one station (2.1 MB worst case)
+  bool evaluation_counted = false;
+  JobContext ctx;
+  ctx.progress = [&](const ProgressEvent& e) { evaluation_counted |= e.stage == Stage::kEvaluation && e.total > 0; };
+  Result<PlanResult> batched = Plan(Synthetic("comb:5"), o, ctx);
+  ASSERT_TRUE(one.ok()) << one.status().ToString();
+  ASSERT_TRUE(batched.ok()) << batched.status().ToString();
+  ASSERT_GE(batched->stations.size(), 3u);
+  EXPECT_TRUE(batched->reduction.removed.empty());
+  EXPECT_FALSE(evaluation_counted);
+  Result<VoxelScene> scene = Voxelize(Synthetic("comb:5"), {0.1, kDefaultMemoryBudgetBytes});
+  ASSERT_TRUE(scene.ok());
+  std::vector<WorldPoint> positions;
+  for (const PlannedStation& st : batched->stations) positions.push_back(st.position);
+  Result<Evaluation> fresh = Evaluate(*scene, positions, planner::StationEvaluateOptions(o));
+  ASSERT_TRUE(fresh.ok()) << fresh.status().ToString();
+  for (const Evaluation* e : {&*fresh, &one->evaluation}) {
+    EXPECT_EQ(batched->evaluation.overall.global_visibility, e->overall.global_visibility);
+    EXPECT_EQ(batched->evaluation.overall.fully_visible_fraction, e->overall.fully_visible_fraction);
+    EXPECT_EQ(batched->evaluation.overall.partially_visible_fraction, e->overall.partially_visible_fraction);
+    EXPECT_EQ(batched->evaluation.best_face_values, e->best_face_values);
+    EXPECT_EQ(batched->evaluation.sole_viewer, e->sole_viewer);
+    ASSERT_EQ(batched->evaluation.per_viewpoint.size(), e->per_viewpoint.size());
+    for (size_t k = 0; k < e->per_viewpoint.size(); ++k) {
+      EXPECT_EQ(batched->evaluation.per_viewpoint[k].global_visibility, e->per_viewpoint[k].global_visibility) << k;
+    }
+  }
+  EXPECT_TRUE(batched->evaluation.best_values.empty());  // the join state is dropped once every station is in
 }
 
 TEST(PlannerTest, UserCandidatesWithADuplicateAreReducedToDistinctStations) {

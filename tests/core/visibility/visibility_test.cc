@@ -2,9 +2,14 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <mutex>
+#include <optional>
 #include <random>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "testing/scenes.h"
 #include "vc/raycast/occluders.h"
@@ -466,6 +471,88 @@ TEST(EvaluateTest, TaskPerViewpointGivesTheSameFiguresAsOneThread) {
       EXPECT_EQ(other.sole_viewer, one.sole_viewer) << what;
     }
   }
+}
+
+// Evaluations of consecutive groups of viewpoints, joined, are one evaluation of them all, bit for
+// bit: the overall and per-viewpoint figures, the best face values, the sole viewers (shifted to
+// the joined indices) and the sparse values; for both face sets. The reduction's batches rely on it.
+TEST(EvaluateTest, JoinedEvaluationsEqualOneEvaluationOfAll) {
+  std::mt19937_64 rng(37);
+  const VoxelScene s = RandomScene(rng, 3000, 150, 0.1);
+  const auto vps = RandomViewpoints(rng, 11, 150, 0.1);
+  for (const FaceSet faces : {FaceSet::kAll, FaceSet::kExposed}) {
+    EvaluateOptions opt;
+    opt.faces = faces;
+    opt.threads = 2;
+    opt.scanner.max_range_m = 4.0;  // a short range, so that many voxels have a sole viewer
+    opt.keep_face_values = true;
+    opt.keep_sparse_per_viewpoint_values = true;
+    Result<Evaluation> all = Evaluate(s, vps, opt);
+    ASSERT_TRUE(all.ok()) << all.status().ToString();
+    opt.keep_join_state = true;
+    std::optional<Evaluation> joined;
+    for (const auto& [b, e] : std::vector<std::pair<size_t, size_t>>{{0, 4}, {4, 9}, {9, 11}}) {
+      Result<Evaluation> part = Evaluate(s, std::vector<WorldPoint>(vps.begin() + b, vps.begin() + e), opt);
+      ASSERT_TRUE(part.ok()) << part.status().ToString();
+      ASSERT_EQ(part->best_values.size(), s.occupied.size() * kFacesPerVoxel);
+      if (!joined) {
+        joined = std::move(*part);
+        continue;
+      }
+      Result<Evaluation> j = JoinEvaluations(std::move(*joined), std::move(*part));
+      ASSERT_TRUE(j.ok()) << j.status().ToString();
+      joined = std::move(*j);
+    }
+    const std::string what = faces == FaceSet::kAll ? "all faces" : "exposed faces";
+    EXPECT_GT(all->overall.global_visibility, 0.0) << what;
+    EXPECT_EQ(joined->faces_total, all->faces_total) << what;
+    EXPECT_EQ(joined->overall.global_visibility, all->overall.global_visibility) << what;
+    EXPECT_EQ(joined->overall.fully_visible_fraction, all->overall.fully_visible_fraction) << what;
+    EXPECT_EQ(joined->overall.mean_full_visibility, all->overall.mean_full_visibility) << what;
+    EXPECT_EQ(joined->overall.partially_visible_fraction, all->overall.partially_visible_fraction) << what;
+    ASSERT_EQ(joined->per_viewpoint.size(), vps.size()) << what;
+    ASSERT_EQ(joined->per_viewpoint_sparse_values.size(), vps.size()) << what;
+    for (size_t k = 0; k < vps.size(); ++k) {
+      EXPECT_EQ(joined->per_viewpoint[k].global_visibility, all->per_viewpoint[k].global_visibility) << what << k;
+      EXPECT_EQ(joined->per_viewpoint_sparse_values[k].faces, all->per_viewpoint_sparse_values[k].faces) << what << k;
+      EXPECT_EQ(joined->per_viewpoint_sparse_values[k].values, all->per_viewpoint_sparse_values[k].values) << what;
+    }
+    EXPECT_EQ(joined->best_face_values, all->best_face_values) << what;
+    EXPECT_EQ(joined->sole_viewer, all->sole_viewer) << what;
+    // Some voxel has a sole viewer after the first group, so the shift is tested.
+    EXPECT_TRUE(std::any_of(joined->sole_viewer.begin(), joined->sole_viewer.end(), [](int32_t v) { return v >= 4; }))
+        << what;
+  }
+}
+
+TEST(EvaluateTest, JoinRefusesEvaluationsItCannotJoinNamingWhy) {
+  std::mt19937_64 rng(41);
+  const VoxelScene s = RandomScene(rng, 300, 14, 0.1);
+  const VoxelScene other = RandomScene(rng, 200, 14, 0.1);
+  const auto vps = RandomViewpoints(rng, 2, 14, 0.1);
+  EvaluateOptions opt;
+  opt.keep_join_state = true;
+  auto eval = [&](const VoxelScene& scene, const EvaluateOptions& o) {
+    Result<Evaluation> e = Evaluate(scene, vps, o);
+    EXPECT_TRUE(e.ok()) << e.status().ToString();
+    return *e;
+  };
+  auto refused = [&](Evaluation a, Evaluation b, const std::string& why) {
+    Result<Evaluation> j = JoinEvaluations(std::move(a), std::move(b));
+    ASSERT_FALSE(j.ok()) << why;
+    EXPECT_EQ(j.status().code(), StatusCode::kInvalidArgument);
+    EXPECT_NE(j.status().message().find(why), std::string::npos) << j.status().ToString();
+  };
+  EXPECT_TRUE(JoinEvaluations(eval(s, opt), eval(s, opt)).ok());
+  EvaluateOptions plain;
+  refused(eval(s, opt), eval(s, plain), "keep_join_state");
+  refused(eval(s, opt), eval(other, opt), "different scenes");
+  EvaluateOptions with_values = opt;
+  with_values.keep_face_values = true;
+  refused(eval(s, opt), eval(s, with_values), "keep_face_values");
+  EvaluateOptions sampled = opt;
+  sampled.sample_faces = 100;
+  refused(eval(s, opt), eval(s, sampled), "sampled");
 }
 
 TEST(EvaluateTest, SamplingIsUnbiasedWithinItsConfidenceInterval) {

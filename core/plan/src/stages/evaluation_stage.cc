@@ -1,6 +1,8 @@
+#include <mutex>
 #include <string>
 #include <utility>
 
+#include "progress_pacer.h"
 #include "vc/plan/stages.h"
 
 namespace vc::planner {
@@ -26,7 +28,21 @@ Result<EvaluationOutput> RunEvaluationStage(EvaluationInput in, const PlanOption
   } else if (in.reusable) {
     out.evaluation = std::move(*in.reusable);  // same stations, nothing was removed
   } else {
-    VC_ASSIGN_OR_RETURN(out.evaluation, Evaluate(in.scene, in.positions, StationEvaluateOptions(options), ctx));
+    // Evaluate reports stations evaluated; each report gets the time left at the rate so far
+    // (none before the first station), at most once a second besides the last.
+    JobContext sub = ctx;
+    internal::ProgressPacer pacer;
+    std::mutex pacer_mutex;
+    if (ctx.progress) {
+      sub.progress = [&](const ProgressEvent& e) {
+        std::lock_guard<std::mutex> lock(pacer_mutex);
+        if (!(pacer.Due() || e.done >= e.total)) return;
+        ProgressEvent paced = e;
+        if (paced.message.empty()) paced.message = pacer.TimeLeft(e.done, e.total);
+        ctx.progress(paced);
+      };
+    }
+    VC_ASSIGN_OR_RETURN(out.evaluation, Evaluate(in.scene, in.positions, StationEvaluateOptions(options), sub));
   }
   out.voxel_centers.reserve(n_voxels);
   for (size_t i = 0; i < n_voxels; ++i) out.voxel_centers.push_back(in.scene.Center(i));

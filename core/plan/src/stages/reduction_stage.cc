@@ -26,14 +26,15 @@ EvaluateOptions ReductionEvaluateOptions(const PlanOptions& options) {
 
 // Reduction on every station's V of every face it sees. Stations are evaluated a batch at a time
 // into sparse values (what each sees), which RunReduction keeps while they fit the cache budget
-// (otherwise it asks for them again after each removal). When all stations fit one batch, that
-// evaluation also keeps the face values the evaluation stage needs, and is the final evaluation
-// if nothing is removed.
+// (otherwise it asks for them again after each removal). The first pass over all stations also
+// keeps the face values the evaluation stage needs, batch by batch, joined (JoinEvaluations) into
+// the evaluation of every station: the final evaluation if nothing is removed.
 Result<ReductionOutput> RunReductionStage(const ReductionInput& in, const PlanOptions& options, const JobContext& ctx) {
   const std::vector<WorldPoint>& stations = in.stations.positions;
   const uint64_t faces_total = in.scene.occupied.size() * kFacesPerVoxel;
   const uint64_t cache_budget = std::min<uint64_t>(options.memory_budget_bytes / 4, uint64_t{1} << 30);
-  std::optional<Evaluation> all_evaluation;
+  std::optional<Evaluation> all_evaluation;  // of the stations 0 .. joined - 1
+  size_t joined = 0;
   ReductionOutput out;
   const StationFaceValuesFn values = [&](const std::vector<int>& batch,
                                          const JobContext& sub) -> Result<std::vector<SparseFaceValues>> {
@@ -55,12 +56,26 @@ Result<ReductionOutput> RunReductionStage(const ReductionInput& in, const PlanOp
       }
       return std::move(d.values);
     }
-    const bool whole = batch.size() == stations.size() && !all_evaluation;  // the first call, every station
-    eval_options.keep_face_values = whole;
+    // The first pass streams the stations in order, so a batch that starts at the next station
+    // not joined yet belongs to it (a pass after a removal starts again from the first kept one).
+    const bool first_pass = !batch.empty() && static_cast<size_t>(batch.front()) == joined && joined < stations.size();
+    eval_options.keep_face_values = first_pass;
+    // The join state only where another batch will be joined on (one batch is the whole evaluation).
+    eval_options.keep_join_state = first_pass && batch.size() < stations.size();
     VC_ASSIGN_OR_RETURN(Evaluation e, Evaluate(in.scene, positions, eval_options, sub));
     std::vector<SparseFaceValues> batch_values = std::move(e.per_viewpoint_sparse_values);
     e.per_viewpoint_sparse_values.clear();
-    if (whole) all_evaluation = std::move(e);
+    if (first_pass) {
+      if (all_evaluation) {
+        VC_ASSIGN_OR_RETURN(e, JoinEvaluations(std::move(*all_evaluation), std::move(e)));
+      }
+      all_evaluation = std::move(e);
+      joined += batch.size();
+      if (joined == stations.size()) {  // every station: nothing more to join on
+        all_evaluation->best_values = {};
+        all_evaluation->best_perceptions = {};
+      }
+    }
     return batch_values;
   };
   ReductionRunOptions red_options;
@@ -97,7 +112,7 @@ Result<ReductionOutput> RunReductionStage(const ReductionInput& in, const PlanOp
       out.keep.push_back(static_cast<int>(k));
     }
   }
-  if (run.removed.empty()) out.evaluation = std::move(all_evaluation);
+  if (run.removed.empty() && joined == stations.size()) out.evaluation = std::move(all_evaluation);
   return out;
 }
 

@@ -205,6 +205,10 @@ struct EvaluateOptions {
   // per voxel of the scene; what the reduction holds). Exact mode only; the scene must have fewer
   // than 2^32 / 6 voxels (INVALID_ARGUMENT otherwise).
   bool keep_sparse_per_viewpoint_values = false;
+  // Keep each face's best V as the overall figures sum it (double) and its perception
+  // (Evaluation::best_values, best_perceptions: 9 bytes per face), so that JoinEvaluations can
+  // join this evaluation with one of other viewpoints. Exact mode only.
+  bool keep_join_state = false;
   // Exact mode: decide every lattice corner on its own (its ray, after the per-ray shortcuts: the
   // occluder cache and the grazing-layer test) instead of first by groups of faces (same answers,
   // slower; kept as the reference for tests and benchmarks).
@@ -244,6 +248,10 @@ struct Evaluation {
   // faces V > 0 ("what only this station sees"); kNoViewer if none does, kSeveralViewers if
   // several do.
   std::vector<int32_t> sole_viewer;
+  // With keep_join_state: per face (voxel id * 6 + face), the best V over the viewpoints and its
+  // Perception (faces outside F hold 0 and kNone).
+  std::vector<double> best_values;
+  std::vector<uint8_t> best_perceptions;
 };
 
 // Evaluates a set of viewpoints on `scene` (s.6): G of the whole set and figures per viewpoint.
@@ -252,5 +260,14 @@ struct Evaluation {
 // mode) a scene whose voxels are not sorted and unique as VoxelScene requires.
 Result<Evaluation> Evaluate(const VoxelScene& scene, const std::vector<WorldPoint>& viewpoints,
                             const EvaluateOptions& options, const JobContext& ctx = {});
+
+// The evaluation of `first`'s viewpoints followed by `second`'s, exactly as one Evaluate of them
+// all with the same options gives it: the overall figures (summed in face order from the joined
+// best values), the per-viewpoint figures and kept values in that order, the best face values and
+// the sole viewers (second's indices shifted by first's count), and the join state, so that more
+// evaluations can be joined on. Both must be exact evaluations of one scene and face set with
+// keep_join_state (and keep_face_values in both or neither); INVALID_ARGUMENT otherwise, naming
+// what differs. The reduction joins its batches of stations this way into the final evaluation.
+Result<Evaluation> JoinEvaluations(Evaluation first, Evaluation second);
 
 }  // namespace vc
