@@ -71,9 +71,9 @@ Result<ReductionOutput> RunReductionStage(const ReductionInput& in, const PlanOp
       }
       all_evaluation = std::move(e);
       joined += batch.size();
-      if (joined == stations.size()) {  // every station: nothing more to join on
-        all_evaluation->best_values = {};
-        all_evaluation->best_perceptions = {};
+      if (joined == stations.size()) {  // every station: nothing more to join on; give the memory back
+        std::vector<double>().swap(all_evaluation->best_values);
+        std::vector<uint8_t>().swap(all_evaluation->best_perceptions);
       }
     }
     return batch_values;
