@@ -398,8 +398,8 @@ Result<CoverProblem> RareVoxelProblem(const std::vector<VoxelSet>& sets, const S
 // The Lagrangian bound's options in a plan: at most kBoundPairVisits pairs visited (about a second;
 // on geb079 the first two cores, docs/PLANNING.md "The Lagrangian bound over cores").
 constexpr uint64_t kBoundPairVisits = uint64_t{3} << 27;
-// ... and its plans (the Lagrangian heuristic) at most kPlanPairVisits, a third of that: hub:4 to
-// hub:9 take 23-37 plans, 9-50 M visits, to reach their optimum; on geb079, whose best plan (49)
+// ... and its plans (the Lagrangian heuristic) at most kPlanPairVisits, a third of that: hub:4, 5, 7,
+// 8 and 9 take 23-37 plans, 9-50 M visits, to reach their optimum; on geb079, whose best plan (49)
 // stays above its bound (46), the budget's 20 plans cost about 1.5 s (3 << 27: 59 plans, 2.4 s).
 constexpr uint64_t kPlanPairVisits = uint64_t{1} << 27;
 constexpr uint64_t kRareVoxelPairs = uint64_t{1} << 20;
