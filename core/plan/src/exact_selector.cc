@@ -398,6 +398,10 @@ Result<CoverProblem> RareVoxelProblem(const std::vector<VoxelSet>& sets, const S
 // The Lagrangian bound's options in a plan: at most kBoundPairVisits pairs visited (about a second;
 // on geb079 the first two cores, docs/PLANNING.md "The Lagrangian bound over cores").
 constexpr uint64_t kBoundPairVisits = uint64_t{3} << 27;
+// ... and its plans (the Lagrangian heuristic) at most kPlanPairVisits, a third of that: hub:4, 5, 7,
+// 8 and 9 take 23-37 plans, 9-50 M visits, to reach their optimum; on geb079, whose best plan (49)
+// stays above its bound (46), the budget's 20 plans cost about 1.5 s (3 << 27: 59 plans, 2.4 s).
+constexpr uint64_t kPlanPairVisits = uint64_t{1} << 27;
 constexpr uint64_t kRareVoxelPairs = uint64_t{1} << 20;
 // Auto's swap search before the integer program may use this share of the time limit.
 constexpr double kSwapShare = 0.25;
@@ -405,13 +409,17 @@ constexpr double kSwapShare = 0.25;
 constexpr double kSearchShare = 0.25;
 constexpr size_t kSearchColumns = 64;
 
-// The Lagrangian bound on the columns over the reduced model's classes.
-Result<int> ModelLagrangianBound(const ReducedModel& m, uint64_t need, int upper_bound, const JobContext& ctx) {
+// The Lagrangian bound on the columns over the reduced model's classes, and the best plan its
+// multipliers gave (the Lagrangian heuristic, lagrangian_bound.h; its columns, ascending).
+Result<LagrangianBound> ModelLagrangianBound(const ReducedModel& m, uint64_t need, int upper_bound,
+                                             const JobContext& ctx) {
   const CoverProblem p{m.weight, m.seen_by, static_cast<int>(m.columns.size()), need};
-  VC_ASSIGN_OR_RETURN(
-      LagrangianBound b,
-      ComputeLagrangianBound(p, {.upper_bound = upper_bound, .max_pair_visits = kBoundPairVisits}, ctx));
-  return b.bound;
+  return ComputeLagrangianBound(p,
+                                {.upper_bound = upper_bound,
+                                 .max_pair_visits = kBoundPairVisits,
+                                 .primal_plans = true,
+                                 .max_plan_pair_visits = kPlanPairVisits},
+                                ctx);
 }
 
 // Voxels covered by the union of `picks`.
@@ -909,9 +917,10 @@ class ExactRun {
   const uint64_t greedy_covered_;
   const uint64_t greedy_pass_covered_;
   const StopReason greedy_stop_;
-  bool greedy_connected_ = true;    // set once the flow model has checked greedy's plan
-  std::optional<SizeProbe> probe_;  // the model's size before the reduction, once probed
-  std::optional<int> model_bound_;  // ModelBound, once computed
+  bool greedy_connected_ = true;      // set once the flow model has checked greedy's plan
+  std::optional<SizeProbe> probe_;    // the model's size before the reduction, once probed
+  std::optional<int> model_bound_;    // ModelBound, once computed
+  std::vector<int> lagrangian_plan_;  // with it: the Lagrangian heuristic's plan (candidates, the forced ones first)
   Selection out_;
 };
 
@@ -1060,8 +1069,10 @@ Result<int> ExactRun::ModelBound(const ReducedModel& m, uint64_t need) {
   if (!model_bound_) {
     const int forced = static_cast<int>(m.forced.size());
     const int upper_bound = static_cast<int>(greedy_picks_.size());
-    VC_ASSIGN_OR_RETURN(int columns, ModelLagrangianBound(m, need, std::max(1, upper_bound - forced), ctx_));
-    model_bound_ = forced + std::max(static_cast<int>(CountingBound(m, need)), columns);
+    VC_ASSIGN_OR_RETURN(LagrangianBound b, ModelLagrangianBound(m, need, std::max(1, upper_bound - forced), ctx_));
+    model_bound_ = forced + std::max(static_cast<int>(CountingBound(m, need)), b.bound);
+    lagrangian_plan_ = m.forced;
+    for (int j : b.plan) lagrangian_plan_.push_back(m.columns[j]);
   }
   return *model_bound_;
 }
@@ -1069,9 +1080,10 @@ Result<int> ExactRun::ModelBound(const ReducedModel& m, uint64_t need) {
 // Auto's way past the integer program where a cheap bound settles it (issue 36: on atrium:2 the
 // root LP alone outlasts the 20 s limit, while the Lagrangian bound, a fraction of a second, is
 // already the optimum). Greedy's plan at the bound is optimal as it is; above it, the swap local
-// search from greedy's plan (kSwapShare of the time limit) that reaches the bound is optimal too.
-// Otherwise nothing: CBC runs as before, warm-started from greedy, and reuses the bound if its
-// root LP is cut off.
+// search from greedy's plan (kSwapShare of the time limit) that reaches the bound is optimal too,
+// and where the swaps stall, the Lagrangian heuristic's plan at the bound (its 1-for-1 exchanges that
+// cover more within the next kSearchShare). Otherwise nothing: CBC runs as before, warm-started
+// from greedy, and reuses the bound if its root LP is cut off.
 Result<std::optional<Selection>> ExactRun::TryTheBoundFirst(const Classes& cl, const ReducedModel& m, uint64_t need) {
   VC_ASSIGN_OR_RETURN(int bound, ModelBound(m, need));
   Optimality& opt = out_.optimality;
@@ -1089,6 +1101,19 @@ Result<std::optional<Selection>> ExactRun::TryTheBoundFirst(const Classes& cl, c
                       SwapLocalSearch(cl, greedy_picks_, fixed_, static_cast<int>(sets_.size()), target_, false,
                                       deadline, ctx_, static_cast<size_t>(bound)));
   if (static_cast<int>(picks.size()) <= bound && Covered(sets_, picks) >= target_) return proven(std::move(picks));
+  // The Lagrangian heuristic's plan (issue 36: on hub:K the swaps from greedy's 2K + 1 stations
+  // find no 2K, the multipliers do), checked over the candidates' own sets.
+  if (!lagrangian_plan_.empty() && static_cast<int>(lagrangian_plan_.size()) <= bound &&
+      Covered(sets_, lagrangian_plan_) >= target_) {
+    how = "the Lagrangian or counting bound proves the Lagrangian heuristic's plan";
+    const Clock::time_point swap_deadline =
+        start_ + std::chrono::duration_cast<Clock::duration>(
+                     std::chrono::duration<double>(options_.time_limit_s * (kSwapShare + kSearchShare)));
+    VC_ASSIGN_OR_RETURN(std::vector<int> thicker,
+                        SwapLocalSearch(cl, lagrangian_plan_, fixed_, static_cast<int>(sets_.size()), target_, false,
+                                        swap_deadline, ctx_, static_cast<size_t>(bound)));
+    return proven(std::move(thicker));
+  }
   // A small model: raise the bound by proving, size by size, that no plan of `bound` stations
   // reaches the target (FixedSizeSearch). A plan found at some size only stops the search: CBC
   // finds one too, so the plan stays what CBC returns (and the same as before this step).

@@ -33,6 +33,7 @@ class Subgradient {
       most_seers_ = std::max(most_seers_, p.seen_by[k].size());
     }
     for (uint64_t w : width) widest_ = std::max(widest_, w);
+    if (o.primal_plans) width_ = std::move(width);
     u_.assign(p.weight.size(), 0.0);
     y_.assign(p.weight.size(), 0.0);
     g_.assign(p.weight.size(), 0.0);
@@ -54,7 +55,12 @@ class Subgradient {
       SetCore(whole ? most_seers_ : limit, first);
       first = false;
       VC_ASSIGN_OR_RETURN(const bool budget_left, Phase(ctx, ub, out));
-      if (!budget_left || whole || out.bound >= ub) break;
+      if (!budget_left || whole || Done(out, ub)) break;
+    }
+    // No step ran (the counting bound met UB at once): a plan from the start's multipliers.
+    if (o_.primal_plans && out.plan.empty()) {
+      Evaluate();
+      MakePlan(out);
     }
     out.bound = std::max(0, std::min(out.bound, p_.columns));
     return out;
@@ -88,14 +94,20 @@ class Subgradient {
     }
   }
 
+  // Whether the bound reached UB or the best plan's size (nothing better is left to prove).
+  static bool Done(const LagrangianBound& out, double ub) {
+    return out.bound >= ub || (!out.plan.empty() && out.bound >= static_cast<int>(out.plan.size()));
+  }
+
   // Subgradient steps over the current core: at most max_iterations, until lambda falls below
-  // min_step_scale or the bound reaches UB. False when the pair-visit budget ran out.
+  // min_step_scale or the bound reaches UB (or the best plan). False when the pair-visit budget ran
+  // out. With primal_plans, a plan at every step whose L(u) is the core's best so far.
   Result<bool> Phase(const JobContext& ctx, double ub, LagrangianBound& out) {
     double scale = 2.0;
     double best = -1;  // this core's best L(u)
     int since_better = 0;
     uint64_t chosen_pairs = 0;  // the last subgradient's pair visits
-    for (int it = 0; it < o_.max_iterations && out.bound < ub; ++it) {
+    for (int it = 0; it < o_.max_iterations && !Done(out, ub); ++it) {
       if (out.pair_visits + pairs_ + chosen_pairs > o_.max_pair_visits && out.iterations > 0) return false;
       VC_RETURN_IF_ERROR(ctx.CheckCancelled("Lagrangian bound"));
       const Evaluation e = Evaluate();
@@ -108,6 +120,7 @@ class Subgradient {
       if (value > best) {
         best = value;
         since_better = 0;
+        if (o_.primal_plans && out.plan_pair_visits < o_.max_plan_pair_visits) MakePlan(out);
       } else if (++since_better >= o_.patience) {
         scale /= 2;
         since_better = 0;
@@ -157,9 +170,11 @@ class Subgradient {
     Evaluation e;
     long double magnitude = 0;
     long double price_error = 0;
+    reduced_.resize(p_.columns);
     for (int j = 0; j < p_.columns; ++j) {
       const double s = PriceOf(sees_[j]);
       const long double reduced = 1.0L - s;
+      reduced_[j] = 1.0 - s;
       magnitude += 1.0L + s;
       price_error += static_cast<long double>(sees_[j].size() + 1) * 0x1p-52L * s;
       if (reduced < 0) {
@@ -204,6 +219,74 @@ class Subgradient {
     return cost;
   }
 
+  // A plan from the current multipliers (the header's primal heuristic): greedy by the score of
+  // Caprara, Fischetti & Toth until need is covered, then the columns the others make redundant
+  // dropped by decreasing reduced cost. Kept in out.plan when it has fewer columns.
+  void MakePlan(LagrangianBound& out) {
+    if (all_sees_.empty()) {
+      all_sees_.assign(p_.columns, {});
+      for (size_t k = 0; k < p_.weight.size(); ++k) {
+        for (int j : p_.seen_by[k]) all_sees_[j].push_back(static_cast<int>(k));
+      }
+      plan_count_.assign(p_.weight.size(), 0);
+    }
+    ++out.plans;
+    // Per column: its reduced cost over the classes still uncovered, and their weight.
+    std::vector<double> gamma = reduced_;
+    std::vector<uint64_t> gain = width_;
+    std::vector<int> plan;
+    uint64_t covered = 0;
+    while (covered < p_.need) {
+      const double rest = static_cast<double>(p_.need - covered);
+      int best = -1;
+      double best_score = 0;
+      for (int j = 0; j < p_.columns; ++j) {
+        if (gain[j] == 0) continue;  // nothing new (every column in the plan among them)
+        const double mu = std::min(static_cast<double>(gain[j]), rest);
+        const double score = gamma[j] > 0 ? gamma[j] / mu : gamma[j] * mu;
+        if (best < 0 || score < best_score) {
+          best = j;
+          best_score = score;
+        }
+      }
+      if (best < 0) break;  // unreachable: CheckProblem ensures the columns see need
+      plan.push_back(best);
+      for (int k : all_sees_[best]) {
+        if (plan_count_[k]++ > 0) continue;
+        covered += p_.weight[k];
+        for (int j : p_.seen_by[k]) {
+          gain[j] -= p_.weight[k];
+          gamma[j] += u_[k];
+        }
+        out.plan_pair_visits += p_.seen_by[k].size();
+      }
+      out.plan_pair_visits += all_sees_[best].size();
+    }
+    // Redundant columns, the least attractive (highest reduced cost) first.
+    std::vector<int> order = plan;
+    std::sort(order.begin(), order.end(),
+              [&](int a, int b) { return reduced_[a] != reduced_[b] ? reduced_[a] > reduced_[b] : a > b; });
+    std::vector<int> kept;
+    for (int j : order) {
+      uint64_t unique = 0;
+      for (int k : all_sees_[j]) unique += plan_count_[k] == 1 ? p_.weight[k] : 0;
+      out.plan_pair_visits += 2 * all_sees_[j].size();
+      if (covered - unique >= p_.need) {
+        covered -= unique;
+        for (int k : all_sees_[j]) --plan_count_[k];
+      } else {
+        kept.push_back(j);
+      }
+    }
+    for (int j : kept) {
+      for (int k : all_sees_[j]) plan_count_[k] = 0;
+    }
+    if (out.plan.empty() || kept.size() < out.plan.size()) {
+      std::sort(kept.begin(), kept.end());
+      out.plan = std::move(kept);
+    }
+  }
+
   // Moves the classes the knapsack takes to the front of `priced` (by u_k / w_k ascending, ties:
   // the lower class), the last of them, which may be split, last: a weighted quickselect for the
   // class where the weight reaches `need`, then a sort of the few around it.
@@ -233,17 +316,21 @@ class Subgradient {
 
   const CoverProblem& p_;
   const LagrangianOptions& o_;
-  std::vector<int> core_;               // the classes of the current core, ascending
-  std::vector<std::vector<int>> sees_;  // per column: the core classes it sees, ascending
-  std::vector<double> u_;               // per class: the multiplier of y_k <= sum x_j (0 outside the core)
-  std::vector<double> y_;               // per core class: its share in the last knapsack
-  std::vector<double> g_;               // per core class: the last subgradient
-  std::vector<int> covered_;            // per class: chosen columns that see it (0 between iterations)
-  std::vector<Priced> priced_;          // the knapsack's classes of u_k > 0 (kept to reuse its memory)
-  uint64_t coverable_ = 0;              // weight of the classes some column sees
-  uint64_t widest_ = 1;                 // the widest column's weight (at least 1)
-  uint64_t pairs_ = 0;                  // (class, column) pairs of the core
-  size_t most_seers_ = 0;               // the most columns that see one class
+  std::vector<int> core_;                   // the classes of the current core, ascending
+  std::vector<std::vector<int>> sees_;      // per column: the core classes it sees, ascending
+  std::vector<double> u_;                   // per class: the multiplier of y_k <= sum x_j (0 outside the core)
+  std::vector<double> y_;                   // per core class: its share in the last knapsack
+  std::vector<double> g_;                   // per core class: the last subgradient
+  std::vector<int> covered_;                // per class: chosen columns that see it (0 between iterations)
+  std::vector<Priced> priced_;              // the knapsack's classes of u_k > 0 (kept to reuse its memory)
+  std::vector<double> reduced_;             // per column: 1 - sum_{k seen} u_k at the last evaluation
+  std::vector<uint64_t> width_;             // per column: the weight it sees (with primal_plans)
+  std::vector<std::vector<int>> all_sees_;  // per column: every class it sees (built by the first plan)
+  std::vector<int> plan_count_;             // per class: plan columns that see it (0 between plans)
+  uint64_t coverable_ = 0;                  // weight of the classes some column sees
+  uint64_t widest_ = 1;                     // the widest column's weight (at least 1)
+  uint64_t pairs_ = 0;                      // (class, column) pairs of the core
+  size_t most_seers_ = 0;                   // the most columns that see one class
 };
 
 Status CheckProblem(const CoverProblem& p) {

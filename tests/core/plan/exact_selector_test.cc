@@ -1,7 +1,8 @@
 // ExactSelector: the integer program's optimum equals exhaustive search on small random instances
 // (minimum stations, and maximum coverage with max_stations, including targets no plan of that
 // size reaches), fixed stations stay first, never worse than greedy, comb:5's optimum on the 1 m
-// grid, the model reduction, the time limit, cancellation and the memory-budget fallback.
+// grid, the model reduction, the time limit, cancellation and the memory-budget fallback; auto's
+// shortcuts past CBC (the bound met by greedy, the swaps, the search or the Lagrangian heuristic).
 #include "vc/plan/exact_selector.h"
 
 #include <gtest/gtest.h>
@@ -9,6 +10,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <iostream>
 #include <random>
 #include <string>
 #include <thread>
@@ -125,7 +127,7 @@ TEST(ExactSelectorTest, MinimumStationsEqualsExhaustiveSearch) {
 // more coverage, or as much with fewer stations); the bounds are the solver's either way.
 TEST(ExactSelectorTest, PreferGreedyKeepsGreedysPlanUnlessStrictlyBetter) {
   std::mt19937 rng(33);
-  int kept_although_exact_differs = 0, replaced = 0, by_the_bound = 0, by_the_search = 0;
+  int kept_although_exact_differs = 0, replaced = 0, by_the_bound = 0, by_the_search = 0, by_the_heuristic = 0;
   for (int trial = 0; trial < 160; ++trial) {
     const int n = 4 + static_cast<int>(rng() % 9);
     const size_t voxels = 20 + rng() % 120;
@@ -165,7 +167,11 @@ TEST(ExactSelectorTest, PreferGreedyKeepsGreedysPlanUnlessStrictlyBetter) {
     by_the_bound += got->optimality.note.find("no integer program solved") != std::string::npos;
     // ... and where a search over every plan one station smaller raised the bound to it.
     by_the_search += got->optimality.note.find("a search over every plan") != std::string::npos;
+    // ... and where the Lagrangian heuristic's plan met the bound.
+    by_the_heuristic += got->optimality.note.find("Lagrangian heuristic") != std::string::npos;
   }
+  std::cout << "[ shortcuts ] " << by_the_bound << " by the bound, " << by_the_search << " by the search, "
+            << by_the_heuristic << " by the Lagrangian heuristic's plan, of 160\n";
   EXPECT_GT(by_the_bound, 0) << "the bound never settled a selection: the shortcut is untested";
   EXPECT_GT(by_the_search, 0) << "the search never raised the bound: it is untested";
   EXPECT_GT(kept_although_exact_differs, 0) << "exact never reordered greedy's plan: the test proves little";
@@ -383,6 +389,51 @@ TEST(ExactSelectorTest, NeverWorseThanGreedyOnLargerInstances) {
     EXPECT_LE(got->optimality.lower_bound, got->picks.size());
     EXPECT_NE(got->optimality.status, OptimalityStatus::kHeuristic);
   }
+}
+
+// Rooms around a hall (hub:K in miniature): per room a deep station that sees only the room and
+// one just inside its door that sees the room and a share of the hall, the shares tiling it; one
+// hall station sees all of the hall. Greedy takes the hall first, then a deep station per room
+// (the lower index among equal gains): K + 1. No drop, 2-for-1 or 1-for-1 exchange gets below that
+// (every door station must come in at once), so the swap search stalls; the Lagrangian heuristic's
+// plan is the K door stations, which the bound proves: optimal, no integer program.
+TEST(ExactSelectorTest, LagrangianPlanProvesRoomsAroundAHallWhereTheSwapsStall) {
+  const int rooms = 6;
+  const size_t room_voxels = 60, share_voxels = 400, per_room = room_voxels + share_voxels;
+  std::vector<VoxelSet> sets(2 * rooms + 1, VoxelSet(rooms * per_room));
+  for (int r = 0; r < rooms; ++r) {
+    for (size_t v = r * per_room; v < r * per_room + room_voxels; ++v) {
+      sets[r].set(v);          // deep station r
+      sets[rooms + r].set(v);  // door station r
+    }
+    for (size_t v = r * per_room + room_voxels; v < (r + 1) * per_room; ++v) {
+      sets[rooms + r].set(v);
+      sets[2 * rooms].set(v);  // the hall station
+    }
+  }
+  ExactSelectorOptions o;
+  o.greedy.target_coverage = 0.99;  // below 1: no sole view is fixed, the model keeps its choice
+  Result<Selection> greedy = GreedySelector(o.greedy).Select(sets, 0, {});
+  ASSERT_TRUE(greedy.ok());
+  EXPECT_EQ(static_cast<int>(greedy->picks.size()), rooms + 1);
+  o.prefer_greedy = true;
+  Result<Selection> got = ExactSelector(o).Select(sets, 0, {});
+  ASSERT_TRUE(got.ok()) << got.status().ToString();
+  ASSERT_EQ(static_cast<int>(got->picks.size()), rooms);
+  for (int p : got->picks) EXPECT_GE(p, rooms) << "not a door station";
+  EXPECT_LT(*std::max_element(got->picks.begin(), got->picks.end()), 2 * rooms) << "the hall station";
+  EXPECT_GE(got->covered, Target(0.99, got->coverable));
+  EXPECT_EQ(got->covered, Union(sets, got->picks));
+  EXPECT_EQ(got->optimality.status, OptimalityStatus::kOptimal);
+  EXPECT_EQ(got->optimality.lower_bound, rooms);
+  EXPECT_NE(got->optimality.note.find("Lagrangian heuristic"), std::string::npos) << got->optimality.note;
+  EXPECT_NE(got->optimality.note.find("no integer program solved"), std::string::npos) << got->optimality.note;
+  // CBC agrees.
+  o.prefer_greedy = false;
+  Result<Selection> exact = ExactSelector(o).Select(sets, 0, {});
+  ASSERT_TRUE(exact.ok());
+  EXPECT_EQ(exact->picks.size(), got->picks.size());
+  EXPECT_EQ(exact->optimality.status, OptimalityStatus::kOptimal);
 }
 
 // A random instance hard enough that CBC does not prove the optimum within a fraction of a second.

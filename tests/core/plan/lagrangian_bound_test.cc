@@ -1,7 +1,8 @@
 // ComputeLagrangianBound: never above the optimum found by exhaustive search on small random
 // instances (full and partial cover; one core and several), equal to it where the LP is integral (interval matrices),
 // above the counting bound where the widest candidate says little, deterministic, and the
-// argument and cancellation errors.
+// argument and cancellation errors. Its plans (primal_plans): always a cover of need, never below
+// the optimum, often at it, the bound the same as without them, and the rooms-around-a-hall plan.
 #include "vc/plan/lagrangian_bound.h"
 
 #include <gtest/gtest.h>
@@ -9,6 +10,7 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <iostream>
 #include <numeric>
 #include <random>
 #include <string>
@@ -162,16 +164,97 @@ TEST(LagrangianBoundTest, BeatsTheCountingBoundOnRoomsAroundAHall) {
   EXPECT_LE(partial->bound, rooms);
 }
 
+// The classes the columns of `plan` see, by weight.
+uint64_t CoveredBy(const CoverProblem& p, const std::vector<int>& plan) {
+  uint64_t w = 0;
+  for (size_t k = 0; k < p.weight.size(); ++k) {
+    const bool seen = std::any_of(p.seen_by[k].begin(), p.seen_by[k].end(),
+                                  [&](int j) { return std::binary_search(plan.begin(), plan.end(), j); });
+    w += seen ? p.weight[k] : 0;
+  }
+  return w;
+}
+
+// primal_plans: the plan covers need with distinct columns in range (ascending), has at least the
+// optimum's columns and no fewer than the bound, which is the bound without plans (the same
+// steps, at most as many of them: the run stops where the bound meets the plan).
+TEST(LagrangianBoundTest, PlansAlwaysCoverTheNeedAndLeaveTheBoundAsItWas) {
+  std::mt19937 rng(361);
+  int at_optimum = 0, proven = 0, stopped_sooner = 0;
+  const int trials = 300;
+  for (int trial = 0; trial < trials; ++trial) {
+    CoverProblem p = RandomProblem(rng, 3 + static_cast<int>(rng() % 11), 5 + static_cast<int>(rng() % 40),
+                                   0.05 + 0.3 * (rng() % 100) / 100.0);
+    const double share = std::vector<double>{1.0, 0.99, 0.9, 0.7, 0.4}[trial % 5];
+    p.need = std::max<uint64_t>(1, static_cast<uint64_t>(std::ceil(share * static_cast<double>(CoverableWeight(p)))));
+    const int optimum = Exhaustive(p);
+    const int first_core = std::vector<int>{16, 2, 1}[trial % 3];
+    const LagrangianOptions plain{.upper_bound = p.columns, .first_core_seers = first_core};
+    LagrangianOptions with_plans = plain;
+    with_plans.primal_plans = true;
+    Result<LagrangianBound> without = ComputeLagrangianBound(p, plain);
+    Result<LagrangianBound> got = ComputeLagrangianBound(p, with_plans);
+    ASSERT_TRUE(without.ok() && got.ok()) << got.status().ToString();
+    const std::string what = "trial " + std::to_string(trial) + ", need " + std::to_string(p.need);
+    EXPECT_TRUE(without->plan.empty()) << what;
+    ASSERT_FALSE(got->plan.empty()) << what;
+    EXPECT_GE(got->plans, 1) << what;
+    EXPECT_GT(got->plan_pair_visits, 0u) << what;
+    EXPECT_TRUE(std::is_sorted(got->plan.begin(), got->plan.end())) << what;
+    EXPECT_EQ(std::adjacent_find(got->plan.begin(), got->plan.end()), got->plan.end()) << what;
+    EXPECT_GE(got->plan.front(), 0) << what;
+    EXPECT_LT(got->plan.back(), p.columns) << what;
+    EXPECT_GE(CoveredBy(p, got->plan), p.need) << what;
+    EXPECT_GE(static_cast<int>(got->plan.size()), optimum) << what;
+    EXPECT_GE(static_cast<int>(got->plan.size()), got->bound) << what;
+    EXPECT_EQ(got->bound, without->bound) << what;
+    EXPECT_LE(got->iterations, without->iterations) << what;
+    at_optimum += static_cast<int>(got->plan.size()) == optimum;
+    proven += static_cast<int>(got->plan.size()) == got->bound;
+    stopped_sooner += got->iterations < without->iterations;
+  }
+  std::cout << "[ plans ] " << at_optimum << " at the optimum, " << proven << " proven by the bound, " << stopped_sooner
+            << " stopped the steps sooner, of " << trials << "\n";
+  EXPECT_GT(at_optimum, trials * 9 / 10) << "the plans are rarely optimal on small instances";
+  EXPECT_GT(proven, trials * 8 / 10) << "the bound rarely proves the plan";
+  EXPECT_GT(stopped_sooner, trials / 2) << "a plan at the bound rarely stopped the steps";
+}
+
+// The hall of BeatsTheCountingBoundOnRoomsAroundAHall, but each room's far side is also seen by a
+// station just inside its door that sees a share of the hall, the shares tiling it: the optimum is
+// one station per room (none in the hall), which the plan reaches and the bound proves.
+TEST(LagrangianBoundTest, PlanProvenOnRoomsAroundAHall) {
+  const int rooms = 12;
+  CoverProblem p;
+  p.columns = 2 * rooms + 1;  // per room: deep (2r), at the door (2r + 1); the hall station last
+  const int hall = 2 * rooms;
+  for (int r = 0; r < rooms; ++r) {
+    p.weight.push_back(60);
+    p.seen_by.push_back({2 * r, 2 * r + 1});  // the room
+    p.weight.push_back(400);
+    p.seen_by.push_back({2 * r + 1, hall});  // the door station's share of the hall
+  }
+  for (const uint64_t need : {CoverableWeight(p), CoverableWeight(p) * 99 / 100}) {
+    p.need = need;
+    Result<LagrangianBound> got = ComputeLagrangianBound(p, {.upper_bound = rooms + 1, .primal_plans = true});
+    ASSERT_TRUE(got.ok()) << got.status().ToString();
+    EXPECT_EQ(got->bound, rooms) << need;
+    ASSERT_EQ(static_cast<int>(got->plan.size()), rooms) << need;
+    for (int r = 0; r < rooms; ++r) EXPECT_EQ(got->plan[r], 2 * r + 1) << need;
+  }
+}
+
 TEST(LagrangianBoundTest, SameInputSameBound) {
   std::mt19937 rng(11);
   CoverProblem p = RandomProblem(rng, 60, 2000, 0.05);
   p.need = CoverableWeight(p) * 9 / 10;
-  Result<LagrangianBound> a = ComputeLagrangianBound(p);
-  Result<LagrangianBound> b = ComputeLagrangianBound(p);
+  Result<LagrangianBound> a = ComputeLagrangianBound(p, {.primal_plans = true});
+  Result<LagrangianBound> b = ComputeLagrangianBound(p, {.primal_plans = true});
   ASSERT_TRUE(a.ok() && b.ok());
   EXPECT_EQ(a->bound, b->bound);
   EXPECT_EQ(a->relaxation, b->relaxation);
   EXPECT_EQ(a->iterations, b->iterations);
+  EXPECT_EQ(a->plan, b->plan);
 }
 
 TEST(LagrangianBoundTest, PairVisitsCapStopsTheIterations) {

@@ -68,7 +68,9 @@ struct ExactSelectorOptions {
   // selection is already optimal stays exactly what greedy planned. With it (the station count as
   // objective, no min_overlap) the counting and Lagrangian bounds come first: greedy's plan at the
   // bound, or the swap local search from it (up to a quarter of time_limit_s) reaching the bound,
-  // is proven optimal without the integer program (a note says so); otherwise CBC runs as before.
+  // or else the Lagrangian heuristic's plan (lagrangian_bound.h, primal_plans) at the bound, made no
+  // thinner by 1-for-1 exchanges that cover more, is proven optimal without the integer program (a
+  // note says so); otherwise CBC runs as before.
   bool prefer_greedy = false;
 };
 

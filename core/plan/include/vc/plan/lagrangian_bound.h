@@ -35,6 +35,18 @@
 // Each core stops after max_iterations steps or when lambda falls below min_step_scale; the whole
 // stops when the bound reaches UB or before max_pair_visits pairs would be exceeded. No clocks and
 // one thread: the same input gives the same bound on any machine.
+//
+// Plans (primal_plans; issue 36, the Lagrangian heuristic of Beasley 1990 and Caprara, Fischetti &
+// Toth 1999): at each step whose L(u) is the best of its core so far the multipliers are turned into
+// a plan. From no column, add the column of the lowest score, gamma_j / mu_j when gamma_j > 0 and
+// gamma_j mu_j otherwise, where gamma_j = 1 - (u_k of the classes j would newly cover) is its
+// reduced cost over what is still uncovered and mu_j the weight it would newly cover, capped at what
+// `need` still lacks (ties: the lower column), until the plan covers `need`; then drop, in order of
+// decreasing reduced cost 1 - sum_{k seen by j} u_k (ties: the higher column), every column the others
+// cover `need` without. The plan with the fewest columns is kept (the first found among equals); the
+// whole stops once the bound reaches its size (then both are optimal). Each plan visits every
+// (class, column) pair about twice; they count against max_plan_pair_visits, not max_pair_visits,
+// so the bound and its steps are those of the run without plans (it only stops sooner).
 // Thread-safe (no state between calls).
 #pragma once
 
@@ -60,7 +72,9 @@ struct LagrangianOptions {
   int patience = 20;             // iterations without a better L(u) before lambda halves
   int first_core_seers = 16;     // the first core: the classes at most this many columns see (below 1: 1)
   double min_step_scale = 1e-3;  // stop once lambda falls below this
-  uint64_t max_pair_visits = uint64_t{2} << 30;  // stop once this many (class, column) pairs were visited
+  uint64_t max_pair_visits = uint64_t{2} << 30;       // stop once this many (class, column) pairs were visited
+  bool primal_plans = false;                          // also turn the multipliers into plans (above)
+  uint64_t max_plan_pair_visits = uint64_t{1} << 30;  // no further plan once the plans visited this many pairs
 };
 
 struct LagrangianBound {
@@ -69,11 +83,17 @@ struct LagrangianBound {
   int counting_bound = 0;    // ceil(need / W), the start's bound, for comparison
   int iterations = 0;        // subgradient iterations run, over all cores
   uint64_t pair_visits = 0;  // (class, column) pairs visited
+  // With primal_plans: the plan of the fewest columns found (ascending; its classes weigh at least
+  // need; empty only when need is 0: with no step run, one plan from the start's multipliers), the
+  // plans made and the pairs they visited.
+  std::vector<int> plan;
+  int plans = 0;
+  uint64_t plan_pair_visits = 0;
 };
 
-// The bound above. INVALID_ARGUMENT for a class weight of 0, a column out of range, or need above
-// the weight of the classes some column sees (no plan reaches it); CANCELLED / DEADLINE_EXCEEDED
-// from ctx (polled every iteration).
+// The bound above (and, with primal_plans, a plan). INVALID_ARGUMENT for a class weight of 0, a column out of range, or
+// need above the weight of the classes some column sees (no plan reaches it); CANCELLED / DEADLINE_EXCEEDED from ctx
+// (polled every iteration).
 [[nodiscard]] Result<LagrangianBound> ComputeLagrangianBound(const CoverProblem& problem,
                                                              const LagrangianOptions& options = {},
                                                              const JobContext& ctx = {});
