@@ -902,6 +902,11 @@ class ExactRun {
   bool AtLeastAsGoodAsGreedy(const std::vector<int>& picks) const;
   bool StrictlyBetterThanGreedy(const std::vector<int>& picks) const;
   Selection Finish(std::vector<int> picks);
+  // The time `share` of the time limit after the selection started.
+  Clock::time_point Deadline(double share) const {
+    return start_ +
+           std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(options_.time_limit_s * share));
+  }
 
   const ExactSelectorOptions& options_;
   const std::vector<VoxelSet>& sets_;
@@ -1026,8 +1031,7 @@ Result<Selection> ExactRun::SelectOverBudget(const Classes* cl, const ReducedMod
     VC_ASSIGN_OR_RETURN(built, BuildClasses(sets_, ProgressRange(ctx_, kProbeEnd, kClassesEnd)));
     cl = &*built;
   }
-  const Clock::time_point deadline =
-      start_ + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(options_.time_limit_s));
+  const Clock::time_point deadline = Deadline(1.0);
   VC_ASSIGN_OR_RETURN(
       std::vector<int> picks,
       SwapLocalSearch(*cl, greedy_picks_, fixed_, static_cast<int>(sets_.size()), target_, max_mode_, deadline, ctx_));
@@ -1095,8 +1099,7 @@ Result<std::optional<Selection>> ExactRun::TryTheBoundFirst(const Classes& cl, c
     return std::optional<Selection>(Finish(std::move(picks)));
   };
   if (static_cast<int>(greedy_picks_.size()) <= bound) return proven(greedy_picks_);
-  const Clock::time_point deadline = start_ + std::chrono::duration_cast<Clock::duration>(
-                                                  std::chrono::duration<double>(options_.time_limit_s * kSwapShare));
+  const Clock::time_point deadline = Deadline(kSwapShare);
   VC_ASSIGN_OR_RETURN(std::vector<int> picks,
                       SwapLocalSearch(cl, greedy_picks_, fixed_, static_cast<int>(sets_.size()), target_, false,
                                       deadline, ctx_, static_cast<size_t>(bound)));
@@ -1106,9 +1109,7 @@ Result<std::optional<Selection>> ExactRun::TryTheBoundFirst(const Classes& cl, c
   if (!lagrangian_plan_.empty() && static_cast<int>(lagrangian_plan_.size()) <= bound &&
       Covered(sets_, lagrangian_plan_) >= target_) {
     how = "the Lagrangian or counting bound proves the Lagrangian heuristic's plan";
-    const Clock::time_point swap_deadline =
-        start_ + std::chrono::duration_cast<Clock::duration>(
-                     std::chrono::duration<double>(options_.time_limit_s * (kSwapShare + kSearchShare)));
+    const Clock::time_point swap_deadline = Deadline(kSwapShare + kSearchShare);
     VC_ASSIGN_OR_RETURN(std::vector<int> thicker,
                         SwapLocalSearch(cl, lagrangian_plan_, fixed_, static_cast<int>(sets_.size()), target_, false,
                                         swap_deadline, ctx_, static_cast<size_t>(bound)));
@@ -1118,9 +1119,7 @@ Result<std::optional<Selection>> ExactRun::TryTheBoundFirst(const Classes& cl, c
   // reaches the target (FixedSizeSearch). A plan found at some size only stops the search: CBC
   // finds one too, so the plan stays what CBC returns (and the same as before this step).
   if (m.columns.size() <= kSearchColumns) {
-    const Clock::time_point search_deadline =
-        start_ + std::chrono::duration_cast<Clock::duration>(
-                     std::chrono::duration<double>(options_.time_limit_s * (kSwapShare + kSearchShare)));
+    const Clock::time_point search_deadline = Deadline(kSwapShare + kSearchShare);
     FixedSizeSearch search(m, need, search_deadline, ctx_);
     const int forced = static_cast<int>(m.forced.size());
     while (bound < static_cast<int>(picks.size())) {
