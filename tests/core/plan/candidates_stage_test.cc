@@ -46,6 +46,29 @@ bool HasWarning(const CandidatesOutput& out, const std::string& text) {
                      [&](const std::string& w) { return w.find(text) != std::string::npos; });
 }
 
+// The grid's options carry every candidate row of the plan's options (refinement and local
+// candidates start from them, so a row missing here would be missing there too).
+TEST(CandidatesStageTest, CandidateOptionsForCarriesEveryCandidateRow) {
+  PlanOptions plan;
+  plan.grid_spacing_m = 0.7;
+  plan.tripod_height_m = 1.3;
+  plan.clearance_m = 0.35;
+  plan.tripod_heights_m = {1.2, 1.8};
+  plan.doorway_candidates = false;
+  plan.ground = GroundModel::kTerrain;
+  plan.walk_max_step_m = 0.4;
+  const CandidateOptions o = CandidateOptionsFor(plan);
+  EXPECT_EQ(o.grid_spacing_m, 0.7);
+  EXPECT_EQ(o.tripod_height_m, 1.3);
+  EXPECT_EQ(o.clearance_m, 0.35);
+  EXPECT_EQ(o.tripod_heights_m, (std::vector<double>{1.2, 1.8}));
+  EXPECT_FALSE(o.doorway_candidates);
+  EXPECT_EQ(o.ground, GroundModel::kTerrain);
+  EXPECT_EQ(o.walk_max_step_m, 0.4);
+  plan.doorway_candidates = true;
+  EXPECT_TRUE(CandidateOptionsFor(plan).doorway_candidates);
+}
+
 TEST(CandidatesStageTest, AFixedStationOverTheFloorPassesWithoutWarning) {
   const VoxelScene scene = RoomWithAHoleAndAPit();
   Result<CandidatesOutput> free = Candidates(scene, {});

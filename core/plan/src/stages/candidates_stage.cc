@@ -120,14 +120,7 @@ Result<CandidatesOutput> UserCandidates(const VoxelScene& scene, const PlanOptio
 
 // The generated grid; FAILED_PRECONDITION when no floor is found or no candidate survives.
 Result<CandidatesOutput> GridCandidates(const VoxelScene& scene, const PlanOptions& options, const JobContext& ctx) {
-  const CandidateOptions cand_options{.grid_spacing_m = options.grid_spacing_m,
-                                      .tripod_height_m = options.tripod_height_m,
-                                      .clearance_m = options.clearance_m,
-                                      .tripod_heights_m = options.tripod_heights_m,
-                                      .doorway_candidates = options.doorway_candidates,
-                                      .ground = options.ground,
-                                      .walk_max_step_m = options.walk_max_step_m};
-  VC_ASSIGN_OR_RETURN(CandidateGrid grid, GenerateCandidates(scene, cand_options, ctx));
+  VC_ASSIGN_OR_RETURN(CandidateGrid grid, GenerateCandidates(scene, CandidateOptionsFor(options), ctx));
   CandidatesOutput out;
   if (!options.keep_out.empty()) {
     size_t kept = 0;
@@ -181,6 +174,16 @@ Result<CandidatesOutput> GridCandidates(const VoxelScene& scene, const PlanOptio
 }
 
 }  // namespace
+
+CandidateOptions CandidateOptionsFor(const PlanOptions& options) {
+  return {.grid_spacing_m = options.grid_spacing_m,
+          .tripod_height_m = options.tripod_height_m,
+          .clearance_m = options.clearance_m,
+          .tripod_heights_m = options.tripod_heights_m,
+          .doorway_candidates = options.doorway_candidates,
+          .ground = options.ground,
+          .walk_max_step_m = options.walk_max_step_m};
+}
 
 Result<CandidatesOutput> RunCandidatesStage(const CandidatesInput& in, const PlanOptions& options,
                                             const JobContext& ctx) {

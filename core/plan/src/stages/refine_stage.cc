@@ -42,13 +42,11 @@ TrialPositions TrialsAround(const OccupancyGrid& grid, const Stations& stations,
   for (size_t k = 0; k < stations.size(); ++k) {
     if (stations.fixed[k]) continue;
     const double height = std::isnan(stations.floor_z_m[k]) ? 0.0 : StationHeight(stations, k, heights);
-    const CandidateOptions cand_options{.grid_spacing_m = options.grid_spacing_m,
-                                        .tripod_height_m = height,
-                                        .clearance_m = options.clearance_m,
-                                        .tripod_heights_m = {},
-                                        .doorway_candidates = false,
-                                        .ground = ground,
-                                        .walk_max_step_m = options.walk_max_step_m};
+    CandidateOptions cand_options = CandidateOptionsFor(options);
+    cand_options.tripod_height_m = height;
+    cand_options.tripod_heights_m = {};
+    cand_options.doorway_candidates = false;
+    cand_options.ground = ground;
     for (int iy = -steps; iy <= steps; ++iy) {
       for (int ix = -steps; ix <= steps; ++ix) {
         if (ix == 0 && iy == 0) continue;

@@ -79,13 +79,10 @@ Result<LocalRefinementResult> SelectWithLocalCandidates(const SelectionInput& in
   };
 
   const std::vector<double> heights = options.TripodHeights();
-  const CandidateOptions cand_options{.grid_spacing_m = options.grid_spacing_m,
-                                      .tripod_height_m = *std::min_element(heights.begin(), heights.end()),
-                                      .clearance_m = options.clearance_m,
-                                      .tripod_heights_m = options.tripod_heights_m,
-                                      .doorway_candidates = false,
-                                      .ground = in.ground,
-                                      .walk_max_step_m = options.walk_max_step_m};
+  CandidateOptions cand_options = CandidateOptionsFor(options);
+  cand_options.tripod_height_m = *std::min_element(heights.begin(), heights.end());
+  cand_options.doorway_candidates = false;
+  cand_options.ground = in.ground;
   LocalRefinementOptions local{options.local_candidates_radius_m, options.local_candidates_step_m,
                                options.local_candidates_rounds, options.keep_out};
   local.target_coverage = options.target_coverage;

@@ -19,6 +19,7 @@
 #include "vc/base/geometry.h"
 #include "vc/base/progress.h"
 #include "vc/base/status.h"
+#include "vc/plan/candidates.h"
 #include "vc/plan/planner.h"
 #include "vc/plan/route.h"
 #include "vc/plan/selector.h"
@@ -86,6 +87,9 @@ struct CandidatesOutput {
 // inside an occupied voxel, or a fixed station outside the scene's bounds (widened by 2 m, naming
 // them); a warning for a fixed station without an occupied voxel within 3 m straight below.
 // FAILED_PRECONDITION when no floor is found or no candidate survives.
+// The candidate grid's options (every row of PlanOptions it uses). Refinement and local candidates
+// start from them, each with its own height, ground model and no doorway candidates.
+[[nodiscard]] CandidateOptions CandidateOptionsFor(const PlanOptions& options);
 [[nodiscard]] Result<CandidatesOutput> RunCandidatesStage(const CandidatesInput& in, const PlanOptions& options,
                                                           const JobContext& ctx);
 
