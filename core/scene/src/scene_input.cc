@@ -41,26 +41,21 @@ Result<SceneInput> FromCloud(Result<readers::PointCloud> read, InputFormat forma
   return in;
 }
 
-// An octree's keys are centred on its own origin, in metres: it is read as it is (frame origin 0).
-Status CheckOctreeUnits(std::string_view source, const ReadOptions& options) {
+// Formats that hold metres (FormatHoldsMetres) take no other unit: an octree's keys are centred on
+// its own origin, in metres (it is read as it is, frame origin 0); an E57 file's Cartesian
+// coordinates and poses are metres by the standard (ASTM E2807), so a CRS in feet does not make
+// them feet (docs/PLANNING.md, "Units"). INVALID_ARGUMENT naming the format's reason otherwise.
+Status CheckMetricUnits(InputFormat format, std::string_view source, const ReadOptions& options) {
   if (options.metres_per_unit == 1.0) return Status::Ok();
   std::ostringstream units;
   units << options.metres_per_unit;
-  return readers::InvalidInput(
-      source, "OctoMap octrees are read in metres (their resolution is in metres), but units of " + units.str() +
-                  " m were given; read the octree without units");
-}
-
-// An E57 file's Cartesian coordinates and poses are metres by the standard (ASTM E2807), so no
-// other unit applies (docs/PLANNING.md, "Units"): a CRS in feet does not make them feet.
-Status CheckE57Units(std::string_view source, const ReadOptions& options) {
-  if (options.metres_per_unit == 1.0) return Status::Ok();
-  std::ostringstream units;
-  units << options.metres_per_unit;
-  return readers::InvalidInput(source, "E57 files hold metres by the standard (ASTM E2807), but units of " +
-                                           units.str() +
-                                           " m were given; read the E57 without units (with a CRS in feet, "
-                                           "vc-client --crs alone: the file is read in metres)");
+  const bool e57 = format == InputFormat::kE57;
+  const std::string holds = e57 ? "E57 files hold metres by the standard (ASTM E2807)"
+                                : "OctoMap octrees are read in metres (their resolution is in metres)";
+  const std::string advice = e57 ? "read the E57 without units (with a CRS in feet, vc-client --crs alone: the file "
+                                   "is read in metres)"
+                                 : "read the octree without units";
+  return readers::InvalidInput(source, holds + ", but units of " + units.str() + " m were given; " + advice);
 }
 
 Result<SceneInput> FromOctree(Result<std::shared_ptr<octomap::OcTree>> read, InputFormat format) {
@@ -125,12 +120,13 @@ Result<SceneInput> ReadGraphInput(std::string_view bytes, std::string_view sourc
 
 Result<SceneInput> ReadDecompressed(std::string_view bytes, std::string_view source, const ReadOptions& options) {
   if (bytes.empty()) return readers::InvalidInput(source, "input is empty (0 bytes)");
-  switch (DetectInputFormat(bytes)) {
+  const InputFormat format = DetectInputFormat(bytes);
+  switch (format) {
     case InputFormat::kOctomapBinary:
-      VC_RETURN_IF_ERROR(CheckOctreeUnits(source, options));
+      VC_RETURN_IF_ERROR(CheckMetricUnits(format, source, options));
       return FromOctree(ReadOctreeBinary(bytes, source, options.max_result_bytes), InputFormat::kOctomapBinary);
     case InputFormat::kOctomapText:
-      VC_RETURN_IF_ERROR(CheckOctreeUnits(source, options));
+      VC_RETURN_IF_ERROR(CheckMetricUnits(format, source, options));
       return FromOctree(ReadOctreeText(bytes, source, options.max_result_bytes), InputFormat::kOctomapText);
     case InputFormat::kVoxelStream:
       return readers::ReadVoxelStream(bytes, source, options);
@@ -139,7 +135,7 @@ Result<SceneInput> ReadDecompressed(std::string_view bytes, std::string_view sou
     case InputFormat::kLas:
       return FromCloud(readers::ReadLas(bytes, source, options), InputFormat::kLas, source);
     case InputFormat::kE57:
-      VC_RETURN_IF_ERROR(CheckE57Units(source, options));
+      VC_RETURN_IF_ERROR(CheckMetricUnits(format, source, options));
       return ReadE57Input(bytes, source, options);
     case InputFormat::kPcd:
       return FromCloud(readers::ReadPcd(bytes, source, options), InputFormat::kPcd, source);
