@@ -25,6 +25,7 @@ fi
 
 start_server() {  # start_server BUILD CPU VAR: starts it (in this shell, so pids holds it), VAR=port
   local log="$work/server-$RANDOM.log" port=""
+  : >"$log"  # before the server starts: the wait below may read it before the server's own redirect has made it
   taskset -c "$2" "$1/server/vc-server" --listen 127.0.0.1:0 --workers 1 --threads-per-job 1 >"$log" 2>&1 &
   pids+=($!)
   for _ in $(seq 1 100); do

@@ -24,6 +24,7 @@ cleanup() {
 trap cleanup EXIT
 
 start() {  # start NAME [flags...] -> ${NAME}_addr
+  : >"$work/$1.log"  # before the server starts: the wait below may read it before the server's own redirect has made it
   "$bin/server/vc-server" --listen 127.0.0.1:0 --workers 1 "${@:2}" >"$work/$1.log" 2>&1 &
   pids+=($!)
   local port=""

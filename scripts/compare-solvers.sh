@@ -26,6 +26,7 @@ cleanup() {
 }
 trap cleanup EXIT
 
+: >"$work/server.log"  # before the server starts: the wait below may read it before the server's own redirect has made it
 "$bin/server/vc-server" --listen 127.0.0.1:0 --workers 1 >"$work/server.log" 2>&1 &
 server_pid=$!
 port=""

@@ -35,6 +35,7 @@ stop_server() {
 trap 'stop_server; rm -f "$log"' EXIT
 
 echo "=== starting vc-server on a free loopback port"
+: >"$log"  # before the server starts: the wait below may read it before the server's own redirect has made it
 "$server" --listen 127.0.0.1:0 --workers 1 >"$log" 2>&1 &
 server_pid=$!
 port=""

@@ -42,6 +42,7 @@ cleanup() {
 trap cleanup EXIT
 
 start_server() {  # start_server LOG [flags...]: prints the port
+  : >"$work/$1"  # before the server starts: the wait below may read it before the server's own redirect has made it
   "$bin/server/vc-server" --listen 127.0.0.1:0 --workers 1 "${@:2}" >"$work/$1" 2>&1 &
   pids+=($!)
   local p=""

@@ -34,6 +34,7 @@ now_ms() { echo $(( $(date +%s%N) / 1000000 )); }
 # start_server LOG [vc-server flags...]: sets SERVER_PID, PORT, ADDR.
 start_server() {
   local log=$1; shift
+  : >"$log"  # before the server starts: the wait below may read it before the server's own redirect has made it
   "$SERVER" --listen 127.0.0.1:0 "$@" >"$log" 2>&1 &
   SERVER_PID=$!
   PORT=""

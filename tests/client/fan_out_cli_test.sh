@@ -18,6 +18,7 @@ trap 'for p in "${pids[@]}"; do kill -9 "$p" 2>/dev/null || true; done; cleanup'
 start() {
   local name="$1"
   shift
+  : >"$work/$name.log"  # before the server starts: the wait below may read it before the server's own redirect has made it
   "$server_bin" --listen 127.0.0.1:0 --workers 1 "$@" >"$work/$name.log" 2>&1 &
   local pid=$! port=""
   pids+=("$pid")

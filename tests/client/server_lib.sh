@@ -15,6 +15,7 @@ start_server() {
   local bin="$1"
   shift
   # Port 0: the server picks a free port and logs it.
+  : >"$work/server.log"  # before the server starts: the wait below may read it before the server's own redirect has made it
   "$bin" --listen 127.0.0.1:0 "$@" >"$work/server.log" 2>&1 &
   server_pid=$!
   local port=""
