@@ -10,6 +10,7 @@
 # on one build, e.g. AB_ARGS_A="--scanner leica-rtc360" scripts/ab-plan.sh build/release build/release
 # (the stations and G then differ by design).
 set -euo pipefail
+source "$(dirname "${BASH_SOURCE[0]}")/lib/server_port.sh"
 cd "$(dirname "$0")/.."
 a=$1 b=$2 rounds=${3:-2}
 shift $(( $# >= 3 ? 3 : 2 ))
@@ -24,16 +25,10 @@ if ((${#files[@]} == 0)); then
 fi
 
 start_server() {  # start_server BUILD CPU VAR: starts it (in this shell, so pids holds it), VAR=port
-  local log="$work/server-$RANDOM.log" port=""
-  : >"$log"  # before the server starts: the wait below may read it before the server's own redirect has made it
-  taskset -c "$2" "$1/server/vc-server" --listen 127.0.0.1:0 --workers 1 --threads-per-job 1 >"$log" 2>&1 &
-  pids+=($!)
-  for _ in $(seq 1 100); do
-    port=$(sed -n 's/.*listening on .* (port \([0-9]*\)).*/\1/p' "$log" | head -1)
-    [[ -n "$port" ]] && break
-    sleep 0.1
-  done
-  [[ -n "$port" ]] || { cat "$log" >&2; exit 1; }
+  local log="$work/server-$RANDOM.log" port
+  vc_launch "$log" taskset -c "$2" "$1/server/vc-server" --listen 127.0.0.1:0 --workers 1 --threads-per-job 1
+  pids+=("$vc_pid")
+  port=$(vc_wait_port "$log" "$vc_pid") || { cat "$log" >&2; exit 1; }
   printf -v "$3" '%s' "$port"
 }
 

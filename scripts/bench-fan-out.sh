@@ -8,6 +8,7 @@
 # Usage: scripts/bench-fan-out.sh [BUILD_DIR (default build/release)] [SCENE (default geb079; hall, a file)]
 #   [SHARD (default 128)] [-- vc-client FLAGS...]
 set -euo pipefail
+source "$(dirname "${BASH_SOURCE[0]}")/lib/server_port.sh"
 cd "$(dirname "$0")/.."
 bin=${1:-build/release}
 scene=${2:-geb079}
@@ -24,16 +25,10 @@ cleanup() {
 trap cleanup EXIT
 
 start() {  # start NAME [flags...] -> ${NAME}_addr
-  : >"$work/$1.log"  # before the server starts: the wait below may read it before the server's own redirect has made it
-  "$bin/server/vc-server" --listen 127.0.0.1:0 --workers 1 "${@:2}" >"$work/$1.log" 2>&1 &
-  pids+=($!)
-  local port=""
-  for _ in $(seq 1 100); do
-    port=$(sed -n 's/.*listening on .* (port \([0-9]*\)).*/\1/p' "$work/$1.log" | head -1)
-    [[ -n "$port" ]] && break
-    sleep 0.1
-  done
-  [[ -n "$port" ]] || { cat "$work/$1.log"; exit 1; }
+  vc_launch "$work/$1.log" "$bin/server/vc-server" --listen 127.0.0.1:0 --workers 1 "${@:2}"
+  pids+=("$vc_pid")
+  local port
+  port=$(vc_wait_port "$work/$1.log" "$vc_pid") || { cat "$work/$1.log"; exit 1; }
   printf -v "$1_addr" '%s' "127.0.0.1:$port"
 }
 

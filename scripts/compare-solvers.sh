@@ -11,6 +11,7 @@
 #   "room-scan1" the real furnished room, "room-merged" both room scans in one frame,
 #   scripts/merge-room-scans.py)] [-- FLAGS...]
 set -euo pipefail
+source "$(dirname "${BASH_SOURCE[0]}")/lib/server_port.sh"
 cd "$(dirname "$0")/.."
 bin=${1:-build/release}
 solvers=${2:-greedy exact}
@@ -26,16 +27,9 @@ cleanup() {
 }
 trap cleanup EXIT
 
-: >"$work/server.log"  # before the server starts: the wait below may read it before the server's own redirect has made it
-"$bin/server/vc-server" --listen 127.0.0.1:0 --workers 1 >"$work/server.log" 2>&1 &
-server_pid=$!
-port=""
-for _ in $(seq 1 100); do
-  port=$(sed -n 's/.*listening on .* (port \([0-9]*\)).*/\1/p' "$work/server.log" | head -1)
-  [[ -n "$port" ]] && break
-  sleep 0.1
-done
-[[ -n "$port" ]] || { cat "$work/server.log"; exit 1; }
+vc_launch "$work/server.log" "$bin/server/vc-server" --listen 127.0.0.1:0 --workers 1
+server_pid=$vc_pid
+port=$(vc_wait_port "$work/server.log" "$server_pid") || { cat "$work/server.log"; exit 1; }
 
 printf '%-10s %-7s %8s %9s %-10s %6s %6s %9s %8s  %s\n' scene solver stations coverage status bound gap select_s total_s \
   "model (candidates/classes/rows; before)  scene% field_min G stop"

@@ -8,6 +8,7 @@
 # vc-out/, and stops the server.
 # Usage: scripts/demo.sh [extra vc-client submit flags...]
 set -euo pipefail
+source "$(dirname "${BASH_SOURCE[0]}")/lib/server_port.sh"
 cd "$(dirname "$0")/.."
 
 scene=../shared/data/geb079/geb079.bt
@@ -35,17 +36,9 @@ stop_server() {
 trap 'stop_server; rm -f "$log"' EXIT
 
 echo "=== starting vc-server on a free loopback port"
-: >"$log"  # before the server starts: the wait below may read it before the server's own redirect has made it
-"$server" --listen 127.0.0.1:0 --workers 1 >"$log" 2>&1 &
-server_pid=$!
-port=""
-for _ in $(seq 1 100); do
-  port=$(sed -n 's/.*listening on .* (port \([0-9]*\)).*/\1/p' "$log" | head -1)
-  [[ -n "$port" ]] && break
-  kill -0 "$server_pid" 2>/dev/null || { cat "$log"; echo "demo: vc-server failed to start" >&2; exit 1; }
-  sleep 0.1
-done
-[[ -n "$port" ]] || { cat "$log"; echo "demo: vc-server did not report its port" >&2; exit 1; }
+vc_launch "$log" "$server" --listen 127.0.0.1:0 --workers 1
+server_pid=$vc_pid
+port=$(vc_wait_port "$log" "$server_pid") || { cat "$log"; echo "demo: vc-server did not start or report its port" >&2; exit 1; }
 addr="127.0.0.1:$port"
 "$client" health --server "$addr"
 

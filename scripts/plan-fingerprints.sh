@@ -19,6 +19,7 @@
 #   --no-doorway-candidates: the grid's candidates alone (doorway candidates are on by default
 #     since issue 36): the lines from before they became the default.
 set -euo pipefail
+source "$(dirname "${BASH_SOURCE[0]}")/lib/server_port.sh"
 cd "$(dirname "$0")/.."
 bin=${1:-build/release}
 quick="" fan_out="" route="" client_flags=()
@@ -42,17 +43,9 @@ cleanup() {
 trap cleanup EXIT
 
 start_server() {  # start_server LOG [flags...]: prints the port
-  : >"$work/$1"  # before the server starts: the wait below may read it before the server's own redirect has made it
-  "$bin/server/vc-server" --listen 127.0.0.1:0 --workers 1 "${@:2}" >"$work/$1" 2>&1 &
-  pids+=($!)
-  local p=""
-  for _ in $(seq 1 100); do
-    p=$(sed -n 's/.*listening on .* (port \([0-9]*\)).*/\1/p' "$work/$1" | head -1)
-    [[ -n "$p" ]] && break
-    sleep 0.1
-  done
-  [[ -n "$p" ]] || { cat "$work/$1" >&2; exit 1; }
-  port=$p
+  vc_launch "$work/$1" "$bin/server/vc-server" --listen 127.0.0.1:0 --workers 1 "${@:2}"
+  pids+=("$vc_pid")
+  port=$(vc_wait_port "$work/$1" "$vc_pid") || { cat "$work/$1" >&2; exit 1; }
 }
 if [[ -n "$fan_out" ]]; then
   start_server peer1.log; p1=$port

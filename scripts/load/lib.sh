@@ -2,6 +2,7 @@
 # build directory holding BIN/server/vc-server, BIN/client/vc-client and BIN/core/vc-synth. Every server is
 # started on 127.0.0.1 with port 0 (a free port) and stopped by the EXIT trap; every wait is bounded.
 set -uo pipefail
+source "$(dirname "${BASH_SOURCE[0]}")/../lib/server_port.sh"
 
 LOAD_ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)
 DATA=${VC_DATA:-$LOAD_ROOT/../shared/data}
@@ -34,18 +35,9 @@ now_ms() { echo $(( $(date +%s%N) / 1000000 )); }
 # start_server LOG [vc-server flags...]: sets SERVER_PID, PORT, ADDR.
 start_server() {
   local log=$1; shift
-  : >"$log"  # before the server starts: the wait below may read it before the server's own redirect has made it
-  "$SERVER" --listen 127.0.0.1:0 "$@" >"$log" 2>&1 &
-  SERVER_PID=$!
-  PORT=""
-  local i
-  for i in $(seq 1 100); do
-    PORT=$(sed -n 's/.*listening on .* (port \([0-9]*\)).*/\1/p' "$log" | head -1)
-    [[ -n "$PORT" ]] && break
-    kill -0 "$SERVER_PID" 2>/dev/null || break
-    sleep 0.1
-  done
-  if [[ -z "$PORT" ]]; then
+  vc_launch "$log" "$SERVER" --listen 127.0.0.1:0 "$@"
+  SERVER_PID=$vc_pid
+  if ! PORT=$(vc_wait_port "$log" "$SERVER_PID"); then
     cat "$log" >&2; echo "$(basename "$0"): vc-server did not start" >&2; exit 1
   fi
   ADDR="127.0.0.1:$PORT"

@@ -18,16 +18,10 @@ trap 'for p in "${pids[@]}"; do kill -9 "$p" 2>/dev/null || true; done; cleanup'
 start() {
   local name="$1"
   shift
-  : >"$work/$name.log"  # before the server starts: the wait below may read it before the server's own redirect has made it
-  "$server_bin" --listen 127.0.0.1:0 --workers 1 "$@" >"$work/$name.log" 2>&1 &
-  local pid=$! port=""
+  vc_launch "$work/$name.log" "$server_bin" --listen 127.0.0.1:0 --workers 1 "$@"
+  local pid=$vc_pid port
   pids+=("$pid")
-  for _ in $(seq 1 100); do
-    port=$(sed -n 's/.*listening on .* (port \([0-9]*\)).*/\1/p' "$work/$name.log" | head -1)
-    [[ -n "$port" ]] && break
-    sleep 0.1
-  done
-  [[ -n "$port" ]] || { cat "$work/$name.log" >&2; fail "$name did not start"; }
+  port=$(vc_wait_port "$work/$name.log" "$pid") || { cat "$work/$name.log" >&2; fail "$name did not start"; }
   printf -v "${name}_addr" '%s' "127.0.0.1:$port"
   printf -v "${name}_pid" '%s' "$pid"
 }

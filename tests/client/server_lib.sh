@@ -2,6 +2,7 @@
 # on a free loopback port, cleanup on exit, and `fail`.
 # After `start_server SERVER_BIN [flags...]`: $work, $server_pid, $addr (127.0.0.1:port);
 # the server's log is $work/server.log. `stop_server` sends SIGTERM and checks it exits 0.
+source "$(dirname "${BASH_SOURCE[0]}")/../../scripts/lib/server_port.sh"
 work=$(mktemp -d)
 server_pid=""
 cleanup() {
@@ -15,17 +16,10 @@ start_server() {
   local bin="$1"
   shift
   # Port 0: the server picks a free port and logs it.
-  : >"$work/server.log"  # before the server starts: the wait below may read it before the server's own redirect has made it
-  "$bin" --listen 127.0.0.1:0 "$@" >"$work/server.log" 2>&1 &
-  server_pid=$!
-  local port=""
-  for _ in $(seq 1 100); do
-    port=$(sed -n 's/.*listening on .* (port \([0-9]*\)).*/\1/p' "$work/server.log" | head -1)
-    [[ -n "$port" ]] && break
-    kill -0 "$server_pid" 2>/dev/null || fail "vc-server exited"
-    sleep 0.1
-  done
-  [[ -n "$port" ]] || fail "vc-server did not report its port"
+  vc_launch "$work/server.log" "$bin" --listen 127.0.0.1:0 "$@"
+  server_pid=$vc_pid
+  local port
+  port=$(vc_wait_port "$work/server.log" "$server_pid") || fail "vc-server exited or did not report its port"
   addr="127.0.0.1:$port"
 }
 
