@@ -458,7 +458,7 @@ struct CheckedSubmit {
 };
 
 vc::Result<CheckedSubmit> CheckSubmit(const CommandLine& cl) {
-  CheckedSubmit checked{cl.plan, {}, {}};
+  CheckedSubmit checked{cl.plan, {}, {}, {}};
   vc::Result<SceneFile> file = ReadSceneBytes(cl);  // its error comes after the flags'
   VC_ASSIGN_OR_RETURN(checked.crs, vc::client::CheckCrsFlag(cl.crs, cl.units, file.ok() ? file->format : std::nullopt));
   VC_ASSIGN_OR_RETURN(checked.lines, vc::client::LoadPlanFiles(cl.plan_files, &checked.plan));

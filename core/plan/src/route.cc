@@ -1370,7 +1370,11 @@ class NearMoves {
   // One pass of 2-opt moves (each reversal adds an edge to one of an end's nearest points), then
   // of Or-opt moves (a segment of 1-3 points, either way round, next to one of its ends' nearest
   // points, or at either end of the path); whether any shortened the path.
-  bool Pass() { return TwoOptPass() | OrOptPass(); }
+  bool Pass() {
+    const bool two_opt = TwoOptPass();  // first, then Or-opt on its result: both always run
+    const bool or_opt = OrOptPass();
+    return two_opt || or_opt;
+  }
 
  private:
   static constexpr double kEps = 1e-9;

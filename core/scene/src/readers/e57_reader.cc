@@ -358,7 +358,7 @@ class XmlReader {
       VC_RETURN_IF_ERROR(ExpectType(*r, "Structure"));
       double q[4];
       for (int i = 0; i < 4; ++i) {
-        VC_ASSIGN_OR_RETURN(q[i], Required(*r, std::string_view("wxyz" + i, 1), index));
+        VC_ASSIGN_OR_RETURN(q[i], Required(*r, std::string_view("wxyz").substr(i, 1), index));
       }
       Eigen::Quaterniond rotation(q[0], q[1], q[2], q[3]);
       const double norm = rotation.norm();
@@ -373,7 +373,7 @@ class XmlReader {
     if (const XmlNode* t = Child(pose, "translation")) {
       VC_RETURN_IF_ERROR(ExpectType(*t, "Structure"));
       for (int i = 0; i < 3; ++i) {
-        VC_ASSIGN_OR_RETURN(scan->translation_m[i], Required(*t, std::string_view("xyz" + i, 1), index));
+        VC_ASSIGN_OR_RETURN(scan->translation_m[i], Required(*t, std::string_view("xyz").substr(i, 1), index));
       }
     }
     return Status::Ok();
