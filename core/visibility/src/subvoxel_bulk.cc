@@ -19,6 +19,7 @@
 #include <Eigen/Core>
 #include <algorithm>
 #include <optional>
+#include <utility>
 #include <vector>
 
 #include "subvoxel_internal.h"
@@ -29,23 +30,28 @@ namespace {
 
 using Eigen::Vector3d;
 
-// How far before the first occupied cube (segment parameter) a trace resumes its walk.
-constexpr double kResumeMargin = 1e-6;
-
 // Segments uo -> ends[i] (ends[i] inside voxel owners[i]'s cube), each judged as one segment of the
-// test: seen[i] whether it sees its owner.
+// test: seen[i] whether it sees its owner, and where not, blocker[i] the first blocker (or -1).
 void JudgeSegments(const VoxelScene& scene, std::span<const SurfacePatch> patches, const SubvoxelTables& tables,
                    const Vector3d& uo, std::span<const uint32_t> owners, std::span<const Vector3d> ends,
-                   std::vector<char>& seen) {
+                   std::vector<char>& seen, std::vector<int64_t>& blocker) {
   const std::vector<Vector3d> origins(ends.size(), uo);
   std::vector<std::optional<VoxelIndex>> first(ends.size());
   FirstOccupiedBatch(scene.grid, origins, ends, first);
   seen.assign(ends.size(), 0);
+  blocker.assign(ends.size(), -1);
   for (size_t i = 0; i < ends.size(); ++i) {
     const uint32_t id = owners[i];
     if (first[i] && *first[i] == KeyToIndex(scene.occupied[id])) {
       seen[i] = 1;
       continue;
+    }
+    if (first[i]) {
+      const int judged = SubvoxelJudgeAtFirst(scene, patches, tables, uo, id, ends[i], *first[i], &blocker[i]);
+      if (judged >= 0) {
+        seen[i] = char(judged);
+        continue;
+      }
     }
     double s_start = 0;
     if (first[i]) {
@@ -61,7 +67,9 @@ void JudgeSegments(const VoxelScene& scene, std::span<const SurfacePatch> patche
       }
       s_start = std::max(0.0, enter - kResumeMargin);
     }
-    seen[i] = TraceSubvoxelSegment(scene, patches, uo, id, ends[i], s_start, &tables).seen();
+    const SubvoxelRay ray = TraceSubvoxelSegment(scene, patches, uo, id, ends[i], s_start, &tables);
+    seen[i] = ray.seen();
+    blocker[i] = ray.first_blocker;
   }
 }
 
@@ -75,41 +83,48 @@ void SubvoxelVisibleAmong(const VoxelScene& scene, std::span<const SurfacePatch>
   owners.reserve(ids.size());
   ends.reserve(ids.size());
   for (const uint32_t id : ids) {
-    Vector3d aim;
-    if (!SubvoxelAimPasses(scene, patches, uo, id, limits, &aim)) continue;
+    const Vector3d& aim = tables.Aim(id);
+    if (!SubvoxelAimPasses(patches[id], aim, uo, limits)) continue;
     owners.push_back(id);
     ends.push_back(aim);
   }
   std::vector<char> seen;
-  JudgeSegments(scene, patches, tables, uo, owners, ends, seen);
+  std::vector<int64_t> blocker;
+  JudgeSegments(scene, patches, tables, uo, owners, ends, seen, blocker);
   // The box fall-back, one face a round: round r takes the r-th face (TraceSubvoxel's order) of
-  // each voxel that is not flat and not seen yet.
-  std::vector<uint32_t> left;
+  // each voxel that is not flat and not seen yet. A face's segment that the blocker which last
+  // stopped a segment of the voxel proves blocked (SubvoxelBlockedBy) is not walked.
+  std::vector<std::pair<uint32_t, int64_t>> left, next;
   for (size_t i = 0; i < owners.size(); ++i) {
     if (seen[i]) {
       set.set(owners[i]);
     } else if (!patches[owners[i]].flat) {
-      left.push_back(owners[i]);
+      left.emplace_back(owners[i], blocker[i]);
     }
   }
   for (int round = 0; round < 3 && !left.empty(); ++round) {
     owners.clear();
     ends.clear();
-    for (const uint32_t id : left) {
+    next.clear();
+    for (const auto& [id, last] : left) {
       Eigen::Vector3d faces[3];
-      if (SubvoxelFaceAims(scene, patches, uo, id, faces) <= round) continue;
+      if (SubvoxelFaceAims(scene, patches, uo, id, faces, &tables) <= round) continue;
+      if (SubvoxelBlockedBy(scene, patches, tables, uo, id, faces[round], last)) {
+        next.emplace_back(id, last);
+        continue;
+      }
       owners.push_back(id);
       ends.push_back(faces[round]);
     }
-    JudgeSegments(scene, patches, tables, uo, owners, ends, seen);
-    left.clear();
+    JudgeSegments(scene, patches, tables, uo, owners, ends, seen, blocker);
     for (size_t i = 0; i < owners.size(); ++i) {
       if (seen[i]) {
         set.set(owners[i]);
       } else {
-        left.push_back(owners[i]);
+        next.emplace_back(owners[i], blocker[i]);
       }
     }
+    left.swap(next);
   }
 }
 
