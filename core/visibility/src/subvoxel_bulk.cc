@@ -23,19 +23,38 @@
 #include <vector>
 
 #include "subvoxel_internal.h"
+#include "vc/raycast/occluders.h"
 #include "vc/raycast/ray_traversal.h"
+#include "vc/visibility/surface_groups.h"
 
 namespace vc::internal {
 namespace {
 
 using Eigen::Vector3d;
 
+// How far inside the viewpoint's free box (voxels) the batched walks start.
+constexpr double kBoxMargin = 1e-3;
+
 // Segments uo -> ends[i] (ends[i] inside voxel owners[i]'s cube), each judged as one segment of the
 // test: seen[i] whether it sees its owner, and where not, blocker[i] the first blocker (or -1).
 void JudgeSegments(const VoxelScene& scene, std::span<const SurfacePatch> patches, const SubvoxelTables& tables,
                    const Vector3d& uo, std::span<const uint32_t> owners, std::span<const Vector3d> ends,
-                   std::vector<char>& seen, std::vector<int64_t>& blocker) {
-  const std::vector<Vector3d> origins(ends.size(), uo);
+                   std::vector<char>& seen, std::vector<int64_t>& blocker, const FreeBox& around) {
+  std::vector<Vector3d> origins(ends.size(), uo);
+  if (!around.empty()) {
+    const double lo[3] = {double(around.lo.x), double(around.lo.y), double(around.lo.z)};
+    const double hi[3] = {double(around.hi.x) + 1, double(around.hi.y) + 1, double(around.hi.z) + 1};
+    for (size_t i = 0; i < ends.size(); ++i) {
+      const Vector3d d = ends[i] - uo;
+      double leave = 1;
+      for (int a = 0; a < 3; ++a) {
+        if (d[a] > 0) leave = std::min(leave, (hi[a] - uo[a]) / d[a]);
+        if (d[a] < 0) leave = std::min(leave, (lo[a] - uo[a]) / d[a]);
+      }
+      const double s = leave - kBoxMargin / d.lpNorm<Eigen::Infinity>();
+      if (s > 0 && s < 1) origins[i] = uo + s * d;
+    }
+  }
   std::vector<std::optional<VoxelIndex>> first(ends.size());
   FirstOccupiedBatch(scene.grid, origins, ends, first);
   seen.assign(ends.size(), 0);
@@ -78,6 +97,7 @@ void JudgeSegments(const VoxelScene& scene, std::span<const SurfacePatch> patche
 void SubvoxelVisibleAmong(const VoxelScene& scene, std::span<const SurfacePatch> patches, const SubvoxelTables& tables,
                           const Vector3d& uo, const ScannerLimits& limits, std::span<const uint32_t> ids,
                           VoxelSet& set) {
+  const FreeBox around = ShortcutsHold(scene.grid, uo) ? GrowFreeBox(scene.grid, uo) : FreeBox{};
   std::vector<uint32_t> owners;
   std::vector<Vector3d> ends;
   owners.reserve(ids.size());
@@ -90,7 +110,7 @@ void SubvoxelVisibleAmong(const VoxelScene& scene, std::span<const SurfacePatch>
   }
   std::vector<char> seen;
   std::vector<int64_t> blocker;
-  JudgeSegments(scene, patches, tables, uo, owners, ends, seen, blocker);
+  JudgeSegments(scene, patches, tables, uo, owners, ends, seen, blocker, around);
   // The box fall-back, one face a round: round r takes the r-th face (TraceSubvoxel's order) of
   // each voxel that is not flat and not seen yet. A face's segment that the blocker which last
   // stopped a segment of the voxel proves blocked (SubvoxelBlockedBy) is not walked.
@@ -116,7 +136,7 @@ void SubvoxelVisibleAmong(const VoxelScene& scene, std::span<const SurfacePatch>
       owners.push_back(id);
       ends.push_back(faces[round]);
     }
-    JudgeSegments(scene, patches, tables, uo, owners, ends, seen, blocker);
+    JudgeSegments(scene, patches, tables, uo, owners, ends, seen, blocker, around);
     for (size_t i = 0; i < owners.size(); ++i) {
       if (seen[i]) {
         set.set(owners[i]);
