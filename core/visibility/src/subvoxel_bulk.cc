@@ -10,6 +10,14 @@
 // so no blocker. The segments of the box fall-back (a voxel that is not flat and not seen by its
 // aim point) go the same way, a face a batch, each batch only for the voxels not seen yet.
 //
+// Less walking that keeps every answer (docs/VISIBILITY.md "The engine"):
+// - the walks start where the segment leaves the viewpoint's free box (GrowFreeBox, shrunk by
+//   kBoxMargin): the part before lies in free voxels, so holds no blocker;
+// - a segment whose first occupied voxel's blocker alone gives the trace's answer (margins:
+//   SubvoxelJudgeAtFirst) is not traced;
+// - a box fall-back segment that the blocker which last stopped a segment of its voxel proves
+//   blocked (SubvoxelBlockedBy) is not walked.
+//
 // A trace resumed that way walks the segment from a point on it rather than from o, so at an exact
 // tie (the segment passing exactly through a lattice edge or corner) it may step into the other
 // voxel than the walk from o does. There a blocker that the segment meets only at that edge is met
@@ -32,7 +40,8 @@ namespace {
 
 using Eigen::Vector3d;
 
-// How far inside the viewpoint's free box (voxels) the batched walks start.
+// How far inside the viewpoint's free box (voxels) the batched walks start: far above the
+// rounding of the start point, so that it lies in a voxel of the box.
 constexpr double kBoxMargin = 1e-3;
 
 // Segments uo -> ends[i] (ends[i] inside voxel owners[i]'s cube), each judged as one segment of the
@@ -42,8 +51,10 @@ void JudgeSegments(const VoxelScene& scene, std::span<const SurfacePatch> patche
                    std::vector<char>& seen, std::vector<int64_t>& blocker, const FreeBox& around) {
   std::vector<Vector3d> origins(ends.size(), uo);
   if (!around.empty()) {
-    const double lo[3] = {double(around.lo.x), double(around.lo.y), double(around.lo.z)};
-    const double hi[3] = {double(around.hi.x) + 1, double(around.hi.y) + 1, double(around.hi.z) + 1};
+    // The box shrunk by kBoxMargin on every side (uo is inside it, SubvoxelVisibleAmong checks):
+    // each walk starts where its segment leaves that.
+    const double lo[3] = {around.lo.x + kBoxMargin, around.lo.y + kBoxMargin, around.lo.z + kBoxMargin};
+    const double hi[3] = {around.hi.x + 1 - kBoxMargin, around.hi.y + 1 - kBoxMargin, around.hi.z + 1 - kBoxMargin};
     for (size_t i = 0; i < ends.size(); ++i) {
       const Vector3d d = ends[i] - uo;
       double leave = 1;
@@ -51,8 +62,7 @@ void JudgeSegments(const VoxelScene& scene, std::span<const SurfacePatch> patche
         if (d[a] > 0) leave = std::min(leave, (hi[a] - uo[a]) / d[a]);
         if (d[a] < 0) leave = std::min(leave, (lo[a] - uo[a]) / d[a]);
       }
-      const double s = leave - kBoxMargin / d.lpNorm<Eigen::Infinity>();
-      if (s > 0 && s < 1) origins[i] = uo + s * d;
+      if (leave > 0 && leave < 1) origins[i] = uo + leave * d;
     }
   }
   std::vector<std::optional<VoxelIndex>> first(ends.size());
@@ -97,7 +107,14 @@ void JudgeSegments(const VoxelScene& scene, std::span<const SurfacePatch> patche
 void SubvoxelVisibleAmong(const VoxelScene& scene, std::span<const SurfacePatch> patches, const SubvoxelTables& tables,
                           const Vector3d& uo, const ScannerLimits& limits, std::span<const uint32_t> ids,
                           VoxelSet& set) {
-  const FreeBox around = ShortcutsHold(scene.grid, uo) ? GrowFreeBox(scene.grid, uo) : FreeBox{};
+  FreeBox around = ShortcutsHold(scene.grid, uo) ? GrowFreeBox(scene.grid, uo) : FreeBox{};
+  // Only with uo inside the box by the margin, so that every segment leaves it once, through the
+  // open box before that.
+  for (int a = 0; a < 3 && !around.empty(); ++a) {
+    const double lo = a == 0 ? around.lo.x : a == 1 ? around.lo.y : around.lo.z;
+    const double hi = (a == 0 ? around.hi.x : a == 1 ? around.hi.y : around.hi.z) + 1.0;
+    if (!(uo[a] >= lo + kBoxMargin && uo[a] <= hi - kBoxMargin)) around = FreeBox{};
+  }
   std::vector<uint32_t> owners;
   std::vector<Vector3d> ends;
   owners.reserve(ids.size());
