@@ -8,6 +8,7 @@
 
 #include "subvoxel_internal.h"
 #include "vc/base/popcount.h"
+#include "vc/raycast/occluders.h"
 #include "vc/raycast/walk.h"
 #include "visibility_internal.h"
 
@@ -162,20 +163,127 @@ SubvoxelRay TraceSegment(const VoxelScene& scene, std::span<const SurfacePatch> 
 
 }  // namespace
 
-bool SubvoxelAimPasses(const VoxelScene& scene, std::span<const SurfacePatch> patches, const Eigen::Vector3d& uo,
-                       size_t id, const ScannerLimits& limits, Eigen::Vector3d* aim) {
-  const SurfacePatch& target = patches[id];
-  *aim = SubvoxelAimIS(scene, patches, id);
-  const Eigen::Vector3d to_viewpoint = uo - *aim;
+int SubvoxelJudgeAtFirst(const VoxelScene& scene, std::span<const SurfacePatch> patches, const SubvoxelTables& tables,
+                         const Eigen::Vector3d& uo, size_t id, const Eigen::Vector3d& end, const VoxelIndex& first,
+                         int64_t* blocker) {
+  constexpr double kMargin = 1e-4;
+  const Eigen::Vector3d d = end - uo;
+  if (!(d.lpNorm<Eigen::Infinity>() <= kMaxShortcutLength)) return -1;
+  const double lo[3] = {double(first.x), double(first.y), double(first.z)};
+  // The entry face (axis a) and parameter, as JudgeSegments computes them.
+  double enter = 0;
+  int a = -1;
+  for (int i = 0; i < 3; ++i) {
+    if (d[i] == 0) continue;
+    const double t0 = (lo[i] - uo[i]) / d[i], t1 = (lo[i] + 1 - uo[i]) / d[i];
+    if (std::min(t0, t1) > enter) {
+      enter = std::min(t0, t1);
+      a = i;
+    }
+  }
+  if (a < 0) return -1;
+  const OccupancyGrid& g = scene.grid;
+  const VoxelIndex& glo = g.min_index();
+  const uint32_t rel[3] = {uint32_t(first.x - glo.x), uint32_t(first.y - glo.y), uint32_t(first.z - glo.z)};
+  const uint32_t slot = g.BrickSlot(g.BrickLinear(rel[0] >> 3, rel[1] >> 3, rel[2] >> 3));
+  const size_t w = size_t(tables.Id(slot, rel));
+  const SurfacePatch& patch = patches[w];
+  const double s = BlockerHit(uo, end, tables.Box(w), patch, tables.Centroid(w));
+  if (s == kNoHit) return -1;
+  // The resumed trace starts at s0; from there to the hit the segment must stay inside the cube of
+  // `first` and of its face-neighbour across the entry face, away from every other face.
+  const double s0 = std::max(0.0, enter - kResumeMargin);
+  const Eigen::Vector3d p0 = uo + s0 * d, hit = uo + s * d;
+  for (int i = 0; i < 3; ++i) {
+    if (i == a) continue;
+    for (const double x : {p0[i], hit[i]}) {
+      if (!(x >= lo[i] + kMargin && x <= lo[i] + 1 - kMargin)) return -1;
+    }
+  }
+  if (d[a] > 0 ? !(p0[a] >= lo[a] - 1 + kMargin && hit[a] <= lo[a] + 1 - kMargin)
+               : !(p0[a] <= lo[a] + 2 - kMargin && hit[a] >= lo[a] + kMargin)) {
+    return -1;
+  }
+  *blocker = int64_t(w);
+  return SameSurface(hit, end, patches[id], patch) ? 1 : 0;
+}
+
+namespace {
+
+// The parameter interval [*t0, *t1] of the segment uo + t d in the unit cube at `lo`; false when
+// it misses it.
+bool CubeChord(const Eigen::Vector3d& uo, const Eigen::Vector3d& d, const VoxelIndex& lo, double* t0, double* t1) {
+  const double c[3] = {double(lo.x), double(lo.y), double(lo.z)};
+  double enter = -std::numeric_limits<double>::infinity(), leave = std::numeric_limits<double>::infinity();
+  for (int i = 0; i < 3; ++i) {
+    if (d[i] == 0) {
+      if (!(uo[i] >= c[i] && uo[i] <= c[i] + 1)) return false;
+      continue;
+    }
+    const double a = (c[i] - uo[i]) / d[i], b = (c[i] + 1 - uo[i]) / d[i];
+    enter = std::max(enter, std::min(a, b));
+    leave = std::min(leave, std::max(a, b));
+  }
+  *t0 = enter;
+  *t1 = leave;
+  return enter < leave;
+}
+
+}  // namespace
+
+bool SubvoxelBlockedBy(const VoxelScene& scene, std::span<const SurfacePatch> patches, const SubvoxelTables& tables,
+                       const Eigen::Vector3d& uo, size_t id, const Eigen::Vector3d& end, int64_t w) {
+  constexpr double kMargin = 1e-4;
+  if (w < 0 || size_t(w) == id) return false;
+  const Eigen::Vector3d d = end - uo;
+  if (!(d.lpNorm<Eigen::Infinity>() <= kMaxShortcutLength)) return false;
+  const SurfacePatch& blocker = patches[size_t(w)];
+  const double s = BlockerHit(uo, end, tables.Box(size_t(w)), blocker, tables.Centroid(size_t(w)));
+  if (s == kNoHit) return false;
+  // Some point of the segment well inside w's cube, so that a walk visits w (or stops before it).
+  const VoxelIndex wv = KeyToIndex(scene.occupied[size_t(w)]);
+  double w0 = 0, w1 = 0, v0 = 0, v1 = 0;
+  if (!CubeChord(uo, d, wv, &w0, &w1) || !CubeChord(uo, d, KeyToIndex(scene.occupied[id]), &v0, &v1)) return false;
+  const double s_mid = 0.5 * (w0 + w1);
+  const Eigen::Vector3d mid = uo + s_mid * d;
+  const double lo[3] = {double(wv.x), double(wv.y), double(wv.z)};
+  for (int i = 0; i < 3; ++i) {
+    if (!(mid[i] >= lo[i] + kMargin && mid[i] <= lo[i] + 1 - kMargin)) return false;
+  }
+  // The target's cube is entered after both, so the walk does not stop at it first.
+  const double length = d.norm();
+  if (!((v0 - std::max(s, s_mid)) * length > kMargin)) return false;
+  // No point of the segment up to the hit is on the target's surface (SameSurface): farther than
+  // the tolerance from the end, and for a flat target on one side of its plane, farther than the
+  // tolerance from it.
+  const double away = kSameSurfaceTolerance + kMargin;
+  if (!((1 - s) * length > away)) return false;
+  if (patches[id].flat) {
+    const Eigen::Vector3d n = patches[id].normal.cast<double>();
+    const double h0 = n.dot(uo - end), h1 = n.dot(uo + s * d - end);
+    if (!((h0 > away && h1 > away) || (h0 < -away && h1 < -away))) return false;
+  }
+  return true;
+}
+
+bool SubvoxelAimPasses(const SurfacePatch& target, const Eigen::Vector3d& aim, const Eigen::Vector3d& uo,
+                       const ScannerLimits& limits) {
+  const Eigen::Vector3d to_viewpoint = uo - aim;
   int axis = 0, sign = 1;
   NearestFace(target.flat ? target.normal.cast<double>() : to_viewpoint, to_viewpoint, &axis, &sign);
-  return limits.Passes(*aim, axis, sign);
+  return limits.Passes(aim, axis, sign);
+}
+
+bool SubvoxelAimPasses(const VoxelScene& scene, std::span<const SurfacePatch> patches, const Eigen::Vector3d& uo,
+                       size_t id, const ScannerLimits& limits, Eigen::Vector3d* aim) {
+  *aim = SubvoxelAimIS(scene, patches, id);
+  return SubvoxelAimPasses(patches[id], *aim, uo, limits);
 }
 
 int SubvoxelFaceAims(const VoxelScene& scene, std::span<const SurfacePatch> patches, const Eigen::Vector3d& uo,
-                     size_t id, Eigen::Vector3d faces[3]) {
+                     size_t id, Eigen::Vector3d faces[3], const SubvoxelTables* tables) {
   if (patches[id].flat) return 0;
-  const Eigen::AlignedBox3d box = SubvoxelBoxIS(scene, patches, id);
+  const Eigen::AlignedBox3d box = tables ? tables->Box(id) : SubvoxelBoxIS(scene, patches, id);
   int n = 0;
   for (int i = 0; i < 3; ++i) {
     for (const bool high : {false, true}) {
@@ -234,9 +342,11 @@ SubvoxelTables::SubvoxelTables(const VoxelScene& scene, std::span<const SurfaceP
   }
   boxes_.resize(scene.occupied.size());
   centroids_.resize(scene.occupied.size());
+  aims_.resize(scene.occupied.size());
   for (size_t id = 0; id < scene.occupied.size(); ++id) {
     boxes_[id] = SubvoxelBoxIS(scene, patches, id);
     centroids_[id] = g.WorldToIndexSpace(patches[id].centroid_m.cast<double>());
+    aims_[id] = SubvoxelAimIS(scene, patches, id);
   }
 }
 

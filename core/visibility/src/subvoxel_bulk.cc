@@ -10,6 +10,14 @@
 // so no blocker. The segments of the box fall-back (a voxel that is not flat and not seen by its
 // aim point) go the same way, a face a batch, each batch only for the voxels not seen yet.
 //
+// Less walking that keeps every answer (docs/VISIBILITY.md "The engine"):
+// - the walks start where the segment leaves the viewpoint's free box (GrowFreeBox, shrunk by
+//   kBoxMargin): the part before lies in free voxels, so holds no blocker;
+// - a segment whose first occupied voxel's blocker alone gives the trace's answer (margins:
+//   SubvoxelJudgeAtFirst) is not traced;
+// - a box fall-back segment that the blocker which last stopped a segment of its voxel proves
+//   blocked (SubvoxelBlockedBy) is not walked.
+//
 // A trace resumed that way walks the segment from a point on it rather than from o, so at an exact
 // tie (the segment passing exactly through a lattice edge or corner) it may step into the other
 // voxel than the walk from o does. There a blocker that the segment meets only at that edge is met
@@ -19,33 +27,60 @@
 #include <Eigen/Core>
 #include <algorithm>
 #include <optional>
+#include <utility>
 #include <vector>
 
 #include "subvoxel_internal.h"
+#include "vc/raycast/occluders.h"
 #include "vc/raycast/ray_traversal.h"
+#include "vc/visibility/surface_groups.h"
 
 namespace vc::internal {
 namespace {
 
 using Eigen::Vector3d;
 
-// How far before the first occupied cube (segment parameter) a trace resumes its walk.
-constexpr double kResumeMargin = 1e-6;
+// How far inside the viewpoint's free box (voxels) the batched walks start: far above the
+// rounding of the start point, so that it lies in a voxel of the box.
+constexpr double kBoxMargin = 1e-3;
 
 // Segments uo -> ends[i] (ends[i] inside voxel owners[i]'s cube), each judged as one segment of the
-// test: seen[i] whether it sees its owner.
+// test: seen[i] whether it sees its owner, and where not, blocker[i] the first blocker (or -1).
 void JudgeSegments(const VoxelScene& scene, std::span<const SurfacePatch> patches, const SubvoxelTables& tables,
                    const Vector3d& uo, std::span<const uint32_t> owners, std::span<const Vector3d> ends,
-                   std::vector<char>& seen) {
-  const std::vector<Vector3d> origins(ends.size(), uo);
+                   std::vector<char>& seen, std::vector<int64_t>& blocker, const FreeBox& around) {
+  std::vector<Vector3d> origins(ends.size(), uo);
+  if (!around.empty()) {
+    // The box shrunk by kBoxMargin on every side (uo is inside it, SubvoxelVisibleAmong checks):
+    // each walk starts where its segment leaves that.
+    const double lo[3] = {around.lo.x + kBoxMargin, around.lo.y + kBoxMargin, around.lo.z + kBoxMargin};
+    const double hi[3] = {around.hi.x + 1 - kBoxMargin, around.hi.y + 1 - kBoxMargin, around.hi.z + 1 - kBoxMargin};
+    for (size_t i = 0; i < ends.size(); ++i) {
+      const Vector3d d = ends[i] - uo;
+      double leave = 1;
+      for (int a = 0; a < 3; ++a) {
+        if (d[a] > 0) leave = std::min(leave, (hi[a] - uo[a]) / d[a]);
+        if (d[a] < 0) leave = std::min(leave, (lo[a] - uo[a]) / d[a]);
+      }
+      if (leave > 0 && leave < 1) origins[i] = uo + leave * d;
+    }
+  }
   std::vector<std::optional<VoxelIndex>> first(ends.size());
   FirstOccupiedBatch(scene.grid, origins, ends, first);
   seen.assign(ends.size(), 0);
+  blocker.assign(ends.size(), -1);
   for (size_t i = 0; i < ends.size(); ++i) {
     const uint32_t id = owners[i];
     if (first[i] && *first[i] == KeyToIndex(scene.occupied[id])) {
       seen[i] = 1;
       continue;
+    }
+    if (first[i]) {
+      const int judged = SubvoxelJudgeAtFirst(scene, patches, tables, uo, id, ends[i], *first[i], &blocker[i]);
+      if (judged >= 0) {
+        seen[i] = char(judged);
+        continue;
+      }
     }
     double s_start = 0;
     if (first[i]) {
@@ -61,7 +96,9 @@ void JudgeSegments(const VoxelScene& scene, std::span<const SurfacePatch> patche
       }
       s_start = std::max(0.0, enter - kResumeMargin);
     }
-    seen[i] = TraceSubvoxelSegment(scene, patches, uo, id, ends[i], s_start, &tables).seen();
+    const SubvoxelRay ray = TraceSubvoxelSegment(scene, patches, uo, id, ends[i], s_start, &tables);
+    seen[i] = ray.seen();
+    blocker[i] = ray.first_blocker;
   }
 }
 
@@ -70,46 +107,61 @@ void JudgeSegments(const VoxelScene& scene, std::span<const SurfacePatch> patche
 void SubvoxelVisibleAmong(const VoxelScene& scene, std::span<const SurfacePatch> patches, const SubvoxelTables& tables,
                           const Vector3d& uo, const ScannerLimits& limits, std::span<const uint32_t> ids,
                           VoxelSet& set) {
+  FreeBox around = ShortcutsHold(scene.grid, uo) ? GrowFreeBox(scene.grid, uo) : FreeBox{};
+  // Only with uo inside the box by the margin, so that every segment leaves it once, through the
+  // open box before that.
+  for (int a = 0; a < 3 && !around.empty(); ++a) {
+    const double lo = a == 0 ? around.lo.x : a == 1 ? around.lo.y : around.lo.z;
+    const double hi = (a == 0 ? around.hi.x : a == 1 ? around.hi.y : around.hi.z) + 1.0;
+    if (!(uo[a] >= lo + kBoxMargin && uo[a] <= hi - kBoxMargin)) around = FreeBox{};
+  }
   std::vector<uint32_t> owners;
   std::vector<Vector3d> ends;
   owners.reserve(ids.size());
   ends.reserve(ids.size());
   for (const uint32_t id : ids) {
-    Vector3d aim;
-    if (!SubvoxelAimPasses(scene, patches, uo, id, limits, &aim)) continue;
+    const Vector3d& aim = tables.Aim(id);
+    if (!SubvoxelAimPasses(patches[id], aim, uo, limits)) continue;
     owners.push_back(id);
     ends.push_back(aim);
   }
   std::vector<char> seen;
-  JudgeSegments(scene, patches, tables, uo, owners, ends, seen);
+  std::vector<int64_t> blocker;
+  JudgeSegments(scene, patches, tables, uo, owners, ends, seen, blocker, around);
   // The box fall-back, one face a round: round r takes the r-th face (TraceSubvoxel's order) of
-  // each voxel that is not flat and not seen yet.
-  std::vector<uint32_t> left;
+  // each voxel that is not flat and not seen yet. A face's segment that the blocker which last
+  // stopped a segment of the voxel proves blocked (SubvoxelBlockedBy) is not walked.
+  std::vector<std::pair<uint32_t, int64_t>> left, next;
   for (size_t i = 0; i < owners.size(); ++i) {
     if (seen[i]) {
       set.set(owners[i]);
     } else if (!patches[owners[i]].flat) {
-      left.push_back(owners[i]);
+      left.emplace_back(owners[i], blocker[i]);
     }
   }
   for (int round = 0; round < 3 && !left.empty(); ++round) {
     owners.clear();
     ends.clear();
-    for (const uint32_t id : left) {
+    next.clear();
+    for (const auto& [id, last] : left) {
       Eigen::Vector3d faces[3];
-      if (SubvoxelFaceAims(scene, patches, uo, id, faces) <= round) continue;
+      if (SubvoxelFaceAims(scene, patches, uo, id, faces, &tables) <= round) continue;
+      if (SubvoxelBlockedBy(scene, patches, tables, uo, id, faces[round], last)) {
+        next.emplace_back(id, last);
+        continue;
+      }
       owners.push_back(id);
       ends.push_back(faces[round]);
     }
-    JudgeSegments(scene, patches, tables, uo, owners, ends, seen);
-    left.clear();
+    JudgeSegments(scene, patches, tables, uo, owners, ends, seen, blocker, around);
     for (size_t i = 0; i < owners.size(); ++i) {
       if (seen[i]) {
         set.set(owners[i]);
       } else {
-        left.push_back(owners[i]);
+        next.emplace_back(owners[i], blocker[i]);
       }
     }
+    left.swap(next);
   }
 }
 

@@ -23,7 +23,8 @@ SubvoxelRay TraceSubvoxel(const VoxelScene& scene, std::span<const SurfacePatch>
 // voxel ids by brick (per non-empty brick of the grid, the ids of its occupied voxels in bit order,
 // word z then bit y * 8 + x, so that a voxel's id is a popcount away instead of a binary search,
 // VoxelScene::IdOf), and each voxel's blocking box (SubvoxelBoxIS) and centroid (index space), the
-// same doubles the single queries compute. 76 bytes per occupied voxel and 4 per non-empty brick.
+// same doubles the single queries compute, and its aim point (SubvoxelAimIS). 100 bytes per
+// occupied voxel and 4 per non-empty brick.
 class SubvoxelTables {
  public:
   SubvoxelTables(const VoxelScene& scene, std::span<const SurfacePatch> patches);
@@ -31,6 +32,7 @@ class SubvoxelTables {
   int64_t Id(uint32_t slot, const uint32_t rel[3]) const { return ids_[start_[slot - 1] + Rank(slot, rel)]; }
   const Eigen::AlignedBox3d& Box(size_t id) const { return boxes_[id]; }
   const Eigen::Vector3d& Centroid(size_t id) const { return centroids_[id]; }
+  const Eigen::Vector3d& Aim(size_t id) const { return aims_[id]; }
 
  private:
   uint32_t Rank(uint32_t slot, const uint32_t rel[3]) const;
@@ -39,6 +41,7 @@ class SubvoxelTables {
   std::vector<uint32_t> ids_;
   std::vector<Eigen::AlignedBox3d> boxes_;
   std::vector<Eigen::Vector3d> centroids_;
+  std::vector<Eigen::Vector3d> aims_;
 };
 
 // TraceSubvoxel in parts, for the bulk engine (subvoxel_bulk.cc), which walks the segments in SIMD
@@ -46,16 +49,44 @@ class SubvoxelTables {
 // - whether the aim point of voxel `id` passes `limits`, and the aim point (index space);
 bool SubvoxelAimPasses(const VoxelScene& scene, std::span<const SurfacePatch> patches, const Eigen::Vector3d& uo,
                        size_t id, const ScannerLimits& limits, Eigen::Vector3d* aim);
+//   the same for a target patch whose aim point (SubvoxelAimIS) is known;
+bool SubvoxelAimPasses(const SurfacePatch& target, const Eigen::Vector3d& aim, const Eigen::Vector3d& uo,
+                       const ScannerLimits& limits);
 // - the ends of the segments of the box fall-back (a voxel that is not flat; none otherwise), in
-//   TraceSubvoxel's order; returns how many (at most 3);
+//   TraceSubvoxel's order; returns how many (at most 3); `tables` (may be null) hold the box;
 int SubvoxelFaceAims(const VoxelScene& scene, std::span<const SurfacePatch> patches, const Eigen::Vector3d& uo,
-                     size_t id, Eigen::Vector3d faces[3]);
+                     size_t id, Eigen::Vector3d faces[3], const SubvoxelTables* tables = nullptr);
 // - one segment uo -> end (end inside voxel id's cube) judged by the test, walked from its parameter
 //   `s_start` (0: from uo; the caller knows that the part before it passes through no occupied
 //   voxel); `tables` (may be null) speed up the walk.
 SubvoxelRay TraceSubvoxelSegment(const VoxelScene& scene, std::span<const SurfacePatch> patches,
                                  const Eigen::Vector3d& uo, size_t id, const Eigen::Vector3d& end, double s_start,
                                  const SubvoxelTables* tables);
+// How far before the cube of a segment's first occupied voxel (segment parameter) the bulk
+// engine resumes its trace.
+inline constexpr double kResumeMargin = 1e-6;
+// The segment uo -> end (end inside voxel id's cube) judged by the blocker of `first` alone, the
+// first occupied voxel FirstOccupiedBatch found on it (not voxel id), where that gives the answer
+// TraceSubvoxelSegment resumed kResumeMargin before `first`'s cube would: the segment meets that
+// blocker, and from the resumed start to the hit it stays in `first`'s cube and the free cube
+// before it, at least 1e-4 voxels from every other face (so the trace's walk visits only those two
+// and stops after `first`). 1: seen (the blocker is on voxel id's surface), 0: blocked, -1: not
+// decided (then trace). Only for segments of at most kMaxShortcutLength voxels. Where decided,
+// `*blocker` is `first`'s id.
+int SubvoxelJudgeAtFirst(const VoxelScene& scene, std::span<const SurfacePatch> patches, const SubvoxelTables& tables,
+                         const Eigen::Vector3d& uo, size_t id, const Eigen::Vector3d& end, const VoxelIndex& first,
+                         int64_t* blocker);
+// A certificate that the segment uo -> end (end inside voxel id's cube) is blocked under the test,
+// by voxel `w` (any occupied voxel but id; -1: none), without a walk: the segment meets w's blocker
+// at parameter s; it passes through w's cube at least 1e-4 voxels inside all its faces (at the
+// middle of its chord), and both that and s come at least 1e-4 voxels before it enters id's cube, so
+// every walk tests w's blocker (or has stopped at an earlier hit) before it reaches id; and no point
+// of the segment up to s can be on id's surface: it is farther than kSameSurfaceTolerance + 1e-4
+// from `end`, and for a flat id as far from id's plane through `end`, on the viewpoint's side. So
+// the first blocker comes at or before s and is not on id's surface: blocked, for the trace from uo
+// and for one resumed anywhere before w. Only for segments of at most kMaxShortcutLength voxels.
+bool SubvoxelBlockedBy(const VoxelScene& scene, std::span<const SurfacePatch> patches, const SubvoxelTables& tables,
+                       const Eigen::Vector3d& uo, size_t id, const Eigen::Vector3d& end, int64_t w);
 // The sub-voxel test from `uo` (index space; in range and in no occupied voxel) under `limits`, for
 // the voxels `ids`: the bit of each voxel seen is set in `set` (subvoxel_bulk.cc). The same answers
 // as TraceSubvoxel but at exact ties (subvoxel_bulk.cc says which).
