@@ -4,7 +4,8 @@
 // check and the per-core ratio; the full visibility-set computation (both selection tests); the
 // end-to-end plan per stage; peak RSS; and scaling tables against footprint and candidate
 // spacing. No assertions on time: figures are printed for docs/BENCHMARKS.md. `--quick` runs a
-// small scene in seconds so CI keeps the tool building and running.
+// small scene in seconds so CI keeps the tool building and running. `--bar` runs the bar
+// method instead: the whole plan against OctoMap castRay on the plan's compatibility rays.
 #include <hwy/targets.h>
 #include <sys/resource.h>
 
@@ -28,6 +29,7 @@
 #include "vc/scene/surface_patches.h"
 #include "vc/scene/voxel_scene.h"
 #include "vc/synth/synth.h"
+#include "vc/visibility/scanner_limits.h"
 #include "vc/visibility/visibility.h"
 
 namespace {
@@ -200,6 +202,9 @@ struct BenchOptions {
   int rays = 200000, octomap_rays = 20000, threads = 2, repeat = 5;
   bool quick = false, scaling = true, rays_only = false, fine_eval = false, all_targets = false, sets = true;
   bool visibility_only = false, candidates_only = false;
+  bool bar = false;               // --bar: the bar method (docs/BENCHMARKS.md, "The bar method")
+  int bar_rays = 400000;          // --bar: the compatibility rays sampled for OctoMap
+  bool spacing_given = false;     // --spacing on the command line (--bar: 0.02 m otherwise)
   bool resolution_given = false;  // --resolution on the command line: an OctoMap is resampled to it
   int every = 4;
   std::string test = "surface";  // --visibility-only's selection test
@@ -238,6 +243,12 @@ void AddFlags(CLI::App& app, BenchOptions* o) {
                  "with --visibility-only: the sets' selection test (surface, subvoxel, or either with -per-voxel "
                  "for the per-ray engine); given, only the sets are timed")
       ->check(CLI::IsMember({"surface", "subvoxel", "surface-per-voxel", "subvoxel-per-voxel"}));
+  app.add_flag("--bar", o->bar,
+               "only the bar method: the plan of the scene (default hall at --spacing 0.02) twice, the second "
+               "timed, against OctoMap castRay on a sample of the compatibility rays of the plan's candidates, "
+               "extrapolated to all of them (docs/BENCHMARKS.md, \"The bar method\")");
+  app.add_option("--bar-rays", o->bar_rays, "with --bar: the compatibility rays sampled for OctoMap")
+      ->check(CLI::Range(1000, 100000000));
   app.add_flag("--all-targets", o->all_targets, "also time the SIMD batch kernel on every other instruction set");
   app.add_flag("--fine-eval", o->fine_eval,
                "only the fine evaluation: the hall sampled at 0.005 m, a 10-station plan evaluated at 0.01 m "
@@ -539,6 +550,219 @@ void PrintScaling(const LoadedScene& scene, const BenchOptions& o) {
   for (double g : {2.0, 1.0, 0.5}) std::printf("| %.2f | %.2f |\n", g, RunPlan(scene.input, o, g).seconds);
 }
 
+// The compatibility rays of a plan (ALGORITHM.md section 3, docs/VISIBILITY.md "Compatibility"):
+// for every candidate that can be a viewpoint (in range, not inside an occupied voxel) and every
+// occupied voxel with a free 6-neighbour whose centre passes the scanner's limits, the segment from
+// the candidate to the voxel's centre; the voxel is compatible iff it is the first occupied voxel on
+// it. (A voxel whose 6 neighbours are all occupied is never compatible, so neither method casts to
+// it.) `count` is exact; `sample` holds `sample_size` of them drawn uniformly with replacement.
+struct CompatibilityRays {
+  uint64_t count = 0, all_pairs = 0;  // the rays; every candidate x every occupied voxel
+  size_t valid_candidates = 0, testable_voxels = 0;
+  std::vector<std::pair<uint32_t, uint32_t>> sample;  // (candidate, voxel id)
+};
+
+CompatibilityRays CountCompatibilityRays(const vc::VoxelScene& s, const std::vector<vc::WorldPoint>& candidates,
+                                         const vc::ScannerModel& scanner, size_t sample_size) {
+  const vc::OccupancyGrid& g = s.grid;
+  CompatibilityRays r;
+  r.all_pairs = uint64_t(candidates.size()) * s.occupied.size();
+  std::vector<vc::VoxelIndex> index(s.occupied.size());
+  std::vector<uint32_t> testable;
+  for (size_t i = 0; i < s.occupied.size(); ++i) {
+    index[i] = g.WorldToIndex(s.Center(i));
+    const vc::VoxelIndex& v = index[i];
+    const bool enclosed = g.Occupied(v.x - 1, v.y, v.z) && g.Occupied(v.x + 1, v.y, v.z) &&
+                          g.Occupied(v.x, v.y - 1, v.z) && g.Occupied(v.x, v.y + 1, v.z) &&
+                          g.Occupied(v.x, v.y, v.z - 1) && g.Occupied(v.x, v.y, v.z + 1);
+    if (!enclosed) testable.push_back(uint32_t(i));
+  }
+  r.testable_voxels = testable.size();
+  std::vector<uint32_t> valid;
+  std::vector<vc::ScannerLimits> limits;
+  for (size_t k = 0; k < candidates.size(); ++k) {
+    if (!vc::ViewpointInRange(candidates[k], g.resolution_m()) || g.Occupied(g.WorldToIndex(candidates[k]))) continue;
+    valid.push_back(uint32_t(k));
+    limits.emplace_back(scanner, g.resolution_m(), g.WorldToIndexSpace(candidates[k]));
+  }
+  r.valid_candidates = valid.size();
+  auto passes = [&](size_t j, uint32_t id) {
+    const vc::ScannerLimits& l = limits[j];
+    if (!l.active()) return true;
+    const vc::VoxelIndex& v = index[id];
+    int axis = 0, sign = 1;
+    if (l.JudgesFace()) l.EntryFace(v, &axis, &sign);
+    return l.Passes(Eigen::Vector3d(v.x + 0.5, v.y + 0.5, v.z + 0.5), axis, sign);
+  };
+  for (size_t j = 0; j < valid.size(); ++j) {
+    if (!limits[j].active()) {
+      r.count += testable.size();
+      continue;
+    }
+    for (uint32_t id : testable) r.count += passes(j, id);
+  }
+  // Uniform over the rays: a uniform (candidate, testable voxel) pair, kept if it passes.
+  std::mt19937_64 rng(2014);
+  std::uniform_int_distribution<size_t> pick_c(0, valid.empty() ? 0 : valid.size() - 1);
+  std::uniform_int_distribution<size_t> pick_v(0, testable.empty() ? 0 : testable.size() - 1);
+  while (r.count > 0 && r.sample.size() < sample_size) {
+    const size_t j = pick_c(rng);
+    const uint32_t id = testable[pick_v(rng)];
+    if (passes(j, id)) r.sample.emplace_back(valid[j], id);
+  }
+  return r;
+}
+
+// CPU seconds (user and system) this process has used so far.
+double CpuSeconds() {
+  rusage ru{};
+  getrusage(RUSAGE_SELF, &ru);
+  return double(ru.ru_utime.tv_sec + ru.ru_stime.tv_sec) + 1e-6 * double(ru.ru_utime.tv_usec + ru.ru_stime.tv_usec);
+}
+
+// OctoMap castRay on the sampled rays with `threads` threads (each a contiguous share), each ray
+// from the candidate along the direction to the voxel's centre (normalised in float, as OctoMap
+// does), as far as the scene's diagonal (its first occupied voxel is the ray's answer: the voxel is
+// compatible iff it is that voxel). Then our FirstOccupied on the same segments: how many first hits differ
+// (the identity check), and how many rays' voxels are compatible. Returns castRay's rays/s.
+struct OctomapCompatibility {
+  double rays_per_s = 0;
+  double cpu_s_per_ray = 0;  // this process's CPU seconds over the rays cast
+  size_t differ = 0, compatible = 0;
+};
+
+OctomapCompatibility TimeOctomapCompatibility(const vc::VoxelScene& s, const octomap::OcTree& tree,
+                                              const std::vector<vc::WorldPoint>& candidates, const CompatibilityRays& r,
+                                              int threads) {
+  const size_t m = r.sample.size();
+  std::vector<Ray> rays(m);
+  std::vector<double> length(m);
+  const double diagonal_m = (s.BoundsMax() - s.BoundsMin()).norm();
+  for (size_t i = 0; i < m; ++i) {
+    const Eigen::Vector3f o = candidates[r.sample[i].first].cast<float>();  // OctoMap's point3d is float
+    const Eigen::Vector3f d = s.Center(r.sample[i].second).cast<float>() - o;
+    length[i] = diagonal_m;
+    rays[i] = {o.cast<double>(), (d / d.norm()).cast<double>()};
+  }
+  std::vector<vc::CastRayOutcome> theirs(m);
+  const double cpu0 = CpuSeconds();
+  const auto t0 = Clock::now();
+  std::vector<std::thread> pool;
+  for (int t = 0; t < threads; ++t) {
+    pool.emplace_back([&, t] {
+      for (size_t i = m * t / threads; i < m * (t + 1) / threads; ++i)
+        theirs[i] = vc::OctomapCastRay(tree, rays[i].origin, rays[i].direction, length[i]);
+    });
+  }
+  for (std::thread& t : pool) t.join();
+  OctomapCompatibility out;
+  out.rays_per_s = double(m) / Seconds(t0);
+  out.cpu_s_per_ray = (CpuSeconds() - cpu0) / double(m);
+  const Segments seg = [&] {
+    Segments all{std::vector<Eigen::Vector3d>(m), std::vector<Eigen::Vector3d>(m)};
+    for (size_t i = 0; i < m; ++i) {
+      all.a[i] = rays[i].origin * s.grid.inv_resolution();
+      all.b[i] = (rays[i].origin + rays[i].direction * length[i]) * s.grid.inv_resolution();
+    }
+    return all;
+  }();
+  for (size_t i = 0; i < m; ++i) {
+    const auto ours = vc::FirstOccupied(s.grid, seg.a[i], seg.b[i]);
+    const bool hit = theirs[i].kind == vc::CastRayOutcome::Kind::kHitOccupied;
+    out.differ += hit != ours.has_value() || (hit && vc::IndexToKey(*ours) != theirs[i].hit);
+    out.compatible += hit && theirs[i].hit == s.occupied[r.sample[i].second];
+  }
+  return out;
+}
+
+// vc::Plan of `input`, timed (wall and this process's CPU seconds); prints the error if it fails.
+std::optional<std::pair<TimedPlan, double>> TimedPlanRun(const vc::SceneInput& input, const vc::PlanOptions& po) {
+  const double cpu0 = CpuSeconds();
+  const auto t0 = Clock::now();
+  auto plan = vc::Plan(input, po);
+  if (!plan.ok()) {
+    std::fprintf(stderr, "vc-bench: %s\n", plan.status().ToString().c_str());
+    return std::nullopt;
+  }
+  const double wall = Seconds(t0);
+  return std::make_pair(TimedPlan{std::move(plan).value(), wall}, CpuSeconds() - cpu0);
+}
+
+// The bar method (docs/BENCHMARKS.md, "The bar method"): the whole vc::Plan of the scene twice
+// (the second is the figure), and OctoMap castRay on a sample of the first plan's compatibility
+// rays with as many threads as the plan, once between the two plans and once after the second;
+// the faster of the two rates is extrapolated to all the rays. Prints both, the ratio and the
+// second plan's stages.
+int BarMethod(const BenchOptions& o) {
+  std::printf("vc-bench --bar: scene %s at %.3f m spacing, plan defaults, %d threads (hardware: %u)\n", o.scene.c_str(),
+              o.spacing, o.threads, std::thread::hardware_concurrency());
+  auto t0 = Clock::now();
+  auto input = LoadScene(o.scene, o.spacing, 1);
+  if (!input.ok()) {
+    std::fprintf(stderr, "vc-bench: %s\n", input.status().ToString().c_str());
+    return 2;
+  }
+  std::printf("scene: %zu points, generated/read in %.2f s\n", input->points.size(), Seconds(t0));
+  vc::PlanOptions po;
+  po.threads = o.threads;
+  const auto first = TimedPlanRun(*input, po);
+  if (!first) return 2;
+  std::printf("first plan (cold): %.3f s\n", first->first.seconds);
+  const vc::PlanResult& cold = *first->first.plan;
+  auto voxels = vc::Voxelize(*input, {cold.resolution_m, po.memory_budget_bytes});
+  if (!voxels.ok()) {
+    std::fprintf(stderr, "vc-bench: %s\n", voxels.status().ToString().c_str());
+    return 2;
+  }
+  const std::vector<vc::WorldPoint>& candidates = cold.heat_map.positions;
+  t0 = Clock::now();
+  const CompatibilityRays rays = CountCompatibilityRays(*voxels, candidates, po.scanner, size_t(o.bar_rays));
+  std::printf(
+      "compatibility rays: %zu of %zu candidates valid x %zu of %zu occupied voxels testable (not enclosed), "
+      "within the scanner's limits: %llu rays (every candidate x every voxel: %llu); counted in %.2f s\n",
+      rays.valid_candidates, candidates.size(), rays.testable_voxels, voxels->occupied.size(),
+      (unsigned long long)rays.count, (unsigned long long)rays.all_pairs, Seconds(t0));
+  if (rays.count == 0) return 2;
+  auto tree = input->octree ? std::const_pointer_cast<octomap::OcTree>(input->octree)
+                            : vc::BuildOctree(voxels->resolution_m, voxels->occupied);
+  OctomapCompatibility om[2];
+  om[0] = TimeOctomapCompatibility(*voxels, *tree, candidates, rays, o.threads);
+  const auto second = TimedPlanRun(*input, po);
+  if (!second) return 2;
+  om[1] = TimeOctomapCompatibility(*voxels, *tree, candidates, rays, o.threads);
+  const vc::PlanResult& plan = *second->first.plan;
+  const double plan_s = second->first.seconds;
+  if (plan.heat_map.positions != candidates)
+    std::printf("NOTE: the second plan's candidates differ from the first's\n");
+  for (int r = 0; r < 2; ++r) {
+    std::printf(
+        "OctoMap castRay %s, %d threads: %zu sampled rays at %.0f rays/s, %zu of them to a compatible voxel; "
+        "first hits against FirstOccupied on the same segments: %zu differ%s\n",
+        r == 0 ? "before the second plan" : "after it", o.threads, rays.sample.size(), om[r].rays_per_s,
+        om[r].compatible, om[r].differ,
+        om[r].differ == 0 ? " (identical)"
+                          : " (rays from the candidates' lattice points meet exact ties, which the two break either "
+                            "way: docs/VISIBILITY.md, the tie rule)");
+  }
+  PrintPlan(plan, plan_s, o.threads);
+  const double rate = std::max(om[0].rays_per_s, om[1].rays_per_s);
+  const double octomap_s = double(rays.count) / rate;
+  std::printf("\n| the bar method | seconds |\n|---|---|\n");
+  std::printf(
+      "| OctoMap castRay, the %llu compatibility rays at the faster round's %.0f rays/s (%d threads) | %.1f |\n",
+      (unsigned long long)rays.count, rate, o.threads, octomap_s);
+  std::printf("| vc::Plan, second run, %d threads (voxelise to route; this process's CPU: %.1f s) | %.3f |\n",
+              o.threads, second->second, plan_s);
+  std::printf("| **ratio** | **%.1fx** |\n", octomap_s / plan_s);
+  // The same in CPU seconds (per core for both), which a loaded machine disturbs less than wall time.
+  const double cpu_per_ray = std::min(om[0].cpu_s_per_ray, om[1].cpu_s_per_ray);
+  std::printf("| CPU seconds: OctoMap %.1f (the faster round's %.3g s per ray), vc::Plan %.1f | ratio %.1fx |\n",
+              double(rays.count) * cpu_per_ray, cpu_per_ray, second->second,
+              double(rays.count) * cpu_per_ray / second->second);
+  std::printf("peak RSS: %.1f MiB\n", PeakRssMiB());
+  return 0;
+}
+
 // The rays, the plan and the scaling tables (as the flags select); 0 when the ray engines agree.
 int RunBench(const BenchOptions& o) {
   std::printf("vc-bench: scene %s, resolution %.3f m, candidate grid %.2f m, %d threads (hardware: %u)\n",
@@ -578,8 +802,13 @@ int main(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
   o.test_given = app.count("--test") > 0;
   o.resolution_given = app.count("--resolution") > 0;
+  o.spacing_given = app.count("--spacing") > 0;
   std::setvbuf(stdout, nullptr, _IOLBF, 0);  // figures appear as they are measured
   if (o.fine_eval) return FineEvaluation(o.threads);
+  if (o.bar) {
+    if (!o.spacing_given) o.spacing = 0.02;
+    return BarMethod(o);
+  }
   if (o.quick) ApplyQuick(&o);
   return RunBench(o);
 }

@@ -5,7 +5,7 @@
 #              slow: vc-server and vc-client end to end, the paper experiment), the `heavy` ones
 #              (CBC against exhaustive search on hundreds of instances, geb079's full plan: 15 times
 #              slower under ASan), the `meter` ones (resident memory, which ASan's quarantine hides)
-#              and vc-bench --quick, vc-route-bench --quick
+#              and vc-bench --quick (also --visibility-only and a small --bar), vc-route-bench --quick
 #   asan     - AddressSanitizer + UndefinedBehaviorSanitizer (clang++): every test except the `slow`
 #              and `heavy` labels (every other unit test runs here, once); the same build holds the
 #              libFuzzer targets
@@ -65,9 +65,10 @@ for p in "${presets[@]}"; do
         echo "=== preset $p: tests"
         ctest --preset "$p" -j2
       fi
-      echo "=== preset $p: vc-bench --quick, and --visibility-only (figures only, no timing assertions)"
+      echo "=== preset $p: vc-bench --quick, --visibility-only and a small --bar (figures only, no timing assertions)"
       "build/$p/bench/vc-bench" --quick
       "build/$p/bench/vc-bench" --quick --visibility-only --repeat 1
+      "build/$p/bench/vc-bench" --bar --scene rooms:3 --spacing 0.05 --bar-rays 2000
       "build/$p/bench/vc-route-bench" --quick
       ;;
   esac

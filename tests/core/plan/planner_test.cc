@@ -601,18 +601,25 @@ TEST(PlannerTest, ReductionBatchesJoinedAreTheFinalEvaluation) {
   PlanOptions o = TestOptions();
   o.target_coverage = 1.0;
   Result<PlanResult> one = Plan(Synthetic("comb:5"), o);
-  o.memory_budget_bytes = 16'000'000;  // cache budget 4 MB: the first batch is one station (2.1 MB worst case)
+  Result<VoxelScene> scene = Voxelize(Synthetic("comb:5"), {0.1, kDefaultMemoryBudgetBytes});
+  ASSERT_TRUE(scene.ok());
+  // The smallest budget that keeps the joined evaluation (half of it); the cache gets a quarter,
+  // 82 bytes per voxel: room for one station at the worst case (48 per voxel), so one per batch.
+  o.memory_budget_bytes = 2 * planner::ReductionJoinBytes(scene->occupied.size());
+  const planner::ReductionMemory memory = planner::ReductionMemoryFor(scene->occupied.size(), o.memory_budget_bytes);
+  ASSERT_TRUE(memory.keep_join);
+  const uint64_t worst_station_bytes = scene->occupied.size() * kFacesPerVoxel * 8;
   bool evaluation_counted = false;
   JobContext ctx;
   ctx.progress = [&](const ProgressEvent& e) { evaluation_counted |= e.stage == Stage::kEvaluation && e.total > 0; };
   Result<PlanResult> batched = Plan(Synthetic("comb:5"), o, ctx);
   ASSERT_TRUE(one.ok()) << one.status().ToString();
   ASSERT_TRUE(batched.ok()) << batched.status().ToString();
-  ASSERT_GE(batched->stations.size(), 3u);
+  // More stations than the first batch holds: at least two batches were joined.
+  ASSERT_GT(batched->stations.size() * worst_station_bytes, memory.cache_bytes);
   EXPECT_TRUE(batched->reduction.removed.empty());
   EXPECT_FALSE(evaluation_counted);
-  Result<VoxelScene> scene = Voxelize(Synthetic("comb:5"), {0.1, kDefaultMemoryBudgetBytes});
-  ASSERT_TRUE(scene.ok());
+  for (const std::string& w : batched->warnings) EXPECT_EQ(w.find("joined evaluation"), std::string::npos) << w;
   std::vector<WorldPoint> positions;
   for (const PlannedStation& st : batched->stations) positions.push_back(st.position);
   Result<Evaluation> fresh = Evaluate(*scene, positions, planner::StationEvaluateOptions(o));
@@ -629,6 +636,64 @@ TEST(PlannerTest, ReductionBatchesJoinedAreTheFinalEvaluation) {
     }
   }
   EXPECT_TRUE(batched->evaluation.best_values.empty());  // the join state is dropped once every station is in
+}
+
+// The joined evaluation is charged to half the budget (what the candidates' sets held); the cache
+// keeps its quarter (at most 1 GiB) either way.
+TEST(PlannerTest, ReductionMemoryChargesTheJoinedEvaluationToHalfTheBudget) {
+  EXPECT_EQ(planner::ReductionJoinBytes(1000), 2 * 1000 * (6 * (8 + 1 + 4) + 4));
+  const uint64_t join = planner::ReductionJoinBytes(1000);
+  planner::ReductionMemory m = planner::ReductionMemoryFor(1000, 2 * join);
+  EXPECT_TRUE(m.keep_join);
+  EXPECT_EQ(m.join_bytes, join);
+  EXPECT_EQ(m.cache_bytes, join / 2);
+  m = planner::ReductionMemoryFor(1000, 2 * join - 2);
+  EXPECT_FALSE(m.keep_join);
+  EXPECT_EQ(m.cache_bytes, (2 * join - 2) / 4);
+  m = planner::ReductionMemoryFor(1000, kDefaultMemoryBudgetBytes);
+  EXPECT_TRUE(m.keep_join);
+  EXPECT_EQ(m.cache_bytes, uint64_t{1} << 30);
+  // The default budget keeps the join up to 13 M voxels (2 GiB / 164 bytes).
+  EXPECT_TRUE(planner::ReductionMemoryFor(13'000'000, kDefaultMemoryBudgetBytes).keep_join);
+  EXPECT_FALSE(planner::ReductionMemoryFor(13'200'000, kDefaultMemoryBudgetBytes).keep_join);
+}
+
+// A budget too small for the joined evaluation: the reduction keeps none, says so, and the
+// evaluation stage evaluates the final stations, with the same result as the joined one.
+TEST(PlannerTest, ReductionWithoutRoomForTheJoinEvaluatesAgain) {
+  PlanOptions o = TestOptions();
+  o.target_coverage = 1.0;
+  Result<PlanResult> one = Plan(Synthetic("comb:5"), o);
+  Result<VoxelScene> scene = Voxelize(Synthetic("comb:5"), {0.1, kDefaultMemoryBudgetBytes});
+  ASSERT_TRUE(scene.ok());
+  // Just too small for the join; the cache (a quarter, 82 bytes per voxel) too small for two
+  // stations at the worst case (48 bytes per voxel each): batches of one, none joined.
+  o.memory_budget_bytes = 2 * planner::ReductionJoinBytes(scene->occupied.size()) - 8;
+  const planner::ReductionMemory memory = planner::ReductionMemoryFor(scene->occupied.size(), o.memory_budget_bytes);
+  ASSERT_FALSE(memory.keep_join);
+  ASSERT_GT(one->stations.size() * scene->occupied.size() * kFacesPerVoxel * 8, memory.cache_bytes);
+  bool evaluation_counted = false;
+  JobContext ctx;
+  ctx.progress = [&](const ProgressEvent& e) { evaluation_counted |= e.stage == Stage::kEvaluation && e.total > 0; };
+  Result<PlanResult> again = Plan(Synthetic("comb:5"), o, ctx);
+  ASSERT_TRUE(one.ok()) << one.status().ToString();
+  ASSERT_TRUE(again.ok()) << again.status().ToString();
+  ASSERT_TRUE(again->reduction.removed.empty());
+  EXPECT_TRUE(evaluation_counted);
+  const auto warning = std::find_if(again->warnings.begin(), again->warnings.end(), [](const std::string& w) {
+    return w.rfind("reduction: the joined evaluation of the stations (", 0) == 0;
+  });
+  ASSERT_NE(warning, again->warnings.end());
+  EXPECT_NE(warning->find("the evaluation stage evaluates the final stations again; a memory budget of"),
+            std::string::npos)
+      << *warning;
+  ASSERT_EQ(again->stations.size(), one->stations.size());
+  for (size_t k = 0; k < one->stations.size(); ++k) {
+    EXPECT_EQ(again->stations[k].position, one->stations[k].position) << k;
+  }
+  EXPECT_EQ(again->evaluation.overall.global_visibility, one->evaluation.overall.global_visibility);
+  EXPECT_EQ(again->evaluation.best_face_values, one->evaluation.best_face_values);
+  EXPECT_EQ(again->evaluation.sole_viewer, one->evaluation.sole_viewer);
 }
 
 TEST(PlannerTest, UserCandidatesWithADuplicateAreReducedToDistinctStations) {

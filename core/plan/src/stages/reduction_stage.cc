@@ -3,6 +3,7 @@
 #include <optional>
 #include <utility>
 
+#include "format.h"
 #include "vc/plan/reduction.h"
 #include "vc/plan/scan_graph.h"
 #include "vc/plan/stage_runner.h"
@@ -17,6 +18,19 @@ ReductionOutput KeepAllStations(size_t count) {
   return out;
 }
 
+uint64_t ReductionJoinBytes(uint64_t voxels) {
+  const uint64_t per_voxel = kFacesPerVoxel * (sizeof(double) + sizeof(uint8_t) + sizeof(float)) + sizeof(int32_t);
+  return 2 * voxels * per_voxel;
+}
+
+ReductionMemory ReductionMemoryFor(uint64_t voxels, uint64_t memory_budget_bytes) {
+  ReductionMemory m;
+  m.join_bytes = ReductionJoinBytes(voxels);
+  m.keep_join = m.join_bytes <= memory_budget_bytes / 2;
+  m.cache_bytes = std::min<uint64_t>(memory_budget_bytes / 4, uint64_t{1} << 30);
+  return m;
+}
+
 EvaluateOptions ReductionEvaluateOptions(const PlanOptions& options) {
   EvaluateOptions eval_options = StationEvaluateOptions(options);
   eval_options.keep_face_values = false;
@@ -28,11 +42,13 @@ EvaluateOptions ReductionEvaluateOptions(const PlanOptions& options) {
 // into sparse values (what each sees), which RunReduction keeps while they fit the cache budget
 // (otherwise it asks for them again after each removal). The first pass over all stations also
 // keeps the face values the evaluation stage needs, batch by batch, joined (JoinEvaluations) into
-// the evaluation of every station: the final evaluation if nothing is removed.
+// the evaluation of every station: the final evaluation if nothing is removed. That joined
+// evaluation is charged to the memory budget (ReductionMemoryFor: half of it); when it does not
+// fit, nothing is joined and the evaluation stage evaluates the final stations itself.
 Result<ReductionOutput> RunReductionStage(const ReductionInput& in, const PlanOptions& options, const JobContext& ctx) {
   const std::vector<WorldPoint>& stations = in.stations.positions;
   const uint64_t faces_total = in.scene.occupied.size() * kFacesPerVoxel;
-  const uint64_t cache_budget = std::min<uint64_t>(options.memory_budget_bytes / 4, uint64_t{1} << 30);
+  const ReductionMemory memory = ReductionMemoryFor(in.scene.occupied.size(), options.memory_budget_bytes);
   std::optional<Evaluation> all_evaluation;  // of the stations 0 .. joined - 1
   size_t joined = 0;
   ReductionOutput out;
@@ -58,7 +74,9 @@ Result<ReductionOutput> RunReductionStage(const ReductionInput& in, const PlanOp
     }
     // The first pass streams the stations in order, so a batch that starts at the next station
     // not joined yet belongs to it (a pass after a removal starts again from the first kept one).
-    const bool first_pass = !batch.empty() && static_cast<size_t>(batch.front()) == joined && joined < stations.size();
+    // Without room for the join state, only a batch of every station is kept (nothing to join).
+    const bool first_pass = !batch.empty() && static_cast<size_t>(batch.front()) == joined &&
+                            joined < stations.size() && (memory.keep_join || batch.size() == stations.size());
     eval_options.keep_face_values = first_pass;
     // The join state only where another batch will be joined on (one batch is the whole evaluation).
     eval_options.keep_join_state = first_pass && batch.size() < stations.size();
@@ -81,7 +99,7 @@ Result<ReductionOutput> RunReductionStage(const ReductionInput& in, const PlanOp
   ReductionRunOptions red_options;
   red_options.reduce_to = options.reduce_to;
   red_options.threads = options.threads;
-  red_options.cache_budget_bytes = cache_budget;
+  red_options.cache_budget_bytes = memory.cache_bytes;
   // Across replicas, every station in one call: the replicas split it into shards among them.
   red_options.batch_stations = in.face_values ? std::max<int>(1, int(stations.size())) : kReductionStationsPerBatch;
   red_options.fixed = in.stations.fixed;
@@ -113,6 +131,13 @@ Result<ReductionOutput> RunReductionStage(const ReductionInput& in, const PlanOp
     }
   }
   if (run.removed.empty() && joined == stations.size()) out.evaluation = std::move(all_evaluation);
+  if (!memory.keep_join && run.removed.empty() && !out.evaluation && !in.face_values) {
+    out.warnings.push_back("reduction: the joined evaluation of the stations (" + Num(memory.join_bytes / 1048576.0) +
+                           " MiB) does not fit in half the memory budget (" +
+                           Num(double(options.memory_budget_bytes / 2) / 1048576.0) +
+                           " MiB), so the evaluation stage evaluates the final stations again; a memory budget of " +
+                           Num(2.0 * double(memory.join_bytes) / 1048576.0) + " MiB or more avoids that");
+  }
   return out;
 }
 

@@ -204,6 +204,21 @@ inline constexpr int kReductionStationsPerBatch = 256;
 [[nodiscard]] EvaluateOptions ReductionEvaluateOptions(const PlanOptions& options);
 // Every one of `count` stations kept, nothing evaluated: the output when reduction does not run.
 [[nodiscard]] ReductionOutput KeepAllStations(size_t count);
+// The bytes the reduction's joined evaluation holds at its peak on a scene of `voxels` occupied
+// voxels: the evaluation joined so far and the batch being joined into it, each with the join
+// state (9 bytes per face), the face values (4 per face) and the sole viewers (4 per voxel).
+[[nodiscard]] uint64_t ReductionJoinBytes(uint64_t voxels);
+// The reduction's shares of the memory budget: the cache of the stations' values, a quarter (at
+// most 1 GiB, as before); the joined evaluation, the half that the candidates' visibility sets held
+// (selection frees them before the reduction starts). The joined evaluation is kept only if it fits
+// that half; otherwise the evaluation stage evaluates the final stations again (a warning says so),
+// which holds less: one evaluation, no join state.
+struct ReductionMemory {
+  bool keep_join = false;
+  uint64_t join_bytes = 0;   // ReductionJoinBytes of the scene
+  uint64_t cache_bytes = 0;  // the cache's share: a quarter of the budget, at most 1 GiB
+};
+[[nodiscard]] ReductionMemory ReductionMemoryFor(uint64_t voxels, uint64_t memory_budget_bytes);
 // Errors of Evaluate and RunReduction (CANCELLED / DEADLINE_EXCEEDED from ctx).
 [[nodiscard]] Result<ReductionOutput> RunReductionStage(const ReductionInput& in, const PlanOptions& options,
                                                         const JobContext& ctx);
