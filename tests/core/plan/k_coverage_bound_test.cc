@@ -148,7 +148,8 @@ TEST(KCoverageBoundTest, MaxKIsCappedByTheColumnsAndNothingAsked) {
   EXPECT_EQ(got[1].upper_bound, 7u);
   o.max_k = 0;
   EXPECT_TRUE(KCoverageBounds(p, o).empty());
-  EXPECT_TRUE(KCoverageBounds(KCoverageProblem{}, KCoverageOptions{3}).empty());
+  o.max_k = 3;
+  EXPECT_TRUE(KCoverageBounds(KCoverageProblem{}, o).empty());
 }
 
 }  // namespace

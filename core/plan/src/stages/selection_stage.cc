@@ -245,11 +245,11 @@ Result<SelectionOutput> RunSelectionStage(SelectionInput in, const PlanOptions& 
       in.callbacks.on_station(ps, static_cast<int>(k));
     }
   }
-  // The per-k bound in at most a twentieth of the selection's time so far, and at least half a
-  // second (docs/PLANNING.md, "The coverage curve"; docs/BENCHMARKS.md measures it).
+  // The per-k bound's steps and search in at most a twentieth of the selection's time so far, and
+  // at least 0.1 s (docs/PLANNING.md, "The coverage curve"; docs/BENCHMARKS.md measures it).
   const double selection_s = std::chrono::duration<double>(Clock::now() - start).count();
   VC_ASSIGN_OR_RETURN(out.best_coverage, BestCoverageOf(sets, fixed, static_cast<int>(out.selection.picks.size()),
-                                                        std::max(0.5, 0.05 * selection_s), ctx));
+                                                        std::max(0.1, 0.05 * selection_s), ctx));
   sets.clear();
   sets.shrink_to_fit();
   return out;
