@@ -134,12 +134,14 @@ std::unique_ptr<Selector> SelectorFor(const PlanOptions& options, double resolut
 }
 
 Result<std::vector<std::optional<BestCoverage>>> BestCoverageOf(const std::vector<VoxelSet>& sets, int fixed, int max_k,
-                                                                double seconds, const JobContext& ctx) {
+                                                                double seconds, uint64_t max_bytes,
+                                                                const JobContext& ctx) {
   std::vector<std::optional<BestCoverage>> out;
   if (max_k < 1 || static_cast<int>(sets.size()) <= fixed) return out;
   uint64_t pairs = 0;
   for (const VoxelSet& s : sets) pairs += CountBits(s);
-  if (pairs > kMaxBestCoveragePairs) return out;
+  const uint64_t voxels = sets.front().size();
+  if (pairs > kMaxBestCoveragePairs || 16 * pairs + 8 * voxels > max_bytes) return out;
   const Clock::time_point deadline =
       Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(seconds));
   const JobContext quiet{ctx.cancel, {}};  // the classes' progress is the exact selector's to report
@@ -246,10 +248,13 @@ Result<SelectionOutput> RunSelectionStage(SelectionInput in, const PlanOptions& 
     }
   }
   // The per-k bound's steps and search in at most a twentieth of the selection's time so far, and
-  // at least 0.1 s (docs/PLANNING.md, "The coverage curve"; docs/BENCHMARKS.md measures it).
+  // at least 0.1 s (docs/PLANNING.md, "The coverage curve"; docs/BENCHMARKS.md measures it); its
+  // classes in a quarter of the memory budget, beside the sets (half of it), the exact selector's
+  // model freed by now.
   const double selection_s = std::chrono::duration<double>(Clock::now() - start).count();
-  VC_ASSIGN_OR_RETURN(out.best_coverage, BestCoverageOf(sets, fixed, static_cast<int>(out.selection.picks.size()),
-                                                        std::max(0.1, 0.05 * selection_s), ctx));
+  VC_ASSIGN_OR_RETURN(out.best_coverage,
+                      BestCoverageOf(sets, fixed, static_cast<int>(out.selection.picks.size()),
+                                     std::max(0.1, 0.05 * selection_s), options.memory_budget_bytes / 4, ctx));
   sets.clear();
   sets.shrink_to_fit();
   return out;
