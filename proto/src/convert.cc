@@ -433,11 +433,18 @@ v1::CoveragePoint ToProto(const CoveragePoint& c) {
   p.set_coverable_fraction(c.coverable_fraction);
   p.set_scene_fraction(c.scene_fraction);
   p.set_setup_scan_s(c.setup_scan_s);
+  if (c.best_voxels_upper_bound) p.set_best_voxels_upper_bound(*c.best_voxels_upper_bound);
+  if (c.best_voxels) p.set_best_voxels(*c.best_voxels);
+  p.set_best_voxels_optimal(c.best_voxels_optimal);
   return p;
 }
 
 CoveragePoint FromProto(const v1::CoveragePoint& p) {
-  return {p.stations(), p.covered_voxels(), p.coverable_fraction(), p.scene_fraction(), p.setup_scan_s()};
+  CoveragePoint c{p.stations(), p.covered_voxels(), p.coverable_fraction(), p.scene_fraction(), p.setup_scan_s()};
+  if (p.has_best_voxels_upper_bound()) c.best_voxels_upper_bound = p.best_voxels_upper_bound();
+  if (p.has_best_voxels()) c.best_voxels = p.best_voxels();
+  c.best_voxels_optimal = p.best_voxels_optimal();
+  return c;
 }
 
 v1::StopReason ToProto(StopReason r) {

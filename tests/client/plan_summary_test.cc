@@ -142,6 +142,25 @@ TEST(CoverageTableTest, StationsSceneShareAndFieldTimeAtEachLevel) {
   EXPECT_NE(PlanSummary(KnownCurve()).find("      99 %   49.5%         5  13 min\n"), std::string::npos);
 }
 
+// With the per-k bound: the fewest stations any plan over the candidates needs for each level (one
+// station's bound, 82, already reaches 80 %; "-" where no bound reaches a level).
+TEST(CoverageTableTest, AnyPlanColumnFromThePerKBound) {
+  PlanResult r = KnownCurve();
+  AddBestCoverage(r.coverage_curve, {BestCoverage{82, 50}, BestCoverage{85, 80}, BestCoverage{93, 92},
+                                     BestCoverage{97, 96}, BestCoverage{99, 99}});
+  EXPECT_EQ(CoverageTable(r),
+            "  coverage   scene  stations   any plan  field time (set-up and scans)\n"
+            "      80 %   40.0%         2       >= 1  5 min\n"
+            "      90 %   46.0%         3       >= 3  8 min\n"
+            "      95 %   48.0%         4       >= 4  10 min\n"
+            "      99 %   49.5%         5       >= 5  13 min\n"
+            "  (any plan: no plan over these candidates reaches the level with fewer stations)\n");
+  r.coverage_curve.resize(4);  // the bound reaches 97 at most: 99 % gets "-"
+  EXPECT_NE(CoverageTable(r).find("      99 %       -         -          -  not reached by this plan\n"),
+            std::string::npos)
+      << CoverageTable(r);
+}
+
 TEST(StopLineTest, NamesTheRuleThatStoppedTheSelection) {
   PlanResult r = ThreeStations();
   r.stop_reason = StopReason::kTargetReached;

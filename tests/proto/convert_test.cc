@@ -163,7 +163,7 @@ PlanResult BigResult(size_t voxels, size_t candidates) {
   r.optimality.note = "n";
   r.optimality.local_candidates = {2, 90, {4, 3, 3}, {26912, 26912, 26912}};
   r.distribution = {3, 31, 2, 5000000000};
-  r.coverage_curve = {{1, 5, 0.5, 0.25, 165}, {2, 9, 0.9, 0.45, 330}};
+  r.coverage_curve = {{1, 5, 0.5, 0.25, 165}, {2, 9, 0.9, 0.45, 330, 10, 9, false}};
   r.unseen_causes = {1, 2, 3, 4, 5, 6, 7};
   return r;
 }
@@ -274,6 +274,11 @@ TEST(PlanResultChunks, ReassembleExactlyAndStayUnderOneMebibyte) {
   EXPECT_EQ(back->coverage_curve[1].coverable_fraction, 0.9);
   EXPECT_EQ(back->coverage_curve[1].scene_fraction, 0.45);
   EXPECT_EQ(back->coverage_curve[1].setup_scan_s, 330);
+  EXPECT_FALSE(back->coverage_curve[0].best_voxels_upper_bound);  // not computed stays absent
+  EXPECT_FALSE(back->coverage_curve[0].best_voxels);
+  EXPECT_EQ(back->coverage_curve[1].best_voxels_upper_bound, 10u);
+  EXPECT_EQ(back->coverage_curve[1].best_voxels, 9u);
+  EXPECT_FALSE(back->coverage_curve[1].best_voxels_optimal);
   EXPECT_EQ(back->unseen_causes.interior, 1u);
   EXPECT_EQ(back->unseen_causes.in_keep_out, 2u);
   EXPECT_EQ(back->unseen_causes.no_candidate_on_floor, 3u);

@@ -14,9 +14,24 @@
 #include <cstdint>
 #include <vector>
 
+#include "vc/base/progress.h"
+#include "vc/base/status.h"
+#include "vc/visibility/voxel_set.h"
+
 class OsiClpSolverInterface;
 
 namespace vc::planner::internal {
+
+// The coverable voxels partitioned into classes seen by exactly the same candidates (partition
+// refinement: each candidate splits the classes it touches), with each class's candidates.
+struct Classes {
+  std::vector<uint64_t> weight;           // voxels per class
+  std::vector<std::vector<int>> seen_by;  // per class: candidates seeing it, ascending
+  std::vector<std::vector<int>> sees;     // per candidate: classes it sees, ascending
+};
+// The classes of `sets` (one per candidate), reported as "exact: voxel classes" progress of the
+// selection stage; CANCELLED from ctx.
+Result<Classes> BuildClasses(const std::vector<VoxelSet>& sets, const JobContext& ctx);
 
 // A run of consecutive rows or columns of one kind; count 0 where the model has none of them.
 struct Block {

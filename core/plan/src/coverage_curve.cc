@@ -1,5 +1,7 @@
 #include "vc/plan/coverage_curve.h"
 
+#include <algorithm>
+
 namespace vc {
 
 std::vector<CoveragePoint> CoverageCurve(const std::vector<uint64_t>& marginal_gains_voxels, uint64_t occupied_voxels,
@@ -20,15 +22,30 @@ std::vector<CoveragePoint> CoverageCurve(const std::vector<uint64_t>& marginal_g
   return curve;
 }
 
+void AddBestCoverage(std::vector<CoveragePoint>& curve, const std::vector<std::optional<BestCoverage>>& best) {
+  for (size_t k = 0; k < curve.size() && k < best.size(); ++k) {
+    if (!best[k]) continue;
+    CoveragePoint& p = curve[k];
+    p.best_voxels_upper_bound = best[k]->upper_bound_voxels;  // >= covered_voxels: the plan's k are k stations
+    p.best_voxels = std::max(best[k]->best_voxels, p.covered_voxels);
+    p.best_voxels_optimal = *p.best_voxels == *p.best_voxels_upper_bound;
+  }
+}
+
 std::vector<CoverageMilestone> CoverageMilestones(const std::vector<CoveragePoint>& curve, uint64_t coverable_voxels,
                                                   const std::vector<double>& levels) {
   std::vector<CoverageMilestone> out;
   out.reserve(levels.size());
   for (double level : levels) {
-    CoverageMilestone m{level, std::nullopt};
+    CoverageMilestone m{level, std::nullopt, std::nullopt};
+    const auto reaches = [&](uint64_t voxels) {
+      return coverable_voxels > 0 && static_cast<double>(voxels) >= level * static_cast<double>(coverable_voxels);
+    };
     for (const CoveragePoint& p : curve) {
-      if (coverable_voxels > 0 &&
-          static_cast<double>(p.covered_voxels) >= level * static_cast<double>(coverable_voxels)) {
+      if (!m.fewest_possible_stations && p.best_voxels_upper_bound && reaches(*p.best_voxels_upper_bound)) {
+        m.fewest_possible_stations = p.stations;
+      }
+      if (reaches(p.covered_voxels)) {
         m.reached = p;
         break;
       }

@@ -34,6 +34,8 @@
 namespace vc::planner {
 namespace {
 
+using internal::BuildClasses;
+using internal::Classes;
 using internal::CoverModel;
 using internal::ReducedModel;
 using internal::ScanArc;
@@ -59,77 +61,6 @@ uint64_t TargetVoxels(double target, uint64_t coverable) {
   while (k > 0 && static_cast<double>(k - 1) >= t) --k;
   while (static_cast<double>(k) < t) ++k;
   return std::min(k, coverable);
-}
-
-// The coverable voxels partitioned into classes seen by exactly the same candidates (partition
-// refinement: each candidate splits the classes it touches), with each class's candidates.
-struct Classes {
-  std::vector<uint64_t> weight;           // voxels per class
-  std::vector<std::vector<int>> seen_by;  // per class: candidates seeing it, ascending
-  std::vector<std::vector<int>> sees;     // per candidate: classes it sees, ascending
-};
-
-Result<Classes> BuildClasses(const std::vector<VoxelSet>& sets, const JobContext& ctx) {
-  const size_t n_voxels = sets.empty() ? 0 : sets[0].size();
-  // Class 0 = seen by no candidate so far; ids grow as candidates split classes.
-  std::vector<int32_t> cls(n_voxels, 0);
-  std::vector<int32_t> remap(1, -1), stamp(1, -1);
-  int32_t next = 1;
-  // Two passes over the candidates, counted as one.
-  const uint64_t steps = 2 * sets.size();
-  internal::ProgressPacer pacer;
-  auto report = [&](uint64_t done) {
-    if (!pacer.Due()) return;
-    std::string note = "exact: voxel classes";
-    if (const std::string left = pacer.TimeLeft(done, steps); !left.empty()) note += ", " + left;
-    ctx.ReportCount(Stage::kSelection, done, steps, "candidate passes", std::move(note));
-  };
-  for (size_t c = 0; c < sets.size(); ++c) {
-    if (c % 64 == 0) {
-      VC_RETURN_IF_ERROR(ctx.CheckCancelled("exact selection (voxel classes)"));
-      report(c);
-    }
-    ForEachBit(sets[c], [&](size_t v) {
-      const int32_t old = cls[v];
-      if (stamp[old] != static_cast<int32_t>(c)) {
-        stamp[old] = static_cast<int32_t>(c);
-        remap[old] = next++;
-        remap.push_back(-1);
-        stamp.push_back(-1);
-      }
-      cls[v] = remap[old];
-    });
-  }
-  // Compact the ids that still hold voxels (class 0 holds the uncoverable ones).
-  std::vector<int32_t> compact(next, -1);
-  Classes out;
-  for (size_t v = 0; v < n_voxels; ++v) {
-    const int32_t k = cls[v];
-    if (k == 0) continue;
-    if (compact[k] < 0) {
-      compact[k] = static_cast<int32_t>(out.weight.size());
-      out.weight.push_back(0);
-    }
-    ++out.weight[compact[k]];
-  }
-  out.seen_by.resize(out.weight.size());
-  out.sees.resize(sets.size());
-  std::vector<int32_t> last(out.weight.size(), -1);
-  for (size_t c = 0; c < sets.size(); ++c) {
-    if (c % 64 == 0) {
-      VC_RETURN_IF_ERROR(ctx.CheckCancelled("exact selection (voxel classes)"));
-      report(sets.size() + c);
-    }
-    ForEachBit(sets[c], [&](size_t v) {
-      const int32_t k = compact[cls[v]];
-      if (last[k] == static_cast<int32_t>(c)) return;
-      last[k] = static_cast<int32_t>(c);
-      out.seen_by[k].push_back(static_cast<int>(c));
-      out.sees[c].push_back(k);
-    });
-    std::sort(out.sees[c].begin(), out.sees[c].end());
-  }
-  return out;
 }
 
 // Completes `m` once the reduction is done: resolves chains of stand-ins to a column or a forced

@@ -106,6 +106,21 @@ std::optional<std::string> ScanGraphWarning(const ScanGraph& graph) {
          "(a finer grid_spacing_m, user candidates), or lower min_overlap";
 }
 
+// The selection's per-k bound (SelectionOutput::best_coverage) on the plan's curve where it bounds
+// the plan's prefixes: it is over the selection's candidates and coverable voxels, so it holds while
+// the final stations are among them (not after refinement, which moves them and grows the coverable
+// set) and the fixed stations lead the plan, as the bound counts them.
+void AddBestCoverageWhereValid(PlanResult& result, const std::vector<std::optional<BestCoverage>>& best,
+                               const PlanOptions& options) {
+  const size_t n_fixed = options.fixed_stations.size();
+  const auto is_fixed = [](const PlannedStation& s) { return s.fixed; };
+  const bool fixed_lead =
+      std::count_if(result.stations.begin(), result.stations.end(), is_fixed) == static_cast<std::ptrdiff_t>(n_fixed) &&
+      std::all_of(result.stations.begin(), result.stations.begin() + std::min(n_fixed, result.stations.size()),
+                  is_fixed);
+  if (!options.refine && fixed_lead) AddBestCoverage(result.coverage_curve, best);
+}
+
 }  // namespace
 
 FieldTime ComputeFieldTime(size_t stations, double walk_m, const PlanOptions& options) {
@@ -185,6 +200,7 @@ Result<PlanResult> Plan(const SceneInput& input, const PlanOptions& options, con
   result.optimality = selected.selection.optimality;
   if (!result.optimality.note.empty()) result.warnings.push_back(result.optimality.note);
   for (std::string& w : selected.warnings) result.warnings.push_back(std::move(w));
+  const std::vector<std::optional<BestCoverage>> best_coverage = std::move(selected.best_coverage);
   planner::Stations stations = std::move(selected.stations);
   VoxelSet coverable = std::move(selected.coverable);
 
@@ -264,6 +280,7 @@ Result<PlanResult> Plan(const SceneInput& input, const PlanOptions& options, con
   for (const PlannedStation& s : result.stations) gains.push_back(s.marginal_gain);
   result.coverage_curve = CoverageCurve(gains, result.occupied_voxels, result.coverable_voxels,
                                         local_options.setup_seconds + result.field_time.scan_seconds_per_station);
+  AddBestCoverageWhereValid(result, best_coverage, local_options);
   result.timings = runner.timings();
   result.total_seconds = runner.elapsed_seconds();
   return result;

@@ -760,29 +760,39 @@ Json UnseenCausesJson(const UnseenCauses& u) {
               {"hidden", u.hidden}};
 }
 
-// plan.json's `coverage_curve`: one point per station (vc/plan/coverage_curve.h).
+// plan.json's `coverage_curve`: one point per station (vc/plan/coverage_curve.h), with the best k
+// stations' bound and the most found where computed (absent otherwise).
 Json CoverageCurveJson(const std::vector<CoveragePoint>& curve) {
   Json out = Json::array();
   for (const CoveragePoint& c : curve) {
-    out.push_back({{"stations", c.stations},
-                   {"covered_voxels", c.covered_voxels},
-                   {"coverable_fraction", c.coverable_fraction},
-                   {"scene_fraction", c.scene_fraction},
-                   {"setup_scan_s", c.setup_scan_s}});
+    Json p = {{"stations", c.stations},
+              {"covered_voxels", c.covered_voxels},
+              {"coverable_fraction", c.coverable_fraction},
+              {"scene_fraction", c.scene_fraction},
+              {"setup_scan_s", c.setup_scan_s}};
+    if (c.best_voxels_upper_bound) {
+      p["best_voxels_upper_bound"] = *c.best_voxels_upper_bound;
+      p["best_voxels"] = c.best_voxels.value_or(c.covered_voxels);
+      p["best_voxels_optimal"] = c.best_voxels_optimal;
+    }
+    out.push_back(std::move(p));
   }
   return out;
 }
 
 // plan.json's `coverage_milestones`: the stations needed for 80, 90, 95 and 99 % of the coverable
-// voxels, with the scene's share and the set-up and scan time there (stations null: never reached).
+// voxels, with the scene's share and the set-up and scan time there (stations null: never reached),
+// and the fewest stations any plan needs for the level by the per-k bound (null: no bound reaches it).
 Json CoverageMilestonesJson(const PlanResult& r) {
   Json out = Json::array();
   const std::vector<double> levels(std::begin(kCoverageMilestones), std::end(kCoverageMilestones));
   for (const CoverageMilestone& m : CoverageMilestones(r.coverage_curve, r.coverable_voxels, levels)) {
-    out.push_back({{"coverable_fraction", m.coverable_fraction},
-                   {"stations", m.reached ? Json(m.reached->stations) : Json(nullptr)},
-                   {"scene_fraction", m.reached ? Json(m.reached->scene_fraction) : Json(nullptr)},
-                   {"setup_scan_s", m.reached ? Json(m.reached->setup_scan_s) : Json(nullptr)}});
+    out.push_back(
+        {{"coverable_fraction", m.coverable_fraction},
+         {"stations", m.reached ? Json(m.reached->stations) : Json(nullptr)},
+         {"scene_fraction", m.reached ? Json(m.reached->scene_fraction) : Json(nullptr)},
+         {"setup_scan_s", m.reached ? Json(m.reached->setup_scan_s) : Json(nullptr)},
+         {"fewest_possible_stations", m.fewest_possible_stations ? Json(*m.fewest_possible_stations) : Json(nullptr)}});
   }
   return out;
 }

@@ -418,7 +418,20 @@ std::string CoverageCurveSvg(const PlanResult& r) {
          " " + Fixed(-sy, 6) + ")\"><polyline id=\"coverage-points\" vector-effect=\"non-scaling-stroke\" points=\"0,0";
   for (const CoveragePoint& c : curve)
     svg += " " + std::to_string(c.stations) + "," + Fixed(100 * c.coverable_fraction, 3);
-  svg += "\"/></g>\n";
+  svg += "\"/>";
+  // The per-k bound, dashed: no k stations over these candidates cover more (absent: not computed).
+  std::string bound;
+  for (const CoveragePoint& c : curve) {
+    if (c.best_voxels_upper_bound && r.coverable_voxels > 0)
+      bound += " " + std::to_string(c.stations) + "," +
+               Fixed(100.0 * static_cast<double>(*c.best_voxels_upper_bound) / r.coverable_voxels, 3);
+  }
+  if (!bound.empty())
+    svg += "<polyline id=\"coverage-bound\" vector-effect=\"non-scaling-stroke\" points=\"" + bound.substr(1) + "\"/>";
+  svg += "</g>\n";
+  if (!bound.empty())
+    svg += "<text class=\"legend\" x=\"" + px(n) + "\" y=\"" + py(8) +
+           "\" text-anchor=\"end\">dashed: the most any plan of k stations can cover</text>\n";
   std::string list = "<ul id=\"milestones\">\n";
   const std::vector<double> levels(std::begin(kCoverageMilestones), std::end(kCoverageMilestones));
   // One mark per station count reached, naming every level it reaches (90, 95 and 99 % often fall
@@ -435,7 +448,11 @@ std::string CoverageCurveSvg(const PlanResult& r) {
     marks.back().second.push_back(level);
     list += "<li>" + level + " % of what can be covered: " + std::to_string(c.stations) + " station" +
             (c.stations == 1 ? "" : "s") + " (" + Fixed(100 * c.scene_fraction, 1) +
-            " % of the whole scene; setting up and scanning them about " + Duration(c.setup_scan_s) + ")</li>\n";
+            " % of the whole scene; setting up and scanning them about " + Duration(c.setup_scan_s) + ")" +
+            (m.fewest_possible_stations ? "; no plan over these candidates reaches it with fewer than " +
+                                              std::to_string(*m.fewest_possible_stations) + " stations"
+                                        : "") +
+            "</li>\n";
   }
   for (const auto& [c, marked_levels] : marks) {
     std::string data_levels, label;

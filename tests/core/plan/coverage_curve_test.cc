@@ -44,5 +44,31 @@ TEST(CoverageMilestonesTest, TheFewestLeadingStationsReachingEachLevel) {
   EXPECT_DOUBLE_EQ(m[0].coverable_fraction, 0.80);
 }
 
+// The per-k bound: set where given (none past its end or where nullopt), best at least the plan's
+// own prefix, optimal where the two meet; the milestones' fewest possible stations is the first k
+// whose bound reaches the level.
+TEST(CoverageCurveTest, BestCoverageAndTheFewestStationsAnyPlanNeeds) {
+  std::vector<CoveragePoint> c = CoverageCurve({60, 25, 10, 3}, 200, 100, 60);
+  AddBestCoverage(c, {BestCoverage{70, 65}, std::nullopt, BestCoverage{96, 96}});
+  ASSERT_TRUE(c[0].best_voxels_upper_bound && c[0].best_voxels);
+  EXPECT_EQ(*c[0].best_voxels_upper_bound, 70u);
+  EXPECT_EQ(*c[0].best_voxels, 65u);
+  EXPECT_FALSE(c[0].best_voxels_optimal);
+  EXPECT_FALSE(c[1].best_voxels_upper_bound);
+  EXPECT_FALSE(c[1].best_voxels);
+  EXPECT_EQ(*c[2].best_voxels, 96u);  // above the plan's 95
+  EXPECT_TRUE(c[2].best_voxels_optimal);
+  EXPECT_FALSE(c[3].best_voxels_upper_bound);
+  std::vector<CoveragePoint> prefix_best = CoverageCurve({60}, 200, 100, 60);
+  AddBestCoverage(prefix_best, {BestCoverage{62, 55}});
+  EXPECT_EQ(*prefix_best[0].best_voxels, 60u);  // the plan's own 60 beats the 55 found
+
+  const std::vector<CoverageMilestone> m = CoverageMilestones(c, 100, {0.60, 0.90, 0.99});
+  EXPECT_EQ(m[0].fewest_possible_stations, 1);  // 70 >= 60
+  EXPECT_EQ(m[1].fewest_possible_stations, 3);  // k = 2 carries no bound; 96 >= 90
+  EXPECT_FALSE(m[2].fewest_possible_stations);  // no bound reaches 99
+  EXPECT_FALSE(CoverageMilestones(CoverageCurve({60}, 200, 100, 60), 100, {0.5})[0].fewest_possible_stations);
+}
+
 }  // namespace
 }  // namespace vc

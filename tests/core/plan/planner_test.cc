@@ -1197,6 +1197,49 @@ TEST(PlannerTest, CoverageCurveAgreesWithTheStationsAndStationsCsv) {
   }
 }
 
+// The per-k bound on the curve (vc/plan/k_coverage_bound.h): every point carries it, the plan's
+// prefix <= the best found <= the bound <= the coverable voxels, both monotone in k; a fixed
+// station counts as given (one station: exactly its own voxels, proven); refinement moves stations
+// off the candidates the bound is over, so a refined plan carries none.
+void ExpectValidBestCoverage(const PlanResult& r) {
+  uint64_t bound_before = 0, best_before = 0;
+  for (const CoveragePoint& c : r.coverage_curve) {
+    ASSERT_TRUE(c.best_voxels_upper_bound && c.best_voxels) << c.stations;
+    EXPECT_LE(c.covered_voxels, *c.best_voxels) << c.stations;
+    EXPECT_LE(*c.best_voxels, *c.best_voxels_upper_bound) << c.stations;
+    EXPECT_LE(*c.best_voxels_upper_bound, r.coverable_voxels) << c.stations;
+    EXPECT_GE(*c.best_voxels_upper_bound, bound_before) << c.stations;
+    EXPECT_GE(*c.best_voxels, best_before) << c.stations;
+    EXPECT_EQ(c.best_voxels_optimal, *c.best_voxels == *c.best_voxels_upper_bound) << c.stations;
+    bound_before = *c.best_voxels_upper_bound, best_before = *c.best_voxels;
+  }
+}
+
+TEST(PlannerTest, CoverageCurveCarriesTheBestKStationBound) {
+  PlanOptions o = TestOptions();
+  o.grid_spacing_m = 2.0;
+  Result<PlanResult> r = Plan(Synthetic("rooms:3"), o);
+  ASSERT_TRUE(r.ok()) << r.status().ToString();
+  ASSERT_GE(r->coverage_curve.size(), 2u);
+  ExpectValidBestCoverage(*r);
+  // The plan reaches the coverable voxels, so the bound does by then at the latest.
+  EXPECT_EQ(*r->coverage_curve.back().best_voxels_upper_bound, r->coverable_voxels);
+
+  o.fixed_stations = {r->stations.back().position};
+  Result<PlanResult> fixed = Plan(Synthetic("rooms:3"), o);
+  ASSERT_TRUE(fixed.ok()) << fixed.status().ToString();
+  ASSERT_TRUE(fixed->stations[0].fixed);
+  ExpectValidBestCoverage(*fixed);
+  EXPECT_EQ(*fixed->coverage_curve[0].best_voxels_upper_bound, fixed->coverage_curve[0].covered_voxels);
+  EXPECT_TRUE(fixed->coverage_curve[0].best_voxels_optimal);
+
+  o.fixed_stations.clear();
+  o.refine = true;
+  Result<PlanResult> refined = Plan(Synthetic("rooms:3"), o);
+  ASSERT_TRUE(refined.ok()) << refined.status().ToString();
+  for (const CoveragePoint& c : refined->coverage_curve) EXPECT_FALSE(c.best_voxels_upper_bound) << c.stations;
+}
+
 // Greedy's own gains to every last voxel (no consolidation, no reduction), 3 minutes a station,
 // no gain rule yet: the gain-rule tests below set one.
 PlanOptions GainRuleTestOptions() {

@@ -195,6 +195,29 @@ TEST(SelectionStageTest, TurnsAnySelectorsPicksIntoStationsAndReportsEach) {
   EXPECT_FALSE(reported[0].fixed);
 }
 
+// The per-k bound over sets with a fixed station first: k = 1 is the fixed station alone (its 4
+// voxels, proven), then the best candidates added to it; none where the classes would exceed the
+// memory given.
+TEST(SelectionStageTest, BestCoverageOfCountsTheFixedStationsAsGiven) {
+  std::vector<VoxelSet> sets(4, VoxelSet(12));
+  for (int v = 0; v < 4; ++v) sets[0].set(v);   // fixed
+  for (int v = 2; v < 8; ++v) sets[1].set(v);   // adds 4
+  for (int v = 8; v < 11; ++v) sets[2].set(v);  // adds 3
+  for (int v = 0; v < 6; ++v) sets[3].set(v);   // adds 2
+  Result<std::vector<std::optional<BestCoverage>>> b = BestCoverageOf(sets, 1, 3, 1.0, uint64_t{1} << 30, {});
+  ASSERT_TRUE(b.ok()) << b.status().ToString();
+  ASSERT_EQ(b->size(), 3u);
+  const uint64_t expected[] = {4, 8, 11};
+  for (size_t k = 0; k < 3; ++k) {
+    ASSERT_TRUE((*b)[k]) << k;
+    EXPECT_EQ((*b)[k]->upper_bound_voxels, expected[k]) << k;
+    EXPECT_EQ((*b)[k]->best_voxels, expected[k]) << k;
+  }
+  Result<std::vector<std::optional<BestCoverage>>> small = BestCoverageOf(sets, 1, 3, 1.0, 100, {});
+  ASSERT_TRUE(small.ok());
+  EXPECT_TRUE(small->empty());
+}
+
 // Sets over 12 voxels: the fixed station sees 0-3, candidates see 4-7, 8-11, 0-5 and 2-3.
 std::vector<VoxelSet> FixedAndCandidates() {
   std::vector<VoxelSet> sets(5, VoxelSet(12));

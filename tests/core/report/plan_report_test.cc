@@ -203,6 +203,25 @@ TEST(PlanReportTest, PlanJsonHasTheCoverageCurveAndItsMilestones) {
   j = json::parse(PlanToJson(r));
   EXPECT_TRUE(j["coverage_milestones"][0]["stations"].is_null());
   EXPECT_TRUE(j["coverage_milestones"][0]["scene_fraction"].is_null());
+  EXPECT_TRUE(j["coverage_milestones"][0]["fewest_possible_stations"].is_null());
+  EXPECT_FALSE(j["coverage_curve"][0].contains("best_voxels_upper_bound"));  // not computed: absent
+}
+
+// The per-k bound and the best found in each point, and the fewest stations any plan needs per level.
+TEST(PlanReportTest, PlanJsonHasTheBestKStationCoverageAndItsBound) {
+  PlanResult r = SamplePlan();
+  r.coverage_curve = CoverageCurve({3, 1}, 5, 4, 146);
+  AddBestCoverage(r.coverage_curve, {BestCoverage{4, 3}, BestCoverage{4, 4}});
+  const json j = json::parse(PlanToJson(r));
+  EXPECT_EQ(j["coverage_curve"][0]["best_voxels_upper_bound"], 4);
+  EXPECT_EQ(j["coverage_curve"][0]["best_voxels"], 3);
+  EXPECT_EQ(j["coverage_curve"][0]["best_voxels_optimal"], false);
+  EXPECT_EQ(j["coverage_curve"][1]["best_voxels_optimal"], true);
+  // The bound of 1 station (4 of 4) reaches every level; the plan needs 2.
+  for (const json& m : j["coverage_milestones"]) {
+    EXPECT_EQ(m["fewest_possible_stations"], 1) << m;
+    EXPECT_EQ(m["stations"], 2) << m;
+  }
 }
 
 // The gain rule that ran: its parameter and value, and one station's threshold in voxels

@@ -388,6 +388,23 @@ TEST(ReportHtmlTest, CoverageCurveHoldsEveryPointAndMarksTheMilestones) {
   EXPECT_EQ(items[3], "99 % of what can be covered: not reached by this plan");
 }
 
+// The per-k bound as a second, dashed line and, per milestone, the fewest stations any plan needs.
+TEST(ReportHtmlTest, CoverageCurveDrawsThePerKBound) {
+  PlanResult plan = BlockPlan();
+  plan.coverage_curve = CoverageCurve({10, 6, 2}, 24, 20, 30);  // 50, 80, 90 %
+  const std::string without = PlanToHtml(plan);
+  EXPECT_EQ(without.find("coverage-bound\""), std::string::npos);
+  AddBestCoverage(plan.coverage_curve, {BestCoverage{12, 10}, BestCoverage{17, 16}, BestCoverage{19, 18}});
+  const std::string html = PlanToHtml(plan);
+  const std::string svg = Between(html, "<svg id=\"coverage-curve\"", "</svg>");
+  EXPECT_EQ(Between(svg, "<polyline id=\"coverage-bound\" vector-effect=\"non-scaling-stroke\" points=\"", "\""),
+            "1,60.000 2,85.000 3,95.000");
+  const std::vector<std::string> items = Texts(Between(html, "<ul id=\"milestones\">", "</ul>"), "li");
+  ASSERT_EQ(items.size(), 4u);
+  EXPECT_NE(items[0].find("no plan over these candidates reaches it with fewer than 2 stations"), std::string::npos)
+      << items[0];
+}
+
 TEST(ReportHtmlTest, WithoutACoverageCurveThePageSaysSo) {
   const std::string html = PlanToHtml(BlockPlan());
   EXPECT_EQ(html.find("<svg"), std::string::npos);

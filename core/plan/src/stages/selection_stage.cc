@@ -6,9 +6,11 @@
 #include <utility>
 #include <vector>
 
+#include "cover_model.h"
 #include "vc/plan/candidates.h"
 #include "vc/plan/exact_selector.h"
 #include "vc/plan/greedy.h"
+#include "vc/plan/k_coverage_bound.h"
 #include "vc/plan/keep_out.h"
 #include "vc/plan/local_refinement.h"
 #include "vc/plan/planner.h"
@@ -131,7 +133,47 @@ std::unique_ptr<Selector> SelectorFor(const PlanOptions& options, double resolut
   return std::make_unique<ExactSelector>(ExactOptionsFor(options, resolution_m));
 }
 
+Result<std::vector<std::optional<BestCoverage>>> BestCoverageOf(const std::vector<VoxelSet>& sets, int fixed, int max_k,
+                                                                double seconds, uint64_t max_bytes,
+                                                                const JobContext& ctx) {
+  std::vector<std::optional<BestCoverage>> out;
+  if (max_k < 1 || static_cast<int>(sets.size()) <= fixed) return out;
+  uint64_t pairs = 0;
+  for (const VoxelSet& s : sets) pairs += CountBits(s);
+  const uint64_t voxels = sets.front().size();
+  if (pairs > kMaxBestCoveragePairs || 16 * pairs + 8 * voxels > max_bytes) return out;
+  const Clock::time_point deadline =
+      Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(seconds));
+  const JobContext quiet{ctx.cancel, {}};  // the classes' progress is the exact selector's to report
+  VC_ASSIGN_OR_RETURN(internal::Classes cl, internal::BuildClasses(sets, quiet));
+  KCoverageProblem problem;
+  problem.columns = static_cast<int>(sets.size()) - fixed;
+  uint64_t given = 0;  // the fixed stations' voxels
+  for (size_t i = 0; i < cl.weight.size(); ++i) {
+    if (cl.seen_by[i].front() < fixed) {  // ascending: a fixed station sees it
+      given += cl.weight[i];
+      continue;
+    }
+    problem.weight.push_back(cl.weight[i]);
+    std::vector<int> seen;
+    for (int c : cl.seen_by[i]) seen.push_back(c - fixed);
+    problem.seen_by.push_back(std::move(seen));
+  }
+  cl = {};
+  KCoverageOptions options;
+  options.max_k = max_k - fixed;
+  options.deadline = deadline;
+  const std::vector<KCoverage> bounds = KCoverageBounds(problem, options);
+  out.assign(static_cast<size_t>(max_k), std::nullopt);
+  if (fixed > 0) out[fixed - 1] = BestCoverage{given, given};
+  for (size_t k = 0; k < bounds.size(); ++k) {
+    out[fixed + k] = BestCoverage{given + bounds[k].upper_bound, given + bounds[k].best};
+  }
+  return out;
+}
+
 Result<SelectionOutput> RunSelectionStage(SelectionInput in, const PlanOptions& options, const JobContext& ctx) {
+  const Clock::time_point start = Clock::now();
   SelectionOutput out;
   // The fixed stations' sets first: the selector starts with them picked.
   const int fixed = static_cast<int>(in.fixed_sets.size());
@@ -205,6 +247,14 @@ Result<SelectionOutput> RunSelectionStage(SelectionInput in, const PlanOptions& 
       in.callbacks.on_station(ps, static_cast<int>(k));
     }
   }
+  // The per-k bound's steps and search in at most a twentieth of the selection's time so far, and
+  // at least 0.1 s (docs/PLANNING.md, "The coverage curve"; docs/BENCHMARKS.md measures it); its
+  // classes in a quarter of the memory budget, beside the sets (half of it), the exact selector's
+  // model freed by now.
+  const double selection_s = std::chrono::duration<double>(Clock::now() - start).count();
+  VC_ASSIGN_OR_RETURN(out.best_coverage,
+                      BestCoverageOf(sets, fixed, static_cast<int>(out.selection.picks.size()),
+                                     std::max(0.1, 0.05 * selection_s), options.memory_budget_bytes / 4, ctx));
   sets.clear();
   sets.shrink_to_fit();
   return out;

@@ -143,7 +143,21 @@ struct SelectionOutput {
   VoxelSet coverable;                 // union of every candidate's and fixed station's set
   Selection selection;                // what the selector reported
   std::vector<std::string> warnings;  // the local-candidates loop's, when the memory budget cut it short
+  // Per k = 1..picks (index k - 1), what any k stations cover at most and the most found, over the
+  // candidates and fixed stations selected from (the fixed ones always among the k; none for fewer
+  // k); empty where not computed (BestCoverageOf).
+  std::vector<std::optional<BestCoverage>> best_coverage;
 };
+// The per-k bound and best coverage (vc/plan/k_coverage_bound.h) over `sets`, the `fixed` stations'
+// first: their voxels count as given and the k - fixed others are chosen among the rest. Empty over
+// kMaxBestCoveragePairs (voxel, set) pairs or where the classes could take more than `max_bytes`
+// (16 bytes a (voxel, set) pair and 8 a voxel, at most); the steps and search stop at `seconds`
+// (the bounds stay valid).
+inline constexpr uint64_t kMaxBestCoveragePairs = uint64_t{1} << 28;
+[[nodiscard]] Result<std::vector<std::optional<BestCoverage>>> BestCoverageOf(const std::vector<VoxelSet>& sets,
+                                                                              int fixed, int max_k, double seconds,
+                                                                              uint64_t max_bytes,
+                                                                              const JobContext& ctx);
 // With options.local_candidates, RefineLocally (local_refinement.h) around the selector: positions
 // on a local_candidates_step_m sub-grid around each chosen station (on its floor, with the
 // clearance, outside keep-out zones) become candidates, their sets cut to the first coverable set
