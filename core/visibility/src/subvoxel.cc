@@ -163,10 +163,88 @@ SubvoxelRay TraceSegment(const VoxelScene& scene, std::span<const SurfacePatch> 
 
 }  // namespace
 
+namespace {
+
+// How far (voxels) the points SubvoxelJudgeAtFirst checks keep from the faces they must not meet.
+constexpr double kJudgeMargin = 1e-4;
+
+// Whether the resumed trace's start p0 lies where SubvoxelJudgeAtFirst needs it: in the cube of
+// `first` (lower corner `lo`) or in its face-neighbour across the entry face (axis a, entered
+// upwards when `up`), away from the other faces.
+bool ResumeStartClear(const Eigen::Vector3d& p0, const double lo[3], int a, bool up) {
+  for (int i = 0; i < 3; ++i) {
+    if (i != a && !(p0[i] >= lo[i] + kJudgeMargin && p0[i] <= lo[i] + 1 - kJudgeMargin)) return false;
+  }
+  return up ? p0[a] >= lo[a] - 1 + kJudgeMargin : p0[a] <= lo[a] + 2 - kJudgeMargin;
+}
+
+// How many cubes past `first` JudgePastMissed follows before it leaves the segment to the trace.
+constexpr int kMaxCubesPastMissed = 4;
+
+// SubvoxelJudgeAtFirst where the segment uo + t d (to `end`, inside voxel id's cube) misses the
+// blocker of `first` (entered across axis a; the trace resumes at s0). It follows the segment from
+// cube to cube as the trace's walk does, each exit through one face at least kJudgeMargin from the
+// others (so that every walk takes the same cubes in the same order), for at most
+// kMaxCubesPastMissed cubes: 1 where it reaches id's cube first (clear) or meets the blocker of an
+// occupied cube well inside it on id's surface (SameSurface), 0 where that blocker is not on it
+// (blocked; `*blocker` is that voxel, -1 when clear); -1 where a margin fails or the cubes run out.
+int JudgePastMissed(const VoxelScene& scene, std::span<const SurfacePatch> patches, const SubvoxelTables& tables,
+                    const Eigen::Vector3d& uo, size_t id, const Eigen::Vector3d& end, const VoxelIndex& first, int a,
+                    double s0, int64_t* blocker) {
+  const Eigen::Vector3d d = end - uo;
+  const OccupancyGrid& g = scene.grid;
+  const VoxelIndex& glo = g.min_index();
+  const VoxelIndex v = KeyToIndex(scene.occupied[id]);
+  double lo[3] = {double(first.x), double(first.y), double(first.z)};
+  if (!ResumeStartClear(uo + s0 * d, lo, a, d[a] > 0)) return -1;
+  int cur[3] = {first.x, first.y, first.z};
+  for (int k = 0; k < kMaxCubesPastMissed; ++k) {
+    // Leave the cube at `cur` (whose blocker, if any, the segment misses) through face b.
+    double leave = std::numeric_limits<double>::infinity();
+    int b = -1;
+    for (int i = 0; i < 3; ++i) {
+      if (d[i] == 0) continue;
+      const double t = ((d[i] > 0 ? lo[i] + 1 : lo[i]) - uo[i]) / d[i];
+      if (t < leave) leave = t, b = i;
+    }
+    if (b < 0 || !(leave < 1)) return -1;
+    const Eigen::Vector3d out = uo + leave * d;
+    for (int i = 0; i < 3; ++i) {
+      if (i != b && !(out[i] >= lo[i] + kJudgeMargin && out[i] <= lo[i] + 1 - kJudgeMargin)) return -1;
+    }
+    cur[b] += d[b] > 0 ? 1 : -1;
+    lo[b] = cur[b];
+    if (cur[0] == v.x && cur[1] == v.y && cur[2] == v.z) {
+      *blocker = -1;
+      return 1;
+    }
+    const uint32_t rel[3] = {uint32_t(cur[0] - glo.x), uint32_t(cur[1] - glo.y), uint32_t(cur[2] - glo.z)};
+    if (!(rel[0] < uint32_t(g.dims().x()) && rel[1] < uint32_t(g.dims().y()) && rel[2] < uint32_t(g.dims().z()))) {
+      continue;
+    }
+    const uint32_t slot = g.BrickSlot(g.BrickLinear(rel[0] >> 3, rel[1] >> 3, rel[2] >> 3));
+    if (slot == 0 || !((g.BrickBits(slot)[rel[2] & 7] >> (((rel[1] & 7) << 3) | (rel[0] & 7))) & 1u)) continue;
+    const size_t w = size_t(tables.Id(slot, rel));
+    const double s = BlockerHit(uo, end, tables.Box(w), patches[w], tables.Centroid(w));
+    if (s == kNoHit) continue;
+    // The hit well inside this cube (past the entry face b, before the others): the walk stops
+    // after it, and no other cube's blocker ties with it.
+    const Eigen::Vector3d hit = uo + s * d;
+    for (int i = 0; i < 3; ++i) {
+      if (!(hit[i] >= lo[i] + kJudgeMargin && hit[i] <= lo[i] + 1 - kJudgeMargin)) return -1;
+    }
+    *blocker = int64_t(w);
+    return SameSurface(hit, end, patches[id], patches[w]) ? 1 : 0;
+  }
+  return -1;
+}
+
+}  // namespace
+
 int SubvoxelJudgeAtFirst(const VoxelScene& scene, std::span<const SurfacePatch> patches, const SubvoxelTables& tables,
                          const Eigen::Vector3d& uo, size_t id, const Eigen::Vector3d& end, const VoxelIndex& first,
                          int64_t* blocker) {
-  constexpr double kMargin = 1e-4;
+  constexpr double kMargin = kJudgeMargin;
   const Eigen::Vector3d d = end - uo;
   if (!(d.lpNorm<Eigen::Infinity>() <= kMaxShortcutLength)) return -1;
   const double lo[3] = {double(first.x), double(first.y), double(first.z)};
@@ -189,21 +267,16 @@ int SubvoxelJudgeAtFirst(const VoxelScene& scene, std::span<const SurfacePatch> 
   const size_t w = size_t(tables.Id(slot, rel));
   const SurfacePatch& patch = patches[w];
   const double s = BlockerHit(uo, end, tables.Box(w), patch, tables.Centroid(w));
-  if (s == kNoHit) return -1;
+  const double s0 = std::max(0.0, enter - kResumeMargin);
+  if (s == kNoHit) return JudgePastMissed(scene, patches, tables, uo, id, end, first, a, s0, blocker);
   // The resumed trace starts at s0; from there to the hit the segment must stay inside the cube of
   // `first` and of its face-neighbour across the entry face, away from every other face.
-  const double s0 = std::max(0.0, enter - kResumeMargin);
   const Eigen::Vector3d p0 = uo + s0 * d, hit = uo + s * d;
+  if (!ResumeStartClear(p0, lo, a, d[a] > 0)) return -1;
   for (int i = 0; i < 3; ++i) {
-    if (i == a) continue;
-    for (const double x : {p0[i], hit[i]}) {
-      if (!(x >= lo[i] + kMargin && x <= lo[i] + 1 - kMargin)) return -1;
-    }
+    if (i != a && !(hit[i] >= lo[i] + kMargin && hit[i] <= lo[i] + 1 - kMargin)) return -1;
   }
-  if (d[a] > 0 ? !(p0[a] >= lo[a] - 1 + kMargin && hit[a] <= lo[a] + 1 - kMargin)
-               : !(p0[a] <= lo[a] + 2 - kMargin && hit[a] >= lo[a] + kMargin)) {
-    return -1;
-  }
+  if (d[a] > 0 ? !(hit[a] <= lo[a] + 1 - kMargin) : !(hit[a] >= lo[a] + kMargin)) return -1;
   *blocker = int64_t(w);
   return SameSurface(hit, end, patches[id], patch) ? 1 : 0;
 }

@@ -13,7 +13,8 @@
 // Less walking that keeps every answer (docs/VISIBILITY.md "The engine"):
 // - the walks start where the segment leaves the viewpoint's free box (GrowFreeBox, shrunk by
 //   kBoxMargin): the part before lies in free voxels, so holds no blocker;
-// - a segment whose first occupied voxel's blocker alone gives the trace's answer (margins:
+// - a segment whose first occupied voxel's blocker alone gives the trace's answer, or that misses
+//   it and meets the target or a deciding blocker within the next few cubes (margins:
 //   SubvoxelJudgeAtFirst) is not traced;
 // - a box fall-back segment that the blocker which last stopped a segment of its voxel proves
 //   blocked (SubvoxelBlockedBy) is not walked.

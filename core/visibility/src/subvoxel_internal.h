@@ -70,9 +70,13 @@ inline constexpr double kResumeMargin = 1e-6;
 // TraceSubvoxelSegment resumed kResumeMargin before `first`'s cube would: the segment meets that
 // blocker, and from the resumed start to the hit it stays in `first`'s cube and the free cube
 // before it, at least 1e-4 voxels from every other face (so the trace's walk visits only those two
-// and stops after `first`). 1: seen (the blocker is on voxel id's surface), 0: blocked, -1: not
-// decided (then trace). Only for segments of at most kMaxShortcutLength voxels. Where decided,
-// `*blocker` is `first`'s id.
+// and stops after `first`). Where the segment misses that blocker, the cubes after `first` are
+// followed as the trace's walk takes them (each exit at least 1e-4 voxels from the other faces),
+// for at most 4: reaching voxel id's cube first is clear (seen), and the blocker of an occupied
+// cube met well inside it judges as `first`'s would. 1: seen (clear, or the blocker is on voxel
+// id's surface), 0: blocked, -1: not decided (then trace). Only for segments of at most
+// kMaxShortcutLength voxels. Where decided, `*blocker` is the deciding blocker's voxel id (-1 when
+// clear), as the trace reports it.
 int SubvoxelJudgeAtFirst(const VoxelScene& scene, std::span<const SurfacePatch> patches, const SubvoxelTables& tables,
                          const Eigen::Vector3d& uo, size_t id, const Eigen::Vector3d& end, const VoxelIndex& first,
                          int64_t* blocker);
