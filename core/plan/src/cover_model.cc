@@ -3,6 +3,7 @@
 #include <CoinPackedMatrix.hpp>
 #include <OsiClpSolverInterface.hpp>
 #include <algorithm>
+#include <cmath>
 #include <string>
 #include <utility>
 
@@ -226,6 +227,14 @@ bool CoverModel::SetWarmFlow(WarmStart& warm) const {
   warm.values[root_cols_[root]] = 1.0;
   warm.values[source_flow_cols_[root]] = warm.stations;
   return true;
+}
+
+uint64_t TargetVoxels(double target, uint64_t coverable) {
+  const double t = target * static_cast<double>(coverable);
+  uint64_t k = static_cast<uint64_t>(std::max(0.0, std::ceil(t)));
+  while (k > 0 && static_cast<double>(k - 1) >= t) --k;
+  while (static_cast<double>(k) < t) ++k;
+  return std::min(k, coverable);
 }
 
 Result<Classes> BuildClasses(const std::vector<VoxelSet>& sets, const JobContext& ctx) {

@@ -33,6 +33,10 @@ struct Classes {
 // selection stage; CANCELLED from ctx.
 Result<Classes> BuildClasses(const std::vector<VoxelSet>& sets, const JobContext& ctx);
 
+// The smallest voxel count k with k >= target * coverable (the greedy's stopping test): the need
+// the exact selector's model and its bound are for.
+uint64_t TargetVoxels(double target, uint64_t coverable);
+
 // A run of consecutive rows or columns of one kind; count 0 where the model has none of them.
 struct Block {
   int first = 0;

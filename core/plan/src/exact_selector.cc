@@ -39,6 +39,7 @@ using internal::Classes;
 using internal::CoverModel;
 using internal::ReducedModel;
 using internal::ScanArc;
+using internal::TargetVoxels;
 using internal::WarmStart;
 using Clock = std::chrono::steady_clock;
 
@@ -52,15 +53,6 @@ double SecondsSince(Clock::time_point t0) { return std::chrono::duration<double>
 template <typename F>
 void ForEachBit(const VoxelSet& s, F&& f) {
   s.ForEach(f);
-}
-
-// The smallest voxel count k with k >= target * coverable (the greedy's stopping test).
-uint64_t TargetVoxels(double target, uint64_t coverable) {
-  const double t = target * static_cast<double>(coverable);
-  uint64_t k = static_cast<uint64_t>(std::max(0.0, std::ceil(t)));
-  while (k > 0 && static_cast<double>(k - 1) >= t) --k;
-  while (static_cast<double>(k) < t) ++k;
-  return std::min(k, coverable);
 }
 
 // Completes `m` once the reduction is done: resolves chains of stand-ins to a column or a forced

@@ -218,6 +218,48 @@ TEST(SelectionStageTest, BestCoverageOfCountsTheFixedStationsAsGiven) {
   EXPECT_TRUE(small->empty());
 }
 
+// The selector's proven bound at the target caps the per-k bound below it: 100 coverable voxels, the
+// 0.95 target's need is 95; a bound of 3 stations means k = 1, 2 cover at most 94; k = 3 and points
+// without a bound stay; nothing changes without a proven bound or with min_overlap, max_stations or
+// local candidates (their bound is about another problem).
+TEST(SelectionStageTest, CapBelowTheSelectorsBoundUsesTheBoundAtTheTarget) {
+  const auto fresh = [] {
+    return std::vector<std::optional<BestCoverage>>{BestCoverage{60, 50}, BestCoverage{100, 96}, std::nullopt,
+                                                    BestCoverage{100, 100}};
+  };
+  Selection selection;
+  selection.coverable = 100;
+  selection.optimality.lower_bound = 3;
+  PlanOptions o;
+  o.target_coverage = 0.95;
+  std::vector<std::optional<BestCoverage>> b = fresh();
+  CapBelowTheSelectorsBound(b, selection, o);
+  EXPECT_EQ(b[0]->upper_bound_voxels, 60u);
+  EXPECT_EQ(b[0]->best_voxels, 50u);
+  EXPECT_EQ(b[1]->upper_bound_voxels, 94u);
+  EXPECT_EQ(b[1]->best_voxels, 94u);
+  EXPECT_FALSE(b[2]);
+  EXPECT_EQ(b[3]->upper_bound_voxels, 100u);
+
+  const auto unchanged = [&](const Selection& sel, const PlanOptions& opt) {
+    std::vector<std::optional<BestCoverage>> c = fresh();
+    CapBelowTheSelectorsBound(c, sel, opt);
+    return c[1]->upper_bound_voxels == 100 && c[1]->best_voxels == 96;
+  };
+  Selection no_bound = selection;
+  no_bound.optimality.lower_bound = 0;
+  EXPECT_TRUE(unchanged(no_bound, o));
+  PlanOptions connected = o;
+  connected.min_overlap = 0.3;
+  EXPECT_TRUE(unchanged(selection, connected));
+  PlanOptions capped = o;
+  capped.max_stations = 3;
+  EXPECT_TRUE(unchanged(selection, capped));
+  PlanOptions local = o;
+  local.local_candidates = true;
+  EXPECT_TRUE(unchanged(selection, local));
+}
+
 // Sets over 12 voxels: the fixed station sees 0-3, candidates see 4-7, 8-11, 0-5 and 2-3.
 std::vector<VoxelSet> FixedAndCandidates() {
   std::vector<VoxelSet> sets(5, VoxelSet(12));

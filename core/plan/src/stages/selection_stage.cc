@@ -172,6 +172,21 @@ Result<std::vector<std::optional<BestCoverage>>> BestCoverageOf(const std::vecto
   return out;
 }
 
+void CapBelowTheSelectorsBound(std::vector<std::optional<BestCoverage>>& best, const Selection& selection,
+                               const PlanOptions& options) {
+  if (options.min_overlap > 0 || options.max_stations > 0 || options.local_candidates) return;
+  const double lower_bound = selection.optimality.lower_bound;
+  if (!(lower_bound > 0) || selection.coverable == 0) return;
+  const uint64_t need = internal::TargetVoxels(options.target_coverage, selection.coverable);
+  if (need == 0) return;
+  const size_t below = static_cast<size_t>(std::ceil(lower_bound - 1e-9)) - 1;  // k = 1 .. below cover < need
+  for (size_t k = 0; k < below && k < best.size(); ++k) {
+    if (!best[k]) continue;
+    best[k]->upper_bound_voxels = std::min(best[k]->upper_bound_voxels, need - 1);
+    best[k]->best_voxels = std::min(best[k]->best_voxels, best[k]->upper_bound_voxels);
+  }
+}
+
 Result<SelectionOutput> RunSelectionStage(SelectionInput in, const PlanOptions& options, const JobContext& ctx) {
   const Clock::time_point start = Clock::now();
   SelectionOutput out;
@@ -255,6 +270,7 @@ Result<SelectionOutput> RunSelectionStage(SelectionInput in, const PlanOptions& 
   VC_ASSIGN_OR_RETURN(out.best_coverage,
                       BestCoverageOf(sets, fixed, static_cast<int>(out.selection.picks.size()),
                                      std::max(0.1, 0.05 * selection_s), options.memory_budget_bytes / 4, ctx));
+  CapBelowTheSelectorsBound(out.best_coverage, out.selection, options);
   sets.clear();
   sets.shrink_to_fit();
   return out;

@@ -158,6 +158,14 @@ inline constexpr uint64_t kMaxBestCoveragePairs = uint64_t{1} << 28;
                                                                               int fixed, int max_k, double seconds,
                                                                               uint64_t max_bytes,
                                                                               const JobContext& ctx);
+// The selector's own bound tightens the per-k bound below it: selection.optimality.lower_bound says
+// no plan of fewer stations covers the target's voxels (need = the smallest count reaching
+// options.target_coverage of selection.coverable), so for k < lower_bound the bound becomes at most
+// need - 1 (and best_voxels with it). Only where that bound is about the same problem as the per-k
+// bound: any stations among the same sets over the same coverable voxels (not with min_overlap's
+// connection, max_stations or local_candidates' extra rounds); nothing without a proven bound.
+void CapBelowTheSelectorsBound(std::vector<std::optional<BestCoverage>>& best, const Selection& selection,
+                               const PlanOptions& options);
 // With options.local_candidates, RefineLocally (local_refinement.h) around the selector: positions
 // on a local_candidates_step_m sub-grid around each chosen station (on its floor, with the
 // clearance, outside keep-out zones) become candidates, their sets cut to the first coverable set
