@@ -577,9 +577,11 @@ TEST(PlannerTest, ReductionOneStationAtATimeMatchesTheBatch) {
   o.target_coverage = 1.0;
   o.reduce_to = 3;
   Result<PlanResult> batch = Plan(Synthetic("comb:5"), o);
-  o.memory_budget_bytes = 16'000'000;  // cache budget 4 MB < 5 stations x 1.07 MB of face values
-  Result<PlanResult> single = Plan(Synthetic("comb:5"), o);
   ASSERT_TRUE(batch.ok()) << batch.status().ToString();
+  // The smallest budget that holds the reduction's table (16.9 MB): cache budget 4.2 MB < 5
+  // stations x 1.15 MB of face values.
+  o.memory_budget_bytes = planner::ReductionTableBudgetBytes(batch->occupied_voxels);
+  Result<PlanResult> single = Plan(Synthetic("comb:5"), o);
   ASSERT_TRUE(single.ok()) << single.status().ToString();
   ASSERT_GE(single->reduction.size, 5);
   EXPECT_GT(single->reduction.size * single->occupied_voxels * kFacesPerVoxel * sizeof(float),
@@ -603,9 +605,10 @@ TEST(PlannerTest, ReductionBatchesJoinedAreTheFinalEvaluation) {
   Result<PlanResult> one = Plan(Synthetic("comb:5"), o);
   Result<VoxelScene> scene = Voxelize(Synthetic("comb:5"), {0.1, kDefaultMemoryBudgetBytes});
   ASSERT_TRUE(scene.ok());
-  // The smallest budget that keeps the joined evaluation (half of it); the cache gets a quarter,
-  // 82 bytes per voxel: room for one station at the worst case (48 per voxel), so one per batch.
-  o.memory_budget_bytes = 2 * planner::ReductionJoinBytes(scene->occupied.size());
+  // The smallest budget that keeps the joined evaluation (beside the table, in three quarters of
+  // it); the cache gets a quarter, 143 bytes per voxel: room for two stations at the worst case (48
+  // per voxel each), so two per batch.
+  o.memory_budget_bytes = planner::ReductionJoinBudgetBytes(scene->occupied.size());
   const planner::ReductionMemory memory = planner::ReductionMemoryFor(scene->occupied.size(), o.memory_budget_bytes);
   ASSERT_TRUE(memory.keep_join);
   const uint64_t worst_station_bytes = scene->occupied.size() * kFacesPerVoxel * 8;
@@ -638,24 +641,94 @@ TEST(PlannerTest, ReductionBatchesJoinedAreTheFinalEvaluation) {
   EXPECT_TRUE(batched->evaluation.best_values.empty());  // the join state is dropped once every station is in
 }
 
-// The joined evaluation is charged to half the budget (what the candidates' sets held); the cache
-// keeps its quarter (at most 1 GiB) either way.
-TEST(PlannerTest, ReductionMemoryChargesTheJoinedEvaluationToHalfTheBudget) {
+// The reduction's table (the top-3 table, 144 bytes a voxel, and an evaluation's working set, 122)
+// and the joined evaluation are charged to three quarters of the budget; the cache keeps its quarter
+// (at most 1 GiB) either way.
+TEST(PlannerTest, ReductionMemoryChargesTheTableAndTheJoinToThreeQuartersOfTheBudget) {
   EXPECT_EQ(planner::ReductionJoinBytes(1000), 2 * 1000 * (6 * (8 + 1 + 4) + 4));
-  const uint64_t join = planner::ReductionJoinBytes(1000);
-  planner::ReductionMemory m = planner::ReductionMemoryFor(1000, 2 * join);
+  EXPECT_EQ(planner::EvaluateWorkingBytes(1000), 1000 * (12 + 32 + 24 + 6 * 9));
+  EXPECT_EQ(planner::ReductionTableBytes(1000), 1000 * (6 * 24 + 122));
+  const uint64_t table = planner::ReductionTableBytes(1000), join = planner::ReductionJoinBytes(1000);
+  const uint64_t with_join = planner::ReductionJoinBudgetBytes(1000);
+  EXPECT_GE(with_join / 4 * 3, table + join);
+  planner::ReductionMemory m = planner::ReductionMemoryFor(1000, with_join);
+  EXPECT_TRUE(m.table_fits);
   EXPECT_TRUE(m.keep_join);
+  EXPECT_EQ(m.table_bytes, table);
   EXPECT_EQ(m.join_bytes, join);
-  EXPECT_EQ(m.cache_bytes, join / 2);
-  m = planner::ReductionMemoryFor(1000, 2 * join - 2);
+  EXPECT_EQ(m.cache_bytes, with_join / 4);
+  m = planner::ReductionMemoryFor(1000, with_join - 4);
+  EXPECT_TRUE(m.table_fits);
   EXPECT_FALSE(m.keep_join);
-  EXPECT_EQ(m.cache_bytes, (2 * join - 2) / 4);
+  EXPECT_EQ(m.cache_bytes, (with_join - 4) / 4);
+  const uint64_t table_only = planner::ReductionTableBudgetBytes(1000);
+  EXPECT_TRUE(planner::ReductionMemoryFor(1000, table_only).table_fits);
+  EXPECT_FALSE(planner::ReductionMemoryFor(1000, table_only - 4).table_fits);
   m = planner::ReductionMemoryFor(1000, kDefaultMemoryBudgetBytes);
   EXPECT_TRUE(m.keep_join);
   EXPECT_EQ(m.cache_bytes, uint64_t{1} << 30);
-  // The default budget keeps the join up to 13 M voxels (2 GiB / 164 bytes).
-  EXPECT_TRUE(planner::ReductionMemoryFor(13'000'000, kDefaultMemoryBudgetBytes).keep_join);
-  EXPECT_FALSE(planner::ReductionMemoryFor(13'200'000, kDefaultMemoryBudgetBytes).keep_join);
+  // The default budget keeps the join up to 7.49 M voxels (3 GiB / 430 bytes), the 4 x 4 tiled
+  // hall's 6.78 M among them, and holds the table up to 12.1 M (3 GiB / 266 bytes).
+  EXPECT_TRUE(planner::ReductionMemoryFor(6'780'000, kDefaultMemoryBudgetBytes).keep_join);
+  EXPECT_TRUE(planner::ReductionMemoryFor(7'490'000, kDefaultMemoryBudgetBytes).keep_join);
+  EXPECT_FALSE(planner::ReductionMemoryFor(7'500'000, kDefaultMemoryBudgetBytes).keep_join);
+  EXPECT_TRUE(planner::ReductionMemoryFor(12'100'000, kDefaultMemoryBudgetBytes).table_fits);
+  EXPECT_FALSE(planner::ReductionMemoryFor(12'200'000, kDefaultMemoryBudgetBytes).table_fits);
+}
+
+// Below the budget that holds the reduction's table the stage refuses before allocating it, naming
+// itself, the figure and the budget that plans the scene; at that budget the plan is the same.
+TEST(PlannerTest, ReductionRefusesWhenItsTableDoesNotFitTheBudget) {
+  PlanOptions o = TestOptions();
+  o.target_coverage = 1.0;
+  Result<PlanResult> one = Plan(Synthetic("comb:5"), o);
+  ASSERT_TRUE(one.ok()) << one.status().ToString();
+  const uint64_t table_budget = planner::ReductionTableBudgetBytes(one->occupied_voxels);
+  o.memory_budget_bytes = table_budget - 4;
+  bool reduction_started = false;
+  JobContext ctx;
+  ctx.progress = [&](const ProgressEvent& e) { reduction_started |= e.stage == Stage::kReduction; };
+  Result<PlanResult> refused = Plan(Synthetic("comb:5"), o, ctx);
+  ASSERT_FALSE(refused.ok());
+  EXPECT_EQ(refused.status().code(), StatusCode::kResourceExhausted);
+  EXPECT_TRUE(reduction_started);  // the stages before it ran within the budget
+  const std::string m = refused.status().message();
+  EXPECT_EQ(m.rfind("reduction: its table of the stations' best face values (", 0), 0u) << m;
+  EXPECT_NE(m.find("--memory-budget-bytes " + std::to_string(table_budget) + ")"), std::string::npos) << m;
+  EXPECT_NE(m.find("--no-reduce"), std::string::npos) << m;
+  o.memory_budget_bytes = table_budget;
+  Result<PlanResult> fits = Plan(Synthetic("comb:5"), o);
+  ASSERT_TRUE(fits.ok()) << fits.status().ToString();
+  ASSERT_EQ(fits->stations.size(), one->stations.size());
+  for (size_t k = 0; k < one->stations.size(); ++k) {
+    EXPECT_EQ(fits->stations[k].position, one->stations[k].position) << k;
+  }
+  EXPECT_EQ(fits->evaluation.overall.global_visibility, one->evaluation.overall.global_visibility);
+}
+
+// The evaluation stage charges what it holds (EvaluationStageBytes) before it evaluates: below it,
+// RESOURCE_EXHAUSTED names the stage and the budget that plans the scene.
+TEST(PlannerTest, EvaluationRefusesWhenItsEvaluationDoesNotFitTheBudget) {
+  PlanOptions o = TestOptions();
+  o.target_coverage = 1.0;
+  o.reduce = false;  // the evaluation stage evaluates the stations itself
+  Result<PlanResult> one = Plan(Synthetic("comb:5"), o);
+  ASSERT_TRUE(one.ok()) << one.status().ToString();
+  const uint64_t need = planner::EvaluationStageBytes(one->occupied_voxels, one->stations.size(), o.threads);
+  EXPECT_GE(need, one->occupied_voxels * (122 + 4 + 24 + 24));
+  o.memory_budget_bytes = need - 1;
+  Result<PlanResult> refused = Plan(Synthetic("comb:5"), o);
+  ASSERT_FALSE(refused.ok());
+  EXPECT_EQ(refused.status().code(), StatusCode::kResourceExhausted);
+  const std::string m = refused.status().message();
+  EXPECT_EQ(m.rfind("evaluation: evaluating the " + std::to_string(one->stations.size()) + " final stations on ", 0),
+            0u)
+      << m;
+  EXPECT_NE(m.find("--memory-budget-bytes " + std::to_string(need) + ")"), std::string::npos) << m;
+  o.memory_budget_bytes = need;
+  Result<PlanResult> fits = Plan(Synthetic("comb:5"), o);
+  ASSERT_TRUE(fits.ok()) << fits.status().ToString();
+  EXPECT_EQ(fits->evaluation.overall.global_visibility, one->evaluation.overall.global_visibility);
 }
 
 // A budget too small for the joined evaluation: the reduction keeps none, says so, and the
@@ -666,9 +739,9 @@ TEST(PlannerTest, ReductionWithoutRoomForTheJoinEvaluatesAgain) {
   Result<PlanResult> one = Plan(Synthetic("comb:5"), o);
   Result<VoxelScene> scene = Voxelize(Synthetic("comb:5"), {0.1, kDefaultMemoryBudgetBytes});
   ASSERT_TRUE(scene.ok());
-  // Just too small for the join; the cache (a quarter, 82 bytes per voxel) too small for two
-  // stations at the worst case (48 bytes per voxel each): batches of one, none joined.
-  o.memory_budget_bytes = 2 * planner::ReductionJoinBytes(scene->occupied.size()) - 8;
+  // Just too small for the join beside the table; the cache (a quarter, 143 bytes per voxel) too
+  // small for every station at the worst case (48 bytes per voxel each): none joined.
+  o.memory_budget_bytes = planner::ReductionJoinBudgetBytes(scene->occupied.size()) - 8;
   const planner::ReductionMemory memory = planner::ReductionMemoryFor(scene->occupied.size(), o.memory_budget_bytes);
   ASSERT_FALSE(memory.keep_join);
   ASSERT_GT(one->stations.size() * scene->occupied.size() * kFacesPerVoxel * 8, memory.cache_bytes);

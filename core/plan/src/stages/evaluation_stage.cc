@@ -2,7 +2,9 @@
 #include <string>
 #include <utility>
 
+#include "format.h"
 #include "progress_pacer.h"
+#include "vc/base/parallel.h"
 #include "vc/plan/stages.h"
 
 namespace vc::planner {
@@ -13,6 +15,17 @@ EvaluateOptions StationEvaluateOptions(const PlanOptions& options) {
   eval_options.threads = options.threads;
   eval_options.keep_face_values = true;
   return eval_options;
+}
+
+uint64_t EvaluationStageBytes(uint64_t voxels, uint64_t stations, int threads) {
+  const uint64_t own =
+      EvaluateWorkingBytes(voxels) + voxels * (sizeof(int32_t) + kFacesPerVoxel * sizeof(float) + sizeof(WorldPoint));
+  // vc::Evaluate gives each extra thread its own best values and sole viewers while they take at
+  // most 256 MiB in all (kEvaluateExtraWorkBytes in evaluate.cc); charged whenever they may.
+  const uint64_t workers = static_cast<uint64_t>(ResolveThreads(threads, std::max<uint64_t>(stations, 1)));
+  const uint64_t extra =
+      (workers - 1) * voxels * (kFacesPerVoxel * (sizeof(double) + sizeof(uint8_t)) + sizeof(int32_t));
+  return own + (extra <= (uint64_t{256} << 20) ? extra : 0);
 }
 
 Result<EvaluationOutput> RunEvaluationStage(EvaluationInput in, const PlanOptions& options, const JobContext& ctx) {
@@ -28,6 +41,15 @@ Result<EvaluationOutput> RunEvaluationStage(EvaluationInput in, const PlanOption
   } else if (in.reusable) {
     out.evaluation = std::move(*in.reusable);  // same stations, nothing was removed
   } else {
+    const uint64_t need = EvaluationStageBytes(n_voxels, in.positions.size(), options.threads);
+    if (need > options.memory_budget_bytes) {  // refused before anything is allocated
+      return ResourceExhaustedError("evaluation: evaluating the " + std::to_string(in.positions.size()) +
+                                    " final stations on " + std::to_string(n_voxels) + " voxels takes " +
+                                    std::to_string(need) + " bytes, over the memory budget (" +
+                                    std::to_string(options.memory_budget_bytes) + " bytes); a memory budget of " +
+                                    Num(need / 1048576.0) + " MiB or more (--memory-budget-bytes " +
+                                    std::to_string(need) + ") plans it, or a coarser resolution_m has fewer voxels");
+    }
     // Evaluate reports stations evaluated; each report gets the time left at the rate so far
     // (none before the first station), at most once a second besides the last.
     JobContext sub = ctx;

@@ -23,12 +23,36 @@ uint64_t ReductionJoinBytes(uint64_t voxels) {
   return 2 * voxels * per_voxel;
 }
 
+uint64_t EvaluateWorkingBytes(uint64_t voxels) {
+  const uint64_t per_voxel = sizeof(VoxelIndex) + 8 * sizeof(uint32_t) + 3 * sizeof(uint64_t) +
+                             kFacesPerVoxel * (sizeof(double) + sizeof(uint8_t));
+  return voxels * per_voxel;
+}
+
+uint64_t ReductionTableBytes(uint64_t voxels) {
+  return voxels * kFacesPerVoxel * sizeof(FaceTop3) + EvaluateWorkingBytes(voxels);
+}
+
 ReductionMemory ReductionMemoryFor(uint64_t voxels, uint64_t memory_budget_bytes) {
   ReductionMemory m;
+  m.table_bytes = ReductionTableBytes(voxels);
   m.join_bytes = ReductionJoinBytes(voxels);
-  m.keep_join = m.join_bytes <= memory_budget_bytes / 2;
+  const uint64_t three_quarters = memory_budget_bytes / 4 * 3;
+  m.table_fits = m.table_bytes <= three_quarters;
+  m.keep_join = m.table_bytes + m.join_bytes <= three_quarters;
   m.cache_bytes = std::min<uint64_t>(memory_budget_bytes / 4, uint64_t{1} << 30);
   return m;
+}
+
+namespace {
+// The smallest budget b with bytes <= b / 4 * 3.
+uint64_t BudgetForThreeQuarters(uint64_t bytes) { return (bytes + 2) / 3 * 4; }
+}  // namespace
+
+uint64_t ReductionTableBudgetBytes(uint64_t voxels) { return BudgetForThreeQuarters(ReductionTableBytes(voxels)); }
+
+uint64_t ReductionJoinBudgetBytes(uint64_t voxels) {
+  return BudgetForThreeQuarters(ReductionTableBytes(voxels) + ReductionJoinBytes(voxels));
 }
 
 EvaluateOptions ReductionEvaluateOptions(const PlanOptions& options) {
@@ -38,17 +62,36 @@ EvaluateOptions ReductionEvaluateOptions(const PlanOptions& options) {
   return eval_options;
 }
 
+namespace {
+// RESOURCE_EXHAUSTED for a reduction whose table does not fit: the figures and what would plan it.
+Status TableRefusal(const ReductionMemory& memory, uint64_t voxels, uint64_t memory_budget_bytes) {
+  const uint64_t enough = ReductionTableBudgetBytes(voxels);
+  return ResourceExhaustedError("reduction: its table of the stations' best face values (" +
+                                std::to_string(memory.table_bytes) + " bytes for " + std::to_string(voxels) +
+                                " voxels: 24 bytes a face, and an evaluation's working set) does not fit in three "
+                                "quarters of the memory budget (" +
+                                std::to_string(memory_budget_bytes / 4 * 3) + " bytes); a memory budget of " +
+                                Num(enough / 1048576.0) + " MiB or more (--memory-budget-bytes " +
+                                std::to_string(enough) +
+                                ") plans it, or --no-reduce skips the reduction, or a coarser resolution_m has fewer "
+                                "voxels");
+}
+}  // namespace
+
 // Reduction on every station's V of every face it sees. Stations are evaluated a batch at a time
 // into sparse values (what each sees), which RunReduction keeps while they fit the cache budget
 // (otherwise it asks for them again after each removal). The first pass over all stations also
 // keeps the face values the evaluation stage needs, batch by batch, joined (JoinEvaluations) into
 // the evaluation of every station: the final evaluation if nothing is removed. That joined
-// evaluation is charged to the memory budget (ReductionMemoryFor: half of it); when it does not
-// fit, nothing is joined and the evaluation stage evaluates the final stations itself.
+// evaluation is charged to the memory budget beside the table (ReductionMemoryFor: three quarters
+// of it); when it does not fit, nothing is joined and the evaluation stage evaluates the final
+// stations itself. Across replicas nothing is joined either: the replicas' sparse values carry V
+// alone, not the perception nor the double-precision best V that JoinEvaluations needs.
 Result<ReductionOutput> RunReductionStage(const ReductionInput& in, const PlanOptions& options, const JobContext& ctx) {
   const std::vector<WorldPoint>& stations = in.stations.positions;
   const uint64_t faces_total = in.scene.occupied.size() * kFacesPerVoxel;
   const ReductionMemory memory = ReductionMemoryFor(in.scene.occupied.size(), options.memory_budget_bytes);
+  if (!memory.table_fits) return TableRefusal(memory, in.scene.occupied.size(), options.memory_budget_bytes);
   std::optional<Evaluation> all_evaluation;  // of the stations 0 .. joined - 1
   size_t joined = 0;
   ReductionOutput out;
@@ -133,10 +176,12 @@ Result<ReductionOutput> RunReductionStage(const ReductionInput& in, const PlanOp
   if (run.removed.empty() && joined == stations.size()) out.evaluation = std::move(all_evaluation);
   if (!memory.keep_join && run.removed.empty() && !out.evaluation && !in.face_values) {
     out.warnings.push_back("reduction: the joined evaluation of the stations (" + Num(memory.join_bytes / 1048576.0) +
-                           " MiB) does not fit in half the memory budget (" +
-                           Num(double(options.memory_budget_bytes / 2) / 1048576.0) +
+                           " MiB) does not fit beside its table (" + Num(memory.table_bytes / 1048576.0) +
+                           " MiB) in three quarters of the memory budget (" +
+                           Num(double(options.memory_budget_bytes / 4 * 3) / 1048576.0) +
                            " MiB), so the evaluation stage evaluates the final stations again; a memory budget of " +
-                           Num(2.0 * double(memory.join_bytes) / 1048576.0) + " MiB or more avoids that");
+                           Num(ReductionJoinBudgetBytes(in.scene.occupied.size()) / 1048576.0) +
+                           " MiB or more avoids that");
   }
   return out;
 }

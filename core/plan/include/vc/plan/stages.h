@@ -230,18 +230,35 @@ inline constexpr int kReductionStationsPerBatch = 256;
 // voxels: the evaluation joined so far and the batch being joined into it, each with the join
 // state (9 bytes per face), the face values (4 per face) and the sole viewers (4 per voxel).
 [[nodiscard]] uint64_t ReductionJoinBytes(uint64_t voxels);
-// The reduction's shares of the memory budget: the cache of the stations' values, a quarter (at
-// most 1 GiB, as before); the joined evaluation, the half that the candidates' visibility sets held
-// (selection frees them before the reduction starts). The joined evaluation is kept only if it fits
-// that half; otherwise the evaluation stage evaluates the final stations again (a warning says so),
-// which holds less: one evaluation, no join state.
+// The bytes of an Evaluate call's working set on a scene of `voxels` voxels, whatever the stations:
+// the voxels' lattice indices (12 bytes a voxel), their corners (8 ids of 4 bytes, and about 3
+// distinct corners of 8 bytes a voxel) and each face's best V and perception (9 bytes a face).
+[[nodiscard]] uint64_t EvaluateWorkingBytes(uint64_t voxels);
+// What the reduction holds whatever it keeps: the top-3 table (one FaceTop3, 24 bytes a face,
+// vc/plan/reduction.h) and the working set of the Evaluate call of a batch (EvaluateWorkingBytes):
+// 266 bytes a voxel.
+[[nodiscard]] uint64_t ReductionTableBytes(uint64_t voxels);
+// The reduction's shares of the memory budget (docs/PLANNING.md, "Memory, stage by stage"): the
+// cache of the stations' values, a quarter (at most 1 GiB, as before); the table and the joined
+// evaluation, the other three quarters (the candidates' visibility sets held half of the budget;
+// selection frees them before the reduction starts). The table is needed: over the three quarters
+// the stage refuses (RESOURCE_EXHAUSTED) before allocating it. The joined evaluation is kept only if
+// it fits beside the table; otherwise the evaluation stage evaluates the final stations again (a
+// warning says so), which holds less: one evaluation, no join state, no table.
 struct ReductionMemory {
-  bool keep_join = false;
+  bool table_fits = false;   // table_bytes <= three quarters of the budget
+  bool keep_join = false;    // table_bytes + join_bytes <= three quarters of the budget
+  uint64_t table_bytes = 0;  // ReductionTableBytes of the scene
   uint64_t join_bytes = 0;   // ReductionJoinBytes of the scene
   uint64_t cache_bytes = 0;  // the cache's share: a quarter of the budget, at most 1 GiB
 };
 [[nodiscard]] ReductionMemory ReductionMemoryFor(uint64_t voxels, uint64_t memory_budget_bytes);
-// Errors of Evaluate and RunReduction (CANCELLED / DEADLINE_EXCEEDED from ctx).
+// The smallest memory budgets that hold the reduction's table (RunReductionStage refuses below it),
+// and the table with the joined evaluation, on a scene of `voxels` voxels.
+[[nodiscard]] uint64_t ReductionTableBudgetBytes(uint64_t voxels);
+[[nodiscard]] uint64_t ReductionJoinBudgetBytes(uint64_t voxels);
+// Errors of Evaluate and RunReduction (CANCELLED / DEADLINE_EXCEEDED from ctx); RESOURCE_EXHAUSTED,
+// before anything is allocated, when its table does not fit in three quarters of the memory budget.
 [[nodiscard]] Result<ReductionOutput> RunReductionStage(const ReductionInput& in, const PlanOptions& options,
                                                         const JobContext& ctx);
 
@@ -256,7 +273,14 @@ struct EvaluationOutput {
   std::vector<WorldPoint> voxel_centers;  // occupied voxel centres (world, m) in id order
   std::vector<std::string> warnings;      // for PlanResult::warnings, in order
 };
-// Errors of Evaluate (CANCELLED / DEADLINE_EXCEEDED from ctx).
+// The bytes the evaluation stage holds at its peak when it evaluates `stations` final stations on
+// a scene of `voxels` voxels with `threads` threads (0 = all): EvaluateWorkingBytes (122 bytes a
+// voxel), the sole viewers (4) and the face values out (24), the voxels' centres (24); each extra
+// thread's best values and sole viewers (58 bytes a voxel) while they stay within the 256 MiB
+// vc::Evaluate allows them. Charged to the whole budget (no other stage's structure is held then).
+[[nodiscard]] uint64_t EvaluationStageBytes(uint64_t voxels, uint64_t stations, int threads);
+// Errors of Evaluate (CANCELLED / DEADLINE_EXCEEDED from ctx); RESOURCE_EXHAUSTED, before anything
+// is allocated, when the stage must evaluate and EvaluationStageBytes exceeds the memory budget.
 [[nodiscard]] Result<EvaluationOutput> RunEvaluationStage(EvaluationInput in, const PlanOptions& options,
                                                           const JobContext& ctx);
 
