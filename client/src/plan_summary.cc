@@ -178,6 +178,7 @@ std::string OptimalityLine(const PlanResult& r) {
     for (int n : l.stations_per_solve) counts += (counts.empty() ? "" : " -> ") + std::to_string(n);
     local = Format("local candidates: %d position(s) in %d round(s); stations per selection %s\n", l.added, l.rounds,
                    counts.c_str());
+    if (!l.coarse_to_fine.empty()) local += l.coarse_to_fine + "\n";
   }
   return local + OptimalityBoundLine(r);
 }

@@ -330,6 +330,7 @@ v1::Optimality ToProto(const planner::Optimality& o) {
     pl->set_added(l.added);
     for (int s : l.stations_per_solve) pl->add_stations_per_solve(s);
     for (uint64_t c : l.covered_per_solve) pl->add_covered_per_solve(c);
+    pl->set_coarse_to_fine(l.coarse_to_fine);
   }
   return p;
 }
@@ -367,6 +368,7 @@ Result<planner::Optimality> FromProto(const v1::Optimality& p) {
   o.local_candidates.added = pl.added();
   o.local_candidates.stations_per_solve.assign(pl.stations_per_solve().begin(), pl.stations_per_solve().end());
   o.local_candidates.covered_per_solve.assign(pl.covered_per_solve().begin(), pl.covered_per_solve().end());
+  o.local_candidates.coarse_to_fine = pl.coarse_to_fine();
   return o;
 }
 

@@ -43,6 +43,7 @@ TEST(PlanParameters, RoundTripKeepsEveryField) {
   o.local_candidates_radius_m = 0.75;
   o.local_candidates_step_m = 0.3;
   o.local_candidates_rounds = 2;
+  o.coarse_above_candidates = 1234;
   o.route_start = WorldPoint(1, 2, std::nan(""));
   auto back = FromProto(ToProto(o));
   ASSERT_TRUE(back.ok());
@@ -57,6 +58,7 @@ TEST(PlanParameters, RoundTripKeepsEveryField) {
   EXPECT_EQ(back->local_candidates_radius_m, 0.75);
   EXPECT_EQ(back->local_candidates_step_m, 0.3);
   EXPECT_EQ(back->local_candidates_rounds, 2);
+  EXPECT_EQ(back->coarse_above_candidates, 1234);
   EXPECT_EQ(back->candidates.size(), 2u);
   ASSERT_TRUE(back->route_start.has_value());
   EXPECT_TRUE(std::isnan(back->route_start->z()));
@@ -161,7 +163,7 @@ PlanResult BigResult(size_t voxels, size_t candidates) {
   r.optimality.forced = 1;
   r.optimality.dominated = 2;
   r.optimality.note = "n";
-  r.optimality.local_candidates = {2, 90, {4, 3, 3}, {26912, 26912, 26912}};
+  r.optimality.local_candidates = {2, 90, {4, 3, 3}, {26912, 26912, 26912}, "coarse then fine: why"};
   r.distribution = {3, 31, 2, 5000000000};
   r.coverage_curve = {{1, 5, 0.5, 0.25, 165}, {2, 9, 0.9, 0.45, 330, 10, 9, false}};
   r.unseen_causes = {1, 2, 3, 4, 5, 6, 7};
@@ -264,6 +266,7 @@ TEST(PlanResultChunks, ReassembleExactlyAndStayUnderOneMebibyte) {
   EXPECT_EQ(o.local_candidates.added, 90);
   EXPECT_EQ(o.local_candidates.stations_per_solve, (std::vector<int>{4, 3, 3}));
   EXPECT_EQ(o.local_candidates.covered_per_solve, (std::vector<uint64_t>{26912, 26912, 26912}));
+  EXPECT_EQ(o.local_candidates.coarse_to_fine, "coarse then fine: why");
   EXPECT_EQ(back->distribution.replicas, 3);
   EXPECT_EQ(back->distribution.shards, 31);
   EXPECT_EQ(back->distribution.retried, 2);
@@ -345,10 +348,12 @@ TEST(PlanResultChunks, ASoleViewerNamingAMissingStationOrOnSomeChunksOnlyIsDataL
 // PlanResult.ground; PlanOptions' ground row, PlanParameters.ground, fits its padding. 1624 and 440:
 // min_gain_m2_per_minute, a row carried as PlanParameters.min_gain_m2_per_minute. 1672:
 // Evaluation::best_values and best_perceptions, the reduction's join state, cleared once its batches
-// are joined and never part of a result on the wire.)
+// are joined and never part of a result on the wire. 1712 and 448: coarse_above_candidates, a row
+// carried as PlanParameters.coarse_above_candidates, and LocalCandidatesReport::coarse_to_fine,
+// carried as LocalCandidates.coarse_to_fine.)
 TEST(PlanResultChunks, EveryCoreFieldIsCarried) {
-  EXPECT_EQ(sizeof(PlanResult), 1672u) << "PlanResult changed: update the vc.v1 PlanResult and vc::wire";
-  EXPECT_EQ(sizeof(PlanOptions), 440u) << "PlanOptions changed: update vc.v1 PlanParameters and vc::wire";
+  EXPECT_EQ(sizeof(PlanResult), 1712u) << "PlanResult changed: update the vc.v1 PlanResult and vc::wire";
+  EXPECT_EQ(sizeof(PlanOptions), 448u) << "PlanOptions changed: update vc.v1 PlanParameters and vc::wire";
 }
 
 // A georeferenced plan: local positions, the frame's origin at UTM-like coordinates (and once

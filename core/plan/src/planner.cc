@@ -121,6 +121,21 @@ void AddBestCoverageWhereValid(PlanResult& result, const std::vector<std::option
   if (!options.refine && fixed_lead) AddBestCoverage(result.coverage_curve, best);
 }
 
+// The visibility stage's context: `ctx`, and with coarse then fine each progress event without a
+// message of its own says that this is the coarse round (the fine round's say "local candidates").
+JobContext VisibilityContext(const JobContext& ctx, const planner::CandidatesOutput& candidates) {
+  if (!candidates.coarse || !ctx.progress) return ctx;
+  const std::string note = "coarse then fine: the " + Num(candidates.coarse->coarse_spacing_m) +
+                           " m grid first, then " + Num(candidates.coarse->fine_spacing_m) + " m around its picks";
+  JobContext out{ctx.cancel, {}};
+  out.progress = [progress = ctx.progress, note](const ProgressEvent& e) {
+    ProgressEvent noted = e;
+    if (noted.message.empty()) noted.message = note;
+    progress(noted);
+  };
+  return out;
+}
+
 }  // namespace
 
 FieldTime ComputeFieldTime(size_t stations, double walk_m, const PlanOptions& options) {
@@ -171,6 +186,8 @@ Result<PlanResult> Plan(const SceneInput& input, const PlanOptions& options, con
   result.cells_failing_clearance = candidates.cells_failing_clearance;
   result.warnings = std::move(voxelized.warnings);
   result.warnings.insert(result.warnings.end(), candidates.warnings.begin(), candidates.warnings.end());
+  // Coarse then fine (docs/PLANNING.md): the coarse grid, then the fine positions around its picks.
+  if (candidates.coarse) local_options = planner::CoarseToFineOptions(local_options);
 
   if (local_options.sparse_set_gain <= 0) {  // sparse sets are checked as they are computed
     VC_RETURN_IF_ERROR(planner::CheckVisibilitySetBudget(
@@ -180,7 +197,7 @@ Result<PlanResult> Plan(const SceneInput& input, const PlanOptions& options, con
   VC_ASSIGN_OR_RETURN(planner::VisibilityOutput visibility, runner.Run(Stage::kVisibility, [&](const JobContext& c) {
     return planner::RunVisibilityStage(
         {scene, candidates.positions, candidates.floor_z_m, local_options.fixed_stations, callbacks, patches},
-        local_options, c);
+        local_options, VisibilityContext(c, candidates));
   }));
   result.heat_map = std::move(visibility.heat_map);
   result.distribution = visibility.distribution;
@@ -188,16 +205,18 @@ Result<PlanResult> Plan(const SceneInput& input, const PlanOptions& options, con
 
   const std::unique_ptr<planner::Selector> selector = planner::SelectorFor(local_options, scene.resolution_m);
   VC_ASSIGN_OR_RETURN(planner::SelectionOutput selected, runner.Run(Stage::kSelection, [&](const JobContext& c) {
-    return planner::RunSelectionStage(
-        {scene, *selector, std::move(visibility.sets), std::move(visibility.fixed_sets), candidates.positions,
-         candidates.floor_z_m, result.heat_map.visible_voxels, callbacks, patches, candidates.ground.model},
-        local_options, c);
+    return planner::RunSelectionStage({scene, *selector, std::move(visibility.sets), std::move(visibility.fixed_sets),
+                                       candidates.positions, candidates.floor_z_m, result.heat_map.visible_voxels,
+                                       callbacks, patches, candidates.ground.model, candidates.coarse.has_value()},
+                                      local_options, c);
   }));
   result.stop_reason = selected.selection.stop;
   result.greedy_stations = selected.selection.first_pass_picks;
   result.consolidated = selected.selection.saved_by_improvement;
   result.connecting_stations = selected.selection.connectors;
   result.optimality = selected.selection.optimality;
+  result.optimality.local_candidates.coarse_to_fine =
+      planner::CoarseToFineNote(candidates, options.coarse_above_candidates);
   if (!result.optimality.note.empty()) result.warnings.push_back(result.optimality.note);
   for (std::string& w : selected.warnings) result.warnings.push_back(std::move(w));
   const std::vector<std::optional<BestCoverage>> best_coverage = std::move(selected.best_coverage);

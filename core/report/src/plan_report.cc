@@ -89,6 +89,7 @@ Json OptimalityJson(const planner::Optimality& o) {
                              {"added", l.added},
                              {"stations_per_solve", l.stations_per_solve},
                              {"covered_per_solve", l.covered_per_solve}};
+    if (!l.coarse_to_fine.empty()) j["local_candidates"]["coarse_to_fine"] = l.coarse_to_fine;
   }
   return j;
 }

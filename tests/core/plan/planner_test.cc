@@ -303,6 +303,62 @@ TEST(PlannerTest, LocalCandidatesReachTheCombsOptimumWhereA2mGridCannot) {
   }
 }
 
+// Coarse then fine (docs/PLANNING.md, "Coarse then fine candidates"): above
+// coarse_above_candidates the plan selects over the grid of twice the spacing, then once more with
+// the grid's positions around its picks; at the threshold the plan is the full grid's, the same as
+// with the rule off.
+TEST(PlannerTest, CoarseThenFineAboveTheThresholdAndTheFullGridAtIt) {
+  PlanOptions o = TestOptions();
+  o.solver = SelectionSolver::kGreedy;
+  o.coarse_above_candidates = 0;
+  const SceneInput input = Synthetic("hub:3");
+  Result<PlanResult> full = Plan(input, o);
+  ASSERT_TRUE(full.ok()) << full.status().ToString();
+  const int n = static_cast<int>(full->candidate_count);
+  ASSERT_GT(n, 40);
+
+  o.coarse_above_candidates = n;
+  Result<PlanResult> at = Plan(input, o);
+  ASSERT_TRUE(at.ok()) << at.status().ToString();
+  EXPECT_EQ(static_cast<int>(at->candidate_count), n);
+  EXPECT_TRUE(at->optimality.local_candidates.coarse_to_fine.empty());
+  EXPECT_TRUE(at->optimality.local_candidates.stations_per_solve.empty());
+  ASSERT_EQ(at->stations.size(), full->stations.size());
+  for (size_t k = 0; k < at->stations.size(); ++k) {
+    EXPECT_EQ(at->stations[k].position, full->stations[k].position) << k;
+  }
+  EXPECT_EQ(at->covered_voxels, full->covered_voxels);
+  EXPECT_EQ(at->evaluation.overall.global_visibility, full->evaluation.overall.global_visibility);
+
+  o.coarse_above_candidates = n - 1;
+  Result<PlanResult> coarse = Plan(input, o);
+  PlanOptions two_m = o;
+  two_m.coarse_above_candidates = 0;
+  two_m.grid_spacing_m = 2.0;
+  Result<PlanResult> grid2 = Plan(input, two_m);
+  ASSERT_TRUE(coarse.ok() && grid2.ok()) << coarse.status().ToString() << grid2.status().ToString();
+  std::cout << "[ hub:3, 1 m grid ] " << Describe(*full) << "\n[ hub:3, 2 m grid ] " << Describe(*grid2)
+            << "\n[ hub:3, coarse then fine ] " << Describe(*coarse) << "\n";
+  EXPECT_EQ(coarse->candidate_count, grid2->candidate_count);  // the coarse grid's
+  EXPECT_LT(static_cast<int>(coarse->candidate_count), n);
+  const planner::LocalCandidatesReport& l = coarse->optimality.local_candidates;
+  EXPECT_NE(l.coarse_to_fine.find("the 1 m grid gives " + std::to_string(n) +
+                                  " candidates, more than coarse_above_candidates = " + std::to_string(n - 1)),
+            std::string::npos)
+      << l.coarse_to_fine;
+  EXPECT_NE(l.coarse_to_fine.find("the 2 m grid's " + std::to_string(coarse->candidate_count)), std::string::npos)
+      << l.coarse_to_fine;
+  EXPECT_NE(PlanToJson(*coarse).find("\"coarse_to_fine\""), std::string::npos);
+  // One fine round: the 1 m positions around the first solve's picks (8 per pick at most).
+  ASSERT_EQ(l.stations_per_solve.size(), 2u);
+  EXPECT_EQ(l.rounds, 1);
+  EXPECT_GT(l.added, 0);
+  EXPECT_LE(l.added, 8 * l.stations_per_solve.front());
+  // The fine positions' sets are whole: the coverable set is the coarse grid's and what they add.
+  EXPECT_GE(coarse->coverable_voxels, grid2->coverable_voxels);
+  EXPECT_GE(double(coarse->covered_voxels), o.target_coverage * double(grid2->coverable_voxels));
+}
+
 // Sparse visibility sets (vc/visibility/voxel_set.h) change memory and time, never the plan: with
 // every set sparse, each stage that takes sets (greedy and consolidation, the exact solver, local
 // candidates, refinement, registration) gives the plan of dense sets.
@@ -922,6 +978,7 @@ TEST(PlannerTest, ValidateRejectsBadParametersClearly) {
       {[](PlanOptions& o) { o.max_stations = -2; }, "max_stations"},
       {[](PlanOptions& o) { o.reduce_to = -1; }, "reduce_to"},
       {[](PlanOptions& o) { o.threads = -1; }, "threads"},
+      {[](PlanOptions& o) { o.coarse_above_candidates = -1; }, "coarse_above_candidates"},
       {[](PlanOptions& o) { o.scanner.max_range_m = 0.1; }, "max_range_m"},
       {[](PlanOptions& o) { o.scanner.hfov_deg = 0; }, "scanner.hfov_deg"},
       // Stations have no heading, so a partial field of view cannot be planned.

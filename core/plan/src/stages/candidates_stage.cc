@@ -185,12 +185,51 @@ CandidateOptions CandidateOptionsFor(const PlanOptions& options) {
           .walk_max_step_m = options.walk_max_step_m};
 }
 
+PlanOptions CoarseToFineOptions(const PlanOptions& options) {
+  PlanOptions out = options;
+  out.local_candidates = true;
+  out.local_candidates_radius_m = options.grid_spacing_m;
+  out.local_candidates_step_m = options.grid_spacing_m;
+  out.local_candidates_rounds = 1;
+  return out;
+}
+
+std::string CoarseToFineNote(const CandidatesOutput& candidates, int32_t threshold) {
+  if (!candidates.coarse) return "";
+  const CandidatesOutput::CoarseGrid& coarse = *candidates.coarse;
+  const size_t coarse_candidates = candidates.positions.size();
+  return "coarse then fine: the " + Num(coarse.fine_spacing_m) + " m grid gives " +
+         std::to_string(coarse.fine_candidates) +
+         " candidates, more than coarse_above_candidates = " + std::to_string(threshold) +
+         ", so the plan selected over the " + Num(coarse.coarse_spacing_m) + " m grid's " +
+         std::to_string(coarse_candidates) + ", then again with the " + Num(coarse.fine_spacing_m) +
+         " m positions around its picks, their sets whole (coarse_above_candidates = 0 plans on the full grid)";
+}
+
 Result<CandidatesOutput> RunCandidatesStage(const CandidatesInput& in, const PlanOptions& options,
                                             const JobContext& ctx) {
   VC_RETURN_IF_ERROR(CheckUserPositions(in.scene, options.fixed_stations, "fixed_stations"));
   VC_ASSIGN_OR_RETURN(std::vector<std::string> fixed_warnings, CheckFixedStations(in.scene, options.fixed_stations));
   Result<CandidatesOutput> out =
       options.candidates.empty() ? GridCandidates(in.scene, options, ctx) : UserCandidates(in.scene, options);
+  const bool may_go_coarse =
+      options.candidates.empty() && options.coarse_above_candidates > 0 && !options.local_candidates;
+  if (out.ok() && may_go_coarse && out->positions.size() > static_cast<size_t>(options.coarse_above_candidates)) {
+    PlanOptions coarse_options = options;
+    coarse_options.grid_spacing_m = options.grid_spacing_m * kCoarseGridFactor;
+    Result<CandidatesOutput> coarse = GridCandidates(in.scene, coarse_options, ctx);
+    if (coarse.ok()) {  // else (no candidate on the coarse grid) the full grid stays
+      coarse->coarse =
+          CandidatesOutput::CoarseGrid{options.grid_spacing_m, coarse_options.grid_spacing_m, out->positions.size()};
+      ctx.Report(Stage::kCandidates, 1.0,
+                 "coarse then fine: " + std::to_string(out->positions.size()) + " candidates on the " +
+                     Num(options.grid_spacing_m) +
+                     " m grid > coarse_above_candidates = " + std::to_string(options.coarse_above_candidates) +
+                     "; selecting over the " + Num(coarse_options.grid_spacing_m) + " m grid's " +
+                     std::to_string(coarse->positions.size()) + " first");
+      out = std::move(coarse);
+    }
+  }
   if (out.ok()) out->warnings.insert(out->warnings.begin(), fixed_warnings.begin(), fixed_warnings.end());
   return out;
 }

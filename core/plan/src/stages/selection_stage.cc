@@ -53,7 +53,8 @@ ExactSelectorOptions ExactOptionsFor(const PlanOptions& options, double resoluti
 }
 
 // RefineLocally with the stage's selector over the fixed stations and the candidates (`sets`,
-// consumed), with the added positions' sets cut to the coverable set of the first selection and
+// consumed), with the added positions' sets cut to the coverable set of the first selection (but
+// with in.keep_added_sets_whole) and
 // as many of them as the memory budget holds beside the sets already held.
 Result<LocalRefinementResult> SelectWithLocalCandidates(const SelectionInput& in, std::vector<VoxelSet> sets, int fixed,
                                                         const PlanOptions& options, const JobContext& ctx) {
@@ -74,8 +75,8 @@ Result<LocalRefinementResult> SelectWithLocalCandidates(const SelectionInput& in
     ctx.Report(Stage::kSelection, 0.0,
                "local candidates: visibility of " + std::to_string(positions.size()) + " positions");
     VC_ASSIGN_OR_RETURN(std::vector<VoxelSet> out, ComputeVisibilitySets(in.scene, positions, set_options, quiet));
-    for (VoxelSet& s : out) {
-      s.Intersect(coverable);
+    if (!in.keep_added_sets_whole) {
+      for (VoxelSet& s : out) s.Intersect(coverable);
     }
     return out;
   };

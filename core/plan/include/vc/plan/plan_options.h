@@ -30,6 +30,10 @@
 //   better one; docs/PLANNING.md, "Exact selection").
 // - local_candidates: solve, add a sub-grid of candidates around each chosen station, solve again
 //   over all, while the plan improves (vc/plan/local_refinement.h; docs/PLANNING.md).
+// - coarse_above_candidates: coarse-then-fine candidates (docs/PLANNING.md, "Coarse then fine
+//   candidates"): when the grid gives more candidates than this and neither user candidates nor
+//   local_candidates are given, the plan runs on a grid of kCoarseGridFactor x grid_spacing_m, then
+//   one local-candidates round adds the grid_spacing_m positions around each pick.
 // - refine: proximity refinement (ALGORITHM.md s.7.4), each station to the best of a sub-grid.
 // - reduce / reduce_to: reduction (s.7.5) removes zero-loss stations; with reduce_to > 0 it keeps
 //   removing the cheapest single or pair until at most reduce_to stations remain.
@@ -67,6 +71,8 @@
   X(double, local_candidates_step_m, 0.25, "m", "local-candidates-step", kPositive, "sub-grid step")                  \
   X(int32_t, local_candidates_rounds, 4, "rounds", "local-candidates-rounds", kPositive,                              \
     "selections after the first, at most")                                                                            \
+  X(int32_t, coarse_above_candidates, 4000, "candidates", "coarse-above-candidates", kNonNegative,                    \
+    "above this many grid candidates, plan on a 2x grid, then add grid positions around the picks (0 = never)")       \
   X(bool, refine, false, "", "refine", kAny, "refine each station on a local sub-grid")                               \
   X(double, refine_radius_m, 0.5, "m", "refine-radius", kPositive, "refinement radius")                               \
   X(double, refine_step_m, 0.25, "m", "refine-step", kPositive, "refinement step")                                    \

@@ -66,6 +66,9 @@ struct LocalCandidatesReport {
   int added = 0;                            // positions added over all rounds
   std::vector<int> stations_per_solve;      // the first selection's first; empty when the loop did not run
   std::vector<uint64_t> covered_per_solve;  // voxels, per selection
+  // Why the loop ran as the fine round of coarse-then-fine candidates (PlanOptions::
+  // coarse_above_candidates; CoarseToFineNote in stages.h); empty when it did not.
+  std::string coarse_to_fine;
 };
 
 struct Optimality {

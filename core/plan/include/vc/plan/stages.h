@@ -81,6 +81,15 @@ struct CandidatesOutput {
   uint64_t cells_failing_clearance = 0;
   uint64_t in_keep_out = 0;           // candidates dropped because they lie in a keep-out zone
   std::vector<std::string> warnings;  // for PlanResult::warnings, in order
+  // Set when the coarse-then-fine path runs (PlanOptions::coarse_above_candidates): the grid at
+  // fine_spacing_m gave fine_candidates, more than the threshold, so `positions` (and the counts
+  // above) are the grid's at coarse_spacing_m.
+  struct CoarseGrid {
+    double fine_spacing_m = 0;
+    double coarse_spacing_m = 0;
+    uint64_t fine_candidates = 0;
+  };
+  std::optional<CoarseGrid> coarse;
 };
 // Generated candidates at every height of options.TripodHeights(), or the user's; either without
 // those in a keep-out zone. INVALID_ARGUMENT for a user candidate or fixed station out of range or
@@ -89,9 +98,25 @@ struct CandidatesOutput {
 // FAILED_PRECONDITION when no floor is found or no candidate survives.
 // The candidate grid's options (every row of PlanOptions it uses). Refinement and local candidates
 // start from them, each with its own height, ground model and no doorway candidates.
+// With options.coarse_above_candidates > 0, no user candidates and local_candidates off: when the
+// grid gives more candidates than coarse_above_candidates, the output is the grid at
+// kCoarseGridFactor x grid_spacing_m instead (CandidatesOutput::coarse; the full grid when the
+// coarse one has no candidate), and a progress line says so.
 [[nodiscard]] CandidateOptions CandidateOptionsFor(const PlanOptions& options);
 [[nodiscard]] Result<CandidatesOutput> RunCandidatesStage(const CandidatesInput& in, const PlanOptions& options,
                                                           const JobContext& ctx);
+
+// The coarse grid's spacing in units of grid_spacing_m (docs/PLANNING.md, "Coarse then fine
+// candidates": 2 halves the time of fr_campus's plan; 3 would leave the fine round 8 positions per
+// pick that a pick 3 cells away cannot reach).
+inline constexpr double kCoarseGridFactor = 2.0;
+// The options the rest of a coarse-then-fine plan runs with: `options` with one local-candidates
+// round of grid_spacing_m steps within grid_spacing_m of each pick (the fine grid's 8 positions
+// around it).
+[[nodiscard]] PlanOptions CoarseToFineOptions(const PlanOptions& options);
+// Why the coarse-then-fine path ran (candidates.coarse set) with `threshold`
+// (coarse_above_candidates), for plan.json (LocalCandidatesReport::coarse_to_fine); empty when not.
+[[nodiscard]] std::string CoarseToFineNote(const CandidatesOutput& candidates, int32_t threshold);
 
 // RESOURCE_EXHAUSTED (naming `what`) when `positions` visibility sets over `voxels` voxels need
 // more than half of `budget_bytes`; checked before a stage computes that many sets.
@@ -137,6 +162,9 @@ struct SelectionInput {
   // The candidates' ground model (CandidatesOutput::ground): on kTerrain the local candidates
   // stand on the ground reached on foot from their station (MovedStationFloor).
   GroundModel ground = GroundModel::kAuto;
+  // Coarse then fine (CandidatesOutput::coarse): the added positions' sets are kept whole, so the
+  // fine round may cover voxels no coarse candidate sees (the coverable set grows).
+  bool keep_added_sets_whole = false;
 };
 struct SelectionOutput {
   Stations stations;                  // the fixed stations, then the picks, in pick order
@@ -169,7 +197,8 @@ void CapBelowTheSelectorsBound(std::vector<std::optional<BestCoverage>>& best, c
 // With options.local_candidates, RefineLocally (local_refinement.h) around the selector: positions
 // on a local_candidates_step_m sub-grid around each chosen station (on its floor, with the
 // clearance, outside keep-out zones) become candidates, their sets cut to the first coverable set
-// (the coverage problem stays the same: voxels only they see raise no target), and selection runs
+// (the coverage problem stays the same: voxels only they see raise no target; whole with
+// in.keep_added_sets_whole), and selection runs
 // again with in.selector over all while it improves. A station at an added position has candidate
 // index -1. Positions beyond what half the memory budget holds are not added (a warning says so).
 // Errors of the selector (CANCELLED / DEADLINE_EXCEEDED from ctx).
