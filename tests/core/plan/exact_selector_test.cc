@@ -391,6 +391,31 @@ TEST(ExactSelectorTest, NeverWorseThanGreedyOnLargerInstances) {
   }
 }
 
+// With the time limit too short for CBC to improve anything, auto's plan is the better of greedy's
+// and the Lagrangian heuristic's (CBC's warm start, ExactRun::WarmPicks): never more stations than
+// greedy's, always at the target, and fewer where the heuristic's plan is (geb079: 49 against 51).
+TEST(ExactSelectorTest, AutoStartsFromTheLagrangianPlanWhereItBeatsGreedy) {
+  std::mt19937 rng(11);
+  for (int trial = 0; trial < 40; ++trial) {
+    std::vector<VoxelSet> sets = RandomSets(rng, 60, 800, 0.04);
+    ExactSelectorOptions o;
+    o.prefer_greedy = true;
+    o.greedy.target_coverage = trial % 2 ? 1.0 : 0.97;
+    o.time_limit_s = 1e-3;
+    Result<Selection> got = ExactSelector(o).Select(sets, 0, {});
+    ASSERT_TRUE(got.ok()) << got.status().ToString();
+    Result<Selection> greedy = GreedySelector(o.greedy).Select(sets, 0, {});
+    ASSERT_TRUE(greedy.ok());
+    EXPECT_LE(got->picks.size(), greedy->picks.size()) << "trial " << trial;
+    EXPECT_GE(Union(sets, got->picks), Target(o.greedy.target_coverage, got->coverable)) << "trial " << trial;
+    EXPECT_LE(got->optimality.lower_bound, got->picks.size()) << "trial " << trial;
+    // Trial 6: greedy 46, the swaps from it stall, the Lagrangian heuristic's plan 45 (not at the
+    // bound); before CBC started from it, auto returned greedy's 46 here.
+    if (trial == 6) EXPECT_EQ(greedy->picks.size(), 46u);
+    if (trial == 6) EXPECT_LE(got->picks.size(), 45u);
+  }
+}
+
 // Rooms around a hall (hub:K in miniature): per room a deep station that sees only the room and
 // one just inside its door that sees the room and a share of the hall, the shares tiling it; one
 // hall station sees all of the hall. Greedy takes the hall first, then a deep station per room

@@ -1483,16 +1483,15 @@ TEST(PlannerTest, RealScanGeb079) {
   ASSERT_TRUE(r.ok()) << r.status().ToString();
   std::cout << "[ geb079 ] " << Describe(*r) << "\n";
   ASSERT_FALSE(r->stations.empty());
-  // auto: greedy's plan, station for station, with the integer program's bound beside it.
+  // auto: fewer stations than greedy's plan (the Lagrangian heuristic's 49 against greedy's 51 as
+  // CBC's warm start, which CBC does not improve on within the limit), for what greedy covered when
+  // the gain rule stopped it, with the integer program's bound beside it.
   PlanOptions g = o;
   g.solver = SelectionSolver::kGreedy;
   Result<PlanResult> greedy = Plan(*in, g);
   ASSERT_TRUE(greedy.ok()) << greedy.status().ToString();
-  ASSERT_EQ(r->stations.size(), greedy->stations.size());
-  for (size_t k = 0; k < r->stations.size(); ++k) {
-    EXPECT_EQ(r->stations[k].position, greedy->stations[k].position) << "station " << k;
-  }
-  EXPECT_EQ(r->evaluation.overall.global_visibility, greedy->evaluation.overall.global_visibility);
+  EXPECT_LT(r->stations.size(), greedy->stations.size());
+  EXPECT_EQ(r->optimality.stations, static_cast<int>(r->stations.size()));
   EXPECT_EQ(r->optimality.solver, "exact");
   EXPECT_NE(r->optimality.status, planner::OptimalityStatus::kHeuristic);
   EXPECT_GT(r->optimality.lower_bound, 0);
