@@ -115,8 +115,9 @@ std::string OptimalityBoundLine(const PlanResult& r) {
 std::string CoverageTable(const PlanResult& r) {
   if (r.coverage_curve.empty()) return "";
   // "any plan": the smallest k whose per-k bound reaches the level (no plan of fewer stations can);
-  // the column is there only when the curve carries the bound.
-  const bool bound = r.coverage_curve.front().best_voxels_upper_bound.has_value();
+  // the column is there only when the curve carries the bound (from k = F with F fixed stations).
+  const bool bound = std::any_of(r.coverage_curve.begin(), r.coverage_curve.end(),
+                                 [](const CoveragePoint& p) { return p.best_voxels_upper_bound.has_value(); });
   std::string out = Format("  %8s %7s %9s", "coverage", "scene", "stations");
   if (bound) out += Format(" %10s", "any plan");
   out += "  field time (set-up and scans)\n";

@@ -161,6 +161,16 @@ TEST(CoverageTableTest, AnyPlanColumnFromThePerKBound) {
       << CoverageTable(r);
 }
 
+// Two fixed stations: no bound for k = 1 (fewer than the fixed ones), the column is still there.
+TEST(CoverageTableTest, AnyPlanColumnWhenTheBoundStartsAtTheFixedStations) {
+  PlanResult r = KnownCurve();
+  AddBestCoverage(r.coverage_curve, {std::nullopt, BestCoverage{85, 80}, BestCoverage{93, 92}, BestCoverage{97, 96},
+                                     BestCoverage{99, 99}});
+  const std::string s = CoverageTable(r);
+  EXPECT_NE(s.find("   any plan  "), std::string::npos) << s;
+  EXPECT_NE(s.find("      80 %   40.0%         2       >= 2  5 min\n"), std::string::npos) << s;
+}
+
 TEST(StopLineTest, NamesTheRuleThatStoppedTheSelection) {
   PlanResult r = ThreeStations();
   r.stop_reason = StopReason::kTargetReached;

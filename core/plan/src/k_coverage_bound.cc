@@ -100,9 +100,11 @@ struct Run {
   long double Evaluate(const std::vector<double>& v, int k, std::vector<int>& top, std::vector<int>& count) {
     long double base = 0;
     for (size_t i = 0; i < v.size(); ++i) base += static_cast<long double>(p.weight[i]) * (1.0 - v[i]);
-    std::vector<double> price(sees.size(), 0.0);
+    // In long double: FloorBound's tolerance (1e-9 of the total) must cover the sums' rounding, and
+    // k prices of up to |S_j| terms each in double could exceed it on large models.
+    std::vector<long double> price(sees.size(), 0.0L);
     for (size_t j = 0; j < sees.size(); ++j) {
-      for (int i : sees[j]) price[j] += static_cast<double>(p.weight[i]) * v[i];
+      for (int i : sees[j]) price[j] += static_cast<long double>(p.weight[i]) * v[i];
     }
     visits += pairs;
     top.resize(sees.size());

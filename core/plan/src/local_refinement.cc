@@ -110,6 +110,9 @@ Result<LocalRefinementResult> RefineLocally(const Selector& selector, const Voxe
     VC_ASSIGN_OR_RETURN(Selection next, selector.Select(out.candidates.sets, fixed, ctx));
     out.stations_per_solve.push_back(static_cast<int>(next.picks.size()));
     out.covered_per_solve.push_back(next.covered);
+    // Both over the grown sets: where the added positions' sets are kept whole (coarse then fine)
+    // they may see voxels no earlier set did, and the kept plan's share is of those too.
+    out.selection.coverable = next.coverable;
     if (!Better(next, out.selection, options.target_coverage)) break;
     out.selection = std::move(next);
   }

@@ -121,6 +121,16 @@ void AddBestCoverageWhereValid(PlanResult& result, const std::vector<std::option
   if (!options.refine && fixed_lead) AddBestCoverage(result.coverage_curve, best);
 }
 
+// The candidate stage's figures in the result.
+void TakeCandidateFigures(const planner::CandidatesOutput& candidates, PlanResult& result) {
+  result.candidate_count = candidates.positions.size();
+  result.floor_levels_m = candidates.floor_levels_m;
+  result.ground = candidates.ground;
+  result.grid_cells = candidates.grid_cells;
+  result.cells_without_floor = candidates.cells_without_floor;
+  result.cells_failing_clearance = candidates.cells_failing_clearance;
+}
+
 // The visibility stage's context: `ctx`, and with coarse then fine each progress event without a
 // message of its own says that this is the coarse round (the fine round's say "local candidates").
 JobContext VisibilityContext(const JobContext& ctx, const planner::CandidatesOutput& candidates) {
@@ -178,12 +188,7 @@ Result<PlanResult> Plan(const SceneInput& input, const PlanOptions& options, con
   VC_ASSIGN_OR_RETURN(planner::CandidatesOutput candidates, runner.Run(Stage::kCandidates, [&](const JobContext& c) {
     return planner::RunCandidatesStage({scene}, local_options, c);
   }));
-  result.candidate_count = candidates.positions.size();
-  result.floor_levels_m = candidates.floor_levels_m;
-  result.ground = candidates.ground;
-  result.grid_cells = candidates.grid_cells;
-  result.cells_without_floor = candidates.cells_without_floor;
-  result.cells_failing_clearance = candidates.cells_failing_clearance;
+  TakeCandidateFigures(candidates, result);
   result.warnings = std::move(voxelized.warnings);
   result.warnings.insert(result.warnings.end(), candidates.warnings.begin(), candidates.warnings.end());
   // Coarse then fine (docs/PLANNING.md): the coarse grid, then the fine positions around its picks.

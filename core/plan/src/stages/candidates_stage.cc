@@ -218,7 +218,10 @@ Result<CandidatesOutput> RunCandidatesStage(const CandidatesInput& in, const Pla
     PlanOptions coarse_options = options;
     coarse_options.grid_spacing_m = options.grid_spacing_m * kCoarseGridFactor;
     Result<CandidatesOutput> coarse = GridCandidates(in.scene, coarse_options, ctx);
-    if (coarse.ok()) {  // else (no candidate on the coarse grid) the full grid stays
+    // No candidate on the coarse grid (FAILED_PRECONDITION): the full grid stays; anything else
+    // (cancelled, out of time or memory) ends the stage as it would have on the full grid.
+    if (!coarse.ok() && coarse.status().code() != StatusCode::kFailedPrecondition) return coarse.status();
+    if (coarse.ok()) {
       coarse->coarse =
           CandidatesOutput::CoarseGrid{options.grid_spacing_m, coarse_options.grid_spacing_m, out->positions.size()};
       ctx.Report(Stage::kCandidates, 1.0,

@@ -142,7 +142,10 @@ Result<std::vector<std::optional<BestCoverage>>> BestCoverageOf(const std::vecto
   uint64_t pairs = 0;
   for (const VoxelSet& s : sets) pairs += CountBits(s);
   const uint64_t voxels = sets.front().size();
-  if (pairs > kMaxBestCoveragePairs || 16 * pairs + 8 * voxels > max_bytes) return out;
+  if (pairs > kMaxBestCoveragePairs ||
+      kBestCoverageBytesPerPair * pairs + kBestCoverageBytesPerVoxel * voxels > max_bytes) {
+    return out;
+  }
   const Clock::time_point deadline =
       Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(seconds));
   const JobContext quiet{ctx.cancel, {}};  // the classes' progress is the exact selector's to report

@@ -57,7 +57,8 @@ struct CoverageMilestone {
 
 // Each of `levels` (fractions in (0, 1]) with the first point of `curve` whose covered voxels reach
 // level x coverable (the test greedy selection stops on), and the smallest k whose bound reaches it;
-// `coverable_voxels` as the curve's.
+// `coverable_voxels` as the curve's. A point without a bound counts as reaching no level: the curve
+// has none only below the plan's fixed stations (no plan has fewer stations than those), or none.
 [[nodiscard]] std::vector<CoverageMilestone> CoverageMilestones(const std::vector<CoveragePoint>& curve,
                                                                 uint64_t coverable_voxels,
                                                                 const std::vector<double>& levels);

@@ -179,9 +179,14 @@ struct SelectionOutput {
 // The per-k bound and best coverage (vc/plan/k_coverage_bound.h) over `sets`, the `fixed` stations'
 // first: their voxels count as given and the k - fixed others are chosen among the rest. Empty over
 // kMaxBestCoveragePairs (voxel, set) pairs or where the classes could take more than `max_bytes`
-// (16 bytes a (voxel, set) pair and 8 a voxel, at most); the steps and search stop at `seconds`
+// (kBestCoverageBytesPerPair a (voxel, set) pair and kBestCoverageBytesPerVoxel a voxel: the
+// classes' seen_by and sees, the problem's copy and the bound's own column lists, 4 bytes a pair
+// each with room for their vectors' growth; BuildClasses' id maps; a vector per class, the classes
+// at most the voxels); the steps and search stop at `seconds`
 // (the bounds stay valid).
 inline constexpr uint64_t kMaxBestCoveragePairs = uint64_t{1} << 28;
+inline constexpr uint64_t kBestCoverageBytesPerPair = 32;
+inline constexpr uint64_t kBestCoverageBytesPerVoxel = 136;
 [[nodiscard]] Result<std::vector<std::optional<BestCoverage>>> BestCoverageOf(const std::vector<VoxelSet>& sets,
                                                                               int fixed, int max_k, double seconds,
                                                                               uint64_t max_bytes,
