@@ -51,6 +51,29 @@ VoxelScene SceneOf(const std::vector<Eigen::Vector3f>& points, double resolution
   return scene.ok() ? std::move(*scene) : VoxelScene{};
 }
 
+// The batched engine's sets from `viewpoints` (0.1 m voxels) equal the per-ray reference's, voxel by
+// voxel (`what` names the case in a failure); something is seen and something hidden.
+void ExpectEngineMatchesReference(const VoxelScene& scene, const std::vector<SurfacePatch>& patches,
+                                  const std::vector<WorldPoint>& viewpoints, const std::string& what) {
+  const Reference reference{scene, patches};
+  VisibilitySetsOptions options;
+  options.test = SelectionTest::kSubvoxel;
+  options.surface_patches = patches;
+  auto sets = ComputeVisibilitySets(scene, viewpoints, options);
+  ASSERT_TRUE(sets.ok()) << sets.status().ToString();
+  uint64_t seen = 0;
+  for (size_t k = 0; k < viewpoints.size(); ++k) {
+    const Eigen::Vector3d uo = viewpoints[k] / 0.1;
+    for (size_t id = 0; id < scene.occupied.size(); ++id) {
+      const bool expected = reference.Seen(uo, id);
+      ASSERT_EQ((*sets)[k].test(id), expected) << what << ", viewpoint " << k << " voxel " << id;
+      seen += expected;
+    }
+  }
+  EXPECT_GT(seen, 100u);                                              // something is seen
+  EXPECT_GT(viewpoints.size() * scene.occupied.size() - seen, 100u);  // and something is hidden
+}
+
 // The bulk engine (batched walks resumed at the first occupied voxel, subvoxel_bulk.cc), the same
 // engine one voxel at a time (VisibilitySetsOptions::per_voxel) and the single query all agree with
 // the reference, voxel by voxel, on cluttered scenes seen from random points and from candidate-like
@@ -121,7 +144,6 @@ TEST(SubvoxelTest, EngineMatchesThePerRayReferenceOnRandomPatches) {
         p.box_hi[i] = uint8_t(std::max(a, b));
       }
     }
-    const Reference reference{scene, patches};
     std::vector<WorldPoint> viewpoints;
     while (viewpoints.size() < 12) {
       // Random points only: from lattice points the segments meet exact ties, where the engines
@@ -130,22 +152,7 @@ TEST(SubvoxelTest, EngineMatchesThePerRayReferenceOnRandomPatches) {
       VoxelKey key;
       if (CoordToKey(0.1, o, &key) && scene.IdOf(key) < 0) viewpoints.push_back(o);
     }
-    VisibilitySetsOptions options;
-    options.test = SelectionTest::kSubvoxel;
-    options.surface_patches = patches;
-    auto sets = ComputeVisibilitySets(scene, viewpoints, options);
-    ASSERT_TRUE(sets.ok()) << sets.status().ToString();
-    uint64_t seen = 0;
-    for (size_t k = 0; k < viewpoints.size(); ++k) {
-      const Eigen::Vector3d uo = viewpoints[k] / 0.1;
-      for (size_t id = 0; id < scene.occupied.size(); ++id) {
-        const bool expected = reference.Seen(uo, id);
-        ASSERT_EQ((*sets)[k].test(id), expected) << "seed " << seed << " viewpoint " << k << " voxel " << id;
-        seen += expected;
-      }
-    }
-    EXPECT_GT(seen, 100u);
-    EXPECT_GT(viewpoints.size() * scene.occupied.size() - seen, 100u);
+    ExpectEngineMatchesReference(scene, patches, viewpoints, "seed " + std::to_string(seed));
   }
 }
 
@@ -218,25 +225,9 @@ TEST(SubvoxelTest, EngineMatchesThePerRayReferenceOverAGrazedFloor) {
   }
   const VoxelScene scene = SceneOf(points, 0.1);
   const std::vector<SurfacePatch> patches = ComputeSurfacePatches(scene, points);
-  const Reference reference{scene, patches};
   std::vector<WorldPoint> viewpoints;
   for (int k = 0; k < 12; ++k) viewpoints.emplace_back(0.01 + 0.2 * u(rng), -0.1 + 0.2 * u(rng), 0.15 + 0.1 * u(rng));
-  VisibilitySetsOptions options;
-  options.test = SelectionTest::kSubvoxel;
-  options.surface_patches = patches;
-  auto sets = ComputeVisibilitySets(scene, viewpoints, options);
-  ASSERT_TRUE(sets.ok()) << sets.status().ToString();
-  uint64_t seen = 0;
-  for (size_t k = 0; k < viewpoints.size(); ++k) {
-    const Eigen::Vector3d uo = viewpoints[k] / 0.1;
-    for (size_t id = 0; id < scene.occupied.size(); ++id) {
-      const bool expected = reference.Seen(uo, id);
-      ASSERT_EQ((*sets)[k].test(id), expected) << "viewpoint " << k << " voxel " << id;
-      seen += expected;
-    }
-  }
-  EXPECT_GT(seen, 100u);
-  EXPECT_GT(viewpoints.size() * scene.occupied.size() - seen, 100u);
+  ExpectEngineMatchesReference(scene, patches, viewpoints, "grazed floor");
 }
 
 // Patches from `points` at 0.1 m, for the hand-made scenes below.
