@@ -49,12 +49,6 @@ constexpr double kGreedyShare = 0.3, kProbeEnd = 0.33, kClassesEnd = 0.4, kReduc
 
 double SecondsSince(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
-// Calls f(v) for every set bit v of s.
-template <typename F>
-void ForEachBit(const VoxelSet& s, F&& f) {
-  s.ForEach(f);
-}
-
 // Completes `m` once the reduction is done: resolves chains of stand-ins to a column or a forced
 // candidate, numbers the candidates still active as columns and merges the classes still to
 // cover by their (now smaller) sets of columns.
