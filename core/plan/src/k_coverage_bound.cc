@@ -164,12 +164,11 @@ struct Run {
       const uint64_t share = left / static_cast<uint64_t>(max_k - k + 1);
       if (share < 2 * pairs) continue;
       // Warm start: k - 1's multipliers where they do better at k than greedy's prefix.
-      std::vector<double> from_prefix = PrefixMultipliers(ub_prefix[k]);
       const long double warm = v.empty() ? static_cast<long double>(total) + 1 : Evaluate(v, k, top, count);
       if (warm < static_cast<long double>(ub[k])) {
         ub[k] = std::min(ub[k], FloorBound(warm));
       } else {
-        v = std::move(from_prefix);
+        v = PrefixMultipliers(ub_prefix[k]);
       }
       Subgradient(k, v, share);
     }

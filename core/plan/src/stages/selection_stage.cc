@@ -150,6 +150,7 @@ Result<std::vector<std::optional<BestCoverage>>> BestCoverageOf(const std::vecto
       Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(seconds));
   const JobContext quiet{ctx.cancel, {}};  // the classes' progress is the exact selector's to report
   VC_ASSIGN_OR_RETURN(internal::Classes cl, internal::BuildClasses(sets, quiet));
+  std::vector<std::vector<int>>().swap(cl.sees);  // KCoverageBounds builds its own per column
   KCoverageProblem problem;
   problem.columns = static_cast<int>(sets.size()) - fixed;
   uint64_t given = 0;  // the fixed stations' voxels
@@ -159,9 +160,8 @@ Result<std::vector<std::optional<BestCoverage>>> BestCoverageOf(const std::vecto
       continue;
     }
     problem.weight.push_back(cl.weight[i]);
-    std::vector<int> seen;
-    for (int c : cl.seen_by[i]) seen.push_back(c - fixed);
-    problem.seen_by.push_back(std::move(seen));
+    for (int& c : cl.seen_by[i]) c -= fixed;
+    problem.seen_by.push_back(std::move(cl.seen_by[i]));
   }
   cl = {};
   KCoverageOptions options;
