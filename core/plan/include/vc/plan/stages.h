@@ -91,18 +91,19 @@ struct CandidatesOutput {
   };
   std::optional<CoarseGrid> coarse;
 };
+// The candidate grid's options (every row of PlanOptions it uses). Refinement and local candidates
+// start from them, each with its own height, ground model and no doorway candidates.
+[[nodiscard]] CandidateOptions CandidateOptionsFor(const PlanOptions& options);
 // Generated candidates at every height of options.TripodHeights(), or the user's; either without
 // those in a keep-out zone. INVALID_ARGUMENT for a user candidate or fixed station out of range or
 // inside an occupied voxel, or a fixed station outside the scene's bounds (widened by 2 m, naming
 // them); a warning for a fixed station without an occupied voxel within 3 m straight below.
 // FAILED_PRECONDITION when no floor is found or no candidate survives.
-// The candidate grid's options (every row of PlanOptions it uses). Refinement and local candidates
-// start from them, each with its own height, ground model and no doorway candidates.
 // With options.coarse_above_candidates > 0, no user candidates and local_candidates off: when the
 // grid gives more candidates than coarse_above_candidates, the output is the grid at
 // kCoarseGridFactor x grid_spacing_m instead (CandidatesOutput::coarse; the full grid when the
-// coarse one has no candidate), and a progress line says so.
-[[nodiscard]] CandidateOptions CandidateOptionsFor(const PlanOptions& options);
+// coarse one has no candidate, other errors of the coarse grid end the stage), and a progress line
+// says so.
 [[nodiscard]] Result<CandidatesOutput> RunCandidatesStage(const CandidatesInput& in, const PlanOptions& options,
                                                           const JobContext& ctx);
 
