@@ -112,6 +112,7 @@ struct Source {
   size_t next;  // the first segment not yet prepared
   std::optional<VoxelIndex>* out;
   std::vector<size_t>* unsure;
+  char* certified;    // may be null: set to 1 for each segment a lane answers
   const int32_t* lo;  // GridView::lo: start voxels are stored relative to the box's corner
   Prepared prep;
 
@@ -273,6 +274,7 @@ class LaneGroup {
       if (unsure & lane) {
         src.unsure->push_back(size_t(s_.id[l]));
       } else {
+        if (src.certified) src.certified[s_.id[l]] = 1;
         src.out[s_.id[l]] =
             (hits & lane)
                 ? std::optional<VoxelIndex>(VoxelIndex{s_.hx[l] + g_.lo[0], s_.hy[l] + g_.lo[1], s_.hz[l] + g_.lo[2]})
@@ -506,10 +508,11 @@ HWY_INLINE void LaneGroup::Advance() {
 constexpr bool kLanesPay = HWY_TARGET == HWY_AVX3 || HWY_TARGET == HWY_AVX3_DL;
 
 // Returns the target it was compiled for, and in *lanes whether it used the lanes, so callers and
-// tests see what the dispatch chose. Segments the lanes leave go to `unsure`.
+// tests see what the dispatch chose. Segments the lanes leave go to `unsure`; those they answer are
+// marked in `certified` (if not null).
 int64_t FirstOccupiedBatchImpl(const OccupancyGrid& grid, const Eigen::Vector3d* a, const Eigen::Vector3d* b,
                                size_t count, std::optional<VoxelIndex>* out, bool force_lanes, bool* lanes,
-                               std::vector<size_t>* unsure) {
+                               std::vector<size_t>* unsure, char* certified) {
   *lanes = kLanesPay || force_lanes;
   if (!*lanes) {
     for (size_t i = 0; i < count; ++i) out[i] = FirstOccupied(grid, a[i], b[i]);
@@ -517,7 +520,7 @@ int64_t FirstOccupiedBatchImpl(const OccupancyGrid& grid, const Eigen::Vector3d*
   }
   HWY_ASSERT(hn::Lanes(D()) <= 16);
   const GridView view(grid);
-  Source src{a, b, count, 0, out, unsure, view.lo, {}};
+  Source src{a, b, count, 0, out, unsure, certified, view.lo, {}};
   // Two independent groups, so that one group's gathers overlap the other's arithmetic; the lanes
   // in empty bricks jump in one pass of kStepPasses + 1 (see the top of this file).
   LaneGroup g0(view, src), g1(view, src);
@@ -547,9 +550,11 @@ HWY_EXPORT(FirstOccupiedBatchImpl);
 
 std::string FirstOccupiedBatch(const OccupancyGrid& grid, std::span<const Eigen::Vector3d> a,
                                std::span<const Eigen::Vector3d> b, std::span<std::optional<VoxelIndex>> out,
-                               BatchKernel kernel, size_t* rechecked) {
+                               BatchKernel kernel, size_t* rechecked, std::span<char> certified) {
   const size_t n = std::min({a.size(), b.size(), out.size()});
   if (rechecked) *rechecked = 0;
+  HWY_ASSERT(certified.empty() || certified.size() >= n);
+  std::fill_n(certified.data(), certified.empty() ? 0 : n, char{0});
   // The kernel forms brick numbers, payload word numbers, segment numbers and voxel coordinates
   // relative to the box's corner (a voxel within +-2^30, plus at most kMaxLaneSteps, minus the
   // corner) in int32: so the box must lie within +-2^29.
@@ -567,7 +572,8 @@ std::string FirstOccupiedBatch(const OccupancyGrid& grid, std::span<const Eigen:
   bool lanes = false;
   std::vector<size_t> unsure;
   const int64_t target = HWY_DYNAMIC_DISPATCH(FirstOccupiedBatchImpl)(grid, a.data(), b.data(), n, out.data(),
-                                                                      kernel == BatchKernel::kLanes, &lanes, &unsure);
+                                                                      kernel == BatchKernel::kLanes, &lanes, &unsure,
+                                                                      certified.empty() ? nullptr : certified.data());
   for (size_t i : unsure) out[i] = FirstOccupied(grid, a[i], b[i]);
   if (rechecked) *rechecked = unsure.size();
   return std::string(hwy::TargetName(target)) + (lanes ? " lanes" : " per segment");

@@ -178,8 +178,12 @@ bool ResumeStartClear(const Eigen::Vector3d& p0, const double lo[3], int a, bool
   return up ? p0[a] >= lo[a] - 1 + kJudgeMargin : p0[a] <= lo[a] + 2 - kJudgeMargin;
 }
 
-// How many cubes past `first` JudgePastMissed follows before it leaves the segment to the trace.
+// How many cubes past `first` JudgePastMissed follows before it leaves the segment to the trace
+// (or to a walk resumed past them).
 constexpr int kMaxCubesPastMissed = 4;
+// How far past the last cube's exit (voxels, along the longest axis) a resumed walk starts: well
+// below kJudgeMargin, so that the point lies in the cube after the exit face.
+constexpr double kResumeStep = 1e-5;
 
 // SubvoxelJudgeAtFirst where the segment uo + t d (to `end`, inside voxel id's cube) misses the
 // blocker of `first` (entered across axis a; the trace resumes at s0). It follows the segment from
@@ -188,9 +192,12 @@ constexpr int kMaxCubesPastMissed = 4;
 // kMaxCubesPastMissed cubes: 1 where it reaches id's cube first (clear) or meets the blocker of an
 // occupied cube well inside it on id's surface (SameSurface), 0 where that blocker is not on it
 // (blocked; `*blocker` is that voxel, -1 when clear); -1 where a margin fails or the cubes run out.
+// Where the cubes run out and the segment leaves the last one through one face (with the margin),
+// `*resume` is a parameter just past that exit, in the next cube (its floor is that cube's index),
+// from which a walk may go on (SubvoxelJudgeAtFirst).
 int JudgePastMissed(const VoxelScene& scene, std::span<const SurfacePatch> patches, const SubvoxelTables& tables,
                     const Eigen::Vector3d& uo, size_t id, const Eigen::Vector3d& end, const VoxelIndex& first, int a,
-                    double s0, int64_t* blocker) {
+                    double s0, int64_t* blocker, double* resume) {
   const Eigen::Vector3d d = end - uo;
   const OccupancyGrid& g = scene.grid;
   const VoxelIndex& glo = g.min_index();
@@ -198,7 +205,7 @@ int JudgePastMissed(const VoxelScene& scene, std::span<const SurfacePatch> patch
   double lo[3] = {double(first.x), double(first.y), double(first.z)};
   if (!ResumeStartClear(uo + s0 * d, lo, a, d[a] > 0)) return -1;
   int cur[3] = {first.x, first.y, first.z};
-  for (int k = 0; k < kMaxCubesPastMissed; ++k) {
+  for (int k = 0;; ++k) {
     // Leave the cube at `cur` (whose blocker, if any, the segment misses) through face b.
     double leave = std::numeric_limits<double>::infinity();
     int b = -1;
@@ -211,6 +218,17 @@ int JudgePastMissed(const VoxelScene& scene, std::span<const SurfacePatch> patch
     const Eigen::Vector3d out = uo + leave * d;
     for (int i = 0; i < 3; ++i) {
       if (i != b && !(out[i] >= lo[i] + kJudgeMargin && out[i] <= lo[i] + 1 - kJudgeMargin)) return -1;
+    }
+    if (k == kMaxCubesPastMissed) {
+      // Just past the exit (at most kResumeStep voxels along any axis, less than the margin): in
+      // the next cube, where the rounding leaves the point there.
+      const double t = leave + kResumeStep / d.lpNorm<Eigen::Infinity>();
+      const Eigen::Vector3d p = uo + t * d;
+      cur[b] += d[b] > 0 ? 1 : -1;
+      if (t < 1 && std::floor(p[0]) == cur[0] && std::floor(p[1]) == cur[1] && std::floor(p[2]) == cur[2]) {
+        *resume = t;
+      }
+      return -1;
     }
     cur[b] += d[b] > 0 ? 1 : -1;
     lo[b] = cur[b];
@@ -236,15 +254,15 @@ int JudgePastMissed(const VoxelScene& scene, std::span<const SurfacePatch> patch
     *blocker = int64_t(w);
     return SameSurface(hit, end, patches[id], patches[w]) ? 1 : 0;
   }
-  return -1;
 }
 
 }  // namespace
 
 int SubvoxelJudgeAtFirst(const VoxelScene& scene, std::span<const SurfacePatch> patches, const SubvoxelTables& tables,
                          const Eigen::Vector3d& uo, size_t id, const Eigen::Vector3d& end, const VoxelIndex& first,
-                         int64_t* blocker) {
+                         int64_t* blocker, double* resume) {
   constexpr double kMargin = kJudgeMargin;
+  *resume = -1;
   const Eigen::Vector3d d = end - uo;
   if (!(d.lpNorm<Eigen::Infinity>() <= kMaxShortcutLength)) return -1;
   const double lo[3] = {double(first.x), double(first.y), double(first.z)};
@@ -268,7 +286,7 @@ int SubvoxelJudgeAtFirst(const VoxelScene& scene, std::span<const SurfacePatch> 
   const SurfacePatch& patch = patches[w];
   const double s = BlockerHit(uo, end, tables.Box(w), patch, tables.Centroid(w));
   const double s0 = std::max(0.0, enter - kResumeMargin);
-  if (s == kNoHit) return JudgePastMissed(scene, patches, tables, uo, id, end, first, a, s0, blocker);
+  if (s == kNoHit) return JudgePastMissed(scene, patches, tables, uo, id, end, first, a, s0, blocker, resume);
   // The resumed trace starts at s0; from there to the hit the segment must stay inside the cube of
   // `first` and of its face-neighbour across the entry face, away from every other face.
   const Eigen::Vector3d p0 = uo + s0 * d, hit = uo + s * d;

@@ -45,6 +45,88 @@ using Eigen::Vector3d;
 // rounding of the start point, so that it lies in a voxel of the box.
 constexpr double kBoxMargin = 1e-3;
 
+// The parameter of the segment uo -> end at which the trace resumes, kResumeMargin before it enters
+// the cube of its first occupied voxel `w` (up to rounding).
+double ResumeBefore(const Vector3d& uo, const Vector3d& end, const VoxelIndex& w) {
+  const Vector3d d = end - uo;
+  const double lo[3] = {double(w.x), double(w.y), double(w.z)};
+  double enter = 0;
+  for (int a = 0; a < 3; ++a) {
+    if (d[a] == 0) continue;
+    const double t0 = (lo[a] - uo[a]) / d[a], t1 = (lo[a] + 1 - uo[a]) / d[a];
+    enter = std::max(enter, std::min(t0, t1));
+  }
+  return std::max(0.0, enter - kResumeMargin);
+}
+
+// How many times a segment is walked on past the cubes SubvoxelJudgeAtFirst followed before it is
+// traced.
+constexpr int kMaxWalksOn = 8;
+
+// A segment SubvoxelJudgeAtFirst left undecided past the cubes it followed: which (i), where its
+// trace would resume (s_trace) and where the walk goes on (resume).
+struct WalkOn {
+  size_t i;
+  double s_trace, resume;
+};
+
+// The segments of `on` walked on in batches from their resume points to their next occupied voxel
+// and judged there by SubvoxelJudgeAtFirst, again and again; where a lane did not certify its walk
+// (a near-tie: FirstOccupiedBatch's `certified`), or the judgment fails, the segment is traced as
+// without the walk. Every cube before a resume point is free or has a blocker the segment misses,
+// and a certified walk passes the cubes in the order of every walk along the segment, so the next
+// occupied voxel is the one the trace would test next.
+void JudgeWalkingOn(const VoxelScene& scene, std::span<const SurfacePatch> patches, const SubvoxelTables& tables,
+                    const Vector3d& uo, std::span<const uint32_t> owners, std::span<const Vector3d> ends,
+                    std::vector<WalkOn> on, std::vector<char>& seen, std::vector<int64_t>& blocker) {
+  std::vector<Vector3d> from, to;
+  std::vector<std::optional<VoxelIndex>> first;
+  std::vector<char> certified;
+  std::vector<WalkOn> next;
+  const auto trace = [&](const WalkOn& w) {
+    const SubvoxelRay ray = TraceSubvoxelSegment(scene, patches, uo, owners[w.i], ends[w.i], w.s_trace, &tables);
+    seen[w.i] = ray.seen();
+    blocker[w.i] = ray.first_blocker;
+  };
+  for (int round = 0; round < kMaxWalksOn && !on.empty(); ++round) {
+    from.clear();
+    to.clear();
+    for (const WalkOn& w : on) {
+      from.push_back(uo + w.resume * (ends[w.i] - uo));
+      to.push_back(ends[w.i]);
+    }
+    first.assign(on.size(), std::nullopt);
+    certified.assign(on.size(), 0);
+    FirstOccupiedBatch(scene.grid, from, to, first, BatchKernel::kAuto, nullptr, certified);
+    next.clear();
+    for (size_t j = 0; j < on.size(); ++j) {
+      const WalkOn& w = on[j];
+      const uint32_t id = owners[w.i];
+      if (!certified[j] || !first[j]) {
+        trace(w);
+        continue;
+      }
+      if (*first[j] == KeyToIndex(scene.occupied[id])) {
+        seen[w.i] = 1;
+        blocker[w.i] = -1;
+        continue;
+      }
+      double resume = -1;
+      const int judged =
+          SubvoxelJudgeAtFirst(scene, patches, tables, uo, id, ends[w.i], *first[j], &blocker[w.i], &resume);
+      if (judged >= 0) {
+        seen[w.i] = char(judged);
+      } else if (resume >= 0) {
+        next.push_back({w.i, w.s_trace, resume});
+      } else {
+        trace(w);
+      }
+    }
+    on.swap(next);
+  }
+  for (const WalkOn& w : on) trace(w);
+}
+
 // Segments uo -> ends[i] (ends[i] inside voxel owners[i]'s cube), each judged as one segment of the
 // test: seen[i] whether it sees its owner, and where not, blocker[i] the first blocker (or -1).
 void JudgeSegments(const VoxelScene& scene, std::span<const SurfacePatch> patches, const SubvoxelTables& tables,
@@ -70,37 +152,31 @@ void JudgeSegments(const VoxelScene& scene, std::span<const SurfacePatch> patche
   FirstOccupiedBatch(scene.grid, origins, ends, first);
   seen.assign(ends.size(), 0);
   blocker.assign(ends.size(), -1);
+  std::vector<WalkOn> on;
   for (size_t i = 0; i < ends.size(); ++i) {
     const uint32_t id = owners[i];
     if (first[i] && *first[i] == KeyToIndex(scene.occupied[id])) {
       seen[i] = 1;
       continue;
     }
+    double resume = -1;
     if (first[i]) {
-      const int judged = SubvoxelJudgeAtFirst(scene, patches, tables, uo, id, ends[i], *first[i], &blocker[i]);
+      const int judged = SubvoxelJudgeAtFirst(scene, patches, tables, uo, id, ends[i], *first[i], &blocker[i], &resume);
       if (judged >= 0) {
         seen[i] = char(judged);
         continue;
       }
     }
-    double s_start = 0;
-    if (first[i]) {
-      // The segment enters the first occupied cube at this parameter (up to rounding).
-      const VoxelIndex& w = *first[i];
-      const Vector3d d = ends[i] - uo;
-      const double lo[3] = {double(w.x), double(w.y), double(w.z)};
-      double enter = 0;
-      for (int a = 0; a < 3; ++a) {
-        if (d[a] == 0) continue;
-        const double t0 = (lo[a] - uo[a]) / d[a], t1 = (lo[a] + 1 - uo[a]) / d[a];
-        enter = std::max(enter, std::min(t0, t1));
-      }
-      s_start = std::max(0.0, enter - kResumeMargin);
+    const double s_start = first[i] ? ResumeBefore(uo, ends[i], *first[i]) : 0.0;
+    if (resume >= 0) {
+      on.push_back({i, s_start, resume});
+      continue;
     }
     const SubvoxelRay ray = TraceSubvoxelSegment(scene, patches, uo, id, ends[i], s_start, &tables);
     seen[i] = ray.seen();
     blocker[i] = ray.first_blocker;
   }
+  JudgeWalkingOn(scene, patches, tables, uo, owners, ends, std::move(on), seen, blocker);
 }
 
 }  // namespace

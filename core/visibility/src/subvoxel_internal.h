@@ -76,10 +76,13 @@ inline constexpr double kResumeMargin = 1e-6;
 // cube met well inside it judges as `first`'s would. 1: seen (clear, or the blocker is on voxel
 // id's surface), 0: blocked, -1: not decided (then trace). Only for segments of at most
 // kMaxShortcutLength voxels. Where decided, `*blocker` is the deciding blocker's voxel id (-1 when
-// clear), as the trace reports it.
+// clear), as the trace reports it. Where not decided because the cubes ran out (each left with the
+// margin), `*resume` is a parameter of the segment just past the last exit, in the next cube, from
+// which the segment may be walked on: every cube before it is free or has a blocker the segment
+// misses. Otherwise (and where decided) `*resume` is -1.
 int SubvoxelJudgeAtFirst(const VoxelScene& scene, std::span<const SurfacePatch> patches, const SubvoxelTables& tables,
                          const Eigen::Vector3d& uo, size_t id, const Eigen::Vector3d& end, const VoxelIndex& first,
-                         int64_t* blocker);
+                         int64_t* blocker, double* resume);
 // A certificate that the segment uo -> end (end inside voxel id's cube) is blocked under the test,
 // by voxel `w` (any occupied voxel but id; -1: none), without a walk: the segment meets w's blocker
 // at parameter s; it passes through w's cube at least 1e-4 voxels inside all its faces (at the

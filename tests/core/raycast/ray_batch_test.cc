@@ -209,16 +209,53 @@ TEST(FirstOccupiedBatchTest, ExactTiesAndOversizedSegmentsAreLeftToFirstOccupied
     const std::string name = hwy::TargetName(target);
     for (const Segments* set : {&ties, &oversized, &generic}) {
       std::vector<std::optional<VoxelIndex>> got(set->a.size());
+      std::vector<char> certified(set->a.size(), 7);
       size_t rechecked = 99999;
-      FirstOccupiedBatch(*grid, set->a, set->b, got, BatchKernel::kLanes, &rechecked);
+      FirstOccupiedBatch(*grid, set->a, set->b, got, BatchKernel::kLanes, &rechecked, certified);
+      size_t uncertified = 0;
       for (size_t i = 0; i < got.size(); ++i) {
         ASSERT_EQ(got[i], FirstOccupied(*grid, set->a[i], set->b[i])) << name << ", segment " << i;
+        ASSERT_TRUE(certified[i] == 0 || certified[i] == 1) << name << ", segment " << i;
+        uncertified += certified[i] == 0;
       }
+      // The segments left to FirstOccupied are exactly those not certified.
+      EXPECT_EQ(uncertified, rechecked) << name;
       if (set == &generic) {
         EXPECT_LT(rechecked, got.size() / 20) << name << ": generic rays should rarely be near-ties";
       } else {
         EXPECT_EQ(rechecked, got.size()) << name << (set == &ties ? ": exact ties" : ": oversized segments");
       }
+    }
+  }
+  hwy::SetSupportedTargetsForTest(0);
+}
+
+// Where the lanes do not run (kAuto below AVX-512), no segment is certified: FirstOccupied walked
+// them all; where they do, the generic segments are.
+TEST(FirstOccupiedBatchTest, CertifiedOnlyWhereTheLanesAnswered) {
+  std::vector<VoxelIndex> occ;
+  for (int x = -20; x <= 20; ++x)
+    for (int y = -20; y <= 20; ++y) occ.push_back({x, y, -10});
+  auto grid = OccupancyGrid::Build(0.1, occ, 1 << 24);
+  ASSERT_TRUE(grid.ok());
+  Segments s;
+  std::mt19937_64 rng(9);
+  std::uniform_real_distribution<double> u(-18, 18);
+  for (int r = 0; r < 500; ++r) s.Add({u(rng), u(rng), 5.3}, {u(rng), u(rng), -9.5});
+  for (int64_t target : hwy::SupportedAndGeneratedTargets()) {
+    hwy::SetSupportedTargetsForTest(target);
+    std::vector<std::optional<VoxelIndex>> got(s.a.size());
+    std::vector<char> certified(s.a.size(), 1);
+    const std::string ran = FirstOccupiedBatch(*grid, s.a, s.b, got, BatchKernel::kAuto, nullptr, certified);
+    size_t count = 0;
+    for (size_t i = 0; i < got.size(); ++i) {
+      ASSERT_EQ(got[i], FirstOccupied(*grid, s.a[i], s.b[i])) << ran << ", segment " << i;
+      count += certified[i] == 1;
+    }
+    if (ran.ends_with(" lanes")) {
+      EXPECT_GT(count, got.size() * 19 / 20) << ran;
+    } else {
+      EXPECT_EQ(count, 0u) << ran;
     }
   }
   hwy::SetSupportedTargetsForTest(0);

@@ -68,9 +68,15 @@ std::optional<VoxelIndex> FirstOccupied(const OccupancyGrid& grid, const Eigen::
 // the lanes on any target (for tests and benchmarks). A grid of 2^31 bricks or more, or one not
 // within +-2^29 voxels of the origin, and batches of 2^31 segments or more, are walked per
 // segment. Returns what ran, e.g. "AVX3 lanes", "AVX2 per segment", "SCALAR lanes".
+// `certified` (if not empty; at least as long as `out`): certified[i] is 1 where a lane walked
+// segment i and took every decision with the margin, so the voxels it passed are in the exact order
+// of the segment's boundary crossings (any walk along the same line, from any start before a[i],
+// crosses them in that order, up to near-ties inside free boxes the lane jumped across), and 0
+// where FirstOccupied walked it (near-ties, and every segment when the lanes do not run).
 enum class BatchKernel { kAuto, kLanes };
 std::string FirstOccupiedBatch(const OccupancyGrid& grid, std::span<const Eigen::Vector3d> a,
                                std::span<const Eigen::Vector3d> b, std::span<std::optional<VoxelIndex>> out,
-                               BatchKernel kernel = BatchKernel::kAuto, size_t* rechecked = nullptr);
+                               BatchKernel kernel = BatchKernel::kAuto, size_t* rechecked = nullptr,
+                               std::span<char> certified = {});
 
 }  // namespace vc
