@@ -16,6 +16,9 @@
 // - a segment whose first occupied voxel's blocker alone gives the trace's answer, or that misses
 //   it and meets the target or a deciding blocker within the next few cubes (margins:
 //   SubvoxelJudgeAtFirst) is not traced;
+// - a segment that misses that blocker and the few cubes after it is walked on in batches from
+//   just past the last cube followed, where FirstOccupiedBatch certifies the walk, and judged again
+//   at its next occupied voxel (JudgeWalkingOn), instead of traced;
 // - a box fall-back segment that the blocker which last stopped a segment of its voxel proves
 //   blocked (SubvoxelBlockedBy) is not walked.
 //
