@@ -271,9 +271,11 @@ int SubvoxelJudgeAtFirst(const VoxelScene& scene, std::span<const SurfacePatch> 
   int a = -1;
   for (int i = 0; i < 3; ++i) {
     if (d[i] == 0) continue;
-    const double t0 = (lo[i] - uo[i]) / d[i], t1 = (lo[i] + 1 - uo[i]) / d[i];
-    if (std::min(t0, t1) > enter) {
-      enter = std::min(t0, t1);
+    // The nearer face's parameter: min((lo - uo) / d, (lo + 1 - uo) / d), bit for bit (rounding
+    // and a division by one d keep the order of the two).
+    const double t = ((d[i] > 0 ? lo[i] : lo[i] + 1) - uo[i]) / d[i];
+    if (t > enter) {
+      enter = t;
       a = i;
     }
   }

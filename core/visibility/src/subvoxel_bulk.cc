@@ -56,8 +56,8 @@ double ResumeBefore(const Vector3d& uo, const Vector3d& end, const VoxelIndex& w
   double enter = 0;
   for (int a = 0; a < 3; ++a) {
     if (d[a] == 0) continue;
-    const double t0 = (lo[a] - uo[a]) / d[a], t1 = (lo[a] + 1 - uo[a]) / d[a];
-    enter = std::max(enter, std::min(t0, t1));
+    // min((lo - uo) / d, (lo + 1 - uo) / d), bit for bit, as in SubvoxelJudgeAtFirst.
+    enter = std::max(enter, ((d[a] > 0 ? lo[a] : lo[a] + 1) - uo[a]) / d[a]);
   }
   return std::max(0.0, enter - kResumeMargin);
 }
@@ -152,7 +152,9 @@ void JudgeSegments(const VoxelScene& scene, std::span<const SurfacePatch> patche
     }
   }
   std::vector<std::optional<VoxelIndex>> first(ends.size());
-  FirstOccupiedBatch(scene.grid, origins, ends, first);
+  // Walking on pays only where the lanes run and so certify walks (elsewhere every walk on would
+  // be walked again by the trace).
+  const bool lanes = FirstOccupiedBatch(scene.grid, origins, ends, first).ends_with(" lanes");
   seen.assign(ends.size(), 0);
   blocker.assign(ends.size(), -1);
   std::vector<WalkOn> on;
@@ -171,7 +173,7 @@ void JudgeSegments(const VoxelScene& scene, std::span<const SurfacePatch> patche
       }
     }
     const double s_start = first[i] ? ResumeBefore(uo, ends[i], *first[i]) : 0.0;
-    if (resume >= 0) {
+    if (resume >= 0 && lanes) {
       on.push_back({i, s_start, resume});
       continue;
     }
@@ -211,34 +213,50 @@ void SubvoxelVisibleAmong(const VoxelScene& scene, std::span<const SurfacePatch>
   // The box fall-back, one face a round: round r takes the r-th face (TraceSubvoxel's order) of
   // each voxel that is not flat and not seen yet. A face's segment that the blocker which last
   // stopped a segment of the voxel proves blocked (SubvoxelBlockedBy) is not walked.
-  std::vector<std::pair<uint32_t, int64_t>> left, next;
+  // Each voxel left: its faces' segment ends (SubvoxelFaceAims, computed once) and the blocker
+  // that last stopped one of its segments.
+  struct Left {
+    uint32_t id;
+    int faces;
+    int64_t last;
+    Eigen::Vector3d face[3];
+  };
+  std::vector<Left> left, next;
+  std::vector<size_t> walked;  // per segment of a round, its voxel's place in `left`
   for (size_t i = 0; i < owners.size(); ++i) {
     if (seen[i]) {
       set.set(owners[i]);
     } else if (!patches[owners[i]].flat) {
-      left.emplace_back(owners[i], blocker[i]);
+      Left& l = left.emplace_back();
+      l.id = owners[i];
+      l.last = blocker[i];
+      l.faces = SubvoxelFaceAims(scene, patches, uo, l.id, l.face, &tables);
+      if (l.faces == 0) left.pop_back();
     }
   }
   for (int round = 0; round < 3 && !left.empty(); ++round) {
     owners.clear();
     ends.clear();
     next.clear();
-    for (const auto& [id, last] : left) {
-      Eigen::Vector3d faces[3];
-      if (SubvoxelFaceAims(scene, patches, uo, id, faces, &tables) <= round) continue;
-      if (SubvoxelBlockedBy(scene, patches, tables, uo, id, faces[round], last)) {
-        next.emplace_back(id, last);
+    walked.clear();
+    for (size_t j = 0; j < left.size(); ++j) {
+      const Left& l = left[j];
+      if (l.faces <= round) continue;
+      if (SubvoxelBlockedBy(scene, patches, tables, uo, l.id, l.face[round], l.last)) {
+        next.push_back(l);
         continue;
       }
-      owners.push_back(id);
-      ends.push_back(faces[round]);
+      owners.push_back(l.id);
+      ends.push_back(l.face[round]);
+      walked.push_back(j);
     }
     JudgeSegments(scene, patches, tables, uo, owners, ends, seen, blocker, around);
     for (size_t i = 0; i < owners.size(); ++i) {
       if (seen[i]) {
         set.set(owners[i]);
       } else {
-        next.emplace_back(owners[i], blocker[i]);
+        next.push_back(left[walked[i]]);
+        next.back().last = blocker[i];
       }
     }
     left.swap(next);
