@@ -7,6 +7,10 @@
 # stations, coverage and reduction agree. Greedy selection (deterministic).
 # Usage: scripts/bench-fan-out.sh [BUILD_DIR (default build/release)] [SCENE (default geb079; hall, a file)]
 #   [SHARD (default 128)] [-- vc-client FLAGS...]
+# Environment: WARM=0 skips the two warm-up plans (a campus plan takes minutes: each replica then
+# voxelizes the scene inside the measured plan, the peers inside their first shard); KEEP=DIR keeps
+# the servers' logs and both plans there (scripts/fan-out-projection.py reads them) instead of a
+# temporary folder.
 set -euo pipefail
 source "$(dirname "${BASH_SOURCE[0]}")/lib/server_port.sh"
 cd "$(dirname "$0")/.."
@@ -16,11 +20,17 @@ shard=${3:-128}
 shift $(( $# < 3 ? $# : 3 ))
 [[ "${1:-}" == "--" ]] && shift
 extra=("$@")
-work=$(mktemp -d)
+keep=${KEEP:-}
+if [[ -n "$keep" ]]; then
+  mkdir -p "$keep"
+  work=$(cd "$keep" && pwd)
+else
+  work=$(mktemp -d)
+fi
 pids=()
 cleanup() {
   for p in "${pids[@]}"; do kill "$p" 2>/dev/null || true; wait "$p" 2>/dev/null || true; done
-  rm -rf "$work"
+  [[ -n "$keep" ]] || rm -rf "$work"
 }
 trap cleanup EXIT
 
@@ -48,8 +58,10 @@ plan() {  # plan NAME ADDR
     || { cat "$work/$1.out"; exit 1; }
 }
 # Warm both (each replica voxelizes the scene once and keeps it), then measure.
-plan warm_lone "$lone_addr"
-plan warm_a "$a_addr"
+if [[ "${WARM:-1}" != 0 ]]; then
+  plan warm_lone "$lone_addr"
+  plan warm_a "$a_addr"
+fi
 plan one "$lone_addr"
 plan three "$a_addr"
 python3 - "$work/one/plan.json" "$work/three/plan.json" "$scene" "$shard" <<'PY'
@@ -72,5 +84,7 @@ per = (f"{d['bytes_exchanged'] / d['shards'] / 1024:.0f} KiB, {((v3 - v1) + (r3 
 print(f"| {sys.argv[3]} | {one['candidates']['count']} | {one['reduction']['size']} | {shard} | {v1:.2f} → {v3:.2f} s "
       f"| {r1:.2f} → {r3:.2f} s | {d['shards'] if d else 0} ({vis_shards} + {red_shards}) | {d['replicas'] if d else 1} "
       f"| {d['retried'] if d else 0} | {(d['bytes_exchanged'] if d else 0) / 1048576:.1f} MiB | {per} | {'yes' if same else 'NO'} |")
+stages = list(dict.fromkeys(list(t1) + list(t3)))
+print("\nper stage, 1 → 3 replicas: " + ", ".join(f"{k} {t1.get(k, 0):.2f} → {t3.get(k, 0):.2f} s" for k in stages))
 sys.exit(0 if same else 1)
 PY

@@ -121,6 +121,24 @@ Result<GroundModel> FromProto(v1::GroundModel m) {
   return InvalidArgumentError("unknown ground model value " + std::to_string(int(m)) + "; use AUTO, FLOORS or TERRAIN");
 }
 
+v1::VisibilityFigures ToProto(const VisibilityFigures& f) {
+  v1::VisibilityFigures out;
+  out.set_global_visibility(f.global_visibility);
+  out.set_fully_visible_fraction(f.fully_visible_fraction);
+  out.set_mean_full_visibility(f.mean_full_visibility);
+  out.set_partially_visible_fraction(f.partially_visible_fraction);
+  return out;
+}
+
+VisibilityFigures FromProto(const v1::VisibilityFigures& f) {
+  VisibilityFigures out;
+  out.global_visibility = f.global_visibility();
+  out.fully_visible_fraction = f.fully_visible_fraction();
+  out.mean_full_visibility = f.mean_full_visibility();
+  out.partially_visible_fraction = f.partially_visible_fraction();
+  return out;
+}
+
 namespace {
 
 // A local position in the input's frame, and back. A zero origin leaves the bits as they are
@@ -215,24 +233,6 @@ Status Apply(const v1::ScannerModel& p, ScannerModel* scanner) {
   }
   VC_SCANNER_PARAMETERS(VC_ROW_FROM_PROTO)
   return Status::Ok();
-}
-
-v1::VisibilityFigures ToProto(const VisibilityFigures& f) {
-  v1::VisibilityFigures out;
-  out.set_global_visibility(f.global_visibility);
-  out.set_fully_visible_fraction(f.fully_visible_fraction);
-  out.set_mean_full_visibility(f.mean_full_visibility);
-  out.set_partially_visible_fraction(f.partially_visible_fraction);
-  return out;
-}
-
-VisibilityFigures FromProto(const v1::VisibilityFigures& f) {
-  VisibilityFigures out;
-  out.global_visibility = f.global_visibility();
-  out.fully_visible_fraction = f.fully_visible_fraction();
-  out.mean_full_visibility = f.mean_full_visibility();
-  out.partially_visible_fraction = f.partially_visible_fraction();
-  return out;
 }
 
 v1::Reduction ToProto(const Reduction& r, const WorldPoint& frame_origin_m) {

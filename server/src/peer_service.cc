@@ -10,6 +10,7 @@
 #include "job_reactor.h"
 #include "vc/plan/stages.h"
 #include "vc/server/service.h"
+#include "vc/wire/convert.h"
 #include "vc/wire/face_values_codec.h"
 #include "vc/wire/sha256.h"
 #include "vc/wire/voxel_set_codec.h"
@@ -60,18 +61,23 @@ Status RunShard(ServiceState& state, const v1::ShardRequest& request, v1::ShardR
       return Status::Ok();
     }
     case v1::SHARD_KIND_FACE_VALUES: {
-      VC_ASSIGN_OR_RETURN(const Evaluation e,
-                          Evaluate(*scene, viewpoints, planner::ReductionEvaluateOptions(options), ctx));
+      EvaluateOptions eval_options = planner::ReductionEvaluateOptions(options);
+      eval_options.keep_sparse_join_state = request.keep_join_state();
+      VC_ASSIGN_OR_RETURN(const Evaluation e, Evaluate(*scene, viewpoints, eval_options, ctx));
+      // On the wire: 4 bytes a face and a float V, or with the join state a double V and a perception.
+      const uint64_t per_face = request.keep_join_state() ? 4 + 8 + 1 : 4 + 4;
       uint64_t bytes = 0;
-      for (const SparseFaceValues& v : e.per_viewpoint_sparse_values) bytes += v.size() * 8;
+      for (const SparseFaceValues& v : e.per_viewpoint_sparse_values) bytes += v.size() * per_face;
       if (bytes > kMaxFaceValuesBytes) {  // far below protobuf's 2 GiB per message
         return InvalidArgumentError(fmt::format(
             "ComputeShard: the face values of {} stations take {}, over {} per shard; lower the coordinator's "
             "--shard-candidates",
             viewpoints.size(), HumanBytes(bytes), HumanBytes(kMaxFaceValuesBytes)));
       }
-      for (const SparseFaceValues& v : e.per_viewpoint_sparse_values) {
-        *response->add_face_values() = wire::EncodeFaceValues(v);
+      for (size_t k = 0; k < e.per_viewpoint_sparse_values.size(); ++k) {
+        v1::FaceValues* m = response->add_face_values();
+        *m = wire::EncodeFaceValues(e.per_viewpoint_sparse_values[k]);
+        if (request.keep_join_state()) *m->mutable_figures() = wire::ToProto(e.per_viewpoint[k]);
       }
       return Status::Ok();
     }

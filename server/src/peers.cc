@@ -82,6 +82,7 @@ struct LaneJob {
   v1::ShardKind kind;
   double compact_gain;  // the sets arrive sparse where the plan keeps them sparse
   const char* what;     // the stage, for messages
+  bool join_state;      // face values: ask for their join state (ShardRequest.keep_join_state)
 };
 
 // `count` items decoded one by one from `encoded` with `decode`; DATA_LOSS saying `mismatch(n)`
@@ -108,10 +109,17 @@ Result<std::vector<T>> DecodeItems(const v1::ShardResponse& resp, size_t count, 
         [&](const std::string& b) { return wire::DecodeVoxelSet(b, job.occupied_voxels, job.compact_gain); },
         [&](int n) { return fmt::format("it answered {} sets for {} viewpoints", n, count); });
   } else {
-    static_assert(std::is_same_v<T, SparseFaceValues>);
-    return DecodeEach<SparseFaceValues>(
+    static_assert(std::is_same_v<T, StationFaceValues>);
+    return DecodeEach<StationFaceValues>(
         resp.face_values(), count,
-        [&](const v1::FaceValues& m) { return wire::DecodeFaceValues(m, job.occupied_voxels * kFacesPerVoxel); },
+        [&](const v1::FaceValues& m) -> Result<StationFaceValues> {
+          VC_ASSIGN_OR_RETURN(SparseFaceValues v, wire::DecodeFaceValues(m, job.occupied_voxels * kFacesPerVoxel));
+          StationFaceValues out{std::move(v), std::nullopt};
+          // An older replica ignores keep_join_state and answers without figures (or join state).
+          if (job.join_state && m.has_figures() && out.values.HasJoinState())
+            out.figures = wire::FromProto(m.figures());
+          return out;
+        },
         [&](int n) { return fmt::format("it answered face values of {} stations for {}", n, count); });
   }
 }
@@ -236,6 +244,7 @@ class PeerLane {
     *req.mutable_parameters() = job_.parameters;
     req.set_first_index(a.begin);
     req.set_kind(job_.kind);
+    req.set_keep_join_state(job_.join_state);
     for (size_t i = a.begin; i < a.end; ++i) *req.add_viewpoints() = wire::ToProto(job_.viewpoints[i]);
     grpc::ClientContext c;
     Prepare(c, job_.shard_deadline);
@@ -373,7 +382,11 @@ Status RunOwnLane(ShardBoard& board, const std::vector<WorldPoint>& viewpoints, 
     }
     const std::vector<WorldPoint> slice(viewpoints.begin() + std::ptrdiff_t(a->begin),
                                         viewpoints.begin() + std::ptrdiff_t(a->end));
+    const auto started = std::chrono::steady_clock::now();
     Result<std::vector<T>> items = local(slice, quiet);
+    // As a peer logs its ComputeShard, so that every shard's compute time is in the logs.
+    spdlog::info("fan-out: {}: own shard viewpoints={}+{} elapsed={:.3f}s", lane.what, a->begin, slice.size(),
+                 std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count());
     if (items.ok() && items->size() != slice.size()) {
       items = InternalError(fmt::format("{}: {} results for {} viewpoints", lane.what, items->size(), slice.size()));
     }
@@ -485,7 +498,8 @@ Result<FanOutResult<T>> PeerFanOut::FanOut(const SceneRef& ref, const v1::PlanPa
                     options_.shard_deadline,
                     spec.kind,
                     spec.compact_gain,
-                    spec.what};
+                    spec.what,
+                    spec.join_state};
   std::vector<std::unique_ptr<PeerLane<T>>> lanes;
   LaneThreads threads(board);  // declared after what the lanes use, so joined before it goes
   for (size_t i = 0; i < addresses.size(); ++i) {
@@ -507,8 +521,8 @@ Result<FanOutResult<T>> PeerFanOut::FanOut(const SceneRef& ref, const v1::PlanPa
 Result<DistributedSets> PeerFanOut::Compute(const SceneRef& ref, const v1::PlanParameters& parameters,
                                             const VoxelScene& scene, const std::vector<WorldPoint>& viewpoints,
                                             const VisibilitySetsOptions& options, const JobContext& ctx) {
-  const ShardSpec spec{v1::SHARD_KIND_VISIBILITY_SETS, options.compact_gain, Stage::kVisibility,
-                       "the visibility stage"};
+  const ShardSpec spec{v1::SHARD_KIND_VISIBILITY_SETS, options.compact_gain, Stage::kVisibility, "the visibility stage",
+                       false};
   const LocalShard<VoxelSet> local = [&](const std::vector<WorldPoint>& slice, const JobContext& c) {
     return ComputeVisibilitySets(scene, slice, options, c);
   };
@@ -524,15 +538,32 @@ Result<DistributedFaceValues> PeerFanOut::ComputeFaceValues(const SceneRef& ref,
                                                             const VoxelScene& scene,
                                                             const std::vector<WorldPoint>& stations,
                                                             const EvaluateOptions& options, const JobContext& ctx) {
-  const ShardSpec spec{v1::SHARD_KIND_FACE_VALUES, 0, Stage::kReduction, "the reduction"};
-  const LocalShard<SparseFaceValues> local = [&](const std::vector<WorldPoint>& slice,
-                                                 const JobContext& c) -> Result<std::vector<SparseFaceValues>> {
+  const ShardSpec spec{v1::SHARD_KIND_FACE_VALUES, 0, Stage::kReduction, "the reduction",
+                       options.keep_sparse_join_state};
+  const LocalShard<StationFaceValues> local = [&](const std::vector<WorldPoint>& slice,
+                                                  const JobContext& c) -> Result<std::vector<StationFaceValues>> {
     VC_ASSIGN_OR_RETURN(Evaluation e, Evaluate(scene, slice, options, c));
-    return std::move(e.per_viewpoint_sparse_values);
+    std::vector<StationFaceValues> out;
+    out.reserve(slice.size());
+    for (size_t k = 0; k < slice.size(); ++k) {
+      out.push_back({std::move(e.per_viewpoint_sparse_values[k]), std::nullopt});
+      if (options.keep_sparse_join_state) out.back().figures = e.per_viewpoint[k];
+    }
+    return out;
   };
-  VC_ASSIGN_OR_RETURN(FanOutResult<SparseFaceValues> got,
-                      FanOut<SparseFaceValues>(ref, parameters, scene, stations, spec, local, ctx));
-  return DistributedFaceValues{std::move(got.items), got.distribution, std::move(got.warnings)};
+  VC_ASSIGN_OR_RETURN(FanOutResult<StationFaceValues> got,
+                      FanOut<StationFaceValues>(ref, parameters, scene, stations, spec, local, ctx));
+  DistributedFaceValues out{{}, {}, got.distribution, std::move(got.warnings)};
+  // The figures only when every station has them: one older replica's shard leaves the join out.
+  bool joinable = options.keep_sparse_join_state;
+  for (const StationFaceValues& s : got.items) joinable = joinable && s.figures.has_value();
+  out.values.reserve(got.items.size());
+  if (joinable) out.figures.reserve(got.items.size());
+  for (StationFaceValues& s : got.items) {
+    out.values.push_back(std::move(s.values));
+    if (joinable) out.figures.push_back(*s.figures);
+  }
+  return out;
 }
 
 }  // namespace vc::server

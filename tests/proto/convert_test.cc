@@ -170,6 +170,16 @@ PlanResult BigResult(size_t voxels, size_t candidates) {
   return r;
 }
 
+// A station's figures between replicas (FaceValues.figures): every double bit for bit.
+TEST(VisibilityFigures, RoundTripBitForBit) {
+  const VisibilityFigures f{0.1 + 0.2, 1.0 / 3.0, std::nextafter(0.5, 1.0), 5e-324};
+  const VisibilityFigures back = FromProto(ToProto(f));
+  EXPECT_EQ(back.global_visibility, f.global_visibility);
+  EXPECT_EQ(back.fully_visible_fraction, f.fully_visible_fraction);
+  EXPECT_EQ(back.mean_full_visibility, f.mean_full_visibility);
+  EXPECT_EQ(back.partially_visible_fraction, f.partially_visible_fraction);
+}
+
 TEST(PlanResultChunks, TheGroundChoiceRoundTrips) {
   PlanResult r = BigResult(3, 2);
   r.ground = {GroundModel::kTerrain, 0.37, "terrain: only 37%"};

@@ -89,8 +89,13 @@ std::string Warnings(const PlanResult& r) {
 // (kOtherScene).
 class FakePeer final : public v1::StationPlanner::CallbackService {
  public:
-  enum class Mode { kHang, kDie, kOtherScene };
-  explicit FakePeer(Mode mode) : mode_(mode) {
+  // kOld: a replica older than ShardRequest.keep_join_state, in front of a real one (`behind`,
+  // which must hold the scene already): it passes each shard on without that field.
+  enum class Mode { kHang, kDie, kOtherScene, kOld };
+  explicit FakePeer(Mode mode, const std::string& behind = "") : mode_(mode) {
+    if (!behind.empty()) {
+      behind_ = v1::StationPlanner::NewStub(grpc::CreateChannel(behind, grpc::InsecureChannelCredentials()));
+    }
     grpc::ServerBuilder b;
     b.AddListeningPort("127.0.0.1:0", grpc::InsecureServerCredentials(), &port_);
     b.RegisterService(this);
@@ -118,6 +123,15 @@ class FakePeer final : public v1::StationPlanner::CallbackService {
                                          v1::ShardResponse* response) override {
     ++shards_;
     first_shard.Set();
+    if (mode_ == Mode::kOld) {
+      v1::ShardRequest older = *request;
+      older.clear_keep_join_state();
+      grpc::ClientContext c;
+      const grpc::Status st = behind_->ComputeShard(&c, older, response);  // blocking: a test's fake
+      auto* r = ctx->DefaultReactor();
+      r->Finish(st);
+      return r;
+    }
     if (mode_ == Mode::kOtherScene) {
       response->set_occupied_voxels(3);
       response->set_scene_crc32c(7);
@@ -136,6 +150,7 @@ class FakePeer final : public v1::StationPlanner::CallbackService {
     void OnDone() override { delete this; }
   };
   const Mode mode_;
+  std::unique_ptr<v1::StationPlanner::Stub> behind_;
   int port_ = 0;
   std::atomic<int> shards_{0};
   std::unique_ptr<grpc::Server> server_;
@@ -200,6 +215,82 @@ TEST(FanOut, TheReductionsEvaluationIsShardedAcrossReplicas) {
   EXPECT_EQ(fanned->distribution.shards, int((viewpoints + 3) / 4 + (stations + 3) / 4));
   EXPECT_EQ(fanned->distribution.replicas, 2) << Warnings(*fanned);
   EXPECT_TRUE(fanned->warnings.empty()) << Warnings(*fanned);
+}
+
+// Nine fixed stations (never removed, and they cover the room, so none is removable) under a
+// budget whose cache holds four stations at the worst case: the reduction asks the replicas in
+// several batches.
+PlanOptions SeveralReductionBatches() {
+  PlanOptions options = Options();
+  for (double x : {1.0, 4.0, 7.0}) {
+    for (double y : {1.0, 3.0, 5.0}) options.fixed_stations.push_back(WorldPoint(x, y, 1.5));
+  }
+  auto input = ReadScene(Room(), "room.ply");
+  auto voxelized = planner::RunVoxelizeStage({*input}, options, {});
+  const uint64_t voxels = voxelized->scene.occupied.size();
+  // Room for the join and its state in flight (15/32 of the budget for the table and the join).
+  options.memory_budget_bytes =
+      (planner::ReductionTableBytes(voxels) + planner::ReductionJoinBytes(voxels)) * 32 / 15 + 64;
+  return options;
+}
+
+void ExpectSameEvaluation(const PlanResult& a, const PlanResult& b) {
+  EXPECT_EQ(a.evaluation.overall.global_visibility, b.evaluation.overall.global_visibility);
+  EXPECT_EQ(a.evaluation.overall.fully_visible_fraction, b.evaluation.overall.fully_visible_fraction);
+  EXPECT_EQ(a.evaluation.overall.mean_full_visibility, b.evaluation.overall.mean_full_visibility);
+  EXPECT_EQ(a.evaluation.overall.partially_visible_fraction, b.evaluation.overall.partially_visible_fraction);
+  ASSERT_EQ(a.stations.size(), b.stations.size());
+  for (size_t k = 0; k < a.stations.size(); ++k) {
+    EXPECT_EQ(a.stations[k].global_visibility, b.stations[k].global_visibility) << k;
+  }
+}
+
+// The replicas answer the reduction's first pass with each station's join state, which the
+// coordinator joins into the final evaluation: the single replica's, bit for bit, over several
+// batches (docs/PLANNING.md, "Reduction"; the core test PlannerTest.
+// ReductionJoinsTheReplicasValuesIntoTheFinalEvaluation shows the evaluation stage then evaluates
+// nothing).
+TEST(FanOut, TheReplicasValuesJoinIntoTheFinalEvaluationAsOnOneReplica) {
+  const PlanOptions options = SeveralReductionBatches();
+  auto b = testing::StartServer(Replica());
+  auto c = testing::StartServer(Replica());
+  ASSERT_TRUE(b && c);
+  const auto alone = PlanOn(testing::Address(*b), "", options);
+  ASSERT_TRUE(alone.ok()) << alone.status().ToString();
+  ASSERT_TRUE(alone->reduction.removed.empty());
+  ASSERT_GT(alone->stations.size(), 4u);
+  EXPECT_TRUE(alone->warnings.empty()) << Warnings(*alone);
+  server::ServerOptions o = Coordinator({testing::Address(*b), testing::Address(*c)});
+  o.local_shards = false;
+  auto a = testing::StartServer(o);
+  ASSERT_TRUE(a);
+  const auto fanned = PlanOn(testing::Address(*a), "", options);
+  ASSERT_TRUE(fanned.ok()) << fanned.status().ToString();
+  ExpectSamePlan(*alone, *fanned);
+  ExpectSameEvaluation(*alone, *fanned);
+  EXPECT_EQ(fanned->distribution.replicas, 2) << Warnings(*fanned);
+  EXPECT_TRUE(fanned->warnings.empty()) << Warnings(*fanned);
+}
+
+// A replica older than the join state answers values alone: the coordinator evaluates the final
+// stations again, says so, and the plan is the same.
+TEST(FanOut, AnOlderReplicasValuesFallBackToEvaluatingAgain) {
+  const PlanOptions options = SeveralReductionBatches();
+  auto b = testing::StartServer(Replica());
+  ASSERT_TRUE(b);
+  const auto alone = PlanOn(testing::Address(*b), "", options);  // b now holds the scene
+  ASSERT_TRUE(alone.ok()) << alone.status().ToString();
+  FakePeer old(FakePeer::Mode::kOld, testing::Address(*b));
+  server::ServerOptions o = Coordinator({old.address()});
+  o.local_shards = false;
+  auto a = testing::StartServer(o);
+  ASSERT_TRUE(a);
+  const auto fanned = PlanOn(testing::Address(*a), "", options);
+  ASSERT_TRUE(fanned.ok()) << fanned.status().ToString();
+  EXPECT_GT(old.shards(), 0);
+  ExpectSamePlan(*alone, *fanned);
+  ExpectSameEvaluation(*alone, *fanned);
+  EXPECT_TRUE(HasWarning(*fanned, "older than this one")) << Warnings(*fanned);
 }
 
 TEST(FanOut, AReplicaListedAmongItsOwnPeersIsSkipped) {
@@ -358,12 +449,13 @@ class PeerCalls : public ::testing::Test {
     return resp.has_scene();
   }
   grpc::Status Shard(const std::string& sha, v1::ShardResponse* resp, const std::string& token = "t",
-                     v1::ShardKind kind = v1::SHARD_KIND_VISIBILITY_SETS) {
+                     v1::ShardKind kind = v1::SHARD_KIND_VISIBILITY_SETS, bool keep_join_state = false) {
     grpc::ClientContext c;
     Prepare(&c, token);
     v1::ShardRequest req;
     req.set_scene_sha256(sha);
     req.set_kind(kind);
+    req.set_keep_join_state(keep_join_state);
     *req.mutable_parameters() = wire::ToProto(Options());
     *req.add_viewpoints() = wire::ToProto(WorldPoint(2, 2, 1.5));
     *req.add_viewpoints() = wire::ToProto(WorldPoint(100, 100, 100));  // outside the room: sees nothing
@@ -431,6 +523,42 @@ TEST_F(PeerCalls, ComputeShardAnswersFaceValuesAsEvaluateGivesThem) {
   }
   EXPECT_GT(local->per_viewpoint_sparse_values[0].size(), 1000u);
   EXPECT_EQ(local->per_viewpoint_sparse_values[1].size(), 0u);
+  for (int k = 0; k < 2; ++k) EXPECT_FALSE(resp.face_values(k).has_figures());  // not asked for
+}
+
+// Asked for the join state: each station's doubles, perceptions and figures, as Evaluate gives
+// them with keep_sparse_join_state; no floats on the wire.
+TEST_F(PeerCalls, ComputeShardAnswersTheJoinStateWhenAskedFor) {
+  const std::string sha = wire::Sha256Hex(Room());
+  ASSERT_TRUE(Share(sha, Room().size(), Room()).ok());
+  v1::ShardResponse resp;
+  const grpc::Status s = Shard(sha, &resp, "t", v1::SHARD_KIND_FACE_VALUES, true);
+  ASSERT_TRUE(s.ok()) << s.error_message();
+  ASSERT_EQ(resp.face_values_size(), 2);
+  auto input = ReadScene(Room(), "room.ply");
+  ASSERT_TRUE(input.ok()) << input.status().ToString();
+  auto voxelized = planner::RunVoxelizeStage({*input}, Options(), {});
+  ASSERT_TRUE(voxelized.ok());
+  EvaluateOptions eval_options = planner::ReductionEvaluateOptions(Options());
+  eval_options.keep_sparse_join_state = true;
+  auto local = Evaluate(voxelized->scene, {WorldPoint(2, 2, 1.5), WorldPoint(100, 100, 100)}, eval_options);
+  ASSERT_TRUE(local.ok());
+  for (int k = 0; k < 2; ++k) {
+    const v1::FaceValues& m = resp.face_values(k);
+    EXPECT_TRUE(m.values().empty()) << k;
+    ASSERT_TRUE(m.has_figures()) << k;
+    EXPECT_EQ(m.figures().global_visibility(), local->per_viewpoint[k].global_visibility) << k;
+    EXPECT_EQ(m.figures().fully_visible_fraction(), local->per_viewpoint[k].fully_visible_fraction) << k;
+    auto got = wire::DecodeFaceValues(m, resp.occupied_voxels() * kFacesPerVoxel);
+    ASSERT_TRUE(got.ok()) << got.status().ToString();
+    const SparseFaceValues& want = local->per_viewpoint_sparse_values[k];
+    EXPECT_EQ(got->faces, want.faces) << k;
+    EXPECT_EQ(got->values, want.values) << k;
+    EXPECT_EQ(got->exact_values, want.exact_values) << k;
+    EXPECT_EQ(got->perceptions, want.perceptions) << k;
+  }
+  EXPECT_GT(local->per_viewpoint_sparse_values[0].size(), 1000u);
+  EXPECT_GT(local->per_viewpoint[0].global_visibility, 0.0);
 }
 
 }  // namespace

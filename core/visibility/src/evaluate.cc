@@ -586,6 +586,10 @@ Status ExactEvaluation::ValueFaces(size_t k, int threads, Work& w) {
         if (sparse && val > 0) {
           sparse->faces.push_back(uint32_t(slot));
           sparse->values.push_back(float(val));
+          if (job_.options.keep_sparse_join_state) {
+            sparse->exact_values.push_back(val);
+            sparse->perceptions.push_back(uint8_t(p));
+          }
         }
         KeepBest(val, uint8_t(p), w.best[slot], w.best_p[slot]);
         seen |= val > 0;
@@ -611,11 +615,16 @@ void ExactEvaluation::JoinSparseValues() {
     SparseFaceValues& out = ev_.per_viewpoint_sparse_values[k];
     size_t count = 0;
     for (const SparseFaceValues& c : sparse_chunks_[k]) count += c.size();
+    const bool join_state = job_.options.keep_sparse_join_state;
     out.faces.reserve(count);
     out.values.reserve(count);
+    out.exact_values.reserve(join_state ? count : 0);
+    out.perceptions.reserve(join_state ? count : 0);
     for (SparseFaceValues& c : sparse_chunks_[k]) {
       out.faces.insert(out.faces.end(), c.faces.begin(), c.faces.end());
       out.values.insert(out.values.end(), c.values.begin(), c.values.end());
+      out.exact_values.insert(out.exact_values.end(), c.exact_values.begin(), c.exact_values.end());
+      out.perceptions.insert(out.perceptions.end(), c.perceptions.begin(), c.perceptions.end());
       c = SparseFaceValues{};
     }
   }
@@ -749,6 +758,57 @@ Result<Evaluation> JoinEvaluations(Evaluation first, Evaluation second) {
   Append(first.per_viewpoint_face_values, second.per_viewpoint_face_values);
   Append(first.per_viewpoint_sparse_values, second.per_viewpoint_sparse_values);
   return first;
+}
+
+Result<Evaluation> EvaluationOfSparseValues(const VoxelScene& scene, FaceSet faces,
+                                            std::vector<VisibilityFigures> per_viewpoint,
+                                            const std::vector<SparseFaceValues>& values) {
+  if (per_viewpoint.size() != values.size()) {
+    return InvalidArgumentError("evaluation of sparse values: " + std::to_string(per_viewpoint.size()) +
+                                " viewpoints' figures for " + std::to_string(values.size()) + " viewpoints' values");
+  }
+  const size_t n = scene.occupied.size();
+  const uint64_t slots = uint64_t(n) * kFacesPerVoxel;
+  Evaluation ev;
+  ev.resolution_m = scene.resolution_m;
+  for (size_t i = 0; i < n; ++i) {
+    const VoxelIndex v = KeyToIndex(scene.occupied[i]);
+    for (int f = 0; f < kFacesPerVoxel; ++f) ev.faces_total += FaceInSet(scene.grid, v, Face(f), faces);
+  }
+  ev.faces_evaluated = ev.faces_total;
+  ev.per_viewpoint = std::move(per_viewpoint);
+  if (ev.faces_total == 0) return ev;  // as Evaluate: nothing more
+  std::vector<double> best(slots, 0.0);
+  std::vector<uint8_t> best_p(slots, uint8_t(Perception::kNone));
+  ev.sole_viewer.assign(n, kNoViewer);
+  for (size_t k = 0; k < values.size(); ++k) {
+    const SparseFaceValues& s = values[k];
+    if (!s.HasJoinState()) {
+      return InvalidArgumentError("evaluation of sparse values: viewpoint " + std::to_string(k + 1) +
+                                  "'s values carry no double-precision V and perception (keep_sparse_join_state)");
+    }
+    for (size_t j = 0; j < s.size(); ++j) {
+      const uint32_t slot = s.faces[j];
+      if (slot >= slots || (j > 0 && s.faces[j - 1] >= slot)) {
+        return InvalidArgumentError("evaluation of sparse values: viewpoint " + std::to_string(k + 1) + "'s face " +
+                                    std::to_string(slot) + " is not ascending below " + std::to_string(slots));
+      }
+      KeepBest(s.exact_values[j], s.perceptions[j], best[slot], best_p[slot]);
+      const size_t voxel = slot / kFacesPerVoxel;
+      ev.sole_viewer[voxel] = CombineViewers(ev.sole_viewer[voxel], int32_t(k));
+    }
+  }
+  // Faces outside F and faces no viewpoint sees hold (0, kNone), which add nothing to a tally: summed
+  // in face order, the figures are those of Evaluate's Finish.
+  Tally total;
+  for (uint64_t slot = 0; slot < slots; ++slot) total.Add(Perception(best_p[slot]), best[slot]);
+  ev.overall = total.Figures(ev.faces_total);
+  ev.best_face_values.resize(n);
+  for (size_t i = 0; i < n; ++i)
+    for (int f = 0; f < kFacesPerVoxel; ++f) ev.best_face_values[i][f] = float(best[i * kFacesPerVoxel + f]);
+  ev.best_values = std::move(best);
+  ev.best_perceptions = std::move(best_p);
+  return ev;
 }
 
 }  // namespace vc

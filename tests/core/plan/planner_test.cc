@@ -697,6 +697,103 @@ TEST(PlannerTest, ReductionBatchesJoinedAreTheFinalEvaluation) {
   EXPECT_TRUE(batched->evaluation.best_values.empty());  // the join state is dropped once every station is in
 }
 
+// Across replicas (PlanCallbacks::face_values, as vc-server's peers answer: shards of three
+// stations) the batches' values come with their join state and are joined into the final
+// evaluation as one replica joins its own: the same evaluation, bit for bit, and the evaluation
+// stage evaluates nothing. Replicas too old to give the join state, or a budget without room for it
+// in flight, cost one more evaluation, with a note, and the same result.
+TEST(PlannerTest, ReductionJoinsTheReplicasValuesIntoTheFinalEvaluation) {
+  PlanOptions o = TestOptions();
+  o.target_coverage = 1.0;
+  Result<PlanResult> one = Plan(Synthetic("comb:5"), o);
+  ASSERT_TRUE(one.ok()) << one.status().ToString();
+  Result<VoxelScene> scene = Voxelize(Synthetic("comb:5"), {0.1, kDefaultMemoryBudgetBytes});
+  ASSERT_TRUE(scene.ok());
+  const uint64_t voxels = scene->occupied.size();
+  // The table, the join and 9/8 of the cache (the join state in flight) in three quarters of the
+  // budget: 15/32 of it for the table and the join; the cache's quarter then holds four stations at
+  // the worst case, so more than one batch.
+  const uint64_t with_room =
+      (planner::ReductionTableBytes(voxels) + planner::ReductionJoinBytes(voxels)) * 32 / 15 + 64;
+  const uint64_t worst_station_bytes = voxels * kFacesPerVoxel * 8;
+  int calls = 0;
+  auto replicas = [&](bool old) {
+    return [&, old](const VoxelScene& sc, const std::vector<WorldPoint>& stations, const EvaluateOptions& options,
+                    const JobContext& ctx) -> Result<DistributedFaceValues> {
+      ++calls;
+      DistributedFaceValues d;
+      EvaluateOptions asked = options;
+      if (old) asked.keep_sparse_join_state = false;  // an older replica ignores the request
+      for (size_t b = 0; b < stations.size(); b += 3) {
+        const std::vector<WorldPoint> shard(stations.begin() + b, stations.begin() + std::min(b + 3, stations.size()));
+        VC_ASSIGN_OR_RETURN(Evaluation e, Evaluate(sc, shard, asked, ctx));
+        for (size_t k = 0; k < shard.size(); ++k) {
+          d.values.push_back(std::move(e.per_viewpoint_sparse_values[k]));
+          if (asked.keep_sparse_join_state) d.figures.push_back(e.per_viewpoint[k]);
+        }
+      }
+      d.distribution.shards = int((stations.size() + 2) / 3);
+      d.distribution.replicas = 2;
+      return d;
+    };
+  };
+  auto plan = [&](bool old, uint64_t budget, bool& evaluation_counted) {
+    PlanOptions with = o;
+    with.memory_budget_bytes = budget;
+    PlanCallbacks callbacks;
+    callbacks.face_values = replicas(old);
+    JobContext ctx;
+    evaluation_counted = false;
+    ctx.progress = [&](const ProgressEvent& e) { evaluation_counted |= e.stage == Stage::kEvaluation && e.total > 0; };
+    return Plan(Synthetic("comb:5"), with, ctx, callbacks);
+  };
+  auto expect_same_evaluation = [&](const PlanResult& r, const std::string& what) {
+    EXPECT_EQ(r.evaluation.overall.global_visibility, one->evaluation.overall.global_visibility) << what;
+    EXPECT_EQ(r.evaluation.overall.fully_visible_fraction, one->evaluation.overall.fully_visible_fraction) << what;
+    EXPECT_EQ(r.evaluation.overall.mean_full_visibility, one->evaluation.overall.mean_full_visibility) << what;
+    EXPECT_EQ(r.evaluation.overall.partially_visible_fraction, one->evaluation.overall.partially_visible_fraction)
+        << what;
+    EXPECT_EQ(r.evaluation.best_face_values, one->evaluation.best_face_values) << what;
+    EXPECT_EQ(r.evaluation.sole_viewer, one->evaluation.sole_viewer) << what;
+    ASSERT_EQ(r.evaluation.per_viewpoint.size(), one->evaluation.per_viewpoint.size()) << what;
+    for (size_t k = 0; k < r.evaluation.per_viewpoint.size(); ++k) {
+      EXPECT_EQ(r.evaluation.per_viewpoint[k].global_visibility, one->evaluation.per_viewpoint[k].global_visibility)
+          << what << k;
+      EXPECT_EQ(r.evaluation.per_viewpoint[k].fully_visible_fraction,
+                one->evaluation.per_viewpoint[k].fully_visible_fraction)
+          << what << k;
+    }
+    EXPECT_EQ(r.evaluation.faces_total, one->evaluation.faces_total) << what;
+    EXPECT_TRUE(r.evaluation.best_values.empty()) << what;  // the join state is dropped at the end
+  };
+  auto has = [](const PlanResult& r, const std::string& part) {
+    return std::any_of(r.warnings.begin(), r.warnings.end(),
+                       [&](const std::string& w) { return w.find(part) != std::string::npos; });
+  };
+  bool counted = false;
+  Result<PlanResult> joined = plan(false, with_room, counted);
+  ASSERT_TRUE(joined.ok()) << joined.status().ToString();
+  ASSERT_GT(joined->stations.size() * worst_station_bytes, with_room / 4);  // more than one batch
+  EXPECT_GE(calls, 2);
+  EXPECT_TRUE(joined->reduction.removed.empty());
+  EXPECT_FALSE(counted) << "the evaluation stage evaluated the stations again";
+  EXPECT_FALSE(has(*joined, "reduction:"));  // (at this budget the solver warns that it went greedy)
+  expect_same_evaluation(*joined, "joined");
+
+  Result<PlanResult> older = plan(true, with_room, counted);
+  ASSERT_TRUE(older.ok()) << older.status().ToString();
+  EXPECT_TRUE(counted);
+  EXPECT_TRUE(has(*older, "older than this one")) << older->warnings.size();
+  expect_same_evaluation(*older, "older replicas");
+
+  // The smallest budget that joins on one replica has no room for the join state in flight.
+  Result<PlanResult> tight = plan(false, planner::ReductionJoinBudgetBytes(voxels), counted);
+  ASSERT_TRUE(tight.ok()) << tight.status().ToString();
+  EXPECT_TRUE(counted);
+  EXPECT_TRUE(has(*tight, "join state in flight")) << tight->warnings.size();
+  expect_same_evaluation(*tight, "tight budget");
+}
+
 // The reduction's table (the top-3 table, 144 bytes a voxel, and an evaluation's working set, 122)
 // and the joined evaluation are charged to three quarters of the budget; the cache keeps its quarter
 // (at most 1 GiB) either way.

@@ -555,6 +555,99 @@ TEST(EvaluateTest, JoinRefusesEvaluationsItCannotJoinNamingWhy) {
   refused(eval(s, opt), eval(s, sampled), "sampled");
 }
 
+// The evaluation built from groups of viewpoints' sparse values with their join state (as replicas
+// give them), joined, is one evaluation of them all, bit for bit; for both face sets. The sparse
+// values with the join state are the plain ones with each face's double V and perception beside.
+TEST(EvaluateTest, EvaluationOfSparseValuesJoinedEqualsOneEvaluationOfAll) {
+  std::mt19937_64 rng(43);
+  const VoxelScene s = RandomScene(rng, 3000, 150, 0.1);
+  const auto vps = RandomViewpoints(rng, 9, 150, 0.1);
+  for (const FaceSet faces : {FaceSet::kAll, FaceSet::kExposed}) {
+    const std::string what = faces == FaceSet::kAll ? "all faces" : "exposed faces";
+    EvaluateOptions opt;
+    opt.faces = faces;
+    opt.threads = 2;
+    opt.scanner.max_range_m = 4.0;  // many voxels with a sole viewer
+    opt.keep_face_values = true;
+    opt.keep_sparse_per_viewpoint_values = true;
+    Result<Evaluation> all = Evaluate(s, vps, opt);
+    ASSERT_TRUE(all.ok()) << all.status().ToString();
+    EvaluateOptions sparse = opt;
+    sparse.keep_face_values = false;
+    sparse.keep_sparse_join_state = true;
+    std::optional<Evaluation> joined;
+    for (const auto& [b, e] : std::vector<std::pair<size_t, size_t>>{{0, 3}, {3, 8}, {8, 9}}) {
+      Result<Evaluation> part = Evaluate(s, std::vector<WorldPoint>(vps.begin() + b, vps.begin() + e), sparse);
+      ASSERT_TRUE(part.ok()) << part.status().ToString();
+      for (size_t k = 0; k < e - b; ++k) {
+        const SparseFaceValues& got = part->per_viewpoint_sparse_values[k];
+        const SparseFaceValues& plain = all->per_viewpoint_sparse_values[b + k];
+        ASSERT_TRUE(got.HasJoinState()) << what << k;
+        EXPECT_EQ(got.faces, plain.faces) << what << k;
+        EXPECT_EQ(got.values, plain.values) << what << k;
+        for (size_t j = 0; j < got.size(); ++j) {
+          ASSERT_EQ(float(got.exact_values[j]), got.values[j]) << what << k;
+          ASSERT_TRUE(got.perceptions[j] == 1 || got.perceptions[j] == 2) << what << k;
+        }
+      }
+      Result<Evaluation> built =
+          EvaluationOfSparseValues(s, faces, part->per_viewpoint, part->per_viewpoint_sparse_values);
+      ASSERT_TRUE(built.ok()) << built.status().ToString();
+      if (!joined) {
+        joined = std::move(*built);
+        continue;
+      }
+      Result<Evaluation> j = JoinEvaluations(std::move(*joined), std::move(*built));
+      ASSERT_TRUE(j.ok()) << j.status().ToString();
+      joined = std::move(*j);
+    }
+    EXPECT_GT(all->overall.global_visibility, 0.0) << what;
+    EXPECT_EQ(joined->faces_total, all->faces_total) << what;
+    EXPECT_EQ(joined->faces_evaluated, all->faces_evaluated) << what;
+    EXPECT_EQ(joined->overall.global_visibility, all->overall.global_visibility) << what;
+    EXPECT_EQ(joined->overall.fully_visible_fraction, all->overall.fully_visible_fraction) << what;
+    EXPECT_EQ(joined->overall.mean_full_visibility, all->overall.mean_full_visibility) << what;
+    EXPECT_EQ(joined->overall.partially_visible_fraction, all->overall.partially_visible_fraction) << what;
+    ASSERT_EQ(joined->per_viewpoint.size(), vps.size()) << what;
+    for (size_t k = 0; k < vps.size(); ++k) {
+      EXPECT_EQ(joined->per_viewpoint[k].global_visibility, all->per_viewpoint[k].global_visibility) << what << k;
+    }
+    EXPECT_EQ(joined->best_face_values, all->best_face_values) << what;
+    EXPECT_EQ(joined->sole_viewer, all->sole_viewer) << what;
+    EXPECT_TRUE(std::any_of(joined->sole_viewer.begin(), joined->sole_viewer.end(), [](int32_t v) { return v >= 3; }))
+        << what;
+  }
+}
+
+TEST(EvaluateTest, EvaluationOfSparseValuesRefusesValuesWithoutJoinState) {
+  std::mt19937_64 rng(47);
+  const VoxelScene s = RandomScene(rng, 300, 14, 0.1);
+  const auto vps = RandomViewpoints(rng, 2, 14, 0.1);
+  EvaluateOptions opt;
+  opt.keep_sparse_per_viewpoint_values = true;
+  Result<Evaluation> plain = Evaluate(s, vps, opt);
+  ASSERT_TRUE(plain.ok()) << plain.status().ToString();
+  ASSERT_GT(plain->per_viewpoint_sparse_values[0].size() + plain->per_viewpoint_sparse_values[1].size(), 0u);
+  Result<Evaluation> e =
+      EvaluationOfSparseValues(s, FaceSet::kAll, plain->per_viewpoint, plain->per_viewpoint_sparse_values);
+  ASSERT_FALSE(e.ok());
+  EXPECT_EQ(e.status().code(), StatusCode::kInvalidArgument);
+  EXPECT_NE(e.status().message().find("keep_sparse_join_state"), std::string::npos) << e.status().ToString();
+  e = EvaluationOfSparseValues(s, FaceSet::kAll, {}, plain->per_viewpoint_sparse_values);
+  ASSERT_FALSE(e.ok());
+  EXPECT_NE(e.status().message().find("figures"), std::string::npos) << e.status().ToString();
+  opt.keep_sparse_join_state = true;
+  Result<Evaluation> with = Evaluate(s, vps, opt);
+  ASSERT_TRUE(with.ok());
+  std::vector<SparseFaceValues> unsorted = with->per_viewpoint_sparse_values;
+  SparseFaceValues& v = unsorted[0].size() > 1 ? unsorted[0] : unsorted[1];
+  ASSERT_GT(v.size(), 1u);
+  std::swap(v.faces[0], v.faces[1]);
+  e = EvaluationOfSparseValues(s, FaceSet::kAll, with->per_viewpoint, unsorted);
+  ASSERT_FALSE(e.ok());
+  EXPECT_NE(e.status().message().find("ascending"), std::string::npos) << e.status().ToString();
+}
+
 TEST(EvaluateTest, SamplingIsUnbiasedWithinItsConfidenceInterval) {
   std::mt19937_64 rng(99);
   const VoxelScene s = RandomScene(rng, 400, 20, 0.1);

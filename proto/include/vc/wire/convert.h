@@ -55,6 +55,9 @@ v1::StopReason ToProto(StopReason r);
 // DATA_LOSS for UNSPECIFIED or an unknown value.
 Result<StopReason> FromProto(v1::StopReason r);
 v1::FaceSet ToProto(FaceSet f);
+// Per-viewpoint or overall figures, field for field (also a station's, between replicas).
+v1::VisibilityFigures ToProto(const VisibilityFigures& f);
+VisibilityFigures FromProto(const v1::VisibilityFigures& f);
 // One point of the coverage curve, field for field.
 v1::CoveragePoint ToProto(const CoveragePoint& c);
 CoveragePoint FromProto(const v1::CoveragePoint& p);

@@ -13,9 +13,14 @@
 
 namespace vc::wire {
 
+// With the join state (SparseFaceValues::HasJoinState, a station that sees something): the faces,
+// the doubles and the perceptions, no floats; else the faces and the floats. The figures are the
+// caller's to set.
 v1::FaceValues EncodeFaceValues(const SparseFaceValues& values);
 // DATA_LOSS when the arrays are not whole, differ in length, list faces that are not ascending or
-// not below faces_total, or a V that is not in (0, 1] (NaN and infinities included).
+// not below faces_total, or a V that is not in (0, 1] (NaN and infinities included); with the join
+// state, also a perception that is not partial or full, or floats beside the doubles. The floats
+// of a message with the join state are those of its doubles.
 Result<SparseFaceValues> DecodeFaceValues(const v1::FaceValues& message, uint64_t faces_total);
 
 }  // namespace vc::wire

@@ -23,6 +23,7 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -36,6 +37,13 @@ namespace vc::server {
 
 template <class T>
 struct FanOutResult;  // peers.cc
+
+// One station's face values from a shard, and its figures when asked for and given with the join
+// state (EvaluateOptions::keep_sparse_join_state).
+struct StationFaceValues {
+  SparseFaceValues values;
+  std::optional<VisibilityFigures> figures;
+};
 
 class PeerFanOut {
  public:
@@ -60,7 +68,8 @@ class PeerFanOut {
   // The faces with V > 0 of each of `stations` on `scene`, exactly as vc::Evaluate(scene, stations,
   // options, ctx) with keep_sparse_per_viewpoint_values gives them (the reduction's evaluation);
   // `options` must be planner::ReductionEvaluateOptions of the plan's options (peers rebuild them
-  // from `parameters`).
+  // from `parameters`), with keep_sparse_join_state where the caller joins the values into an
+  // evaluation (then DistributedFaceValues::figures, unless a peer is too old to give them).
   Result<DistributedFaceValues> ComputeFaceValues(const SceneRef& ref, const v1::PlanParameters& parameters,
                                                   const VoxelScene& scene, const std::vector<WorldPoint>& stations,
                                                   const EvaluateOptions& options, const JobContext& ctx);
@@ -81,6 +90,7 @@ class PeerFanOut {
     double compact_gain;
     Stage stage;
     const char* what;
+    bool join_state = false;  // face values: ask for their join state too
   };
   template <class T>
   using LocalShard = std::function<Result<std::vector<T>>(const std::vector<WorldPoint>&, const JobContext&)>;

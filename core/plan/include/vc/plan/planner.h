@@ -119,8 +119,12 @@ using VisibilitySetsFn =
 
 // The reduction's per-station evaluation, by its caller (across replicas): for each station its
 // faces with V > 0, exactly as vc::Evaluate with keep_sparse_per_viewpoint_values gives them.
+// Asked for the join state (EvaluateOptions::keep_sparse_join_state), also each station's figures
+// and its values' join state, exactly as Evaluate gives them, when every replica gave them (an
+// older one does not): `figures` then holds one per station, else it is empty.
 struct DistributedFaceValues {
   std::vector<SparseFaceValues> values;
+  std::vector<VisibilityFigures> figures;
   Distribution distribution;
   std::vector<std::string> warnings;
 };

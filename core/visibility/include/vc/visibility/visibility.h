@@ -209,6 +209,11 @@ struct EvaluateOptions {
   // (Evaluation::best_values, best_perceptions: 9 bytes per face), so that JoinEvaluations can
   // join this evaluation with one of other viewpoints. Exact mode only.
   bool keep_join_state = false;
+  // With keep_sparse_per_viewpoint_values: keep with each viewpoint's faces their V as the figures
+  // sum it (double) and their perception too (SparseFaceValues::exact_values, perceptions: 9 bytes
+  // more a face seen), so that EvaluationOfSparseValues can build the evaluation of the viewpoints
+  // from them (the reduction's values from replicas, joined into the final evaluation).
+  bool keep_sparse_join_state = false;
   // Exact mode: decide every lattice corner on its own (its ray, after the per-ray shortcuts: the
   // occluder cache and the grazing-layer test) instead of first by groups of faces (same answers,
   // slower; kept as the reference for tests and benchmarks).
@@ -216,12 +221,20 @@ struct EvaluateOptions {
 };
 
 // One viewpoint's faces with V > 0: their indices in F order (voxel id * 6 + face), ascending,
-// and V of each.
+// and V of each; with EvaluateOptions::keep_sparse_join_state also V as a double (values holds it
+// as a float) and the Perception of each (empty otherwise).
 struct SparseFaceValues {
   std::vector<uint32_t> faces;
   std::vector<float> values;
+  std::vector<double> exact_values;
+  std::vector<uint8_t> perceptions;
   size_t size() const { return faces.size(); }
-  uint64_t MemoryBytes() const { return faces.capacity() * sizeof(uint32_t) + values.capacity() * sizeof(float); }
+  // Both join-state arrays, one entry per face.
+  bool HasJoinState() const { return exact_values.size() == faces.size() && perceptions.size() == faces.size(); }
+  uint64_t MemoryBytes() const {
+    return faces.capacity() * sizeof(uint32_t) + values.capacity() * sizeof(float) +
+           exact_values.capacity() * sizeof(double) + perceptions.capacity() * sizeof(uint8_t);
+  }
 };
 
 // Evaluation::sole_viewer's values for a voxel no viewpoint sees, and one several viewpoints see.
@@ -269,5 +282,17 @@ Result<Evaluation> Evaluate(const VoxelScene& scene, const std::vector<WorldPoin
 // keep_join_state (and keep_face_values in both or neither); INVALID_ARGUMENT otherwise, naming
 // what differs. The reduction joins its batches of stations this way into the final evaluation.
 Result<Evaluation> JoinEvaluations(Evaluation first, Evaluation second);
+
+// The evaluation of viewpoints on `scene` from what each sees: their per-viewpoint figures and
+// their faces with V > 0 with the join state (EvaluateOptions::keep_sparse_join_state), exactly as
+// Evaluate of them with keep_face_values and keep_join_state gives it (the overall figures summed
+// in face order from the best values, the best face values, the sole viewers), without the
+// per-viewpoint values; `faces` is the face set they were evaluated on. INVALID_ARGUMENT when the
+// counts differ, a viewpoint's values lack the join state, or a face is not ascending below
+// 6 x the scene's voxels. The reduction builds the evaluation of the stations the replicas
+// evaluated this way, to join it as its own batches.
+Result<Evaluation> EvaluationOfSparseValues(const VoxelScene& scene, FaceSet faces,
+                                            std::vector<VisibilityFigures> per_viewpoint,
+                                            const std::vector<SparseFaceValues>& values);
 
 }  // namespace vc
