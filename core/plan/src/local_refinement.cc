@@ -1,5 +1,6 @@
 #include "vc/plan/local_refinement.h"
 
+#include <algorithm>
 #include <cmath>
 #include <optional>
 #include <string>
@@ -38,6 +39,24 @@ bool Known(const std::vector<WorldPoint>& positions, const WorldPoint& p, double
   return false;
 }
 
+// Whether the neighbourhood rule lets a position `p` get a set (LocalRefinementOptions::
+// neighbourhood_m): the candidates within neighbourhood_m of it (in x, y and z; on the coarse grid,
+// the corners of its cell) see at least min_neighbourhood_gain_voxels voxels `covered` leaves out.
+bool WorthASet(const CandidateSets& c, const WorldPoint& p, const VoxelSet& covered,
+               const LocalRefinementOptions& options) {
+  const double reach = options.neighbourhood_m + 1e-6;
+  VoxelSet hood(covered.size());
+  for (size_t j = 0; j < c.positions.size(); ++j) {
+    const WorldPoint& q = c.positions[j];
+    if (std::abs(q.x() - p.x()) > reach || std::abs(q.y() - p.y()) > reach || std::abs(q.z() - p.z()) > reach) {
+      continue;
+    }
+    hood.Union(c.sets[j]);
+  }
+  hood.Subtract(covered);
+  return hood.count() >= std::max<uint64_t>(1, options.min_neighbourhood_gain_voxels);
+}
+
 }  // namespace
 
 Result<LocalRefinementResult> RefineLocally(const Selector& selector, const VoxelScene& scene, CandidateSets in,
@@ -47,6 +66,9 @@ Result<LocalRefinementResult> RefineLocally(const Selector& selector, const Voxe
   if (!(options.step_m > 0) || !(options.radius_m >= options.step_m) || !std::isfinite(options.radius_m) ||
       options.max_rounds < 0) {
     return InvalidArgumentError("local refinement needs 0 < step_m <= radius_m (finite) and max_rounds >= 0");
+  }
+  if (!(options.neighbourhood_m >= 0) || !std::isfinite(options.neighbourhood_m)) {
+    return InvalidArgumentError("local refinement needs a finite neighbourhood_m >= 0 (0 = every position)");
   }
   if (in.positions.size() != in.sets.size() || in.positions.size() != in.floor_z_m.size()) {
     return InvalidArgumentError("local refinement: " + std::to_string(in.positions.size()) + " positions, " +
@@ -63,6 +85,16 @@ Result<LocalRefinementResult> RefineLocally(const Selector& selector, const Voxe
     VC_RETURN_IF_ERROR(ctx.CheckCancelled("local refinement"));
     std::vector<WorldPoint> added;
     std::vector<double> added_floor;
+    // The neighbourhood rule, where the solve stopped short of the target (the round is for coverage;
+    // a solve reaching it may still give way to one of fewer stations, so every position gets a set).
+    const bool by_neighbourhood = options.neighbourhood_m > 0 && !Reaches(out.selection, options.target_coverage);
+    out.neighbourhood_rounds += by_neighbourhood;
+    std::vector<WorldPoint> passed_over;  // by the rule this round
+    VoxelSet covered;                     // by the solve's picks
+    if (by_neighbourhood && !out.candidates.sets.empty()) {
+      covered = VoxelSet(out.candidates.sets.front().size());
+      for (int pick : out.selection.picks) covered.Union(out.candidates.sets[static_cast<size_t>(pick)]);
+    }
     for (size_t k = static_cast<size_t>(fixed); k < out.selection.picks.size(); ++k) {
       const int pick = out.selection.picks[k];
       const WorldPoint& s = out.candidates.positions[pick];
@@ -84,11 +116,17 @@ Result<LocalRefinementResult> RefineLocally(const Selector& selector, const Voxe
           if (!HasClearance(scene.grid, p, candidate_options.clearance_m)) continue;
           if (KeepOutZoneContaining(options.keep_out, p) >= 0) continue;
           if (Known(out.candidates.positions, p, options.step_m) || Known(added, p, options.step_m)) continue;
+          if (Known(passed_over, p, options.step_m)) continue;
+          if (by_neighbourhood && !WorthASet(out.candidates, p, covered, options)) {
+            passed_over.push_back(p);  // once, though several picks' sub-grids reach it
+            continue;
+          }
           added.push_back(p);
           added_floor.push_back(*top);
         }
       }
     }
+    out.passed_over += static_cast<int>(passed_over.size());
     if (static_cast<uint64_t>(out.added) + added.size() > options.max_added) {
       out.limited = true;
       added.resize(options.max_added - static_cast<uint64_t>(out.added));

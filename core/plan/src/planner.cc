@@ -221,7 +221,8 @@ Result<PlanResult> Plan(const SceneInput& input, const PlanOptions& options, con
   result.connecting_stations = selected.selection.connectors;
   result.optimality = selected.selection.optimality;
   result.optimality.local_candidates.coarse_to_fine =
-      planner::CoarseToFineNote(candidates, options.coarse_above_candidates);
+      planner::CoarseToFineNote(candidates, options.coarse_above_candidates) +
+      result.optimality.local_candidates.coarse_to_fine;  // the fine round's neighbourhood rule, if it ran
   if (!result.optimality.note.empty()) result.warnings.push_back(result.optimality.note);
   for (std::string& w : selected.warnings) result.warnings.push_back(std::move(w));
   const std::vector<std::optional<BestCoverage>> best_coverage = std::move(selected.best_coverage);

@@ -209,6 +209,13 @@ TEST(LocalRefinementTest, BadOptionsOrMismatchedInputsAreInvalidArgument) {
             StatusCode::kInvalidArgument);
   CandidateSets short_floors = s.in;
   short_floors.floor_z_m.pop_back();
+  LocalRefinementOptions bad_hood;
+  bad_hood.neighbourhood_m = std::nan("");
+  EXPECT_EQ(RefineLocally(selector, s.scene, s.in, 0, CandidateOptions{}, fn, bad_hood).status().code(),
+            StatusCode::kInvalidArgument);
+  bad_hood.neighbourhood_m = -1;
+  EXPECT_EQ(RefineLocally(selector, s.scene, s.in, 0, CandidateOptions{}, fn, bad_hood).status().code(),
+            StatusCode::kInvalidArgument);
   EXPECT_EQ(RefineLocally(selector, s.scene, short_floors, 0, CandidateOptions{}, fn, {}).status().code(),
             StatusCode::kInvalidArgument);
   EXPECT_EQ(selector.calls, 0);
@@ -222,6 +229,105 @@ TEST(LocalRefinementTest, VisibilityErrorsPassThrough) {
   };
   Result<LocalRefinementResult> r = RefineLocally(selector, s.scene, s.in, 0, CandidateOptions{}, fn, {});
   EXPECT_EQ(r.status().code(), StatusCode::kResourceExhausted);
+}
+
+// The neighbourhood rule (coarse then fine), on made-up sets over 12 voxels: candidate `a` sees
+// voxels 0-4, `b` (the candidate farthest from it) 5-9, and `c` (a grid neighbour of `a`) voxel 10
+// alone, which a greedy needing gains of 2 leaves uncovered (voxel 11 no one sees). So only `a`'s
+// neighbourhood can still gain.
+struct NeighbourhoodFixture {
+  static constexpr size_t kN = 12;
+  Fixture s;
+  int a = 0, b = 0, c = -1;
+  GreedySelector selector{[] {
+    GreedyOptions g;
+    g.min_marginal_gain_voxels = 2;
+    return g;
+  }()};
+  NeighbourhoodFixture() {
+    const std::vector<WorldPoint>& p = s.in.positions;
+    auto dist = [&](int i, int j) { return (p[i] - p[j]).head<2>().cwiseAbs().maxCoeff(); };
+    for (int j = 1; j < static_cast<int>(p.size()); ++j) {
+      if (dist(a, j) > dist(a, b)) b = j;
+      if (j != b && dist(a, j) > 0.5 && dist(a, j) < 1.01 && (c < 0 || dist(a, j) < dist(a, c))) c = j;
+    }
+    for (size_t j = 0; j < p.size(); ++j)
+      s.in.sets[j] = SetOf(j == size_t(a) ? 0 : j == size_t(b) ? 5 : 0, j == size_t(a) || j == size_t(b) ? 5 : 0);
+    s.in.sets[c] = SetOf(10, 1);
+  }
+  static VoxelSet SetOf(size_t first, size_t count) {
+    VoxelSet v(kN);
+    for (size_t i = first; i < first + count; ++i) v.set(i);
+    return v;
+  }
+  // The added positions see nothing (the rule decides before any is computed).
+  VisibilityFn Fn() const {
+    return [](const std::vector<WorldPoint>& q) -> Result<std::vector<VoxelSet>> {
+      return std::vector<VoxelSet>(q.size(), VoxelSet(kN));
+    };
+  }
+};
+
+// Short of the target, only the positions whose neighbours see an uncovered voxel (c's) get a set:
+// some around a, none around b; at neighbourhood_m 0 (the rule off) positions around both do.
+TEST(LocalRefinementTest, TheNeighbourhoodRuleAddsOnlyPositionsWhoseNeighboursSeeUncoveredVoxels) {
+  NeighbourhoodFixture f;
+  ASSERT_GE(f.c, 0);
+  const WorldPoint pa = f.s.in.positions[f.a], pb = f.s.in.positions[f.b], pc = f.s.in.positions[f.c];
+  ASSERT_GT((pa - pb).head<2>().cwiseAbs().maxCoeff(), 2.5);  // b's positions are far from c
+  auto within = [](const WorldPoint& p, const WorldPoint& q, double m) {
+    return (p - q).head<2>().cwiseAbs().maxCoeff() <= m + 1e-9;
+  };
+  LocalRefinementOptions o;
+  o.neighbourhood_m = 1.0;
+  o.min_neighbourhood_gain_voxels = 1;
+  Result<LocalRefinementResult> r = RefineLocally(f.selector, f.s.scene, f.s.in, 0, CandidateOptions{}, f.Fn(), o);
+  ASSERT_TRUE(r.ok()) << r.status().ToString();
+  EXPECT_EQ(r->stations_per_solve.front(), 2);  // a and b; c's one voxel is below the greedy's 2
+  EXPECT_EQ(r->neighbourhood_rounds, 1);
+  ASSERT_GT(r->added, 0);
+  EXPECT_GT(r->passed_over, 0);  // b's, and a's on the side away from c
+  for (size_t i = f.s.in.positions.size(); i < r->candidates.positions.size(); ++i) {
+    const WorldPoint& q = r->candidates.positions[i];
+    EXPECT_TRUE(within(q, pa, o.radius_m)) << "position " << i << " not around a";
+    EXPECT_TRUE(within(q, pc, o.neighbourhood_m)) << "position " << i << " has no neighbour seeing voxel 10";
+  }
+  const int all_positions = r->added + r->passed_over;
+  // A higher threshold than any neighbourhood offers (1 voxel): no position, no round.
+  o.min_neighbourhood_gain_voxels = 2;
+  r = RefineLocally(f.selector, f.s.scene, f.s.in, 0, CandidateOptions{}, f.Fn(), o);
+  ASSERT_TRUE(r.ok()) << r.status().ToString();
+  EXPECT_EQ(r->added, 0);
+  EXPECT_EQ(r->passed_over, all_positions);
+  EXPECT_EQ(r->rounds, 0);
+  // The rule off: positions around both picks, as many as the rule passed over and kept.
+  o.neighbourhood_m = 0;
+  r = RefineLocally(f.selector, f.s.scene, f.s.in, 0, CandidateOptions{}, f.Fn(), o);
+  ASSERT_TRUE(r.ok()) << r.status().ToString();
+  EXPECT_EQ(r->neighbourhood_rounds, 0);
+  EXPECT_EQ(r->passed_over, 0);
+  EXPECT_EQ(r->added, all_positions);
+  bool around_b = false;
+  for (size_t i = f.s.in.positions.size(); i < r->candidates.positions.size(); ++i) {
+    around_b |= within(r->candidates.positions[i], pb, o.radius_m);
+  }
+  EXPECT_TRUE(around_b);
+}
+
+// A solve that reaches the target leaves the round to save stations: every position gets a set
+// whatever its neighbourhood, and the rule decides nothing.
+TEST(LocalRefinementTest, TheNeighbourhoodRuleDoesNotApplyOnceTheTargetIsReached) {
+  NeighbourhoodFixture f;
+  LocalRefinementOptions o;
+  o.neighbourhood_m = 1.0;
+  o.min_neighbourhood_gain_voxels = 1000;
+  o.target_coverage = 0.9;  // 10 of 11 coverable voxels
+  Result<LocalRefinementResult> r = RefineLocally(f.selector, f.s.scene, f.s.in, 0, CandidateOptions{}, f.Fn(), o);
+  ASSERT_TRUE(r.ok()) << r.status().ToString();
+  EXPECT_EQ(r->neighbourhood_rounds, 0);
+  EXPECT_EQ(r->passed_over, 0);
+  EXPECT_GT(r->added, 0);
+  EXPECT_EQ(r->rounds, 1);
 }
 
 // An exact selector for tiny optima: the first single candidate or pair (in index order) whose

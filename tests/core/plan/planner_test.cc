@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -357,6 +358,40 @@ TEST(PlannerTest, CoarseThenFineAboveTheThresholdAndTheFullGridAtIt) {
   // The fine positions' sets are whole: the coverable set is the coarse grid's and what they add.
   EXPECT_GE(coarse->coverable_voxels, grid2->coverable_voxels);
   EXPECT_GE(double(coarse->covered_voxels), o.target_coverage * double(grid2->coverable_voxels));
+}
+
+// Coarse then fine short of the target (target_coverage 1: the gain rule stops greedy first): the
+// fine round's neighbourhood rule decides which fine positions get a set, and plan.json says how
+// many it passed over (docs/PLANNING.md, "Coarse then fine candidates"). At the default target the
+// coarse solve of hub:3 reaches it and the rule decides nothing (the test above: no such note).
+TEST(PlannerTest, CoarseThenFineShortOfTheTargetPassesOverFinePositionsWithNothingNearToGain) {
+  PlanOptions o = TestOptions();
+  o.solver = SelectionSolver::kGreedy;
+  o.coarse_above_candidates = 10;
+  o.target_coverage = 1.0;
+  const SceneInput input = Synthetic("hub:3");
+  Result<PlanResult> r = Plan(input, o);
+  ASSERT_TRUE(r.ok()) << r.status().ToString();
+  std::cout << "[ hub:3, coarse then fine, target 1 ] " << Describe(*r) << "\n";
+  const planner::LocalCandidatesReport& l = r->optimality.local_candidates;
+  ASSERT_FALSE(l.coarse_to_fine.empty());
+  ASSERT_LT(r->covered_voxels, r->coverable_voxels);  // short of the target: the rule applies
+  const std::string mark = " fine positions passed over (the candidates within 1 m of each see fewer than ";
+  const size_t at = l.coarse_to_fine.find(mark);
+  ASSERT_NE(at, std::string::npos) << l.coarse_to_fine;
+  // "; N of M fine positions passed over ...": M is what the round considered, N of them got no set.
+  const size_t semi = l.coarse_to_fine.rfind("; ", at);
+  ASSERT_NE(semi, std::string::npos);
+  int passed = -1, considered = -1;
+  ASSERT_EQ(std::sscanf(l.coarse_to_fine.c_str() + semi, "; %d of %d", &passed, &considered), 2) << l.coarse_to_fine;
+  EXPECT_GT(passed, 0) << l.coarse_to_fine;  // hub:3's rooms are covered: most positions have nothing near to gain
+  EXPECT_EQ(considered - passed, l.added) << l.coarse_to_fine;
+  int min_gain = 0;
+  ASSERT_EQ(std::sscanf(l.coarse_to_fine.c_str() + at + mark.size(), "%d", &min_gain), 1);
+  EXPECT_GE(min_gain, 1);
+  // The fine round never loses what the coarse solve covered (the loop keeps the better solve).
+  ASSERT_FALSE(l.covered_per_solve.empty());
+  EXPECT_GE(r->covered_voxels, l.covered_per_solve.front());
 }
 
 // Sparse visibility sets (vc/visibility/voxel_set.h) change memory and time, never the plan: with

@@ -35,6 +35,16 @@ struct LocalRefinementOptions {
   std::vector<KeepOutZone> keep_out;  // no position is added inside these
   double target_coverage = 1.0;       // a solve reaching this fraction of its coverable voxels beats one that does not
   uint64_t max_added = UINT64_MAX;    // positions added over all rounds, at most (the caller's memory budget)
+  // > 0 (coarse then fine), in a round after a solve short of target_coverage: a sub-grid position
+  // gets a set (and becomes a candidate) only where its neighbourhood can still gain, i.e. the
+  // candidates within neighbourhood_m of it (in x, y and z; at neighbourhood_m = step_m on a grid of
+  // twice the step through the picks, the corners of its cell) see at least
+  // min_neighbourhood_gain_voxels voxels the solve's picks leave uncovered. A heuristic, not a
+  // bound: the position is taken to see no more than the candidates around it (docs/PLANNING.md,
+  // "Coarse then fine candidates"). After a solve reaching the target (the round can only save
+  // stations) and at 0: every position gets a set.
+  double neighbourhood_m = 0;
+  uint64_t min_neighbourhood_gain_voxels = 1;  // at least 1
 };
 
 // Candidates and their sets: positions[i] sees sets[i]; floor_z_m[i] is the top of its floor (m,
@@ -54,6 +64,10 @@ struct LocalRefinementResult {
   int rounds = 0;            // solves after the first
   int added = 0;             // positions added over all rounds
   bool limited = false;      // max_added cut a round short (the rounds after it add nothing)
+  // The rounds the neighbourhood rule decided, and the positions it passed over in them (their
+  // neighbours see fewer than min_neighbourhood_gain_voxels uncovered voxels; not in `added`).
+  int neighbourhood_rounds = 0;
+  int passed_over = 0;
   // Stations and covered voxels of each solve, the first solve's first.
   std::vector<int> stations_per_solve;
   std::vector<uint64_t> covered_per_solve;
@@ -66,7 +80,9 @@ struct LocalRefinementResult {
 // clearance (HasClearance), outside options.keep_out, and are not yet candidates (at most
 // options.max_added over all rounds); solves again over all; keeps the new solve if it is better:
 // reaching target_coverage beats not reaching it, then fewer stations, or as many covering more
-// (short of the target: more covered, then fewer stations). Stops after a round without
+// (short of the target: more covered, then fewer stations). With options.neighbourhood_m > 0 and a
+// solve short of the target only the positions whose neighbourhood can still gain are added
+// (LocalRefinementOptions). Stops after a round without
 // improvement, without new positions, or after max_rounds. INVALID_ARGUMENT for bad options or inputs of different
 // lengths; the selector's and the callback's errors pass through; CANCELLED / DEADLINE_EXCEEDED from ctx.
 Result<LocalRefinementResult> RefineLocally(const Selector& selector, const VoxelScene& scene, CandidateSets in,
