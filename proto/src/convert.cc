@@ -442,7 +442,12 @@ v1::CoveragePoint ToProto(const CoveragePoint& c) {
 }
 
 CoveragePoint FromProto(const v1::CoveragePoint& p) {
-  CoveragePoint c{p.stations(), p.covered_voxels(), p.coverable_fraction(), p.scene_fraction(), p.setup_scan_s()};
+  CoveragePoint c;
+  c.stations = p.stations();
+  c.covered_voxels = p.covered_voxels();
+  c.coverable_fraction = p.coverable_fraction();
+  c.scene_fraction = p.scene_fraction();
+  c.setup_scan_s = p.setup_scan_s();
   if (p.has_best_voxels_upper_bound()) c.best_voxels_upper_bound = p.best_voxels_upper_bound();
   if (p.has_best_voxels()) c.best_voxels = p.best_voxels();
   c.best_voxels_optimal = p.best_voxels_optimal();
