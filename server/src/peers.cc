@@ -116,8 +116,20 @@ Result<std::vector<T>> DecodeItems(const v1::ShardResponse& resp, size_t count, 
           VC_ASSIGN_OR_RETURN(SparseFaceValues v, wire::DecodeFaceValues(m, job.occupied_voxels * kFacesPerVoxel));
           StationFaceValues out{std::move(v), std::nullopt};
           // An older replica ignores keep_join_state and answers without figures (or join state).
-          if (job.join_state && m.has_figures() && out.values.HasJoinState())
-            out.figures = wire::FromProto(m.figures());
+          if (job.join_state && m.has_figures() && out.values.HasJoinState()) {
+            const VisibilityFigures f = wire::FromProto(m.figures());
+            for (const double x : {f.global_visibility, f.fully_visible_fraction, f.mean_full_visibility,
+                                   f.partially_visible_fraction}) {
+              // Each figure is a mean of values in [0, 1] or a share of F; anything else is not Evaluate's.
+              if (!(x >= 0 && x <= 1))
+                return DataLossError(fmt::format(
+                    "a station's figures (G {}, fully visible {}, mean full V {}, partially visible {}) are not "
+                    "all finite and within [0, 1]",
+                    f.global_visibility, f.fully_visible_fraction, f.mean_full_visibility,
+                    f.partially_visible_fraction));
+            }
+            out.figures = f;
+          }
           return out;
         },
         [&](int n) { return fmt::format("it answered face values of {} stations for {}", n, count); });

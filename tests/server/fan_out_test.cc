@@ -91,7 +91,9 @@ class FakePeer final : public v1::StationPlanner::CallbackService {
  public:
   // kOld: a replica older than ShardRequest.keep_join_state, in front of a real one (`behind`,
   // which must hold the scene already): it passes each shard on without that field.
-  enum class Mode { kHang, kDie, kOtherScene, kOld };
+  // kBadFigures: passes each shard on to `behind` as it is, then answers every station's figures
+  // with a G that is not a number.
+  enum class Mode { kHang, kDie, kOtherScene, kOld, kBadFigures };
   explicit FakePeer(Mode mode, const std::string& behind = "") : mode_(mode) {
     if (!behind.empty()) {
       behind_ = v1::StationPlanner::NewStub(grpc::CreateChannel(behind, grpc::InsecureChannelCredentials()));
@@ -123,11 +125,16 @@ class FakePeer final : public v1::StationPlanner::CallbackService {
                                          v1::ShardResponse* response) override {
     ++shards_;
     first_shard.Set();
-    if (mode_ == Mode::kOld) {
-      v1::ShardRequest older = *request;
-      older.clear_keep_join_state();
+    if (mode_ == Mode::kOld || mode_ == Mode::kBadFigures) {
+      v1::ShardRequest passed = *request;
+      if (mode_ == Mode::kOld) passed.clear_keep_join_state();
       grpc::ClientContext c;
-      const grpc::Status st = behind_->ComputeShard(&c, older, response);  // blocking: a test's fake
+      const grpc::Status st = behind_->ComputeShard(&c, passed, response);  // blocking: a test's fake
+      if (mode_ == Mode::kBadFigures) {
+        for (v1::FaceValues& m : *response->mutable_face_values()) {
+          if (m.has_figures()) m.mutable_figures()->set_global_visibility(std::nan(""));
+        }
+      }
       auto* r = ctx->DefaultReactor();
       r->Finish(st);
       return r;
@@ -291,6 +298,27 @@ TEST(FanOut, AnOlderReplicasValuesFallBackToEvaluatingAgain) {
   ExpectSamePlan(*alone, *fanned);
   ExpectSameEvaluation(*alone, *fanned);
   EXPECT_TRUE(HasWarning(*fanned, "older than this one")) << Warnings(*fanned);
+}
+
+// A replica whose stations' figures are not Evaluate's (here G is not a number) is left out of the
+// rest of the reduction, naming why; the coordinator computes its shards and the plan and
+// evaluation are one replica's.
+TEST(FanOut, AReplicasFiguresOutsideTheirRangeAreRefused) {
+  const PlanOptions options = SeveralReductionBatches();
+  auto b = testing::StartServer(Replica());
+  ASSERT_TRUE(b);
+  const auto alone = PlanOn(testing::Address(*b), "", options);  // b now holds the scene
+  ASSERT_TRUE(alone.ok()) << alone.status().ToString();
+  FakePeer bad(FakePeer::Mode::kBadFigures, testing::Address(*b));
+  auto a = testing::StartServer(Coordinator({bad.address()}));
+  ASSERT_TRUE(a);
+  const auto r = PlanOn(testing::Address(*a), "", options);
+  ASSERT_TRUE(r.ok()) << r.status().ToString();
+  EXPECT_GT(bad.shards(), 0);
+  ExpectSamePlan(*alone, *r);
+  ExpectSameEvaluation(*alone, *r);
+  EXPECT_TRUE(HasWarning(*r, "not all finite and within [0, 1]")) << Warnings(*r);
+  EXPECT_TRUE(HasWarning(*r, "was left out of the rest of the reduction")) << Warnings(*r);
 }
 
 TEST(FanOut, AReplicaListedAmongItsOwnPeersIsSkipped) {

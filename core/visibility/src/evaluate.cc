@@ -771,9 +771,13 @@ Result<Evaluation> EvaluationOfSparseValues(const VoxelScene& scene, FaceSet fac
   const uint64_t slots = uint64_t(n) * kFacesPerVoxel;
   Evaluation ev;
   ev.resolution_m = scene.resolution_m;
+  std::vector<uint8_t> in_set(slots, 0);  // the faces of F, by slot
   for (size_t i = 0; i < n; ++i) {
     const VoxelIndex v = KeyToIndex(scene.occupied[i]);
-    for (int f = 0; f < kFacesPerVoxel; ++f) ev.faces_total += FaceInSet(scene.grid, v, Face(f), faces);
+    for (int f = 0; f < kFacesPerVoxel; ++f) {
+      in_set[i * kFacesPerVoxel + f] = FaceInSet(scene.grid, v, Face(f), faces);
+      ev.faces_total += in_set[i * kFacesPerVoxel + f];
+    }
   }
   ev.faces_evaluated = ev.faces_total;
   ev.per_viewpoint = std::move(per_viewpoint);
@@ -793,12 +797,16 @@ Result<Evaluation> EvaluationOfSparseValues(const VoxelScene& scene, FaceSet fac
         return InvalidArgumentError("evaluation of sparse values: viewpoint " + std::to_string(k + 1) + "'s face " +
                                     std::to_string(slot) + " is not ascending below " + std::to_string(slots));
       }
+      if (!in_set[slot]) {  // Evaluate values only the faces of F: such a value is not Evaluate's
+        return InvalidArgumentError("evaluation of sparse values: viewpoint " + std::to_string(k + 1) + "'s face " +
+                                    std::to_string(slot) + " is not in the evaluated face set");
+      }
       KeepBest(s.exact_values[j], s.perceptions[j], best[slot], best_p[slot]);
       const size_t voxel = slot / kFacesPerVoxel;
       ev.sole_viewer[voxel] = CombineViewers(ev.sole_viewer[voxel], int32_t(k));
     }
   }
-  // Faces outside F and faces no viewpoint sees hold (0, kNone), which add nothing to a tally: summed
+  // Faces outside F (refused above) and faces no viewpoint sees hold (0, kNone), which add nothing to a tally: summed
   // in face order, the figures are those of Evaluate's Finish.
   Tally total;
   for (uint64_t slot = 0; slot < slots; ++slot) total.Add(Perception(best_p[slot]), best[slot]);

@@ -385,10 +385,8 @@ TEST(PlannerTest, CoarseThenFineShortOfTheTargetPassesOverFinePositionsWithNothi
   int passed = -1, considered = -1;
   ASSERT_EQ(std::sscanf(l.coarse_to_fine.c_str() + semi, "; %d of %d", &passed, &considered), 2) << l.coarse_to_fine;
   EXPECT_GT(passed, 0) << l.coarse_to_fine;  // hub:3's rooms are covered: most positions have nothing near to gain
-  EXPECT_EQ(considered - passed, l.added) << l.coarse_to_fine;
-  int min_gain = 0;
-  ASSERT_EQ(std::sscanf(l.coarse_to_fine.c_str() + at + mark.size(), "%d", &min_gain), 1);
-  EXPECT_GE(min_gain, 1);
+  EXPECT_GT(considered, passed) << l.coarse_to_fine;  // and some near the uncovered voxels get a set
+  EXPECT_GT(l.added, 0) << l.coarse_to_fine;
   // The fine round never loses what the coarse solve covered (the loop keeps the better solve).
   ASSERT_FALSE(l.covered_per_solve.empty());
   EXPECT_GE(r->covered_voxels, l.covered_per_solve.front());

@@ -244,18 +244,23 @@ TEST(FirstOccupiedBatchTest, CertifiedOnlyWhereTheLanesAnswered) {
   for (int r = 0; r < 500; ++r) s.Add({u(rng), u(rng), 5.3}, {u(rng), u(rng), -9.5});
   for (int64_t target : hwy::SupportedAndGeneratedTargets()) {
     hwy::SetSupportedTargetsForTest(target);
-    std::vector<std::optional<VoxelIndex>> got(s.a.size());
-    std::vector<char> certified(s.a.size(), 1);
-    const std::string ran = FirstOccupiedBatch(*grid, s.a, s.b, got, BatchKernel::kAuto, nullptr, certified);
-    size_t count = 0;
-    for (size_t i = 0; i < got.size(); ++i) {
-      ASSERT_EQ(got[i], FirstOccupied(*grid, s.a[i], s.b[i])) << ran << ", segment " << i;
-      count += certified[i] == 1;
-    }
-    if (ran.ends_with(" lanes")) {
-      EXPECT_GT(count, got.size() * 19 / 20) << ran;
-    } else {
-      EXPECT_EQ(count, 0u) << ran;
+    for (const BatchKernel kernel : {BatchKernel::kAuto, BatchKernel::kLanes}) {
+      std::vector<std::optional<VoxelIndex>> got(s.a.size());
+      std::vector<char> certified(s.a.size(), 1);
+      size_t rechecked = 0;
+      const std::string ran = FirstOccupiedBatch(*grid, s.a, s.b, got, kernel, &rechecked, certified);
+      size_t count = 0;
+      for (size_t i = 0; i < got.size(); ++i) {
+        ASSERT_EQ(got[i], FirstOccupied(*grid, s.a[i], s.b[i])) << ran << ", segment " << i;
+        count += certified[i] == 1;
+      }
+      if (ran.ends_with(" lanes")) {
+        // Exactly the segments not left to FirstOccupied are certified.
+        EXPECT_EQ(count + rechecked, got.size()) << ran;
+        EXPECT_GT(count, got.size() * 19 / 20) << ran;
+      } else {
+        EXPECT_EQ(count, 0u) << ran;
+      }
     }
   }
   hwy::SetSupportedTargetsForTest(0);

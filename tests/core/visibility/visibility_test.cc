@@ -619,6 +619,27 @@ TEST(EvaluateTest, EvaluationOfSparseValuesJoinedEqualsOneEvaluationOfAll) {
   }
 }
 
+// A value for a face outside F (a face between two occupied voxels, with the exposed faces) is not
+// one Evaluate gives: refused, not summed into the figures (a peer's reply is checked by this).
+TEST(EvaluateTest, EvaluationOfSparseValuesRefusesAFaceOutsideTheFaceSet) {
+  const VoxelScene s = MakeScene({{0, 0, 0}, {1, 0, 0}});
+  ASSERT_EQ(s.occupied.size(), 2u);
+  const size_t low = KeyToIndex(s.occupied[0]).x < KeyToIndex(s.occupied[1]).x ? 0 : 1;
+  SparseFaceValues v;
+  v.faces = {uint32_t(low * kFacesPerVoxel + int(Face::kPosX))};  // the face its neighbour covers
+  v.values = {0.5f};
+  v.exact_values = {0.5};
+  v.perceptions = {uint8_t(Perception::kFull)};
+  Result<Evaluation> e = EvaluationOfSparseValues(s, FaceSet::kExposed, {VisibilityFigures{}}, {v});
+  ASSERT_FALSE(e.ok());
+  EXPECT_EQ(e.status().code(), StatusCode::kInvalidArgument);
+  EXPECT_NE(e.status().message().find("not in the evaluated face set"), std::string::npos) << e.status().ToString();
+  e = EvaluationOfSparseValues(s, FaceSet::kAll, {VisibilityFigures{}}, {v});  // in F with all faces
+  ASSERT_TRUE(e.ok()) << e.status().ToString();
+  EXPECT_EQ(e->faces_total, 12u);
+  EXPECT_DOUBLE_EQ(e->overall.global_visibility, 0.5 / 12);
+}
+
 TEST(EvaluateTest, EvaluationOfSparseValuesRefusesValuesWithoutJoinState) {
   std::mt19937_64 rng(47);
   const VoxelScene s = RandomScene(rng, 300, 14, 0.1);
