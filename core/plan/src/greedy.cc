@@ -959,6 +959,11 @@ class Consolidation {
 
 }  // namespace
 
+uint64_t SmallestGainPickedVoxels(const GreedyOptions& options) {
+  const double gain_rule = std::ceil(GainRuleVoxelsPerMinute(options) * options.station_seconds / 60.0 - 1e-9);
+  return std::max<uint64_t>({1, options.min_marginal_gain_voxels, static_cast<uint64_t>(std::max(0.0, gain_rule))});
+}
+
 Result<GreedyResult> SelectGreedy(const std::vector<VoxelSet>& sets, const GreedyOptions& options,
                                   const JobContext& ctx) {
   VC_RETURN_IF_ERROR(CheckOptions(options, sets.size()));

@@ -263,6 +263,27 @@ TEST(GreedyTest, GainRuleStopsWhereAStationIsWorthLessThanItsMinutes) {
   EXPECT_EQ(Greedy(sets, o).picks.size(), 3u);
 }
 
+// SmallestGainPickedVoxels is where greedy's rules stop: a gain of exactly it is picked, one less
+// is not (the coarse-then-fine round gates its fine positions with it).
+TEST(GreedyTest, SmallestGainPickedIsWhereTheRulesStop) {
+  std::vector<VoxelSet> sets = {MakeSet(10, {0, 1, 2, 3, 4, 5}), MakeSet(10, {6, 7, 8}), MakeSet(10, {9})};
+  GreedyOptions o = FullCoverage();
+  EXPECT_EQ(SmallestGainPickedVoxels(o), 1u);  // no rule: any gain
+  o.station_seconds = 120;
+  o.min_gain_voxels_per_minute = 1.5;  // 3 voxels a station
+  EXPECT_EQ(SmallestGainPickedVoxels(o), 3u);
+  EXPECT_EQ(Picks(Greedy(sets, o)), std::vector<int>({0, 1}));  // the gain of 3 picked, of 1 not
+  o.min_gain_voxels_per_minute = 1.6;  // 3.2 voxels: at least 4
+  EXPECT_EQ(SmallestGainPickedVoxels(o), 4u);
+  EXPECT_EQ(Picks(Greedy(sets, o)), std::vector<int>({0}));
+  o.min_gain_voxels_per_minute = 0;
+  o.surface_voxels_per_m2 = 4;
+  o.min_gain_m2_per_minute = 0.625;  // 2.5 m^2 / 2 min x 4 voxels = 5 voxels
+  EXPECT_EQ(SmallestGainPickedVoxels(o), 5u);
+  o.min_marginal_gain_voxels = 7;  // the larger rule
+  EXPECT_EQ(SmallestGainPickedVoxels(o), 7u);
+}
+
 TEST(GreedyTest, AreaGainRuleConvertsSquareMetresToVoxels) {
   // Gains 6, 3, 1 at 2 minutes a station and 4 surface voxels per m^2 (0.5 m voxels).
   std::vector<VoxelSet> sets = {MakeSet(10, {0, 1, 2, 3, 4, 5}), MakeSet(10, {6, 7, 8}), MakeSet(10, {9})};

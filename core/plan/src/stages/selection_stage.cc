@@ -53,17 +53,6 @@ ExactSelectorOptions ExactOptionsFor(const PlanOptions& options, double resoluti
   return exact;
 }
 
-// The fine round's neighbourhood rule: the smallest gain a fine position's neighbourhood must still
-// offer for the position to get a set, the selector's own smallest pick (greedy's gain rule in voxels per station,
-// min_marginal_gain_voxels), at least 1.
-uint64_t FineRoundMinGainVoxels(const PlanOptions& options, double resolution_m) {
-  const GreedyOptions g = SelectorOptionsFor(options, resolution_m);
-  const double per_minute = g.min_gain_voxels_per_minute > 0 ? g.min_gain_voxels_per_minute
-                                                             : g.min_gain_m2_per_minute * g.surface_voxels_per_m2;
-  const double gain_rule = std::ceil(per_minute * g.station_seconds / 60.0 - 1e-9);
-  return std::max<uint64_t>({1, g.min_marginal_gain_voxels, static_cast<uint64_t>(std::max(0.0, gain_rule))});
-}
-
 // RefineLocally with the stage's selector over the fixed stations and the candidates (`sets`,
 // consumed), with the added positions' sets cut to the coverable set of the first selection (but
 // with in.keep_added_sets_whole) and
@@ -108,7 +97,8 @@ Result<LocalRefinementResult> SelectWithLocalCandidates(const SelectionInput& in
   local.max_added = fit > all.positions.size() ? fit - all.positions.size() : 0;
   if (in.keep_added_sets_whole) {  // coarse then fine: sets only where the neighbourhood can gain
     local.neighbourhood_m = options.local_candidates_step_m;  // the coarse cell's corners
-    local.min_neighbourhood_gain_voxels = FineRoundMinGainVoxels(options, in.scene.resolution_m);
+    // the selector's own smallest pick (its gain rule, min_marginal_gain_voxels): fewer cannot be picked
+    local.min_neighbourhood_gain_voxels = SmallestGainPickedVoxels(SelectorOptionsFor(options, in.scene.resolution_m));
   }
 
   VC_ASSIGN_OR_RETURN(LocalRefinementResult out, RefineLocally(in.selector, in.scene, std::move(all), fixed,
@@ -118,7 +108,7 @@ Result<LocalRefinementResult> SelectWithLocalCandidates(const SelectionInput& in
   report.added = out.added;
   report.stations_per_solve = out.stations_per_solve;
   report.covered_per_solve = out.covered_per_solve;
-  if (out.neighbourhood_rounds > 0) {
+  if (out.neighbourhood_rounds > 0) {  // one round (coarse then fine): N and M count distinct positions
     report.coarse_to_fine = "; " + std::to_string(out.passed_over) + " of " +
                             std::to_string(out.added + out.passed_over) +
                             " fine positions passed over (the candidates within " + Num(local.neighbourhood_m) +

@@ -44,6 +44,11 @@ struct GreedyResult {
 Result<GreedyResult> SelectGreedy(const std::vector<VoxelSet>& sets, const GreedyOptions& options,
                                   const JobContext& ctx = {});
 
+// The smallest gain SelectGreedy picks a station for after the first one: min_marginal_gain_voxels
+// (at least 1) and the gain rule's voxels per station (GreedyOptions: voxels per minute x
+// station_seconds / 60), rounded up; whichever is larger.
+uint64_t SmallestGainPickedVoxels(const GreedyOptions& options);
+
 // Consolidation (our extension, after the greedy picks): drops a pick whose voxels the other picks
 // all cover, or replaces two picks by one candidate that sees every voxel only those two covered,
 // until neither applies. The covered set never shrinks and the count only falls. Greedy is not
