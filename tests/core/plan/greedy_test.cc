@@ -273,7 +273,7 @@ TEST(GreedyTest, SmallestGainPickedIsWhereTheRulesStop) {
   o.min_gain_voxels_per_minute = 1.5;  // 3 voxels a station
   EXPECT_EQ(SmallestGainPickedVoxels(o), 3u);
   EXPECT_EQ(Picks(Greedy(sets, o)), std::vector<int>({0, 1}));  // the gain of 3 picked, of 1 not
-  o.min_gain_voxels_per_minute = 1.6;  // 3.2 voxels: at least 4
+  o.min_gain_voxels_per_minute = 1.6;                           // 3.2 voxels: at least 4
   EXPECT_EQ(SmallestGainPickedVoxels(o), 4u);
   EXPECT_EQ(Picks(Greedy(sets, o)), std::vector<int>({0}));
   o.min_gain_voxels_per_minute = 0;
