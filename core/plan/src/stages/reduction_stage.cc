@@ -127,8 +127,8 @@ uint64_t PeerJoinBudgetBytes(uint64_t voxels) {
 
 constexpr char kOlderReplicaNote[] =
     "reduction: a replica answered the stations' face values without their perceptions and double-precision V "
-    "(a vc-server older than this one), so the evaluation stage evaluates the final stations again; replicas of "
-    "this version join them into the final evaluation";
+    "(most likely a vc-server older than this one), so the evaluation stage evaluates the final stations again; "
+    "replicas of this version join them into the final evaluation";
 
 }  // namespace
 
