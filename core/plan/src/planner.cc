@@ -146,6 +146,33 @@ JobContext VisibilityContext(const JobContext& ctx, const planner::CandidatesOut
   return out;
 }
 
+// The selection stage's figures, notes and warnings into `result` (`selected`'s warnings moved).
+void TakeSelectionFigures(planner::SelectionOutput& selected, const planner::CandidatesOutput& candidates,
+                          const PlanOptions& options, PlanResult& result) {
+  result.stop_reason = selected.selection.stop;
+  result.greedy_stations = selected.selection.first_pass_picks;
+  result.consolidated = selected.selection.saved_by_improvement;
+  result.connecting_stations = selected.selection.connectors;
+  result.optimality = selected.selection.optimality;
+  result.optimality.local_candidates.coarse_to_fine =
+      planner::CoarseToFineNote(candidates, options.coarse_above_candidates) +
+      result.optimality.local_candidates.coarse_to_fine;  // the fine round's neighbourhood rule, if it ran
+  if (!result.optimality.note.empty()) result.warnings.push_back(result.optimality.note);
+  for (std::string& w : selected.warnings) result.warnings.push_back(std::move(w));
+}
+
+// The route stage's route (or why there is none) into `result` (the route's warnings moved).
+void TakeRoute(planner::RouteOutput& routed, const PlanOptions& local_options, PlanResult& result) {
+  std::optional<planner::Route>& route = routed.route;
+  if (route) {
+    result.route = {route->order,     route->legs_m, route->length_m,
+                    route->polylines, route->parts,  local_options.route_start};
+    for (std::string& w : route->warnings) result.warnings.push_back(std::move(w));
+  } else {
+    result.warnings.push_back("no walking route: " + routed.unrouted_reason);
+  }
+}
+
 }  // namespace
 
 FieldTime ComputeFieldTime(size_t stations, double walk_m, const PlanOptions& options) {
@@ -215,16 +242,7 @@ Result<PlanResult> Plan(const SceneInput& input, const PlanOptions& options, con
                                        callbacks, patches, candidates.ground.model, candidates.coarse.has_value()},
                                       local_options, c);
   }));
-  result.stop_reason = selected.selection.stop;
-  result.greedy_stations = selected.selection.first_pass_picks;
-  result.consolidated = selected.selection.saved_by_improvement;
-  result.connecting_stations = selected.selection.connectors;
-  result.optimality = selected.selection.optimality;
-  result.optimality.local_candidates.coarse_to_fine =
-      planner::CoarseToFineNote(candidates, options.coarse_above_candidates) +
-      result.optimality.local_candidates.coarse_to_fine;  // the fine round's neighbourhood rule, if it ran
-  if (!result.optimality.note.empty()) result.warnings.push_back(result.optimality.note);
-  for (std::string& w : selected.warnings) result.warnings.push_back(std::move(w));
+  TakeSelectionFigures(selected, candidates, options, result);
   const std::vector<std::optional<BestCoverage>> best_coverage = std::move(selected.best_coverage);
   planner::Stations stations = std::move(selected.stations);
   VoxelSet coverable = std::move(selected.coverable);
@@ -292,14 +310,7 @@ Result<PlanResult> Plan(const SceneInput& input, const PlanOptions& options, con
     return planner::RunRouteStage({input, scene, final_positions, final_floor_z, result.floor_levels_m}, local_options,
                                   c);
   }));
-  std::optional<planner::Route>& route = routed.route;
-  if (route) {
-    result.route = {route->order,     route->legs_m, route->length_m,
-                    route->polylines, route->parts,  local_options.route_start};
-    for (std::string& w : route->warnings) result.warnings.push_back(std::move(w));
-  } else {
-    result.warnings.push_back("no walking route: " + routed.unrouted_reason);
-  }
+  TakeRoute(routed, local_options, result);
   result.field_time = ComputeFieldTime(result.stations.size(), result.route.length_m, local_options);
   std::vector<uint64_t> gains;
   for (const PlannedStation& s : result.stations) gains.push_back(s.marginal_gain);
