@@ -266,19 +266,9 @@ int SubvoxelJudgeAtFirst(const VoxelScene& scene, std::span<const SurfacePatch> 
   const Eigen::Vector3d d = end - uo;
   if (!(d.lpNorm<Eigen::Infinity>() <= kMaxShortcutLength)) return -1;
   const double lo[3] = {double(first.x), double(first.y), double(first.z)};
-  // The entry face (axis a) and parameter, as JudgeSegments computes them.
-  double enter = 0;
+  // The entry face (axis a) and parameter, as JudgeSegments's ResumeBefore computes them.
   int a = -1;
-  for (int i = 0; i < 3; ++i) {
-    if (d[i] == 0) continue;
-    // The nearer face's parameter: min((lo - uo) / d, (lo + 1 - uo) / d), bit for bit (rounding
-    // and a division by one d keep the order of the two).
-    const double t = ((d[i] > 0 ? lo[i] : lo[i] + 1) - uo[i]) / d[i];
-    if (t > enter) {
-      enter = t;
-      a = i;
-    }
-  }
+  const double enter = CubeEntry(uo, d, first, &a);
   if (a < 0) return -1;
   const OccupancyGrid& g = scene.grid;
   const VoxelIndex& glo = g.min_index();

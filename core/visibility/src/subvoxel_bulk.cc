@@ -51,15 +51,8 @@ constexpr double kBoxMargin = 1e-3;
 // The parameter of the segment uo -> end at which the trace resumes, kResumeMargin before it enters
 // the cube of its first occupied voxel `w` (up to rounding).
 double ResumeBefore(const Vector3d& uo, const Vector3d& end, const VoxelIndex& w) {
-  const Vector3d d = end - uo;
-  const double lo[3] = {double(w.x), double(w.y), double(w.z)};
-  double enter = 0;
-  for (int a = 0; a < 3; ++a) {
-    if (d[a] == 0) continue;
-    // min((lo - uo) / d, (lo + 1 - uo) / d), bit for bit, as in SubvoxelJudgeAtFirst.
-    enter = std::max(enter, ((d[a] > 0 ? lo[a] : lo[a] + 1) - uo[a]) / d[a]);
-  }
-  return std::max(0.0, enter - kResumeMargin);
+  int axis = -1;
+  return std::max(0.0, CubeEntry(uo, end - uo, w, &axis) - kResumeMargin);
 }
 
 // How many times a segment is walked on past the cubes SubvoxelJudgeAtFirst followed before it is

@@ -65,6 +65,25 @@ SubvoxelRay TraceSubvoxelSegment(const VoxelScene& scene, std::span<const Surfac
 // How far before the cube of a segment's first occupied voxel (segment parameter) the bulk
 // engine resumes its trace.
 inline constexpr double kResumeMargin = 1e-6;
+
+// The parameter t >= 0 at which the segment uo + t d enters the cube of voxel w: the largest of the
+// nearer faces' parameters per axis, min((lo - uo) / d, (lo + 1 - uo) / d) bit for bit (rounding and
+// one division by d keep the order of the two), and in *axis that face's axis (-1 where none lies
+// past uo: t = 0).
+inline double CubeEntry(const Eigen::Vector3d& uo, const Eigen::Vector3d& d, const VoxelIndex& w, int* axis) {
+  const double lo[3] = {double(w.x), double(w.y), double(w.z)};
+  double enter = 0;
+  *axis = -1;
+  for (int i = 0; i < 3; ++i) {
+    if (d[i] == 0) continue;
+    const double t = ((d[i] > 0 ? lo[i] : lo[i] + 1) - uo[i]) / d[i];
+    if (t > enter) {
+      enter = t;
+      *axis = i;
+    }
+  }
+  return enter;
+}
 // The segment uo -> end (end inside voxel id's cube) judged by the blocker of `first` alone, the
 // first occupied voxel FirstOccupiedBatch found on it (not voxel id), where that gives the answer
 // TraceSubvoxelSegment resumed kResumeMargin before `first`'s cube would: the segment meets that

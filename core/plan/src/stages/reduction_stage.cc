@@ -76,9 +76,6 @@ Status TableRefusal(const ReductionMemory& memory, uint64_t voxels, uint64_t mem
                                 ") plans it, or --no-reduce skips the reduction, or a coarser resolution_m has fewer "
                                 "voxels");
 }
-}  // namespace
-
-namespace {
 
 // The first pass's evaluation of the stations so far (0 .. joined - 1), each batch joined on.
 struct JoinedStations {
