@@ -77,7 +77,7 @@ vis_shards = -(-one["candidates"]["count"] // shard)
 red_shards = -(-one["reduction"]["size"] // shard) if one["reduction"]["size"] else 0
 if vis_shards + red_shards < 2:  # one shard per stage: computed locally, nothing fanned out
     vis_shards = red_shards = 0
-print("| scene | candidates | stations | shard | visibility, 1 → 3 replicas | reduction, 1 → 3 replicas | shards (visibility + reduction) | replicas | retried | bytes exchanged | per shard | same plan |")
+print("| scene | candidates | stations | shard | visibility, 1 → 3 replicas | reduction, 1 → 3 replicas | shards in all (the visibility stage's + the reduction's at one shard size) | replicas | retried | bytes exchanged | per shard | same plan |")
 print("|---|---|---|---|---|---|---|---|---|---|---|---|")
 per = (f"{d['bytes_exchanged'] / d['shards'] / 1024:.0f} KiB, {((v3 - v1) + (r3 - r1)) / d['shards'] * 1000:+.0f} ms"
        if d and d["shards"] else "(computed locally)")

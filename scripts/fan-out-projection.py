@@ -10,14 +10,16 @@ Prints each fan-out call's shards per lane (seconds summed), and the projection:
 lone replica took it, less the fanned-out share of the visibility stage and of the reduction's
 evaluation, which three hosts as this one split three ways (ideally; or as the shards fell here, the
 busiest lane's share of the shard seconds). The reduction's calls are weighted by their stations
-(the evaluation of the stations is nearly all of the stage). A call of one shard runs on the
+(the evaluation of the stations is nearly all of the stage). A second call of sets is the fine
+round's of coarse-then-fine candidates (in the selection stage): its work is its wall time here
+(three replicas on one host take as long as one for the same sets). A call of one shard runs on the
 coordinator alone and stays serial.
 Usage: scripts/fan-out-projection.py DIR
 """
 import json
 import re
 import sys
-from datetime import datetime
+from datetime import datetime, timedelta
 
 STAMP = re.compile(r"^\[(\d{4}-\d\d-\d\d \d\d:\d\d:\d\d\.\d+)\]")
 OWN = re.compile(r"fan-out: (.+?): own shard viewpoints=(\d+)\+(\d+) elapsed=([\d.]+)s")
@@ -44,10 +46,12 @@ def main(d):
             if m := PEER.search(line):
                 shards.append((stamp(line), "peer " + lane, int(m.group(2)), float(m.group(3))))
     per_call = [dict() for _ in calls]
+    began = [c[0] for c in calls]  # when each call's first shard began
     for t, lane, _, sec in shards:
         k = next((i for i, c in enumerate(calls) if t <= c[0]), None)
         if k is not None:
             per_call[k][lane] = per_call[k].get(lane, 0.0) + sec
+            began[k] = min(began[k], t - timedelta(seconds=sec))
     print("| fan-out call | viewpoints | shards | shard seconds per lane | busiest lane's share |")
     print("|---|---|---|---|---|")
     for (t, stage, n, s), lanes in zip(calls, per_call):
@@ -57,11 +61,20 @@ def main(d):
     t1 = one["timings_s"]
     stations_evaluated = sum(c[2] for c in calls if c[1] == "the reduction") or 1
     saved_ideal = saved_fell = 0.0
-    for (t, stage, n, s), lanes in zip(calls, per_call):
+    first_visibility = True
+    for (t, stage, n, s), lanes, start in zip(calls, per_call, began):
         if s < 2:
             continue  # one shard: the coordinator alone
         share = max(lanes.values()) / sum(lanes.values())
-        work = t1["visibility"] if stage == "the visibility stage" else t1.get("reduction", 0) * n / stations_evaluated
+        if stage == "the visibility stage" and first_visibility:
+            work = t1["visibility"]
+            first_visibility = False
+        elif stage == "the visibility stage":
+            # A later call of sets is the fine round's (in the selection stage): its wall time with
+            # the three replicas on this host, which take as long as one for the same sets.
+            work = (t - start).total_seconds()
+        else:
+            work = t1.get("reduction", 0) * n / stations_evaluated
         saved_ideal += work * (1 - 1 / 3)
         saved_fell += work * (1 - share)
     total1 = t1["total"]

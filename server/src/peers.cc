@@ -489,11 +489,27 @@ std::shared_ptr<v1::StationPlanner::Stub> PeerFanOut::StubFor(const std::string&
   return stub;
 }
 
+namespace {
+
+// Viewpoints per shard: --shard-candidates for visibility sets. A station's face values cost several
+// sets' worth and a reduction batch holds tens to hundreds of stations, so those are cut into at
+// least kMinFaceValueShards shards where the stations allow (fr_campus's first batch of 61 stations
+// was one shard of 128, evaluated on the coordinator alone while the peers waited).
+constexpr size_t kMinFaceValueShards = 12;
+
+size_t ShardViewpoints(v1::ShardKind kind, size_t viewpoints, int shard_candidates) {
+  const size_t most = size_t(shard_candidates);
+  if (kind != v1::SHARD_KIND_FACE_VALUES) return most;
+  return std::clamp<size_t>((viewpoints + kMinFaceValueShards - 1) / kMinFaceValueShards, 1, most);
+}
+
+}  // namespace
+
 template <class T>
 Result<FanOutResult<T>> PeerFanOut::FanOut(const SceneRef& ref, const v1::PlanParameters& parameters,
                                            const VoxelScene& scene, const std::vector<WorldPoint>& viewpoints,
                                            const ShardSpec& spec, const LocalShard<T>& local, const JobContext& ctx) {
-  ShardBoard board(viewpoints.size(), size_t(options_.shard_candidates));
+  ShardBoard board(viewpoints.size(), ShardViewpoints(spec.kind, viewpoints.size(), options_.shard_candidates));
   std::vector<std::vector<T>> results(board.size());
   std::vector<std::string> warnings;
   const std::vector<std::string> addresses = board.size() > 1 ? Addresses(&warnings) : std::vector<std::string>{};

@@ -163,6 +163,13 @@ class FakePeer final : public v1::StationPlanner::CallbackService {
   std::unique_ptr<grpc::Server> server_;
 };
 
+// The reduction's shards of `stations` at --shard-candidates 4: at least 12 shards where the
+// stations allow, at most 4 stations each (peers.cc, ShardViewpoints).
+size_t ReductionShards(size_t stations) {
+  const size_t per_shard = std::clamp<size_t>((stations + 11) / 12, 1, 4);
+  return (stations + per_shard - 1) / per_shard;
+}
+
 TEST(FanOut, ThreeReplicasPlanExactlyAsOne) {
   auto b = testing::StartServer(Replica());
   auto c = testing::StartServer(Replica());
@@ -181,7 +188,7 @@ TEST(FanOut, ThreeReplicasPlanExactlyAsOne) {
   ExpectSamePlan(*alone, *fanned);
   // The visibility stage's shards of candidates, then the reduction's of stations.
   const size_t viewpoints = fanned->candidate_count, stations = size_t(fanned->reduction.size);
-  EXPECT_EQ(fanned->distribution.shards, int((viewpoints + 3) / 4 + (stations + 3) / 4));
+  EXPECT_EQ(fanned->distribution.shards, int((viewpoints + 3) / 4 + ReductionShards(stations)));
   EXPECT_EQ(fanned->distribution.replicas, 2) << Warnings(*fanned);
   EXPECT_GT(fanned->distribution.bytes_exchanged, Room().size());  // the scene went to both, then sets came back
   EXPECT_TRUE(fanned->warnings.empty()) << Warnings(*fanned);
@@ -219,7 +226,7 @@ TEST(FanOut, TheReductionsEvaluationIsShardedAcrossReplicas) {
   ExpectSamePlan(*alone, *fanned);
   const size_t viewpoints = fanned->candidate_count + options.fixed_stations.size();
   const size_t stations = size_t(fanned->reduction.size);
-  EXPECT_EQ(fanned->distribution.shards, int((viewpoints + 3) / 4 + (stations + 3) / 4));
+  EXPECT_EQ(fanned->distribution.shards, int((viewpoints + 3) / 4 + ReductionShards(stations)));
   EXPECT_EQ(fanned->distribution.replicas, 2) << Warnings(*fanned);
   EXPECT_TRUE(fanned->warnings.empty()) << Warnings(*fanned);
 }

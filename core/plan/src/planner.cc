@@ -159,6 +159,7 @@ void TakeSelectionFigures(planner::SelectionOutput& selected, const planner::Can
       result.optimality.local_candidates.coarse_to_fine;  // the fine round's neighbourhood rule, if it ran
   if (!result.optimality.note.empty()) result.warnings.push_back(result.optimality.note);
   for (std::string& w : selected.warnings) result.warnings.push_back(std::move(w));
+  result.distribution.Add(selected.distribution);
 }
 
 // The route stage's route (or why there is none) into `result` (the route's warnings moved).

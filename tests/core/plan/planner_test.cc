@@ -361,6 +361,62 @@ TEST(PlannerTest, CoarseThenFineAboveTheThresholdAndTheFullGridAtIt) {
   EXPECT_GE(double(coarse->covered_voxels), o.target_coverage * double(grid2->coverable_voxels));
 }
 
+// The fine round's sets go through PlanCallbacks::visibility_sets as the visibility stage's do
+// (vc-server fans both out over its peers): the same plan as computed here, the fine round's shards
+// counted in the plan's distribution, and their progress reported as the selection stage's.
+TEST(PlannerTest, CoarseThenFineFansOutTheFineRoundsSets) {
+  PlanOptions o = TestOptions();
+  o.solver = SelectionSolver::kGreedy;
+  const SceneInput input = Synthetic("hub:3");
+  o.coarse_above_candidates = 0;
+  Result<PlanResult> full = Plan(input, o);
+  ASSERT_TRUE(full.ok()) << full.status().ToString();
+  o.coarse_above_candidates = static_cast<int>(full->candidate_count) - 1;
+  Result<PlanResult> here = Plan(input, o);
+  ASSERT_TRUE(here.ok()) << here.status().ToString();
+  ASSERT_GT(here->optimality.local_candidates.added, 0);
+
+  std::vector<size_t> asked;  // positions per call
+  PlanCallbacks callbacks;
+  callbacks.visibility_sets = [&](const VoxelScene& scene, const std::vector<WorldPoint>& positions,
+                                  const VisibilitySetsOptions& set_options,
+                                  const JobContext& ctx) -> Result<DistributedSets> {
+    asked.push_back(positions.size());
+    DistributedSets d;
+    for (size_t b = 0; b < positions.size(); b += 5) {  // shards of 5, as a fan-out would split them
+      const std::vector<WorldPoint> shard(positions.begin() + b, positions.begin() + std::min(b + 5, positions.size()));
+      VC_ASSIGN_OR_RETURN(std::vector<VoxelSet> sets, ComputeVisibilitySets(scene, shard, set_options, {}));
+      for (VoxelSet& s : sets) d.sets.push_back(std::move(s));
+      ++d.distribution.shards;
+      ctx.ReportCount(Stage::kVisibility, d.sets.size(), positions.size(), "shards");  // as vc-server's does
+    }
+    d.distribution.replicas = 2;
+    return d;
+  };
+  std::vector<ProgressEvent> events;
+  JobContext ctx;
+  ctx.progress = [&](const ProgressEvent& e) { events.push_back(e); };
+  Result<PlanResult> spread = Plan(input, o, ctx, callbacks);
+  ASSERT_TRUE(spread.ok()) << spread.status().ToString();
+
+  ASSERT_EQ(asked.size(), 2u) << "the visibility stage's call, then the fine round's";
+  EXPECT_EQ(asked[0], here->candidate_count);
+  EXPECT_EQ(asked[1], static_cast<size_t>(here->optimality.local_candidates.added));
+  EXPECT_EQ(spread->distribution.shards, int((asked[0] + 4) / 5 + (asked[1] + 4) / 5));
+  ASSERT_EQ(spread->stations.size(), here->stations.size());
+  for (size_t k = 0; k < here->stations.size(); ++k) {
+    EXPECT_EQ(spread->stations[k].position, here->stations[k].position) << k;
+  }
+  EXPECT_EQ(spread->covered_voxels, here->covered_voxels);
+  EXPECT_EQ(spread->coverable_voxels, here->coverable_voxels);
+  EXPECT_EQ(spread->evaluation.overall.global_visibility, here->evaluation.overall.global_visibility);
+  const std::string fine = "local candidates: visibility of " + std::to_string(asked[1]) + " positions";
+  const int fine_counts = int(std::count_if(events.begin(), events.end(), [&](const ProgressEvent& e) {
+    return e.stage == Stage::kSelection && e.message == fine && e.total == asked[1];
+  }));
+  EXPECT_EQ(fine_counts, int((asked[1] + 4) / 5)) << "the fine round's shards, counted as the selection stage's";
+}
+
 // Coarse then fine short of the target (target_coverage 1: the gain rule stops greedy first): the
 // fine round's neighbourhood rule decides which fine positions get a set, and plan.json says how
 // many it passed over (docs/PLANNING.md, "Coarse then fine candidates"). At the default target the

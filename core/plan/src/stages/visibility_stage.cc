@@ -36,6 +36,28 @@ VisibilitySetsOptions VisibilitySetsOptionsFor(const PlanOptions& options,
   return set_options;
 }
 
+Result<DistributedSets> VisibilitySetsOf(const VisibilitySetsFn& visibility_sets, const VoxelScene& scene,
+                                         const std::vector<WorldPoint>& positions,
+                                         const VisibilitySetsOptions& set_options,
+                                         std::span<const SurfacePatch> surface_patches, const JobContext& ctx) {
+  if (!visibility_sets || !surface_patches.empty()) {
+    VC_ASSIGN_OR_RETURN(std::vector<VoxelSet> sets, ComputeVisibilitySets(scene, positions, set_options, ctx));
+    return DistributedSets{std::move(sets), {}, {}};
+  }
+  VC_ASSIGN_OR_RETURN(DistributedSets d, visibility_sets(scene, positions, set_options, ctx));
+  if (d.sets.size() != positions.size()) {
+    return InternalError("the distributed visibility sets were " + std::to_string(d.sets.size()) + " for " +
+                         std::to_string(positions.size()) + " positions");
+  }
+  for (const VoxelSet& set : d.sets) {
+    if (set.size() != scene.occupied.size()) {
+      return InternalError("a distributed visibility set held " + std::to_string(set.size()) +
+                           " voxels for a scene of " + std::to_string(scene.occupied.size()));
+    }
+  }
+  return d;
+}
+
 Result<VisibilityOutput> RunVisibilityStage(const VisibilityInput& in, const PlanOptions& options,
                                             const JobContext& ctx) {
   const VisibilitySetsOptions set_options = VisibilitySetsOptionsFor(options, in.surface_patches);
@@ -43,24 +65,11 @@ Result<VisibilityOutput> RunVisibilityStage(const VisibilityInput& in, const Pla
   // One pass over the fixed stations and the candidates; the fixed stations' sets come first.
   std::vector<WorldPoint> all = in.fixed_stations;
   all.insert(all.end(), in.candidates.begin(), in.candidates.end());
-  if (in.callbacks.visibility_sets && in.surface_patches.empty()) {
-    VC_ASSIGN_OR_RETURN(DistributedSets d, in.callbacks.visibility_sets(in.scene, all, set_options, ctx));
-    if (d.sets.size() != all.size()) {
-      return InternalError("the distributed visibility stage returned " + std::to_string(d.sets.size()) + " sets for " +
-                           std::to_string(all.size()) + " positions");
-    }
-    for (const VoxelSet& set : d.sets) {
-      if (set.size() != in.scene.occupied.size()) {
-        return InternalError("the distributed visibility stage returned a set of " + std::to_string(set.size()) +
-                             " voxels for a scene of " + std::to_string(in.scene.occupied.size()));
-      }
-    }
-    out.sets = std::move(d.sets);
-    out.distribution = d.distribution;
-    out.warnings = std::move(d.warnings);
-  } else {
-    VC_ASSIGN_OR_RETURN(out.sets, ComputeVisibilitySets(in.scene, all, set_options, ctx));
-  }
+  VC_ASSIGN_OR_RETURN(DistributedSets d, VisibilitySetsOf(in.callbacks.visibility_sets, in.scene, all, set_options,
+                                                          in.surface_patches, ctx));
+  out.sets = std::move(d.sets);
+  out.distribution = d.distribution;
+  out.warnings = std::move(d.warnings);
   if (!in.fixed_stations.empty()) {
     const auto split = out.sets.begin() + static_cast<std::ptrdiff_t>(in.fixed_stations.size());
     out.fixed_sets.assign(std::make_move_iterator(out.sets.begin()), std::make_move_iterator(split));

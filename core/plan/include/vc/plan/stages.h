@@ -144,6 +144,14 @@ struct VisibilityOutput {
 // use the same), with `surface_patches` (VoxelizeOutput's) for the sub-voxel test.
 [[nodiscard]] VisibilitySetsOptions VisibilitySetsOptionsFor(const PlanOptions& options,
                                                              std::span<const SurfacePatch> surface_patches = {});
+// The sets of `positions` from `visibility_sets` (vc-server fans them out over its peers) when it is
+// set and there are no surface patches (peers hold none), else ComputeVisibilitySets here; the
+// same sets either way. INTERNAL when the callback returns the wrong number or size of sets.
+[[nodiscard]] Result<DistributedSets> VisibilitySetsOf(const VisibilitySetsFn& visibility_sets, const VoxelScene& scene,
+                                                       const std::vector<WorldPoint>& positions,
+                                                       const VisibilitySetsOptions& set_options,
+                                                       std::span<const SurfacePatch> surface_patches,
+                                                       const JobContext& ctx);
 // With surface patches (the sub-voxel test) the sets are computed here, never by
 // callbacks.visibility_sets: peers hold no patches. CANCELLED / DEADLINE_EXCEEDED from ctx.
 [[nodiscard]] Result<VisibilityOutput> RunVisibilityStage(const VisibilityInput& in, const PlanOptions& options,
@@ -168,10 +176,14 @@ struct SelectionInput {
   bool keep_added_sets_whole = false;
 };
 struct SelectionOutput {
-  Stations stations;                  // the fixed stations, then the picks, in pick order
-  VoxelSet coverable;                 // union of every candidate's and fixed station's set
-  Selection selection;                // what the selector reported
-  std::vector<std::string> warnings;  // the local-candidates loop's, when the memory budget cut it short
+  Stations stations;    // the fixed stations, then the picks, in pick order
+  VoxelSet coverable;   // union of every candidate's and fixed station's set
+  Selection selection;  // what the selector reported
+  // the local-candidates loop's, when the memory budget cut it short, and its fan-out's
+  std::vector<std::string> warnings;
+  // How the local-candidates loop's sets were spread over the replicas (VisibilitySetsOf); zero
+  // when computed here.
+  Distribution distribution;
   // Per k = 1..picks (index k - 1), what any k stations cover at most and the most found, over the
   // candidates and fixed stations selected from (the fixed ones always among the k; none for fewer
   // k); empty where not computed (BestCoverageOf).
