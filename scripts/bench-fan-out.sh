@@ -73,16 +73,13 @@ same = (one["viewpoints"] == three["viewpoints"] and one["coverage"] == three["c
 t1, t3 = one["timings_s"], three["timings_s"]
 v1, v3 = t1["visibility"], t3["visibility"]
 r1, r3 = t1.get("reduction", 0.0), t3.get("reduction", 0.0)
-vis_shards = -(-one["candidates"]["count"] // shard)
-red_shards = -(-one["reduction"]["size"] // shard) if one["reduction"]["size"] else 0
-if vis_shards + red_shards < 2:  # one shard per stage: computed locally, nothing fanned out
-    vis_shards = red_shards = 0
-print("| scene | candidates | stations | shard | visibility, 1 → 3 replicas | reduction, 1 → 3 replicas | shards in all (the visibility stage's + the reduction's at one shard size) | replicas | retried | bytes exchanged | per shard | same plan |")
-print("|---|---|---|---|---|---|---|---|---|---|---|---|")
-per = (f"{d['bytes_exchanged'] / d['shards'] / 1024:.0f} KiB, {((v3 - v1) + (r3 - r1)) / d['shards'] * 1000:+.0f} ms"
+s1, s3 = t1.get("selection", 0.0), t3.get("selection", 0.0)
+print("| scene | candidates | stations | shard | visibility, 1 → 3 replicas | selection, 1 → 3 replicas | reduction, 1 → 3 replicas | shards in all | replicas | retried | bytes exchanged | per shard | same plan |")
+print("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
+per = (f"{d['bytes_exchanged'] / d['shards'] / 1024:.0f} KiB, {((v3 - v1) + (s3 - s1) + (r3 - r1)) / d['shards'] * 1000:+.0f} ms"
        if d and d["shards"] else "(computed locally)")
 print(f"| {sys.argv[3]} | {one['candidates']['count']} | {one['reduction']['size']} | {shard} | {v1:.2f} → {v3:.2f} s "
-      f"| {r1:.2f} → {r3:.2f} s | {d['shards'] if d else 0} ({vis_shards} + {red_shards}) | {d['replicas'] if d else 1} "
+      f"| {s1:.2f} → {s3:.2f} s | {r1:.2f} → {r3:.2f} s | {d['shards'] if d else 0} | {d['replicas'] if d else 1} "
       f"| {d['retried'] if d else 0} | {(d['bytes_exchanged'] if d else 0) / 1048576:.1f} MiB | {per} | {'yes' if same else 'NO'} |")
 stages = list(dict.fromkeys(list(t1) + list(t3)))
 print("\nper stage, 1 → 3 replicas: " + ", ".join(f"{k} {t1.get(k, 0):.2f} → {t3.get(k, 0):.2f} s" for k in stages))

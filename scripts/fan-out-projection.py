@@ -10,9 +10,9 @@ Prints each fan-out call's shards per lane (seconds summed), and the projection:
 lone replica took it, less the fanned-out share of the visibility stage and of the reduction's
 evaluation, which three hosts as this one split three ways (ideally; or as the shards fell here, the
 busiest lane's share of the shard seconds). The reduction's calls are weighted by their stations
-(the evaluation of the stations is nearly all of the stage). A second call of sets is the fine
-round's of coarse-then-fine candidates (in the selection stage): its work is its wall time here
-(three replicas on one host take as long as one for the same sets). A call of one shard runs on the
+(the evaluation of the stations is nearly all of the stage). A call of the selection stage's sets
+("the fine round's sets" of coarse-then-fine candidates, "the local candidates' sets") counts its
+wall time here as its work (three replicas on one host take as long as one for the same sets). A call of one shard runs on the
 coordinator alone and stays serial.
 Usage: scripts/fan-out-projection.py DIR
 """
@@ -61,20 +61,24 @@ def main(d):
     t1 = one["timings_s"]
     stations_evaluated = sum(c[2] for c in calls if c[1] == "the reduction") or 1
     saved_ideal = saved_fell = 0.0
-    first_visibility = True
+    local_sets = 0.0  # the selection stage's fanned-out sets, taken out of its serial seconds
+    seen_visibility = False
     for (t, stage, n, s), lanes, start in zip(calls, per_call, began):
+        # Logs of b3da04e named the fine round's call "the visibility stage" too: only the first is.
+        first_visibility = stage == "the visibility stage" and not seen_visibility
+        seen_visibility = seen_visibility or stage == "the visibility stage"
         if s < 2:
             continue  # one shard: the coordinator alone
         share = max(lanes.values()) / sum(lanes.values())
-        if stage == "the visibility stage" and first_visibility:
+        if first_visibility:
             work = t1["visibility"]
-            first_visibility = False
-        elif stage == "the visibility stage":
-            # A later call of sets is the fine round's (in the selection stage): its wall time with
+        elif stage == "the reduction":
+            work = t1.get("reduction", 0) * n / stations_evaluated
+        else:
+            # The selection stage's local candidates ("the fine round's sets"): its wall time with
             # the three replicas on this host, which take as long as one for the same sets.
             work = (t - start).total_seconds()
-        else:
-            work = t1.get("reduction", 0) * n / stations_evaluated
+            local_sets += work
         saved_ideal += work * (1 - 1 / 3)
         saved_fell += work * (1 - share)
     total1 = t1["total"]
@@ -82,8 +86,11 @@ def main(d):
     print(f"one replica: {total1:.1f} s; coordinator and two peers on this host: {three['timings_s']['total']:.1f} s")
     print(f"three hosts, projected: {total1 - saved_ideal:.1f} s split ideally, {total1 - saved_fell:.1f} s as the "
           f"shards fell here ({total1 / (total1 - saved_ideal):.2f} x and {total1 / (total1 - saved_fell):.2f} x)")
-    print("serial on the coordinator (one replica's seconds): " + ", ".join(
-        f"{k} {v:.1f} s" for k, v in t1.items() if k not in ("visibility", "reduction", "total")))
+    serial = {k: v for k, v in t1.items() if k not in ("visibility", "reduction", "total")}
+    if "selection" in serial:
+        serial["selection"] = max(0.0, serial["selection"] - local_sets)
+    print("serial on the coordinator (one replica's seconds, less the fanned-out sets): " + ", ".join(
+        f"{k} {v:.1f} s" for k, v in serial.items()))
 
 
 if __name__ == "__main__":

@@ -489,21 +489,12 @@ std::shared_ptr<v1::StationPlanner::Stub> PeerFanOut::StubFor(const std::string&
   return stub;
 }
 
-namespace {
-
-// Viewpoints per shard: --shard-candidates for visibility sets. A station's face values cost several
-// sets' worth and a reduction batch holds tens to hundreds of stations, so those are cut into at
-// least kMinFaceValueShards shards where the stations allow (fr_campus's first batch of 61 stations
-// was one shard of 128, evaluated on the coordinator alone while the peers waited).
-constexpr size_t kMinFaceValueShards = 12;
-
 size_t ShardViewpoints(v1::ShardKind kind, size_t viewpoints, int shard_candidates) {
-  const size_t most = size_t(shard_candidates);
+  const size_t most = size_t(std::max(shard_candidates, 1));
   if (kind != v1::SHARD_KIND_FACE_VALUES) return most;
-  return std::clamp<size_t>((viewpoints + kMinFaceValueShards - 1) / kMinFaceValueShards, 1, most);
+  const size_t spread = (viewpoints + kMinFaceValueShards - 1) / kMinFaceValueShards;
+  return std::min(most, std::max(spread, kMinFaceValueShardStations));
 }
-
-}  // namespace
 
 template <class T>
 Result<FanOutResult<T>> PeerFanOut::FanOut(const SceneRef& ref, const v1::PlanParameters& parameters,
@@ -548,9 +539,9 @@ Result<FanOutResult<T>> PeerFanOut::FanOut(const SceneRef& ref, const v1::PlanPa
 
 Result<DistributedSets> PeerFanOut::Compute(const SceneRef& ref, const v1::PlanParameters& parameters,
                                             const VoxelScene& scene, const std::vector<WorldPoint>& viewpoints,
-                                            const VisibilitySetsOptions& options, const JobContext& ctx) {
-  const ShardSpec spec{v1::SHARD_KIND_VISIBILITY_SETS, options.compact_gain, Stage::kVisibility, "the visibility stage",
-                       false};
+                                            const VisibilitySetsOptions& options, const JobContext& ctx,
+                                            const char* what) {
+  const ShardSpec spec{v1::SHARD_KIND_VISIBILITY_SETS, options.compact_gain, Stage::kVisibility, what, false};
   const LocalShard<VoxelSet> local = [&](const std::vector<WorldPoint>& slice, const JobContext& c) {
     return ComputeVisibilitySets(scene, slice, options, c);
   };

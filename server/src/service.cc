@@ -71,8 +71,9 @@ class PlanReactor final : public JobReactor<v1::PlanRequest, v1::PlanResponse> {
     };
     if (fan_out() != nullptr) {
       callbacks.visibility_sets = [this, ref](const VoxelScene& scene, const std::vector<WorldPoint>& viewpoints,
-                                              const VisibilitySetsOptions& set_options, const JobContext& c) {
-        return fan_out()->Compute(ref(), wire::ToProto(options_), scene, viewpoints, set_options, c);
+                                              const VisibilitySetsOptions& set_options, const JobContext& c,
+                                              const char* what) {
+        return fan_out()->Compute(ref(), wire::ToProto(options_), scene, viewpoints, set_options, c, what);
       };
       callbacks.face_values = [this, ref](const VoxelScene& scene, const std::vector<WorldPoint>& stations,
                                           const EvaluateOptions& eval_options, const JobContext& c) {

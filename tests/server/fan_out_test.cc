@@ -3,6 +3,7 @@
 // token costs time, not the plan; the calls between replicas check what they are sent.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 
@@ -10,6 +11,7 @@
 #include "vc/client/client.h"
 #include "vc/plan/stages.h"
 #include "vc/scene/scene_input.h"
+#include "vc/server/peers.h"
 #include "vc/wire/face_values_codec.h"
 #include "vc/wire/sha256.h"
 #include "vc/wire/status_mapping.h"
@@ -163,11 +165,24 @@ class FakePeer final : public v1::StationPlanner::CallbackService {
   std::unique_ptr<grpc::Server> server_;
 };
 
-// The reduction's shards of `stations` at --shard-candidates 4: at least 12 shards where the
-// stations allow, at most 4 stations each (peers.cc, ShardViewpoints).
+// The reduction's shards of `stations` at --shard-candidates 4 (ShardViewpoints).
 size_t ReductionShards(size_t stations) {
-  const size_t per_shard = std::clamp<size_t>((stations + 11) / 12, 1, 4);
+  const size_t per_shard = server::ShardViewpoints(v1::SHARD_KIND_FACE_VALUES, stations, 4);
   return (stations + per_shard - 1) / per_shard;
+}
+
+// Shards of visibility sets hold --shard-candidates viewpoints; shards of face values are at least
+// 12 where the stations allow, of 4 stations at least (a small plan's few stay on the coordinator)
+// and of --shard-candidates at most.
+TEST(FanOut, ShardSizes) {
+  EXPECT_EQ(server::ShardViewpoints(v1::SHARD_KIND_VISIBILITY_SETS, 4065, 128), 128u);
+  EXPECT_EQ(server::ShardViewpoints(v1::SHARD_KIND_VISIBILITY_SETS, 3, 128), 128u);
+  EXPECT_EQ(server::ShardViewpoints(v1::SHARD_KIND_FACE_VALUES, 61, 128), 6u);    // 11 shards
+  EXPECT_EQ(server::ShardViewpoints(v1::SHARD_KIND_FACE_VALUES, 696, 128), 58u);  // 12 shards
+  EXPECT_EQ(server::ShardViewpoints(v1::SHARD_KIND_FACE_VALUES, 18, 128), 4u);    // 5 shards
+  EXPECT_EQ(server::ShardViewpoints(v1::SHARD_KIND_FACE_VALUES, 3, 128), 4u);     // one: stays local
+  EXPECT_EQ(server::ShardViewpoints(v1::SHARD_KIND_FACE_VALUES, 100000, 128), 128u);
+  EXPECT_EQ(server::ShardViewpoints(v1::SHARD_KIND_FACE_VALUES, 61, 2), 2u);
 }
 
 TEST(FanOut, ThreeReplicasPlanExactlyAsOne) {
@@ -227,6 +242,34 @@ TEST(FanOut, TheReductionsEvaluationIsShardedAcrossReplicas) {
   const size_t viewpoints = fanned->candidate_count + options.fixed_stations.size();
   const size_t stations = size_t(fanned->reduction.size);
   EXPECT_EQ(fanned->distribution.shards, int((viewpoints + 3) / 4 + ReductionShards(stations)));
+  EXPECT_EQ(fanned->distribution.replicas, 2) << Warnings(*fanned);
+  EXPECT_TRUE(fanned->warnings.empty()) << Warnings(*fanned);
+}
+
+// Coarse then fine candidates (docs/PLANNING.md): the fine round's sets are fanned out too, as the
+// visibility stage's; the plan is the single replica's.
+TEST(FanOut, TheFineRoundsSetsAreShardedAcrossReplicas) {
+  PlanOptions options = Options();
+  options.coarse_above_candidates = 10;  // the room's ~35 candidates at 1 m: the 2 m grid first
+  auto b = testing::StartServer(Replica());
+  auto c = testing::StartServer(Replica());
+  ASSERT_TRUE(b && c);
+  const auto alone = PlanOn(testing::Address(*b), "", options);
+  ASSERT_TRUE(alone.ok()) << alone.status().ToString();
+  const planner::LocalCandidatesReport& fine = alone->optimality.local_candidates;
+  ASSERT_FALSE(fine.coarse_to_fine.empty());
+  ASSERT_GT(fine.added, 0);
+  server::ServerOptions o = Coordinator({testing::Address(*b), testing::Address(*c)});
+  o.local_shards = false;
+  auto a = testing::StartServer(o);
+  ASSERT_TRUE(a);
+  const auto fanned = PlanOn(testing::Address(*a), "", options);
+  ASSERT_TRUE(fanned.ok()) << fanned.status().ToString();
+  ExpectSamePlan(*alone, *fanned);
+  EXPECT_EQ(fanned->optimality.local_candidates.added, fine.added);
+  const size_t coarse = fanned->candidate_count, added = size_t(fine.added);
+  const size_t stations = size_t(fanned->reduction.size);
+  EXPECT_EQ(fanned->distribution.shards, int((coarse + 3) / 4 + (added + 3) / 4 + ReductionShards(stations)));
   EXPECT_EQ(fanned->distribution.replicas, 2) << Warnings(*fanned);
   EXPECT_TRUE(fanned->warnings.empty()) << Warnings(*fanned);
 }

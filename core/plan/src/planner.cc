@@ -158,7 +158,12 @@ void TakeSelectionFigures(planner::SelectionOutput& selected, const planner::Can
       planner::CoarseToFineNote(candidates, options.coarse_above_candidates) +
       result.optimality.local_candidates.coarse_to_fine;  // the fine round's neighbourhood rule, if it ran
   if (!result.optimality.note.empty()) result.warnings.push_back(result.optimality.note);
-  for (std::string& w : selected.warnings) result.warnings.push_back(std::move(w));
+  // (the fan-out's warnings about a replica or the peers' addresses may repeat the visibility stage's)
+  for (std::string& w : selected.warnings) {
+    if (std::find(result.warnings.begin(), result.warnings.end(), w) == result.warnings.end()) {
+      result.warnings.push_back(std::move(w));
+    }
+  }
   result.distribution.Add(selected.distribution);
 }
 

@@ -377,18 +377,21 @@ TEST(PlannerTest, CoarseThenFineFansOutTheFineRoundsSets) {
   ASSERT_GT(here->optimality.local_candidates.added, 0);
 
   std::vector<size_t> asked;  // positions per call
+  std::vector<std::string> named;
   PlanCallbacks callbacks;
   callbacks.visibility_sets = [&](const VoxelScene& scene, const std::vector<WorldPoint>& positions,
-                                  const VisibilitySetsOptions& set_options,
-                                  const JobContext& ctx) -> Result<DistributedSets> {
+                                  const VisibilitySetsOptions& set_options, const JobContext& ctx,
+                                  const char* what) -> Result<DistributedSets> {
     asked.push_back(positions.size());
+    named.push_back(what);
     DistributedSets d;
     for (size_t b = 0; b < positions.size(); b += 5) {  // shards of 5, as a fan-out would split them
       const std::vector<WorldPoint> shard(positions.begin() + b, positions.begin() + std::min(b + 5, positions.size()));
       VC_ASSIGN_OR_RETURN(std::vector<VoxelSet> sets, ComputeVisibilitySets(scene, shard, set_options, {}));
       for (VoxelSet& s : sets) d.sets.push_back(std::move(s));
       ++d.distribution.shards;
-      ctx.ReportCount(Stage::kVisibility, d.sets.size(), positions.size(), "shards");  // as vc-server's does
+      // (vc-server's fan-out counts shards done; this one, positions done)
+      ctx.ReportCount(Stage::kVisibility, d.sets.size(), positions.size(), "positions");
     }
     d.distribution.replicas = 2;
     return d;
@@ -400,6 +403,7 @@ TEST(PlannerTest, CoarseThenFineFansOutTheFineRoundsSets) {
   ASSERT_TRUE(spread.ok()) << spread.status().ToString();
 
   ASSERT_EQ(asked.size(), 2u) << "the visibility stage's call, then the fine round's";
+  EXPECT_EQ(named, (std::vector<std::string>{"the visibility stage", "the fine round's sets"}));
   EXPECT_EQ(asked[0], here->candidate_count);
   EXPECT_EQ(asked[1], static_cast<size_t>(here->optimality.local_candidates.added));
   EXPECT_EQ(spread->distribution.shards, int((asked[0] + 4) / 5 + (asked[1] + 4) / 5));

@@ -73,22 +73,23 @@ Result<LocalRefinementResult> SelectWithLocalCandidates(const SelectionInput& in
 
   const VisibilitySetsOptions set_options = VisibilitySetsOptionsFor(options, in.surface_patches);
   // The added positions' sets as the visibility stage's (through in.callbacks.visibility_sets when
-  // set: vc-server fans them out over its peers), their progress counted as the selection stage's
-  // (fr_campus's 820 fine positions at 0.2 m take a minute).
+  // set: vc-server fans them out over its peers), their progress counted in the selection stage
+  // (ctx is the stage's: StageContext sets the stage) under the loop's own line (fr_campus's 820
+  // fine positions at 0.2 m take a minute).
+  const char* what = in.keep_added_sets_whole ? "the fine round's sets" : "the local candidates' sets";
   const VisibilityFn visibility = [&](const std::vector<WorldPoint>& positions) -> Result<std::vector<VoxelSet>> {
-    const std::string what = "local candidates: visibility of " + std::to_string(positions.size()) + " positions";
-    ctx.Report(Stage::kSelection, 0.0, what);
+    const std::string line = "local candidates: visibility of " + std::to_string(positions.size()) + " positions";
+    ctx.Report(Stage::kSelection, 0.0, line);
     JobContext sets_ctx{ctx.cancel, {}};
     if (ctx.progress) {
-      sets_ctx.progress = [&](const ProgressEvent& e) {
-        ProgressEvent as_selection = e;
-        as_selection.stage = Stage::kSelection;
-        as_selection.message = what;
-        ctx.progress(as_selection);
+      sets_ctx.progress = [&ctx, line](const ProgressEvent& e) {
+        ProgressEvent under_line = e;
+        under_line.message = line;
+        ctx.progress(under_line);
       };
     }
     VC_ASSIGN_OR_RETURN(DistributedSets d, VisibilitySetsOf(in.callbacks.visibility_sets, in.scene, positions,
-                                                            set_options, in.surface_patches, sets_ctx));
+                                                            set_options, in.surface_patches, sets_ctx, what));
     out_spread.distribution.Add(d.distribution);
     for (std::string& w : d.warnings) out_spread.warnings.push_back(std::move(w));
     if (!in.keep_added_sets_whole) {

@@ -39,12 +39,13 @@ VisibilitySetsOptions VisibilitySetsOptionsFor(const PlanOptions& options,
 Result<DistributedSets> VisibilitySetsOf(const VisibilitySetsFn& visibility_sets, const VoxelScene& scene,
                                          const std::vector<WorldPoint>& positions,
                                          const VisibilitySetsOptions& set_options,
-                                         std::span<const SurfacePatch> surface_patches, const JobContext& ctx) {
+                                         std::span<const SurfacePatch> surface_patches, const JobContext& ctx,
+                                         const char* what) {
   if (!visibility_sets || !surface_patches.empty()) {
     VC_ASSIGN_OR_RETURN(std::vector<VoxelSet> sets, ComputeVisibilitySets(scene, positions, set_options, ctx));
     return DistributedSets{std::move(sets), {}, {}};
   }
-  VC_ASSIGN_OR_RETURN(DistributedSets d, visibility_sets(scene, positions, set_options, ctx));
+  VC_ASSIGN_OR_RETURN(DistributedSets d, visibility_sets(scene, positions, set_options, ctx, what));
   if (d.sets.size() != positions.size()) {
     return InternalError("the distributed visibility sets were " + std::to_string(d.sets.size()) + " for " +
                          std::to_string(positions.size()) + " positions");
@@ -66,7 +67,7 @@ Result<VisibilityOutput> RunVisibilityStage(const VisibilityInput& in, const Pla
   std::vector<WorldPoint> all = in.fixed_stations;
   all.insert(all.end(), in.candidates.begin(), in.candidates.end());
   VC_ASSIGN_OR_RETURN(DistributedSets d, VisibilitySetsOf(in.callbacks.visibility_sets, in.scene, all, set_options,
-                                                          in.surface_patches, ctx));
+                                                          in.surface_patches, ctx, "the visibility stage"));
   out.sets = std::move(d.sets);
   out.distribution = d.distribution;
   out.warnings = std::move(d.warnings);

@@ -45,6 +45,16 @@ struct StationFaceValues {
   std::optional<VisibilityFigures> figures;
 };
 
+// Viewpoints per shard of a fan-out of `viewpoints` (--shard-candidates = `shard_candidates`): that
+// many for visibility sets. A station's face values cost several sets' worth and a reduction batch
+// holds tens to hundreds of stations, so those are cut into at least kMinFaceValueShards shards
+// where the stations allow, of at least kMinFaceValueShardStations (a small plan's few stations stay
+// on the coordinator) and at most shard_candidates stations. (fr_campus's first reduction batch of
+// 61 stations was one shard of 128, evaluated on the coordinator alone while the peers waited.)
+inline constexpr size_t kMinFaceValueShards = 12;
+inline constexpr size_t kMinFaceValueShardStations = 4;
+[[nodiscard]] size_t ShardViewpoints(v1::ShardKind kind, size_t viewpoints, int shard_candidates);
+
 class PeerFanOut {
  public:
   // The scene as peers get it: by hash from their cache, or these bytes.
@@ -60,10 +70,11 @@ class PeerFanOut {
 
   // The sets of `viewpoints` on `scene` (which `parameters` voxelized from `ref`), exactly as
   // ComputeVisibilitySets(scene, viewpoints, options, ctx); CANCELLED / DEADLINE_EXCEEDED from ctx.
-  // Peers' failures are warnings, not errors.
+  // Peers' failures are warnings, not errors. `what` names the call in logs and warnings (a
+  // string literal: VisibilitySetsFn).
   Result<DistributedSets> Compute(const SceneRef& ref, const v1::PlanParameters& parameters, const VoxelScene& scene,
                                   const std::vector<WorldPoint>& viewpoints, const VisibilitySetsOptions& options,
-                                  const JobContext& ctx);
+                                  const JobContext& ctx, const char* what = "the visibility stage");
 
   // The faces with V > 0 of each of `stations` on `scene`, exactly as vc::Evaluate(scene, stations,
   // options, ctx) with keep_sparse_per_viewpoint_values gives them (the reduction's evaluation);

@@ -107,15 +107,17 @@ struct Distribution {
 
 // The visibility sets of `viewpoints`, computed elsewhere than ComputeVisibilitySets (vc-server
 // fans them out over its peers): must return exactly what ComputeVisibilitySets(scene, viewpoints,
-// options, ctx) returns, with how it was spread and any warnings for PlanResult::warnings.
+// options, ctx) returns, with how it was spread and any warnings for PlanResult::warnings. `what`
+// names the call for logs and warnings: "the visibility stage", or the selection stage's local
+// candidates ("the fine round's sets" of coarse-then-fine candidates, "the local candidates' sets").
 struct DistributedSets {
   std::vector<VoxelSet> sets;
   Distribution distribution;
   std::vector<std::string> warnings;
 };
-using VisibilitySetsFn =
-    std::function<Result<DistributedSets>(const VoxelScene& scene, const std::vector<WorldPoint>& viewpoints,
-                                          const VisibilitySetsOptions& options, const JobContext& ctx)>;
+using VisibilitySetsFn = std::function<Result<DistributedSets>(
+    const VoxelScene& scene, const std::vector<WorldPoint>& viewpoints, const VisibilitySetsOptions& options,
+    const JobContext& ctx, const char* what)>;
 
 // The reduction's per-station evaluation, by its caller (across replicas): for each station its
 // faces with V > 0, exactly as vc::Evaluate with keep_sparse_per_viewpoint_values gives them.

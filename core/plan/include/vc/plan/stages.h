@@ -144,14 +144,15 @@ struct VisibilityOutput {
 // use the same), with `surface_patches` (VoxelizeOutput's) for the sub-voxel test.
 [[nodiscard]] VisibilitySetsOptions VisibilitySetsOptionsFor(const PlanOptions& options,
                                                              std::span<const SurfacePatch> surface_patches = {});
-// The sets of `positions` from `visibility_sets` (vc-server fans them out over its peers) when it is
-// set and there are no surface patches (peers hold none), else ComputeVisibilitySets here; the
-// same sets either way. INTERNAL when the callback returns the wrong number or size of sets.
+// The sets of `positions` from `visibility_sets` (vc-server fans them out over its peers; `what`
+// names the call, VisibilitySetsFn) when it is set and there are no surface patches (peers hold
+// none), else ComputeVisibilitySets here; the same sets either way. INTERNAL when the callback
+// returns the wrong number or size of sets.
 [[nodiscard]] Result<DistributedSets> VisibilitySetsOf(const VisibilitySetsFn& visibility_sets, const VoxelScene& scene,
                                                        const std::vector<WorldPoint>& positions,
                                                        const VisibilitySetsOptions& set_options,
                                                        std::span<const SurfacePatch> surface_patches,
-                                                       const JobContext& ctx);
+                                                       const JobContext& ctx, const char* what);
 // With surface patches (the sub-voxel test) the sets are computed here, never by
 // callbacks.visibility_sets: peers hold no patches. CANCELLED / DEADLINE_EXCEEDED from ctx.
 [[nodiscard]] Result<VisibilityOutput> RunVisibilityStage(const VisibilityInput& in, const PlanOptions& options,
