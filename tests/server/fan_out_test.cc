@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <utility>
 
 #include "testing/test_server.h"
 #include "vc/client/client.h"
@@ -165,6 +166,20 @@ class FakePeer final : public v1::StationPlanner::CallbackService {
   std::unique_ptr<grpc::Server> server_;
 };
 
+// `options` planned on a lone replica (B), then on a coordinator (A) that leaves every shard to B
+// and C.
+std::pair<Result<PlanResult>, Result<PlanResult>> PlanAloneAndFannedOut(const PlanOptions& options) {
+  auto b = testing::StartServer(Replica());
+  auto c = testing::StartServer(Replica());
+  if (!b || !c) return {InternalError("no replica started"), InternalError("no replica started")};
+  Result<PlanResult> alone = PlanOn(testing::Address(*b), "", options);
+  server::ServerOptions o = Coordinator({testing::Address(*b), testing::Address(*c)});
+  o.local_shards = false;
+  auto a = testing::StartServer(o);
+  if (!a) return {std::move(alone), InternalError("no coordinator started")};
+  return {std::move(alone), PlanOn(testing::Address(*a), "", options)};
+}
+
 // The reduction's shards of `stations` at --shard-candidates 4 (ShardViewpoints).
 size_t ReductionShards(size_t stations) {
   const size_t per_shard = server::ShardViewpoints(v1::SHARD_KIND_FACE_VALUES, stations, 4);
@@ -226,17 +241,9 @@ TEST(FanOut, TheReductionsEvaluationIsShardedAcrossReplicas) {
   for (double x : {1.0, 4.0, 7.0}) {
     for (double y : {1.0, 3.0, 5.0}) options.fixed_stations.push_back(WorldPoint(x, y, 1.5));
   }
-  auto b = testing::StartServer(Replica());
-  auto c = testing::StartServer(Replica());
-  ASSERT_TRUE(b && c);
-  const auto alone = PlanOn(testing::Address(*b), "", options);
+  const auto [alone, fanned] = PlanAloneAndFannedOut(options);
   ASSERT_TRUE(alone.ok()) << alone.status().ToString();
   ASSERT_GE(alone->reduction.size, 9);
-  server::ServerOptions o = Coordinator({testing::Address(*b), testing::Address(*c)});
-  o.local_shards = false;
-  auto a = testing::StartServer(o);
-  ASSERT_TRUE(a);
-  const auto fanned = PlanOn(testing::Address(*a), "", options);
   ASSERT_TRUE(fanned.ok()) << fanned.status().ToString();
   ExpectSamePlan(*alone, *fanned);
   const size_t viewpoints = fanned->candidate_count + options.fixed_stations.size();
@@ -251,19 +258,11 @@ TEST(FanOut, TheReductionsEvaluationIsShardedAcrossReplicas) {
 TEST(FanOut, TheFineRoundsSetsAreShardedAcrossReplicas) {
   PlanOptions options = Options();
   options.coarse_above_candidates = 10;  // the room's ~35 candidates at 1 m: the 2 m grid first
-  auto b = testing::StartServer(Replica());
-  auto c = testing::StartServer(Replica());
-  ASSERT_TRUE(b && c);
-  const auto alone = PlanOn(testing::Address(*b), "", options);
+  const auto [alone, fanned] = PlanAloneAndFannedOut(options);
   ASSERT_TRUE(alone.ok()) << alone.status().ToString();
   const planner::LocalCandidatesReport& fine = alone->optimality.local_candidates;
   ASSERT_FALSE(fine.coarse_to_fine.empty());
   ASSERT_GT(fine.added, 0);
-  server::ServerOptions o = Coordinator({testing::Address(*b), testing::Address(*c)});
-  o.local_shards = false;
-  auto a = testing::StartServer(o);
-  ASSERT_TRUE(a);
-  const auto fanned = PlanOn(testing::Address(*a), "", options);
   ASSERT_TRUE(fanned.ok()) << fanned.status().ToString();
   ExpectSamePlan(*alone, *fanned);
   EXPECT_EQ(fanned->optimality.local_candidates.added, fine.added);
