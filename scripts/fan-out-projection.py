@@ -14,7 +14,7 @@ busiest lane's share of the shard seconds). The reduction's calls are weighted b
 ("the fine round's sets" of coarse-then-fine candidates, "the local candidates' sets") counts its
 wall time here as its work (three replicas on one host take as long as one for the same sets). A call of one shard runs on the
 coordinator alone and stays serial.
-Usage: scripts/fan-out-projection.py DIR
+Usage: scripts/fan-out-projection.py DIR   (tested by scripts/fan_out_projection_test.py)
 """
 import json
 import re

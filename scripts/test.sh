@@ -28,6 +28,7 @@ start=$(date +%s)
 echo "=== layering (scripts/check-layers.py), code health (scripts/check-code-health.py) and formatting"
 python3 scripts/check-layers.py
 python3 scripts/check_code_health_test.py
+python3 scripts/fan_out_projection_test.py
 python3 scripts/check-code-health.py
 git ls-files '*.h' '*.cc' | xargs clang-format --dry-run --Werror
 echo "clang-format: every tracked .h/.cc file is formatted"
