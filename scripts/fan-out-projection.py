@@ -12,8 +12,8 @@ evaluation, which three hosts as this one split three ways (ideally; or as the s
 busiest lane's share of the shard seconds). The reduction's calls are weighted by their stations
 (the evaluation of the stations is nearly all of the stage). A call of the selection stage's sets
 ("the fine round's sets" of coarse-then-fine candidates, "the local candidates' sets") counts its
-wall time here as its work (three replicas on one host take as long as one for the same sets). A call of one shard runs on the
-coordinator alone and stays serial.
+wall time here as its work (three replicas on one host take as long as one for the same sets). A
+call of one shard runs on the coordinator alone and stays serial.
 Usage: scripts/fan-out-projection.py DIR   (tested by scripts/fan_out_projection_test.py)
 """
 import json

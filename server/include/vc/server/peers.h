@@ -74,7 +74,7 @@ class PeerFanOut {
   // string literal: VisibilitySetsFn).
   Result<DistributedSets> Compute(const SceneRef& ref, const v1::PlanParameters& parameters, const VoxelScene& scene,
                                   const std::vector<WorldPoint>& viewpoints, const VisibilitySetsOptions& options,
-                                  const JobContext& ctx, const char* what = "the visibility stage");
+                                  const JobContext& ctx, const char* what);
 
   // The faces with V > 0 of each of `stations` on `scene`, exactly as vc::Evaluate(scene, stations,
   // options, ctx) with keep_sparse_per_viewpoint_values gives them (the reduction's evaluation);
