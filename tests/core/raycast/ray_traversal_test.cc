@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "testing/test_paths.h"
+#include "vc/raycast/walk.h"
 #include "vc/scene/octomap_adapter.h"
 #include "vc/scene/scene_input.h"
 #include "vc/scene/voxel_scene.h"
@@ -185,6 +186,76 @@ TEST(FirstOccupiedTest, EmptySpaceSkippingMatchesPlainWalkOnSparseScenes) {
     }
   }
   EXPECT_GT(hits, 2000);
+}
+
+// The walk FirstOccupied must be, written plainly: Advance one voxel at a time, and jump
+// (JumpAcrossFreeBrickBox) only on entering an empty brick. At an exact tie after a jump its answer
+// is decided by the jump's rounding (docs/VISIBILITY.md, "Ray traversal and the tie rule"), so an
+// optimisation of FirstOccupied that skips voxels any other way must reproduce this, ties included.
+std::optional<VoxelIndex> FirstOccupiedWithBrickJumpsOnly(const OccupancyGrid& g, const Vector3d& a,
+                                                          const Vector3d& b) {
+  internal::Walk w(a, b);
+  const VoxelIndex& lo = g.min_index();
+  const int lo3[3] = {lo.x, lo.y, lo.z};
+  bool was_inside = false;
+  while (true) {
+    const uint32_t rel[3] = {uint32_t(w.cur[0] - lo3[0]), uint32_t(w.cur[1] - lo3[1]), uint32_t(w.cur[2] - lo3[2])};
+    if (rel[0] < uint32_t(g.dims().x()) && rel[1] < uint32_t(g.dims().y()) && rel[2] < uint32_t(g.dims().z())) {
+      was_inside = true;
+      const uint64_t brick = g.BrickLinear(rel[0] >> 3, rel[1] >> 3, rel[2] >> 3);
+      if (g.BrickSlot(brick) == 0) {
+        if (!internal::JumpAcrossFreeBrickBox(g, brick, rel, lo3, w)) return std::nullopt;
+      } else if (g.Occupied(w.cur[0], w.cur[1], w.cur[2])) {
+        return VoxelIndex{w.cur[0], w.cur[1], w.cur[2]};
+      }
+    } else if (was_inside) {
+      return std::nullopt;
+    }
+    if (w.remaining == 0) return std::nullopt;
+    w.Advance();
+  }
+}
+
+// On terrain with grazing rays (where nearly every step is inside a non-empty brick), walls and
+// clutter, with segments between lattice points and voxel centres (exact ties all along) and random
+// ones, FirstOccupied's answers are the plain walk's above, voxel for voxel. (Stepping across the
+// free layers and cubes of non-empty bricks with n * t_delta jumps fails this at once.)
+TEST(FirstOccupiedTest, IsThePlainWalkWithBrickJumpsTiesIncludedOnTerrain) {
+  std::mt19937_64 rng(37);
+  std::uniform_int_distribution<int> xy(-40, 40), clutter(0, 99), kind(0, 2);
+  std::uniform_real_distribution<double> u(-40, 40), height(0.2, 6.0);
+  int hits = 0, misses = 0;
+  for (int scene = 0; scene < 6; ++scene) {
+    std::vector<VoxelIndex> occ;
+    for (int x = -40; x <= 40; ++x)
+      for (int y = -40; y <= 40; ++y) {
+        const int ground = int(std::floor(1.5 * std::sin(0.11 * x + scene) + 0.04 * y));  // gentle slopes
+        occ.push_back({x, y, ground});
+        if (scene % 2 == 0) occ.push_back({x, y, ground - 1});
+        if (clutter(rng) < 2) occ.push_back({x, y, ground + 1 + clutter(rng) % 5});  // posts, kerbs
+        if (x == 13 && y > -20 && y < 25)
+          for (int z = ground; z < ground + 9; ++z) occ.push_back({x, y, z});  // a wall
+      }
+    auto grid = OccupancyGrid::Build(0.2, occ, 1 << 26);
+    ASSERT_TRUE(grid.ok());
+    for (int r = 0; r < 4000; ++r) {
+      const int k = kind(rng);
+      Vector3d a(xy(rng), xy(rng), 0), b(xy(rng), xy(rng), 0);
+      if (k == 2) a = Vector3d(u(rng), u(rng), 0), b = Vector3d(u(rng), u(rng), 0);
+      if (k == 1) a += Vector3d(0.5, 0.5, 0.0);
+      a.z() = std::round(height(rng) * (k == 2 ? 10 : 1)) / (k == 2 ? 10 : 1) + (k == 1 ? 0.5 : 0.0);
+      b.z() = k == 2 ? u(rng) / 20 : std::floor(u(rng) / 20);  // at or just above the ground: grazing
+      const auto expect = FirstOccupiedWithBrickJumpsOnly(*grid, a, b);
+      const auto got = FirstOccupied(*grid, a, b);
+      ASSERT_EQ(got.has_value(), expect.has_value()) << "scene " << scene << " ray " << r;
+      if (got) {
+        ASSERT_EQ(T(*got), T(*expect)) << "scene " << scene << " ray " << r;
+      }
+      (expect ? hits : misses) += 1;
+    }
+  }
+  EXPECT_GT(hits, 4000);
+  EXPECT_GT(misses, 1000);
 }
 
 // Cross-check against OctoMap's own castRay on the real geb079 map: identical first hits.
