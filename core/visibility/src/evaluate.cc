@@ -316,6 +316,9 @@ Result<Evaluation> EvaluateSampled(const EvaluationJob& job, Evaluation ev) {
 constexpr uint64_t kCornerChunk = 64 * 256;
 constexpr uint64_t kVoxelChunk = 4096;
 constexpr uint64_t kBricksPerTask = 256;
+// See CastRaysToUndecidedCorners: on fr_campus the corner rays' occluders are mostly met far from
+// their corners (ground and walls between tripod and target), on the hall near them.
+constexpr int kGrowOccluderBeyond = 8;
 static_assert(kCornerChunk % kCullBlock == 0 && kVoxelChunk % kCullBlock == 0);
 
 // Exact mode over one job whose voxels are sorted and unique. Per viewpoint: the visible lattice
@@ -541,11 +544,20 @@ Status ExactEvaluation::CastRaysToUndecidedCorners(size_t k, int threads, Work& 
   const std::vector<uint64_t>& corners = lattice_.corners;
   return ParallelChunks(corners.size(), kCornerChunk, threads, job_.ctx, [&](uint64_t, uint64_t b, uint64_t e) {
     OccluderCache cache(job_.shortcuts[k]);
+    // An occluder met more than kGrowOccluderBeyond voxels before its corner is cached as the solid
+    // box grown from it (SurfaceTargets::GrownBox, remembered across viewpoints), which proves more
+    // of the next corners' rays blocked than the voxel alone; one met nearer, as the voxel (growing
+    // those did not pay on the hall). docs/BENCHMARKS.md, "Grown occluders for the corner rays".
+    auto remember = [&](const VoxelIndex& hit, const VoxelIndex& c) {
+      if (cache.Find(hit)) return;
+      const int before = std::max({std::abs(hit.x - c.x), std::abs(hit.y - c.y), std::abs(hit.z - c.z)});
+      cache.Add(before > kGrowOccluderBeyond ? targets_.GrownBox(hit) : internal::SolidBox{hit, hit});
+    };
     for (uint64_t block_begin = b; block_begin < e; block_begin += kCullBlock) {
       if (corner_boxes_.OutOfRange(job_.limits[k], block_begin / kCullBlock)) continue;
       for (uint64_t c = block_begin; c < std::min(block_begin + kCullBlock, e); ++c) {
         if ((w.decided_bits[c >> 6] >> (c & 63)) & 1) continue;
-        if (CornerVisibleCached(job_.g, job_.uo[k], UnpackCorner(corners[c]), cache)) {
+        if (CornerVisibleCached(job_.g, job_.uo[k], UnpackCorner(corners[c]), cache, remember)) {
           w.visible_bits[c >> 6] |= uint64_t{1} << (c & 63);
         }
       }

@@ -84,8 +84,12 @@ inline bool LastLayerBlocksCorner(const OccupancyGrid& g, const Eigen::Vector3d&
   return false;
 }
 
+// Whether corner c is seen from uo (the 8-voxel corner rule), trying the shortcuts first; an
+// occluder a walk meets is handed to remember(hit, c), which may put it (or a box grown from it) in
+// the cache.
+template <typename Remember>
 inline bool CornerVisibleCached(const OccupancyGrid& g, const Eigen::Vector3d& uo, const VoxelIndex& c,
-                                OccluderCache& cache) {
+                                OccluderCache& cache, Remember&& remember) {
   if (cache.enabled() && LastLayerBlocksCorner(g, uo, c)) return false;  // shortcuts hold (occluders.h)
   // Occluders in the 2x2x2 block around c do not count: once a segment enters that (convex)
   // block it stays inside it up to c, so every voxel outside it is visited first.
@@ -95,8 +99,13 @@ inline bool CornerVisibleCached(const OccupancyGrid& g, const Eigen::Vector3d& u
   if (!hit) return true;
   const bool near = (hit->x == c.x || hit->x == c.x - 1) && (hit->y == c.y || hit->y == c.y - 1) &&
                     (hit->z == c.z || hit->z == c.z - 1);
-  if (!near) cache.Add(*hit);
+  if (!near) remember(*hit, c);
   return near;
+}
+
+inline bool CornerVisibleCached(const OccupancyGrid& g, const Eigen::Vector3d& uo, const VoxelIndex& c,
+                                OccluderCache& cache) {
+  return CornerVisibleCached(g, uo, c, cache, [&](const VoxelIndex& hit, const VoxelIndex&) { cache.Add(hit); });
 }
 
 // Corner k (bit 0: +x, bit 1: +y, bit 2: +z) of voxel v.

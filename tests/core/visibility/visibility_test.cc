@@ -421,6 +421,52 @@ TEST(EvaluateTest, AShortRangeGivesTheOraclesValuesAndSparseValuesListThem) {
   EXPECT_GT(beyond, 10000u);  // most of the scene lies out of range
 }
 
+// The corner rays' occluder cache holds the solid box grown from an occluder met more than 8
+// voxels before its corner (evaluate.cc): behind thick blocks and a wall standing on two layers of
+// ground, seen from tripod heights where rays graze the ground, every face still gets the plain
+// oracle's V (a box grown one voxel too far, into free space, fails this).
+TEST(EvaluateTest, GrownOccluderBoxesGiveTheOraclesValuesBehindSolidBlocks) {
+  std::mt19937_64 rng(43);
+  const double r = 0.1;
+  const int extent = 56;
+  std::vector<VoxelIndex> v;
+  for (int x = 0; x < extent; ++x)
+    for (int y = 0; y < extent; ++y) v.push_back({x, y, 0}), v.push_back({x, y, 1});
+  std::uniform_int_distribution<int> at(4, extent - 12), side(3, 8), height(4, 12);
+  for (int b = 0; b < 7; ++b) {
+    const int x0 = at(rng), y0 = at(rng), sx = side(rng), sy = side(rng), h = height(rng);
+    for (int x = x0; x < x0 + sx; ++x)
+      for (int y = y0; y < y0 + sy; ++y)
+        for (int z = 2; z < 2 + h; ++z) v.push_back({x, y, z});
+  }
+  for (int x = 30; x < 32; ++x)
+    for (int y = 8; y < 48; ++y)
+      for (int z = 2; z < 15; ++z) v.push_back({x, y, z});
+  const VoxelScene s = MakeScene(v, r);
+  std::uniform_real_distribution<double> u(0.3, extent - 0.3), z(2.3, 16.0);
+  std::vector<WorldPoint> vps;
+  while (vps.size() < 5) {
+    const Vector3d p(u(rng), u(rng), z(rng));
+    if (!s.grid.Occupied(int(std::floor(p.x())), int(std::floor(p.y())), int(std::floor(p.z())))) vps.push_back(p * r);
+  }
+  EvaluateOptions opt;
+  opt.keep_per_viewpoint_values = true;
+  auto ev = Evaluate(s, vps, opt);
+  ASSERT_TRUE(ev.ok()) << ev.status().ToString();
+  size_t seen = 0, hidden = 0;
+  for (size_t k = 0; k < vps.size(); ++k) {
+    for (size_t slot = 0; slot < ev->per_viewpoint_face_values[k].size(); ++slot) {
+      const VoxelIndex voxel = KeyToIndex(s.occupied[slot / 6]);
+      const double want = PlainFaceValue(s.grid, vps[k], voxel, int(slot % 6));
+      ASSERT_NEAR(ev->per_viewpoint_face_values[k][slot], want, 1e-6)
+          << "viewpoint " << k << " voxel " << slot / 6 << " face " << slot % 6;
+      (want > 0 ? seen : hidden) += 1;
+    }
+  }
+  EXPECT_GT(seen, 3000u);
+  EXPECT_GT(hidden, 10000u);
+}
+
 // With enough viewpoints per thread each thread evaluates whole viewpoints and the threads' best
 // values are merged; with fewer, each viewpoint runs on all threads. Both must give the same
 // figures, bit for bit, as one thread; on the small scene also the brute-force values. The large

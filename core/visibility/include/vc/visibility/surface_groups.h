@@ -88,6 +88,14 @@ class SurfaceTargets {
   void AppendCornerDecisions(const Eigen::Vector3d& uo, const ScannerLimits& limits, size_t brick_begin,
                              size_t brick_end, GroupWalk& walk, std::vector<CornerDecision>& decisions) const;
 
+  // GrowSolidBox(grid_, h, kGrowLimit), remembered across viewpoints and threads: a box depends
+  // only on the grid and h, and the same voxels are hit from many viewpoints (on the hall, 2.1 M
+  // growths come from 133k distinct voxels). A direct-mapped table of 2^box_bits_ slots (about
+  // one per target, at most 2^18: 8 MiB), allocated at the first growth; a slot holds the last
+  // box grown for a voxel that maps to it, and is read and written under its shard's lock. Public
+  // for the exact evaluation's corner rays (evaluate.cc), which cache far occluders grown.
+  SolidBox GrownBox(const VoxelIndex& h) const;
+
  private:
   struct Target {
     uint32_t id;
@@ -104,13 +112,6 @@ class SurfaceTargets {
   struct CornerKind;
   template <typename Kind>
   void WalkGroups(const Eigen::Vector3d& uo, const Brick& brick, GroupWalk& walk, Kind& kind) const;
-
-  // GrowSolidBox(grid_, h, kGrowLimit), remembered across viewpoints and threads: a box depends
-  // only on the grid and h, and the same voxels are hit from many viewpoints (on the hall, 2.1 M
-  // growths come from 133k distinct voxels). A direct-mapped table of 2^box_bits_ slots (about
-  // one per target, at most 2^18: 8 MiB), allocated at the first growth; a slot holds the last
-  // box grown for a voxel that maps to it, and is read and written under its shard's lock.
-  SolidBox GrownBox(const VoxelIndex& h) const;
 
   const OccupancyGrid& grid_;
   std::vector<Target> targets_;
