@@ -549,9 +549,12 @@ Status ExactEvaluation::CastRaysToUndecidedCorners(size_t k, int threads, Work& 
     // of the next corners' rays blocked than the voxel alone; one met nearer, as the voxel (growing
     // those did not pay on the hall). docs/BENCHMARKS.md, "Grown occluders for the corner rays".
     auto remember = [&](const VoxelIndex& hit, const VoxelIndex& c) {
-      if (cache.Find(hit)) return;
       const int before = std::max({std::abs(hit.x - c.x), std::abs(hit.y - c.y), std::abs(hit.z - c.z)});
-      cache.Add(before > kGrowOccluderBeyond ? targets_.GrownBox(hit) : internal::SolidBox{hit, hit});
+      if (before <= kGrowOccluderBeyond) {
+        cache.Add(hit);  // the voxel, unless a cached box holds it
+      } else if (!cache.Find(hit)) {
+        cache.Add(targets_.GrownBox(hit));
+      }
     };
     for (uint64_t block_begin = b; block_begin < e; block_begin += kCullBlock) {
       if (corner_boxes_.OutOfRange(job_.limits[k], block_begin / kCullBlock)) continue;
