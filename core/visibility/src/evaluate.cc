@@ -319,6 +319,22 @@ constexpr uint64_t kBricksPerTask = 256;
 // See CastRaysToUndecidedCorners: on fr_campus the corner rays' occluders are mostly met far from
 // their corners (ground and walls between tripod and target), on the hall near them.
 constexpr int kGrowOccluderBeyond = 8;
+
+// The corner rays' cache: the last few occluders (OccluderCache), then the far ones indexed by their
+// direction from the viewpoint (DirectionalOccluders), which outlive the small cache.
+struct CornerRayCache {
+  OccluderCache recent;
+  internal::DirectionalOccluders far;
+  CornerRayCache(bool enabled, const Vector3d& viewpoint) : recent(enabled), far(viewpoint) {}
+  bool enabled() const { return recent.enabled(); }
+  bool Blocks(const Vector3d& a, const Vector3d& b, const VoxelIndex& keep_lo, const VoxelIndex& keep_hi) {
+    return recent.Blocks(a, b, keep_lo, keep_hi) || (recent.enabled() && far.Blocks(b, keep_lo, keep_hi));
+  }
+  void AddFar(const internal::SolidBox& box) {
+    recent.Add(box);
+    if (recent.enabled()) far.Add(box);
+  }
+};
 static_assert(kCornerChunk % kCullBlock == 0 && kVoxelChunk % kCullBlock == 0);
 
 // Exact mode over one job whose voxels are sorted and unique. Per viewpoint: the visible lattice
@@ -543,17 +559,18 @@ Status ExactEvaluation::DecideCornersByGroups(size_t k, int threads, Work& w) co
 Status ExactEvaluation::CastRaysToUndecidedCorners(size_t k, int threads, Work& w) const {
   const std::vector<uint64_t>& corners = lattice_.corners;
   return ParallelChunks(corners.size(), kCornerChunk, threads, job_.ctx, [&](uint64_t, uint64_t b, uint64_t e) {
-    OccluderCache cache(job_.shortcuts[k]);
+    CornerRayCache cache(job_.shortcuts[k], job_.uo[k]);
     // An occluder met more than kGrowOccluderBeyond voxels before its corner is cached as the solid
     // box grown from it (SurfaceTargets::GrownBox, remembered across viewpoints), which proves more
-    // of the next corners' rays blocked than the voxel alone; one met nearer, as the voxel (growing
-    // those did not pay on the hall). docs/BENCHMARKS.md, "Grown occluders for the corner rays".
+    // of the next corners' rays blocked than the voxel alone, and indexed by its direction; one met
+    // nearer, as the voxel (growing those did not pay on the hall). docs/BENCHMARKS.md, "Grown
+    // occluders for the corner rays" and "A directional index of far occluders".
     auto remember = [&](const VoxelIndex& hit, const VoxelIndex& c) {
       const int before = std::max({std::abs(hit.x - c.x), std::abs(hit.y - c.y), std::abs(hit.z - c.z)});
       if (before <= kGrowOccluderBeyond) {
-        cache.Add(hit);  // the voxel, unless a cached box holds it
-      } else if (!cache.Find(hit)) {
-        cache.Add(targets_.GrownBox(hit));
+        cache.recent.Add(hit);  // the voxel, unless a cached box holds it
+      } else if (!cache.recent.Find(hit)) {
+        cache.AddFar(targets_.GrownBox(hit));
       }
     };
     for (uint64_t block_begin = b; block_begin < e; block_begin += kCullBlock) {

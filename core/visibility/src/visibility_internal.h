@@ -87,9 +87,10 @@ inline bool LastLayerBlocksCorner(const OccupancyGrid& g, const Eigen::Vector3d&
 // Whether corner c is seen from uo (the 8-voxel corner rule), trying the shortcuts first; an
 // occluder a walk meets is handed to remember(hit, c), which may put it (or a box grown from it) in
 // the cache.
-template <typename Remember>
-inline bool CornerVisibleCached(const OccupancyGrid& g, const Eigen::Vector3d& uo, const VoxelIndex& c,
-                                OccluderCache& cache, Remember&& remember) {
+// Cache: OccluderCache, or anything with its enabled() and Blocks(a, b, keep_lo, keep_hi).
+template <typename Cache, typename Remember>
+inline bool CornerVisibleCached(const OccupancyGrid& g, const Eigen::Vector3d& uo, const VoxelIndex& c, Cache& cache,
+                                Remember&& remember) {
   if (cache.enabled() && LastLayerBlocksCorner(g, uo, c)) return false;  // shortcuts hold (occluders.h)
   // Occluders in the 2x2x2 block around c do not count: once a segment enters that (convex)
   // block it stays inside it up to c, so every voxel outside it is visited first.

@@ -8,6 +8,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <vector>
 
 #include "vc/scene/occupancy_grid.h"
 
@@ -178,6 +180,89 @@ class OccluderCache {
   SolidBox boxes_[kSize];
   bool enabled_ = true;
   int count_ = 0;
+};
+
+// Far occluders indexed by their direction from one viewpoint, for rays to many targets spread
+// around it: a cube map of 6 x kBins x kBins bins, each holding the kPerBin latest boxes registered
+// in it. A box is registered in the bins of the rectangle its 8 corners project to on one face of
+// the cube (a box spanning two faces or more than kMaxBinsPerBox bins is not registered). Blocks(b)
+// tests the boxes of the bin that b's direction falls in. The index only proposes boxes: each is
+// tested as OccluderCache tests its own (PassesThroughInterior, outside the keep box), so an index
+// that missed or held any box would still give the walk's answer. It catches what the small LRU
+// cache has dropped: the boxes behind which a whole region of targets lies, met again when the
+// targets' order comes back to that direction (docs/BENCHMARKS.md, "A directional index of far
+// occluders"). The bins are allocated at the first box (192 KiB), so a task that meets no far
+// occluder pays nothing.
+class DirectionalOccluders {
+ public:
+  static constexpr int kBins = 64, kPerBin = 2, kMaxBinsPerBox = 64;
+
+  explicit DirectionalOccluders(const Eigen::Vector3d& viewpoint) : viewpoint_(viewpoint) {}
+
+  // True if segment viewpoint->b provably passes through an indexed box that contains no voxel of
+  // the box [keep_lo, keep_hi].
+  bool Blocks(const Eigen::Vector3d& b, const VoxelIndex& keep_lo, const VoxelIndex& keep_hi) const {
+    if (boxes_.empty()) return false;
+    const Segment seg(viewpoint_, b);
+    return FindIf(b, [&](const SolidBox& box) {
+             return !box.Overlaps(keep_lo, keep_hi) && PassesThroughInterior(seg, box);
+           }) != nullptr;
+  }
+  // A box of the bin that point p's direction from the viewpoint falls in for which pred(box)
+  // holds, or nullptr.
+  template <typename Pred>
+  const SolidBox* FindIf(const Eigen::Vector3d& p, Pred&& pred) const {
+    if (boxes_.empty()) return nullptr;
+    int face, iu, iv;
+    if (!Bin(p - viewpoint_, face, iu, iv)) return nullptr;
+    const int32_t* slot = &slots_[SlotIndex(face, iu, iv)];
+    for (int j = 0; j < kPerBin && slot[j] >= 0; ++j) {
+      const SolidBox& box = boxes_[size_t(slot[j])];
+      if (pred(box)) return &box;
+    }
+    return nullptr;
+  }
+
+  void Add(const SolidBox& box) {
+    int face0 = -1, u0 = kBins, u1 = -1, v0 = kBins, v1 = -1;
+    for (int q = 0; q < 8; ++q) {
+      const Eigen::Vector3d p(q & 1 ? box.hi.x + 1 : box.lo.x, q & 2 ? box.hi.y + 1 : box.lo.y,
+                              q & 4 ? box.hi.z + 1 : box.lo.z);
+      int face, iu, iv;
+      if (!Bin(p - viewpoint_, face, iu, iv) || (face0 >= 0 && face != face0)) return;
+      face0 = face;
+      u0 = std::min(u0, iu), u1 = std::max(u1, iu), v0 = std::min(v0, iv), v1 = std::max(v1, iv);
+    }
+    if ((u1 - u0 + 1) * (v1 - v0 + 1) > kMaxBinsPerBox || boxes_.size() >= size_t(INT32_MAX)) return;
+    if (slots_.empty()) slots_.assign(size_t(6) * kBins * kBins * kPerBin, -1);
+    const auto id = int32_t(boxes_.size());
+    boxes_.push_back(box);
+    for (int iu = u0; iu <= u1; ++iu) {
+      for (int iv = v0; iv <= v1; ++iv) {
+        int32_t* slot = &slots_[SlotIndex(face0, iu, iv)];
+        std::copy_backward(slot, slot + kPerBin - 1, slot + kPerBin);
+        slot[0] = id;
+      }
+    }
+  }
+
+ private:
+  static size_t SlotIndex(int face, int iu, int iv) { return size_t((face * kBins + iu) * kBins + iv) * kPerBin; }
+  // The cube face (2 * axis + positive) that direction d leaves through, and its bin there.
+  static bool Bin(const Eigen::Vector3d& d, int& face, int& iu, int& iv) {
+    const Eigen::Vector3d a = d.cwiseAbs();
+    const int m = a.x() >= a.y() && a.x() >= a.z() ? 0 : a.y() >= a.z() ? 1 : 2;
+    if (!(a[m] > 0)) return false;
+    face = 2 * m + (d[m] > 0);
+    const double u = d[(m + 1) % 3] / a[m], v = d[(m + 2) % 3] / a[m];
+    iu = std::clamp(int((u + 1) * 0.5 * kBins), 0, kBins - 1);
+    iv = std::clamp(int((v + 1) * 0.5 * kBins), 0, kBins - 1);
+    return true;
+  }
+
+  Eigen::Vector3d viewpoint_;
+  std::vector<int32_t> slots_;  // per bin, kPerBin box ids, the latest first; -1: none
+  std::vector<SolidBox> boxes_;
 };
 
 }  // namespace vc::internal
