@@ -321,11 +321,12 @@ constexpr uint64_t kBricksPerTask = 256;
 constexpr int kGrowOccluderBeyond = 8;
 
 // The corner rays' cache: the last few occluders (OccluderCache), then the far ones indexed by their
-// direction from the viewpoint (DirectionalOccluders), which outlive the small cache.
+// direction from the viewpoint (DirectionalOccluders), which outlive the small cache (and serve
+// these rays better than the cache's dropped boxes, which it therefore does not keep).
 struct CornerRayCache {
   OccluderCache recent;
   internal::DirectionalOccluders far;
-  CornerRayCache(bool enabled, const Vector3d& viewpoint) : recent(enabled), far(viewpoint) {}
+  CornerRayCache(bool enabled, const Vector3d& viewpoint) : recent(enabled, /*keep_dropped=*/false), far(viewpoint) {}
   bool enabled() const { return recent.enabled(); }
   bool Blocks(const Vector3d& a, const Vector3d& b, const VoxelIndex& keep_lo, const VoxelIndex& keep_hi) {
     return recent.Blocks(a, b, keep_lo, keep_hi) || (recent.enabled() && far.Blocks(b, keep_lo, keep_hi));

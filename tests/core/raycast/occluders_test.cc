@@ -220,6 +220,79 @@ TEST(OccluderCacheTest, KeepsTheFourMostRecentlyUsedBoxes) {
   EXPECT_EQ(T(found->lo), T(VoxelIndex{2, 0, 0}));
 }
 
+// The 4 boxes the cache dropped last still prove segments blocked (Blocks alone tries them), and a
+// box that does goes back to the front; FindIf and Find see only the 4 in the cache; a cache made
+// with keep_dropped false forgets them.
+TEST(OccluderCacheTest, BlocksAlsoTriesTheFourBoxesDroppedLast) {
+  auto wall = [](int x) { return SolidBox{{x, 0, 0}, {x, 3, 3}}; };  // crosses y = z = 1.5 at x..x+1
+  auto through = [](int x) { return std::pair{Vector3d(x - 5.0, 1.5, 1.5), Vector3d(x + 5.0, 1.5, 1.5)}; };
+  OccluderCache cache, forgetful(true, /*keep_dropped=*/false);
+  for (int k = 0; k < 8; ++k) {
+    cache.Add(wall(20 * k));
+    forgetful.Add(wall(20 * k));
+  }
+  // Walls 0..3 (x = 0, 20, 40, 60) were dropped, the oldest first.
+  for (int k = 0; k < 4; ++k) {
+    EXPECT_EQ(cache.Find(VoxelIndex{20 * k, 1, 1}), nullptr) << k;
+    const auto [a, b] = through(20 * k);
+    const VoxelIndex end{20 * k + 5, 1, 1};
+    EXPECT_FALSE(forgetful.Blocks(a, b, end)) << k;
+    EXPECT_FALSE(cache.Blocks(a, b, VoxelIndex{20 * k, 1, 1})) << "the kept voxel is inside the dropped box";
+  }
+  const auto [a2, b2] = through(40);
+  EXPECT_TRUE(cache.Blocks(a2, b2, VoxelIndex{45, 1, 1}));
+  ASSERT_NE(cache.Find(VoxelIndex{40, 1, 1}), nullptr) << "wall 2 is back in the cache";
+  // It pushed out the least recently used box (wall 4), which is now one of the dropped ones.
+  EXPECT_EQ(cache.Find(VoxelIndex{80, 1, 1}), nullptr);
+  const auto [a4, b4] = through(80);
+  EXPECT_TRUE(cache.Blocks(a4, b4, VoxelIndex{85, 1, 1}));
+  // A segment along an axis plane of a dropped box (an axis with no extent: inv = 0) proves
+  // nothing unless it runs inside the box by the margin.
+  const auto [a1, b1] = through(20);
+  EXPECT_TRUE(cache.Blocks(a1, b1, VoxelIndex{25, 1, 1}));
+  EXPECT_FALSE(cache.Blocks(Vector3d(55, 0.0, 1.5), Vector3d(65, 0.0, 1.5), VoxelIndex{65, 0, 1}))
+      << "on the face y = 0 of wall 3";
+  // A segment that enters a dropped box within the margin of its start proves nothing.
+  EXPECT_FALSE(cache.Blocks(Vector3d(60 - 5e-6, 1.5, 1.5), Vector3d(70, 1.5, 1.5), VoxelIndex{70, 1, 1}));
+  EXPECT_TRUE(cache.Blocks(Vector3d(59.9, 1.5, 1.5), Vector3d(70, 1.5, 1.5), VoxelIndex{70, 1, 1}));
+}
+
+// The dropped boxes' test is PassesThroughInterior's, box for box: on random boxes and segments
+// (a third of them along an axis), a cache of 8 boxes (4 kept, 4 dropped) proves a segment blocked
+// exactly when one of the 8 does by PassesThroughInterior outside the keep box.
+TEST(OccluderCacheTest, TheDroppedBoxesTestIsPassesThroughInteriors) {
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> u(-12, 14);
+  std::uniform_int_distribution<int> axis_pick(0, 2), lattice(-12, 14);
+  int blocked = 0;
+  for (int trial = 0; trial < 400; ++trial) {
+    OccluderCache cache;
+    std::vector<SolidBox> boxes;
+    for (int k = 0; k < 8; ++k) {
+      boxes.push_back(RandomBox(rng, 8, 6));
+      cache.Add(boxes.back());
+    }
+    for (int n = 0; n < 50; ++n) {
+      Vector3d a(u(rng), u(rng), u(rng)), b(u(rng), u(rng), u(rng));
+      if (n % 3 == 0) {  // along an axis, on a lattice plane or a voxel's middle
+        const int ax = axis_pick(rng);
+        for (int i = 0; i < 3; ++i) {
+          if (i != ax) b[i] = a[i] = lattice(rng) + (n % 2 ? 0.5 : 0.0);
+        }
+      }
+      const VoxelIndex keep{int(std::floor(b.x())), int(std::floor(b.y())), int(std::floor(b.z()))};
+      const Segment seg(a, b);
+      bool expected = false;
+      for (const SolidBox& box : boxes)
+        expected = expected || (!box.Overlaps(keep, keep) && PassesThroughInterior(seg, box));
+      OccluderCache copy = cache;  // Blocks reorders the cache
+      ASSERT_EQ(copy.Blocks(a, b, keep), expected) << "trial " << trial << " segment " << n;
+      blocked += expected;
+    }
+  }
+  EXPECT_GT(blocked, 1000);
+}
+
 // The property the visibility engine relies on: whenever the cache says a segment is blocked, the
 // exact walk (FirstOccupied with the kept voxel transparent) meets an occupied voxel.
 TEST(OccluderCacheTest, ABlockedSegmentAlwaysMeetsAnOccupiedVoxel) {
@@ -230,7 +303,7 @@ TEST(OccluderCacheTest, ABlockedSegmentAlwaysMeetsAnOccupiedVoxel) {
     const SolidScene s = RandomSolidScene(rng, 12);
     std::uniform_int_distribution<size_t> pick(0, s.voxels.size() - 1);
     OccluderCache cache;
-    for (int k = 0; k < 4; ++k) cache.Add(GrowSolidBox(s.grid, s.voxels[pick(rng)], 16));
+    for (int k = 0; k < 8; ++k) cache.Add(GrowSolidBox(s.grid, s.voxels[pick(rng)], 16));  // 4 kept, 4 dropped
     for (int n = 0; n < 6000; ++n) {
       const Vector3d a(u(rng), u(rng), u(rng));
       const VoxelIndex target = s.voxels[pick(rng)];
