@@ -328,8 +328,9 @@ struct CornerRayCache {
   internal::DirectionalOccluders far;
   CornerRayCache(bool enabled, const Vector3d& viewpoint) : recent(enabled, /*keep_dropped=*/false), far(viewpoint) {}
   bool enabled() const { return recent.enabled(); }
+  // `far` holds nothing when the cache is disabled (AddFar), so it proves nothing then either.
   bool Blocks(const Vector3d& a, const Vector3d& b, const VoxelIndex& keep_lo, const VoxelIndex& keep_hi) {
-    return recent.Blocks(a, b, keep_lo, keep_hi) || (recent.enabled() && far.Blocks(b, keep_lo, keep_hi));
+    return recent.Blocks(a, b, keep_lo, keep_hi) || far.Blocks(b, keep_lo, keep_hi);
   }
   void AddFar(const internal::SolidBox& box) {
     recent.Add(box);

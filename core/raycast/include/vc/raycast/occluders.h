@@ -279,24 +279,16 @@ class DirectionalOccluders {
   // the box [keep_lo, keep_hi].
   bool Blocks(const Eigen::Vector3d& b, const VoxelIndex& keep_lo, const VoxelIndex& keep_hi) const {
     if (boxes_.empty()) return false;
-    const Segment seg(viewpoint_, b);
-    return FindIf(b, [&](const SolidBox& box) {
-             return !box.Overlaps(keep_lo, keep_hi) && PassesThroughInterior(seg, box);
-           }) != nullptr;
-  }
-  // A box of the bin that point p's direction from the viewpoint falls in for which pred(box)
-  // holds, or nullptr.
-  template <typename Pred>
-  const SolidBox* FindIf(const Eigen::Vector3d& p, Pred&& pred) const {
-    if (boxes_.empty()) return nullptr;
     int face, iu, iv;
-    if (!Bin(p - viewpoint_, face, iu, iv)) return nullptr;
+    if (!Bin(b - viewpoint_, face, iu, iv)) return false;
     const int32_t* slot = &slots_[SlotIndex(face, iu, iv)];
+    if (slot[0] < 0) return false;
+    const Segment seg(viewpoint_, b);
     for (int j = 0; j < kPerBin && slot[j] >= 0; ++j) {
       const SolidBox& box = boxes_[size_t(slot[j])];
-      if (pred(box)) return &box;
+      if (!box.Overlaps(keep_lo, keep_hi) && PassesThroughInterior(seg, box)) return true;
     }
-    return nullptr;
+    return false;
   }
 
   void Add(const SolidBox& box) {
