@@ -19,6 +19,7 @@
 #include "vc/base/huge_pages.h"
 #include "vc/base/parallel.h"
 #include "vc/raycast/occluders.h"
+#include "vc/visibility/corner_order.h"
 #include "vc/visibility/surface_groups.h"
 #include "vc/visibility/visibility.h"
 #include "visibility_internal.h"
@@ -170,10 +171,10 @@ EvaluationJob Prepare(const VoxelScene& scene, const std::vector<WorldPoint>& vi
   return job;
 }
 
-// Bounding boxes (index space) of consecutive blocks of kCullBlock points (corners or voxels, in
-// their sorted order: a block is a short run of rows), for skipping what no face centre in the
-// scanner's range and horizontal field of view needs (ScannerLimits::BoxVerdict): outside them V
-// is 0 whatever is seen.
+// Bounding boxes (index space) of consecutive blocks of kCullBlock points (voxels in their sorted
+// order: a short run of rows; corners in the rays' brick order: part of a brick, or a few), for
+// skipping what no face centre in the scanner's range and horizontal field of view needs
+// (ScannerLimits::BoxVerdict): outside them V is 0 whatever is seen.
 constexpr uint64_t kCullBlock = 256;
 struct BlockBoxes {
   std::vector<Vector3d> lo, hi;
@@ -412,6 +413,8 @@ class ExactEvaluation {
   // within 1 (per axis) of each of its corners: a block of voxels whose cubes, or of corners whose
   // boxes [c - 1, c + 1], are all out of range holds nothing that changes a face's V (> 0), so it
   // is skipped; skipped corners count as unseen, which only faces out of range could notice.
+  // The corner rays' order (internal::CornersByBrick); corner_boxes_'s blocks are runs of it.
+  const std::vector<uint32_t> corner_order_;
   const BlockBoxes corner_boxes_;
   const BlockBoxes voxel_boxes_;
   const uint64_t voxel_chunks_;
@@ -431,8 +434,10 @@ ExactEvaluation::ExactEvaluation(const EvaluationJob& job, LatticeCorners lattic
       lattice_(std::move(lattice)),
       ev_(std::move(ev)),
       faces_in_set_(FacesInSetMask(job.g, job.index, job.options.faces)),
+      corner_order_(internal::CornersByBrick(lattice_.corners.size(),
+                                             [&](size_t c) { return UnpackCorner(lattice_.corners[c]); })),
       corner_boxes_(
-          lattice_.corners.size(), [&](size_t c) { return UnpackCorner(lattice_.corners[c]); }, 1.0, 1.0),
+          corner_order_.size(), [&](size_t i) { return UnpackCorner(lattice_.corners[corner_order_[i]]); }, 1.0, 1.0),
       voxel_boxes_(
           job.n, [&](size_t i) { return job.index[i]; }, 0.0, 1.0),
       voxel_chunks_((job.n + kVoxelChunk - 1) / kVoxelChunk),
@@ -560,6 +565,9 @@ Status ExactEvaluation::DecideCornersByGroups(size_t k, int threads, Work& w) co
 
 Status ExactEvaluation::CastRaysToUndecidedCorners(size_t k, int threads, Work& w) const {
   const std::vector<uint64_t>& corners = lattice_.corners;
+  // Tasks take runs of the brick order, whose corners share words of the bitset with other tasks'.
+  const internal::BitWriter visible_out{
+      w.visible_bits.data(), ResolveThreads(threads, (corners.size() + kCornerChunk - 1) / kCornerChunk) > 1};
   return ParallelChunks(corners.size(), kCornerChunk, threads, job_.ctx, [&](uint64_t, uint64_t b, uint64_t e) {
     CornerRayCache cache(job_.shortcuts[k], job_.uo[k]);
     // An occluder met more than kGrowOccluderBeyond voxels before its corner is cached as the solid
@@ -577,11 +585,10 @@ Status ExactEvaluation::CastRaysToUndecidedCorners(size_t k, int threads, Work& 
     };
     for (uint64_t block_begin = b; block_begin < e; block_begin += kCullBlock) {
       if (corner_boxes_.OutOfRange(job_.limits[k], block_begin / kCullBlock)) continue;
-      for (uint64_t c = block_begin; c < std::min(block_begin + kCullBlock, e); ++c) {
+      for (uint64_t i = block_begin; i < std::min(block_begin + kCullBlock, e); ++i) {
+        const uint32_t c = corner_order_[i];
         if ((w.decided_bits[c >> 6] >> (c & 63)) & 1) continue;
-        if (CornerVisibleCached(job_.g, job_.uo[k], UnpackCorner(corners[c]), cache, remember)) {
-          w.visible_bits[c >> 6] |= uint64_t{1} << (c & 63);
-        }
+        if (CornerVisibleCached(job_.g, job_.uo[k], UnpackCorner(corners[c]), cache, remember)) visible_out.Set(c);
       }
     }
   });

@@ -892,13 +892,13 @@ TEST(PlannerTest, ReductionJoinsTheReplicasValuesIntoTheFinalEvaluation) {
   expect_same_evaluation(*tight, "tight budget");
 }
 
-// The reduction's table (the top-3 table, 144 bytes a voxel, and an evaluation's working set, 122)
+// The reduction's table (the top-3 table, 144 bytes a voxel, and an evaluation's working set, 134)
 // and the joined evaluation are charged to three quarters of the budget; the cache keeps its quarter
 // (at most 1 GiB) either way.
 TEST(PlannerTest, ReductionMemoryChargesTheTableAndTheJoinToThreeQuartersOfTheBudget) {
   EXPECT_EQ(planner::ReductionJoinBytes(1000), 2 * 1000 * (6 * (8 + 1 + 4) + 4));
-  EXPECT_EQ(planner::EvaluateWorkingBytes(1000), 1000 * (12 + 32 + 24 + 6 * 9));
-  EXPECT_EQ(planner::ReductionTableBytes(1000), 1000 * (6 * 24 + 122));
+  EXPECT_EQ(planner::EvaluateWorkingBytes(1000), 1000 * (12 + 32 + 24 + 12 + 6 * 9));
+  EXPECT_EQ(planner::ReductionTableBytes(1000), 1000 * (6 * 24 + 134));
   const uint64_t table = planner::ReductionTableBytes(1000), join = planner::ReductionJoinBytes(1000);
   const uint64_t with_join = planner::ReductionJoinBudgetBytes(1000);
   EXPECT_GE(with_join / 4 * 3, table + join);
@@ -918,13 +918,13 @@ TEST(PlannerTest, ReductionMemoryChargesTheTableAndTheJoinToThreeQuartersOfTheBu
   m = planner::ReductionMemoryFor(1000, kDefaultMemoryBudgetBytes);
   EXPECT_TRUE(m.keep_join);
   EXPECT_EQ(m.cache_bytes, uint64_t{1} << 30);
-  // The default budget keeps the join up to 7.49 M voxels (3 GiB / 430 bytes), the 4 x 4 tiled
-  // hall's 6.78 M among them, and holds the table up to 12.1 M (3 GiB / 266 bytes).
+  // The default budget keeps the join up to 7.28 M voxels (3 GiB / 442 bytes), the 4 x 4 tiled
+  // hall's 6.78 M among them, and holds the table up to 11.58 M (3 GiB / 278 bytes).
   EXPECT_TRUE(planner::ReductionMemoryFor(6'780'000, kDefaultMemoryBudgetBytes).keep_join);
-  EXPECT_TRUE(planner::ReductionMemoryFor(7'490'000, kDefaultMemoryBudgetBytes).keep_join);
-  EXPECT_FALSE(planner::ReductionMemoryFor(7'500'000, kDefaultMemoryBudgetBytes).keep_join);
-  EXPECT_TRUE(planner::ReductionMemoryFor(12'100'000, kDefaultMemoryBudgetBytes).table_fits);
-  EXPECT_FALSE(planner::ReductionMemoryFor(12'200'000, kDefaultMemoryBudgetBytes).table_fits);
+  EXPECT_TRUE(planner::ReductionMemoryFor(7'280'000, kDefaultMemoryBudgetBytes).keep_join);
+  EXPECT_FALSE(planner::ReductionMemoryFor(7'290'000, kDefaultMemoryBudgetBytes).keep_join);
+  EXPECT_TRUE(planner::ReductionMemoryFor(11'580'000, kDefaultMemoryBudgetBytes).table_fits);
+  EXPECT_FALSE(planner::ReductionMemoryFor(11'590'000, kDefaultMemoryBudgetBytes).table_fits);
 }
 
 // Below the budget that holds the reduction's table the stage refuses before allocating it, naming
@@ -966,7 +966,7 @@ TEST(PlannerTest, EvaluationRefusesWhenItsEvaluationDoesNotFitTheBudget) {
   Result<PlanResult> one = Plan(Synthetic("comb:5"), o);
   ASSERT_TRUE(one.ok()) << one.status().ToString();
   const uint64_t need = planner::EvaluationStageBytes(one->occupied_voxels, one->stations.size(), o.threads);
-  EXPECT_GE(need, one->occupied_voxels * (122 + 4 + 24 + 24));
+  EXPECT_GE(need, one->occupied_voxels * (134 + 4 + 24 + 24));
   o.memory_budget_bytes = need - 1;
   Result<PlanResult> refused = Plan(Synthetic("comb:5"), o);
   ASSERT_FALSE(refused.ok());

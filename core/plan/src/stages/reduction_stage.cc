@@ -24,7 +24,7 @@ uint64_t ReductionJoinBytes(uint64_t voxels) {
 }
 
 uint64_t EvaluateWorkingBytes(uint64_t voxels) {
-  const uint64_t per_voxel = sizeof(VoxelIndex) + 8 * sizeof(uint32_t) + 3 * sizeof(uint64_t) +
+  const uint64_t per_voxel = sizeof(VoxelIndex) + 8 * sizeof(uint32_t) + 3 * (sizeof(uint64_t) + sizeof(uint32_t)) +
                              kFacesPerVoxel * (sizeof(double) + sizeof(uint8_t));
   return voxels * per_voxel;
 }

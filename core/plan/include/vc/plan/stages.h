@@ -280,11 +280,12 @@ inline constexpr int kReductionStationsPerBatch = 256;
 [[nodiscard]] uint64_t ReductionJoinBytes(uint64_t voxels);
 // The bytes of an Evaluate call's working set on a scene of `voxels` voxels, whatever the stations:
 // the voxels' lattice indices (12 bytes a voxel), their corners (8 ids of 4 bytes, and about 3
-// distinct corners of 8 bytes a voxel) and each face's best V and perception (9 bytes a face).
+// distinct corners a voxel, each 8 bytes and 4 for its place in the rays' order) and each face's
+// best V and perception (9 bytes a face): 134 bytes a voxel.
 [[nodiscard]] uint64_t EvaluateWorkingBytes(uint64_t voxels);
 // What the reduction holds whatever it keeps: the top-3 table (one FaceTop3, 24 bytes a face,
 // vc/plan/reduction.h) and the working set of the Evaluate call of a batch (EvaluateWorkingBytes):
-// 266 bytes a voxel.
+// 278 bytes a voxel.
 [[nodiscard]] uint64_t ReductionTableBytes(uint64_t voxels);
 // The reduction's shares of the memory budget (docs/PLANNING.md, "Memory, stage by stage"): the
 // cache of the stations' values, a quarter (at most 1 GiB, as before); the table and the joined
@@ -322,7 +323,7 @@ struct EvaluationOutput {
   std::vector<std::string> warnings;      // for PlanResult::warnings, in order
 };
 // The bytes the evaluation stage holds at its peak when it evaluates `stations` final stations on
-// a scene of `voxels` voxels with `threads` threads (0 = all): EvaluateWorkingBytes (122 bytes a
+// a scene of `voxels` voxels with `threads` threads (0 = all): EvaluateWorkingBytes (134 bytes a
 // voxel), the sole viewers (4) and the face values out (24), the voxels' centres (24); each extra
 // thread's best values and sole viewers (58 bytes a voxel) while they stay within the 256 MiB
 // vc::Evaluate allows them. Charged to the whole budget (no other stage's structure is held then).
