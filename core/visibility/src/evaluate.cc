@@ -19,7 +19,7 @@
 #include "vc/base/huge_pages.h"
 #include "vc/base/parallel.h"
 #include "vc/raycast/occluders.h"
-#include "vc/visibility/corner_order.h"
+#include "vc/visibility/spatial_order.h"
 #include "vc/visibility/surface_groups.h"
 #include "vc/visibility/visibility.h"
 #include "visibility_internal.h"

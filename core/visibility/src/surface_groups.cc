@@ -30,6 +30,7 @@
 
 #include "vc/raycast/ray_traversal.h"
 #include "vc/raycast/walk.h"
+#include "vc/visibility/spatial_order.h"
 
 namespace vc::internal {
 namespace {
@@ -317,12 +318,14 @@ SurfaceTargets::SurfaceTargets(const OccupancyGrid& grid, const std::vector<Voxe
                                const std::vector<uint32_t>& ids)
     : grid_(grid) {
   const VoxelIndex& m = grid.min_index();
+  // Bricks along the 3-D Z-order curve: a task's run of bricks is a compact block of the scene,
+  // where its occluder cache serves (docs/BENCHMARKS.md, "Corner rays brick by brick").
   std::vector<std::pair<uint64_t, uint32_t>> keyed;
   keyed.reserve(ids.size());
   for (uint32_t id : ids) {
     const VoxelIndex& v = index[id];
     const uint32_t rx = uint32_t(v.x - m.x), ry = uint32_t(v.y - m.y), rz = uint32_t(v.z - m.z);
-    keyed.emplace_back(grid.BrickLinear(rx >> 3, ry >> 3, rz >> 3), id);
+    keyed.emplace_back(ZOrder3(rx >> 3, ry >> 3, rz >> 3), id);
   }
   std::sort(keyed.begin(), keyed.end());
   targets_.reserve(keyed.size());

@@ -1,6 +1,7 @@
-// Internal to vc_core: the order in which the exact evaluation's corner rays take the lattice
-// corners (evaluate.cc). Any order gives the same answers; this one makes consecutive rays go to
-// neighbouring corners, which is what the occluder caches and the grid's memory reward.
+// Internal to vc_core: the orders in which the visibility engine takes bricks of targets
+// (surface_groups.cc) and the exact evaluation's corner rays take the lattice corners
+// (evaluate.cc). Any order gives the same answers; these make consecutive work go to neighbouring
+// places, which is what the occluder caches and the grid's memory reward.
 #pragma once
 
 #include <algorithm>
@@ -14,14 +15,30 @@
 
 namespace vc::internal {
 
-// The bits of x (< 2^32) spread to the even bit positions: interleaving two such gives the
-// Z-order (Morton) code of a pair.
-inline uint64_t SpreadBits(uint64_t x) {
+// The bits of x (< 2^32) spread to the even bit positions.
+inline uint64_t SpreadBits2(uint64_t x) {
   x = (x | x << 16) & 0x0000ffff0000ffffull;
   x = (x | x << 8) & 0x00ff00ff00ff00ffull;
   x = (x | x << 4) & 0x0f0f0f0f0f0f0f0full;
   x = (x | x << 2) & 0x3333333333333333ull;
   return (x | x << 1) & 0x5555555555555555ull;
+}
+
+// The bits of x (< 2^21) spread to every third bit position, from bit 0.
+inline uint64_t SpreadBits3(uint64_t x) {
+  x &= 0x1fffff;
+  x = (x | x << 32) & 0x001f00000000ffffull;
+  x = (x | x << 16) & 0x001f0000ff0000ffull;
+  x = (x | x << 8) & 0x100f00f00f00f00full;
+  x = (x | x << 4) & 0x10c30c30c30c30c3ull;
+  return (x | x << 2) & 0x1249249249249249ull;
+}
+
+// The place of (x, y) on the Z-order (Morton) curve: x's bits at even positions, y's at odd.
+inline uint64_t ZOrder2(uint64_t x, uint64_t y) { return SpreadBits2(x) | SpreadBits2(y) << 1; }
+// The place of (x, y, z) (each < 2^21) on the 3-D Z-order curve.
+inline uint64_t ZOrder3(uint64_t x, uint64_t y, uint64_t z) {
+  return SpreadBits3(x) | SpreadBits3(y) << 1 | SpreadBits3(z) << 2;
 }
 
 // The positions 0..n-1 of n corners (corner_at(i): a VoxelIndex, the corners sorted by (z, y, x))
@@ -52,7 +69,7 @@ std::vector<uint32_t> CornersByBrick(size_t n, const CornerAt& corner_at) {
   {
     std::vector<uint32_t> by_curve(columns);
     for (size_t i = 0; i < columns; ++i) by_curve[i] = uint32_t(i);
-    auto curve = [&](uint32_t i) { return SpreadBits(i % columns_x) | SpreadBits(i / columns_x) << 1; };
+    auto curve = [&](uint32_t i) { return ZOrder2(i % columns_x, i / columns_x); };
     std::sort(by_curve.begin(), by_curve.end(), [&](uint32_t a, uint32_t b) { return curve(a) < curve(b); });
     for (size_t i = 0; i < columns; ++i) rank[by_curve[i]] = uint32_t(i);
   }

@@ -1,5 +1,5 @@
-// Tests vc/visibility/corner_order.h: the order of the exact evaluation's corner rays.
-#include "vc/visibility/corner_order.h"
+// Tests vc/visibility/spatial_order.h: the orders of the targets' bricks and of the corner rays.
+#include "vc/visibility/spatial_order.h"
 
 #include <gtest/gtest.h>
 
@@ -11,15 +11,27 @@
 namespace vc::internal {
 namespace {
 
-TEST(CornerOrderTest, SpreadBitsInterleavesIntoTheZOrder) {
-  EXPECT_EQ(SpreadBits(0), 0u);
-  EXPECT_EQ(SpreadBits(0b1011), 0b1000101u);
-  EXPECT_EQ(SpreadBits(0xffffffffu), 0x5555555555555555ull);
-  // (x, y) = (2, 1): x's bits at even positions, y's at odd ones.
-  EXPECT_EQ(SpreadBits(2) | SpreadBits(1) << 1, 0b110u);
+// Against interleaving bit by bit, on hand values and random ones over the whole input range.
+TEST(SpatialOrderTest, ZOrderInterleavesTheBits) {
+  EXPECT_EQ(SpreadBits2(0b1011), 0b1000101u);
+  EXPECT_EQ(SpreadBits2(0xffffffffu), 0x5555555555555555ull);
+  EXPECT_EQ(SpreadBits3(0b1011), 0b1000001001u);
+  EXPECT_EQ(SpreadBits3(0x1fffff), 0x1249249249249249ull);
+  EXPECT_EQ(ZOrder2(2, 1), 0b110u);
+  EXPECT_EQ(ZOrder3(1, 0, 1), 0b101u);
+  std::mt19937_64 rng(3);
+  for (int i = 0; i < 1000; ++i) {
+    const uint64_t x = rng() & 0x1fffff, y = rng() & 0x1fffff, z = rng() & 0x1fffff, w = rng() & 0xffffffff;
+    uint64_t two = 0, three = 0;
+    for (int b = 0; b < 32; ++b) two |= ((w >> b) & 1) << (2 * b) | ((x >> b) & 1) << (2 * b + 1);
+    for (int b = 0; b < 21; ++b)
+      three |= ((x >> b) & 1) << (3 * b) | ((y >> b) & 1) << (3 * b + 1) | ((z >> b) & 1) << (3 * b + 2);
+    ASSERT_EQ(ZOrder2(w, x), two) << w << " " << x;
+    ASSERT_EQ(ZOrder3(x, y, z), three) << x << " " << y << " " << z;
+  }
 }
 
-TEST(CornerOrderTest, NoCornersNoOrder) {
+TEST(SpatialOrderTest, NoCornersNoOrder) {
   const std::vector<VoxelIndex> none;
   EXPECT_TRUE(CornersByBrick(0, [&](size_t i) { return none[i]; }).empty());
 }
@@ -27,7 +39,7 @@ TEST(CornerOrderTest, NoCornersNoOrder) {
 // Corners sorted by (z, y, x), some negative, over several slabs and columns of bricks: the order
 // is a permutation; slabs come in turn, a slab's bricks along the Z-order curve of their columns,
 // each brick's corners together and in their own order.
-TEST(CornerOrderTest, BrickBySlabAndZOrderEachBricksCornersInTheirOrder) {
+TEST(SpatialOrderTest, BrickBySlabAndZOrderEachBricksCornersInTheirOrder) {
   std::mt19937 rng(7);
   std::uniform_int_distribution<int> x(-37, 60), y(-20, 45), z(-9, 30);
   std::vector<VoxelIndex> corners;
@@ -51,7 +63,7 @@ TEST(CornerOrderTest, BrickBySlabAndZOrderEachBricksCornersInTheirOrder) {
   // it, and within one brick (equal keys) positions must ascend.
   auto key = [&](const VoxelIndex& c) {
     const uint64_t bx = uint64_t(c.x - lo[0]) >> 3, by = uint64_t(c.y - lo[1]) >> 3, bz = uint64_t(c.z - lo[2]) >> 3;
-    return std::make_pair(bz, SpreadBits(bx) | SpreadBits(by) << 1);
+    return std::make_pair(bz, ZOrder2(bx, by));
   };
   size_t bricks = 0;
   for (size_t i = 1; i < order.size(); ++i) {
