@@ -11,6 +11,7 @@
 #include <limits>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <random>
 #include <string>
 #include <utility>
@@ -542,8 +543,13 @@ Status ExactEvaluation::DecideCornersByGroups(size_t k, int threads, Work& w) co
   // plain load before the atomic one pays.
   const internal::BitWriter decided_out{w.decided_bits.data(), shared}, visible_out{w.visible_bits.data(), shared};
   const internal::FreeBox around = internal::GrowFreeBox(job_.g, job_.uo[k]);  // once, for every chunk
+  // On one thread the chunks run in turn and share one walk: its occluder cache goes on from one
+  // run of bricks to the next (they are neighbours on the Z-order curve) instead of starting empty.
+  std::optional<internal::GroupWalk> one_walk;
+  if (!shared) one_walk.emplace().around = around;
   return ParallelChunks(brick_chunks_, 1, threads, job_.ctx, [&](uint64_t task, uint64_t, uint64_t) {
-    internal::GroupWalk walk;
+    std::optional<internal::GroupWalk> own;
+    internal::GroupWalk& walk = one_walk ? *one_walk : own.emplace();
     walk.around = around;
     std::vector<internal::SurfaceTargets::CornerDecision> decisions;
     const size_t b0 = task * kBricksPerTask, b1 = std::min<size_t>(b0 + kBricksPerTask, targets_.brick_count());
@@ -566,10 +572,14 @@ Status ExactEvaluation::DecideCornersByGroups(size_t k, int threads, Work& w) co
 Status ExactEvaluation::CastRaysToUndecidedCorners(size_t k, int threads, Work& w) const {
   const std::vector<uint64_t>& corners = lattice_.corners;
   // Tasks take runs of the brick order, whose corners share words of the bitset with other tasks'.
-  const internal::BitWriter visible_out{
-      w.visible_bits.data(), ResolveThreads(threads, (corners.size() + kCornerChunk - 1) / kCornerChunk) > 1};
+  const bool shared = ResolveThreads(threads, (corners.size() + kCornerChunk - 1) / kCornerChunk) > 1;
+  const internal::BitWriter visible_out{w.visible_bits.data(), shared};
+  // On one thread the chunks share one cache, which goes on from one run of corners to the next.
+  std::optional<CornerRayCache> one_cache;
+  if (!shared) one_cache.emplace(job_.shortcuts[k], job_.uo[k]);
   return ParallelChunks(corners.size(), kCornerChunk, threads, job_.ctx, [&](uint64_t, uint64_t b, uint64_t e) {
-    CornerRayCache cache(job_.shortcuts[k], job_.uo[k]);
+    std::optional<CornerRayCache> own;
+    CornerRayCache& cache = one_cache ? *one_cache : own.emplace(job_.shortcuts[k], job_.uo[k]);
     // An occluder met more than kGrowOccluderBeyond voxels before its corner is cached as the solid
     // box grown from it (SurfaceTargets::GrownBox, remembered across viewpoints), which proves more
     // of the next corners' rays blocked than the voxel alone, and indexed by its direction; one met
