@@ -519,7 +519,10 @@ void FacingTable(const Vector3d& uo, const int base[3], int8_t facing[3][8]) {
 // Surface visibility: rays to face centres; a face's own voxel is transparent.
 struct SurfaceTargets::CentreKind {
   static constexpr bool kMidDecidesFace = true;
-  static constexpr int kMinGroup = 1;  // every group is tried (a smaller bound did not pay clearly)
+  // A plane of a brick with fewer faces facing o than this goes to the batched lone-face rays
+  // (LeftoverRays): the hall scan's sets 13-19 % faster, fr_campus's about 2 %, the others the same
+  // (docs/BENCHMARKS.md, "Small face groups left to the rays").
+  static constexpr int kMinGroup = 4;
   const OccupancyGrid& grid;
   const Vector3d& uo;
   const Target* t;
@@ -722,8 +725,8 @@ struct SurfaceTargets::CornerKind {
   static constexpr bool kMidDecidesFace = false;
   // A plane of a brick with fewer faces facing o than this is left to the corner rays
   // (evaluate.cc), which since they go brick by brick with their cache decide such faces' corners
-  // for less than the group tests cost: fr_campus's evaluation 12 % faster, geb079's 10 %, the
-  // hall's 5 % (docs/BENCHMARKS.md, "Small face groups left to the corner rays").
+  // for less than the group tests cost: fr_campus's evaluation 5-9 % faster, the hall scan's
+  // 13-17 %, geb079's 3-14 % (docs/BENCHMARKS.md, "Small face groups left to the rays").
   static constexpr int kMinGroup = 8;
   const OccupancyGrid& grid;
   const Vector3d& uo;
