@@ -410,12 +410,12 @@ class ExactEvaluation {
   const LatticeCorners lattice_;
   Evaluation ev_;
   const std::vector<uint8_t> faces_in_set_;
+  // The corner rays' order (internal::CornersByBrick); corner_boxes_'s blocks are runs of it.
+  const std::vector<uint32_t> corner_order_;
   // The scanner's range, block by block. A face centre lies in its voxel's cube [v, v + 1] and
   // within 1 (per axis) of each of its corners: a block of voxels whose cubes, or of corners whose
   // boxes [c - 1, c + 1], are all out of range holds nothing that changes a face's V (> 0), so it
   // is skipped; skipped corners count as unseen, which only faces out of range could notice.
-  // The corner rays' order (internal::CornersByBrick); corner_boxes_'s blocks are runs of it.
-  const std::vector<uint32_t> corner_order_;
   const BlockBoxes corner_boxes_;
   const BlockBoxes voxel_boxes_;
   const uint64_t voxel_chunks_;
