@@ -546,7 +546,7 @@ Status ExactEvaluation::DecideCornersByGroups(size_t k, int threads, Work& w) co
   // On one thread the chunks run in turn and share one walk: its occluder cache goes on from one
   // run of bricks to the next (they are neighbours on the Z-order curve) instead of starting empty.
   std::optional<internal::GroupWalk> one_walk;
-  if (!shared) one_walk.emplace().around = around;
+  if (!shared) one_walk.emplace();
   return ParallelChunks(brick_chunks_, 1, threads, job_.ctx, [&](uint64_t task, uint64_t, uint64_t) {
     std::optional<internal::GroupWalk> own;
     internal::GroupWalk& walk = one_walk ? *one_walk : own.emplace();
