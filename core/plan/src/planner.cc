@@ -294,7 +294,8 @@ Result<PlanResult> Plan(const SceneInput& input, const PlanOptions& options, con
   {
     std::vector<VoxelSet> final_sets;
     for (int k : reduced.keep) final_sets.push_back(std::move(stations.sets[k]));
-    result.scan_graph = planner::BuildScanGraph(planner::OverlapMatrix(final_sets), local_options.min_overlap);
+    result.scan_graph =
+        planner::BuildScanGraph(planner::OverlapMatrix(final_sets, local_options.threads), local_options.min_overlap);
   }
   if (auto w = ScanGraphWarning(result.scan_graph)) result.warnings.push_back(*w);
   if (callbacks.on_final_stations) callbacks.on_final_stations(result.stations);

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <numeric>
 
+#include "vc/base/parallel.h"
+
 namespace vc::planner {
 
 double Overlap(uint64_t common, uint64_t size_a, uint64_t size_b) {
@@ -12,16 +14,22 @@ double Overlap(uint64_t common, uint64_t size_a, uint64_t size_b) {
 
 double Overlap(const VoxelSet& a, const VoxelSet& b) { return Overlap(a.CountAnd(b), a.count(), b.count()); }
 
-OverlapMatrix::OverlapMatrix(const std::vector<VoxelSet>& sets)
+OverlapMatrix::OverlapMatrix(const std::vector<VoxelSet>& sets, int threads)
     : n_(static_cast<int>(sets.size())), values_(sets.size() * sets.size(), 0.0) {
   std::vector<uint64_t> sizes(sets.size());
   for (size_t i = 0; i < sets.size(); ++i) sizes[i] = sets[i].count();
-  for (int i = 0; i < n_; ++i) {
+  // Row i's task fills (i, j) for j > i, its own part of the upper triangle; the lower one is
+  // mirrored after.
+  const Status st = ParallelChunks(sets.size(), 1, threads, {}, [&](uint64_t row, uint64_t, uint64_t) {
+    const int i = static_cast<int>(row);
     for (int j = i + 1; j < n_; ++j) {
-      const double o = Overlap(sets[i].CountAnd(sets[j]), sizes[i], sizes[j]);
-      values_[static_cast<size_t>(i) * n_ + j] = o;
-      values_[static_cast<size_t>(j) * n_ + i] = o;
+      values_[static_cast<size_t>(i) * n_ + j] = Overlap(sets[i].CountAnd(sets[j]), sizes[i], sizes[j]);
     }
+  });
+  (void)st;  // no token: cannot fail
+  for (int i = 0; i < n_; ++i) {
+    for (int j = i + 1; j < n_; ++j)
+      values_[static_cast<size_t>(j) * n_ + i] = values_[static_cast<size_t>(i) * n_ + j];
   }
 }
 

@@ -75,6 +75,26 @@ TEST(ScanGraph, EdgesListEveryPositiveOverlapAndComponentsUseTheThreshold) {
   EXPECT_TRUE(single.edges.empty());
 }
 
+TEST(ScanGraph, MatrixOnSeveralThreadsHoldsEveryPairsOverlap) {
+  std::mt19937_64 rng(11);
+  std::vector<VoxelSet> sets;
+  for (int k = 0; k < 37; ++k) {  // rows of unequal length, more rows than threads
+    VoxelSet s(kVoxels);
+    const size_t begin = rng() % kVoxels, end = std::min<size_t>(kVoxels, begin + rng() % 120);
+    for (size_t v = begin; v < end; ++v)
+      if (rng() % 3) s.set(v);
+    sets.push_back(std::move(s));
+  }
+  for (int threads : {1, 2, 4}) {
+    const OverlapMatrix m(sets, threads);
+    ASSERT_EQ(m.size(), 37);
+    for (int i = 0; i < 37; ++i)
+      for (int j = 0; j < 37; ++j) {
+        EXPECT_EQ(m.at(i, j), i == j ? 1.0 : Overlap(sets[i], sets[j])) << i << " " << j << " threads " << threads;
+      }
+  }
+}
+
 TEST(ScanGraph, ReplaceRecomputesOneStationsRowAndColumn) {
   std::vector<VoxelSet> sets{Range(0, 100), Range(50, 150), Range(300, 350)};
   OverlapMatrix m(sets);

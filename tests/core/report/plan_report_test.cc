@@ -483,7 +483,10 @@ TEST(PlanReportTest, ReductionImageGrowsWithTheMatrix) {
   EXPECT_GT(b.height, a.height - 1);
   EXPECT_GT(b.width, 0);
   EXPECT_GT(c.width, 0);
-  EXPECT_EQ(ReductionImageSize(10).height, 52 + 10 * 48 + 48);  // cells of 48 px up to 10 stations
+  EXPECT_EQ(ReductionImageSize(10).height, 52 + 10 * 48 + 48);    // cells of 48 px up to 10 stations
+  EXPECT_EQ(ReductionImageSize(146).height, 52 + 146 * 14 + 48);  // 14 px while that fits in 2,048
+  EXPECT_EQ(ReductionImageSize(905).height, 52 + 905 * 2 + 48);   // a campus plan: 2 px cells
+  EXPECT_EQ(ReductionImageSize(5000).height, 52 + 5000 + 48);     // never below 1 px
 }
 
 TEST(PlanReportTest, StationsCsvRoundTrips) {

@@ -202,7 +202,7 @@ Result<ReductionOutput> RunReductionStage(const ReductionInput& in, const PlanOp
   OverlapMatrix overlaps;
   int groups = 0;
   if (options.min_overlap > 0) {
-    overlaps = OverlapMatrix(in.stations.sets);
+    overlaps = OverlapMatrix(in.stations.sets, options.threads);
     std::vector<int> all(stations.size());
     for (size_t k = 0; k < stations.size(); ++k) all[k] = static_cast<int>(k);
     groups = CountComponents(overlaps, all, options.min_overlap);

@@ -83,7 +83,7 @@ Result<RefineOutput> RunRefineStage(RefineInput in, const PlanOptions& options, 
   const bool registration = options.min_overlap > 0;
   std::vector<int> all(stations.size());
   for (size_t k = 0; k < stations.size(); ++k) all[k] = static_cast<int>(k);
-  OverlapMatrix overlaps = registration ? OverlapMatrix(stations.sets) : OverlapMatrix();
+  OverlapMatrix overlaps = registration ? OverlapMatrix(stations.sets, options.threads) : OverlapMatrix();
   const int groups = registration ? CountComponents(overlaps, all, options.min_overlap) : 1;
   // Each station in turn moves to its best trial position if that covers more together with the
   // other stations (then sees more alone), and keeps the scan graph's groups; the others stay

@@ -46,11 +46,13 @@ double Overlap(const VoxelSet& a, const VoxelSet& b);
 // Whether `overlap` makes an edge at `min_overlap`.
 inline bool IsEdge(double overlap, double min_overlap) { return overlap > 0 && overlap >= min_overlap; }
 
-// Every pairwise overlap among a few sets (stations), computed once: n (n - 1) / 2 intersections.
+// Every pairwise overlap among a few sets (stations), computed once: n (n - 1) / 2 intersections,
+// a row at a time on `threads` workers (0: all cores), the same values whatever their number. (A
+// campus plan's 905 stations are 409,060 intersections: 8.5 s on one thread.)
 class OverlapMatrix {
  public:
   OverlapMatrix() = default;
-  explicit OverlapMatrix(const std::vector<VoxelSet>& sets);
+  explicit OverlapMatrix(const std::vector<VoxelSet>& sets, int threads = 1);
   [[nodiscard]] int size() const { return n_; }
   [[nodiscard]] double at(int i, int j) const { return i == j ? 1.0 : values_[static_cast<size_t>(i) * n_ + j]; }
   // Replaces node i's set by `set` (a station moved): its row and column are recomputed.
