@@ -590,10 +590,10 @@ constexpr const char* kRedSubtitle = "DIAGONAL: T = [I]   OFF-DIAGONAL: T = [I, 
 // px as fit, at least 1: a campus plan's 905 stations made a 12,670 px square image at 14 px (a
 // 480 MB raster and 5 s of the client's time), 1,810 px now. Values are printed only in cells wide
 // enough, and station numbers every few cells, as before.
-constexpr int kRedMaxSide = 2048;
+constexpr int kRedMinCell = 14, kRedMaxCell = 48, kRedMaxSide = 2048;
 int ReductionCell(int n) {
   n = std::max(n, 1);
-  return n * 14 <= kRedMaxSide ? std::clamp(480 / n, 14, 48) : std::max(kRedMaxSide / n, 1);
+  return n * kRedMinCell <= kRedMaxSide ? std::clamp(480 / n, kRedMinCell, kRedMaxCell) : std::max(kRedMaxSide / n, 1);
 }
 
 Image DrawReduction(const PlanResult& r) {

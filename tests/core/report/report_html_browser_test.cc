@@ -53,8 +53,8 @@ std::string ChromiumMissing() {
 // How long chromium lets the page run before it acts. Virtual time (15 s of it, as fast as the
 // page allows) for --dump-dom and --screenshot; real time for --print-to-pdf, which Debian's
 // Chromium 156.0.8078.129 never finishes under any --virtual-time-budget (the report page, 1 s or
-// 15 s of budget: killed after 60 s; with --timeout=5000 it prints in 5 s, every word and the view's
-// snapshot on paper).
+// 15 s of budget: killed after 60 s). --timeout=15000 bounds the wait in real time; the page
+// prints once loaded, in about 5 s, every word and the view's snapshot on paper.
 enum class Wait { kVirtualTime, kRealTime };
 
 // Runs headless chromium on `url` with `action` (--dump-dom, --screenshot=... or --print-to-pdf=...),
