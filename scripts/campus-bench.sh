@@ -8,6 +8,8 @@
 # 0.5 GiB, and the plan (stations, covered voxels, G). For fr_campus with the defaults it also
 # compares the plan with the one recorded at 2026-12-07 (905 stations, 861,374 voxels, G
 # 0.555908754262561): a change there must be meant and explained (issue 37: "plans no worse").
+# Last, how busy the server kept the cores, stage by stage, and the job's time were every core busy
+# all along (scripts/cpu-use.py over the server's CPU time sampled every half second).
 # Takes 5-7 minutes for fr_campus on 2 cores; run it on an otherwise idle machine.
 #
 # Usage: scripts/campus-bench.sh [BUILD_DIR (build/release)] [SCENE (../shared/data/fr-campus/fr_campus.bt)]
@@ -42,7 +44,9 @@ else
   work=$(mktemp -d)
 fi
 server_pid=""
+sampler_pid=""
 cleanup() {
+  [[ -n "$sampler_pid" ]] && kill "$sampler_pid" 2>/dev/null && wait "$sampler_pid" 2>/dev/null
   [[ -n "$server_pid" ]] && kill "$server_pid" 2>/dev/null && wait "$server_pid" 2>/dev/null
   [[ -z "${KEEP:-}" ]] && rm -rf "$work"
   return 0
@@ -53,6 +57,17 @@ vc_launch "$work/server.log" "$bin/server/vc-server" --listen 127.0.0.1:0 --work
 server_pid=$vc_pid
 port=$(vc_wait_port "$work/server.log" "$server_pid") || { cat "$work/server.log" >&2; exit 1; }
 echo "campus-bench: $scene through $bin (one worker, $(nproc) cores; load average $(cut -d' ' -f1-3 /proc/loadavg))"
+# The server's CPU time every half second (epoch seconds, utime + stime in clock ticks: fields 14 and
+# 15 of /proc/PID/stat) for scripts/cpu-use.py.
+sample_cpu() {
+  local f
+  while read -r -a f <"/proc/$server_pid/stat" 2>/dev/null; do
+    echo "$(date +%s.%N) $((f[13] + f[14]))"
+    sleep 0.5
+  done
+}
+sample_cpu >"$work/cpu.txt" &
+sampler_pid=$!
 start=$(date +%s.%N)
 if ! "$bin/client/vc-client" submit "$scene" --server "127.0.0.1:$port" --out "$work/plan" "${extra[@]}" \
   >"$work/client.log" 2>&1; then
@@ -66,6 +81,10 @@ if ! "$bin/client/vc-client" submit "$scene" --server "127.0.0.1:$port" --out "$
 fi
 wall=$(python3 -c "import sys; print(f'{float(sys.argv[2]) - float(sys.argv[1]):.1f}')" "$start" "$(date +%s.%N)")
 hwm_kb=$(awk '/^VmHWM:/ {print $2}' "/proc/$server_pid/status")
+sleep 0.6  # one more sample after the job's end
+kill "$sampler_pid" 2>/dev/null
+wait "$sampler_pid" 2>/dev/null || true  # the sampler's status is the kill's
+sampler_pid=""
 
 python3 - "$work/plan/plan.json" "$wall" "$hwm_kb" "$target" "$name" "${#extra[@]}" <<'EOF'
 import json, sys
@@ -94,5 +113,7 @@ if name == "fr_campus.bt" and extra == 0:
     else:
         print(f"reference    DIFFERENT from 2026-12-07's plan: {recorded}; explain the change (issue 37: plans no worse)")
 EOF
+python3 scripts/cpu-use.py "$work/server.log" "$work/cpu.txt" ||
+  echo "campus-bench: no figures of the cores' use (scripts/cpu-use.py says why above)"
 [[ -n "${KEEP:-}" ]] && echo "campus-bench: the plan and the logs are in $work"
 exit 0

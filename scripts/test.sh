@@ -29,6 +29,7 @@ echo "=== layering (scripts/check-layers.py), code health (scripts/check-code-he
 python3 scripts/check-layers.py
 python3 scripts/check_code_health_test.py
 python3 scripts/fan_out_projection_test.py
+python3 scripts/cpu_use_test.py
 python3 scripts/check-code-health.py
 git ls-files '*.h' '*.cc' | xargs clang-format --dry-run --Werror
 echo "clang-format: every tracked .h/.cc file is formatted"
