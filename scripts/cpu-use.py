@@ -23,13 +23,16 @@ Usage: scripts/cpu-use.py SERVER_LOG SAMPLES [--cores N] [--clk-tck T] [--low X]
        (N: the machine's cores, os.cpu_count() by default; T: os.sysconf('SC_CLK_TCK'))
 Tested by scripts/cpu_use_test.py."""
 import argparse
+import bisect
 import datetime
 import os
 import re
 import sys
 
-STAGES = ("voxelize", "candidates", "visibility", "selection", "reduction", "evaluation", "route")
-JOB_LINE = re.compile(r"^\[(\d{4}-\d\d-\d\d \d\d:\d\d:\d\d\.\d+)\].* job \S+ Plan .*\brun=([0-9.]+)s")
+# The job's timings (server/src/job_runner.cc: JobLog::timings(), `read=Xs` and each stage's
+# `name=Xs` in the order they ran) sit between `queued=Xs` and `run=Xs`.
+JOB_LINE = re.compile(r"^\[(\d{4}-\d\d-\d\d \d\d:\d\d:\d\d\.\d+)\].* job \S+ Plan .* queued=[0-9.]+s(.*?) "
+                      r"run=([0-9.]+)s")
 
 
 def log_time(stamp):
@@ -43,16 +46,12 @@ def job_windows(log_text):
     if not lines:
         raise ValueError("no finished plan in the server's log (a line 'job ID Plan ... run=Xs')")
     m = lines[-1]
-    line = m.string
     end = log_time(m.group(1))
-    start = end - float(m.group(2))
-    fields = {k: float(v) for k, v in re.findall(r"\b(\w+)=([0-9.]+)s\b", line)}
+    start = end - float(m.group(3))
     windows, at = [], start
-    order = ["read"] + sorted((s for s in STAGES if s in fields), key=lambda s: line.index(f" {s}="))
-    for name in order:
-        seconds = fields.get(name, 0.0)
-        windows.append((name, at, at + seconds))
-        at += seconds
+    for name, seconds in re.findall(r"\b(\w+)=([0-9.]+)s\b", m.group(2)):
+        windows.append((name, at, at + float(seconds)))
+        at += float(seconds)
     if end > at:
         windows.append(("after", at, end))
     return start, end, windows
@@ -79,14 +78,8 @@ def cpu_at(samples, t):
         return samples[0][1]
     if t >= samples[-1][0]:
         return samples[-1][1]
-    lo, hi = 0, len(samples) - 1
-    while hi - lo > 1:
-        mid = (lo + hi) // 2
-        if samples[mid][0] <= t:
-            lo = mid
-        else:
-            hi = mid
-    (t0, c0), (t1, c1) = samples[lo], samples[hi]
+    hi = bisect.bisect_right(samples, (t, float("inf")))
+    (t0, c0), (t1, c1) = samples[hi - 1], samples[hi]
     return c0 + (c1 - c0) * (t - t0) / (t1 - t0)
 
 
