@@ -10,7 +10,7 @@
 #              and `heavy` labels (every other unit test runs here, once); the same build holds the
 #              libFuzzer targets
 #   fuzz     - every libFuzzer target (fuzz/, from the asan build) for 10 s each, two at a time
-#   tsan     - ThreadSanitizer on the tests whose concurrency is all ours (label `tsan`): the worker
+#   tsan     - ThreadSanitizer (clang++) on the tests whose concurrency is all ours (label `tsan`): the worker
 #              pool, upload assembler, outbox, job runner, shard board, status mapping, wire code,
 #              ParallelChunks and the multi-threaded visibility engine. The gRPC
 #              service tests are not run here: Debian's gRPC, absl and protobuf are not instrumented,
@@ -41,7 +41,7 @@ for p in "${presets[@]}"; do
       # Only the service and its tests: the core is covered by the other presets.
       cmake --build --preset "$p" --target base_tests server_jobs_tests proto_tests visibility_tests
       echo "=== preset $p: tests labelled tsan"
-      ctest --preset "$p" -L tsan
+      ctest --preset "$p" -j2 -L tsan
       ;;
     fuzz)
       # Every libFuzzer target for 10 s from its seeds, built by the asan stage (scripts/fuzz.sh;
